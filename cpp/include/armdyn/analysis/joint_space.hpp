@@ -1,0 +1,23 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Joint-space entry points for tree models whose joints define coordinates (revolute, prismatic,
+// cylindrical, fixed): the Cartesian state from joint coordinates (forward kinematics along the
+// tree), joint coordinates from the Cartesian state, and forward dynamics computed through the
+// Cartesian KKT path (not a reduced-coordinate algorithm).
+#pragma once
+
+#include "armdyn/model/model.hpp"
+
+namespace armdyn {
+
+/// Cartesian (u, v) from joint coordinates q and rates qd (n_coords each).
+/// @throws ModelError when the model is not a joint-space tree or sizes are wrong.
+void state_from_joints(const Model& m, const VecX& q, const VecX& qd, VecX& u, VecX& v);
+/// Joint coordinates (angles in (-pi, pi]) and rates at (u, v).
+void joint_coordinates(const Model& m, const VecX& u, const VecX& v, VecX& q, VecX& qd);
+/// qdd for joint torques/forces tau; drives are ignored (joint rows only).
+VecX forward_dynamics(const Model& m, const VecX& q, const VecX& qd, const VecX& tau);
+
+/// Check that the model supports joint-space calls; throws ModelError naming the reason.
+void require_joint_space(const Model& m, const char* what);
+
+}  // namespace armdyn

@@ -1,0 +1,39 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Whole runs: integrate the constrained equations of motion from the model's assembled state (or
+// from given joint coordinates) and record, at every output time, the projected state and its
+// derived outputs (joint coordinates, drive forces, joint reactions, residuals, energies).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "armdyn/model/model.hpp"
+#include "armdyn/solver/integrators.hpp"
+#include "armdyn/solver/kkt.hpp"
+
+namespace armdyn {
+
+struct SimOptions {
+  std::string integrator = "dopri5";  ///< "dopri5" | "rk4"
+  StepOptions step;
+  Metric projection = Metric::Mass;
+};
+
+/// Row-major output tables: one row per output time.
+struct SimResult {
+  long n = 0;
+  std::vector<double> t, u, v, q, qd, drive_forces, reaction_forces, reaction_torques;
+  std::vector<double> position_residual, velocity_residual, kinetic_energy, potential_energy;
+  StepStats stats;
+  long kkt_solves = 0, factorizations = 0, position_projections = 0, newton_iterations = 0;
+  double cpu_seconds = 0.0;
+  std::string error;  ///< non-empty when the run stopped early (SolverError message)
+};
+
+/// Run from (u0, v0) (projected first) over [0, t_end]. Errors during the run stop it: the
+/// result up to the last good output is returned with `error` set.
+/// @throws ModelError for invalid options or initial-state sizes.
+SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const VecX& u0,
+                   const VecX& v0);
+
+}  // namespace armdyn

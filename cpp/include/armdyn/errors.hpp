@@ -1,0 +1,40 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Exception types. User input errors derive from std::invalid_argument (Python ValueError);
+// numerical failures are SolverError (Python armdyn.SolverError, a RuntimeError).
+#pragma once
+
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+namespace armdyn {
+
+/// Invalid model data: names, masses, inertias, axes, topology, array shapes.
+class ModelError : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
+/// Malformed or unsupported URDF.
+class UrdfError : public ModelError {
+ public:
+  using ModelError::ModelError;
+};
+
+/// Numerical failure: singular system, projection or assembly that does not converge,
+/// non-finite values during a run.
+class SolverError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Concatenate streamable parts into a message.
+template <typename... Args>
+std::string msg(const Args&... args) {
+  std::ostringstream os;
+  os.precision(17);
+  (os << ... << args);
+  return os.str();
+}
+
+}  // namespace armdyn

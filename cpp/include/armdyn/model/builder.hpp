@@ -1,0 +1,83 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// ModelBuilder: add bodies, joints, drives and force elements, then finalize() into an
+// immutable Model. Every add_* call validates its input first and leaves the builder unchanged
+// when it throws. Joint points and axes are given in WORLD coordinates at the assembly pose.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "armdyn/model/model.hpp"
+
+namespace armdyn {
+
+struct FinalizeOptions {
+  bool mass_weighted_assembly = true;
+  int max_assembly_iterations = 50;
+};
+
+class ModelBuilder {
+ public:
+  explicit ModelBuilder(const Vec3& gravity = Vec3(0, 0, -9.81));
+
+  /// Add a rigid body. inertia: 3x3 about the centre of mass in body axes [kg m^2];
+  /// position: centre of mass [m]; orientation: unit Euler parameters, scalar-first.
+  /// @throws ModelError on bad mass, inertia, pose or a duplicate name.
+  int add_body(const std::string& name, double mass, const Mat3& inertia, const Vec3& position,
+               const Vec4& orientation);
+
+  int add_revolute(const std::string& name, const std::string& parent, const std::string& child,
+                   const Vec3& point, const Vec3& axis);
+  int add_prismatic(const std::string& name, const std::string& parent, const std::string& child,
+                    const Vec3& point, const Vec3& axis);
+  int add_cylindrical(const std::string& name, const std::string& parent,
+                      const std::string& child, const Vec3& point, const Vec3& axis);
+  int add_spherical(const std::string& name, const std::string& parent, const std::string& child,
+                    const Vec3& point);
+  /// Rigid connection; `point` only sets where reactions are reported.
+  int add_fixed(const std::string& name, const std::string& parent, const std::string& child,
+                const Vec3& point);
+  /// Universal (Cardan) joint: axis1 fixed in parent, axis2 fixed in child, perpendicular.
+  int add_universal(const std::string& name, const std::string& parent, const std::string& child,
+                    const Vec3& point, const Vec3& axis1, const Vec3& axis2);
+  /// Declares a body free (6 DOF, no constraint rows) so that it counts as connected to ground.
+  int add_free(const std::string& name, const std::string& child);
+
+  /// Set position limits and informative effort/velocity limits on a joint.
+  void set_joint_limits(const std::string& joint, double lower, double upper, double effort,
+                        double velocity);
+
+  /// Prescribe joint coordinate `coord` of `joint` by `profile` (a rheonomic constraint).
+  int add_drive(const std::string& joint, const Profile& profile, int coord = 0,
+                const std::string& name = "");
+
+  /// Force (world) at a body point (world coordinates at assembly; default centre of mass) and
+  /// torque (world), optionally scaled by a profile.
+  void add_body_load(const std::string& body, const Vec3& force, const Vec3& torque,
+                     const Vec3* point_world, const Profile* profile);
+  /// Point-to-point spring-damper between two points given in world coordinates at assembly.
+  /// rest_length < 0 means "the assembly distance".
+  void add_spring_damper(const std::string& name, const std::string& body_a, const Vec3& point_a,
+                         const std::string& body_b, const Vec3& point_b, double stiffness,
+                         double damping, double rest_length);
+  /// Spring-damper and/or viscous friction on a joint coordinate.
+  void add_joint_spring_damper(const std::string& joint, double stiffness, double damping,
+                               double rest, int coord = 0);
+  /// Torque (force for prismatic) input on a joint coordinate, from a profile.
+  void add_joint_torque(const std::string& joint, const Profile& profile, int coord = 0);
+
+  /// Validate, analyse the topology and assemble the initial state. The builder is unchanged
+  /// and may be finalized again.
+  /// @throws ModelError on invalid or disconnected models, or when assembly fails.
+  ModelPtr finalize(const FinalizeOptions& options = FinalizeOptions()) const;
+
+  const Model& draft() const { return m_; }
+
+ private:
+  int add_joint(const std::string& name, JointType type, const std::string& parent,
+                const std::string& child, const Vec3& point, const Vec3& axis, const Vec3* axis2);
+  int resolve_body(const std::string& name, const std::string& context) const;
+  Model m_;
+};
+
+}  // namespace armdyn

@@ -1,0 +1,140 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The immutable Model: bodies in Cartesian coordinates with Euler parameters, joints as
+// algebraic constraints, drives as rheonomic constraints, force elements, and the topology
+// analysis done once at finalize().
+//
+// State layout (fixed): per body i, u_i = (x_i [m], e_i) with x_i the centre of mass in world
+// and e_i the scalar-first Euler parameters (body -> world); v_i = (xdot_i [m/s] in world,
+// omega_i [rad/s] in the BODY frame). nq = 7 nb, nv = 6 nb. Body index -1 is ground.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "armdyn/math/types.hpp"
+#include "armdyn/model/profile.hpp"
+
+namespace armdyn {
+
+constexpr int kGround = -1;
+
+struct Body {
+  std::string name;
+  double mass = 0.0;  ///< [kg]
+  Mat3 inertia;       ///< [kg m^2] about the centre of mass, body axes
+  Vec3 position;      ///< centre of mass at assembly [m] (world)
+  Vec4 orientation;   ///< Euler parameters at assembly (body -> world)
+};
+
+enum class JointType { Revolute, Prismatic, Spherical, Fixed, Cylindrical, Universal, Free };
+
+const char* joint_type_name(JointType t);
+
+/// Number of constraint rows of a joint type.
+int joint_rows(JointType t);
+/// Number of joint coordinates (angle and/or displacement) a joint type defines.
+int joint_coords(JointType t);
+
+struct Joint {
+  std::string name;
+  JointType type = JointType::Revolute;
+  int parent = kGround, child = kGround;  ///< body indices, kGround = -1
+  /// joint point in each body's frame, relative to its centre of mass [m] (ground: world)
+  Vec3 point_parent = Vec3::Zero(), point_child = Vec3::Zero();
+  /// joint frame axes (columns x, y, z) in each body's frame; z is the joint axis
+  Mat3 frame_parent = Mat3::Identity(), frame_child = Mat3::Identity();
+  double lower = -1e300, upper = 1e300;        ///< position limits (URDF; reported, not enforced)
+  double effort = 0.0, velocity_limit = 0.0;  ///< URDF limits, informative
+  int row0 = 0;    ///< first constraint row
+  int coord0 = -1; ///< first joint coordinate index, -1 if none
+};
+
+/// Prescribed joint coordinate: q_joint[coord](t) = profile(t).
+struct Drive {
+  std::string name;
+  int joint = 0;
+  int coord = 0;  ///< which coordinate of the joint (cylindrical: 0 angle, 1 displacement)
+  Profile profile;
+  int row = 0;    ///< its constraint row
+};
+
+/// Force and torque on a body, both in world axes; the force acts at `point` (body frame,
+/// relative to the centre of mass). Scaled by `profile` when has_profile.
+struct BodyLoad {
+  int body = 0;
+  Vec3 force = Vec3::Zero(), torque = Vec3::Zero(), point = Vec3::Zero();
+  bool has_profile = false;
+  Profile profile;
+};
+
+/// Point-to-point spring-damper: tension = k (L - L0) + c dL/dt.
+struct SpringDamper {
+  std::string name;
+  int body_a = kGround, body_b = kGround;
+  Vec3 point_a = Vec3::Zero(), point_b = Vec3::Zero();  ///< in body frames (ground: world)
+  double stiffness = 0.0, damping = 0.0, rest_length = 0.0;
+};
+
+/// Generalised force on one joint coordinate: tau = -k (q - q0) - c qdot + input(t).
+/// Covers rotational/linear spring-dampers, viscous friction and torque/force inputs.
+struct CoordForce {
+  int coord = 0;
+  double stiffness = 0.0, damping = 0.0, rest = 0.0;
+  bool has_input = false;
+  Profile input;
+};
+
+/// One joint coordinate (revolute angle, prismatic displacement, ...).
+struct Coord {
+  std::string name;
+  int joint = 0;
+  int sub = 0;           ///< 0: angle (or prismatic displacement), 1: cylindrical displacement
+  bool angular = true;
+};
+
+class Model {
+ public:
+  // --- data (read-only after finalize) ---
+  std::vector<Body> bodies;
+  std::vector<Joint> joints;
+  std::vector<Drive> drives;
+  std::vector<BodyLoad> body_loads;
+  std::vector<SpringDamper> springs;
+  std::vector<CoordForce> coord_forces;
+  std::vector<Coord> coords;
+  Vec3 gravity = Vec3(0, 0, -9.81);
+
+  // --- sizes ---
+  int nb = 0, nq = 0, nv = 0;
+  int nc = 0;        ///< all constraint rows: joints then drives
+  int nc_joint = 0;  ///< joint rows only (rows [0, nc_joint))
+
+  // --- topology analysis ---
+  bool is_tree = false;          ///< every body has exactly one joint path to ground
+  bool joint_space_ok = false;   ///< tree of revolute/prismatic/cylindrical/fixed joints, parent->child
+  std::string joint_space_reason;
+  std::vector<int> tree_order;   ///< joints in parent-before-child order (if is_tree)
+  int rank_joint = 0, rank_all = 0;
+  int mobility = 0;              ///< nv - rank of joint rows (degrees of freedom without drives)
+  int mobility_driven = 0;       ///< nv - rank of all rows (what the drives leave free)
+  std::vector<std::string> redundant_rows;  ///< named redundant constraint rows
+  bool redundant = false;
+  double length_scale = 1.0;     ///< characteristic length for tolerances [m]
+
+  // --- assembled initial state ---
+  VecX u0, v0;
+
+  std::map<std::string, int> body_index, joint_index, drive_index;
+
+  int find_body(const std::string& name) const;    ///< -1 for "ground"; throws ModelError
+  int find_joint(const std::string& name) const;   ///< throws ModelError
+  std::string row_name(int row) const;             ///< e.g. "joint 'elbow' row 4 (rotation)"
+  std::string body_name(int b) const { return b == kGround ? "ground" : bodies[b].name; }
+  std::string summary() const;
+};
+
+using ModelPtr = std::shared_ptr<const Model>;
+
+}  // namespace armdyn

@@ -1,0 +1,42 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Constraint assembly: f(u, t), zeta = F S (velocity-space Jacobian) and xi with
+//   zeta v = rhs (rhs = -df/dt, nonzero only for drives),  zeta vdot = -xi.
+// zeta is stored as row blocks, one per joint (its rows) and one per drive (one row), each with
+// 12 columns for the two bodies it touches. Row order: joints (by joint index), then drives.
+#pragma once
+
+#include <vector>
+
+#include "armdyn/solver/kinematics.hpp"
+
+namespace armdyn {
+
+using BlockMat = Eigen::Matrix<double, Eigen::Dynamic, 12, Eigen::RowMajor, 6, 12>;
+
+struct ConstraintBlock {
+  int row0 = 0, nrows = 0;
+  int body[2] = {kGround, kGround};
+  BlockMat J;
+};
+
+struct ConstraintEval {
+  VecX f, rhs, xi;
+  std::vector<ConstraintBlock> blocks;
+  /// for each body: (block index, slot) of the blocks that touch it
+  std::vector<std::vector<std::pair<int, int>>> body_blocks;
+
+  void init(const Model& m);  ///< sizes and block structure (once per model)
+};
+
+/// Evaluate f, rhs and zeta (and xi when with_xi) at the kinematic state kin and time t.
+void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t, bool with_xi,
+                      ConstraintEval& ce);
+
+/// y = zeta x over rows [0, nrows) (y sized nc; rows >= nrows untouched).
+void zeta_times(const ConstraintEval& ce, int nrows, const VecX& x, VecX& y);
+/// x = zeta^T y over rows [0, nrows) (x sized nv, overwritten).
+void zeta_transpose_times(const ConstraintEval& ce, int nrows, const VecX& y, VecX& x);
+/// Dense zeta (nc x nv), for tests and diagnostics.
+MatX dense_zeta(const Model& m, const ConstraintEval& ce);
+
+}  // namespace armdyn

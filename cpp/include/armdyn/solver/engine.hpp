@@ -1,0 +1,76 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Engine: the per-model workspace that runs the pipeline
+//   (u, v, t) -> body kinematics -> constraints (f, zeta, xi) -> forces (eta) -> KKT -> vdot, delta
+// and the topological projection of (u, v) onto f = 0 and zeta v = rhs. All buffers are sized
+// once in the constructor; nothing is allocated per evaluation.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "armdyn/solver/kkt.hpp"
+
+namespace armdyn {
+
+struct ProjectionStats {
+  long position_projections = 0;  ///< position corrections that needed a factorisation
+  long newton_iterations = 0;
+  long velocity_projections = 0;
+};
+
+class Engine {
+ public:
+  explicit Engine(const Model& m);
+
+  /// Rows taking part: all (joints + drives) by default, or joints only (joint-space calls).
+  void set_include_drives(bool on) { nrows_ = on ? m_.nc : m_.nc_joint; }
+  int nrows() const { return nrows_; }
+  /// Optional joint-space generalised forces (n_coords), added to eta; nullptr for none.
+  void set_joint_torques(const double* tau) { tau_ = tau; }
+
+  /// Kinematics of (u, v); v may be nullptr (at rest).
+  void load(const double* u, const double* v);
+  /// eta at the loaded state: gravity, gyroscopic, loads, springs, coordinate forces.
+  /// @throws SolverError naming the body when a force is not finite.
+  void forces(double t);
+  /// Forward dynamics: vdot (nv) and multipliers (stored, see delta()).
+  /// reuse_factor: the last projection factored A at this very u with the mass metric.
+  void dynamics(double t, const double* u, const double* v, double* vdot, bool reuse_factor = false);
+  /// u' = S(u) v: xdot and 1/2 e (x) [0, omega].
+  void udot(const double* u, const double* v, double* ud) const;
+  /// Project u onto f(u, t) = 0 (minimum-norm Newton in metric W, quaternions renormalised) and
+  /// v onto zeta v = rhs. Leaves A factored at the final u.
+  /// @throws SolverError when the position iteration does not converge.
+  void project(double t, double* u, double* v, Metric metric);
+  /// ||f||_inf and ||zeta v - rhs||_inf over the active rows at (u, v, t).
+  void residuals(double t, const double* u, const double* v, double& rf, double& rv);
+  /// Kinetic and potential (gravity + springs) energy.
+  void energy(const double* u, const double* v, double& ke, double& pe);
+  /// Reaction on joint j's child at the joint point, in the child's joint frame, from the
+  /// multipliers of the last dynamics() call (kinematics must still be loaded).
+  void joint_reaction(int j, Vec3& force, Vec3& torque) const;
+
+  const VecX& delta() const { return delta_; }
+  const VecX& eta() const { return eta_; }
+  const ConstraintEval& constraints() const { return ce_; }
+  ConstraintEval& constraints() { return ce_; }
+  const std::vector<BodyKin>& kin() const { return kin_; }
+  KktSolver& kkt() { return kkt_; }
+  const Model& model() const { return m_; }
+  ProjectionStats pstats;
+  long kkt_solves = 0, factorizations = 0;
+
+ private:
+  void scatter(const Row12& g, int pa, int pb);
+  const Model& m_;
+  std::vector<BodyKin> kin_;
+  ConstraintEval ce_;
+  KktSolver kkt_;
+  VecX eta_, delta_, tmp_nv_, tmp_nc_, mu_;
+  VecX vd_;
+  const double* tau_ = nullptr;
+  int nrows_ = 0;
+  double tol_f_ = 1e-13;
+};
+
+}  // namespace armdyn

@@ -1,0 +1,47 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Explicit integrators on y = (u, v), with a projection after every accepted step:
+//  - DOPRI5: Dormand-Prince 5(4), FSAL, PI step control and 4th-order dense output (Hairer,
+//    Norsett & Wanner, Solving ODEs I, II.5 and II.6; the ode45 scheme). The error is estimated on
+//    the unprojected pair; the accepted value is projected and the first stage re-evaluated there.
+//  - RK4: classical fixed step, projected after each step.
+// Output times on a grid are served from the dense output (DOPRI5) or by landing steps on them
+// (RK4); every output state is projected.
+#pragma once
+
+#include <vector>
+
+#include "armdyn/math/types.hpp"
+
+namespace armdyn {
+
+class OdeSystem {
+ public:
+  virtual ~OdeSystem() = default;
+  /// dy = f(t, y).
+  virtual void rhs(double t, const VecX& y, VecX& dy) = 0;
+  /// Project an accepted y in place, then dy = f(t, y) at the projected state.
+  virtual void project_and_rhs(double t, VecX& y, VecX& dy) = 0;
+  /// Record an output at t (y is a state to be projected by the system, not yet recorded).
+  virtual void output(double t, const VecX& y) = 0;
+};
+
+struct StepStats {
+  long steps = 0, rejected = 0, rhs_evals = 0;
+};
+
+struct StepOptions {
+  double rtol = 1e-6, atol = 1e-8;
+  double dt = 0.0;         ///< RK4 step; DOPRI5 initial step (0: automatic)
+  double max_step = 0.0;   ///< DOPRI5 (0: no limit)
+  double output_dt = 0.0;  ///< 0: output every accepted step
+  long max_steps = 10000000;
+};
+
+/// Integrate from t0 to t1; y holds the projected initial state on entry, the final on exit.
+/// @throws SolverError on step-size underflow, too many steps or non-finite values.
+void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepOptions& opt,
+                      StepStats& stats);
+void integrate_rk4(OdeSystem& sys, VecX& y, double t0, double t1, const StepOptions& opt,
+                   StepStats& stats);
+
+}  // namespace armdyn

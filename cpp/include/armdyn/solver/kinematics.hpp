@@ -1,0 +1,61 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Kinematic "jets": a quantity's value, its rate, its velocity Jacobian and its bias
+// (second time derivative with zero accelerations). Every constraint, drive and
+// joint-coordinate force is built from these, so zeta = F S and xi are exact by construction:
+//   d/dt q = J v,   d2/dt2 q = J vdot + bias.
+// J has 12 columns: [v_a (6), v_b (6)] for the two bodies a joint connects, each v = (xdot world,
+// omega body). Ground has zero velocity and its columns are dropped when scattered.
+#pragma once
+
+#include <vector>
+
+#include "armdyn/math/types.hpp"
+#include "armdyn/model/model.hpp"
+
+namespace armdyn {
+
+/// Per-body kinematic cache for the current (u, v).
+struct BodyKin {
+  Vec3 x = Vec3::Zero();   ///< centre of mass, world
+  Mat3 R = Mat3::Identity();
+  Vec3 xd = Vec3::Zero();  ///< velocity of the centre of mass, world
+  Vec3 w = Vec3::Zero();   ///< angular velocity, body frame
+};
+
+struct VecJet {
+  Vec3 val, rate, bias;
+  Mat3x12 J;
+};
+
+struct ScalarJet {
+  double val = 0, rate = 0, bias = 0;
+  Row12 J = Row12::Zero();
+};
+
+/// Fill kin (size nb) from u (nq) and v (nv). Quaternions are used as given (not normalised).
+void body_kinematics(const Model& m, const double* u, const double* v, std::vector<BodyKin>& kin);
+
+/// Kinematics of ground or of body b (b = kGround gives the identity pose at rest).
+const BodyKin& kin_of(const std::vector<BodyKin>& kin, int b);
+
+/// World direction R_b a of a vector a fixed in body b, placed in Jacobian slot (0 or 1).
+VecJet direction_jet(const BodyKin& k, const Vec3& a, int slot);
+/// World position x_b + R_b s of a point s fixed in body b.
+VecJet point_jet(const BodyKin& k, const Vec3& s, int slot);
+VecJet difference(const VecJet& p, const VecJet& q);  ///< p - q
+ScalarJet dot(const VecJet& a, const VecJet& b);
+ScalarJet component(const VecJet& a, int k);
+/// atan2(s, c) of two scalar jets.
+ScalarJet atan2_jet(const ScalarJet& s, const ScalarJet& c);
+
+/// Joint frame axes of joint j in world, on the parent (side 0) or child (side 1) body.
+VecJet joint_axis_jet(const Model& m, const std::vector<BodyKin>& kin, int joint, int side,
+                      int axis);
+/// Vector from the parent's joint point to the child's joint point, world.
+VecJet joint_separation_jet(const Model& m, const std::vector<BodyKin>& kin, int joint);
+
+/// Jet of joint coordinate c (angle in (-pi, pi] or displacement) in the Jacobian slots of its
+/// joint's (parent, child).
+ScalarJet coord_jet(const Model& m, const std::vector<BodyKin>& kin, int coord);
+
+}  // namespace armdyn

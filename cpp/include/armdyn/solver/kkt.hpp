@@ -1,0 +1,52 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The augmented (KKT) system of the constrained Newton-Euler equations
+//   [ Gamma  zeta^T ] [ vdot  ]   [  eta ]
+//   [ zeta   0      ] [ delta ] = [ -xi  ]
+// solved by the range-space Schur complement A = zeta W^-1 zeta^T (W = Gamma for dynamics and the
+// mass-weighted projection, W = I for the paper's unweighted projection):
+//   A delta = zeta Gamma^-1 eta + xi,   vdot = Gamma^-1 (eta - zeta^T delta).
+// A is assembled block by block from the bodies each row block touches. It is factored by
+// Cholesky; when A is singular (redundant constraints) a complete orthogonal decomposition gives
+// the minimum-norm multipliers, which leaves vdot and zeta^T delta unique.
+#pragma once
+
+#include <Eigen/Cholesky>
+#include <Eigen/QR>
+
+#include "armdyn/solver/constraints.hpp"
+
+namespace armdyn {
+
+enum class Metric { Mass, Identity };
+
+class KktSolver {
+ public:
+  explicit KktSolver(const Model& m);
+
+  /// Assemble A over rows [0, nrows) with metric W and factor it.
+  void factor(const ConstraintEval& ce, int nrows, Metric metric);
+  /// Solve A x = b (b, x sized >= nrows; only the first nrows entries are used).
+  void solve_schur(const VecX& b, VecX& x) const;
+  /// x = W^-1 y (blockwise).
+  void apply_winv(const VecX& y, VecX& x) const;
+  /// Forward dynamics with the current factorisation (must be metric Mass).
+  void accelerations(const ConstraintEval& ce, const VecX& eta, VecX& vdot, VecX& delta);
+
+  int nrows() const { return nrows_; }
+  Metric metric() const { return metric_; }
+  bool used_pseudo_inverse() const { return pinv_; }
+  int rank() const { return rank_; }
+
+ private:
+  const Model& m_;
+  std::vector<Mat6> minv_;  // per-body Gamma^-1 blocks
+  MatX A_;
+  Eigen::LLT<MatX> llt_;
+  Eigen::CompleteOrthogonalDecomposition<MatX> cod_;
+  VecX tmp_nv_, tmp_nc_, b_;
+  int nrows_ = 0, rank_ = 0;
+  Metric metric_ = Metric::Mass;
+  bool pinv_ = false;
+};
+
+}  // namespace armdyn

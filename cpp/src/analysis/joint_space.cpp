@@ -1,0 +1,126 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "armdyn/analysis/joint_space.hpp"
+
+#include "armdyn/errors.hpp"
+#include "armdyn/math/quaternion.hpp"
+#include "armdyn/solver/engine.hpp"
+
+namespace armdyn {
+
+void require_joint_space(const Model& m, const char* what) {
+  if (!m.joint_space_ok)
+    throw ModelError(msg(what, ": needs a tree of revolute, prismatic, cylindrical or fixed "
+                               "joints defined parent -> child; here ",
+                         m.joint_space_reason));
+}
+
+namespace {
+void check_vec(const VecX& x, long n, const char* fn, const char* name) {
+  if (x.size() != n)
+    throw ModelError(msg(fn, ": ", name, " has length ", x.size(), ", expected ", n));
+  if (!x.allFinite()) throw ModelError(msg(fn, ": ", name, " contains NaN or inf"));
+}
+}  // namespace
+
+void state_from_joints(const Model& m, const VecX& q, const VecX& qd, VecX& u, VecX& v) {
+  require_joint_space(m, "state_from_joints");
+  const long nc = static_cast<long>(m.coords.size());
+  check_vec(q, nc, "state_from_joints", "q");
+  check_vec(qd, nc, "state_from_joints", "qd");
+  u.resize(m.nq);
+  v.resize(m.nv);
+  // world pose and velocity of each body, filled parent before child
+  std::vector<Mat3> R(m.nb);
+  std::vector<Vec3> x(m.nb), xd(m.nb), ww(m.nb);
+  for (int ji : m.tree_order) {
+    const Joint& j = m.joints[ji];
+    Mat3 Rp = Mat3::Identity();
+    Vec3 xp = Vec3::Zero(), xdp = Vec3::Zero(), wp = Vec3::Zero();
+    if (j.parent != kGround) {
+      Rp = R[j.parent];
+      xp = x[j.parent];
+      xdp = xd[j.parent];
+      wp = ww[j.parent];
+    }
+    const Vec3 P = xp + Rp * j.point_parent;
+    const Mat3 A = Rp * j.frame_parent;
+    const Vec3 z = A.col(2);
+    double th = 0, thd = 0, d = 0, dd = 0;
+    switch (j.type) {
+      case JointType::Revolute:
+        th = q[j.coord0];
+        thd = qd[j.coord0];
+        break;
+      case JointType::Prismatic:
+        d = q[j.coord0];
+        dd = qd[j.coord0];
+        break;
+      case JointType::Cylindrical:
+        th = q[j.coord0];
+        thd = qd[j.coord0];
+        d = q[j.coord0 + 1];
+        dd = qd[j.coord0 + 1];
+        break;
+      default:
+        break;
+    }
+    // child joint frame B = A Rz(th), placed at P + d z
+    Mat3 Rz;
+    Rz << std::cos(th), -std::sin(th), 0, std::sin(th), std::cos(th), 0, 0, 0, 1;
+    const Mat3 B = A * Rz;
+    const Vec3 Pc = P + d * z;
+    const int c = j.child;
+    R[c] = B * j.frame_child.transpose();
+    x[c] = Pc - R[c] * j.point_child;
+    ww[c] = wp + thd * z;
+    const Vec3 Pcd = xdp + wp.cross(Pc - xp) + dd * z;
+    xd[c] = Pcd + ww[c].cross(x[c] - Pc);
+  }
+  for (int i = 0; i < m.nb; ++i) {
+    u.segment<3>(7 * i) = x[i];
+    u.segment<4>(7 * i + 3) = rot_to_quat(R[i]);
+    v.segment<3>(6 * i) = xd[i];
+    v.segment<3>(6 * i + 3) = R[i].transpose() * ww[i];
+  }
+}
+
+void joint_coordinates(const Model& m, const VecX& u, const VecX& v, VecX& q, VecX& qd) {
+  check_vec(u, m.nq, "joint_coordinates", "u");
+  check_vec(v, m.nv, "joint_coordinates", "v");
+  std::vector<BodyKin> kin;
+  body_kinematics(m, u.data(), v.data(), kin);
+  const int nc = static_cast<int>(m.coords.size());
+  q.resize(nc);
+  qd.resize(nc);
+  for (int c = 0; c < nc; ++c) {
+    const ScalarJet s = coord_jet(m, kin, c);
+    q[c] = s.val;
+    qd[c] = s.rate;
+  }
+}
+
+VecX forward_dynamics(const Model& m, const VecX& q, const VecX& qd, const VecX& tau) {
+  require_joint_space(m, "forward_dynamics");
+  const long nc = static_cast<long>(m.coords.size());
+  check_vec(tau, nc, "forward_dynamics", "tau");
+  VecX u, v;
+  state_from_joints(m, q, qd, u, v);
+  Engine e(m);
+  e.set_include_drives(false);
+  e.set_joint_torques(tau.data());
+  VecX vdot(m.nv);
+  e.dynamics(0.0, u.data(), v.data(), vdot.data());
+  // qdd = J vdot + bias for every coordinate
+  VecX qdd(nc);
+  for (int c = 0; c < nc; ++c) {
+    const ScalarJet s = coord_jet(m, e.kin(), c);
+    const Joint& j = m.joints[m.coords[c].joint];
+    double a = s.bias;
+    if (j.parent != kGround) a += s.J.segment<6>(0).dot(vdot.segment<6>(6 * j.parent));
+    if (j.child != kGround) a += s.J.segment<6>(6).dot(vdot.segment<6>(6 * j.child));
+    qdd[c] = a;
+  }
+  return qdd;
+}
+
+}  // namespace armdyn

@@ -1,0 +1,152 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "armdyn/analysis/simulate.hpp"
+
+#include <chrono>
+#include <cmath>
+
+#include "armdyn/errors.hpp"
+#include "armdyn/solver/engine.hpp"
+
+namespace armdyn {
+
+namespace {
+
+// the constrained equations of motion as an ODE on y = (u, v), with projection and recording
+class MbsSystem : public OdeSystem {
+ public:
+  MbsSystem(const Model& m, Metric metric, SimResult& out)
+      : m_(m), e_(m), metric_(metric), out_(out), yo_(m.nq + m.nv), vd_(m.nv), qprev_(m.coords.size()) {}
+
+  void rhs(double t, const VecX& y, VecX& dy) override {
+    e_.dynamics(t, y.data(), y.data() + m_.nq, dy.data() + m_.nq);
+    e_.udot(y.data(), y.data() + m_.nq, dy.data());
+  }
+
+  void project_and_rhs(double t, VecX& y, VecX& dy) override {
+    e_.project(t, y.data(), y.data() + m_.nq, metric_);
+    e_.dynamics(t, y.data(), y.data() + m_.nq, dy.data() + m_.nq, true);
+    e_.udot(y.data(), y.data() + m_.nq, dy.data());
+  }
+
+  void output(double t, const VecX& y) override {
+    yo_ = y;
+    double* u = yo_.data();
+    double* v = yo_.data() + m_.nq;
+    e_.project(t, u, v, metric_);
+    e_.dynamics(t, u, v, vd_.data(), true);
+    // joint coordinates (angles unwrapped along the run) and rates
+    const long row = out_.n;
+    for (size_t c = 0; c < m_.coords.size(); ++c) {
+      const ScalarJet q = coord_jet(m_, e_.kin(), static_cast<int>(c));
+      double qv = q.val;
+      if (m_.coords[c].angular && row > 0)
+        qv = qprev_[c] + std::remainder(q.val - qprev_[c], 2.0 * M_PI);
+      qprev_[c] = qv;
+      out_.q.push_back(qv);
+      out_.qd.push_back(q.rate);
+    }
+    // actuator efforts: tau = -delta of the drive rows
+    for (const Drive& d : m_.drives) out_.drive_forces.push_back(-e_.delta()[d.row]);
+    for (size_t j = 0; j < m_.joints.size(); ++j) {
+      Vec3 f, tq;
+      e_.joint_reaction(static_cast<int>(j), f, tq);
+      for (int k = 0; k < 3; ++k) {
+        out_.reaction_forces.push_back(f[k]);
+        out_.reaction_torques.push_back(tq[k]);
+      }
+    }
+    double rf, rv, ke, pe;
+    e_.residuals(t, u, v, rf, rv);
+    e_.energy(u, v, ke, pe);
+    out_.t.push_back(t);
+    out_.u.insert(out_.u.end(), u, u + m_.nq);
+    out_.v.insert(out_.v.end(), v, v + m_.nv);
+    out_.position_residual.push_back(rf);
+    out_.velocity_residual.push_back(rv);
+    out_.kinetic_energy.push_back(ke);
+    out_.potential_energy.push_back(pe);
+    out_.n = row + 1;
+  }
+
+  Engine& engine() { return e_; }
+
+ private:
+  const Model& m_;
+  Engine e_;
+  Metric metric_;
+  SimResult& out_;
+  VecX yo_, vd_, qprev_;
+};
+
+}  // namespace
+
+SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const VecX& u0,
+                   const VecX& v0) {
+  if (!(t_end > 0) || !std::isfinite(t_end))
+    throw ModelError(msg("simulate: t_end must be positive and finite, got ", t_end));
+  if (opt.integrator != "dopri5" && opt.integrator != "rk4")
+    throw ModelError(msg("simulate: unknown integrator '", opt.integrator,
+                         "' (expected 'dopri5' or 'rk4')"));
+  const StepOptions& s = opt.step;
+  if (!(s.rtol > 0) || !std::isfinite(s.rtol))
+    throw ModelError(msg("simulate: rtol must be positive, got ", s.rtol));
+  if (!(s.atol > 0) || !std::isfinite(s.atol))
+    throw ModelError(msg("simulate: atol must be positive, got ", s.atol));
+  if (!(s.dt >= 0) || !std::isfinite(s.dt))
+    throw ModelError(msg("simulate: dt must be positive, got ", s.dt));
+  if (opt.integrator == "rk4" && !(s.dt > 0))
+    throw ModelError("simulate: integrator 'rk4' needs a step dt > 0");
+  if (!(s.output_dt >= 0) || !std::isfinite(s.output_dt))
+    throw ModelError(msg("simulate: output_dt must be positive, got ", s.output_dt));
+  if (s.max_steps <= 0) throw ModelError("simulate: max_steps must be positive");
+  if (u0.size() != m.nq || v0.size() != m.nv)
+    throw ModelError(msg("simulate: initial state has sizes (", u0.size(), ", ", v0.size(),
+                         "), expected (", m.nq, ", ", m.nv, ")"));
+  if (!u0.allFinite() || !v0.allFinite())
+    throw ModelError("simulate: initial state contains NaN or inf");
+
+  SimResult out;
+  if (s.output_dt > 0) {
+    const size_t n = static_cast<size_t>(t_end / s.output_dt) + 2;
+    out.t.reserve(n);
+    out.u.reserve(n * m.nq);
+    out.v.reserve(n * m.nv);
+  }
+  MbsSystem sys(m, opt.projection, out);
+  VecX y(m.nq + m.nv);
+  y.head(m.nq) = u0;
+  y.tail(m.nv) = v0;
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    if (opt.integrator == "dopri5")
+      integrate_dopri5(sys, y, 0.0, t_end, s, out.stats);
+    else
+      integrate_rk4(sys, y, 0.0, t_end, s, out.stats);
+  } catch (const SolverError& err) {
+    out.error = err.what();
+  }
+  out.cpu_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  Engine& e = sys.engine();
+  out.kkt_solves = e.kkt_solves;
+  out.factorizations = e.factorizations;
+  out.position_projections = e.pstats.position_projections;
+  out.newton_iterations = e.pstats.newton_iterations;
+  // a failed output may have pushed part of a row: trim every table to n complete rows
+  const size_t n = static_cast<size_t>(out.n);
+  out.t.resize(n);
+  out.u.resize(n * m.nq);
+  out.v.resize(n * m.nv);
+  out.q.resize(n * m.coords.size());
+  out.qd.resize(n * m.coords.size());
+  out.drive_forces.resize(n * m.drives.size());
+  out.reaction_forces.resize(n * 3 * m.joints.size());
+  out.reaction_torques.resize(n * 3 * m.joints.size());
+  out.position_residual.resize(n);
+  out.velocity_residual.resize(n);
+  out.kinetic_energy.resize(n);
+  out.potential_energy.resize(n);
+  return out;
+}
+
+}  // namespace armdyn

@@ -1,0 +1,446 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "armdyn/model/builder.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/QR>
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <numeric>
+
+#include "armdyn/errors.hpp"
+#include "armdyn/math/quaternion.hpp"
+#include "armdyn/solver/engine.hpp"
+
+namespace armdyn {
+
+namespace {
+
+template <typename Derived>
+void require_finite(const Eigen::MatrixBase<Derived>& x, const std::string& what) {
+  if (!x.allFinite()) throw ModelError(msg(what, " contains NaN or inf"));
+}
+
+void require_finite(double x, const std::string& what) {
+  if (!std::isfinite(x)) throw ModelError(msg(what, " must be finite, got ", x));
+}
+
+Vec3 unit_axis(const Vec3& a, const std::string& what) {
+  require_finite(a, what);
+  const double n = a.norm();
+  if (!(n > 1e-12)) throw ModelError(msg(what, " has zero length"));
+  return a / n;
+}
+
+}  // namespace
+
+ModelBuilder::ModelBuilder(const Vec3& gravity) {
+  require_finite(gravity, "gravity");
+  m_.gravity = gravity;
+}
+
+int ModelBuilder::add_body(const std::string& name, double mass, const Mat3& inertia,
+                           const Vec3& position, const Vec4& orientation) {
+  const std::string who = msg("body '", name, "'");
+  if (name.empty()) throw ModelError("body name must not be empty");
+  if (name == "ground") throw ModelError("body name 'ground' is reserved");
+  if (m_.body_index.count(name)) throw ModelError(msg(who, ": duplicate body name"));
+  require_finite(mass, who + ": mass");
+  if (!(mass > 0.0)) throw ModelError(msg(who, ": mass must be positive, got ", mass));
+  require_finite(inertia, who + ": inertia");
+  const double scale = inertia.cwiseAbs().maxCoeff();
+  if ((inertia - inertia.transpose()).cwiseAbs().maxCoeff() > 1e-9 * std::max(scale, 1e-300))
+    throw ModelError(msg(who, ": inertia is not symmetric"));
+  Eigen::SelfAdjointEigenSolver<Mat3> es(0.5 * (inertia + inertia.transpose()));
+  const Vec3 p = es.eigenvalues();  // ascending
+  if (!(p[0] > 0.0))
+    throw ModelError(msg(who, ": inertia is not positive definite (principal moments ", p[0], ", ",
+                         p[1], ", ", p[2], ")"));
+  if (p[0] + p[1] < p[2] * (1.0 - 1e-9))
+    throw ModelError(msg(who, ": inertia violates the triangle inequality (principal moments ",
+                         p[0], " + ", p[1], " < ", p[2], ")"));
+  require_finite(position, who + ": position");
+  require_finite(orientation, who + ": orientation");
+  if (std::abs(orientation.norm() - 1.0) > 1e-6)
+    throw ModelError(msg(who, ": orientation must be a unit quaternion [e0, e1, e2, e3] "
+                              "(scalar first), got norm ", orientation.norm()));
+  Body b;
+  b.name = name;
+  b.mass = mass;
+  b.inertia = 0.5 * (inertia + inertia.transpose());
+  b.position = position;
+  b.orientation = orientation.normalized();
+  const int idx = static_cast<int>(m_.bodies.size());
+  m_.bodies.push_back(b);
+  m_.body_index[name] = idx;
+  return idx;
+}
+
+int ModelBuilder::resolve_body(const std::string& name, const std::string& context) const {
+  if (name == "ground") return kGround;
+  auto it = m_.body_index.find(name);
+  if (it == m_.body_index.end()) throw ModelError(msg(context, ": unknown body '", name, "'"));
+  return it->second;
+}
+
+int ModelBuilder::add_joint(const std::string& name, JointType type, const std::string& parent,
+                            const std::string& child, const Vec3& point, const Vec3& axis,
+                            const Vec3* axis2) {
+  const std::string who = msg(joint_type_name(type), " joint '", name, "'");
+  if (name.empty()) throw ModelError(msg(joint_type_name(type), " joint: name must not be empty"));
+  if (m_.joint_index.count(name)) throw ModelError(msg(who, ": duplicate joint name"));
+  const int pa = resolve_body(parent, who);
+  const int ch = resolve_body(child, who);
+  if (pa == ch) throw ModelError(msg(who, ": links body '", parent, "' to itself"));
+  require_finite(point, who + ": point");
+  Mat3 fw_parent = Mat3::Identity(), fw_child = Mat3::Identity();
+  if (type == JointType::Revolute || type == JointType::Prismatic ||
+      type == JointType::Cylindrical) {
+    fw_parent = fw_child = frame_from_z(unit_axis(axis, who + ": axis"));
+  } else if (type == JointType::Universal) {
+    const Vec3 a1 = unit_axis(axis, who + ": axis1");
+    const Vec3 a2 = unit_axis(*axis2, who + ": axis2");
+    if (std::abs(a1.dot(a2)) > 1e-6)
+      throw ModelError(msg(who, ": axis1 and axis2 must be perpendicular (dot = ", a1.dot(a2), ")"));
+    fw_parent = frame_from_z(a1);
+    fw_child = frame_from_z(a2);
+  }
+  Joint j;
+  j.name = name;
+  j.type = type;
+  j.parent = pa;
+  j.child = ch;
+  // joint point and frame in each body's frame at the assembly pose
+  auto local = [&](int b, const Mat3& fw, Vec3& s, Mat3& f) {
+    if (b == kGround) {
+      s = point;
+      f = fw;
+    } else {
+      const Body& bd = m_.bodies[b];
+      const Mat3 R = quat_to_rot(bd.orientation);
+      s = R.transpose() * (point - bd.position);
+      f = R.transpose() * fw;
+    }
+  };
+  local(pa, fw_parent, j.point_parent, j.frame_parent);
+  local(ch, fw_child, j.point_child, j.frame_child);
+  j.row0 = m_.nc_joint;
+  const int nq = joint_coords(type);
+  j.coord0 = nq ? static_cast<int>(m_.coords.size()) : -1;
+  const int idx = static_cast<int>(m_.joints.size());
+  // commit
+  for (int k = 0; k < nq; ++k) {
+    Coord c;
+    c.joint = idx;
+    c.sub = k;
+    c.angular = (type != JointType::Prismatic) && k == 0;
+    c.name = nq == 1 ? name : name + (k == 0 ? ":angle" : ":displacement");
+    m_.coords.push_back(c);
+  }
+  m_.nc_joint += joint_rows(type);
+  m_.joints.push_back(j);
+  m_.joint_index[name] = idx;
+  return idx;
+}
+
+int ModelBuilder::add_revolute(const std::string& name, const std::string& parent,
+                               const std::string& child, const Vec3& point, const Vec3& axis) {
+  return add_joint(name, JointType::Revolute, parent, child, point, axis, nullptr);
+}
+int ModelBuilder::add_prismatic(const std::string& name, const std::string& parent,
+                                const std::string& child, const Vec3& point, const Vec3& axis) {
+  return add_joint(name, JointType::Prismatic, parent, child, point, axis, nullptr);
+}
+int ModelBuilder::add_cylindrical(const std::string& name, const std::string& parent,
+                                  const std::string& child, const Vec3& point, const Vec3& axis) {
+  return add_joint(name, JointType::Cylindrical, parent, child, point, axis, nullptr);
+}
+int ModelBuilder::add_spherical(const std::string& name, const std::string& parent,
+                                const std::string& child, const Vec3& point) {
+  return add_joint(name, JointType::Spherical, parent, child, point, Vec3::UnitZ(), nullptr);
+}
+int ModelBuilder::add_fixed(const std::string& name, const std::string& parent,
+                            const std::string& child, const Vec3& point) {
+  return add_joint(name, JointType::Fixed, parent, child, point, Vec3::UnitZ(), nullptr);
+}
+int ModelBuilder::add_universal(const std::string& name, const std::string& parent,
+                                const std::string& child, const Vec3& point, const Vec3& axis1,
+                                const Vec3& axis2) {
+  return add_joint(name, JointType::Universal, parent, child, point, axis1, &axis2);
+}
+int ModelBuilder::add_free(const std::string& name, const std::string& child) {
+  const int c = resolve_body(child, msg("free joint '", name, "'"));
+  if (c == kGround) throw ModelError(msg("free joint '", name, "': child must be a body"));
+  return add_joint(name, JointType::Free, "ground", child, m_.bodies[c].position, Vec3::UnitZ(),
+                   nullptr);
+}
+
+void ModelBuilder::set_joint_limits(const std::string& joint, double lower, double upper,
+                                    double effort, double velocity) {
+  auto it = m_.joint_index.find(joint);
+  if (it == m_.joint_index.end()) throw ModelError(msg("set_joint_limits: unknown joint '", joint, "'"));
+  const std::string who = msg("joint '", joint, "' limits");
+  if (std::isnan(lower) || std::isnan(upper) || std::isnan(effort) || std::isnan(velocity))
+    throw ModelError(msg(who, ": NaN"));
+  if (lower > upper) throw ModelError(msg(who, ": lower ", lower, " > upper ", upper));
+  if (effort < 0 || velocity < 0) throw ModelError(msg(who, ": effort and velocity must be >= 0"));
+  Joint& j = m_.joints[it->second];
+  j.lower = lower;
+  j.upper = upper;
+  j.effort = effort;
+  j.velocity_limit = velocity;
+}
+
+int ModelBuilder::add_drive(const std::string& joint, const Profile& profile, int coord,
+                            const std::string& name) {
+  auto it = m_.joint_index.find(joint);
+  if (it == m_.joint_index.end()) throw ModelError(msg("add_drive: unknown joint '", joint, "'"));
+  const Joint& j = m_.joints[it->second];
+  const int nq = joint_coords(j.type);
+  if (coord < 0 || coord >= nq)
+    throw ModelError(msg("add_drive: ", joint_type_name(j.type), " joint '", joint,
+                         "' has no coordinate ", coord, " to drive (it has ", nq, ")"));
+  const std::string dname = name.empty() ? (nq == 1 ? joint : m_.coords[j.coord0 + coord].name) : name;
+  for (const Drive& d : m_.drives) {
+    if (d.joint == it->second && d.coord == coord)
+      throw ModelError(msg("add_drive: coordinate ", coord, " of joint '", joint,
+                           "' is already driven by '", d.name, "'"));
+    if (d.name == dname) throw ModelError(msg("add_drive: duplicate drive name '", dname, "'"));
+  }
+  Drive d;
+  d.name = dname;
+  d.joint = it->second;
+  d.coord = coord;
+  d.profile = profile;
+  const int idx = static_cast<int>(m_.drives.size());
+  m_.drives.push_back(d);
+  m_.drive_index[dname] = idx;
+  return idx;
+}
+
+void ModelBuilder::add_body_load(const std::string& body, const Vec3& force, const Vec3& torque,
+                                 const Vec3* point_world, const Profile* profile) {
+  const int b = resolve_body(body, "add_body_force");
+  if (b == kGround) throw ModelError("add_body_force: cannot load 'ground'");
+  const std::string who = msg("load on body '", body, "'");
+  require_finite(force, who + ": force");
+  require_finite(torque, who + ": torque");
+  BodyLoad l;
+  l.body = b;
+  l.force = force;
+  l.torque = torque;
+  const Body& bd = m_.bodies[b];
+  if (point_world) {
+    require_finite(*point_world, who + ": point");
+    l.point = quat_to_rot(bd.orientation).transpose() * (*point_world - bd.position);
+  }
+  if (profile) {
+    l.has_profile = true;
+    l.profile = *profile;
+  }
+  m_.body_loads.push_back(l);
+}
+
+void ModelBuilder::add_spring_damper(const std::string& name, const std::string& body_a,
+                                     const Vec3& point_a, const std::string& body_b,
+                                     const Vec3& point_b, double stiffness, double damping,
+                                     double rest_length) {
+  const std::string who = msg("spring-damper '", name, "'");
+  const int a = resolve_body(body_a, who);
+  const int b = resolve_body(body_b, who);
+  if (a == b) throw ModelError(msg(who, ": connects body '", body_a, "' to itself"));
+  require_finite(point_a, who + ": point_a");
+  require_finite(point_b, who + ": point_b");
+  require_finite(stiffness, who + ": stiffness");
+  require_finite(damping, who + ": damping");
+  require_finite(rest_length, who + ": rest_length");
+  if (stiffness < 0 || damping < 0)
+    throw ModelError(msg(who, ": stiffness and damping must be >= 0"));
+  const double L = (point_b - point_a).norm();
+  if (!(L > 1e-12)) throw ModelError(msg(who, ": the two points coincide"));
+  SpringDamper s;
+  s.name = name;
+  s.body_a = a;
+  s.body_b = b;
+  auto local = [&](int k, const Vec3& p) -> Vec3 {
+    if (k == kGround) return p;
+    const Body& bd = m_.bodies[k];
+    return quat_to_rot(bd.orientation).transpose() * (p - bd.position);
+  };
+  s.point_a = local(a, point_a);
+  s.point_b = local(b, point_b);
+  s.stiffness = stiffness;
+  s.damping = damping;
+  s.rest_length = rest_length < 0 ? L : rest_length;
+  m_.springs.push_back(s);
+}
+
+void ModelBuilder::add_joint_spring_damper(const std::string& joint, double stiffness,
+                                           double damping, double rest, int coord) {
+  const std::string who = msg("joint spring-damper on '", joint, "'");
+  auto it = m_.joint_index.find(joint);
+  if (it == m_.joint_index.end()) throw ModelError(msg(who, ": unknown joint '", joint, "'"));
+  const Joint& j = m_.joints[it->second];
+  if (coord < 0 || coord >= joint_coords(j.type))
+    throw ModelError(msg(who, ": ", joint_type_name(j.type), " joint has no coordinate ", coord));
+  require_finite(stiffness, who + ": stiffness");
+  require_finite(damping, who + ": damping");
+  require_finite(rest, who + ": rest");
+  if (stiffness < 0 || damping < 0)
+    throw ModelError(msg(who, ": stiffness and damping must be >= 0"));
+  if (stiffness == 0.0 && damping == 0.0) return;  // nothing to pay for
+  CoordForce cf;
+  cf.coord = j.coord0 + coord;
+  cf.stiffness = stiffness;
+  cf.damping = damping;
+  cf.rest = rest;
+  m_.coord_forces.push_back(cf);
+}
+
+void ModelBuilder::add_joint_torque(const std::string& joint, const Profile& profile, int coord) {
+  const std::string who = msg("joint torque on '", joint, "'");
+  auto it = m_.joint_index.find(joint);
+  if (it == m_.joint_index.end()) throw ModelError(msg(who, ": unknown joint '", joint, "'"));
+  const Joint& j = m_.joints[it->second];
+  if (coord < 0 || coord >= joint_coords(j.type))
+    throw ModelError(msg(who, ": ", joint_type_name(j.type), " joint has no coordinate ", coord));
+  CoordForce cf;
+  cf.coord = j.coord0 + coord;
+  cf.has_input = true;
+  cf.input = profile;
+  m_.coord_forces.push_back(cf);
+}
+
+ModelPtr ModelBuilder::finalize(const FinalizeOptions& options) const {
+  auto mp = std::make_shared<Model>(m_);
+  Model& m = *mp;
+  if (m.bodies.empty()) throw ModelError("finalize: the model has no bodies");
+  m.nb = static_cast<int>(m.bodies.size());
+  m.nq = 7 * m.nb;
+  m.nv = 6 * m.nb;
+  for (size_t k = 0; k < m.drives.size(); ++k) m.drives[k].row = m.nc_joint + static_cast<int>(k);
+  m.nc = m.nc_joint + static_cast<int>(m.drives.size());
+
+  // connectivity: every body must reach ground through joints (node nb = ground)
+  std::vector<int> uf(m.nb + 1);
+  std::iota(uf.begin(), uf.end(), 0);
+  auto find = [&](int x) {
+    while (uf[x] != x) x = uf[x] = uf[uf[x]];
+    return x;
+  };
+  auto node = [&](int b) { return b == kGround ? m.nb : b; };
+  for (const Joint& j : m.joints) uf[find(node(j.parent))] = find(node(j.child));
+  std::vector<std::string> loose;
+  for (int i = 0; i < m.nb; ++i)
+    if (find(i) != find(m.nb)) loose.push_back(m.bodies[i].name);
+  if (!loose.empty()) {
+    std::string names;
+    for (size_t k = 0; k < loose.size() && k < 8; ++k) names += (k ? ", '" : "'") + loose[k] + "'";
+    if (loose.size() > 8) names += ", ...";
+    throw ModelError(msg("finalize: bodies not connected to ground: ", names,
+                         " (add a joint, or add_free for a free-floating body)"));
+  }
+
+  // topology: a tree has exactly nb joints; order joints parent-before-child from ground
+  m.is_tree = static_cast<int>(m.joints.size()) == m.nb;
+  m.joint_space_ok = false;
+  if (m.is_tree) {
+    std::vector<char> seen(m.nb + 1, 0);
+    seen[m.nb] = 1;
+    std::deque<int> queue{m.nb};
+    std::vector<char> used(m.joints.size(), 0);
+    bool ok = true;
+    while (!queue.empty()) {
+      const int n = queue.front();
+      queue.pop_front();
+      for (size_t ji = 0; ji < m.joints.size(); ++ji) {
+        if (used[ji]) continue;
+        const Joint& j = m.joints[ji];
+        const int p = node(j.parent), c = node(j.child);
+        if (p != n && c != n) continue;
+        used[ji] = 1;
+        const int other = p == n ? c : p;
+        if (p != n && ok) {
+          ok = false;
+          m.joint_space_reason = msg("joint '", j.name, "' points from child to parent");
+        }
+        seen[other] = 1;
+        queue.push_back(other);
+        m.tree_order.push_back(static_cast<int>(ji));
+      }
+    }
+    for (const Joint& j : m.joints) {
+      if (j.type == JointType::Spherical || j.type == JointType::Universal ||
+          j.type == JointType::Free) {
+        if (ok) m.joint_space_reason = msg(joint_type_name(j.type), " joint '", j.name,
+                                           "' has no joint coordinates");
+        ok = false;
+      }
+    }
+    m.joint_space_ok = ok;
+  } else {
+    m.joint_space_reason = "the model has closed loops";
+  }
+
+  // characteristic length for tolerances
+  double ls = 0.0;
+  for (const Joint& j : m.joints) {
+    if (j.parent != kGround) ls = std::max(ls, j.point_parent.norm());
+    if (j.child != kGround) ls = std::max(ls, j.point_child.norm());
+  }
+  m.length_scale = std::max(ls, 1e-3);
+
+  // assembly: project the given poses onto f(u, 0) = 0, then rest velocities onto zeta v = rhs
+  m.u0 = VecX(m.nq);
+  for (int i = 0; i < m.nb; ++i) {
+    m.u0.segment<3>(7 * i) = m.bodies[i].position;
+    m.u0.segment<4>(7 * i + 3) = m.bodies[i].orientation;
+  }
+  m.v0 = VecX::Zero(m.nv);
+  const Metric metric = options.mass_weighted_assembly ? Metric::Mass : Metric::Identity;
+  {
+    Engine e(m);
+    try {
+      e.project(0.0, m.u0.data(), m.v0.data(), metric);
+    } catch (const SolverError& err) {
+      throw ModelError(msg("finalize: assembly failed (the joints cannot all be satisfied): ",
+                           err.what()));
+    }
+  }
+
+  // rank analysis at the assembled configuration: mobility and redundant rows by name
+  {
+    std::vector<BodyKin> kin;
+    body_kinematics(m, m.u0.data(), nullptr, kin);
+    ConstraintEval ce;
+    ce.init(m);
+    eval_constraints(m, kin, 0.0, false, ce);
+    const MatX z = dense_zeta(m, ce);
+    auto analyse = [&](int nrows, std::vector<std::string>* names) {
+      if (nrows == 0) return 0;
+      Eigen::ColPivHouseholderQR<MatX> qr(z.topRows(nrows).transpose());
+      qr.setThreshold(1e-10);
+      const int r = static_cast<int>(qr.rank());
+      if (names)
+        for (int k = r; k < nrows; ++k) names->push_back(m.row_name(qr.colsPermutation().indices()[k]));
+      return r;
+    };
+    m.rank_joint = analyse(m.nc_joint, &m.redundant_rows);
+    std::vector<std::string> all;
+    m.rank_all = analyse(m.nc, &all);
+    for (const auto& n : all)
+      if (std::find(m.redundant_rows.begin(), m.redundant_rows.end(), n) == m.redundant_rows.end() &&
+          n.rfind("drive", 0) == 0)
+        m.redundant_rows.push_back(n);
+    m.mobility = m.nv - m.rank_joint;
+    m.mobility_driven = m.nv - m.rank_all;
+    m.redundant = m.rank_joint < m.nc_joint || m.rank_all < m.nc;
+  }
+  if (m.redundant) {
+    Engine e(m);
+    e.project(0.0, m.u0.data(), m.v0.data(), metric);
+  }
+  return mp;
+}
+
+}  // namespace armdyn

@@ -1,0 +1,111 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "armdyn/model/model.hpp"
+
+#include <sstream>
+
+#include "armdyn/errors.hpp"
+
+namespace armdyn {
+
+const char* joint_type_name(JointType t) {
+  switch (t) {
+    case JointType::Revolute: return "revolute";
+    case JointType::Prismatic: return "prismatic";
+    case JointType::Spherical: return "spherical";
+    case JointType::Fixed: return "fixed";
+    case JointType::Cylindrical: return "cylindrical";
+    case JointType::Universal: return "universal";
+    case JointType::Free: return "free";
+  }
+  return "?";
+}
+
+int joint_rows(JointType t) {
+  switch (t) {
+    case JointType::Revolute: return 5;
+    case JointType::Prismatic: return 5;
+    case JointType::Spherical: return 3;
+    case JointType::Fixed: return 6;
+    case JointType::Cylindrical: return 4;
+    case JointType::Universal: return 4;
+    case JointType::Free: return 0;
+  }
+  return 0;
+}
+
+int joint_coords(JointType t) {
+  switch (t) {
+    case JointType::Revolute:
+    case JointType::Prismatic: return 1;
+    case JointType::Cylindrical: return 2;
+    default: return 0;
+  }
+}
+
+int Model::find_body(const std::string& name) const {
+  if (name == "ground") return kGround;
+  auto it = body_index.find(name);
+  if (it == body_index.end()) throw ModelError(msg("unknown body '", name, "'"));
+  return it->second;
+}
+
+int Model::find_joint(const std::string& name) const {
+  auto it = joint_index.find(name);
+  if (it == joint_index.end()) throw ModelError(msg("unknown joint '", name, "'"));
+  return it->second;
+}
+
+std::string Model::row_name(int row) const {
+  for (const Joint& j : joints) {
+    const int r = joint_rows(j.type);
+    if (row >= j.row0 && row < j.row0 + r) {
+      const int k = row - j.row0;
+      const char* what = "position";
+      switch (j.type) {
+        case JointType::Revolute:
+        case JointType::Universal:
+        case JointType::Fixed:
+        case JointType::Spherical: what = k < 3 ? "position" : "rotation"; break;
+        case JointType::Prismatic: what = k < 3 ? "rotation" : "position"; break;
+        case JointType::Cylindrical: what = k < 2 ? "rotation" : "position"; break;
+        default: break;
+      }
+      return msg("joint '", j.name, "' row ", k, " (", what, ")");
+    }
+  }
+  for (const Drive& d : drives)
+    if (d.row == row) return msg("drive '", d.name, "'");
+  return msg("row ", row);
+}
+
+std::string Model::summary() const {
+  std::ostringstream os;
+  os << "armdyn Model: " << nb << " bodies, " << joints.size() << " joints, " << drives.size()
+     << " drives\n";
+  os << "  sizes: nq=" << nq << " nv=" << nv << " nc=" << nc << " (joint rows " << nc_joint
+     << ", drive rows " << nc - nc_joint << "), joint coordinates " << coords.size() << "\n";
+  os << "  topology: " << (is_tree ? "tree" : "closed loops") << "; mobility " << mobility
+     << " DOF (nv - rank " << rank_joint << ")";
+  if (!drives.empty()) os << ", " << mobility_driven << " left free by the drives";
+  os << "\n";
+  if (redundant) {
+    os << "  redundant constraint rows (" << redundant_rows.size() << "):";
+    for (const auto& r : redundant_rows) os << "\n    " << r;
+    os << "\n  multipliers: minimum-norm (reactions of redundant joints are not unique)\n";
+  }
+  os << "  KKT path: dense Schur complement, "
+     << (redundant ? "complete orthogonal decomposition" : "Cholesky") << "\n";
+  os << "  gravity: [" << gravity.x() << ", " << gravity.y() << ", " << gravity.z() << "]\n";
+  os << "  bodies:\n";
+  for (const Body& b : bodies) os << "    " << b.name << "  mass " << b.mass << " kg\n";
+  os << "  joints:\n";
+  for (const Joint& j : joints)
+    os << "    " << j.name << "  " << joint_type_name(j.type) << "  " << body_name(j.parent)
+       << " -> " << body_name(j.child) << "\n";
+  for (const Drive& d : drives) os << "  drive " << d.name << ": " << d.profile.describe() << "\n";
+  const size_t nforce = body_loads.size() + springs.size() + coord_forces.size();
+  if (nforce) os << "  force elements: " << nforce << " (besides gravity)\n";
+  return os.str();
+}
+
+}  // namespace armdyn

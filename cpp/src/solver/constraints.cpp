@@ -1,0 +1,158 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "armdyn/solver/constraints.hpp"
+
+#include <cmath>
+
+namespace armdyn {
+
+namespace {
+
+// write one scalar constraint row into block row r
+inline void put_row(ConstraintEval& ce, ConstraintBlock& b, int r, const ScalarJet& s,
+                    bool with_xi) {
+  ce.f[b.row0 + r] = s.val;
+  ce.rhs[b.row0 + r] = 0.0;
+  b.J.row(r) = s.J;
+  if (with_xi) ce.xi[b.row0 + r] = s.bias;
+}
+
+inline double wrap_angle(double a) { return std::remainder(a, 2.0 * M_PI); }
+
+}  // namespace
+
+void ConstraintEval::init(const Model& m) {
+  f = VecX::Zero(m.nc);
+  rhs = VecX::Zero(m.nc);
+  xi = VecX::Zero(m.nc);
+  blocks.clear();
+  body_blocks.assign(m.nb, {});
+  auto add_block = [&](int row0, int nrows, int pa, int pb) {
+    ConstraintBlock b;
+    b.row0 = row0;
+    b.nrows = nrows;
+    b.body[0] = pa;
+    b.body[1] = pb;
+    b.J = BlockMat::Zero(nrows, 12);
+    const int idx = static_cast<int>(blocks.size());
+    blocks.push_back(b);
+    if (pa != kGround) body_blocks[pa].push_back({idx, 0});
+    if (pb != kGround) body_blocks[pb].push_back({idx, 1});
+  };
+  for (const Joint& j : m.joints) {
+    const int r = joint_rows(j.type);
+    if (r > 0) add_block(j.row0, r, j.parent, j.child);
+  }
+  for (const Drive& d : m.drives) {
+    const Joint& j = m.joints[d.joint];
+    add_block(d.row, 1, j.parent, j.child);
+  }
+}
+
+void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t, bool with_xi,
+                      ConstraintEval& ce) {
+  int bi = 0;
+  for (int ji = 0; ji < static_cast<int>(m.joints.size()); ++ji) {
+    const Joint& j = m.joints[ji];
+    if (joint_rows(j.type) == 0) continue;
+    ConstraintBlock& b = ce.blocks[bi++];
+    const BodyKin& ka = kin_of(kin, j.parent);
+    const BodyKin& kb = kin_of(kin, j.child);
+    auto ax = [&](int side, int k) {
+      return side == 0 ? direction_jet(ka, j.frame_parent.col(k), 0)
+                       : direction_jet(kb, j.frame_child.col(k), 1);
+    };
+    const VecJet d = difference(point_jet(kb, j.point_child, 1), point_jet(ka, j.point_parent, 0));
+    int r = 0;
+    switch (j.type) {
+      case JointType::Spherical:
+      case JointType::Revolute:
+      case JointType::Universal:
+      case JointType::Fixed:
+        // coincident joint points: 3 rows
+        for (int k = 0; k < 3; ++k) put_row(ce, b, r++, component(d, k), with_xi);
+        break;
+      default:
+        break;
+    }
+    switch (j.type) {
+      case JointType::Revolute: {
+        // child x and y axes perpendicular to the parent's z axis
+        const VecJet za = ax(0, 2);
+        put_row(ce, b, r++, dot(za, ax(1, 0)), with_xi);
+        put_row(ce, b, r++, dot(za, ax(1, 1)), with_xi);
+        break;
+      }
+      case JointType::Universal:
+        put_row(ce, b, r++, dot(ax(0, 2), ax(1, 2)), with_xi);
+        break;
+      case JointType::Fixed:
+      case JointType::Prismatic: {
+        // relative rotation locked: z_a.x_b = z_a.y_b = x_a.y_b = 0
+        const VecJet za = ax(0, 2), xa = ax(0, 0);
+        put_row(ce, b, r++, dot(za, ax(1, 0)), with_xi);
+        put_row(ce, b, r++, dot(za, ax(1, 1)), with_xi);
+        put_row(ce, b, r++, dot(xa, ax(1, 1)), with_xi);
+        if (j.type == JointType::Prismatic) {
+          // separation along the parent's z axis only
+          put_row(ce, b, r++, dot(xa, d), with_xi);
+          put_row(ce, b, r++, dot(ax(0, 1), d), with_xi);
+        }
+        break;
+      }
+      case JointType::Cylindrical: {
+        const VecJet za = ax(0, 2);
+        put_row(ce, b, r++, dot(za, ax(1, 0)), with_xi);
+        put_row(ce, b, r++, dot(za, ax(1, 1)), with_xi);
+        put_row(ce, b, r++, dot(ax(0, 0), d), with_xi);
+        put_row(ce, b, r++, dot(ax(0, 1), d), with_xi);
+        break;
+      }
+      default:
+        break;
+    }
+  }
+  // drives: q_c(u) - q_ref(t) = 0; zeta v = q_ref', xi = bias - q_ref''
+  for (const Drive& dr : m.drives) {
+    ConstraintBlock& b = ce.blocks[bi++];
+    const ScalarJet q = coord_jet(m, kin, m.joints[dr.joint].coord0 + dr.coord);
+    const ProfileValue p = dr.profile.eval(t);
+    const bool angular = m.coords[m.joints[dr.joint].coord0 + dr.coord].angular;
+    ce.f[b.row0] = angular ? wrap_angle(q.val - p.y) : q.val - p.y;
+    ce.rhs[b.row0] = p.yd;
+    b.J.row(0) = q.J;
+    if (with_xi) ce.xi[b.row0] = q.bias - p.ydd;
+  }
+}
+
+void zeta_times(const ConstraintEval& ce, int nrows, const VecX& x, VecX& y) {
+  for (const ConstraintBlock& b : ce.blocks) {
+    if (b.row0 >= nrows) continue;
+    auto yb = y.segment(b.row0, b.nrows);
+    yb.setZero();
+    for (int s = 0; s < 2; ++s)
+      if (b.body[s] != kGround)
+        yb.noalias() += b.J.middleCols<6>(6 * s) * x.segment<6>(6 * b.body[s]);
+  }
+}
+
+void zeta_transpose_times(const ConstraintEval& ce, int nrows, const VecX& y, VecX& x) {
+  x.setZero();
+  for (const ConstraintBlock& b : ce.blocks) {
+    if (b.row0 >= nrows) continue;
+    for (int s = 0; s < 2; ++s)
+      if (b.body[s] != kGround)
+        x.segment<6>(6 * b.body[s]).noalias() +=
+            b.J.middleCols<6>(6 * s).transpose() * y.segment(b.row0, b.nrows);
+  }
+}
+
+MatX dense_zeta(const Model& m, const ConstraintEval& ce) {
+  MatX z = MatX::Zero(m.nc, m.nv);
+  for (const ConstraintBlock& b : ce.blocks)
+    for (int s = 0; s < 2; ++s)
+      if (b.body[s] != kGround)
+        z.block(b.row0, 6 * b.body[s], b.nrows, 6) = b.J.middleCols<6>(6 * s);
+  return z;
+}
+
+}  // namespace armdyn

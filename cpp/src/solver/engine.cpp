@@ -1,0 +1,262 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "armdyn/solver/engine.hpp"
+
+#include <cmath>
+
+#include "armdyn/errors.hpp"
+#include "armdyn/math/quaternion.hpp"
+
+namespace armdyn {
+
+namespace {
+inline double wrap_angle(double a) { return std::remainder(a, 2.0 * M_PI); }
+}  // namespace
+
+Engine::Engine(const Model& m)
+    : m_(m),
+      kkt_(m),
+      eta_(VecX::Zero(m.nv)),
+      delta_(VecX::Zero(m.nc)),
+      tmp_nv_(VecX::Zero(m.nv)),
+      tmp_nc_(VecX::Zero(m.nc)),
+      mu_(VecX::Zero(m.nc)),
+      vd_(VecX::Zero(m.nv)),
+      nrows_(m.nc) {
+  kin_.resize(m.nb);
+  ce_.init(m);
+  tol_f_ = 1e-13 * std::max(1.0, m.length_scale);
+}
+
+void Engine::load(const double* u, const double* v) { body_kinematics(m_, u, v, kin_); }
+
+void Engine::scatter(const Row12& g, int pa, int pb) {
+  if (pa != kGround) eta_.segment<6>(6 * pa) += g.segment<6>(0).transpose();
+  if (pb != kGround) eta_.segment<6>(6 * pb) += g.segment<6>(6).transpose();
+}
+
+void Engine::forces(double t) {
+  // gravity and gyroscopic terms, per body
+  for (int i = 0; i < m_.nb; ++i) {
+    const Body& b = m_.bodies[i];
+    const BodyKin& k = kin_[i];
+    eta_.segment<3>(6 * i) = b.mass * m_.gravity;
+    eta_.segment<3>(6 * i + 3) = -k.w.cross(b.inertia * k.w);
+  }
+  // applied loads: force at a body point and torque, world axes
+  for (const BodyLoad& l : m_.body_loads) {
+    const double s = l.has_profile ? l.profile.eval(t).y : 1.0;
+    const BodyKin& k = kin_[l.body];
+    const Vec3 fb = k.R.transpose() * (s * l.force);
+    eta_.segment<3>(6 * l.body) += s * l.force;
+    eta_.segment<3>(6 * l.body + 3) += k.R.transpose() * (s * l.torque) + l.point.cross(fb);
+  }
+  // point-to-point spring-dampers: generalised force -tension * dL/dv
+  for (const SpringDamper& sd : m_.springs) {
+    const VecJet d = difference(point_jet(kin_of(kin_, sd.body_b), sd.point_b, 1),
+                                point_jet(kin_of(kin_, sd.body_a), sd.point_a, 0));
+    const double L = d.val.norm();
+    if (!(L > 1e-12))
+      throw SolverError(msg("spring-damper '", sd.name, "': length became zero at t=", t));
+    const Vec3 n = d.val / L;
+    const double Ld = n.dot(d.rate);
+    const double tension = sd.stiffness * (L - sd.rest_length) + sd.damping * Ld;
+    scatter(-tension * (n.transpose() * d.J), sd.body_a, sd.body_b);
+  }
+  // joint-coordinate forces: springs, dampers, friction, inputs
+  for (const CoordForce& cf : m_.coord_forces) {
+    const ScalarJet q = coord_jet(m_, kin_, cf.coord);
+    const Coord& c = m_.coords[cf.coord];
+    const double dq = c.angular ? wrap_angle(q.val - cf.rest) : q.val - cf.rest;
+    double tau = -cf.stiffness * dq - cf.damping * q.rate;
+    if (cf.has_input) tau += cf.input.eval(t).y;
+    const Joint& j = m_.joints[c.joint];
+    scatter(tau * q.J, j.parent, j.child);
+  }
+  // joint-space torques of a joint-space call
+  if (tau_) {
+    for (int c = 0; c < static_cast<int>(m_.coords.size()); ++c) {
+      if (tau_[c] == 0.0) continue;
+      const ScalarJet q = coord_jet(m_, kin_, c);
+      const Joint& j = m_.joints[m_.coords[c].joint];
+      scatter(tau_[c] * q.J, j.parent, j.child);
+    }
+  }
+  if (!eta_.allFinite()) {
+    for (int i = 0; i < m_.nb; ++i)
+      if (!eta_.segment<6>(6 * i).allFinite())
+        throw SolverError(msg("non-finite applied force on body '", m_.bodies[i].name, "' at t=", t));
+  }
+}
+
+void Engine::dynamics(double t, const double* u, const double* v, double* vdot, bool reuse_factor) {
+  load(u, v);
+  eval_constraints(m_, kin_, t, true, ce_);
+  forces(t);
+  if (!(reuse_factor && kkt_.metric() == Metric::Mass && kkt_.nrows() == nrows_)) {
+    kkt_.factor(ce_, nrows_, Metric::Mass);
+    ++factorizations;
+  }
+  Eigen::Map<VecX> vd(vdot, m_.nv);
+  kkt_.accelerations(ce_, eta_, vd_, delta_);
+  ++kkt_solves;
+  if (!vd_.allFinite())
+    throw SolverError(msg("non-finite accelerations at t=", t,
+                          " (singular constraint Jacobian or invalid state)"));
+  vd = vd_;
+}
+
+void Engine::udot(const double* u, const double* v, double* ud) const {
+  for (int i = 0; i < m_.nb; ++i) {
+    const double* ui = u + 7 * i;
+    const double* vi = v + 6 * i;
+    double* o = ud + 7 * i;
+    o[0] = vi[0];
+    o[1] = vi[1];
+    o[2] = vi[2];
+    const Vec4 ed = quat_rate(Vec4(ui[3], ui[4], ui[5], ui[6]), Vec3(vi[3], vi[4], vi[5]));
+    o[3] = ed[0];
+    o[4] = ed[1];
+    o[5] = ed[2];
+    o[6] = ed[3];
+  }
+}
+
+void Engine::project(double t, double* u, double* v, Metric metric) {
+  Eigen::Map<VecX> um(u, m_.nq), vm(v, m_.nv);
+  // quaternions onto the unit sphere (the normalisation rows are not part of zeta)
+  for (int i = 0; i < m_.nb; ++i) {
+    auto e = um.segment<4>(7 * i + 3);
+    const double n = e.norm();
+    if (!(n > 0.0) || !std::isfinite(n))
+      throw SolverError(msg("invalid Euler parameters of body '", m_.bodies[i].name, "' at t=", t));
+    e /= n;
+  }
+  load(u, nullptr);
+  eval_constraints(m_, kin_, t, false, ce_);
+  double rf = nrows_ ? ce_.f.head(nrows_).cwiseAbs().maxCoeff() : 0.0;
+  if (!std::isfinite(rf)) throw SolverError(msg("non-finite constraint residual at t=", t));
+  bool factored = false;
+  if (rf > tol_f_) {
+    // simplified Newton: minimum-norm steps w = -W^-1 zeta^T A^-1 f, Jacobian refreshed when slow
+    ++pstats.position_projections;
+    kkt_.factor(ce_, nrows_, metric);
+    ++factorizations;
+    double rprev = rf;
+    int it = 0;
+    for (; it < 30 && rf > tol_f_; ++it) {
+      kkt_.solve_schur(ce_.f, mu_);
+      zeta_transpose_times(ce_, nrows_, mu_, tmp_nv_);
+      kkt_.apply_winv(tmp_nv_, vd_);
+      for (int i = 0; i < m_.nb; ++i) {
+        um.segment<3>(7 * i) -= vd_.segment<3>(6 * i);
+        const Vec4 e = um.segment<4>(7 * i + 3);
+        um.segment<4>(7 * i + 3) = quat_mul(e, quat_exp(-vd_.segment<3>(6 * i + 3))).normalized();
+      }
+      load(u, nullptr);
+      eval_constraints(m_, kin_, t, false, ce_);
+      rf = ce_.f.head(nrows_).cwiseAbs().maxCoeff();
+      ++pstats.newton_iterations;
+      if (!std::isfinite(rf)) break;
+      if (rf > 0.25 * rprev) {
+        // slow contraction: stop at round-off, otherwise refresh the Jacobian
+        if (rf < 1e-10 * std::max(1.0, m_.length_scale) && it > 1) break;
+        kkt_.factor(ce_, nrows_, metric);
+        ++factorizations;
+      }
+      rprev = rf;
+    }
+    if (!(rf < 1e-9 * std::max(1.0, m_.length_scale))) {
+      int worst = 0;
+      ce_.f.head(nrows_).cwiseAbs().maxCoeff(&worst);
+      throw SolverError(msg("position projection did not converge at t=", t, ": |f| = ", rf,
+                            ", largest at ", m_.row_name(worst)));
+    }
+    factored = false;
+  }
+  // velocities onto zeta v = rhs, with A at the final u
+  load(u, v);
+  if (nrows_ == 0) return;
+  kkt_.factor(ce_, nrows_, metric);
+  ++factorizations;
+  factored = true;
+  (void)factored;
+  zeta_times(ce_, nrows_, vm, tmp_nc_);
+  tmp_nc_.head(nrows_) -= ce_.rhs.head(nrows_);
+  kkt_.solve_schur(tmp_nc_, mu_);
+  zeta_transpose_times(ce_, nrows_, mu_, tmp_nv_);
+  kkt_.apply_winv(tmp_nv_, vd_);
+  vm -= vd_;
+  ++pstats.velocity_projections;
+}
+
+void Engine::residuals(double t, const double* u, const double* v, double& rf, double& rv) {
+  load(u, v);
+  eval_constraints(m_, kin_, t, false, ce_);
+  if (nrows_ == 0) {
+    rf = rv = 0.0;
+    return;
+  }
+  rf = ce_.f.head(nrows_).cwiseAbs().maxCoeff();
+  Eigen::Map<const VecX> vm(v, m_.nv);
+  zeta_times(ce_, nrows_, vm, tmp_nc_);
+  rv = (tmp_nc_.head(nrows_) - ce_.rhs.head(nrows_)).cwiseAbs().maxCoeff();
+}
+
+void Engine::energy(const double* u, const double* v, double& ke, double& pe) {
+  load(u, v);
+  ke = pe = 0.0;
+  for (int i = 0; i < m_.nb; ++i) {
+    const Body& b = m_.bodies[i];
+    const BodyKin& k = kin_[i];
+    ke += 0.5 * b.mass * k.xd.squaredNorm() + 0.5 * k.w.dot(b.inertia * k.w);
+    pe -= b.mass * m_.gravity.dot(k.x);
+  }
+  for (const SpringDamper& sd : m_.springs) {
+    const Vec3 pa = kin_of(kin_, sd.body_a).x + kin_of(kin_, sd.body_a).R * sd.point_a;
+    const Vec3 pb = kin_of(kin_, sd.body_b).x + kin_of(kin_, sd.body_b).R * sd.point_b;
+    const double e = (pb - pa).norm() - sd.rest_length;
+    pe += 0.5 * sd.stiffness * e * e;
+  }
+  for (const CoordForce& cf : m_.coord_forces) {
+    if (cf.stiffness == 0.0) continue;
+    const ScalarJet q = coord_jet(m_, kin_, cf.coord);
+    const double dq = m_.coords[cf.coord].angular ? wrap_angle(q.val - cf.rest) : q.val - cf.rest;
+    pe += 0.5 * cf.stiffness * dq * dq;
+  }
+}
+
+void Engine::joint_reaction(int j, Vec3& force, Vec3& torque) const {
+  const Joint& jt = m_.joints[j];
+  force.setZero();
+  torque.setZero();
+  const int r = joint_rows(jt.type);
+  if (r == 0 || jt.row0 >= nrows_) return;
+  // find the joint's block (blocks are in joint order, rowless joints skipped)
+  const ConstraintBlock* blk = nullptr;
+  for (const ConstraintBlock& b : ce_.blocks)
+    if (b.row0 == jt.row0) {
+      blk = &b;
+      break;
+    }
+  // constraint force on a body: -zeta_b^T delta = (force world, torque body frame about the CoM)
+  const bool on_child = jt.child != kGround;
+  const int slot = on_child ? 1 : 0;
+  const int body = on_child ? jt.child : jt.parent;
+  const Eigen::Matrix<double, 6, 1> g =
+      -blk->J.middleCols<6>(6 * slot).transpose() * delta_.segment(jt.row0, r);
+  const BodyKin& k = kin_[body];
+  const Vec3 F = g.head<3>();
+  const Vec3 s = on_child ? jt.point_child : jt.point_parent;
+  const Mat3& fr = on_child ? jt.frame_child : jt.frame_parent;
+  // torque about the joint point: T_P = T_cm - (P - x) x F, with P - x = R s
+  const Vec3 Tw = k.R * g.tail<3>() - (k.R * s).cross(F);
+  const Mat3 B = k.R * fr;
+  force = B.transpose() * F;
+  torque = B.transpose() * Tw;
+  if (!on_child) {
+    force = -force;
+    torque = -torque;
+  }
+}
+
+}  // namespace armdyn

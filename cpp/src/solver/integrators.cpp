@@ -1,0 +1,199 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "armdyn/solver/integrators.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "armdyn/errors.hpp"
+
+namespace armdyn {
+
+namespace {
+
+// output times t0 + k dt strictly before t1, then t1 (empty when dt <= 0: every step)
+std::vector<double> output_times(double t0, double t1, double dt) {
+  std::vector<double> ts;
+  if (!(dt > 0)) return ts;
+  const double eps = 1e-9 * dt;
+  for (long k = 0;; ++k) {
+    const double t = t0 + static_cast<double>(k) * dt;
+    if (t >= t1 - eps) break;
+    ts.push_back(t);
+  }
+  ts.push_back(t1);
+  return ts;
+}
+
+double wrms(const VecX& e, const VecX& a, const VecX& b, double rtol, double atol) {
+  double s = 0.0;
+  const long n = e.size();
+  for (long i = 0; i < n; ++i) {
+    const double sc = atol + rtol * std::max(std::abs(a[i]), std::abs(b[i]));
+    const double r = e[i] / sc;
+    s += r * r;
+  }
+  return std::sqrt(s / std::max<long>(n, 1));
+}
+
+}  // namespace
+
+void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepOptions& opt,
+                      StepStats& st) {
+  // Dormand-Prince coefficients
+  constexpr double c2 = 1.0 / 5, c3 = 3.0 / 10, c4 = 4.0 / 5, c5 = 8.0 / 9;
+  constexpr double a21 = 1.0 / 5;
+  constexpr double a31 = 3.0 / 40, a32 = 9.0 / 40;
+  constexpr double a41 = 44.0 / 45, a42 = -56.0 / 15, a43 = 32.0 / 9;
+  constexpr double a51 = 19372.0 / 6561, a52 = -25360.0 / 2187, a53 = 64448.0 / 6561,
+                   a54 = -212.0 / 729;
+  constexpr double a61 = 9017.0 / 3168, a62 = -355.0 / 33, a63 = 46732.0 / 5247,
+                   a64 = 49.0 / 176, a65 = -5103.0 / 18656;
+  constexpr double a71 = 35.0 / 384, a73 = 500.0 / 1113, a74 = 125.0 / 192,
+                   a75 = -2187.0 / 6784, a76 = 11.0 / 84;
+  constexpr double e1 = 71.0 / 57600, e3 = -71.0 / 16695, e4 = 71.0 / 1920,
+                   e5 = -17253.0 / 339200, e6 = 22.0 / 525, e7 = -1.0 / 40;
+  constexpr double d1 = -12715105075.0 / 11282082432.0, d3 = 87487479700.0 / 32700410799.0,
+                   d4 = -10690763975.0 / 1880347072.0, d5 = 701980252875.0 / 199316789632.0,
+                   d6 = -1453857185.0 / 822651844.0, d7 = 69997945.0 / 29380423.0;
+  // PI controller (Hairer's DOPRI5 defaults)
+  constexpr double safe = 0.9, fac_min = 0.2, fac_max = 10.0, beta = 0.04;
+  const double expo1 = 0.2 - beta * 0.75;
+
+  const long n = y.size();
+  VecX k1(n), k2(n), k3(n), k4(n), k5(n), k6(n), k7(n), yt(n), y1(n), err(n);
+  VecX r1(n), r2(n), r3(n), r4(n), r5(n), yo(n);
+  const std::vector<double> touts = output_times(t0, t1, opt.output_dt);
+  const bool every_step = touts.empty();
+  size_t ko = 1;
+  const double span = t1 - t0;
+  const double hmax = opt.max_step > 0 ? opt.max_step : span;
+
+  double t = t0;
+  sys.project_and_rhs(t, y, k1);
+  ++st.rhs_evals;
+  sys.output(t, y);
+
+  // initial step (Hairer's hinit)
+  double h = opt.dt;
+  if (!(h > 0)) {
+    const double d0 = wrms(y, y, y, opt.rtol, opt.atol);
+    const double dd1 = wrms(k1, y, y, opt.rtol, opt.atol);
+    double h0 = (d0 < 1e-5 || dd1 < 1e-5) ? 1e-6 : 0.01 * d0 / dd1;
+    h0 = std::min(h0, hmax);
+    yt = y + h0 * k1;
+    sys.rhs(t + h0, yt, k2);
+    ++st.rhs_evals;
+    const double dd2 = wrms(k2 - k1, y, y, opt.rtol, opt.atol) / h0;
+    const double dm = std::max(dd1, dd2);
+    const double h1 = dm <= 1e-15 ? std::max(1e-6, h0 * 1e-3) : std::pow(0.01 / dm, 0.2);
+    h = std::min({100 * h0, h1, hmax});
+  }
+  double facold = 1e-4;
+  bool last_rejected = false;
+  const double hmin = 1e-14 * std::max(1.0, std::abs(t1));
+
+  while (t < t1) {
+    if (st.steps + st.rejected >= opt.max_steps)
+      throw SolverError(msg("dopri5: more than ", opt.max_steps, " steps before t=", t1,
+                            " (reached t=", t, ")"));
+    if (t + 1.01 * h >= t1) h = t1 - t;
+    if (h < hmin)
+      throw SolverError(msg("dopri5: step size underflow (h=", h, ") at t=", t,
+                            "; the problem may be stiff or singular there"));
+    // stages
+    yt = y + h * a21 * k1;
+    sys.rhs(t + c2 * h, yt, k2);
+    yt = y + h * (a31 * k1 + a32 * k2);
+    sys.rhs(t + c3 * h, yt, k3);
+    yt = y + h * (a41 * k1 + a42 * k2 + a43 * k3);
+    sys.rhs(t + c4 * h, yt, k4);
+    yt = y + h * (a51 * k1 + a52 * k2 + a53 * k3 + a54 * k4);
+    sys.rhs(t + c5 * h, yt, k5);
+    yt = y + h * (a61 * k1 + a62 * k2 + a63 * k3 + a64 * k4 + a65 * k5);
+    sys.rhs(t + h, yt, k6);
+    y1 = y + h * (a71 * k1 + a73 * k3 + a74 * k4 + a75 * k5 + a76 * k6);
+    sys.rhs(t + h, y1, k7);
+    st.rhs_evals += 6;
+    err = h * (e1 * k1 + e3 * k3 + e4 * k4 + e5 * k5 + e6 * k6 + e7 * k7);
+    const double en = wrms(err, y, y1, opt.rtol, opt.atol);
+    if (!std::isfinite(en))
+      throw SolverError(msg("dopri5: non-finite error estimate at t=", t));
+    const double fac11 = std::pow(en, expo1);
+    if (en <= 1.0) {
+      // accepted: dense output coefficients, outputs inside (t, t + h], projection
+      double fac = fac11 / std::pow(facold, beta);
+      fac = std::clamp(fac / safe, 1.0 / fac_max, 1.0 / fac_min);
+      double hnew = std::min(h / fac, hmax);
+      if (last_rejected) hnew = std::min(hnew, h);
+      facold = std::max(en, 1e-4);
+      const double tn = (t + h >= t1 - 1e-14 * std::max(1.0, std::abs(t1))) ? t1 : t + h;
+      if (!every_step && ko < touts.size() && touts[ko] <= tn) {
+        r1 = y;
+        r2 = y1 - y;
+        r3 = h * k1 - r2;
+        r4 = r2 - h * k7 - r3;
+        r5 = h * (d1 * k1 + d3 * k3 + d4 * k4 + d5 * k5 + d6 * k6 + d7 * k7);
+        for (; ko < touts.size() && touts[ko] <= tn; ++ko) {
+          const double th = (touts[ko] - t) / h, th1 = 1.0 - th;
+          yo = r1 + th * (r2 + th1 * (r3 + th * (r4 + th1 * r5)));
+          sys.output(touts[ko], yo);
+        }
+      }
+      y = y1;
+      sys.project_and_rhs(tn, y, k1);
+      ++st.rhs_evals;
+      t = tn;
+      ++st.steps;
+      if (every_step) sys.output(t, y);
+      h = hnew;
+      last_rejected = false;
+    } else {
+      h = h / std::min(1.0 / fac_min, fac11 / safe);
+      ++st.rejected;
+      last_rejected = true;
+    }
+  }
+}
+
+void integrate_rk4(OdeSystem& sys, VecX& y, double t0, double t1, const StepOptions& opt,
+                   StepStats& st) {
+  if (!(opt.dt > 0)) throw ModelError("rk4: dt must be positive");
+  const long n = y.size();
+  VecX k1(n), k2(n), k3(n), k4(n), yt(n);
+  const std::vector<double> touts = output_times(t0, t1, opt.output_dt);
+  const bool every_step = touts.empty();
+  size_t ko = 1;
+  double t = t0;
+  sys.project_and_rhs(t, y, k1);
+  ++st.rhs_evals;
+  sys.output(t, y);
+  const double eps = 1e-12 * std::max(1.0, std::abs(t1));
+  while (t < t1 - eps) {
+    if (st.steps >= opt.max_steps)
+      throw SolverError(msg("rk4: more than ", opt.max_steps, " steps before t=", t1));
+    // land exactly on the next output time and on t1
+    double h = std::min(opt.dt, t1 - t);
+    double to = t1;
+    if (!every_step && ko < touts.size()) to = touts[ko];
+    if (t + h > to - eps) h = to - t;
+    yt = y + 0.5 * h * k1;
+    sys.rhs(t + 0.5 * h, yt, k2);
+    yt = y + 0.5 * h * k2;
+    sys.rhs(t + 0.5 * h, yt, k3);
+    yt = y + h * k3;
+    sys.rhs(t + h, yt, k4);
+    y += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+    t = (std::abs(t + h - to) <= eps) ? to : t + h;
+    sys.project_and_rhs(t, y, k1);
+    st.rhs_evals += 4;
+    ++st.steps;
+    if (every_step) {
+      sys.output(t, y);
+    } else if (ko < touts.size() && std::abs(t - touts[ko]) <= eps) {
+      sys.output(t, y);
+      ++ko;
+    }
+  }
+}
+
+}  // namespace armdyn

@@ -1,0 +1,52 @@
+"""armdyn: Cartesian Newton–Euler multibody dynamics with topological projection.
+
+Bodies are described in Cartesian coordinates: centre-of-mass position plus Euler parameters
+(unit quaternion, scalar first ``[e0, e1, e2, e3]``), angular velocity in the body frame. Joints
+and drives are algebraic constraints; accelerations and Lagrange multipliers (joint reactions,
+actuator efforts) come from the augmented system ``[Γ ζᵀ; ζ 0][v'; δ] = [η; −ξ]``, and a
+projection keeps the constraints satisfied to round-off.
+"""
+
+from armdyn._core import (
+    Model,
+    ModelBuilder,
+    ModelError,
+    Profile,
+    SolverError,
+    UrdfError,
+    accelerations,
+    energy,
+    evaluate_constraints,
+    forward_dynamics,
+    generalized_forces,
+    joint_coordinates,
+    mass_matrix,
+    profiles,
+    state_from_joints,
+    urdf_builder,
+)
+from armdyn.simulation import SimulationResult, load_urdf, simulate
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "Model",
+    "ModelBuilder",
+    "ModelError",
+    "Profile",
+    "SimulationResult",
+    "SolverError",
+    "UrdfError",
+    "accelerations",
+    "energy",
+    "evaluate_constraints",
+    "forward_dynamics",
+    "generalized_forces",
+    "joint_coordinates",
+    "load_urdf",
+    "mass_matrix",
+    "profiles",
+    "simulate",
+    "state_from_joints",
+    "urdf_builder",
+]
