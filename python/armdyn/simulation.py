@@ -59,6 +59,8 @@ def simulate(
     qd0=None,
     projection: str = "mass",
     max_steps: int = 10_000_000,
+    u0=None,
+    v0=None,
 ) -> SimulationResult:
     """Integrate the model from t = 0 to ``t_end``; the stepping loop runs in C++ without the GIL.
 
@@ -73,6 +75,8 @@ def simulate(
             interpolated (DOPRI5 dense output) and projected onto the constraints.
         q0, qd0: initial joint coordinates and rates (n_coords,) for joint-space tree models;
             default: the model's assembled state at rest.
+        u0, v0: initial Cartesian state (nq,), (nv,) instead of q0/qd0 (projected onto the
+            constraints first); default: the model's assembled state.
         projection: metric of the minimum-norm projection: ``"mass"`` (kinetic-energy metric,
             reuses the KKT factorisation) or ``"unweighted"`` (the paper's form).
         max_steps: limit on steps.
@@ -89,8 +93,9 @@ def simulate(
         raise _core.ModelError(f"simulate: dt must be positive, got {dt}")
     if output_dt is not None and not (output_dt > 0):
         raise _core.ModelError(f"simulate: output_dt must be positive, got {output_dt}")
-    u0 = v0 = None
     if q0 is not None or qd0 is not None:
+        if u0 is not None or v0 is not None:
+            raise _core.ModelError("simulate: give either q0/qd0 or u0/v0, not both")
         if q0 is None:
             raise _core.ModelError("simulate: qd0 given without q0")
         u0, v0 = _core.state_from_joints(model, q0, qd0)
@@ -102,8 +107,8 @@ def simulate(
         float(atol),
         float(dt or 0.0),
         float(output_dt or 0.0),
-        u0,
-        v0,
+        None if u0 is None else u0,
+        None if v0 is None else v0,
         projection,
         int(max_steps),
     )
