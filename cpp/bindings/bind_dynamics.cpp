@@ -60,124 +60,133 @@ py::dict result_dict(const Model& md, const SimResult& r) {
 }  // namespace
 
 void bind_dynamics(py::module_& m) {
-  m.def("_simulate",
-        [](const Model& md, double t_end, const std::string& integrator, double rtol, double atol,
-           double dt, double output_dt, py::object u0, py::object v0, const std::string& projection,
-           long max_steps) {
-          SimOptions o;
-          o.integrator = integrator;
-          o.step.rtol = rtol;
-          o.step.atol = atol;
-          o.step.dt = dt;
-          o.step.output_dt = output_dt;
-          o.step.max_steps = max_steps;
-          o.projection = metric_of(projection);
-          const VecX u = u0.is_none() ? md.u0 : to_vec(u0, "u0", md.nq);
-          const VecX v = v0.is_none() ? md.v0 : to_vec(v0, "v0", md.nv);
-          SimResult r;
-          {
-            py::gil_scoped_release release;
-            r = simulate(md, t_end, o, u, v);
-          }
-          return result_dict(md, r);
-        },
-        py::arg("model"), py::arg("t_end"), py::arg("integrator"), py::arg("rtol"),
-        py::arg("atol"), py::arg("dt"), py::arg("output_dt"), py::arg("u0"), py::arg("v0"),
-        py::arg("projection"), py::arg("max_steps"));
+  m.def(
+      "_simulate",
+      [](const Model& md, double t_end, const std::string& integrator, double rtol, double atol,
+         double dt, double output_dt, py::object u0, py::object v0, const std::string& projection,
+         long max_steps) {
+        SimOptions o;
+        o.integrator = integrator;
+        o.step.rtol = rtol;
+        o.step.atol = atol;
+        o.step.dt = dt;
+        o.step.output_dt = output_dt;
+        o.step.max_steps = max_steps;
+        o.projection = metric_of(projection);
+        const VecX u = u0.is_none() ? md.u0 : to_vec(u0, "u0", md.nq);
+        const VecX v = v0.is_none() ? md.v0 : to_vec(v0, "v0", md.nv);
+        SimResult r;
+        {
+          py::gil_scoped_release release;
+          r = simulate(md, t_end, o, u, v);
+        }
+        return result_dict(md, r);
+      },
+      py::arg("model"), py::arg("t_end"), py::arg("integrator"), py::arg("rtol"), py::arg("atol"),
+      py::arg("dt"), py::arg("output_dt"), py::arg("u0"), py::arg("v0"), py::arg("projection"),
+      py::arg("max_steps"));
 
-  m.def("state_from_joints",
-        [](const Model& md, py::object q, py::object qd) {
-          const long n = static_cast<long>(md.coords.size());
-          VecX u, v;
-          state_from_joints(md, to_vec(q, "q", n),
-                            qd.is_none() ? VecX::Zero(n) : to_vec(qd, "qd", n), u, v);
-          return py::make_tuple(to_numpy(u), to_numpy(v));
-        },
-        py::arg("model"), py::arg("q"), py::arg("qd") = py::none(),
-        "Cartesian state (u, v) of a joint-space tree model from joint coordinates and rates.");
+  m.def(
+      "state_from_joints",
+      [](const Model& md, py::object q, py::object qd) {
+        const long n = static_cast<long>(md.coords.size());
+        VecX u, v;
+        state_from_joints(md, to_vec(q, "q", n), qd.is_none() ? VecX::Zero(n) : to_vec(qd, "qd", n),
+                          u, v);
+        return py::make_tuple(to_numpy(u), to_numpy(v));
+      },
+      py::arg("model"), py::arg("q"), py::arg("qd") = py::none(),
+      "Cartesian state (u, v) of a joint-space tree model from joint coordinates and rates.");
 
-  m.def("joint_coordinates",
-        [](const Model& md, py::object u, py::object v) {
-          VecX q, qd;
-          joint_coordinates(md, to_vec(u, "u", md.nq), to_vec(v, "v", md.nv), q, qd);
-          return py::make_tuple(to_numpy(q), to_numpy(qd));
-        },
-        py::arg("model"), py::arg("u"), py::arg("v"),
-        "Joint coordinates (angles in (-pi, pi]) and rates at the Cartesian state (u, v).");
+  m.def(
+      "joint_coordinates",
+      [](const Model& md, py::object u, py::object v) {
+        VecX q, qd;
+        joint_coordinates(md, to_vec(u, "u", md.nq), to_vec(v, "v", md.nv), q, qd);
+        return py::make_tuple(to_numpy(q), to_numpy(qd));
+      },
+      py::arg("model"), py::arg("u"), py::arg("v"),
+      "Joint coordinates (angles in (-pi, pi]) and rates at the Cartesian state (u, v).");
 
-  m.def("forward_dynamics",
-        [](const Model& md, py::object q, py::object qd, py::object tau) {
-          const long n = static_cast<long>(md.coords.size());
-          return to_numpy(forward_dynamics(md, to_vec(q, "q", n), to_vec(qd, "qd", n),
-                                           to_vec(tau, "tau", n)));
-        },
-        py::arg("model"), py::arg("q"), py::arg("qd"), py::arg("tau"),
-        "Joint accelerations of a tree model for joint torques/forces tau, computed through the "
-        "Cartesian KKT system (drives are ignored).");
+  m.def(
+      "forward_dynamics",
+      [](const Model& md, py::object q, py::object qd, py::object tau) {
+        const long n = static_cast<long>(md.coords.size());
+        return to_numpy(
+            forward_dynamics(md, to_vec(q, "q", n), to_vec(qd, "qd", n), to_vec(tau, "tau", n)));
+      },
+      py::arg("model"), py::arg("q"), py::arg("qd"), py::arg("tau"),
+      "Joint accelerations of a tree model for joint torques/forces tau, computed through the "
+      "Cartesian KKT system (drives are ignored).");
 
-  m.def("evaluate_constraints",
-        [](const Model& md, py::object u, py::object v, double t) {
-          const VecX uu = to_vec(u, "u", md.nq), vv = to_vec(v, "v", md.nv);
-          check_state(md, uu, vv, "evaluate_constraints");
-          std::vector<BodyKin> kin;
-          body_kinematics(md, uu.data(), vv.data(), kin);
-          ConstraintEval ce;
-          ce.init(md);
-          eval_constraints(md, kin, t, true, ce);
-          py::dict d;
-          d["f"] = to_numpy(ce.f);
-          d["zeta"] = to_numpy(dense_zeta(md, ce));
-          d["xi"] = to_numpy(ce.xi);
-          d["rhs"] = to_numpy(ce.rhs);
-          return d;
-        },
-        py::arg("model"), py::arg("u"), py::arg("v"), py::arg("t") = 0.0,
-        "f (nc,), zeta (nc, nv), xi (nc,) and rhs (nc,) with zeta v = rhs and zeta v' = -xi.");
+  m.def(
+      "evaluate_constraints",
+      [](const Model& md, py::object u, py::object v, double t) {
+        const VecX uu = to_vec(u, "u", md.nq), vv = to_vec(v, "v", md.nv);
+        check_state(md, uu, vv, "evaluate_constraints");
+        std::vector<BodyKin> kin;
+        body_kinematics(md, uu.data(), vv.data(), kin);
+        ConstraintEval ce;
+        ce.init(md);
+        eval_constraints(md, kin, t, true, ce);
+        py::dict d;
+        d["f"] = to_numpy(ce.f);
+        d["zeta"] = to_numpy(dense_zeta(md, ce));
+        d["xi"] = to_numpy(ce.xi);
+        d["rhs"] = to_numpy(ce.rhs);
+        return d;
+      },
+      py::arg("model"), py::arg("u"), py::arg("v"), py::arg("t") = 0.0,
+      "f (nc,), zeta (nc, nv), xi (nc,) and rhs (nc,) with zeta v = rhs and zeta v' = -xi.");
 
-  m.def("accelerations",
-        [](const Model& md, py::object u, py::object v, double t) {
-          const VecX uu = to_vec(u, "u", md.nq), vv = to_vec(v, "v", md.nv);
-          check_state(md, uu, vv, "accelerations");
-          Engine e(md);
-          VecX vd(md.nv);
-          e.dynamics(t, uu.data(), vv.data(), vd.data());
-          return py::make_tuple(to_numpy(vd), to_numpy(e.delta()));
-        },
-        py::arg("model"), py::arg("u"), py::arg("v"), py::arg("t") = 0.0,
-        "Solve the KKT system at (u, v, t): returns (v' (nv,), multipliers delta (nc,)).");
+  m.def(
+      "accelerations",
+      [](const Model& md, py::object u, py::object v, double t) {
+        const VecX uu = to_vec(u, "u", md.nq), vv = to_vec(v, "v", md.nv);
+        check_state(md, uu, vv, "accelerations");
+        Engine e(md);
+        VecX vd(md.nv);
+        e.dynamics(t, uu.data(), vv.data(), vd.data());
+        return py::make_tuple(to_numpy(vd), to_numpy(e.delta()));
+      },
+      py::arg("model"), py::arg("u"), py::arg("v"), py::arg("t") = 0.0,
+      "Solve the KKT system at (u, v, t): returns (v' (nv,), multipliers delta (nc,)).");
 
-  m.def("mass_matrix",
-        [](const Model& md) {
-          MatX g = MatX::Zero(md.nv, md.nv);
-          for (int i = 0; i < md.nb; ++i) {
-            g.block<3, 3>(6 * i, 6 * i) = md.bodies[i].mass * Mat3::Identity();
-            g.block<3, 3>(6 * i + 3, 6 * i + 3) = md.bodies[i].inertia;
-          }
-          return to_numpy(g);
-        },
-        py::arg("model"), "Gamma = blockdiag(m_i I3, J_i) (nv, nv), constant.");
+  m.def(
+      "mass_matrix",
+      [](const Model& md) {
+        MatX g = MatX::Zero(md.nv, md.nv);
+        for (int i = 0; i < md.nb; ++i) {
+          g.block<3, 3>(6 * i, 6 * i) = md.bodies[i].mass * Mat3::Identity();
+          g.block<3, 3>(6 * i + 3, 6 * i + 3) = md.bodies[i].inertia;
+        }
+        return to_numpy(g);
+      },
+      py::arg("model"), "Gamma = blockdiag(m_i I3, J_i) (nv, nv), constant.");
 
-  m.def("generalized_forces",
-        [](const Model& md, py::object u, py::object v, double t) {
-          const VecX uu = to_vec(u, "u", md.nq), vv = to_vec(v, "v", md.nv);
-          check_state(md, uu, vv, "generalized_forces");
-          Engine e(md);
-          e.load(uu.data(), vv.data());
-          e.forces(t);
-          return to_numpy(e.eta());
-        },
-        py::arg("model"), py::arg("u"), py::arg("v"), py::arg("t") = 0.0,
-        "eta (nv,): gravity, gyroscopic -w x Jw, loads, springs, joint forces.");
+  m.def(
+      "generalized_forces",
+      [](const Model& md, py::object u, py::object v, double t) {
+        const VecX uu = to_vec(u, "u", md.nq), vv = to_vec(v, "v", md.nv);
+        check_state(md, uu, vv, "generalized_forces");
+        Engine e(md);
+        e.load(uu.data(), vv.data());
+        e.forces(t);
+        return to_numpy(e.eta());
+      },
+      py::arg("model"), py::arg("u"), py::arg("v"), py::arg("t") = 0.0,
+      "eta (nv,): gravity, gyroscopic -w x Jw, loads, springs, joint forces.");
 
-  m.def("energy",
-        [](const Model& md, py::object u, py::object v) {
-          const VecX uu = to_vec(u, "u", md.nq), vv = to_vec(v, "v", md.nv);
-          Engine e(md);
-          double ke, pe;
-          e.energy(uu.data(), vv.data(), ke, pe);
-          return py::make_tuple(ke, pe);
-        },
-        py::arg("model"), py::arg("u"), py::arg("v"), "(kinetic, potential) energy [J].");
+  m.def(
+      "energy",
+      [](const Model& md, py::object u, py::object v) {
+        const VecX uu = to_vec(u, "u", md.nq), vv = to_vec(v, "v", md.nv);
+        Engine e(md);
+        double ke, pe;
+        e.energy(uu.data(), vv.data(), ke, pe);
+        return py::make_tuple(ke, pe);
+      },
+      py::arg("model"), py::arg("u"), py::arg("v"), "(kinetic, potential) energy [J].");
 }
 
 }  // namespace armdyn

@@ -35,8 +35,9 @@ Profile to_profile(const py::handle& obj, const std::string& name) {
         },
         desc);
   }
-  throw ModelError(msg(name, ": expected an armdyn profile, a number or a callable "
-                             "t -> (y, yd, ydd)"));
+  throw ModelError(msg(name,
+                       ": expected an armdyn profile, a number or a callable "
+                       "t -> (y, yd, ydd)"));
 }
 
 }  // namespace armdyn::py_helpers
@@ -48,31 +49,33 @@ using namespace py_helpers;
 
 void bind_model(py::module_& m) {
   py::class_<Profile>(m, "Profile", "A time profile y(t) with derivatives, evaluated in C++.")
-      .def("eval",
-           [](const Profile& p, double t) {
-             const ProfileValue v = p.eval(t);
-             return py::make_tuple(v.y, v.yd, v.ydd);
-           },
-           py::arg("t"), "Return (y, dy/dt, d2y/dt2) at time t.")
+      .def(
+          "eval",
+          [](const Profile& p, double t) {
+            const ProfileValue v = p.eval(t);
+            return py::make_tuple(v.y, v.yd, v.ydd);
+          },
+          py::arg("t"), "Return (y, dy/dt, d2y/dt2) at time t.")
       .def("__repr__", [](const Profile& p) { return "<armdyn.Profile " + p.describe() + ">"; });
 
   auto prof = m.def_submodule("profiles", "Built-in drive and load profiles (evaluated in C++).");
   prof.def("constant", &Profile::constant, py::arg("value"));
   prof.def("cubic", &Profile::cubic, py::arg("y0"), py::arg("y1"), py::arg("t0"), py::arg("t1"),
            "Cubic rest-to-rest from y0 at t0 to y1 at t1 (3s^2 - 2s^3); constant outside.");
-  prof.def("quintic", &Profile::quintic, py::arg("y0"), py::arg("y1"), py::arg("t0"),
-           py::arg("t1"), "Quintic rest-to-rest (zero velocity and acceleration at both ends).");
+  prof.def("quintic", &Profile::quintic, py::arg("y0"), py::arg("y1"), py::arg("t0"), py::arg("t1"),
+           "Quintic rest-to-rest (zero velocity and acceleration at both ends).");
   prof.def("sine", &Profile::sine, py::arg("amplitude"), py::arg("frequency"),
            py::arg("phase") = 0.0, py::arg("offset") = 0.0,
            "offset + amplitude * sin(2 pi frequency t + phase); frequency in Hz.");
-  prof.def("spline",
-           [](py::object t, py::object y) {
-             const VecX tv = to_vec(t, "spline t"), yv = to_vec(y, "spline y");
-             return Profile::spline(std::vector<double>(tv.data(), tv.data() + tv.size()),
-                                    std::vector<double>(yv.data(), yv.data() + yv.size()));
-           },
-           py::arg("t"), py::arg("y"),
-           "Natural cubic spline through samples; linear extrapolation outside.");
+  prof.def(
+      "spline",
+      [](py::object t, py::object y) {
+        const VecX tv = to_vec(t, "spline t"), yv = to_vec(y, "spline y");
+        return Profile::spline(std::vector<double>(tv.data(), tv.data() + tv.size()),
+                               std::vector<double>(yv.data(), yv.data() + yv.size()));
+      },
+      py::arg("t"), py::arg("y"),
+      "Natural cubic spline through samples; linear extrapolation outside.");
 
   py::class_<Model, std::shared_ptr<Model>>(m, "Model",
                                             "Immutable multibody model (from ModelBuilder.finalize "
@@ -137,14 +140,14 @@ void bind_model(py::module_& m) {
       .def_readonly("redundant_rows", &Model::redundant_rows)
       .def_property_readonly("u0", [](const Model& md) { return to_numpy(md.u0); })
       .def_property_readonly("v0", [](const Model& md) { return to_numpy(md.v0); })
-      .def("joint_limits",
-           [](const Model& md, const std::string& name) {
-             const Joint& j = md.joints[md.find_joint(name)];
-             return py::dict(py::arg("lower") = j.lower, py::arg("upper") = j.upper,
-                             py::arg("effort") = j.effort,
-                             py::arg("velocity") = j.velocity_limit);
-           },
-           py::arg("joint"))
+      .def(
+          "joint_limits",
+          [](const Model& md, const std::string& name) {
+            const Joint& j = md.joints[md.find_joint(name)];
+            return py::dict(py::arg("lower") = j.lower, py::arg("upper") = j.upper,
+                            py::arg("effort") = j.effort, py::arg("velocity") = j.velocity_limit);
+          },
+          py::arg("joint"))
       .def("summary", &Model::summary, "Readable description: sizes, topology, solver path.")
       .def("__repr__", [](const Model& md) {
         return msg("<armdyn.Model nb=", md.nb, " joints=", md.joints.size(),
@@ -153,148 +156,162 @@ void bind_model(py::module_& m) {
 
   auto cast_model = [](ModelPtr p) { return std::const_pointer_cast<Model>(p); };
 
-  py::class_<ModelBuilder>(m, "ModelBuilder",
-                           "Build a model: bodies, joints, drives, force elements; then finalize().")
+  py::class_<ModelBuilder>(
+      m, "ModelBuilder", "Build a model: bodies, joints, drives, force elements; then finalize().")
       .def(py::init([](py::object g) { return ModelBuilder(to_vec3(g, "gravity")); }),
            py::arg("gravity") = py::make_tuple(0.0, 0.0, -9.81))
-      .def("add_body",
-           [](ModelBuilder& b, const std::string& name, double mass, py::object inertia,
-              py::object position, py::object orientation) {
-             const std::string who = "body '" + name + "'";
-             return b.add_body(name, mass, to_inertia(inertia, who + ": inertia"),
-                               to_vec3(position, who + ": position"),
-                               to_vec4(orientation, who + ": orientation"));
-           },
-           py::arg("name"), py::arg("mass"), py::arg("inertia"),
-           py::arg("position") = py::make_tuple(0.0, 0.0, 0.0),
-           py::arg("orientation") = py::make_tuple(1.0, 0.0, 0.0, 0.0),
-           "Add a body: mass [kg], inertia (3,3) about the CoM in body axes [kg m^2] (or its (3,) "
-           "diagonal), CoM position [m], orientation as unit Euler parameters [e0, e1, e2, e3].")
-      .def("add_revolute",
-           [](ModelBuilder& b, const std::string& n, const std::string& p, const std::string& c,
-              py::object point, py::object axis) {
-             return b.add_revolute(n, p, c, to_vec3(point, "joint '" + n + "': point"),
+      .def(
+          "add_body",
+          [](ModelBuilder& b, const std::string& name, double mass, py::object inertia,
+             py::object position, py::object orientation) {
+            const std::string who = "body '" + name + "'";
+            return b.add_body(name, mass, to_inertia(inertia, who + ": inertia"),
+                              to_vec3(position, who + ": position"),
+                              to_vec4(orientation, who + ": orientation"));
+          },
+          py::arg("name"), py::arg("mass"), py::arg("inertia"),
+          py::arg("position") = py::make_tuple(0.0, 0.0, 0.0),
+          py::arg("orientation") = py::make_tuple(1.0, 0.0, 0.0, 0.0),
+          "Add a body: mass [kg], inertia (3,3) about the CoM in body axes [kg m^2] (or its (3,) "
+          "diagonal), CoM position [m], orientation as unit Euler parameters [e0, e1, e2, e3].")
+      .def(
+          "add_revolute",
+          [](ModelBuilder& b, const std::string& n, const std::string& p, const std::string& c,
+             py::object point, py::object axis) {
+            return b.add_revolute(n, p, c, to_vec3(point, "joint '" + n + "': point"),
+                                  to_vec3(axis, "joint '" + n + "': axis"));
+          },
+          py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point"), py::arg("axis"))
+      .def(
+          "add_prismatic",
+          [](ModelBuilder& b, const std::string& n, const std::string& p, const std::string& c,
+             py::object point, py::object axis) {
+            return b.add_prismatic(n, p, c, to_vec3(point, "joint '" + n + "': point"),
                                    to_vec3(axis, "joint '" + n + "': axis"));
-           },
-           py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point"), py::arg("axis"))
-      .def("add_prismatic",
-           [](ModelBuilder& b, const std::string& n, const std::string& p, const std::string& c,
-              py::object point, py::object axis) {
-             return b.add_prismatic(n, p, c, to_vec3(point, "joint '" + n + "': point"),
-                                    to_vec3(axis, "joint '" + n + "': axis"));
-           },
-           py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point"), py::arg("axis"))
-      .def("add_cylindrical",
-           [](ModelBuilder& b, const std::string& n, const std::string& p, const std::string& c,
-              py::object point, py::object axis) {
-             return b.add_cylindrical(n, p, c, to_vec3(point, "joint '" + n + "': point"),
-                                      to_vec3(axis, "joint '" + n + "': axis"));
-           },
-           py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point"), py::arg("axis"))
-      .def("add_spherical",
-           [](ModelBuilder& b, const std::string& n, const std::string& p, const std::string& c,
-              py::object point) {
-             return b.add_spherical(n, p, c, to_vec3(point, "joint '" + n + "': point"));
-           },
-           py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point"))
-      .def("add_fixed",
-           [](ModelBuilder& b, const std::string& n, const std::string& p, const std::string& c,
-              py::object point) {
-             Vec3 pt;
-             if (point.is_none()) {
-               const int ci = c == "ground" ? -1 : b.draft().find_body(c);
-               pt = ci < 0 ? Vec3::Zero() : b.draft().bodies[ci].position;
-             } else {
-               pt = to_vec3(point, "joint '" + n + "': point");
-             }
-             return b.add_fixed(n, p, c, pt);
-           },
-           py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point") = py::none())
-      .def("add_universal",
-           [](ModelBuilder& b, const std::string& n, const std::string& p, const std::string& c,
-              py::object point, py::object a1, py::object a2) {
-             return b.add_universal(n, p, c, to_vec3(point, "joint '" + n + "': point"),
-                                    to_vec3(a1, "joint '" + n + "': axis1"),
-                                    to_vec3(a2, "joint '" + n + "': axis2"));
-           },
-           py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point"),
-           py::arg("axis1"), py::arg("axis2"))
+          },
+          py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point"), py::arg("axis"))
+      .def(
+          "add_cylindrical",
+          [](ModelBuilder& b, const std::string& n, const std::string& p, const std::string& c,
+             py::object point, py::object axis) {
+            return b.add_cylindrical(n, p, c, to_vec3(point, "joint '" + n + "': point"),
+                                     to_vec3(axis, "joint '" + n + "': axis"));
+          },
+          py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point"), py::arg("axis"))
+      .def(
+          "add_spherical",
+          [](ModelBuilder& b, const std::string& n, const std::string& p, const std::string& c,
+             py::object point) {
+            return b.add_spherical(n, p, c, to_vec3(point, "joint '" + n + "': point"));
+          },
+          py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point"))
+      .def(
+          "add_fixed",
+          [](ModelBuilder& b, const std::string& n, const std::string& p, const std::string& c,
+             py::object point) {
+            Vec3 pt;
+            if (point.is_none()) {
+              const int ci = c == "ground" ? -1 : b.draft().find_body(c);
+              pt = ci < 0 ? Vec3::Zero() : b.draft().bodies[ci].position;
+            } else {
+              pt = to_vec3(point, "joint '" + n + "': point");
+            }
+            return b.add_fixed(n, p, c, pt);
+          },
+          py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point") = py::none())
+      .def(
+          "add_universal",
+          [](ModelBuilder& b, const std::string& n, const std::string& p, const std::string& c,
+             py::object point, py::object a1, py::object a2) {
+            return b.add_universal(n, p, c, to_vec3(point, "joint '" + n + "': point"),
+                                   to_vec3(a1, "joint '" + n + "': axis1"),
+                                   to_vec3(a2, "joint '" + n + "': axis2"));
+          },
+          py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point"), py::arg("axis1"),
+          py::arg("axis2"))
       .def("add_free", &ModelBuilder::add_free, py::arg("name"), py::arg("child"))
-      .def("set_joint_limits", &ModelBuilder::set_joint_limits, py::arg("joint"),
-           py::arg("lower"), py::arg("upper"), py::arg("effort") = 0.0,
-           py::arg("velocity") = 0.0)
-      .def("add_drive",
-           [](ModelBuilder& b, const std::string& joint, py::object profile, int coord,
-              py::object name) {
-             return b.add_drive(joint, to_profile(profile, "add_drive '" + joint + "': profile"),
-                                coord, name.is_none() ? "" : name.cast<std::string>());
-           },
-           py::arg("joint"), py::arg("profile"), py::arg("coord") = 0, py::arg("name") = py::none(),
-           "Prescribe a joint coordinate by a profile (armdyn.profiles.*, a number, or a Python "
-           "callable t -> (y, yd, ydd): accepted but slow, it runs Python at every evaluation).")
-      .def("add_body_force",
-           [](ModelBuilder& b, const std::string& body, py::object force, py::object torque,
-              py::object point, py::object profile) {
-             const std::string who = "load on body '" + body + "'";
-             Vec3 pt;
-             Profile pr;
-             if (!point.is_none()) pt = to_vec3(point, who + ": point");
-             if (!profile.is_none()) pr = to_profile(profile, who + ": profile");
-             b.add_body_load(body, to_vec3(force, who + ": force"), to_vec3(torque, who + ": torque"),
-                             point.is_none() ? nullptr : &pt, profile.is_none() ? nullptr : &pr);
-           },
-           py::arg("body"), py::arg("force") = py::make_tuple(0.0, 0.0, 0.0),
-           py::arg("torque") = py::make_tuple(0.0, 0.0, 0.0), py::arg("point") = py::none(),
-           py::arg("profile") = py::none(),
-           "Force [N] at a point (world coordinates at assembly; default the CoM) and torque "
-           "[N m], both in world axes, optionally scaled by a profile.")
-      .def("add_spring_damper",
-           [](ModelBuilder& b, const std::string& n, const std::string& ba, py::object pa,
-              const std::string& bb, py::object pb, double k, double c, py::object rest) {
-             const std::string who = "spring-damper '" + n + "'";
-             b.add_spring_damper(n, ba, to_vec3(pa, who + ": point_a"), bb,
-                                 to_vec3(pb, who + ": point_b"), k, c,
-                                 rest.is_none() ? -1.0 : rest.cast<double>());
-           },
-           py::arg("name"), py::arg("body_a"), py::arg("point_a"), py::arg("body_b"),
-           py::arg("point_b"), py::arg("stiffness"), py::arg("damping") = 0.0,
-           py::arg("rest_length") = py::none())
+      .def("set_joint_limits", &ModelBuilder::set_joint_limits, py::arg("joint"), py::arg("lower"),
+           py::arg("upper"), py::arg("effort") = 0.0, py::arg("velocity") = 0.0)
+      .def(
+          "add_drive",
+          [](ModelBuilder& b, const std::string& joint, py::object profile, int coord,
+             py::object name) {
+            return b.add_drive(joint, to_profile(profile, "add_drive '" + joint + "': profile"),
+                               coord, name.is_none() ? "" : name.cast<std::string>());
+          },
+          py::arg("joint"), py::arg("profile"), py::arg("coord") = 0, py::arg("name") = py::none(),
+          "Prescribe a joint coordinate by a profile (armdyn.profiles.*, a number, or a Python "
+          "callable t -> (y, yd, ydd): accepted but slow, it runs Python at every evaluation).")
+      .def(
+          "add_body_force",
+          [](ModelBuilder& b, const std::string& body, py::object force, py::object torque,
+             py::object point, py::object profile) {
+            const std::string who = "load on body '" + body + "'";
+            Vec3 pt;
+            Profile pr;
+            if (!point.is_none()) pt = to_vec3(point, who + ": point");
+            if (!profile.is_none()) pr = to_profile(profile, who + ": profile");
+            b.add_body_load(body, to_vec3(force, who + ": force"),
+                            to_vec3(torque, who + ": torque"), point.is_none() ? nullptr : &pt,
+                            profile.is_none() ? nullptr : &pr);
+          },
+          py::arg("body"), py::arg("force") = py::make_tuple(0.0, 0.0, 0.0),
+          py::arg("torque") = py::make_tuple(0.0, 0.0, 0.0), py::arg("point") = py::none(),
+          py::arg("profile") = py::none(),
+          "Force [N] at a point (world coordinates at assembly; default the CoM) and torque "
+          "[N m], both in world axes, optionally scaled by a profile.")
+      .def(
+          "add_spring_damper",
+          [](ModelBuilder& b, const std::string& n, const std::string& ba, py::object pa,
+             const std::string& bb, py::object pb, double k, double c, py::object rest) {
+            const std::string who = "spring-damper '" + n + "'";
+            b.add_spring_damper(n, ba, to_vec3(pa, who + ": point_a"), bb,
+                                to_vec3(pb, who + ": point_b"), k, c,
+                                rest.is_none() ? -1.0 : rest.cast<double>());
+          },
+          py::arg("name"), py::arg("body_a"), py::arg("point_a"), py::arg("body_b"),
+          py::arg("point_b"), py::arg("stiffness"), py::arg("damping") = 0.0,
+          py::arg("rest_length") = py::none())
       .def("add_joint_spring_damper", &ModelBuilder::add_joint_spring_damper, py::arg("joint"),
            py::arg("stiffness") = 0.0, py::arg("damping") = 0.0, py::arg("rest") = 0.0,
            py::arg("coord") = 0)
-      .def("add_joint_friction",
-           [](ModelBuilder& b, const std::string& joint, double viscous, int coord) {
-             b.add_joint_spring_damper(joint, 0.0, viscous, 0.0, coord);
-           },
-           py::arg("joint"), py::arg("viscous"), py::arg("coord") = 0,
-           "Viscous joint friction: tau = -viscous * qdot.")
-      .def("add_joint_torque",
-           [](ModelBuilder& b, const std::string& joint, py::object profile, int coord) {
-             b.add_joint_torque(joint, to_profile(profile, "joint torque on '" + joint + "'"),
-                                coord);
-           },
-           py::arg("joint"), py::arg("profile"), py::arg("coord") = 0)
-      .def("finalize",
-           [cast_model](const ModelBuilder& b, bool mass_weighted) {
-             FinalizeOptions o;
-             o.mass_weighted_assembly = mass_weighted;
-             return cast_model(b.finalize(o));
-           },
-           py::arg("mass_weighted_assembly") = true,
-           "Validate, analyse topology and rank, assemble; returns an immutable Model.")
+      .def(
+          "add_joint_friction",
+          [](ModelBuilder& b, const std::string& joint, double viscous, int coord) {
+            b.add_joint_spring_damper(joint, 0.0, viscous, 0.0, coord);
+          },
+          py::arg("joint"), py::arg("viscous"), py::arg("coord") = 0,
+          "Viscous joint friction: tau = -viscous * qdot.")
+      .def(
+          "add_joint_torque",
+          [](ModelBuilder& b, const std::string& joint, py::object profile, int coord) {
+            b.add_joint_torque(joint, to_profile(profile, "joint torque on '" + joint + "'"),
+                               coord);
+          },
+          py::arg("joint"), py::arg("profile"), py::arg("coord") = 0)
+      .def(
+          "finalize",
+          [cast_model](const ModelBuilder& b, bool mass_weighted) {
+            FinalizeOptions o;
+            o.mass_weighted_assembly = mass_weighted;
+            return cast_model(b.finalize(o));
+          },
+          py::arg("mass_weighted_assembly") = true,
+          "Validate, analyse topology and rank, assemble; returns an immutable Model.")
       .def_property_readonly("body_names", [](const ModelBuilder& b) {
         std::vector<std::string> r;
         for (const auto& x : b.draft().bodies) r.push_back(x.name);
         return r;
       });
 
-  m.def("urdf_builder",
-        [](const std::string& src, bool fixed_base, py::object g) {
-          return urdf_builder(src, fixed_base, to_vec3(g, "gravity"));
-        },
-        py::arg("path_or_xml"), py::arg("fixed_base") = true,
-        py::arg("gravity") = py::make_tuple(0.0, 0.0, -9.81),
-        "A ModelBuilder holding a URDF robot (add drives or loads, then finalize()).");
+  m.def(
+      "urdf_builder",
+      [](const std::string& src, bool fixed_base, py::object g) {
+        return urdf_builder(src, fixed_base, to_vec3(g, "gravity"));
+      },
+      py::arg("path_or_xml"), py::arg("fixed_base") = true,
+      py::arg("gravity") = py::make_tuple(0.0, 0.0, -9.81),
+      "A ModelBuilder holding a URDF robot (add drives or loads, then finalize()).");
 }
 
 }  // namespace armdyn

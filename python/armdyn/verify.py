@@ -16,11 +16,7 @@ import time
 import numpy as np
 
 import armdyn as ad
-from armdyn import scenes
-try:
-    from armdyn import reference
-except ImportError:
-    reference = None
+from armdyn import reference, scenes
 
 
 def _crossing(t, y, k):
@@ -54,7 +50,9 @@ def conservation(rtol=1e-10):
     dp = scenes.double_pendulum()
     r = ad.simulate(dp, 10.0, rtol=rtol, atol=rtol, output_dt=0.01)
     e = r.total_energy
-    out["double pendulum energy (rel. to peak kinetic)"] = np.abs(e - e[0]).max() / r.kinetic_energy.max()
+    out["double pendulum energy (rel. to peak kinetic)"] = (
+        np.abs(e - e[0]).max() / r.kinetic_energy.max()
+    )
     fb = scenes.free_body((1.0, 2.0, 3.0))
     v0 = fb.v0.copy()
     v0[3:6] = [0.3, 1.0, 0.2]
@@ -69,8 +67,10 @@ def conservation(rtol=1e-10):
 
 def drift(steps=10_000, dt=1e-3):
     out = {}
-    for name, model in [("double pendulum", scenes.double_pendulum()),
-                        ("slider-crank (closed loop, driven)", scenes.slider_crank())]:
+    for name, model in [
+        ("double pendulum", scenes.double_pendulum()),
+        ("slider-crank (closed loop, driven)", scenes.slider_crank()),
+    ]:
         r = ad.simulate(model, steps * dt, integrator="rk4", dt=dt, output_dt=dt)
         out[name] = (len(r.t) - 1, r.position_residual.max(), r.velocity_residual.max())
     return out
@@ -80,7 +80,8 @@ def rnea_crosscheck(n_arms=5, seed=1):
     rng = np.random.default_rng(seed)
     worst = 0.0
     for k in range(n_arms):
-        model, chain = reference.random_serial_arm(rng, 6, prismatic=(k % 2 == 1))
+        arm = reference.random_serial_arm(rng, 6, prismatic=(k % 2 == 1))
+        model, chain = arm.model, arm.chain
         for _ in range(5):
             q, qd, tau = rng.normal(size=(3, 6))
             a = ad.forward_dynamics(model, q, qd, tau)
@@ -92,11 +93,15 @@ def rnea_crosscheck(n_arms=5, seed=1):
 def main() -> int:
     start = time.perf_counter()
     print("armdyn verify: accuracy against independent references\n")
-    print("1. Simple pendulum period vs closed form 4 sqrt(I/(m g L)) K(sin^2(theta0/2)), rtol=1e-12")
+    print(
+        "1. Simple pendulum period vs closed form 4 sqrt(I/(m g L)) K(sin^2(theta0/2)), rtol=1e-12"
+    )
     for deg in (1e-3 * 180 / np.pi, 30.0, 90.0, 170.0):
         sim, exact = pendulum_period(np.radians(deg))
-        print(f"   theta0 = {deg:8.4f} deg: T = {sim:.12f} s, exact {exact:.12f} s, "
-              f"rel. error {abs(sim - exact) / exact:.1e}")
+        print(
+            f"   theta0 = {deg:8.4f} deg: T = {sim:.12f} s, exact {exact:.12f} s, "
+            f"rel. error {abs(sim - exact) / exact:.1e}"
+        )
     print("\n2. Conservation over 10 s, DOPRI5 rtol = atol = 1e-10")
     for k, v in conservation().items():
         print(f"   {k}: {v:.1e}")

@@ -9,8 +9,9 @@ namespace armdyn {
 
 void require_joint_space(const Model& m, const char* what) {
   if (!m.joint_space_ok)
-    throw ModelError(msg(what, ": needs a tree of revolute, prismatic, cylindrical or fixed "
-                               "joints defined parent -> child; here ",
+    throw ModelError(msg(what,
+                         ": needs a tree of revolute, prismatic, cylindrical or fixed "
+                         "joints defined parent -> child; here ",
                          m.joint_space_reason));
 }
 

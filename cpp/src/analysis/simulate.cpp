@@ -15,7 +15,13 @@ namespace {
 class MbsSystem : public OdeSystem {
  public:
   MbsSystem(const Model& m, Metric metric, SimResult& out)
-      : m_(m), e_(m), metric_(metric), out_(out), yo_(m.nq + m.nv), vd_(m.nv), qprev_(m.coords.size()) {}
+      : m_(m),
+        e_(m),
+        metric_(metric),
+        out_(out),
+        yo_(m.nq + m.nv),
+        vd_(m.nv),
+        qprev_(m.coords.size()) {}
 
   void rhs(double t, const VecX& y, VecX& dy) override {
     e_.dynamics(t, y.data(), y.data() + m_.nq, dy.data() + m_.nq);
@@ -85,8 +91,8 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
   if (!(t_end > 0) || !std::isfinite(t_end))
     throw ModelError(msg("simulate: t_end must be positive and finite, got ", t_end));
   if (opt.integrator != "dopri5" && opt.integrator != "rk4")
-    throw ModelError(msg("simulate: unknown integrator '", opt.integrator,
-                         "' (expected 'dopri5' or 'rk4')"));
+    throw ModelError(
+        msg("simulate: unknown integrator '", opt.integrator, "' (expected 'dopri5' or 'rk4')"));
   const StepOptions& s = opt.step;
   if (!(s.rtol > 0) || !std::isfinite(s.rtol))
     throw ModelError(msg("simulate: rtol must be positive, got ", s.rtol));
@@ -125,8 +131,7 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
   } catch (const SolverError& err) {
     out.error = err.what();
   }
-  out.cpu_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  out.cpu_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   Engine& e = sys.engine();
   out.kkt_solves = e.kkt_solves;
   out.factorizations = e.factorizations;

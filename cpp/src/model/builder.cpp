@@ -62,8 +62,10 @@ int ModelBuilder::add_body(const std::string& name, double mass, const Mat3& ine
   require_finite(position, who + ": position");
   require_finite(orientation, who + ": orientation");
   if (std::abs(orientation.norm() - 1.0) > 1e-6)
-    throw ModelError(msg(who, ": orientation must be a unit quaternion [e0, e1, e2, e3] "
-                              "(scalar first), got norm ", orientation.norm()));
+    throw ModelError(msg(who,
+                         ": orientation must be a unit quaternion [e0, e1, e2, e3] "
+                         "(scalar first), got norm ",
+                         orientation.norm()));
   Body b;
   b.name = name;
   b.mass = mass;
@@ -101,7 +103,8 @@ int ModelBuilder::add_joint(const std::string& name, JointType type, const std::
     const Vec3 a1 = unit_axis(axis, who + ": axis1");
     const Vec3 a2 = unit_axis(*axis2, who + ": axis2");
     if (std::abs(a1.dot(a2)) > 1e-6)
-      throw ModelError(msg(who, ": axis1 and axis2 must be perpendicular (dot = ", a1.dot(a2), ")"));
+      throw ModelError(
+          msg(who, ": axis1 and axis2 must be perpendicular (dot = ", a1.dot(a2), ")"));
     fw_parent = frame_from_z(a1);
     fw_child = frame_from_z(a2);
   }
@@ -178,7 +181,8 @@ int ModelBuilder::add_free(const std::string& name, const std::string& child) {
 void ModelBuilder::set_joint_limits(const std::string& joint, double lower, double upper,
                                     double effort, double velocity) {
   auto it = m_.joint_index.find(joint);
-  if (it == m_.joint_index.end()) throw ModelError(msg("set_joint_limits: unknown joint '", joint, "'"));
+  if (it == m_.joint_index.end())
+    throw ModelError(msg("set_joint_limits: unknown joint '", joint, "'"));
   const std::string who = msg("joint '", joint, "' limits");
   if (std::isnan(lower) || std::isnan(upper) || std::isnan(effort) || std::isnan(velocity))
     throw ModelError(msg(who, ": NaN"));
@@ -200,7 +204,8 @@ int ModelBuilder::add_drive(const std::string& joint, const Profile& profile, in
   if (coord < 0 || coord >= nq)
     throw ModelError(msg("add_drive: ", joint_type_name(j.type), " joint '", joint,
                          "' has no coordinate ", coord, " to drive (it has ", nq, ")"));
-  const std::string dname = name.empty() ? (nq == 1 ? joint : m_.coords[j.coord0 + coord].name) : name;
+  const std::string dname =
+      name.empty() ? (nq == 1 ? joint : m_.coords[j.coord0 + coord].name) : name;
   for (const Drive& d : m_.drives) {
     if (d.joint == it->second && d.coord == coord)
       throw ModelError(msg("add_drive: coordinate ", coord, " of joint '", joint,
@@ -372,8 +377,9 @@ ModelPtr ModelBuilder::finalize(const FinalizeOptions& options) const {
     for (const Joint& j : m.joints) {
       if (j.type == JointType::Spherical || j.type == JointType::Universal ||
           j.type == JointType::Free) {
-        if (ok) m.joint_space_reason = msg(joint_type_name(j.type), " joint '", j.name,
-                                           "' has no joint coordinates");
+        if (ok)
+          m.joint_space_reason =
+              msg(joint_type_name(j.type), " joint '", j.name, "' has no joint coordinates");
         ok = false;
       }
     }
@@ -403,8 +409,8 @@ ModelPtr ModelBuilder::finalize(const FinalizeOptions& options) const {
     try {
       e.project(0.0, m.u0.data(), m.v0.data(), metric);
     } catch (const SolverError& err) {
-      throw ModelError(msg("finalize: assembly failed (the joints cannot all be satisfied): ",
-                           err.what()));
+      throw ModelError(
+          msg("finalize: assembly failed (the joints cannot all be satisfied): ", err.what()));
     }
   }
 
@@ -422,14 +428,16 @@ ModelPtr ModelBuilder::finalize(const FinalizeOptions& options) const {
       qr.setThreshold(1e-10);
       const int r = static_cast<int>(qr.rank());
       if (names)
-        for (int k = r; k < nrows; ++k) names->push_back(m.row_name(qr.colsPermutation().indices()[k]));
+        for (int k = r; k < nrows; ++k)
+          names->push_back(m.row_name(qr.colsPermutation().indices()[k]));
       return r;
     };
     m.rank_joint = analyse(m.nc_joint, &m.redundant_rows);
     std::vector<std::string> all;
     m.rank_all = analyse(m.nc, &all);
     for (const auto& n : all)
-      if (std::find(m.redundant_rows.begin(), m.redundant_rows.end(), n) == m.redundant_rows.end() &&
+      if (std::find(m.redundant_rows.begin(), m.redundant_rows.end(), n) ==
+              m.redundant_rows.end() &&
           n.rfind("drive", 0) == 0)
         m.redundant_rows.push_back(n);
     m.mobility = m.nv - m.rank_joint;

@@ -9,26 +9,40 @@ namespace armdyn {
 
 const char* joint_type_name(JointType t) {
   switch (t) {
-    case JointType::Revolute: return "revolute";
-    case JointType::Prismatic: return "prismatic";
-    case JointType::Spherical: return "spherical";
-    case JointType::Fixed: return "fixed";
-    case JointType::Cylindrical: return "cylindrical";
-    case JointType::Universal: return "universal";
-    case JointType::Free: return "free";
+    case JointType::Revolute:
+      return "revolute";
+    case JointType::Prismatic:
+      return "prismatic";
+    case JointType::Spherical:
+      return "spherical";
+    case JointType::Fixed:
+      return "fixed";
+    case JointType::Cylindrical:
+      return "cylindrical";
+    case JointType::Universal:
+      return "universal";
+    case JointType::Free:
+      return "free";
   }
   return "?";
 }
 
 int joint_rows(JointType t) {
   switch (t) {
-    case JointType::Revolute: return 5;
-    case JointType::Prismatic: return 5;
-    case JointType::Spherical: return 3;
-    case JointType::Fixed: return 6;
-    case JointType::Cylindrical: return 4;
-    case JointType::Universal: return 4;
-    case JointType::Free: return 0;
+    case JointType::Revolute:
+      return 5;
+    case JointType::Prismatic:
+      return 5;
+    case JointType::Spherical:
+      return 3;
+    case JointType::Fixed:
+      return 6;
+    case JointType::Cylindrical:
+      return 4;
+    case JointType::Universal:
+      return 4;
+    case JointType::Free:
+      return 0;
   }
   return 0;
 }
@@ -36,9 +50,12 @@ int joint_rows(JointType t) {
 int joint_coords(JointType t) {
   switch (t) {
     case JointType::Revolute:
-    case JointType::Prismatic: return 1;
-    case JointType::Cylindrical: return 2;
-    default: return 0;
+    case JointType::Prismatic:
+      return 1;
+    case JointType::Cylindrical:
+      return 2;
+    default:
+      return 0;
   }
 }
 
@@ -65,10 +82,17 @@ std::string Model::row_name(int row) const {
         case JointType::Revolute:
         case JointType::Universal:
         case JointType::Fixed:
-        case JointType::Spherical: what = k < 3 ? "position" : "rotation"; break;
-        case JointType::Prismatic: what = k < 3 ? "rotation" : "position"; break;
-        case JointType::Cylindrical: what = k < 2 ? "rotation" : "position"; break;
-        default: break;
+        case JointType::Spherical:
+          what = k < 3 ? "position" : "rotation";
+          break;
+        case JointType::Prismatic:
+          what = k < 3 ? "rotation" : "position";
+          break;
+        case JointType::Cylindrical:
+          what = k < 2 ? "rotation" : "position";
+          break;
+        default:
+          break;
       }
       return msg("joint '", j.name, "' row ", k, " (", what, ")");
     }

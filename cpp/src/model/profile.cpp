@@ -60,14 +60,14 @@ Profile Profile::sine(double amplitude, double frequency, double phase, double o
 Profile Profile::spline(const std::vector<double>& t, const std::vector<double>& y) {
   const size_t n = t.size();
   if (n < 2 || y.size() != n)
-    throw ModelError(msg("profile spline: need >= 2 samples and len(t) == len(y), got ", n, " and ",
-                         y.size()));
+    throw ModelError(
+        msg("profile spline: need >= 2 samples and len(t) == len(y), got ", n, " and ", y.size()));
   for (size_t i = 0; i < n; ++i) {
     require_finite(t[i], "sample time");
     require_finite(y[i], "sample value");
     if (i > 0 && !(t[i] > t[i - 1]))
-      throw ModelError(msg("profile spline: sample times must increase strictly (t[", i, "] = ",
-                           t[i], " <= t[", i - 1, "] = ", t[i - 1], ")"));
+      throw ModelError(msg("profile spline: sample times must increase strictly (t[", i,
+                           "] = ", t[i], " <= t[", i - 1, "] = ", t[i - 1], ")"));
   }
   Profile p;
   p.kind_ = Kind::Spline;
@@ -145,8 +145,9 @@ ProfileValue Profile::eval(double t) const {
         const bool lo = t <= t_[0];
         const size_t i = lo ? 0 : n - 2;
         const double h = t_[i + 1] - t_[i];
-        const double slope = lo ? (y_[1] - y_[0]) / h - h * (2.0 * m_[0] + m_[1]) / 6.0
-                                : (y_[n - 1] - y_[n - 2]) / h + h * (m_[n - 2] + 2.0 * m_[n - 1]) / 6.0;
+        const double slope =
+            lo ? (y_[1] - y_[0]) / h - h * (2.0 * m_[0] + m_[1]) / 6.0
+               : (y_[n - 1] - y_[n - 2]) / h + h * (m_[n - 2] + 2.0 * m_[n - 1]) / 6.0;
         const double te = lo ? t_[0] : t_[n - 1];
         v.y = (lo ? y_[0] : y_[n - 1]) + slope * (t - te);
         v.yd = slope;
@@ -156,7 +157,8 @@ ProfileValue Profile::eval(double t) const {
           static_cast<size_t>(std::upper_bound(t_.begin(), t_.end(), t) - t_.begin()) - 1;
       const double h = t_[i + 1] - t_[i];
       const double a = (t_[i + 1] - t) / h, b = (t - t_[i]) / h;
-      v.y = a * y_[i] + b * y_[i + 1] + ((a * a * a - a) * m_[i] + (b * b * b - b) * m_[i + 1]) * h * h / 6.0;
+      v.y = a * y_[i] + b * y_[i + 1] +
+            ((a * a * a - a) * m_[i] + (b * b * b - b) * m_[i + 1]) * h * h / 6.0;
       v.yd = (y_[i + 1] - y_[i]) / h - (3.0 * a * a - 1.0) * h * m_[i] / 6.0 +
              (3.0 * b * b - 1.0) * h * m_[i + 1] / 6.0;
       v.ydd = a * m_[i] + b * m_[i + 1];
@@ -165,7 +167,8 @@ ProfileValue Profile::eval(double t) const {
     case Kind::Callback:
       v = fn_(t);
       if (!std::isfinite(v.y) || !std::isfinite(v.yd) || !std::isfinite(v.ydd))
-        throw SolverError(msg("profile callback ", description_, " returned a non-finite value at t=", t));
+        throw SolverError(
+            msg("profile callback ", description_, " returned a non-finite value at t=", t));
       break;
   }
   return v;

@@ -84,7 +84,8 @@ void Engine::forces(double t) {
   if (!eta_.allFinite()) {
     for (int i = 0; i < m_.nb; ++i)
       if (!eta_.segment<6>(6 * i).allFinite())
-        throw SolverError(msg("non-finite applied force on body '", m_.bodies[i].name, "' at t=", t));
+        throw SolverError(
+            msg("non-finite applied force on body '", m_.bodies[i].name, "' at t=", t));
   }
 }
 

@@ -88,8 +88,7 @@ void KktSolver::apply_winv(const VecX& y, VecX& x) const {
   for (int b = 0; b < m_.nb; ++b) x.segment<6>(6 * b).noalias() = minv_[b] * y.segment<6>(6 * b);
 }
 
-void KktSolver::accelerations(const ConstraintEval& ce, const VecX& eta, VecX& vdot,
-                              VecX& delta) {
+void KktSolver::accelerations(const ConstraintEval& ce, const VecX& eta, VecX& vdot, VecX& delta) {
   // a = Gamma^-1 eta; delta = A^-1 (zeta a + xi); vdot = a - Gamma^-1 zeta^T delta
   for (int b = 0; b < m_.nb; ++b)
     vdot.segment<6>(6 * b).noalias() = minv_[b] * eta.segment<6>(6 * b);

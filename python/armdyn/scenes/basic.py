@@ -40,14 +40,16 @@ def double_pendulum(l1=1.0, l2=0.8, m1=1.0, m2=0.7, theta1=np.pi / 2, theta2=np.
     p1 = np.array([np.sin(theta1), 0, -np.cos(theta1)])
     p2 = np.array([np.sin(theta2), 0, -np.cos(theta2)])
     elbow = l1 * p1
+
     # rods along body x: orientation turning body x onto the rod direction (about -y)
     def orient(direction):
         ang = np.arctan2(-direction[2], direction[0])
         return (np.cos(ang / 2), 0.0, np.sin(ang / 2), 0.0)
 
     b.add_body("link1", m1, _rod(m1, l1, 0.01, 0), position=0.5 * l1 * p1, orientation=orient(p1))
-    b.add_body("link2", m2, _rod(m2, l2, 0.01, 0), position=elbow + 0.5 * l2 * p2,
-               orientation=orient(p2))
+    b.add_body(
+        "link2", m2, _rod(m2, l2, 0.01, 0), position=elbow + 0.5 * l2 * p2, orientation=orient(p2)
+    )
     b.add_revolute("shoulder", "ground", "link1", point=(0, 0, 0), axis=(0, 1, 0))
     b.add_revolute("elbow", "link1", "link2", point=elbow, axis=(0, 1, 0))
     return b.finalize()

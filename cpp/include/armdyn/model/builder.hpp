@@ -30,8 +30,8 @@ class ModelBuilder {
                    const Vec3& point, const Vec3& axis);
   int add_prismatic(const std::string& name, const std::string& parent, const std::string& child,
                     const Vec3& point, const Vec3& axis);
-  int add_cylindrical(const std::string& name, const std::string& parent,
-                      const std::string& child, const Vec3& point, const Vec3& axis);
+  int add_cylindrical(const std::string& name, const std::string& parent, const std::string& child,
+                      const Vec3& point, const Vec3& axis);
   int add_spherical(const std::string& name, const std::string& parent, const std::string& child,
                     const Vec3& point);
   /// Rigid connection; `point` only sets where reactions are reported.

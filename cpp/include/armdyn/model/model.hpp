@@ -45,10 +45,10 @@ struct Joint {
   Vec3 point_parent = Vec3::Zero(), point_child = Vec3::Zero();
   /// joint frame axes (columns x, y, z) in each body's frame; z is the joint axis
   Mat3 frame_parent = Mat3::Identity(), frame_child = Mat3::Identity();
-  double lower = -1e300, upper = 1e300;        ///< position limits (URDF; reported, not enforced)
+  double lower = -1e300, upper = 1e300;       ///< position limits (URDF; reported, not enforced)
   double effort = 0.0, velocity_limit = 0.0;  ///< URDF limits, informative
-  int row0 = 0;    ///< first constraint row
-  int coord0 = -1; ///< first joint coordinate index, -1 if none
+  int row0 = 0;                               ///< first constraint row
+  int coord0 = -1;                            ///< first joint coordinate index, -1 if none
 };
 
 /// Prescribed joint coordinate: q_joint[coord](t) = profile(t).
@@ -57,7 +57,7 @@ struct Drive {
   int joint = 0;
   int coord = 0;  ///< which coordinate of the joint (cylindrical: 0 angle, 1 displacement)
   Profile profile;
-  int row = 0;    ///< its constraint row
+  int row = 0;  ///< its constraint row
 };
 
 /// Force and torque on a body, both in world axes; the force acts at `point` (body frame,
@@ -90,7 +90,7 @@ struct CoordForce {
 struct Coord {
   std::string name;
   int joint = 0;
-  int sub = 0;           ///< 0: angle (or prismatic displacement), 1: cylindrical displacement
+  int sub = 0;  ///< 0: angle (or prismatic displacement), 1: cylindrical displacement
   bool angular = true;
 };
 
@@ -112,25 +112,26 @@ class Model {
   int nc_joint = 0;  ///< joint rows only (rows [0, nc_joint))
 
   // --- topology analysis ---
-  bool is_tree = false;          ///< every body has exactly one joint path to ground
-  bool joint_space_ok = false;   ///< tree of revolute/prismatic/cylindrical/fixed joints, parent->child
+  bool is_tree = false;  ///< every body has exactly one joint path to ground
+  bool joint_space_ok =
+      false;  ///< tree of revolute/prismatic/cylindrical/fixed joints, parent->child
   std::string joint_space_reason;
-  std::vector<int> tree_order;   ///< joints in parent-before-child order (if is_tree)
+  std::vector<int> tree_order;  ///< joints in parent-before-child order (if is_tree)
   int rank_joint = 0, rank_all = 0;
-  int mobility = 0;              ///< nv - rank of joint rows (degrees of freedom without drives)
-  int mobility_driven = 0;       ///< nv - rank of all rows (what the drives leave free)
+  int mobility = 0;         ///< nv - rank of joint rows (degrees of freedom without drives)
+  int mobility_driven = 0;  ///< nv - rank of all rows (what the drives leave free)
   std::vector<std::string> redundant_rows;  ///< named redundant constraint rows
   bool redundant = false;
-  double length_scale = 1.0;     ///< characteristic length for tolerances [m]
+  double length_scale = 1.0;  ///< characteristic length for tolerances [m]
 
   // --- assembled initial state ---
   VecX u0, v0;
 
   std::map<std::string, int> body_index, joint_index, drive_index;
 
-  int find_body(const std::string& name) const;    ///< -1 for "ground"; throws ModelError
-  int find_joint(const std::string& name) const;   ///< throws ModelError
-  std::string row_name(int row) const;             ///< e.g. "joint 'elbow' row 4 (rotation)"
+  int find_body(const std::string& name) const;   ///< -1 for "ground"; throws ModelError
+  int find_joint(const std::string& name) const;  ///< throws ModelError
+  std::string row_name(int row) const;            ///< e.g. "joint 'elbow' row 4 (rotation)"
   std::string body_name(int b) const { return b == kGround ? "ground" : bodies[b].name; }
   std::string summary() const;
 };

@@ -35,7 +35,8 @@ class Engine {
   void forces(double t);
   /// Forward dynamics: vdot (nv) and multipliers (stored, see delta()).
   /// reuse_factor: the last projection factored A at this very u with the mass metric.
-  void dynamics(double t, const double* u, const double* v, double* vdot, bool reuse_factor = false);
+  void dynamics(double t, const double* u, const double* v, double* vdot,
+                bool reuse_factor = false);
   /// u' = S(u) v: xdot and 1/2 e (x) [0, omega].
   void udot(const double* u, const double* v, double* ud) const;
   /// Project u onto f(u, t) = 0 (minimum-norm Newton in metric W, quaternions renormalised) and

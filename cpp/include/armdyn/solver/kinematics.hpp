@@ -16,7 +16,7 @@ namespace armdyn {
 
 /// Per-body kinematic cache for the current (u, v).
 struct BodyKin {
-  Vec3 x = Vec3::Zero();   ///< centre of mass, world
+  Vec3 x = Vec3::Zero();  ///< centre of mass, world
   Mat3 R = Mat3::Identity();
   Vec3 xd = Vec3::Zero();  ///< velocity of the centre of mass, world
   Vec3 w = Vec3::Zero();   ///< angular velocity, body frame
