@@ -124,7 +124,7 @@ void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t,
   }
 }
 
-void zeta_times(const ConstraintEval& ce, int nrows, const VecX& x, VecX& y) {
+void zeta_times(const ConstraintEval& ce, int nrows, Eigen::Ref<const VecX> x, VecX& y) {
   for (const ConstraintBlock& b : ce.blocks) {
     if (b.row0 >= nrows) continue;
     auto yb = y.segment(b.row0, b.nrows);
@@ -135,7 +135,7 @@ void zeta_times(const ConstraintEval& ce, int nrows, const VecX& x, VecX& y) {
   }
 }
 
-void zeta_transpose_times(const ConstraintEval& ce, int nrows, const VecX& y, VecX& x) {
+void zeta_transpose_times(const ConstraintEval& ce, int nrows, Eigen::Ref<const VecX> y, VecX& x) {
   x.setZero();
   for (const ConstraintBlock& b : ce.blocks) {
     if (b.row0 >= nrows) continue;

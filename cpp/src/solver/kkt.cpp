@@ -74,10 +74,14 @@ void KktSolver::factor(const ConstraintEval& ce, int nrows, Metric metric) {
 
 void KktSolver::solve_schur(const VecX& b, VecX& x) const {
   if (nrows_ == 0) return;
-  if (pinv_)
+  if (pinv_) {
     x.head(nrows_) = cod_.solve(b.head(nrows_));
-  else
-    x.head(nrows_) = llt_.solve(b.head(nrows_));
+  } else {
+    // in place, so that the Cholesky path allocates nothing
+    auto xh = x.head(nrows_);
+    xh = b.head(nrows_);
+    llt_.solveInPlace(xh);
+  }
 }
 
 void KktSolver::apply_winv(const VecX& y, VecX& x) const {

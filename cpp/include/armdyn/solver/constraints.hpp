@@ -33,9 +33,9 @@ void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t,
                       ConstraintEval& ce);
 
 /// y = zeta x over rows [0, nrows) (y sized nc; rows >= nrows untouched).
-void zeta_times(const ConstraintEval& ce, int nrows, const VecX& x, VecX& y);
+void zeta_times(const ConstraintEval& ce, int nrows, Eigen::Ref<const VecX> x, VecX& y);
 /// x = zeta^T y over rows [0, nrows) (x sized nv, overwritten).
-void zeta_transpose_times(const ConstraintEval& ce, int nrows, const VecX& y, VecX& x);
+void zeta_transpose_times(const ConstraintEval& ce, int nrows, Eigen::Ref<const VecX> y, VecX& x);
 /// Dense zeta (nc x nv), for tests and diagnostics.
 MatX dense_zeta(const Model& m, const ConstraintEval& ce);
 
