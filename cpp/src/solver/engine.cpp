@@ -136,7 +136,6 @@ void Engine::project(double t, double* u, double* v, Metric metric) {
   eval_constraints(m_, kin_, t, false, ce_);
   double rf = nrows_ ? ce_.f.head(nrows_).cwiseAbs().maxCoeff() : 0.0;
   if (!std::isfinite(rf)) throw SolverError(msg("non-finite constraint residual at t=", t));
-  bool factored = false;
   if (rf > tol_f_) {
     // simplified Newton: minimum-norm steps w = -W^-1 zeta^T A^-1 f, Jacobian refreshed when slow
     ++pstats.position_projections;
@@ -172,15 +171,12 @@ void Engine::project(double t, double* u, double* v, Metric metric) {
       throw SolverError(msg("position projection did not converge at t=", t, ": |f| = ", rf,
                             ", largest at ", m_.row_name(worst)));
     }
-    factored = false;
   }
   // velocities onto zeta v = rhs, with A at the final u
   load(u, v);
   if (nrows_ == 0) return;
   kkt_.factor(ce_, nrows_, metric);
   ++factorizations;
-  factored = true;
-  (void)factored;
   zeta_times(ce_, nrows_, vm, tmp_nc_);
   tmp_nc_.head(nrows_) -= ce_.rhs.head(nrows_);
   kkt_.solve_schur(tmp_nc_, mu_);
