@@ -2,6 +2,8 @@
 #include "armdyn/solver/kkt.hpp"
 
 #include <Eigen/LU>
+#include <cmath>
+#include <utility>
 
 #include "armdyn/errors.hpp"
 
@@ -11,10 +13,13 @@ KktSolver::KktSolver(const Model& m)
     : m_(m),
       A_(MatX::Zero(m.nc, m.nc)),
       llt_(m.nc),
-      cod_(m.nc, m.nc),
+      perm_(Eigen::VectorXi::Zero(m.nc)),
+      M_(MatX::Zero(m.nc, m.nc)),
+      G_(MatX::Zero(m.nc, m.nc)),
       tmp_nv_(VecX::Zero(m.nv)),
       tmp_nc_(VecX::Zero(m.nc)),
-      b_(VecX::Zero(m.nc)) {
+      b_(VecX::Zero(m.nc)),
+      w_(VecX::Zero(m.nc)) {
   minv_.resize(m.nb);
   for (int i = 0; i < m.nb; ++i) {
     minv_[i].setZero();
@@ -53,29 +58,89 @@ void KktSolver::factor(const ConstraintEval& ce, int nrows, Metric metric) {
     }
   }
   // Cholesky unless the model is known redundant or the factor shows a (near-)zero pivot
-  bool use_cod = m_.redundant;
-  if (!use_cod) {
+  bool pivoted = m_.redundant;
+  if (!pivoted) {
     llt_.compute(A);
     if (llt_.info() != Eigen::Success) {
-      use_cod = true;
+      pivoted = true;
     } else {
       const double maxd = A.diagonal().cwiseAbs().maxCoeff();
       const double minl = llt_.matrixLLT().diagonal().cwiseAbs2().minCoeff();
-      if (!(minl > 1e-12 * maxd)) use_cod = true;
+      if (!(minl > 1e-12 * maxd)) pivoted = true;
     }
   }
-  if (use_cod) {
-    cod_.setThreshold(1e-10);
-    cod_.compute(A);
-    pinv_ = true;
-    rank_ = static_cast<int>(cod_.rank());
+  if (pivoted) factor_pivoted(nrows);
+}
+
+void KktSolver::factor_pivoted(int n) {
+  // Right-looking Cholesky with diagonal pivoting on the full symmetric matrix (the trailing block
+  // is kept symmetric so that row/column swaps stay simple); stops when the largest remaining
+  // pivot is below tol * max diag(A), the numerical rank.
+  auto A = A_.topLeftCorner(n, n);
+  pinv_ = true;
+  for (int i = 0; i < n; ++i) perm_[i] = i;
+  const double maxd = A.diagonal().maxCoeff();
+  const double tol = 1e-10 * (maxd > 0.0 ? maxd : 1.0);
+  int r = 0;
+  for (int k = 0; k < n; ++k) {
+    int j = 0;
+    const double d = A.diagonal().segment(k, n - k).maxCoeff(&j);
+    j += k;
+    if (!(d > tol)) break;
+    if (j != k) {
+      A.row(k).swap(A.row(j));
+      A.col(k).swap(A.col(j));
+      std::swap(perm_[k], perm_[j]);
+    }
+    const double lkk = std::sqrt(A(k, k));
+    A(k, k) = lkk;
+    const int t = n - k - 1;
+    if (t > 0) {
+      A.col(k).tail(t) /= lkk;
+      A.bottomRightCorner(t, t).noalias() -= A.col(k).tail(t) * A.col(k).tail(t).transpose();
+    }
+    r = k + 1;
   }
+  rank_ = r;
+  const int z = n - r;
+  if (z == 0) return;
+  // M = L11^-T L21^T  (r x z);  G = I + M^T M = Z^T Z, factored in place
+  auto M = M_.topLeftCorner(r, z);
+  M = A.bottomLeftCorner(z, r).transpose();
+  A.topLeftCorner(r, r).triangularView<Eigen::Lower>().adjoint().solveInPlace(M);
+  auto G = G_.topLeftCorner(z, z);
+  G.noalias() = M.transpose() * M;
+  G.diagonal().array() += 1.0;
+  Eigen::LLT<Eigen::Ref<MatX>> gfac(G);  // in place: G now holds its lower factor
+}
+
+void KktSolver::solve_pivoted(const VecX& b, VecX& x) const {
+  const int n = nrows_, r = rank_, z = n - r;
+  auto A = A_.topLeftCorner(n, n);
+  // basic solution in permuted coordinates: x1 = L11^-T L11^-1 (P b)_1, x2 = 0
+  auto c = tmp_nc_.head(n);
+  for (int i = 0; i < n; ++i) c[i] = b[perm_[i]];
+  auto c1 = c.head(r);
+  A.topLeftCorner(r, r).triangularView<Eigen::Lower>().solveInPlace(c1);
+  A.topLeftCorner(r, r).triangularView<Eigen::Lower>().adjoint().solveInPlace(c1);
+  c.tail(z).setZero();
+  if (z > 0) {
+    // remove the null-space component: x <- x - Z G^-1 Z^T x with Z = [-M; I], Z^T x = -M^T x1
+    auto w = w_.head(z);
+    w.noalias() = -M_.topLeftCorner(r, z).transpose() * c1;
+    const auto G = G_.topLeftCorner(z, z);
+    G.triangularView<Eigen::Lower>().solveInPlace(w);
+    G.triangularView<Eigen::Lower>().adjoint().solveInPlace(w);
+    c1.noalias() += M_.topLeftCorner(r, z) * w;
+    c.tail(z) = -w;
+  }
+  for (int i = 0; i < n; ++i) x[perm_[i]] = c[i];
 }
 
 void KktSolver::solve_schur(const VecX& b, VecX& x) const {
   if (nrows_ == 0) return;
   if (pinv_) {
-    x.head(nrows_) = cod_.solve(b.head(nrows_));
+    solve_pivoted(b, x);
   } else {
     // in place, so that the Cholesky path allocates nothing
     auto xh = x.head(nrows_);

@@ -6,12 +6,16 @@
 // mass-weighted projection, W = I for the paper's unweighted projection):
 //   A delta = zeta Gamma^-1 eta + xi,   vdot = Gamma^-1 (eta - zeta^T delta).
 // A is assembled block by block from the bodies each row block touches. It is factored by
-// Cholesky; when A is singular (redundant constraints) a complete orthogonal decomposition gives
-// the minimum-norm multipliers, which leaves vdot and zeta^T delta unique.
+// Cholesky; when A is singular (redundant constraints) or nearly so, by a Cholesky factorisation
+// with diagonal pivoting that stops at the numerical rank r,
+//   P A P^T = [L11; L21] [L11; L21]^T,  L11 r x r,
+// and the minimum-norm multipliers are the basic solution minus its component in the null space
+// of A, spanned (in permuted coordinates) by Z = [-L11^-T L21^T; I] (Golub & Van Loan, 5.5.4 and
+// 4.2.9). vdot and zeta^T delta are unique either way. All storage is sized once in the
+// constructor, so neither path allocates per step.
 #pragma once
 
 #include <Eigen/Cholesky>
-#include <Eigen/QR>
 
 #include "armdyn/solver/constraints.hpp"
 
@@ -42,8 +46,14 @@ class KktSolver {
   std::vector<Mat6> minv_;  // per-body Gamma^-1 blocks
   MatX A_;
   Eigen::LLT<MatX> llt_;
-  Eigen::CompleteOrthogonalDecomposition<MatX> cod_;
-  VecX tmp_nv_, tmp_nc_, b_;
+  void factor_pivoted(int n);
+  void solve_pivoted(const VecX& b, VecX& x) const;
+  // pivoted path: factor of P A P^T in A_ (lower), permutation, M = L11^-T L21^T and the
+  // Cholesky factor of G = I + M^T M
+  Eigen::VectorXi perm_;
+  MatX M_, G_;
+  VecX tmp_nv_, b_;
+  mutable VecX tmp_nc_, w_;  // scratch of the const solves
   int nrows_ = 0, rank_ = 0;
   Metric metric_ = Metric::Mass;
   bool pinv_ = false;
