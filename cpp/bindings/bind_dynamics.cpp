@@ -35,6 +35,7 @@ py::dict result_dict(const Model& md, const SimResult& r) {
   d["v"] = to_numpy(r.v.data(), {n, md.nv});
   d["q"] = to_numpy(r.q.data(), {n, static_cast<py::ssize_t>(md.coords.size())});
   d["qd"] = to_numpy(r.qd.data(), {n, static_cast<py::ssize_t>(md.coords.size())});
+  d["qdd"] = to_numpy(r.qdd.data(), {n, static_cast<py::ssize_t>(md.coords.size())});
   d["drive_forces"] =
       to_numpy(r.drive_forces.data(), {n, static_cast<py::ssize_t>(md.drives.size())});
   d["reaction_forces"] = to_numpy(r.reaction_forces.data(), {n, nj, 3});

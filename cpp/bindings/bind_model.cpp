@@ -117,6 +117,13 @@ void bind_model(py::module_& m) {
                                for (const auto& d : md.drives) r.push_back(d.name);
                                return r;
                              })
+      .def_property_readonly("drive_coords",
+                             [](const Model& md) {
+                               std::vector<int> r;
+                               for (const auto& d : md.drives)
+                                 r.push_back(md.joints[d.joint].coord0 + d.coord);
+                               return r;
+                             })
       .def_property_readonly("gravity", [](const Model& md) { return to_numpy(VecX(md.gravity)); })
       .def_property_readonly("masses",
                              [](const Model& md) {

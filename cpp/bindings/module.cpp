@@ -8,6 +8,7 @@ namespace py = pybind11;
 namespace armdyn {
 void bind_model(py::module_& m);
 void bind_dynamics(py::module_& m);
+void bind_validate(py::module_& m);
 }  // namespace armdyn
 
 PYBIND11_MODULE(_core, m) {
@@ -17,4 +18,5 @@ PYBIND11_MODULE(_core, m) {
   py::register_exception<armdyn::SolverError>(m, "SolverError", PyExc_RuntimeError);
   armdyn::bind_model(m);
   armdyn::bind_dynamics(m);
+  armdyn::bind_validate(m);
 }

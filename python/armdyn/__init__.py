@@ -7,6 +7,7 @@ actuator efforts) come from the augmented system ``[Γ ζᵀ; ζ 0][v'; δ] = [�
 projection keeps the constraints satisfied to round-off.
 """
 
+from armdyn import scenes
 from armdyn._core import (
     Model,
     ModelBuilder,
@@ -25,11 +26,15 @@ from armdyn._core import (
     state_from_joints,
     urdf_builder,
 )
+from armdyn.dynamics import InverseDynamicsResult, inverse_dynamics
 from armdyn.simulation import SimulationResult, load_urdf, simulate
+from armdyn.validation import LagrangeValidator
 
 __version__ = "0.1.0"
 
 __all__ = [
+    "InverseDynamicsResult",
+    "LagrangeValidator",
     "Model",
     "ModelBuilder",
     "ModelError",
@@ -42,10 +47,12 @@ __all__ = [
     "evaluate_constraints",
     "forward_dynamics",
     "generalized_forces",
+    "inverse_dynamics",
     "joint_coordinates",
     "load_urdf",
     "mass_matrix",
     "profiles",
+    "scenes",
     "simulate",
     "state_from_joints",
     "urdf_builder",

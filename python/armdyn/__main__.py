@@ -1,5 +1,10 @@
-"""Command line: ``armdyn verify`` prints the solver's accuracy figures (pendulum period, energy
-and momentum conservation, constraint drift, cross-check against recursive Newton–Euler)."""
+"""Command line.
+
+* ``armdyn reproduce [--out DIR]`` regenerates the five-DOF validation paper's Tables 1–4 and
+  Figures 5–8 beside the paper's own figures (Markdown + PNG report).
+* ``armdyn verify`` prints the solver's accuracy figures: pendulum period, energy and momentum
+  conservation, constraint drift, and the cross-check against recursive Newton–Euler.
+"""
 
 from __future__ import annotations
 
@@ -8,14 +13,24 @@ import sys
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="armdyn", description=__doc__)
+    parser = argparse.ArgumentParser(
+        prog="armdyn", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     sub = parser.add_subparsers(dest="command", required=True)
     sub.add_parser("verify", help="print accuracy figures against closed forms and RNEA")
+    rep = sub.add_parser("reproduce", help="regenerate the five-DOF paper's tables and figures")
+    rep.add_argument("--out", default="armdyn-report", help="report folder (Markdown + PNG)")
+    rep.add_argument("--no-plots", action="store_true", help="skip the figures")
     args = parser.parse_args(argv)
     if args.command == "verify":
         from armdyn.verify import main as verify_main
 
         return verify_main()
+    if args.command == "reproduce":
+        from armdyn.reproduce import run
+
+        run(args.out, plots=not args.no_plots)
+        return 0
     return 1
 
 

@@ -17,7 +17,8 @@ class SimulationResult:
         t: (n,) output times [s].
         u: (n, nq) positions: per body CoM (3) and Euler parameters (4, scalar first).
         v: (n, nv) velocities: per body CoM velocity (3, world) and angular velocity (3, body).
-        q, qd: (n, n_coords) joint coordinates (angles unwrapped along the run) and rates.
+        q, qd, qdd: (n, n_coords) joint coordinates (angles unwrapped along the run), rates and
+            accelerations (from the constrained accelerations at each output state).
         drive_forces: (n, n_drives) actuator torque/force of each drive, applied to the child
             about/along the joint axis (the RNEA/URDF effort convention).
         reaction_forces, reaction_torques: (n, n_joints, 3) joint reaction on the child body at
@@ -33,6 +34,7 @@ class SimulationResult:
     v: np.ndarray
     q: np.ndarray
     qd: np.ndarray
+    qdd: np.ndarray
     drive_forces: np.ndarray
     reaction_forces: np.ndarray
     reaction_torques: np.ndarray

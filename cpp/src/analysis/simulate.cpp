@@ -50,6 +50,12 @@ class MbsSystem : public OdeSystem {
       qprev_[c] = qv;
       out_.q.push_back(qv);
       out_.qd.push_back(q.rate);
+      // qdd = J vdot + bias from the accelerations of this very state
+      const Joint& j = m_.joints[m_.coords[c].joint];
+      double a = q.bias;
+      if (j.parent != kGround) a += q.J.segment<6>(0).dot(vd_.segment<6>(6 * j.parent));
+      if (j.child != kGround) a += q.J.segment<6>(6).dot(vd_.segment<6>(6 * j.child));
+      out_.qdd.push_back(a);
     }
     // actuator efforts: tau = -delta of the drive rows
     for (const Drive& d : m_.drives) out_.drive_forces.push_back(-e_.delta()[d.row]);
@@ -144,6 +150,7 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
   out.v.resize(n * m.nv);
   out.q.resize(n * m.coords.size());
   out.qd.resize(n * m.coords.size());
+  out.qdd.resize(n * m.coords.size());
   out.drive_forces.resize(n * m.drives.size());
   out.reaction_forces.resize(n * 3 * m.joints.size());
   out.reaction_torques.resize(n * 3 * m.joints.size());

@@ -112,10 +112,18 @@ void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t,
     }
   }
   // drives: q_c(u) - q_ref(t) = 0; zeta v = q_ref', xi = bias - q_ref''
-  for (const Drive& dr : m.drives) {
+  for (size_t di = 0; di < m.drives.size(); ++di) {
+    const Drive& dr = m.drives[di];
     ConstraintBlock& b = ce.blocks[bi++];
     const ScalarJet q = coord_jet(m, kin, m.joints[dr.joint].coord0 + dr.coord);
-    const ProfileValue p = dr.profile.eval(t);
+    ProfileValue p;
+    if (ce.drive_ref) {
+      p.y = ce.drive_ref[3 * di];
+      p.yd = ce.drive_ref[3 * di + 1];
+      p.ydd = ce.drive_ref[3 * di + 2];
+    } else {
+      p = dr.profile.eval(t);
+    }
     const bool angular = m.coords[m.joints[dr.joint].coord0 + dr.coord].angular;
     ce.f[b.row0] = angular ? wrap_angle(q.val - p.y) : q.val - p.y;
     ce.rhs[b.row0] = p.yd;

@@ -158,8 +158,8 @@ void Engine::project(double t, double* u, double* v, Metric metric) {
       ++pstats.newton_iterations;
       if (!std::isfinite(rf)) break;
       if (rf > 0.25 * rprev) {
-        // slow contraction: stop at round-off, otherwise refresh the Jacobian
-        if (rf < 1e-10 * std::max(1.0, m_.length_scale) && it > 1) break;
+        // slow contraction: stop when it stagnates at round-off, otherwise refresh the Jacobian
+        if (rf >= rprev && rf < 1e-10 * std::max(1.0, m_.length_scale)) break;
         kkt_.factor(ce_, nrows_, metric);
         ++factorizations;
       }

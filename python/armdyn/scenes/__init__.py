@@ -7,5 +7,14 @@ from armdyn.scenes.basic import (
     simple_pendulum,
     slider_crank,
 )
+from armdyn.scenes.paper import five_dof_arm, three_dof_arm
 
-__all__ = ["double_pendulum", "four_bar", "free_body", "simple_pendulum", "slider_crank"]
+__all__ = [
+    "double_pendulum",
+    "five_dof_arm",
+    "four_bar",
+    "free_body",
+    "simple_pendulum",
+    "slider_crank",
+    "three_dof_arm",
+]

@@ -22,7 +22,7 @@ struct SimOptions {
 /// Row-major output tables: one row per output time.
 struct SimResult {
   long n = 0;
-  std::vector<double> t, u, v, q, qd, drive_forces, reaction_forces, reaction_torques;
+  std::vector<double> t, u, v, q, qd, qdd, drive_forces, reaction_forces, reaction_torques;
   std::vector<double> position_residual, velocity_residual, kinetic_energy, potential_energy;
   StepStats stats;
   long kkt_solves = 0, factorizations = 0, position_projections = 0, newton_iterations = 0;

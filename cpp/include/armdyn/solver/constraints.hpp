@@ -21,6 +21,9 @@ struct ConstraintBlock {
 
 struct ConstraintEval {
   VecX f, rhs, xi;
+  /// Optional drive references overriding the drives' profiles: 3 * n_drives values laid out
+  /// (q, qd, qdd) per drive; nullptr to use the profiles (joint-space inverse dynamics).
+  const double* drive_ref = nullptr;
   std::vector<ConstraintBlock> blocks;
   /// for each body: (block index, slot) of the blocks that touch it
   std::vector<std::vector<std::pair<int, int>>> body_blocks;

@@ -16,6 +16,7 @@
 #pragma once
 
 #include <Eigen/Cholesky>
+#include <vector>
 
 #include "armdyn/solver/constraints.hpp"
 
@@ -40,6 +41,14 @@ class KktSolver {
   Metric metric() const { return metric_; }
   bool used_pseudo_inverse() const { return pinv_; }
   int rank() const { return rank_; }
+  /// Rows left out of the pivoted factor (dependent at this configuration); empty on the
+  /// Cholesky path.
+  std::vector<int> dependent_rows() const {
+    std::vector<int> r;
+    if (pinv_)
+      for (int i = rank_; i < nrows_; ++i) r.push_back(perm_[i]);
+    return r;
+  }
 
  private:
   const Model& m_;

@@ -1,0 +1,125 @@
+"""The Lagrange and geometric validators, and the error metrics of the five-DOF paper.
+
+* :class:`LagrangeValidator` — the complete Euler–Lagrange equations of a tree model in its joint
+  coordinates, ``d/dt ∂L/∂q̇ − ∂L/∂q = Q``, built in C++ from joint-space kinematics by automatic
+  differentiation, independently of the Newton–Euler/KKT path. :meth:`LagrangeValidator.compare`
+  checks a simulation or inverse-dynamics result against it with the paper's metrics.
+* :func:`paper_model_3dof` — the paper's printed 3-DOF equations (9)–(11), kept as an explicitly
+  named *paper model*: they are ``−∂L/∂θᵢ`` of a planar point-mass arm, without the
+  ``d/dt ∂L/∂θ̇ᵢ`` terms.
+* :func:`end_effector_position` — generic geometric validator (composed joint transforms), and
+  :func:`paper_end_effector_5dof`, the paper's equations (22)–(25).
+* :func:`torque_error_metrics` — equation (26) percentage errors and their equation (27) RMS.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from armdyn import _core
+
+
+def torque_error_metrics(torques, reference) -> dict:
+    """Equation (26) ``|T − T_ref| / max|T_ref| × 100`` per sample and joint (columns), their
+    equation (27) RMS and maximum per joint, ``ref_max`` per joint and ``average`` (the mean of
+    the per-joint RMS values, as the paper's Table 2 average)."""
+    a = np.asarray(torques, dtype=float)
+    r = np.asarray(reference, dtype=float)
+    if a.ndim == 1:
+        a, r = a[:, None], r[:, None]
+    return _core.torque_error_metrics(a, r)
+
+
+def average_of(values) -> float:
+    """The paper's Table 2 average: the arithmetic mean of the per-joint RMS errors."""
+    v = np.asarray(values, dtype=float)
+    if v.size == 0 or not np.all(np.isfinite(v)):
+        raise _core.ModelError("average_of: need finite values")
+    return float(v.mean())
+
+
+@dataclass
+class Comparison:
+    """Result of :meth:`LagrangeValidator.compare`."""
+
+    t: np.ndarray
+    multibody: np.ndarray  # (n, n_coords) efforts from the result, coordinate order
+    reference: np.ndarray  # (n, n_coords) Lagrange torques
+    percent: np.ndarray  # (n, n_coords) equation (26)
+    rms: np.ndarray  # (n_coords,) equation (27)
+    max: np.ndarray
+    average: float
+    coord_names: list
+
+
+class LagrangeValidator:
+    """Complete Euler–Lagrange equations of a tree model (see the module docstring).
+
+    Args:
+        model: a finalized tree model of revolute/prismatic/cylindrical/fixed joints.
+        rotational_inertia: ``False`` treats every body as a point mass at its centre of mass
+            (a simplified model of the paper's kind).
+    """
+
+    def __init__(self, model: _core.Model, rotational_inertia: bool = True):
+        self.model = model
+        self._v = _core.LagrangeValidator(model, rotational_inertia)
+
+    def torques(self, q, qd, qdd, t=None) -> np.ndarray:
+        """Generalised actuator forces (model joint order) for one sample or rows of samples."""
+        return self._v.torques(q, qd, qdd, t)
+
+    def mass_matrix(self, q) -> np.ndarray:
+        return self._v.mass_matrix(q)
+
+    def compare(self, result) -> Comparison:
+        """Compare the drive efforts of a simulation/inverse-dynamics result with this model.
+
+        Every joint coordinate must be driven; the efforts are reordered to coordinate order.
+        Returns the equation (26) errors, their (27) RMS per joint and the average.
+        """
+        m = self.model
+        coords = list(m.drive_coords)
+        if sorted(coords) != list(range(m.n_coords)):
+            raise _core.ModelError(
+                "LagrangeValidator.compare: every joint coordinate needs exactly one drive; "
+                f"drives act on coordinates {coords} of {m.n_coords}"
+            )
+        mb = np.empty_like(np.asarray(result.drive_forces, dtype=float))
+        mb[:, coords] = result.drive_forces
+        ref = self.torques(result.q, result.qd, result.qdd, result.t)
+        met = torque_error_metrics(mb, ref)
+        return Comparison(
+            t=np.asarray(result.t),
+            multibody=mb,
+            reference=ref,
+            percent=met["percent"],
+            rms=met["rms"],
+            max=met["max"],
+            average=float(met["average"]),
+            coord_names=list(m.coord_names),
+        )
+
+
+def paper_model_3dof(lengths, masses, theta, thetad, g=9.81) -> np.ndarray:
+    """The paper's printed equations (9)–(11) (the *paper model*, incomplete by design).
+
+    ``theta``: absolute link angles from the horizontal [rad], one sample (3,) or rows (n, 3);
+    ``thetad`` their rates; point masses ``masses`` at the ends of links ``lengths``; ``g > 0``.
+    Returns the generalised forces T₁…T₃ conjugate to the absolute angles.
+    """
+    return _core.paper_3dof_torques(lengths, masses, float(g), theta, thetad)
+
+
+def paper_end_effector_5dof(theta, h, l1, l2, l34) -> np.ndarray:
+    """The paper's equations (22)–(25): ``[X, Y, Z]`` in the paper's axes (Y up) for
+    ``theta = (θ1 twist, θ2, θ3, θ4)`` [rad] taken as printed."""
+    return _core.paper_5dof_end_effector(float(h), float(l1), float(l2), float(l34), theta)
+
+
+def end_effector_position(model: _core.Model, body: str, point, q) -> np.ndarray:
+    """World position of ``point`` (body frame, relative to the body's centre of mass) on
+    ``body`` at joint coordinates ``q`` ((n_coords,) or rows), by composed joint transforms."""
+    return _core.end_effector_position(model, body, point, q)
