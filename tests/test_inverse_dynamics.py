@@ -178,7 +178,7 @@ def test_inverse_dynamics_bad_input():
     arm_model = paper.three_dof_arm()
     with pytest.raises(ad.ModelError, match="qdd"):
         ad.inverse_dynamics(arm_model, [0, 0, 0], [0, 0, 0], [0, np.nan, 0])
-    with pytest.raises(ad.ModelError, match="q.*length|shape"):
+    with pytest.raises(ad.ModelError, match=r"q.*length|shape"):
         ad.inverse_dynamics(arm_model, [0, 0], [0, 0, 0], [0, 0, 0])
     with pytest.raises(ad.ModelError, match="increase"):
         ad.inverse_dynamics(arm_model, t=[0.0, 0.5, 0.5])
