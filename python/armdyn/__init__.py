@@ -7,7 +7,7 @@ actuator efforts) come from the augmented system ``[Γ ζᵀ; ζ 0][v'; δ] = [�
 projection keeps the constraints satisfied to round-off.
 """
 
-from armdyn import scenes
+from armdyn import scenes, validation
 from armdyn._core import (
     Model,
     ModelBuilder,
@@ -56,4 +56,5 @@ __all__ = [
     "simulate",
     "state_from_joints",
     "urdf_builder",
+    "validation",
 ]

@@ -74,13 +74,20 @@ class LagrangeValidator:
     def mass_matrix(self, q) -> np.ndarray:
         return self._v.mass_matrix(q)
 
-    def compare(self, result) -> Comparison:
+    def compare(self, result, model=None) -> Comparison:
         """Compare the drive efforts of a simulation/inverse-dynamics result with this model.
 
-        Every joint coordinate must be driven; the efforts are reordered to coordinate order.
-        Returns the equation (26) errors, their (27) RMS per joint and the average.
+        ``model`` is the model that produced ``result`` (default: the validator's own; it must
+        have the same joint coordinates). Every joint coordinate must be driven there; the
+        efforts are reordered to coordinate order. Returns the equation (26) errors, their
+        (27) RMS per joint and the average.
         """
-        m = self.model
+        m = self.model if model is None else model
+        if m.n_coords != self.model.n_coords:
+            raise _core.ModelError(
+                f"LagrangeValidator.compare: the result's model has {m.n_coords} joint "
+                f"coordinates, the validator's {self.model.n_coords}"
+            )
         coords = list(m.drive_coords)
         if sorted(coords) != list(range(m.n_coords)):
             raise _core.ModelError(

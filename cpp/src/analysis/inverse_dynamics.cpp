@@ -75,6 +75,10 @@ InverseDynamicsResult inverse_dynamics_driven(const Model& m, const std::vector<
       throw SolverError(
           msg("inverse_dynamics: ", err.what(), ".", why, " Times solved before this one: ", k));
     }
+    if (const int bad = flipped_joint(m, e.kin()); bad >= 0)
+      throw SolverError(msg("inverse_dynamics: the position problem at t=", t,
+                            " converged to a flipped configuration of joint '", m.joints[bad].name,
+                            "' (use a finer time grid)"));
     // acceleration problem and multipliers, with the factor left by the projection
     e.dynamics(t, u.data(), v.data(), vd.data(), true);
     KktSolver& kkt = e.kkt();

@@ -8,6 +8,7 @@
 #include <deque>
 #include <numeric>
 
+#include "armdyn/analysis/joint_space.hpp"
 #include "armdyn/errors.hpp"
 #include "armdyn/math/quaternion.hpp"
 #include "armdyn/solver/engine.hpp"
@@ -403,6 +404,18 @@ ModelPtr ModelBuilder::finalize(const FinalizeOptions& options) const {
     m.u0.segment<4>(7 * i + 3) = m.bodies[i].orientation;
   }
   m.v0 = VecX::Zero(m.nv);
+  // a driven joint-space tree starts from the forward kinematics of the drives' initial values:
+  // Newton from the build pose could otherwise land on a flipped branch of the joint rows
+  if (m.joint_space_ok && !m.drives.empty()) {
+    VecX q, qd;
+    joint_coordinates(m, m.u0, m.v0, q, qd);
+    for (const Drive& d : m.drives) q[m.joints[d.joint].coord0 + d.coord] = d.profile.eval(0.0).y;
+    if (q.allFinite()) {
+      VecX u, v;
+      state_from_joints(m, q, VecX::Zero(q.size()), u, v);
+      m.u0 = u;
+    }
+  }
   const Metric metric = options.mass_weighted_assembly ? Metric::Mass : Metric::Identity;
   {
     Engine e(m);
@@ -412,6 +425,13 @@ ModelPtr ModelBuilder::finalize(const FinalizeOptions& options) const {
       throw ModelError(
           msg("finalize: assembly failed (the joints cannot all be satisfied): ", err.what()));
     }
+    e.load(m.u0.data(), nullptr);
+    const int bad = flipped_joint(m, e.kin());
+    if (bad >= 0)
+      throw ModelError(msg("finalize: assembly converged to a flipped configuration of joint '",
+                           m.joints[bad].name,
+                           "' (its child frame is turned half a revolution against the parent's); "
+                           "give body poses closer to the joints' configuration"));
   }
 
   // rank analysis at the assembled configuration: mobility and redundant rows by name

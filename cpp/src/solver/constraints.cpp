@@ -154,6 +154,22 @@ void zeta_transpose_times(const ConstraintEval& ce, int nrows, Eigen::Ref<const 
   }
 }
 
+int flipped_joint(const Model& m, const std::vector<BodyKin>& kin) {
+  for (int ji = 0; ji < static_cast<int>(m.joints.size()); ++ji) {
+    const Joint& j = m.joints[ji];
+    int first = 2, last = 2;  // revolute, cylindrical: the joint axes
+    if (j.type == JointType::Prismatic || j.type == JointType::Fixed)
+      first = 0;  // all three axes
+    else if (j.type != JointType::Revolute && j.type != JointType::Cylindrical)
+      continue;
+    const Mat3 A = kin_of(kin, j.parent).R * j.frame_parent;
+    const Mat3 B = kin_of(kin, j.child).R * j.frame_child;
+    for (int k = first; k <= last; ++k)
+      if (!(A.col(k).dot(B.col(k)) > 0.0)) return ji;
+  }
+  return -1;
+}
+
 MatX dense_zeta(const Model& m, const ConstraintEval& ce) {
   MatX z = MatX::Zero(m.nc, m.nv);
   for (const ConstraintBlock& b : ce.blocks)

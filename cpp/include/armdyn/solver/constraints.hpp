@@ -39,6 +39,11 @@ void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t,
 void zeta_times(const ConstraintEval& ce, int nrows, Eigen::Ref<const VecX> x, VecX& y);
 /// x = zeta^T y over rows [0, nrows) (x sized nv, overwritten).
 void zeta_transpose_times(const ConstraintEval& ce, int nrows, Eigen::Ref<const VecX> y, VecX& x);
+/// The rotation rows of revolute, cylindrical, prismatic and fixed joints are dot products of
+/// frame axes; they also vanish on "flipped" branches (e.g. the child's joint axis reversed).
+/// Returns the index of the first joint whose frames sit on such a branch (an aligned axis pair
+/// with a negative dot product), or -1.
+int flipped_joint(const Model& m, const std::vector<BodyKin>& kin);
 /// Dense zeta (nc x nv), for tests and diagnostics.
 MatX dense_zeta(const Model& m, const ConstraintEval& ce);
 
