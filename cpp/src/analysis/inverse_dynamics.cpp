@@ -1,12 +1,14 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "armdyn/analysis/inverse_dynamics.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
 #include "armdyn/analysis/joint_space.hpp"
 #include "armdyn/errors.hpp"
 #include "armdyn/solver/engine.hpp"
+#include "armdyn/solver/kinematics.hpp"
 
 namespace armdyn {
 
@@ -51,34 +53,88 @@ InverseDynamicsResult inverse_dynamics_driven(const Model& m, const std::vector<
   const int nco = static_cast<int>(m.coords.size());
   VecX u = m.u0, v = VecX::Zero(m.nv), vd = VecX::Zero(m.nv), ud = VecX::Zero(m.nq);
   std::vector<double> qprev(nco, 0.0);
-  for (size_t k = 0; k < times.size(); ++k) {
-    const double t = times[k];
-    if (k > 0) {
-      // first-order prediction of the next configuration from the previous solution
-      const double h = t - times[k - 1];
+  const bool fk_predictor = m.joint_space_ok;  // a driven tree: all coordinates are driven
+  VecX qc = VecX::Zero(nco), qdc = VecX::Zero(nco), u_save(m.nq), v_save(m.nv), u_pred(m.nq);
+  // configuration distance: per body max(|dx| / length scale, rotation angle), max over bodies
+  auto distance = [&](const VecX& a, const VecX& b) {
+    double d = 0.0;
+    for (int i = 0; i < m.nb; ++i) {
+      const double dx = (a.segment<3>(7 * i) - b.segment<3>(7 * i)).norm() / m.length_scale;
+      const double c =
+          std::min(1.0, std::abs(a.segment<4>(7 * i + 3).dot(b.segment<4>(7 * i + 3))));
+      d = std::max({d, dx, 2.0 * std::acos(c)});
+    }
+    return d;
+  };
+  // predicted state at time t from the solution (u, v, vd) at t_from
+  auto predict = [&](double t_from, double t) {
+    if (fk_predictor) {
+      joint_coordinates(m, u, v, qc, qdc);
+      for (const Drive& d : m.drives) {
+        const ProfileValue p = d.profile.eval(t);
+        const int c = m.joints[d.joint].coord0 + d.coord;
+        qc[c] = p.y;
+        qdc[c] = p.yd;
+      }
+      state_from_joints(m, qc, qdc, u, v);
+    } else if (t != t_from) {
+      const double h = t - t_from;
       e.udot(u.data(), v.data(), ud.data());
       u += h * ud;
       v += h * vd;
     }
-    // position and velocity problems (Newton; exact solves when zeta is square)
-    try {
-      e.project(t, u.data(), v.data(), Metric::Mass);
-    } catch (const SolverError& err) {
-      KktSolver& kkt = e.kkt();
-      std::string why;
-      if (kkt.used_pseudo_inverse() && kkt.rank() < m.rank_all) {
-        std::string rows;
-        for (int r : kkt.dependent_rows()) rows += (rows.empty() ? "" : "; ") + m.row_name(r);
-        why = msg(" The driven constraints are kinematically singular there: rank ", kkt.rank(),
-                  " instead of ", m.rank_all, "; dependent rows: ", rows, ".");
-      }
-      throw SolverError(
-          msg("inverse_dynamics: ", err.what(), ".", why, " Times solved before this one: ", k));
+  };
+  auto singular_rows = [&]() {
+    KktSolver& kkt = e.kkt();
+    std::string why;
+    if (kkt.used_pseudo_inverse() && kkt.rank() < m.rank_all) {
+      std::string rows;
+      for (int r : kkt.dependent_rows()) rows += (rows.empty() ? "" : "; ") + m.row_name(r);
+      why = msg(" The driven constraints are kinematically singular there: rank ", kkt.rank(),
+                " instead of ", m.rank_all, "; dependent rows: ", rows, ".");
     }
-    if (const int bad = flipped_joint(m, e.kin()); bad >= 0)
-      throw SolverError(msg("inverse_dynamics: the position problem at t=", t,
-                            " converged to a flipped configuration of joint '", m.joints[bad].name,
-                            "' (use a finer time grid)"));
+    return why;
+  };
+  double t_prev = times.front() >= 0.0 ? 0.0 : times.front();  // u0 is assembled at t = 0
+  for (size_t k = 0; k < times.size(); ++k) {
+    const double t = times[k];
+    // position and velocity problems (Newton; exact solves when zeta is square), by
+    // continuation: when Newton fails from the prediction, halve the step towards t
+    double t_cur = t_prev, h = t - t_prev;
+    const double h_min = std::ldexp(std::max(std::abs(h), 1e-300), -12);
+    do {
+      const double t_next = std::min(t_cur + h, t);
+      u_save = u;
+      v_save = v;
+      std::string failure;
+      try {
+        predict(t_cur, t_next);
+        u_pred = u;
+        e.project(t_next, u.data(), v.data(), Metric::Mass);
+        if (const int bad = flipped_joint(m, e.kin()); bad >= 0)
+          failure = msg("the position problem converged to a flipped configuration of joint '",
+                        m.joints[bad].name, "'");
+        // Newton must stay on the branch it was predicted on: a correction much larger than
+        // the predicted motion means it may have jumped to another assembly mode
+        if (!fk_predictor && failure.empty() &&
+            distance(u, u_pred) > 0.25 * distance(u_pred, u_save) + 1e-8)
+          failure = "the position correction is large against the predicted motion";
+      } catch (const SolverError& err) {
+        failure = err.what();
+      }
+      if (failure.empty()) {
+        t_cur = t_next;
+        if (t_cur < t) e.dynamics(t_cur, u.data(), v.data(), vd.data(), true);
+        continue;
+      }
+      u = u_save;
+      v = v_save;
+      h *= 0.5;
+      if (fk_predictor || !(h >= h_min))
+        throw SolverError(msg("inverse_dynamics at t=", t_next, ": ", failure, ".", singular_rows(),
+                              " Times solved before this one: ", k));
+    } while (t_cur < t);
+    t_prev = t;
     // acceleration problem and multipliers, with the factor left by the projection
     e.dynamics(t, u.data(), v.data(), vd.data(), true);
     KktSolver& kkt = e.kkt();
