@@ -53,6 +53,12 @@ py::dict result_dict(const Model& md, const SimResult& r) {
   s["position_projections"] = r.position_projections;
   s["newton_iterations"] = r.newton_iterations;
   s["seconds"] = r.cpu_seconds;
+  s["jacobians"] = r.stats.jacobians;
+  s["lu_factorizations"] = r.stats.lu_factorizations;
+  s["newton_iterations_implicit"] = r.stats.newton_iterations;
+  s["newton_failures"] = r.stats.newton_failures;
+  s["integrator"] = r.integrator;
+  s["integrator_reason"] = r.integrator_reason;
   d["stats"] = s;
   d["error"] = r.error;
   return d;
@@ -65,8 +71,9 @@ void bind_dynamics(py::module_& m) {
       "_simulate",
       [](const Model& md, double t_end, const std::string& integrator, double rtol, double atol,
          double dt, double output_dt, py::object u0, py::object v0, const std::string& projection,
-         long max_steps) {
+         long max_steps, double max_step) {
         SimOptions o;
+        o.step.max_step = max_step;
         o.integrator = integrator;
         o.step.rtol = rtol;
         o.step.atol = atol;
@@ -85,7 +92,7 @@ void bind_dynamics(py::module_& m) {
       },
       py::arg("model"), py::arg("t_end"), py::arg("integrator"), py::arg("rtol"), py::arg("atol"),
       py::arg("dt"), py::arg("output_dt"), py::arg("u0"), py::arg("v0"), py::arg("projection"),
-      py::arg("max_steps"));
+      py::arg("max_steps"), py::arg("max_step") = 0.0);
 
   m.def(
       "state_from_joints",

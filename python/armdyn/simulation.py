@@ -61,6 +61,7 @@ def simulate(
     qd0=None,
     projection: str = "mass",
     max_steps: int = 10_000_000,
+    max_step: float | None = None,
     u0=None,
     v0=None,
 ) -> SimulationResult:
@@ -69,10 +70,14 @@ def simulate(
     Args:
         model: a finalized :class:`armdyn.Model`.
         t_end: end time [s] (> 0).
-        integrator: ``"dopri5"`` (Dormand–Prince 5(4), error control, dense output) or ``"rk4"``
-            (classical fixed step ``dt``).
+        integrator: ``"dopri5"`` (Dormand–Prince 5(4), error control, dense output),
+            ``"rk4"`` (classical fixed step ``dt``), ``"trbdf2"`` (L-stable implicit TR-BDF2
+            with error control, for stiff scenes), or ``"auto"``: TR-BDF2 when the stiffness
+            estimate of the force elements says an explicit method would need more than 5000
+            steps for stability alone, else DOPRI5. ``stats["integrator"]`` and
+            ``stats["integrator_reason"]`` say which was used and why.
         rtol, atol: DOPRI5 tolerances on every component of (u, v).
-        dt: RK4 step (required for rk4); DOPRI5 initial step (optional).
+        dt: RK4 step (required for rk4); DOPRI5/TR-BDF2 initial step (optional).
         output_dt: spacing of output times (default: every accepted step). Output states are
             interpolated (DOPRI5 dense output) and projected onto the constraints.
         q0, qd0: initial joint coordinates and rates (n_coords,) for joint-space tree models;
@@ -82,6 +87,7 @@ def simulate(
         projection: metric of the minimum-norm projection: ``"mass"`` (kinetic-energy metric,
             reuses the KKT factorisation) or ``"unweighted"`` (the paper's form).
         max_steps: limit on steps.
+        max_step: largest step of DOPRI5/TR-BDF2 (default: no limit).
 
     Returns:
         SimulationResult.
@@ -93,6 +99,8 @@ def simulate(
     """
     if dt is not None and not (dt > 0):
         raise _core.ModelError(f"simulate: dt must be positive, got {dt}")
+    if max_step is not None and not (max_step > 0):
+        raise _core.ModelError(f"simulate: max_step must be positive, got {max_step}")
     if output_dt is not None and not (output_dt > 0):
         raise _core.ModelError(f"simulate: output_dt must be positive, got {output_dt}")
     if q0 is not None or qd0 is not None:
@@ -113,6 +121,7 @@ def simulate(
         None if v0 is None else v0,
         projection,
         int(max_steps),
+        float(max_step or 0.0),
     )
     error = raw.pop("error")
     result = SimulationResult(**raw)

@@ -44,7 +44,14 @@ void Engine::forces(double t) {
   }
   // applied loads: force at a body point and torque, world axes
   for (const BodyLoad& l : m_.body_loads) {
-    const double s = l.has_profile ? l.profile.eval(t).y : 1.0;
+    double s = 1.0;
+    if (l.has_profile) {
+      try {
+        s = l.profile.eval(t).y;
+      } catch (const SolverError& err) {
+        throw SolverError(msg("load on body '", m_.bodies[l.body].name, "': ", err.what()));
+      }
+    }
     const BodyKin& k = kin_[l.body];
     const Vec3 fb = k.R.transpose() * (s * l.force);
     eta_.segment<3>(6 * l.body) += s * l.force;
@@ -68,7 +75,13 @@ void Engine::forces(double t) {
     const Coord& c = m_.coords[cf.coord];
     const double dq = c.angular ? wrap_angle(q.val - cf.rest) : q.val - cf.rest;
     double tau = -cf.stiffness * dq - cf.damping * q.rate;
-    if (cf.has_input) tau += cf.input.eval(t).y;
+    if (cf.has_input) {
+      try {
+        tau += cf.input.eval(t).y;
+      } catch (const SolverError& err) {
+        throw SolverError(msg("input on joint coordinate '", c.name, "': ", err.what()));
+      }
+    }
     const Joint& j = m_.joints[c.joint];
     scatter(tau * q.J, j.parent, j.child);
   }

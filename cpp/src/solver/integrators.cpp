@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "armdyn/solver/integrators.hpp"
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "armdyn/errors.hpp"
 
@@ -193,6 +195,175 @@ void integrate_rk4(OdeSystem& sys, VecX& y, double t0, double t1, const StepOpti
     } else if (ko < touts.size() && std::abs(t - touts[ko]) <= eps) {
       sys.output(t, y);
       ++ko;
+    }
+  }
+}
+
+}  // namespace armdyn
+
+namespace armdyn {
+
+void integrate_trbdf2(OdeSystem& sys, VecX& y, double t0, double t1, const StepOptions& opt,
+                      StepStats& st) {
+  // ESDIRK tableau: c = (0, 2d, 1); A = [0 0 0; d d 0; w w d]; b = last row (stiffly accurate);
+  // embedded order 3: bh = ((1 - w)/3, (3w + 1)/3, d/3)
+  const double d = 1.0 - std::sqrt(2.0) / 2.0, w = std::sqrt(2.0) / 4.0, c2 = 2.0 * d;
+  const double e1 = w - (1.0 - w) / 3.0, e2 = w - (3.0 * w + 1.0) / 3.0, e3 = d - d / 3.0;
+  constexpr double safe = 0.9, fac_min = 0.2, fac_max = 5.0;
+  constexpr int max_newton = 8;
+
+  const long n = y.size();
+  VecX K1(n), K2(n), K3(n), Y(n), y1(n), R(n), dK(n), err(n), f0(n), yp(n), fp(n), yo(n), sc(n);
+  MatX J(n, n), M(n, n);
+  Eigen::PartialPivLU<MatX> lu(n);
+  const std::vector<double> touts = output_times(t0, t1, opt.output_dt);
+  const bool every_step = touts.empty();
+  size_t ko = 1;
+  const double span = t1 - t0;
+  const double hmax = opt.max_step > 0 ? opt.max_step : span;
+  const double hmin = 1e-14 * std::max(1.0, std::abs(t1));
+
+  double t = t0;
+  sys.project_and_rhs(t, y, K1);
+  ++st.rhs_evals;
+  sys.output(t, y);
+
+  auto weights = [&](const VecX& a) {
+    for (long i = 0; i < n; ++i) sc[i] = opt.atol + opt.rtol * std::abs(a[i]);
+  };
+  auto wnorm = [&](const VecX& e) {
+    double s = 0.0;
+    for (long i = 0; i < n; ++i) s = std::max(s, std::abs(e[i]) / sc[i]);
+    return s;
+  };
+  // finite-difference Jacobian of f at (t, y), with f(t, y) = K1
+  auto jacobian = [&]() {
+    const double eps = std::sqrt(std::numeric_limits<double>::epsilon());
+    yp = y;
+    for (long j = 0; j < n; ++j) {
+      const double delta = eps * std::max(std::abs(y[j]), 1e-3 * sc[j] / opt.rtol + 1e-8);
+      yp[j] = y[j] + delta;
+      sys.rhs(t, yp, fp);
+      J.col(j) = (fp - K1) / delta;
+      yp[j] = y[j];
+    }
+    st.rhs_evals += n;
+    ++st.jacobians;
+  };
+  double h_lu = -1.0;  // step of the current factorisation
+  auto factor = [&](double h) {
+    M = -h * d * J;
+    M.diagonal().array() += 1.0;
+    lu.compute(M);
+    h_lu = h;
+    ++st.lu_factorizations;
+  };
+  // stage K solving K = f(tc, base + h d K) by simplified Newton; returns false on divergence
+  bool slow = false;
+  auto stage = [&](double tc, const VecX& base, double h, VecX& K) {
+    double prev = 0.0;
+    for (int it = 0; it < max_newton; ++it) {
+      Y = base + h * d * K;
+      sys.rhs(tc, Y, R);
+      ++st.rhs_evals;
+      ++st.newton_iterations;
+      R = K - R;
+      dK = lu.solve(R);
+      K -= dK;
+      const double nrm = h * wnorm(dK);
+      if (!std::isfinite(nrm)) return false;
+      if (it > 0) {
+        const double theta = nrm / prev;
+        if (theta > 0.9) return false;
+        if (theta > 0.3) slow = true;
+        // converged when the estimated remaining error is well below the tolerance
+        if (theta / (1.0 - theta) * nrm <= 0.05) return true;
+      } else if (nrm <= 1e-3) {
+        return true;
+      }
+      prev = nrm;
+    }
+    return false;
+  };
+
+  weights(y);
+  // initial step: a fraction of the span, limited by the first derivative
+  double h = opt.dt > 0
+                 ? opt.dt
+                 : std::min(hmax, 0.01 * std::max(wnorm(K1) > 0 ? 1.0 / wnorm(K1) : span, 1e-6));
+  h = std::min(h, hmax);
+  jacobian();
+  bool jac_current = true;
+  bool refreshed_in_step = false;  // the Jacobian went stale within the last step
+
+  while (t < t1) {
+    if (st.steps + st.rejected >= opt.max_steps)
+      throw SolverError(
+          msg("trbdf2: more than ", opt.max_steps, " steps before t=", t1, " (reached t=", t, ")"));
+    if (t + 1.01 * h >= t1) h = t1 - t;
+    if (h < hmin)
+      throw SolverError(msg("trbdf2: step size underflow (h=", h, ") at t=", t,
+                            "; the problem may be singular there"));
+    weights(y);
+    if (h != h_lu) factor(h);
+    slow = false;
+    // stage 2 at t + 2 d h (trapezoidal), stage 3 at t + h (BDF2); predictors from K1
+    K2 = K1;
+    bool ok = stage(t + c2 * h, f0 = y + h * d * K1, h, K2);
+    if (ok) {
+      K3 = K2;
+      ok = stage(t + h, f0 = y + h * w * (K1 + K2), h, K3);
+    }
+    if (!ok) {
+      ++st.newton_failures;
+      if (!jac_current) {
+        jacobian();  // retry the same step with a fresh Jacobian
+        jac_current = true;
+        refreshed_in_step = true;
+        h_lu = -1.0;
+      } else {
+        h *= 0.25;
+        ++st.rejected;
+      }
+      continue;
+    }
+    y1 = y + h * (w * (K1 + K2) + d * K3);
+    // embedded estimate, filtered through the iteration matrix for stiff components
+    R = h * (e1 * K1 + e2 * K2 + e3 * K3);
+    err = lu.solve(R);
+    weights(y1);
+    const double en = wnorm(err);
+    if (!std::isfinite(en)) throw SolverError(msg("trbdf2: non-finite error estimate at t=", t));
+    double fac = std::clamp(safe * std::pow(std::max(en, 1e-10), -1.0 / 3.0), fac_min, fac_max);
+    if (en <= 1.0) {
+      const double tn = (t + h >= t1 - 1e-14 * std::max(1.0, std::abs(t1))) ? t1 : t + h;
+      // outputs by cubic Hermite interpolation between (y, K1) and (y1, K3)
+      for (; !every_step && ko < touts.size() && touts[ko] <= tn; ++ko) {
+        const double s = (touts[ko] - t) / h, s2 = s * s, s3 = s2 * s;
+        yo = (2 * s3 - 3 * s2 + 1) * y + (s3 - 2 * s2 + s) * h * K1 + (-2 * s3 + 3 * s2) * y1 +
+             (s3 - s2) * h * K3;
+        sys.output(touts[ko], yo);
+      }
+      y = y1;
+      sys.project_and_rhs(tn, y, K1);
+      ++st.rhs_evals;
+      t = tn;
+      ++st.steps;
+      if (every_step) sys.output(t, y);
+      jac_current = false;
+      if (slow || refreshed_in_step) {
+        refreshed_in_step = false;
+        weights(y);
+        jacobian();
+        jac_current = true;
+        h_lu = -1.0;
+      }
+      // keep the factorisation when the step would change only a little
+      const double hnew = std::min(h * fac, hmax);
+      if (!(hnew >= h && hnew <= 1.2 * h && h_lu > 0)) h = hnew;
+    } else {
+      h *= std::max(fac, fac_min);
+      ++st.rejected;
     }
   }
 }

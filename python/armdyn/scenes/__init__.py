@@ -6,6 +6,7 @@ from armdyn.scenes.basic import (
     free_body,
     simple_pendulum,
     slider_crank,
+    spring_mass_pendulum,
 )
 from armdyn.scenes.paper import five_dof_arm, three_dof_arm
 
@@ -16,5 +17,6 @@ __all__ = [
     "free_body",
     "simple_pendulum",
     "slider_crank",
+    "spring_mass_pendulum",
     "three_dof_arm",
 ]

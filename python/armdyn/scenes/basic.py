@@ -108,3 +108,30 @@ def four_bar(a=0.3, b_len=0.6, c=0.5, d=0.7, five_revolutes=False, crank_angle=n
     bld.add_revolute("C", "coupler", "rocker", point=pb, axis=z)
     bld.add_revolute("D", "rocker", "ground", point=pd, axis=z)
     return bld.finalize()
+
+
+def spring_mass_pendulum(stiffness=1e6, damping_ratio=0.2, mass=1.0, length=1.0, theta0=0.5):
+    """A stiff spring-mass pendulum: a light arm (0.5 kg rod) on a pivot about world y, and a bob
+    of ``mass`` sliding along the arm on a prismatic joint held by a linear spring-damper of
+    ``stiffness`` [N/m] (rest length: the arm's ``length``) with damping ``damping_ratio`` of the
+    critical value 2 sqrt(k m). Released at rest at ``theta0`` [rad] from the downward vertical.
+    The spring's frequency sqrt(k/m) sets the stiffness; the pendulum's ≈ sqrt(g/L) the motion.
+    Coordinates: ``pivot`` (angle), ``slide`` (stretch)."""
+    b = _core.ModelBuilder(gravity=(0.0, 0.0, -9.81))
+    s, c = np.sin(theta0), np.cos(theta0)
+    rot = (np.cos(theta0 / 2), 0.0, np.sin(theta0 / 2), 0.0)
+    b.add_body(
+        "arm",
+        0.5,
+        _rod(0.5, length, 0.01, 2),
+        position=(0.5 * length * s, 0, -0.5 * length * c),
+        orientation=rot,
+    )
+    pos = (length * s, 0.0, -length * c)
+    b.add_body("bob", mass, _sphere(mass, 0.03), position=pos, orientation=rot)
+    b.add_revolute("pivot", "ground", "arm", point=(0, 0, 0), axis=(0, 1, 0))
+    b.add_prismatic("slide", "arm", "bob", point=pos, axis=(s, 0.0, -c))
+    b.add_joint_spring_damper(
+        "slide", stiffness=stiffness, damping=damping_ratio * 2.0 * np.sqrt(stiffness * mass)
+    )
+    return b.finalize()

@@ -14,7 +14,7 @@
 namespace armdyn {
 
 struct SimOptions {
-  std::string integrator = "dopri5";  ///< "dopri5" | "rk4"
+  std::string integrator = "dopri5";  ///< "dopri5" | "rk4" | "trbdf2" | "auto"
   StepOptions step;
   Metric projection = Metric::Mass;
 };
@@ -28,7 +28,16 @@ struct SimResult {
   long kkt_solves = 0, factorizations = 0, position_projections = 0, newton_iterations = 0;
   double cpu_seconds = 0.0;
   std::string error;  ///< non-empty when the run stopped early (SolverError message)
+  std::string integrator, integrator_reason;  ///< the method used, and why (for "auto")
 };
+
+/// Stiffness estimate for integrator="auto": the fastest rate |lambda| [1/s] of the force
+/// elements (springs: sqrt(k / m_eff), dampers: c / m_eff, with m_eff the effective mass of the
+/// element's direction under the constraints at the assembled state, from one KKT solve each),
+/// and a sentence naming the element. The explicit DOPRI5 needs about |lambda| t_end / 3.3 steps
+/// for stability alone; "auto" picks TR-BDF2 when that exceeds 5000 steps.
+double stiffness_estimate(const Model& m, std::string& culprit);
+std::string choose_integrator(const Model& m, double t_end, std::string& reason);
 
 /// Run from (u0, v0) (projected first) over [0, t_end]. Errors during the run stop it: the
 /// result up to the last good output is returned with `error` set.

@@ -4,6 +4,12 @@
 //    Norsett & Wanner, Solving ODEs I, II.5 and II.6; the ode45 scheme). The error is estimated on
 //    the unprojected pair; the accepted value is projected and the first stage re-evaluated there.
 //  - RK4: classical fixed step, projected after each step.
+//  - TR-BDF2: the L-stable, stiffly accurate ESDIRK form of the trapezoidal rule followed by
+//    BDF2 (Bank et al. 1985; Hosea & Shampine 1996, the ode23tb scheme), for stiff scenes. Order
+//    2 with an embedded order-3 estimate, filtered by (I - h d J)^-1 for stiff components.
+//    Stages are solved by simplified Newton with a finite-difference Jacobian of the same
+//    right-hand side (the KKT accelerations), reused across steps and refreshed only when
+//    Newton converges slowly or fails. Cubic Hermite dense output; projection after every step.
 // Output times on a grid are served from the dense output (DOPRI5) or by landing steps on them
 // (RK4); every output state is projected.
 #pragma once
@@ -27,6 +33,7 @@ class OdeSystem {
 
 struct StepStats {
   long steps = 0, rejected = 0, rhs_evals = 0;
+  long jacobians = 0, lu_factorizations = 0, newton_iterations = 0, newton_failures = 0;
 };
 
 struct StepOptions {
@@ -40,6 +47,8 @@ struct StepOptions {
 /// Integrate from t0 to t1; y holds the projected initial state on entry, the final on exit.
 /// @throws SolverError on step-size underflow, too many steps or non-finite values.
 void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepOptions& opt,
+                      StepStats& stats);
+void integrate_trbdf2(OdeSystem& sys, VecX& y, double t0, double t1, const StepOptions& opt,
                       StepStats& stats);
 void integrate_rk4(OdeSystem& sys, VecX& y, double t0, double t1, const StepOptions& opt,
                    StepStats& stats);
