@@ -57,6 +57,8 @@ py::dict result_dict(const Model& md, const SimResult& r) {
   s["lu_factorizations"] = r.stats.lu_factorizations;
   s["newton_iterations_implicit"] = r.stats.newton_iterations;
   s["newton_failures"] = r.stats.newton_failures;
+  s["singular_evaluations"] = r.singular_evaluations;
+  s["singular_note"] = r.singular_note;
   s["integrator"] = r.integrator;
   s["integrator_reason"] = r.integrator_reason;
   d["stats"] = s;

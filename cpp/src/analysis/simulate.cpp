@@ -213,6 +213,8 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
   out.factorizations = e.factorizations;
   out.position_projections = e.pstats.position_projections;
   out.newton_iterations = e.pstats.newton_iterations;
+  out.singular_evaluations = e.singular_evaluations;
+  out.singular_note = e.singular_note;
   // a failed output may have pushed part of a row: trim every table to n complete rows
   const size_t n = static_cast<size_t>(out.n);
   out.t.resize(n);

@@ -118,7 +118,7 @@ std::string Model::summary() const {
     os << "\n  multipliers: minimum-norm (reactions of redundant joints are not unique)\n";
   }
   os << "  KKT path: dense Schur complement, "
-     << (redundant ? "complete orthogonal decomposition" : "Cholesky") << "\n";
+     << (redundant ? "pivoted Cholesky (minimum-norm multipliers)" : "Cholesky") << "\n";
   os << "  gravity: [" << gravity.x() << ", " << gravity.y() << ", " << gravity.z() << "]\n";
   os << "  bodies:\n";
   for (const Body& b : bodies) os << "    " << b.name << "  mass " << b.mass << " kg\n";

@@ -110,6 +110,17 @@ void Engine::dynamics(double t, const double* u, const double* v, double* vdot, 
     kkt_.factor(ce_, nrows_, Metric::Mass);
     ++factorizations;
   }
+  if (kkt_.used_pseudo_inverse()) {
+    const int expected = nrows_ == m_.nc ? m_.rank_all : m_.rank_joint;
+    if (kkt_.rank() < expected) {
+      if (singular_evaluations++ == 0) {
+        std::string rows;
+        for (int r : kkt_.dependent_rows()) rows += (rows.empty() ? "" : "; ") + m_.row_name(r);
+        singular_note = msg("singular configuration at t=", t, ": constraint rank ", kkt_.rank(),
+                            " instead of ", expected, "; dependent rows: ", rows);
+      }
+    }
+  }
   Eigen::Map<VecX> vd(vdot, m_.nv);
   kkt_.accelerations(ce_, eta_, vd_, delta_);
   ++kkt_solves;

@@ -82,13 +82,24 @@ def slider_crank(crank=0.1, rod=0.35, speed=2 * np.pi, drive=True):
     return b.finalize()
 
 
-def four_bar(a=0.3, b_len=0.6, c=0.5, d=0.7, five_revolutes=False, crank_angle=np.pi / 3):
+def four_bar(
+    a=0.3,
+    b_len=0.6,
+    c=0.5,
+    d=0.7,
+    five_revolutes=False,
+    crank_angle=np.pi / 3,
+    crank_drive=None,
+    gravity=9.81,
+):
     """Planar four-bar (crank a, coupler b, rocker c, ground d) modelled in 3-D with revolute
     joints, all axes along z, gravity along -y: 3 moving bodies, 4 revolutes = 20 rows of rank 17,
     mobility 1, so 3 rows are redundant. With `five_revolutes` the crank bearing is doubled (a
     second, coaxial revolute "A2" between ground and crank, as real bearings often are): 25 rows,
-    still rank 17 and mobility 1."""
-    bld = _core.ModelBuilder(gravity=(0.0, -9.81, 0.0))
+    still rank 17 and mobility 1. `crank_drive` (a profile of the crank joint "A", relative to the
+    start angle) prescribes the crank. With a = c and b = d the linkage is a parallelogram whose
+    links all become collinear at crank angles 0 and π (its change points)."""
+    bld = _core.ModelBuilder(gravity=(0.0, -gravity, 0.0))
     pa = np.array([a * np.cos(crank_angle), a * np.sin(crank_angle), 0.0])
     pd = np.array([d, 0.0, 0.0])
     # coupler/rocker joint: intersection of the circles |p - pa| = b and |p - pd| = c
@@ -107,6 +118,8 @@ def four_bar(a=0.3, b_len=0.6, c=0.5, d=0.7, five_revolutes=False, crank_angle=n
     bld.add_revolute("B", "crank", "coupler", point=pa, axis=z)
     bld.add_revolute("C", "coupler", "rocker", point=pb, axis=z)
     bld.add_revolute("D", "rocker", "ground", point=pd, axis=z)
+    if crank_drive is not None:
+        bld.add_drive("A", crank_drive)
     return bld.finalize()
 
 

@@ -26,6 +26,8 @@ struct SimResult {
   std::vector<double> position_residual, velocity_residual, kinetic_energy, potential_energy;
   StepStats stats;
   long kkt_solves = 0, factorizations = 0, position_projections = 0, newton_iterations = 0;
+  long singular_evaluations = 0;
+  std::string singular_note;
   double cpu_seconds = 0.0;
   std::string error;  ///< non-empty when the run stopped early (SolverError message)
   std::string integrator, integrator_reason;  ///< the method used, and why (for "auto")

@@ -60,6 +60,10 @@ class Engine {
   const Model& model() const { return m_; }
   ProjectionStats pstats;
   long kkt_solves = 0, factorizations = 0;
+  /// dynamics evaluations where the constraint Jacobian had lower rank than at assembly
+  /// (a singular configuration); the first one is described in singular_note.
+  long singular_evaluations = 0;
+  std::string singular_note;
 
  private:
   void scatter(const Row12& g, int pa, int pb);
