@@ -1,0 +1,617 @@
+"""The catalogue of bad inputs armdyn rejects: one entry per case, each run by
+tests/test_bad_input_catalogue.py, and rendered into docs/bad_inputs.md by
+
+    python tests/bad_input_catalogue.py > docs/bad_inputs.md
+
+Each entry: (id, area, input, function raising, expected exception, regex the message must
+match: the culprit's name).
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import armdyn as ad
+import numpy as np
+from armdyn import _core
+
+DATA = Path(__file__).resolve().parent / "data" / "urdf"
+I3 = np.diag([0.01, 0.02, 0.025])
+
+
+def _b(name="link"):
+    b = ad.ModelBuilder()
+    b.add_body(name, 1.0, I3, position=(0.0, 0.0, -0.5))
+    return b
+
+
+def _hinged():
+    b = _b("link")
+    b.add_revolute("hinge", "ground", "link", (0, 0, 0), (0, 1, 0))
+    return b
+
+
+def _pendulum():
+    return _hinged().finalize()
+
+
+def _driven():
+    b = _hinged()
+    b.add_drive("hinge", _core.profiles.cubic(0.0, 1.0, 0.0, 1.0))
+    return b.finalize()
+
+
+URDF_LINKS = """<link name="base"/><link name="arm"><inertial><mass value="1"/>
+  <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>"""
+
+
+def _urdf(joint: str, links: str = URDF_LINKS) -> str:
+    return f"<robot name='r'>{links}{joint}</robot>"
+
+
+def _slider_crank_dead_centre():
+    r, length = 0.1, 0.35
+    a = np.array([0.0, r, 0.0])
+    x0 = np.sqrt(length**2 - r**2)
+    s = np.array([x0, 0.0, 0.0])
+    b = ad.ModelBuilder(gravity=(0.0, 0.0, 0.0))
+    b.add_body("crank", 1.0, [1e-3, 1e-4, 1e-3], position=a / 2)
+    b.add_body("rod", 0.5, [1e-4, 5e-3, 5e-3], position=(a + s) / 2)
+    b.add_body("slider", 2.0, [1e-3] * 3, position=s)
+    b.add_revolute("crank_pin", "ground", "crank", point=(0, 0, 0), axis=(0, 0, 1))
+    b.add_revolute("crank_rod", "crank", "rod", point=a, axis=(0, 0, 1))
+    b.add_revolute("rod_slider", "rod", "slider", point=s, axis=(0, 0, 1))
+    b.add_prismatic("guide", "ground", "slider", point=s, axis=(1, 0, 0))
+    b.add_drive("guide", _core.profiles.cubic(0.0, r + length - x0, 0.0, 1.0))
+    return ad.inverse_dynamics(b.finalize(), t=np.linspace(0.0, 1.0, 11))
+
+
+def _nan_force_run():
+    b = _hinged()
+    b.add_body_force("link", force=(1.0, 0, 0), profile=lambda t: (np.nan if t > 0.2 else 0, 0, 0))
+    ad.simulate(b.finalize(), 1.0, integrator="rk4", dt=0.01)
+
+
+ME, UE, SE = ad.ModelError, ad.UrdfError, ad.SolverError
+
+CASES = [
+    # ---- bodies
+    ("mass-negative", "body", "mass −1", lambda: _b().add_body("heavy", -1.0, I3), ME, "heavy"),
+    ("mass-zero", "body", "mass 0", lambda: _b().add_body("heavy", 0.0, I3), ME, "heavy"),
+    ("mass-nan", "body", "mass NaN", lambda: _b().add_body("heavy", np.nan, I3), ME, "heavy"),
+    (
+        "inertia-nonsym",
+        "body",
+        "inertia not symmetric",
+        lambda: _b().add_body("skew", 1.0, [[1, 0.5, 0], [0, 1, 0], [0, 0, 1]]),
+        ME,
+        "skew",
+    ),
+    (
+        "inertia-not-pd",
+        "body",
+        "inertia with a negative principal value",
+        lambda: _b().add_body("flat", 1.0, [1.0, 1.0, -1.0]),
+        ME,
+        "flat",
+    ),
+    (
+        "inertia-triangle",
+        "body",
+        "principal inertias violate I1 + I2 ≥ I3",
+        lambda: _b().add_body("weird", 1.0, [0.01, 0.01, 0.05]),
+        ME,
+        "weird",
+    ),
+    (
+        "inertia-shape",
+        "body",
+        "inertia of shape (2, 2)",
+        lambda: _b().add_body("shaped", 1.0, np.eye(2)),
+        ME,
+        "inertia",
+    ),
+    (
+        "position-nan",
+        "body",
+        "position with NaN",
+        lambda: _b().add_body("lost", 1.0, I3, position=(np.nan, 0, 0)),
+        ME,
+        "lost",
+    ),
+    (
+        "position-shape",
+        "body",
+        "position of length 2",
+        lambda: _b().add_body("lost", 1.0, I3, position=(0, 0)),
+        ME,
+        "position",
+    ),
+    (
+        "quat-not-unit",
+        "body",
+        "orientation (1, 1, 0, 0)",
+        lambda: _b().add_body("spun", 1.0, I3, orientation=(1, 1, 0, 0)),
+        ME,
+        "spun",
+    ),
+    (
+        "quat-nan",
+        "body",
+        "orientation with NaN",
+        lambda: _b().add_body("spun", 1.0, I3, orientation=(np.nan, 0, 0, 1)),
+        ME,
+        "spun",
+    ),
+    (
+        "body-duplicate",
+        "body",
+        "second body of the same name",
+        lambda: _b("dup").add_body("dup", 1.0, I3),
+        ME,
+        "dup",
+    ),
+    (
+        "body-ground",
+        "body",
+        "a body named 'ground'",
+        lambda: _b().add_body("ground", 1.0, I3),
+        ME,
+        "ground",
+    ),
+    # ---- joints
+    (
+        "axis-zero-revolute",
+        "joint",
+        "revolute with axis (0, 0, 0)",
+        lambda: _b().add_revolute("axisless", "ground", "link", (0, 0, 0), (0, 0, 0)),
+        ME,
+        "axisless",
+    ),
+    (
+        "axis-zero-prismatic",
+        "joint",
+        "prismatic with axis (0, 0, 0)",
+        lambda: _b().add_prismatic("axisless", "ground", "link", (0, 0, 0), (0, 0, 0)),
+        ME,
+        "axisless",
+    ),
+    (
+        "axis-nan",
+        "joint",
+        "revolute with a NaN axis",
+        lambda: _b().add_revolute("axisnan", "ground", "link", (0, 0, 0), (np.nan, 1, 0)),
+        ME,
+        "axisnan",
+    ),
+    (
+        "universal-not-perp",
+        "joint",
+        "universal joint with parallel axes",
+        lambda: _b().add_universal("cardan", "ground", "link", (0, 0, 0), (0, 0, 1), (0, 0, 1)),
+        ME,
+        "cardan",
+    ),
+    (
+        "joint-unknown-body",
+        "joint",
+        "joint to an unknown body",
+        lambda: _b().add_revolute("j", "ground", "no_such_body", (0, 0, 0), (0, 1, 0)),
+        ME,
+        "no_such_body",
+    ),
+    (
+        "joint-duplicate",
+        "joint",
+        "second joint of the same name",
+        lambda: _hinged().add_revolute("hinge", "ground", "link", (0, 0, 0), (0, 1, 0)),
+        ME,
+        "hinge",
+    ),
+    (
+        "joint-self",
+        "joint",
+        "joint from a body to itself",
+        lambda: _b().add_revolute("self_joint", "link", "link", (0, 0, 0), (0, 1, 0)),
+        ME,
+        "self_joint",
+    ),
+    (
+        "joint-point-nan",
+        "joint",
+        "joint point with inf",
+        lambda: _b().add_spherical("ball", "ground", "link", (np.inf, 0, 0)),
+        ME,
+        "ball",
+    ),
+    # ---- drives and force elements
+    (
+        "drive-spherical",
+        "drive",
+        "drive on a spherical joint",
+        lambda: (
+            lambda b: (
+                b.add_spherical("ball", "ground", "link", (0, 0, 0)),
+                b.add_drive("ball", 0.0),
+            )
+        )(_b()),
+        ME,
+        "ball",
+    ),
+    (
+        "drive-unknown-joint",
+        "drive",
+        "drive on an unknown joint",
+        lambda: _hinged().add_drive("no_such_joint", 0.0),
+        ME,
+        "no_such_joint",
+    ),
+    (
+        "drive-coord-range",
+        "drive",
+        "drive on coordinate 1 of a revolute",
+        lambda: _hinged().add_drive("hinge", 0.0, coord=1),
+        ME,
+        "hinge",
+    ),
+    (
+        "drive-bad-profile",
+        "drive",
+        "profile that is neither a number, Profile nor callable",
+        lambda: _hinged().add_drive("hinge", "fast"),
+        ME,
+        "hinge",
+    ),
+    (
+        "spline-not-increasing",
+        "drive",
+        "spline samples with decreasing times",
+        lambda: _core.profiles.spline([0.0, 1.0, 0.5], [0.0, 1.0, 2.0]),
+        ME,
+        "increas",
+    ),
+    (
+        "spring-negative",
+        "force",
+        "spring-damper with stiffness −1",
+        lambda: _hinged().add_spring_damper("sp", "ground", (0, 0, 0), "link", (0, 0, 0), -1.0),
+        ME,
+        "sp",
+    ),
+    (
+        "friction-negative",
+        "force",
+        "joint friction with viscous −1",
+        lambda: _hinged().add_joint_friction("hinge", viscous=-1.0),
+        ME,
+        "hinge",
+    ),
+    (
+        "force-unknown-body",
+        "force",
+        "body force on an unknown body",
+        lambda: _hinged().add_body_force("nobody", force=(1, 0, 0)),
+        ME,
+        "nobody",
+    ),
+    # ---- topology and assembly
+    (
+        "not-connected",
+        "model",
+        "a body with no joint path to ground",
+        lambda: (lambda b: (b.add_body("floating", 1.0, I3), b.finalize()))(_hinged()),
+        ME,
+        "floating",
+    ),
+    (
+        "assembly-impossible",
+        "model",
+        "joints that cannot all hold (revolute 1 m from its body, and fixed at its CoM)",
+        lambda: (
+            lambda b: (
+                b.add_revolute("far", "ground", "link", (0, 0, 0.5), (0, 1, 0)),
+                b.add_fixed("weld", "ground", "link", (5, 0, 0)),
+                b.add_drive("far", 3.0),
+                b.finalize(),
+            )
+        )(_b()),
+        ME,
+        "assembl",
+    ),
+    # ---- URDF
+    (
+        "urdf-unterminated",
+        "urdf",
+        "unterminated XML",
+        lambda: ad.load_urdf("<robot name='x'>"),
+        UE,
+        "(?i)xml|pars|urdf",
+    ),
+    (
+        "urdf-not-xml",
+        "urdf",
+        "text that is not XML",
+        lambda: ad.load_urdf("not xml"),
+        UE,
+        "(?i)xml|pars|urdf",
+    ),
+    (
+        "urdf-missing-file",
+        "urdf",
+        "a path that does not exist",
+        lambda: ad.load_urdf(DATA / "no_such_robot.urdf"),
+        UE,
+        "no_such_robot",
+    ),
+    (
+        "urdf-floating",
+        "urdf",
+        "a floating joint",
+        lambda: ad.load_urdf(DATA / "bad_floating.urdf"),
+        UE,
+        "(?i)floating",
+    ),
+    (
+        "urdf-massless-moving",
+        "urdf",
+        "a massless link on a moving joint",
+        lambda: ad.load_urdf(DATA / "bad_massless_moving.urdf"),
+        UE,
+        "(?i)mass",
+    ),
+    (
+        "urdf-unknown-parent",
+        "urdf",
+        "a joint whose parent link does not exist",
+        lambda: ad.load_urdf(
+            _urdf(
+                "<joint name='j' type='revolute'><parent link='nolink'/>"
+                "<child link='arm'/><axis xyz='0 0 1'/>"
+                "<limit lower='0' upper='1' effort='1' velocity='1'/></joint>"
+            )
+        ),
+        UE,
+        "nolink",
+    ),
+    (
+        "urdf-zero-axis",
+        "urdf",
+        "a revolute joint with axis 0 0 0",
+        lambda: ad.load_urdf(
+            _urdf(
+                "<joint name='za' type='continuous'><parent link='base'/>"
+                "<child link='arm'/><axis xyz='0 0 0'/></joint>"
+            )
+        ),
+        UE,
+        "za",
+    ),
+    (
+        "urdf-negative-mass",
+        "urdf",
+        "a link with mass −1",
+        lambda: ad.load_urdf(
+            _urdf(
+                "<joint name='j' type='continuous'><parent link='base'/>"
+                "<child link='arm'/><axis xyz='0 0 1'/></joint>",
+                URDF_LINKS.replace('value="1"', 'value="-1"'),
+            )
+        ),
+        UE,
+        "arm",
+    ),
+    (
+        "urdf-planar",
+        "urdf",
+        "a planar joint (unsupported)",
+        lambda: ad.load_urdf(
+            _urdf(
+                "<joint name='pl' type='planar'><parent link='base'/>"
+                "<child link='arm'/><axis xyz='0 0 1'/></joint>"
+            )
+        ),
+        UE,
+        "pl",
+    ),
+    # ---- arrays and joint-space calls
+    (
+        "fd-q-length",
+        "arrays",
+        "forward_dynamics with q of length 2 for 1 coordinate",
+        lambda: ad.forward_dynamics(_pendulum(), [0, 0], [0], [0]),
+        ME,
+        r"\bq\b",
+    ),
+    (
+        "fd-tau-nan",
+        "arrays",
+        "forward_dynamics with tau NaN",
+        lambda: ad.forward_dynamics(_pendulum(), [0], [0], [np.nan]),
+        ME,
+        "tau",
+    ),
+    (
+        "sfj-q-shape",
+        "arrays",
+        "state_from_joints with q of length 3",
+        lambda: ad.state_from_joints(_pendulum(), np.zeros(3), np.zeros(1)),
+        ME,
+        r"\bq\b",
+    ),
+    (
+        "acc-u-length",
+        "arrays",
+        "accelerations with u of length 5",
+        lambda: ad.accelerations(_pendulum(), np.zeros(5), np.zeros(6)),
+        ME,
+        r"\bu\b",
+    ),
+    (
+        "fd-on-loop",
+        "arrays",
+        "forward_dynamics on a closed loop",
+        lambda: ad.forward_dynamics(ad.scenes.four_bar(), np.zeros(4), np.zeros(4), np.zeros(4)),
+        ME,
+        "loop",
+    ),
+    # ---- solver options
+    (
+        "sim-t-end",
+        "solver",
+        "simulate with t_end = −1",
+        lambda: ad.simulate(_pendulum(), -1.0),
+        ME,
+        "t_end",
+    ),
+    (
+        "sim-rtol",
+        "solver",
+        "simulate with rtol = −1e-6",
+        lambda: ad.simulate(_pendulum(), 1.0, rtol=-1e-6),
+        ME,
+        "rtol",
+    ),
+    (
+        "sim-integrator",
+        "solver",
+        "simulate with integrator 'euler_bogus'",
+        lambda: ad.simulate(_pendulum(), 1.0, integrator="euler_bogus"),
+        ME,
+        "euler_bogus",
+    ),
+    (
+        "sim-projection",
+        "solver",
+        "simulate with projection 'sideways'",
+        lambda: ad.simulate(_pendulum(), 1.0, projection="sideways"),
+        ME,
+        "sideways",
+    ),
+    (
+        "sim-rk4-dt",
+        "solver",
+        "rk4 without dt",
+        lambda: ad.simulate(_pendulum(), 1.0, integrator="rk4"),
+        ME,
+        "dt",
+    ),
+    (
+        "sim-max-step",
+        "solver",
+        "simulate with max_step = −1",
+        lambda: ad.simulate(_pendulum(), 1.0, max_step=-1.0),
+        ME,
+        "max_step",
+    ),
+    (
+        "sim-u0-nan",
+        "solver",
+        "initial state with NaN",
+        lambda: ad.simulate(_pendulum(), 1.0, u0=np.full(7, np.nan), v0=np.zeros(6)),
+        ME,
+        "NaN",
+    ),
+    (
+        "sim-nan-force",
+        "solver",
+        "a user force that becomes NaN mid-run",
+        _nan_force_run,
+        SE,
+        "body 'link'",
+    ),
+    (
+        "sim-max-steps",
+        "solver",
+        "more steps needed than max_steps",
+        lambda: ad.simulate(_pendulum(), 10.0, max_steps=5),
+        SE,
+        "steps",
+    ),
+    # ---- inverse dynamics and validators
+    (
+        "id-under-driven",
+        "inverse dynamics",
+        "driven inverse dynamics of an undriven model",
+        lambda: ad.inverse_dynamics(_pendulum(), t=[0.0, 1.0]),
+        ME,
+        "hinge",
+    ),
+    (
+        "id-times",
+        "inverse dynamics",
+        "times not increasing",
+        lambda: ad.inverse_dynamics(_driven(), t=[0.0, 0.5, 0.5]),
+        ME,
+        "increase",
+    ),
+    (
+        "id-singular",
+        "inverse dynamics",
+        "a slider driven to the dead centre of a slider-crank",
+        _slider_crank_dead_centre,
+        SE,
+        "singular.*drive 'guide'",
+    ),
+    (
+        "id-qdd-nan",
+        "inverse dynamics",
+        "joint-space inverse dynamics with qdd NaN",
+        lambda: ad.inverse_dynamics(_pendulum(), [0.0], [0.0], [np.nan]),
+        ME,
+        "qdd",
+    ),
+    (
+        "lagrange-loop",
+        "validators",
+        "Lagrange validator of a closed loop",
+        lambda: ad.LagrangeValidator(ad.scenes.four_bar()),
+        ME,
+        "LagrangeValidator",
+    ),
+    (
+        "metrics-zero-ref",
+        "validators",
+        "error metric against an identically zero reference",
+        lambda: ad.validation.torque_error_metrics(np.ones((3, 1)), np.zeros((3, 1))),
+        ME,
+        "identically zero",
+    ),
+]
+
+
+def render() -> str:
+    """The Markdown table of docs/bad_inputs.md, with the actual messages."""
+    import re
+
+    lines = [
+        "# Bad inputs armdyn rejects",
+        "",
+        "Generated by `python tests/bad_input_catalogue.py > docs/bad_inputs.md`; every row is a",
+        "test in `tests/test_bad_input_catalogue.py` (exception type and the culprit named in the",
+        "message). Model and builder state are left unchanged by a failed call (tested in",
+        "`tests/test_bad_input.py`).",
+        "",
+        f"{len(CASES)} cases.",
+        "",
+        "| id | area | input | exception | message |",
+        "|---|---|---|---|---|",
+    ]
+    for cid, area, what, fn, exc, _pattern in CASES:
+        try:
+            fn()
+            message = "(no exception!)"
+        except exc as e:
+            message = str(e).splitlines()[0]
+        message = re.sub(r" at 0x[0-9a-f]+", "", message)
+        message = re.sub(r"<function \S+>", "<function>", message)
+        message = message.replace(str(DATA), "tests/data/urdf")
+        if len(message) > 160:
+            message = message[:157] + "..."
+        message = message.replace("|", "\\|")
+        lines.append(f"| {cid} | {area} | {what} | `{exc.__name__}` | {message} |")
+    return "\n".join(lines) + "\n"
+
+
+if __name__ == "__main__":
+    sys.stdout.write(render())
