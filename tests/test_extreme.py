@@ -16,26 +16,8 @@ from scipy.integrate import solve_ivp
 # ----------------------------------------------------------------------------------------------
 
 
-def bricard(side=0.3):
-    """Orthogonal Bricard 6R linkage on the edges of a cube: six unit links, consecutive joint
-    axes perpendicular, one link is ground. 6 revolutes = 30 rows on 5 bodies (nv = 30), so
-    Grübler counts 0 DOF; the linkage moves with 1."""
-    p = np.array([(1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 1, 1), (0, 0, 1), (1, 0, 1)], float) * side
-    d = [p[(i + 1) % 6] - p[i] for i in range(6)]
-    b = ad.ModelBuilder(gravity=(0.0, 0.0, -9.81))
-    links = [f"link{i}" for i in range(5)]
-    for i in range(5):
-        b.add_body(links[i], 1.0, [2e-3, 2e-3, 1e-3], position=(p[i] + p[i + 1]) / 2)
-    for i in range(6):
-        axis = np.cross(d[i - 1], d[i])
-        parent = "ground" if i == 0 else links[i - 1]
-        child = links[i] if i < 5 else "ground"
-        b.add_revolute(f"J{i}", parent, child, point=p[i], axis=axis / np.linalg.norm(axis))
-    return b.finalize()
-
-
 def test_bricard_mobility_motion_and_symmetry():
-    model = bricard()
+    model = ad.scenes.bricard()
     assert model.mobility == 1  # while Grübler's count gives 0
     assert len(model.redundant_rows) == 1
     res = ad.simulate(model, 2.0, rtol=1e-10, atol=1e-12, output_dt=0.05)
@@ -220,19 +202,7 @@ def test_fast_heavy_top_million_steps():
     """Symmetric top on a spherical joint, spin 1000 rad/s, tilted 30°, started in steady
     precession: 10⁶ RK4 steps (10 s). Drift ≤ 1e-12 at every recorded state, energy bounded,
     and the precession rate equals the gyroscopic closed form m g l / (I3 ω_s) to O(1/ω_s²)."""
-    m, length, i1, i3, ws, g = 1.0, 0.05, 1.5e-3, 2e-3, 1000.0, 9.81
-    th0 = np.radians(30.0)
-    omega_p = m * g * length / (i3 * ws)
-    e = np.array([np.cos(th0 / 2), np.sin(th0 / 2), 0.0, 0.0])
-    rot = quat_to_rot(e)
-    r = rot @ np.array([0.0, 0.0, length])
-    b = ad.ModelBuilder(gravity=(0.0, 0.0, -g))
-    b.add_body("top", m, [i1, i1, i3], position=r, orientation=e)
-    b.add_spherical("tip", "ground", "top", point=(0, 0, 0))
-    model = b.finalize()
-    w_world = rot @ np.array([0.0, 0.0, ws]) + np.array([0.0, 0.0, omega_p])
-    u0 = np.concatenate([r, e])
-    v0 = np.concatenate([np.cross(w_world, r), rot.T @ w_world])
+    model, u0, v0, omega_p = ad.scenes.heavy_top(spin=1000.0)
     n_steps, dt = 1_000_000, 1e-5
     res = ad.simulate(model, n_steps * dt, integrator="rk4", dt=dt, output_dt=0.01, u0=u0, v0=v0)
     assert res.stats["steps"] == n_steps

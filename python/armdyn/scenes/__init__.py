@@ -8,13 +8,16 @@ from armdyn.scenes.basic import (
     slider_crank,
     spring_mass_pendulum,
 )
+from armdyn.scenes.extreme import bricard, heavy_top
 from armdyn.scenes.paper import five_dof_arm, three_dof_arm
 
 __all__ = [
+    "bricard",
     "double_pendulum",
     "five_dof_arm",
     "four_bar",
     "free_body",
+    "heavy_top",
     "simple_pendulum",
     "slider_crank",
     "spring_mass_pendulum",
