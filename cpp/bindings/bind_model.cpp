@@ -284,11 +284,32 @@ void bind_model(py::module_& m) {
            py::arg("coord") = 0)
       .def(
           "add_joint_friction",
-          [](ModelBuilder& b, const std::string& joint, double viscous, int coord) {
-            b.add_joint_spring_damper(joint, 0.0, viscous, 0.0, coord);
+          [](ModelBuilder& b, const std::string& joint, double viscous, double coulomb,
+             double smoothing_velocity, int coord) {
+            b.add_joint_friction(joint, viscous, coulomb, smoothing_velocity, coord);
           },
-          py::arg("joint"), py::arg("viscous"), py::arg("coord") = 0,
-          "Viscous joint friction: tau = -viscous * qdot.")
+          py::arg("joint"), py::arg("viscous") = 0.0, py::arg("coulomb") = 0.0,
+          py::arg("smoothing_velocity") = 1e-3, py::arg("coord") = 0,
+          "Joint friction: tau = -viscous * qdot - coulomb * tanh(qdot / smoothing_velocity).")
+      .def(
+          "add_motor",
+          [](ModelBuilder& b, const std::string& joint, py::object reference, double kp, double kd,
+             double torque_limit, py::object feedforward, int coord) {
+            const std::string who = "add_motor '" + joint + "'";
+            const Profile ref = to_profile(reference, who + ": reference");
+            if (feedforward.is_none()) {
+              b.add_motor(joint, ref, kp, kd, torque_limit, nullptr, coord);
+            } else {
+              const Profile ff = to_profile(feedforward, who + ": feedforward");
+              b.add_motor(joint, ref, kp, kd, torque_limit, &ff, coord);
+            }
+          },
+          py::arg("joint"), py::arg("reference"), py::arg("kp"), py::arg("kd"),
+          py::arg("torque_limit") = 1e300, py::arg("feedforward") = py::none(),
+          py::arg("coord") = 0,
+          "PD motor on a joint coordinate: tau = clamp(kp (q_ref - q) + kd (qd_ref - qd), "
+          "+-torque_limit) + feedforward(t); the reference is a profile (armdyn.profiles.*, a "
+          "number, or a callable).")
       .def(
           "add_joint_torque",
           [](ModelBuilder& b, const std::string& joint, py::object profile, int coord) {

@@ -135,7 +135,12 @@ double stiffness_estimate(const Model& m, std::string& culprit) {
     const double im = inv_mass(q.J, j.parent, j.child);
     const std::string& name = m.coords[cf.coord].name;
     consider(std::sqrt(cf.stiffness * im), msg("joint '", name, "' spring"));
-    consider(cf.damping * im, msg("joint '", name, "' damping/friction"));
+    consider((cf.damping + cf.coulomb / cf.v_smooth) * im,
+             msg("joint '", name, "' damping/friction"));
+    if (cf.motor) {
+      consider(std::sqrt(cf.kp * im), msg("motor on '", name, "' (kp)"));
+      consider(cf.kd * im, msg("motor on '", name, "' (kd)"));
+    }
   }
   return lam;
 }

@@ -303,6 +303,58 @@ void ModelBuilder::add_joint_spring_damper(const std::string& joint, double stif
   m_.coord_forces.push_back(cf);
 }
 
+void ModelBuilder::add_joint_friction(const std::string& joint, double viscous, double coulomb,
+                                      double smoothing_velocity, int coord) {
+  const std::string who = msg("joint friction on '", joint, "'");
+  auto it = m_.joint_index.find(joint);
+  if (it == m_.joint_index.end()) throw ModelError(msg(who, ": unknown joint '", joint, "'"));
+  const Joint& j = m_.joints[it->second];
+  if (coord < 0 || coord >= joint_coords(j.type))
+    throw ModelError(msg(who, ": ", joint_type_name(j.type), " joint has no coordinate ", coord));
+  require_finite(viscous, who + ": viscous");
+  require_finite(coulomb, who + ": coulomb");
+  require_finite(smoothing_velocity, who + ": smoothing_velocity");
+  if (viscous < 0 || coulomb < 0) throw ModelError(msg(who, ": viscous and coulomb must be >= 0"));
+  if (!(smoothing_velocity > 0))
+    throw ModelError(msg(who, ": smoothing_velocity must be positive, got ", smoothing_velocity));
+  CoordForce cf;
+  cf.coord = j.coord0 + coord;
+  cf.damping = viscous;
+  cf.coulomb = coulomb;
+  cf.v_smooth = smoothing_velocity;
+  cf.name = who;
+  m_.coord_forces.push_back(cf);
+}
+
+void ModelBuilder::add_motor(const std::string& joint, const Profile& reference, double kp,
+                             double kd, double torque_limit, const Profile* feedforward,
+                             int coord) {
+  const std::string who = msg("motor on '", joint, "'");
+  auto it = m_.joint_index.find(joint);
+  if (it == m_.joint_index.end()) throw ModelError(msg(who, ": unknown joint '", joint, "'"));
+  const Joint& j = m_.joints[it->second];
+  if (coord < 0 || coord >= joint_coords(j.type))
+    throw ModelError(msg(who, ": ", joint_type_name(j.type), " joint has no coordinate ", coord));
+  require_finite(kp, who + ": kp");
+  require_finite(kd, who + ": kd");
+  if (kp < 0 || kd < 0) throw ModelError(msg(who, ": kp and kd must be >= 0"));
+  if (!(torque_limit > 0) || std::isnan(torque_limit))
+    throw ModelError(msg(who, ": torque_limit must be positive, got ", torque_limit));
+  CoordForce cf;
+  cf.coord = j.coord0 + coord;
+  cf.motor = true;
+  cf.reference = reference;
+  cf.kp = kp;
+  cf.kd = kd;
+  cf.torque_limit = torque_limit;
+  if (feedforward) {
+    cf.has_input = true;
+    cf.input = *feedforward;
+  }
+  cf.name = who;
+  m_.coord_forces.push_back(cf);
+}
+
 void ModelBuilder::add_joint_torque(const std::string& joint, const Profile& profile, int coord) {
   const std::string who = msg("joint torque on '", joint, "'");
   auto it = m_.joint_index.find(joint);

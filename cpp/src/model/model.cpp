@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "armdyn/model/model.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "armdyn/errors.hpp"
@@ -130,6 +132,21 @@ std::string Model::summary() const {
   const size_t nforce = body_loads.size() + springs.size() + coord_forces.size();
   if (nforce) os << "  force elements: " << nforce << " (besides gravity)\n";
   return os.str();
+}
+
+double coord_force_value(const CoordForce& cf, bool angular, double q, double qdot, double t) {
+  auto diff = [&](double a, double b) {
+    return angular ? std::remainder(a - b, 2.0 * M_PI) : a - b;
+  };
+  double tau = -cf.stiffness * diff(q, cf.rest) - cf.damping * qdot;
+  if (cf.coulomb > 0) tau -= cf.coulomb * std::tanh(qdot / cf.v_smooth);
+  if (cf.has_input) tau += cf.input.eval(t).y;
+  if (cf.motor) {
+    const ProfileValue r = cf.reference.eval(t);
+    const double u = cf.kp * diff(r.y, q) + cf.kd * (r.yd - qdot);
+    tau += std::clamp(u, -cf.torque_limit, cf.torque_limit);
+  }
+  return tau;
 }
 
 }  // namespace armdyn

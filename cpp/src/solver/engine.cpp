@@ -73,15 +73,14 @@ void Engine::forces(double t) {
   for (const CoordForce& cf : m_.coord_forces) {
     const ScalarJet q = coord_jet(m_, kin_, cf.coord);
     const Coord& c = m_.coords[cf.coord];
-    const double dq = c.angular ? wrap_angle(q.val - cf.rest) : q.val - cf.rest;
-    double tau = -cf.stiffness * dq - cf.damping * q.rate;
-    if (cf.has_input) {
-      try {
-        tau += cf.input.eval(t).y;
-      } catch (const SolverError& err) {
-        throw SolverError(msg("input on joint coordinate '", c.name, "': ", err.what()));
-      }
+    double tau;
+    try {
+      tau = coord_force_value(cf, c.angular, q.val, q.rate, t);
+    } catch (const SolverError& err) {
+      throw SolverError(msg("force on joint coordinate '", c.name, "': ", err.what()));
     }
+    if (!std::isfinite(tau))
+      throw SolverError(msg("non-finite force on joint coordinate '", c.name, "' at t=", t));
     const Joint& j = m_.joints[c.joint];
     scatter(tau * q.J, j.parent, j.child);
   }

@@ -89,13 +89,8 @@ VecX LagrangeValidator::torques(const VecX& q, const VecX& qd, const VecX& qdd, 
     Q -= sd.damping * dL.dot(qd) * dL;
   }
   // joint springs, dampers, friction and inputs on the coordinates
-  for (const CoordForce& cf : m.coord_forces) {
-    const bool ang = m.coords[cf.coord].angular;
-    const double dq = ang ? std::remainder(q[cf.coord] - cf.rest, 2 * M_PI) : q[cf.coord] - cf.rest;
-    double tau = -cf.stiffness * dq - cf.damping * qd[cf.coord];
-    if (cf.has_input) tau += cf.input.eval(t).y;
-    Q[cf.coord] += tau;
-  }
+  for (const CoordForce& cf : m.coord_forces)
+    Q[cf.coord] += coord_force_value(cf, m.coords[cf.coord].angular, q[cf.coord], qd[cf.coord], t);
   // body loads: world force at a body point and world torque
   for (const BodyLoad& l : m.body_loads) {
     const double s = l.has_profile ? l.profile.eval(t).y : 1.0;

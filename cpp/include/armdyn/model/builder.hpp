@@ -65,6 +65,13 @@ class ModelBuilder {
                                double rest, int coord = 0);
   /// Torque (force for prismatic) input on a joint coordinate, from a profile.
   void add_joint_torque(const std::string& joint, const Profile& profile, int coord = 0);
+  /// Viscous plus smoothed Coulomb friction: tau = -viscous qdot - coulomb tanh(qdot / v_s).
+  void add_joint_friction(const std::string& joint, double viscous, double coulomb,
+                          double smoothing_velocity, int coord = 0);
+  /// PD motor on a joint coordinate tracking `reference` (angles wrapped), torque limited to
+  /// +-torque_limit, plus an optional feed-forward profile.
+  void add_motor(const std::string& joint, const Profile& reference, double kp, double kd,
+                 double torque_limit, const Profile* feedforward, int coord = 0);
 
   /// Validate, analyse the topology and assemble the initial state. The builder is unchanged
   /// and may be finalized again.

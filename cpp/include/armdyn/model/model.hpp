@@ -77,14 +77,25 @@ struct SpringDamper {
   double stiffness = 0.0, damping = 0.0, rest_length = 0.0;
 };
 
-/// Generalised force on one joint coordinate: tau = -k (q - q0) - c qdot + input(t).
-/// Covers rotational/linear spring-dampers, viscous friction and torque/force inputs.
+/// Generalised force on one joint coordinate:
+///   tau = -k (q - q0) - c qdot - F_c tanh(qdot / v_s) + input(t) + motor,
+///   motor = clamp(kp (q_ref - q) + kd (qd_ref - qdot), -tau_max, tau_max).
+/// Covers rotational/linear spring-dampers, viscous and smoothed Coulomb friction, torque/force
+/// inputs and PD motors with a torque limit.
 struct CoordForce {
   int coord = 0;
   double stiffness = 0.0, damping = 0.0, rest = 0.0;
+  double coulomb = 0.0, v_smooth = 1e-3;  ///< smoothed Coulomb friction
   bool has_input = false;
   Profile input;
+  bool motor = false;  ///< PD motor tracking `reference`
+  Profile reference;
+  double kp = 0.0, kd = 0.0, torque_limit = 1e300;
+  std::string name;  ///< for messages
 };
+
+/// Generalised force of a coordinate force element at (q, qdot, t), angle differences wrapped.
+double coord_force_value(const CoordForce& cf, bool angular, double q, double qdot, double t);
 
 /// One joint coordinate (revolute angle, prismatic displacement, ...).
 struct Coord {
