@@ -57,11 +57,21 @@ py::dict result_dict(const Model& md, const SimResult& r) {
   s["lu_factorizations"] = r.stats.lu_factorizations;
   s["newton_iterations_implicit"] = r.stats.newton_iterations;
   s["newton_failures"] = r.stats.newton_failures;
+  s["events"] = r.stats.events;
   s["singular_evaluations"] = r.singular_evaluations;
   s["singular_note"] = r.singular_note;
   s["integrator"] = r.integrator;
   s["integrator_reason"] = r.integrator_reason;
   d["stats"] = s;
+  py::dict ev;
+  ev["t"] = to_numpy(r.event_t.data(), {static_cast<py::ssize_t>(r.event_t.size())});
+  std::vector<std::string> names;
+  for (int i : r.event_index) names.push_back(md.gears[i].name);
+  ev["gear"] = names;
+  std::vector<bool> onset;
+  for (int dir : r.event_direction) onset.push_back(dir > 0);
+  ev["onset"] = onset;
+  d["events"] = ev;
   d["error"] = r.error;
   return d;
 }

@@ -291,6 +291,13 @@ void bind_model(py::module_& m) {
           py::arg("joint"), py::arg("viscous") = 0.0, py::arg("coulomb") = 0.0,
           py::arg("smoothing_velocity") = 1e-3, py::arg("coord") = 0,
           "Joint friction: tau = -viscous * qdot - coulomb * tanh(qdot / smoothing_velocity).")
+      .def("add_gear_pair", &ModelBuilder::add_gear_pair, py::arg("name"), py::arg("joint_a"),
+           py::arg("joint_b"), py::arg("r_a"), py::arg("r_b"), py::arg("backlash") = 0.0,
+           py::arg("stiffness") = 1e8, py::arg("exponent") = 1.5, py::arg("hc_damping") = 0.0,
+           "Gear pair with backlash between two revolute joints (external mesh): mesh "
+           "displacement s = r_a q_a + r_b q_b, dead zone |s| <= backlash/2, Hunt-Crossley "
+           "contact force F = k d^n (1 + hc_damping d') >= 0 beyond it. Contact onset and "
+           "separation are located as events (result.events).")
       .def(
           "add_motor",
           [](ModelBuilder& b, const std::string& joint, py::object reference, double kp, double kd,

@@ -27,6 +27,8 @@ class SimulationResult:
         velocity_residual: (n,) max |ζ v − rhs|.
         kinetic_energy, potential_energy: (n,) [J]; potential includes gravity and springs.
         stats: step, rejection, KKT-solve and factorisation counts, and run time [s].
+        events: located events (gear contact): ``t`` (times), ``gear`` (names), ``onset``
+            (True at contact onset, False at separation).
     """
 
     t: np.ndarray
@@ -43,6 +45,7 @@ class SimulationResult:
     kinetic_energy: np.ndarray
     potential_energy: np.ndarray
     stats: dict = field(default_factory=dict)
+    events: dict = field(default_factory=dict)
 
     @property
     def total_energy(self) -> np.ndarray:

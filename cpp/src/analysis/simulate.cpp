@@ -15,13 +15,7 @@ namespace {
 class MbsSystem : public OdeSystem {
  public:
   MbsSystem(const Model& m, Metric metric, SimResult& out)
-      : m_(m),
-        e_(m),
-        metric_(metric),
-        out_(out),
-        yo_(m.nq + m.nv),
-        vd_(m.nv),
-        qprev_(m.coords.size()) {}
+      : m_(m), e_(m), metric_(metric), out_(out), yo_(m.nq + m.nv), vd_(m.nv) {}
 
   void rhs(double t, const VecX& y, VecX& dy) override {
     e_.dynamics(t, y.data(), y.data() + m_.nq, dy.data() + m_.nq);
@@ -44,10 +38,8 @@ class MbsSystem : public OdeSystem {
     const long row = out_.n;
     for (size_t c = 0; c < m_.coords.size(); ++c) {
       const ScalarJet q = coord_jet(m_, e_.kin(), static_cast<int>(c));
-      double qv = q.val;
-      if (m_.coords[c].angular && row > 0)
-        qv = qprev_[c] + std::remainder(q.val - qprev_[c], 2.0 * M_PI);
-      qprev_[c] = qv;
+      // angles unwrapped over turns by the engine, which follows them at every projection
+      const double qv = m_.coords[c].angular ? e_.tracked(static_cast<int>(c), q.val) : q.val;
       out_.q.push_back(qv);
       out_.qd.push_back(q.rate);
       // qdd = J vdot + bias from the accelerations of this very state
@@ -80,6 +72,20 @@ class MbsSystem : public OdeSystem {
     out_.n = row + 1;
   }
 
+  int n_events() const override { return static_cast<int>(m_.gears.size()); }
+  void events(double /*t*/, const VecX& y, double* g) override {
+    e_.load(y.data(), y.data() + m_.nq);
+    for (int i = 0; i < n_events(); ++i) {
+      double s, sd;
+      e_.gear_mesh(i, s, sd, g[i]);
+    }
+  }
+  void on_event(double t, int i, int direction) override {
+    out_.event_t.push_back(t);
+    out_.event_index.push_back(i);
+    out_.event_direction.push_back(direction);
+  }
+
   Engine& engine() { return e_; }
 
  private:
@@ -87,7 +93,7 @@ class MbsSystem : public OdeSystem {
   Engine e_;
   Metric metric_;
   SimResult& out_;
-  VecX yo_, vd_, qprev_;
+  VecX yo_, vd_;
 };
 
 }  // namespace
@@ -98,7 +104,7 @@ double stiffness_estimate(const Model& m, std::string& culprit) {
   //   1/m_eff = g . vdot(eta = g^T, xi = 0)   (a KKT solve; driven coordinates give 0).
   double lam = 0.0;
   culprit = "no springs or dampers";
-  if (m.springs.empty() && m.coord_forces.empty()) return 0.0;
+  if (m.springs.empty() && m.coord_forces.empty() && m.gears.empty()) return 0.0;
   Engine e(m);
   e.load(m.u0.data(), m.v0.data());
   ConstraintEval& ce = e.constraints();
@@ -141,6 +147,25 @@ double stiffness_estimate(const Model& m, std::string& culprit) {
       consider(std::sqrt(cf.kp * im), msg("motor on '", name, "' (kp)"));
       consider(cf.kd * im, msg("motor on '", name, "' (kd)"));
     }
+  }
+  for (const GearPair& g : m.gears) {
+    // mesh direction: r_a J_qa + r_b J_qb over the (up to four) bodies of the two joints
+    const ScalarJet qa = coord_jet(m, e.kin(), g.coord_a), qb = coord_jet(m, e.kin(), g.coord_b);
+    const Joint& ja = m.joints[m.coords[g.coord_a].joint];
+    const Joint& jb = m.joints[m.coords[g.coord_b].joint];
+    eta.setZero();
+    auto add = [&](const Row12& row, const Joint& j) {
+      if (j.parent != kGround) eta.segment<6>(6 * j.parent) += row.segment<6>(0).transpose();
+      if (j.child != kGround) eta.segment<6>(6 * j.child) += row.segment<6>(6).transpose();
+    };
+    add(g.r_a * qa.J, ja);
+    add(g.r_b * qb.J, jb);
+    kkt.accelerations(ce, eta, vd, delta);
+    const double im = std::max(0.0, eta.dot(vd));
+    // linearised contact stiffness at a penetration of 1 % of the backlash (or 1 um)
+    const double d = std::max(0.01 * g.backlash, 1e-6);
+    const double k = g.stiffness * g.exponent * std::pow(d, g.exponent - 1.0);
+    consider(std::sqrt(k * im), msg("gear pair '", g.name, "' mesh"));
   }
   return lam;
 }

@@ -326,6 +326,52 @@ void ModelBuilder::add_joint_friction(const std::string& joint, double viscous, 
   m_.coord_forces.push_back(cf);
 }
 
+void ModelBuilder::add_gear_pair(const std::string& name, const std::string& joint_a,
+                                 const std::string& joint_b, double r_a, double r_b,
+                                 double backlash, double stiffness, double exponent,
+                                 double hc_damping) {
+  const std::string who = msg("gear pair '", name, "'");
+  for (const GearPair& g : m_.gears)
+    if (g.name == name) throw ModelError(msg(who, ": duplicate gear pair name"));
+  auto coord_of = [&](const std::string& joint) {
+    auto it = m_.joint_index.find(joint);
+    if (it == m_.joint_index.end()) throw ModelError(msg(who, ": unknown joint '", joint, "'"));
+    const Joint& j = m_.joints[it->second];
+    if (j.type != JointType::Revolute)
+      throw ModelError(msg(who, ": joint '", joint, "' is ", joint_type_name(j.type),
+                           ", a gear needs a revolute joint"));
+    return j.coord0;
+  };
+  const int ca = coord_of(joint_a), cb = coord_of(joint_b);
+  if (ca == cb) throw ModelError(msg(who, ": both gears are on joint '", joint_a, "'"));
+  for (auto [v, n] : {std::pair{r_a, "r_a"}, std::pair{r_b, "r_b"}}) {
+    require_finite(v, who + ": " + n);
+    if (!(v > 0)) throw ModelError(msg(who, ": pitch radius ", n, " must be positive, got ", v));
+  }
+  require_finite(backlash, who + ": backlash");
+  require_finite(stiffness, who + ": stiffness");
+  require_finite(exponent, who + ": exponent");
+  require_finite(hc_damping, who + ": hc_damping");
+  if (backlash < 0) throw ModelError(msg(who, ": backlash must be >= 0, got ", backlash));
+  if (!(stiffness > 0)) throw ModelError(msg(who, ": stiffness must be positive"));
+  if (!(exponent >= 1.0)) throw ModelError(msg(who, ": exponent must be >= 1, got ", exponent));
+  if (hc_damping < 0) throw ModelError(msg(who, ": hc_damping must be >= 0"));
+  GearPair g;
+  g.name = name;
+  g.coord_a = ca;
+  g.coord_b = cb;
+  g.r_a = r_a;
+  g.r_b = r_b;
+  g.backlash = backlash;
+  g.stiffness = stiffness;
+  g.exponent = exponent;
+  g.hc_damping = hc_damping;
+  m_.gears.push_back(g);
+  for (int c : {ca, cb})
+    if (std::find(m_.tracked_coords.begin(), m_.tracked_coords.end(), c) == m_.tracked_coords.end())
+      m_.tracked_coords.push_back(c);
+}
+
 void ModelBuilder::add_motor(const std::string& joint, const Profile& reference, double kp,
                              double kd, double torque_limit, const Profile* feedforward,
                              int coord) {

@@ -129,9 +129,17 @@ std::string Model::summary() const {
     os << "    " << j.name << "  " << joint_type_name(j.type) << "  " << body_name(j.parent)
        << " -> " << body_name(j.child) << "\n";
   for (const Drive& d : drives) os << "  drive " << d.name << ": " << d.profile.describe() << "\n";
-  const size_t nforce = body_loads.size() + springs.size() + coord_forces.size();
+  const size_t nforce = body_loads.size() + springs.size() + coord_forces.size() + gears.size();
   if (nforce) os << "  force elements: " << nforce << " (besides gravity)\n";
   return os.str();
+}
+
+double gear_force(const GearPair& g, double s, double sd, double& penetration) {
+  penetration = std::abs(s) - 0.5 * g.backlash;
+  if (penetration <= 0.0) return 0.0;
+  const double rate = s >= 0 ? sd : -sd;  // penetration rate
+  const double f = g.stiffness * std::pow(penetration, g.exponent) * (1.0 + g.hc_damping * rate);
+  return std::max(f, 0.0);
 }
 
 double coord_force_value(const CoordForce& cf, bool angular, double q, double qdot, double t) {

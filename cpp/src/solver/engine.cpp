@@ -21,6 +21,7 @@ Engine::Engine(const Model& m)
       tmp_nc_(VecX::Zero(m.nc)),
       mu_(VecX::Zero(m.nc)),
       vd_(VecX::Zero(m.nv)),
+      track_ref_(VecX::Zero(static_cast<long>(m.coords.size()))),
       nrows_(m.nc) {
   kin_.resize(m.nb);
   ce_.init(m);
@@ -83,6 +84,21 @@ void Engine::forces(double t) {
       throw SolverError(msg("non-finite force on joint coordinate '", c.name, "' at t=", t));
     const Joint& j = m_.joints[c.joint];
     scatter(tau * q.J, j.parent, j.child);
+  }
+  // gear pairs with backlash: contact force along the line of action
+  for (size_t gi = 0; gi < m_.gears.size(); ++gi) {
+    const GearPair& g = m_.gears[gi];
+    const ScalarJet qa = coord_jet(m_, kin_, g.coord_a), qb = coord_jet(m_, kin_, g.coord_b);
+    const double s = g.r_a * tracked(g.coord_a, qa.val) + g.r_b * tracked(g.coord_b, qb.val);
+    const double sd = g.r_a * qa.rate + g.r_b * qb.rate;
+    double pen;
+    const double f = gear_force(g, s, sd, pen);
+    if (f == 0.0) continue;
+    const double fs = s >= 0 ? f : -f;
+    const Joint& ja = m_.joints[m_.coords[g.coord_a].joint];
+    const Joint& jb = m_.joints[m_.coords[g.coord_b].joint];
+    scatter(-g.r_a * fs * qa.J, ja.parent, ja.child);
+    scatter(-g.r_b * fs * qb.J, jb.parent, jb.child);
   }
   // joint-space torques of a joint-space call
   if (tau_) {
@@ -197,6 +213,7 @@ void Engine::project(double t, double* u, double* v, Metric metric) {
   }
   // velocities onto zeta v = rhs, with A at the final u
   load(u, v);
+  commit_tracking();
   if (nrows_ == 0) return;
   kkt_.factor(ce_, nrows_, metric);
   ++factorizations;
@@ -207,6 +224,20 @@ void Engine::project(double t, double* u, double* v, Metric metric) {
   kkt_.apply_winv(tmp_nv_, vd_);
   vm -= vd_;
   ++pstats.velocity_projections;
+}
+
+void Engine::commit_tracking() {
+  // every angle coordinate is followed over turns (gears need it; outputs use it)
+  for (int c = 0; c < static_cast<int>(m_.coords.size()); ++c)
+    if (m_.coords[c].angular) track_ref_[c] = tracked(c, coord_jet(m_, kin_, c).val);
+}
+
+void Engine::gear_mesh(int gi, double& s, double& sd, double& penetration) const {
+  const GearPair& g = m_.gears[gi];
+  const ScalarJet qa = coord_jet(m_, kin_, g.coord_a), qb = coord_jet(m_, kin_, g.coord_b);
+  s = g.r_a * tracked(g.coord_a, qa.val) + g.r_b * tracked(g.coord_b, qb.val);
+  sd = g.r_a * qa.rate + g.r_b * qb.rate;
+  penetration = std::abs(s) - 0.5 * g.backlash;
 }
 
 void Engine::residuals(double t, const double* u, const double* v, double& rf, double& rv) {

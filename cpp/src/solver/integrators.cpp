@@ -39,6 +39,54 @@ double err_norm(const VecX& e, const VecX& a, const VecX& b, double rtol, double
   return s;
 }
 
+// Event location on a step [t, t + h] with dense output dense(theta, y_out). sgn holds the sign
+// of every event function at the start of the step; gend its values at the end. Returns the
+// theta in (0, 1] of the earliest crossing (on the side where g has its new sign), or -1.
+template <class Dense>
+double locate_events(OdeSystem& sys, double t, double h, const Dense& dense,
+                     const std::vector<int>& sgn, const VecX& gend, VecX& gbuf, VecX& ybuf,
+                     std::vector<int>& crossed) {
+  const int ne = static_cast<int>(sgn.size());
+  double best = -1.0;
+  crossed.clear();
+  for (int i = 0; i < ne; ++i) {
+    if (!(gend[i] * sgn[i] < 0)) continue;
+    // Illinois on [a, b] with g(a) of sign sgn[i], g(b) of the opposite sign
+    double a = 0.0, b = 1.0, fa = sgn[i] * 1e-300, fb = gend[i];
+    {
+      dense(0.0, ybuf);
+      sys.events(t, ybuf, gbuf.data());
+      if (gbuf[i] * sgn[i] > 0) fa = gbuf[i];
+    }
+    int side = 0;
+    for (int it = 0; it < 100 && (b - a) * h > 1e-14 * std::max(1.0, std::abs(t)); ++it) {
+      const double c = (fa == fb) ? 0.5 * (a + b) : b - fb * (b - a) / (fb - fa);
+      const double cc = (c > a && c < b) ? c : 0.5 * (a + b);
+      dense(cc, ybuf);
+      sys.events(t + cc * h, ybuf, gbuf.data());
+      const double fc = gbuf[i];
+      if (fc * sgn[i] > 0) {  // still before the crossing
+        a = cc;
+        fa = fc;
+        if (side == -1) fb *= 0.5;
+        side = -1;
+      } else {
+        b = cc;
+        fb = fc;
+        if (side == 1) fa *= 0.5;
+        side = 1;
+      }
+    }
+    if (best < 0 || b < best - 1e-12) {
+      best = b;
+      crossed.assign(1, i);
+    } else if (std::abs(b - best) <= 1e-12) {
+      crossed.push_back(i);
+    }
+  }
+  return best;
+}
+
 }  // namespace
 
 void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepOptions& opt,
@@ -95,6 +143,17 @@ void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
   double facold = 1e-4;
   bool last_rejected = false;
   const double hmin = 1e-14 * std::max(1.0, std::abs(t1));
+  // events: signs at the start of the step
+  const int ne = sys.n_events();
+  std::vector<int> sgn(ne, 1), crossed;
+  VecX gend(ne), gbuf(ne), ybuf(n);
+  auto reset_signs = [&]() {
+    if (ne == 0) return;
+    sys.events(t, y, gbuf.data());
+    for (int i = 0; i < ne; ++i)
+      if (gbuf[i] != 0.0) sgn[i] = gbuf[i] > 0 ? 1 : -1;
+  };
+  reset_signs();
 
   while (t < t1) {
     if (st.steps + st.rejected >= opt.max_steps)
@@ -129,19 +188,42 @@ void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
       double hnew = std::min(h / fac, hmax);
       if (last_rejected) hnew = std::min(hnew, h);
       facold = std::max(en, 1e-4);
-      const double tn = (t + h >= t1 - 1e-14 * std::max(1.0, std::abs(t1))) ? t1 : t + h;
-      if (!every_step && ko < touts.size() && touts[ko] <= tn) {
+      double tn = (t + h >= t1 - 1e-14 * std::max(1.0, std::abs(t1))) ? t1 : t + h;
+      const bool need_dense = ne > 0 || (!every_step && ko < touts.size() && touts[ko] <= tn);
+      if (need_dense) {
         r1 = y;
         r2 = y1 - y;
         r3 = h * k1 - r2;
         r4 = r2 - h * k7 - r3;
         r5 = h * (d1 * k1 + d3 * k3 + d4 * k4 + d5 * k5 + d6 * k6 + d7 * k7);
+      }
+      auto dense = [&](double th, VecX& out) {
+        const double th1 = 1.0 - th;
+        out = r1 + th * (r2 + th1 * (r3 + th * (r4 + th1 * r5)));
+      };
+      // events: cut the step at the earliest crossing and restart from there
+      bool cut = false;
+      if (ne > 0) {
+        sys.events(tn, y1, gend.data());
+        const double th = locate_events(sys, t, h, dense, sgn, gend, gbuf, ybuf, crossed);
+        if (th > 0 && th < 1.0) {
+          tn = t + th * h;
+          dense(th, y1);
+          cut = true;
+        }
+        for (int i : crossed) {
+          sgn[i] = -sgn[i];
+          sys.on_event(tn, i, sgn[i]);
+          ++st.events;
+        }
+      }
+      if (!every_step && ko < touts.size() && touts[ko] <= tn) {
         for (; ko < touts.size() && touts[ko] <= tn; ++ko) {
-          const double th = (touts[ko] - t) / h, th1 = 1.0 - th;
-          yo = r1 + th * (r2 + th1 * (r3 + th * (r4 + th1 * r5)));
+          dense((touts[ko] - t) / h, yo);
           sys.output(touts[ko], yo);
         }
       }
+      (void)cut;
       y = y1;
       sys.project_and_rhs(tn, y, k1);
       ++st.rhs_evals;
@@ -286,6 +368,14 @@ void integrate_trbdf2(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
     return false;
   };
 
+  const int ne = sys.n_events();
+  std::vector<int> sgn(ne, 1), crossed;
+  VecX gend(ne), gbuf(ne), ybuf(n), yh(n);
+  if (ne > 0) {
+    sys.events(t, y, gbuf.data());
+    for (int i = 0; i < ne; ++i)
+      if (gbuf[i] != 0.0) sgn[i] = gbuf[i] > 0 ? 1 : -1;
+  }
   weights(y);
   // initial step: a fraction of the span, limited by the first derivative
   double h = opt.dt > 0
@@ -336,12 +426,29 @@ void integrate_trbdf2(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
     if (!std::isfinite(en)) throw SolverError(msg("trbdf2: non-finite error estimate at t=", t));
     double fac = std::clamp(safe * std::pow(std::max(en, 1e-10), -1.0 / 3.0), fac_min, fac_max);
     if (en <= 1.0) {
-      const double tn = (t + h >= t1 - 1e-14 * std::max(1.0, std::abs(t1))) ? t1 : t + h;
-      // outputs by cubic Hermite interpolation between (y, K1) and (y1, K3)
+      double tn = (t + h >= t1 - 1e-14 * std::max(1.0, std::abs(t1))) ? t1 : t + h;
+      // dense output: cubic Hermite between (y, K1) and (y1, K3)
+      yh = y1;
+      auto dense = [&](double th, VecX& out) {
+        const double s2 = th * th, s3 = s2 * th;
+        out = (2 * s3 - 3 * s2 + 1) * y + (s3 - 2 * s2 + th) * h * K1 + (-2 * s3 + 3 * s2) * yh +
+              (s3 - s2) * h * K3;
+      };
+      if (ne > 0) {
+        sys.events(tn, y1, gend.data());
+        const double th = locate_events(sys, t, h, dense, sgn, gend, gbuf, ybuf, crossed);
+        if (th > 0 && th < 1.0) {
+          tn = t + th * h;
+          dense(th, y1);
+        }
+        for (int i : crossed) {
+          sgn[i] = -sgn[i];
+          sys.on_event(tn, i, sgn[i]);
+          ++st.events;
+        }
+      }
       for (; !every_step && ko < touts.size() && touts[ko] <= tn; ++ko) {
-        const double s = (touts[ko] - t) / h, s2 = s * s, s3 = s2 * s;
-        yo = (2 * s3 - 3 * s2 + 1) * y + (s3 - 2 * s2 + s) * h * K1 + (-2 * s3 + 3 * s2) * y1 +
-             (s3 - s2) * h * K3;
+        dense((touts[ko] - t) / h, yo);
         sys.output(touts[ko], yo);
       }
       y = y1;

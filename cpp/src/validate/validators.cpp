@@ -91,6 +91,16 @@ VecX LagrangeValidator::torques(const VecX& q, const VecX& qd, const VecX& qdd, 
   // joint springs, dampers, friction and inputs on the coordinates
   for (const CoordForce& cf : m.coord_forces)
     Q[cf.coord] += coord_force_value(cf, m.coords[cf.coord].angular, q[cf.coord], qd[cf.coord], t);
+  // gear pairs (q are unwrapped here)
+  for (const GearPair& g : m.gears) {
+    const double s = g.r_a * q[g.coord_a] + g.r_b * q[g.coord_b];
+    const double sd = g.r_a * qd[g.coord_a] + g.r_b * qd[g.coord_b];
+    double pen;
+    const double f = gear_force(g, s, sd, pen);
+    const double fs = s >= 0 ? f : -f;
+    Q[g.coord_a] -= g.r_a * fs;
+    Q[g.coord_b] -= g.r_b * fs;
+  }
   // body loads: world force at a body point and world torque
   for (const BodyLoad& l : m.body_loads) {
     const double s = l.has_profile ? l.profile.eval(t).y : 1.0;

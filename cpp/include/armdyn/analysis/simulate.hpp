@@ -28,6 +28,9 @@ struct SimResult {
   long kkt_solves = 0, factorizations = 0, position_projections = 0, newton_iterations = 0;
   long singular_evaluations = 0;
   std::string singular_note;
+  /// located events: gear contact onset (+1) and separation (-1), by gear index
+  std::vector<double> event_t;
+  std::vector<int> event_index, event_direction;
   double cpu_seconds = 0.0;
   std::string error;  ///< non-empty when the run stopped early (SolverError message)
   std::string integrator, integrator_reason;  ///< the method used, and why (for "auto")

@@ -68,6 +68,10 @@ class ModelBuilder {
   /// Viscous plus smoothed Coulomb friction: tau = -viscous qdot - coulomb tanh(qdot / v_s).
   void add_joint_friction(const std::string& joint, double viscous, double coulomb,
                           double smoothing_velocity, int coord = 0);
+  /// Gear pair with backlash between two revolute joints (see GearPair).
+  void add_gear_pair(const std::string& name, const std::string& joint_a,
+                     const std::string& joint_b, double r_a, double r_b, double backlash,
+                     double stiffness, double exponent, double hc_damping);
   /// PD motor on a joint coordinate tracking `reference` (angles wrapped), torque limited to
   /// +-torque_limit, plus an optional feed-forward profile.
   void add_motor(const std::string& joint, const Profile& reference, double kp, double kd,

@@ -97,6 +97,24 @@ struct CoordForce {
 /// Generalised force of a coordinate force element at (q, qdot, t), angle differences wrapped.
 double coord_force_value(const CoordForce& cf, bool angular, double q, double qdot, double t);
 
+/// Gear pair with backlash between the angle coordinates of two revolute joints (external
+/// mesh): the mesh displacement along the line of action is s = r_a q_a + r_b q_b (zero when
+/// both gears are at their assembly angles; rolling without slip keeps it constant). Inside the
+/// gap |s| <= backlash/2 no force acts; beyond it the penetration d = |s| - backlash/2 gives the
+/// Hunt-Crossley contact force F = k d^n (1 + alpha d'), clamped at F >= 0 (never pulling), and
+/// the generalised forces tau_a = -r_a sign(s) F, tau_b = -r_b sign(s) F. q_a, q_b are tracked
+/// over several turns (unwrapped).
+struct GearPair {
+  std::string name;
+  int coord_a = 0, coord_b = 0;
+  double r_a = 0.0, r_b = 0.0, backlash = 0.0;
+  double stiffness = 0.0, exponent = 1.5, hc_damping = 0.0;  ///< k [N/m^n], n, alpha [s/m]
+};
+
+/// Mesh force F >= 0 of a gear pair for mesh displacement s and rate sd; also returns the
+/// penetration (negative inside the gap).
+double gear_force(const GearPair& g, double s, double sd, double& penetration);
+
 /// One joint coordinate (revolute angle, prismatic displacement, ...).
 struct Coord {
   std::string name;
@@ -114,6 +132,8 @@ class Model {
   std::vector<BodyLoad> body_loads;
   std::vector<SpringDamper> springs;
   std::vector<CoordForce> coord_forces;
+  std::vector<GearPair> gears;
+  std::vector<int> tracked_coords;  ///< angle coordinates unwrapped over turns (gears)
   std::vector<Coord> coords;
   Vec3 gravity = Vec3(0, 0, -9.81);
 

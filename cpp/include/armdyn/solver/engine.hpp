@@ -5,6 +5,7 @@
 // once in the constructor; nothing is allocated per evaluation.
 #pragma once
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -51,6 +52,16 @@ class Engine {
   /// multipliers of the last dynamics() call (kinematics must still be loaded).
   void joint_reaction(int j, Vec3& force, Vec3& torque) const;
 
+  /// Unwrapped value of a tracked angle coordinate (gears) from its raw (wrapped) value,
+  /// continuous with the value at the last projection.
+  double tracked(int coord, double raw) const {
+    return track_ref_[coord] + std::remainder(raw - track_ref_[coord], 2.0 * M_PI);
+  }
+  /// Gear mesh displacement s, rate and penetration |s| - backlash/2 at the loaded state.
+  void gear_mesh(int g, double& s, double& sd, double& penetration) const;
+  /// Set the tracked angles' references from the loaded state (after each projection).
+  void commit_tracking();
+
   const VecX& delta() const { return delta_; }
   const VecX& eta() const { return eta_; }
   const ConstraintEval& constraints() const { return ce_; }
@@ -73,6 +84,7 @@ class Engine {
   KktSolver kkt_;
   VecX eta_, delta_, tmp_nv_, tmp_nc_, mu_;
   VecX vd_;
+  VecX track_ref_;  // unwrapped reference of tracked angle coordinates (by coordinate index)
   const double* tau_ = nullptr;
   int nrows_ = 0;
   double tol_f_ = 1e-13;

@@ -29,10 +29,17 @@ class OdeSystem {
   virtual void project_and_rhs(double t, VecX& y, VecX& dy) = 0;
   /// Record an output at t (y is a state to be projected by the system, not yet recorded).
   virtual void output(double t, const VecX& y) = 0;
+  /// Event functions g_i(t, y): a sign change inside a step is located on the dense output
+  /// (Illinois method), the step is cut there and the integration restarts from that state
+  /// (DOPRI5 and TR-BDF2; RK4 does not locate events).
+  virtual int n_events() const { return 0; }
+  virtual void events(double /*t*/, const VecX& /*y*/, double* /*g*/) {}
+  /// Called for each located crossing; direction +1 when g goes from negative to positive.
+  virtual void on_event(double /*t*/, int /*i*/, int /*direction*/) {}
 };
 
 struct StepStats {
-  long steps = 0, rejected = 0, rhs_evals = 0;
+  long steps = 0, rejected = 0, rhs_evals = 0, events = 0;
   long jacobians = 0, lu_factorizations = 0, newton_iterations = 0, newton_failures = 0;
 };
 
