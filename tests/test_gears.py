@@ -92,3 +92,93 @@ def test_gear_pair_bad_input():
         b.add_gear_pair("g3", "ja", "nowhere", 0.1, 0.1)
     with pytest.raises(ad.ModelError, match=r"'g4'.*backlash"):
         b.add_gear_pair("g4", "ja", "jc", 0.1, 0.1, backlash=-1.0)
+
+
+# ----------------------------------------------------------------------------------------------
+# ideal gear constraint
+# ----------------------------------------------------------------------------------------------
+
+
+def ideal_pair():
+    b = ad.ModelBuilder(gravity=(0.0, 0.0, 0.0))
+    b.add_body("pinion", MA, [IA / 2 + 1e-6, IA / 2 + 1e-6, IA], position=(0, 0, 0))
+    b.add_body("wheel", MB, [IB / 2 + 1e-6, IB / 2 + 1e-6, IB], position=(RA + RB, 0, 0))
+    b.add_revolute("ja", "ground", "pinion", point=(0, 0, 0), axis=(0, 0, 1))
+    b.add_revolute("jb", "ground", "wheel", point=(RA + RB, 0, 0), axis=(0, 0, 1))
+    b.add_gear("mesh", "ja", "jb", RA, RB)
+    b.add_joint_torque("ja", T)
+    return b.finalize()
+
+
+def test_ideal_gear_over_many_turns():
+    model = ideal_pair()
+    assert model.mobility == 1
+    assert "gear mesh" in model.summary()
+    res = ad.simulate(model, 1.0, rtol=1e-10, atol=1e-12, output_dt=0.05)
+    alpha = T / (IA + (RA / RB) ** 2 * IB)
+    assert res.q[-1, 0] == pytest.approx(0.5 * alpha, rel=1e-8)  # ≈ 1000 rad: 160 turns
+    assert np.max(np.abs(RA * res.q[:, 0] + RB * res.q[:, 1])) <= 1e-11
+    assert np.max(res.position_residual) <= 1e-12
+
+
+def test_ideal_gear_on_a_moving_carrier_conserves_energy():
+    """Both gears ride on a carrier arm pivoting on ground (the gear row touches three bodies):
+    free motion conserves energy and keeps r_a q_a + r_b q_b = 0 in relative angles."""
+    b = ad.ModelBuilder(gravity=(0.0, 0.0, -9.81))
+    b.add_body("carrier", 2.0, [0.01, 0.05, 0.05], position=(0.2, 0, 0))
+    b.add_body("pinion", MA, [IA / 2 + 1e-6, IA / 2 + 1e-6, IA], position=(0.1, 0, 0))
+    b.add_body("wheel", MB, [IB / 2 + 1e-6, IB / 2 + 1e-6, IB], position=(0.1 + RA + RB, 0, 0))
+    b.add_revolute("pivot", "ground", "carrier", point=(0, 0, 0), axis=(0, 1, 0))
+    b.add_revolute("ja", "carrier", "pinion", point=(0.1, 0, 0), axis=(0, 1, 0))
+    b.add_revolute("jb", "carrier", "wheel", point=(0.1 + RA + RB, 0, 0), axis=(0, 1, 0))
+    b.add_gear("mesh", "ja", "jb", RA, RB)
+    model = b.finalize()
+    assert model.mobility == 2
+    u0, v0 = np.asarray(model.u0), np.zeros(model.nv)
+    v0[6 + 4] = 30.0  # spin the pinion (body frame y); projection makes the state consistent
+    res = ad.simulate(model, 2.0, rtol=1e-10, atol=1e-12, output_dt=0.05, u0=u0, v0=v0)
+    names = list(model.coord_names)
+    qa, qb = res.q[:, names.index("ja")], res.q[:, names.index("jb")]
+    assert np.max(np.abs(RA * qa + RB * qb)) <= 1e-11
+    assert np.ptp(qa) > 10.0  # several turns
+    energy = res.total_energy
+    assert np.max(np.abs(energy - energy[0])) <= 1e-8 * np.max(res.kinetic_energy)
+
+
+def test_motor_torque_through_an_ideal_gear_equals_inverse_dynamics_through_the_ratio():
+    """A pinion drive lifts a pendulum load on the wheel. The drive torque at the pinion equals
+    I_a α_a − (r_a/r_b) τ_b, with τ_b the inverse-dynamics torque of the wheel and load driven
+    directly along θ_b = −(r_a/r_b) θ_a (power balance through the ideal gear)."""
+    profile_a = ad.profiles.cubic(0.0, -4.0, 0.0, 1.0)  # pinion turns back: wheel lifts the load
+    ratio = RA / RB
+
+    def build(direct):
+        b = ad.ModelBuilder(gravity=(0.0, 0.0, -9.81))
+        # gears turn about x; the load sits 0.1 m off the wheel axis, so gravity loads the wheel
+        b.add_body("pinion", MA, [IA, IA / 2 + 1e-6, IA / 2 + 1e-6], position=(0, 0, 0))
+        b.add_body("wheel", MB, [IB, IB / 2 + 1e-6, IB / 2 + 1e-6], position=(0, RA + RB, 0))
+        b.add_body("load", 0.5, [1e-4, 1e-4, 1e-4], position=(0, RA + RB + 0.1, 0))
+        b.add_revolute("ja", "ground", "pinion", point=(0, 0, 0), axis=(1, 0, 0))
+        b.add_revolute("jb", "ground", "wheel", point=(0, RA + RB, 0), axis=(1, 0, 0))
+        b.add_fixed("arm", "wheel", "load", point=(0, RA + RB + 0.1, 0))
+        if direct:
+            b.add_drive("ja", profile_a)
+            b.add_drive("jb", lambda t: tuple(-ratio * v for v in profile_a.eval(t)))
+        else:
+            b.add_gear("mesh", "ja", "jb", RA, RB)
+            b.add_drive("ja", profile_a)
+        return b.finalize()
+
+    geared, direct = build(False), build(True)
+    times = np.linspace(0.0, 1.0, 21)
+    sim = ad.simulate(geared, 1.0, rtol=1e-10, atol=1e-12, output_dt=0.05)
+    idr = ad.inverse_dynamics(direct, t=times)
+    alpha_a = np.array([profile_a.eval(t)[2] for t in times])
+    names = list(direct.drive_names)
+    tau_b = idr.drive_forces[:, names.index("jb")]
+    expected = IA * alpha_a - ratio * tau_b
+    assert np.max(np.abs(tau_b)) > 0.1  # the load matters
+    assert np.max(np.abs(sim.drive_forces[:, 0] - expected)) <= 1e-9 * np.max(np.abs(expected))
+    # and the geared model's own inverse dynamics agrees
+    idg = ad.inverse_dynamics(geared, t=times)
+    assert np.max(np.abs(idg.drive_forces[:, 0] - expected)) <= 1e-9 * np.max(np.abs(expected))

@@ -291,6 +291,10 @@ void bind_model(py::module_& m) {
           py::arg("joint"), py::arg("viscous") = 0.0, py::arg("coulomb") = 0.0,
           py::arg("smoothing_velocity") = 1e-3, py::arg("coord") = 0,
           "Joint friction: tau = -viscous * qdot - coulomb * tanh(qdot / smoothing_velocity).")
+      .def("add_gear", &ModelBuilder::add_gear, py::arg("name"), py::arg("joint_a"),
+           py::arg("joint_b"), py::arg("r_a"), py::arg("r_b"),
+           "Ideal gear (no backlash) between two revolute joints: the rolling constraint "
+           "r_a q_a + r_b q_b = 0 (external mesh, multi-turn angles).")
       .def("add_gear_pair", &ModelBuilder::add_gear_pair, py::arg("name"), py::arg("joint_a"),
            py::arg("joint_b"), py::arg("r_a"), py::arg("r_b"), py::arg("backlash") = 0.0,
            py::arg("stiffness") = 1e8, py::arg("exponent") = 1.5, py::arg("hc_damping") = 0.0,

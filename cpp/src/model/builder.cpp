@@ -326,6 +326,35 @@ void ModelBuilder::add_joint_friction(const std::string& joint, double viscous, 
   m_.coord_forces.push_back(cf);
 }
 
+void ModelBuilder::add_gear(const std::string& name, const std::string& joint_a,
+                            const std::string& joint_b, double r_a, double r_b) {
+  const std::string who = msg("gear '", name, "'");
+  for (const GearConstraint& g : m_.gear_constraints)
+    if (g.name == name) throw ModelError(msg(who, ": duplicate gear name"));
+  auto coord_of = [&](const std::string& joint) {
+    auto it = m_.joint_index.find(joint);
+    if (it == m_.joint_index.end()) throw ModelError(msg(who, ": unknown joint '", joint, "'"));
+    const Joint& j = m_.joints[it->second];
+    if (j.type != JointType::Revolute)
+      throw ModelError(msg(who, ": joint '", joint, "' is ", joint_type_name(j.type),
+                           ", a gear needs a revolute joint"));
+    return j.coord0;
+  };
+  const int ca = coord_of(joint_a), cb = coord_of(joint_b);
+  if (ca == cb) throw ModelError(msg(who, ": both gears are on joint '", joint_a, "'"));
+  for (auto [v, n] : {std::pair{r_a, "r_a"}, std::pair{r_b, "r_b"}}) {
+    require_finite(v, who + ": " + n);
+    if (!(v > 0)) throw ModelError(msg(who, ": pitch radius ", n, " must be positive, got ", v));
+  }
+  GearConstraint g;
+  g.name = name;
+  g.coord_a = ca;
+  g.coord_b = cb;
+  g.r_a = r_a;
+  g.r_b = r_b;
+  m_.gear_constraints.push_back(g);
+}
+
 void ModelBuilder::add_gear_pair(const std::string& name, const std::string& joint_a,
                                  const std::string& joint_b, double r_a, double r_b,
                                  double backlash, double stiffness, double exponent,
@@ -422,6 +451,8 @@ ModelPtr ModelBuilder::finalize(const FinalizeOptions& options) const {
   m.nb = static_cast<int>(m.bodies.size());
   m.nq = 7 * m.nb;
   m.nv = 6 * m.nb;
+  // ideal gear rows follow the joint rows; drives come last
+  for (GearConstraint& g : m.gear_constraints) g.row = m.nc_joint++;
   for (size_t k = 0; k < m.drives.size(); ++k) m.drives[k].row = m.nc_joint + static_cast<int>(k);
   m.nc = m.nc_joint + static_cast<int>(m.drives.size());
 
@@ -481,6 +512,11 @@ ModelPtr ModelBuilder::finalize(const FinalizeOptions& options) const {
               msg(joint_type_name(j.type), " joint '", j.name, "' has no joint coordinates");
         ok = false;
       }
+    }
+    if (ok && !m.gear_constraints.empty()) {
+      ok = false;
+      m.joint_space_reason =
+          msg("ideal gear '", m.gear_constraints[0].name, "' couples joint coordinates");
     }
     m.joint_space_ok = ok;
   } else {

@@ -99,6 +99,8 @@ std::string Model::row_name(int row) const {
       return msg("joint '", j.name, "' row ", k, " (", what, ")");
     }
   }
+  for (const GearConstraint& g : gear_constraints)
+    if (row == g.row) return msg("gear '", g.name, "'");
   for (const Drive& d : drives)
     if (d.row == row) return msg("drive '", d.name, "'");
   return msg("row ", row);
@@ -128,6 +130,12 @@ std::string Model::summary() const {
   for (const Joint& j : joints)
     os << "    " << j.name << "  " << joint_type_name(j.type) << "  " << body_name(j.parent)
        << " -> " << body_name(j.child) << "\n";
+  for (const GearConstraint& g : gear_constraints)
+    os << "  gear " << g.name << ": " << coords[g.coord_a].name << " (r " << g.r_a << ") - "
+       << coords[g.coord_b].name << " (r " << g.r_b << "), ideal\n";
+  for (const GearPair& g : gears)
+    os << "  gear pair " << g.name << ": " << coords[g.coord_a].name << " (r " << g.r_a << ") - "
+       << coords[g.coord_b].name << " (r " << g.r_b << "), backlash " << g.backlash << " m\n";
   for (const Drive& d : drives) os << "  drive " << d.name << ": " << d.profile.describe() << "\n";
   const size_t nforce = body_loads.size() + springs.size() + coord_forces.size() + gears.size();
   if (nforce) os << "  force elements: " << nforce << " (besides gravity)\n";

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "armdyn/solver/constraints.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace armdyn {
@@ -12,7 +13,7 @@ inline void put_row(ConstraintEval& ce, ConstraintBlock& b, int r, const ScalarJ
                     bool with_xi) {
   ce.f[b.row0 + r] = s.val;
   ce.rhs[b.row0 + r] = 0.0;
-  b.J.row(r) = s.J;
+  b.J.row(r).head<12>() = s.J;
   if (with_xi) ce.xi[b.row0 + r] = s.bias;
 }
 
@@ -26,26 +27,39 @@ void ConstraintEval::init(const Model& m) {
   xi = VecX::Zero(m.nc);
   blocks.clear();
   body_blocks.assign(m.nb, {});
-  auto add_block = [&](int row0, int nrows, int pa, int pb) {
+  auto add_block_n = [&](int row0, int nrows, const std::vector<int>& bodies) {
     ConstraintBlock b;
     b.row0 = row0;
     b.nrows = nrows;
-    b.body[0] = pa;
-    b.body[1] = pb;
-    b.J = BlockMat::Zero(nrows, 12);
+    b.nbody = static_cast<int>(bodies.size());
+    for (int k = 0; k < b.nbody; ++k) b.body[k] = bodies[k];
+    b.J = BlockMat::Zero(nrows, 6 * kMaxBlockBodies);
     const int idx = static_cast<int>(blocks.size());
     blocks.push_back(b);
-    if (pa != kGround) body_blocks[pa].push_back({idx, 0});
-    if (pb != kGround) body_blocks[pb].push_back({idx, 1});
+    for (int k = 0; k < b.nbody; ++k)
+      if (bodies[k] != kGround) body_blocks[bodies[k]].push_back({idx, k});
   };
+  auto add_block = [&](int row0, int nrows, int pa, int pb) { add_block_n(row0, nrows, {pa, pb}); };
   for (const Joint& j : m.joints) {
     const int r = joint_rows(j.type);
     if (r > 0) add_block(j.row0, r, j.parent, j.child);
   }
+  for (const GearConstraint& g : m.gear_constraints) add_block_n(g.row, 1, gear_bodies(m, g));
   for (const Drive& d : m.drives) {
     const Joint& j = m.joints[d.joint];
     add_block(d.row, 1, j.parent, j.child);
   }
+}
+
+std::vector<int> gear_bodies(const Model& m, const GearConstraint& g) {
+  std::vector<int> bodies;
+  for (int c : {g.coord_a, g.coord_b}) {
+    const Joint& j = m.joints[m.coords[c].joint];
+    for (int b : {j.parent, j.child})
+      if (b != kGround && std::find(bodies.begin(), bodies.end(), b) == bodies.end())
+        bodies.push_back(b);
+  }
+  return bodies;
 }
 
 void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t, bool with_xi,
@@ -111,6 +125,31 @@ void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t,
         break;
     }
   }
+  // ideal gears: r_a q_a + r_b q_b = 0 (multi-turn angles), over up to four bodies
+  for (const GearConstraint& g : m.gear_constraints) {
+    ConstraintBlock& b = ce.blocks[bi++];
+    double f = 0.0, xi = 0.0;
+    b.J.setZero();
+    for (int k = 0; k < 2; ++k) {
+      const int c = k == 0 ? g.coord_a : g.coord_b;
+      const double r = k == 0 ? g.r_a : g.r_b;
+      const ScalarJet q = coord_jet(m, kin, c);
+      const double ref = ce.track_ref ? (*ce.track_ref)[c] : 0.0;
+      f += r * (ref + std::remainder(q.val - ref, 2.0 * M_PI));
+      xi += r * q.bias;
+      const Joint& j = m.joints[m.coords[c].joint];
+      const int ends[2] = {j.parent, j.child};
+      for (int e = 0; e < 2; ++e) {
+        if (ends[e] == kGround) continue;
+        int slot = 0;
+        while (b.body[slot] != ends[e]) ++slot;
+        b.J.block<1, 6>(0, 6 * slot) += r * q.J.segment<6>(6 * e);
+      }
+    }
+    ce.f[b.row0] = f;
+    ce.rhs[b.row0] = 0.0;
+    if (with_xi) ce.xi[b.row0] = xi;
+  }
   // drives: q_c(u) - q_ref(t) = 0; zeta v = q_ref', xi = bias - q_ref''
   for (size_t di = 0; di < m.drives.size(); ++di) {
     const Drive& dr = m.drives[di];
@@ -127,7 +166,7 @@ void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t,
     const bool angular = m.coords[m.joints[dr.joint].coord0 + dr.coord].angular;
     ce.f[b.row0] = angular ? wrap_angle(q.val - p.y) : q.val - p.y;
     ce.rhs[b.row0] = p.yd;
-    b.J.row(0) = q.J;
+    b.J.row(0).head<12>() = q.J;
     if (with_xi) ce.xi[b.row0] = q.bias - p.ydd;
   }
 }
@@ -137,7 +176,7 @@ void zeta_times(const ConstraintEval& ce, int nrows, Eigen::Ref<const VecX> x, V
     if (b.row0 >= nrows) continue;
     auto yb = y.segment(b.row0, b.nrows);
     yb.setZero();
-    for (int s = 0; s < 2; ++s)
+    for (int s = 0; s < b.nbody; ++s)
       if (b.body[s] != kGround)
         yb.noalias() += b.J.middleCols<6>(6 * s) * x.segment<6>(6 * b.body[s]);
   }
@@ -147,7 +186,7 @@ void zeta_transpose_times(const ConstraintEval& ce, int nrows, Eigen::Ref<const 
   x.setZero();
   for (const ConstraintBlock& b : ce.blocks) {
     if (b.row0 >= nrows) continue;
-    for (int s = 0; s < 2; ++s)
+    for (int s = 0; s < b.nbody; ++s)
       if (b.body[s] != kGround)
         x.segment<6>(6 * b.body[s]).noalias() +=
             b.J.middleCols<6>(6 * s).transpose() * y.segment(b.row0, b.nrows);
@@ -173,7 +212,7 @@ int flipped_joint(const Model& m, const std::vector<BodyKin>& kin) {
 MatX dense_zeta(const Model& m, const ConstraintEval& ce) {
   MatX z = MatX::Zero(m.nc, m.nv);
   for (const ConstraintBlock& b : ce.blocks)
-    for (int s = 0; s < 2; ++s)
+    for (int s = 0; s < b.nbody; ++s)
       if (b.body[s] != kGround)
         z.block(b.row0, 6 * b.body[s], b.nrows, 6) = b.J.middleCols<6>(6 * s);
   return z;

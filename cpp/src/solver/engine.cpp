@@ -25,6 +25,7 @@ Engine::Engine(const Model& m)
       nrows_(m.nc) {
   kin_.resize(m.nb);
   ce_.init(m);
+  ce_.track_ref = &track_ref_;
   tol_f_ = 1e-13 * std::max(1.0, m.length_scale);
 }
 

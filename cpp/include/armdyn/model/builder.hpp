@@ -68,6 +68,9 @@ class ModelBuilder {
   /// Viscous plus smoothed Coulomb friction: tau = -viscous qdot - coulomb tanh(qdot / v_s).
   void add_joint_friction(const std::string& joint, double viscous, double coulomb,
                           double smoothing_velocity, int coord = 0);
+  /// Ideal gear between two revolute joints: the constraint r_a q_a + r_b q_b = 0.
+  void add_gear(const std::string& name, const std::string& joint_a, const std::string& joint_b,
+                double r_a, double r_b);
   /// Gear pair with backlash between two revolute joints (see GearPair).
   void add_gear_pair(const std::string& name, const std::string& joint_a,
                      const std::string& joint_b, double r_a, double r_b, double backlash,

@@ -111,6 +111,15 @@ struct GearPair {
   double stiffness = 0.0, exponent = 1.5, hc_damping = 0.0;  ///< k [N/m^n], n, alpha [s/m]
 };
 
+/// Ideal gear (no backlash) between the angle coordinates of two revolute joints: the rolling
+/// condition r_a q_a + r_b q_b = 0 as a constraint row (external mesh; multi-turn angles).
+struct GearConstraint {
+  std::string name;
+  int coord_a = 0, coord_b = 0;
+  double r_a = 0.0, r_b = 0.0;
+  int row = 0;
+};
+
 /// Mesh force F >= 0 of a gear pair for mesh displacement s and rate sd; also returns the
 /// penetration (negative inside the gap).
 double gear_force(const GearPair& g, double s, double sd, double& penetration);
@@ -133,6 +142,7 @@ class Model {
   std::vector<SpringDamper> springs;
   std::vector<CoordForce> coord_forces;
   std::vector<GearPair> gears;
+  std::vector<GearConstraint> gear_constraints;
   std::vector<int> tracked_coords;  ///< angle coordinates unwrapped over turns (gears)
   std::vector<Coord> coords;
   Vec3 gravity = Vec3(0, 0, -9.81);
@@ -140,7 +150,7 @@ class Model {
   // --- sizes ---
   int nb = 0, nq = 0, nv = 0;
   int nc = 0;        ///< all constraint rows: joints then drives
-  int nc_joint = 0;  ///< joint rows only (rows [0, nc_joint))
+  int nc_joint = 0;  ///< joint and ideal-gear rows (rows [0, nc_joint)), before the drives
 
   // --- topology analysis ---
   bool is_tree = false;  ///< every body has exactly one joint path to ground

@@ -11,11 +11,16 @@
 
 namespace armdyn {
 
-using BlockMat = Eigen::Matrix<double, Eigen::Dynamic, 12, Eigen::RowMajor, 6, 12>;
+/// A row block touches up to four bodies (joints and drives: two; ideal gears: the two gears
+/// and their carriers), six columns each.
+constexpr int kMaxBlockBodies = 4;
+using BlockMat = Eigen::Matrix<double, Eigen::Dynamic, 6 * kMaxBlockBodies, Eigen::RowMajor, 6,
+                               6 * kMaxBlockBodies>;
 
 struct ConstraintBlock {
   int row0 = 0, nrows = 0;
-  int body[2] = {kGround, kGround};
+  int nbody = 2;
+  int body[kMaxBlockBodies] = {kGround, kGround, kGround, kGround};
   BlockMat J;
 };
 
@@ -24,6 +29,9 @@ struct ConstraintEval {
   /// Optional drive references overriding the drives' profiles: 3 * n_drives values laid out
   /// (q, qd, qdd) per drive; nullptr to use the profiles (joint-space inverse dynamics).
   const double* drive_ref = nullptr;
+  /// Optional unwrapped references of angle coordinates (by coordinate index), so that ideal
+  /// gear rows see multi-turn angles; nullptr: wrapped angles.
+  const VecX* track_ref = nullptr;
   std::vector<ConstraintBlock> blocks;
   /// for each body: (block index, slot) of the blocks that touch it
   std::vector<std::vector<std::pair<int, int>>> body_blocks;
@@ -31,10 +39,14 @@ struct ConstraintEval {
   void init(const Model& m);  ///< sizes and block structure (once per model)
 };
 
+/// Bodies of an ideal gear's row block (the gears and their carriers, ground excluded).
+std::vector<int> gear_bodies(const Model& m, const GearConstraint& g);
+
 /// Evaluate f, rhs and zeta (and xi when with_xi) at the kinematic state kin and time t.
 void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t, bool with_xi,
                       ConstraintEval& ce);
 
+/// Zeta rows of joints and drives are stored in the first 12 columns (slots 0 and 1).
 /// y = zeta x over rows [0, nrows) (y sized nc; rows >= nrows untouched).
 void zeta_times(const ConstraintEval& ce, int nrows, Eigen::Ref<const VecX> x, VecX& y);
 /// x = zeta^T y over rows [0, nrows) (x sized nv, overwritten).
