@@ -40,6 +40,16 @@ py::dict result_dict(const Model& md, const SimResult& r) {
       to_numpy(r.drive_forces.data(), {n, static_cast<py::ssize_t>(md.drives.size())});
   d["reaction_forces"] = to_numpy(r.reaction_forces.data(), {n, nj, 3});
   d["reaction_torques"] = to_numpy(r.reaction_torques.data(), {n, nj, 3});
+  {
+    const py::ssize_t ng = static_cast<py::ssize_t>(md.gears.size() + md.gear_constraints.size());
+    py::dict gf;
+    std::vector<std::string> names;
+    for (const auto& g : md.gears) names.push_back(g.name);
+    for (const auto& g : md.gear_constraints) names.push_back(g.name);
+    gf["names"] = names;
+    gf["force"] = to_numpy(r.gear_forces.data(), {n, ng});
+    d["gear_forces"] = gf;
+  }
   d["position_residual"] = to_numpy(r.position_residual.data(), {n});
   d["velocity_residual"] = to_numpy(r.velocity_residual.data(), {n});
   d["kinetic_energy"] = to_numpy(r.kinetic_energy.data(), {n});

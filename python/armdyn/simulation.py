@@ -27,6 +27,9 @@ class SimulationResult:
         velocity_residual: (n,) max |ζ v − rhs|.
         kinetic_energy, potential_energy: (n,) [J]; potential includes gravity and springs.
         stats: step, rejection, KKT-solve and factorisation counts, and run time [s].
+        gear_forces: ``names`` (gear pairs, then ideal gears) and ``force`` (n, n_gears): the
+            mesh force along the line of action [N] (positive when the mesh displacement
+            s = r_a q_a + r_b q_b is positive); the torque on gear b is −r_b × force.
         events: located events (gear contact): ``t`` (times), ``gear`` (names), ``onset``
             (True at contact onset, False at separation).
     """
@@ -46,6 +49,7 @@ class SimulationResult:
     potential_energy: np.ndarray
     stats: dict = field(default_factory=dict)
     events: dict = field(default_factory=dict)
+    gear_forces: dict = field(default_factory=dict)
 
     @property
     def total_energy(self) -> np.ndarray:

@@ -55,6 +55,7 @@ InverseDynamicsResult inverse_dynamics_driven(const Model& m, const std::vector<
   std::vector<double> qprev(nco, 0.0);
   const bool fk_predictor = m.joint_space_ok;  // a driven tree: all coordinates are driven
   VecX qc = VecX::Zero(nco), qdc = VecX::Zero(nco), u_save(m.nq), v_save(m.nv), u_pred(m.nq);
+  VecX track_save = e.tracking();
   // configuration distance: per body max(|dx| / length scale, rotation angle), max over bodies
   auto distance = [&](const VecX& a, const VecX& b) {
     double d = 0.0;
@@ -106,6 +107,7 @@ InverseDynamicsResult inverse_dynamics_driven(const Model& m, const std::vector<
       const double t_next = std::min(t_cur + h, t);
       u_save = u;
       v_save = v;
+      track_save = e.tracking();
       std::string failure;
       try {
         predict(t_cur, t_next);
@@ -117,7 +119,7 @@ InverseDynamicsResult inverse_dynamics_driven(const Model& m, const std::vector<
         // Newton must stay on the branch it was predicted on: a correction much larger than
         // the predicted motion means it may have jumped to another assembly mode
         if (!fk_predictor && failure.empty() &&
-            distance(u, u_pred) > 0.25 * distance(u_pred, u_save) + 1e-8)
+            distance(u, u_pred) > std::max(0.25 * distance(u_pred, u_save), 1e-3))
           failure = "the position correction is large against the predicted motion";
       } catch (const SolverError& err) {
         failure = err.what();
@@ -129,6 +131,7 @@ InverseDynamicsResult inverse_dynamics_driven(const Model& m, const std::vector<
       }
       u = u_save;
       v = v_save;
+      e.set_tracking(track_save);
       h *= 0.5;
       if (fk_predictor || !(h >= h_min))
         throw SolverError(msg("inverse_dynamics at t=", t_next, ": ", failure, ".", singular_rows(),

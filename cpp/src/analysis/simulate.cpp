@@ -49,6 +49,15 @@ class MbsSystem : public OdeSystem {
       if (j.child != kGround) a += q.J.segment<6>(6).dot(vd_.segment<6>(6 * j.child));
       out_.qdd.push_back(a);
     }
+    // gear mesh forces: contact law of the gear pairs, multipliers of the ideal gears
+    for (int gi = 0; gi < static_cast<int>(m_.gears.size()); ++gi) {
+      double sm, sd, pen;
+      e_.gear_mesh(gi, sm, sd, pen);
+      const double f = gear_force(m_.gears[gi], sm, sd, pen);
+      out_.gear_forces.push_back(sm >= 0 ? f : -f);
+    }
+    for (const GearConstraint& g : m_.gear_constraints)
+      out_.gear_forces.push_back(e_.delta()[g.row]);
     // actuator efforts: tau = -delta of the drive rows
     for (const Drive& d : m_.drives) out_.drive_forces.push_back(-e_.delta()[d.row]);
     for (size_t j = 0; j < m_.joints.size(); ++j) {
@@ -236,6 +245,13 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
       integrate_rk4(sys, y, 0.0, t_end, s, out.stats);
   } catch (const SolverError& err) {
     out.error = err.what();
+    // say why when the constraints are (nearly) singular at the last accepted state
+    try {
+      const std::string why = sys.engine().diagnose_singularity(out.t.empty() ? 0.0 : out.t.back(),
+                                                                y.data(), y.data() + m.nq);
+      if (!why.empty()) out.error += "; " + why;
+    } catch (const std::exception&) {
+    }
   }
   out.cpu_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   Engine& e = sys.engine();
@@ -260,6 +276,7 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
   out.velocity_residual.resize(n);
   out.kinetic_energy.resize(n);
   out.potential_energy.resize(n);
+  out.gear_forces.resize(n * (m.gears.size() + m.gear_constraints.size()));
   return out;
 }
 

@@ -227,6 +227,18 @@ void Engine::project(double t, double* u, double* v, Metric metric) {
   ++pstats.velocity_projections;
 }
 
+std::string Engine::diagnose_singularity(double t, const double* u, const double* v) {
+  load(u, v);
+  eval_constraints(m_, kin_, t, false, ce_);
+  kkt_.factor_pivoted_at(ce_, nrows_, Metric::Mass, 1e-7);
+  const int expected = nrows_ == m_.nc ? m_.rank_all : m_.rank_joint;
+  if (kkt_.rank() >= expected) return "";
+  std::string rows;
+  for (int r : kkt_.dependent_rows()) rows += (rows.empty() ? "" : "; ") + m_.row_name(r);
+  return msg("the constraint Jacobian is nearly singular at t=", t, " (rank ", kkt_.rank(), " of ",
+             expected, " at a 1e-7 threshold); nearly dependent rows: ", rows);
+}
+
 void Engine::commit_tracking() {
   // every angle coordinate is followed over turns (gears need it; outputs use it)
   for (int c = 0; c < static_cast<int>(m_.coords.size()); ++c)

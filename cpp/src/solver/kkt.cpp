@@ -19,7 +19,9 @@ KktSolver::KktSolver(const Model& m)
       tmp_nv_(VecX::Zero(m.nv)),
       tmp_nc_(VecX::Zero(m.nc)),
       b_(VecX::Zero(m.nc)),
-      w_(VecX::Zero(m.nc)) {
+      w_(VecX::Zero(m.nc)),
+      scale_(VecX::Zero(m.nc)),
+      tmp2_(VecX::Zero(m.nc)) {
   minv_.resize(m.nb);
   for (int i = 0; i < m.nb; ++i) {
     minv_[i].setZero();
@@ -28,7 +30,12 @@ KktSolver::KktSolver(const Model& m)
   }
 }
 
-void KktSolver::factor(const ConstraintEval& ce, int nrows, Metric metric) {
+void KktSolver::factor_pivoted_at(const ConstraintEval& ce, int nrows, Metric metric, double tol) {
+  assemble(ce, nrows, metric);
+  if (nrows > 0) factor_pivoted(nrows, tol);
+}
+
+void KktSolver::assemble(const ConstraintEval& ce, int nrows, Metric metric) {
   nrows_ = nrows;
   metric_ = metric;
   pinv_ = false;
@@ -57,6 +64,12 @@ void KktSolver::factor(const ConstraintEval& ce, int nrows, Metric metric) {
       }
     }
   }
+}
+
+void KktSolver::factor(const ConstraintEval& ce, int nrows, Metric metric) {
+  assemble(ce, nrows, metric);
+  if (nrows == 0) return;
+  auto A = A_.topLeftCorner(nrows, nrows);
   // Cholesky unless the model is known redundant or the factor shows a (near-)zero pivot
   bool pivoted = m_.redundant;
   if (!pivoted) {
@@ -64,33 +77,53 @@ void KktSolver::factor(const ConstraintEval& ce, int nrows, Metric metric) {
     if (llt_.info() != Eigen::Success) {
       pivoted = true;
     } else {
-      const double maxd = A.diagonal().cwiseAbs().maxCoeff();
-      const double minl = llt_.matrixLLT().diagonal().cwiseAbs2().minCoeff();
-      if (!(minl > 1e-12 * maxd)) pivoted = true;
+      // each pivot against its own row's diagonal: invariant to the scale of the rows (bodies
+      // of very different masses give diagonals many decades apart)
+      double minrel = 1.0;
+      for (int i = 0; i < nrows; ++i) {
+        const double l = llt_.matrixLLT()(i, i);
+        minrel = std::min(minrel, l * l / A(i, i));
+      }
+      if (!(minrel > 1e-12)) pivoted = true;
     }
   }
   if (pivoted) factor_pivoted(nrows);
 }
 
-void KktSolver::factor_pivoted(int n) {
-  // Right-looking Cholesky with diagonal pivoting on the full symmetric matrix (the trailing block
-  // is kept symmetric so that row/column swaps stay simple); stops when the largest remaining
-  // pivot is below tol * max diag(A), the numerical rank.
+void KktSolver::factor_pivoted(int n, double tol) {
+  // Right-looking Cholesky with diagonal pivoting of the Jacobi-scaled matrix S A S,
+  // S = diag(A)^-1/2 (unit diagonal, so that the rank decision does not depend on how far apart
+  // the bodies' masses are), on the full symmetric matrix (the trailing block is kept symmetric
+  // so that row/column swaps stay simple); stops when the largest remaining pivot is below
+  // 1e-10, the numerical rank.
   auto A = A_.topLeftCorner(n, n);
   pinv_ = true;
-  for (int i = 0; i < n; ++i) perm_[i] = i;
-  const double maxd = A.diagonal().maxCoeff();
-  const double tol = 1e-10 * (maxd > 0.0 ? maxd : 1.0);
+  for (int i = 0; i < n; ++i) {
+    perm_[i] = i;
+    const double d = A(i, i);
+    scale_[i] = d > 0.0 ? 1.0 / std::sqrt(d) : 1.0;
+  }
+  for (int j = 0; j < n; ++j) A.col(j) *= scale_[j];
+  for (int i = 0; i < n; ++i) A.row(i) *= scale_[i];
   int r = 0;
   for (int k = 0; k < n; ++k) {
-    int j = 0;
-    const double d = A.diagonal().segment(k, n - k).maxCoeff(&j);
-    j += k;
+    // joint (and gear) rows pivot before drive rows, so that when the constraints lose rank
+    // the rows left over name the drives whenever the joints alone are still independent
+    int j = -1;
+    double d = 0.0;
+    for (int pass = 0; pass < 2 && !(d > tol); ++pass) {
+      for (int i = k; i < n; ++i)
+        if ((pass == 1 || perm_[i] < m_.nc_joint) && A(i, i) > d) {
+          d = A(i, i);
+          j = i;
+        }
+    }
     if (!(d > tol)) break;
     if (j != k) {
       A.row(k).swap(A.row(j));
       A.col(k).swap(A.col(j));
       std::swap(perm_[k], perm_[j]);
+      std::swap(scale_[k], scale_[j]);
     }
     const double lkk = std::sqrt(A(k, k));
     A(k, k) = lkk;
@@ -104,35 +137,43 @@ void KktSolver::factor_pivoted(int n) {
   rank_ = r;
   const int z = n - r;
   if (z == 0) return;
-  // M = L11^-T L21^T  (r x z);  G = I + M^T M = Z^T Z, factored in place
+  // scaled, permuted null space Z_y = [-M; I] with M = L11^-T L21^T (r x z); in the original
+  // variables Z = S Z_y, so the Gram matrix of the minimum-norm correction is
+  //   G = Z^T Z = M^T S1^2 M + S2^2, factored in place
   auto M = M_.topLeftCorner(r, z);
   M = A.bottomLeftCorner(z, r).transpose();
   A.topLeftCorner(r, r).triangularView<Eigen::Lower>().adjoint().solveInPlace(M);
   auto G = G_.topLeftCorner(z, z);
-  G.noalias() = M.transpose() * M;
-  G.diagonal().array() += 1.0;
+  G.noalias() = M.transpose() * scale_.head(r).cwiseAbs2().asDiagonal() * M;
+  G.diagonal() += scale_.segment(r, z).cwiseAbs2();
   Eigen::LLT<Eigen::Ref<MatX>> gfac(G);  // in place: G now holds its lower factor
 }
 
 void KktSolver::solve_pivoted(const VecX& b, VecX& x) const {
   const int n = nrows_, r = rank_, z = n - r;
   auto A = A_.topLeftCorner(n, n);
-  // basic solution in permuted coordinates: x1 = L11^-T L11^-1 (P b)_1, x2 = 0
+  // basic solution of the scaled system (S A S) y = S b in permuted coordinates:
+  // y1 = L11^-T L11^-1 (P S b)_1, y2 = 0; then x = S y
   auto c = tmp_nc_.head(n);
-  for (int i = 0; i < n; ++i) c[i] = b[perm_[i]];
+  for (int i = 0; i < n; ++i) c[i] = scale_[i] * b[perm_[i]];
   auto c1 = c.head(r);
   A.topLeftCorner(r, r).triangularView<Eigen::Lower>().solveInPlace(c1);
   A.topLeftCorner(r, r).triangularView<Eigen::Lower>().adjoint().solveInPlace(c1);
+  c1.array() *= scale_.head(r).array();  // x1 = S1 y1
   c.tail(z).setZero();
   if (z > 0) {
-    // remove the null-space component: x <- x - Z G^-1 Z^T x with Z = [-M; I], Z^T x = -M^T x1
+    // remove the null-space component (Euclidean): x <- x - Z G^-1 Z^T x with Z = [-S1 M; S2],
+    // Z^T x = -M^T S1 x1
     auto w = w_.head(z);
-    w.noalias() = -M_.topLeftCorner(r, z).transpose() * c1;
+    auto t1 = tmp2_.head(r);
+    t1 = scale_.head(r).cwiseProduct(c1);
+    w.noalias() = -M_.topLeftCorner(r, z).transpose() * t1;
     const auto G = G_.topLeftCorner(z, z);
     G.triangularView<Eigen::Lower>().solveInPlace(w);
     G.triangularView<Eigen::Lower>().adjoint().solveInPlace(w);
-    c1.noalias() += M_.topLeftCorner(r, z) * w;
-    c.tail(z) = -w;
+    t1.noalias() = M_.topLeftCorner(r, z) * w;
+    c1 += scale_.head(r).cwiseProduct(t1);
+    c.tail(z) = -scale_.segment(r, z).cwiseProduct(w);
   }
   for (int i = 0; i < n; ++i) x[perm_[i]] = c[i];
 }

@@ -9,6 +9,7 @@ from armdyn.scenes.basic import (
     spring_mass_pendulum,
 )
 from armdyn.scenes.extreme import bricard, heavy_top
+from armdyn.scenes.geared_arm import geared_arm_6dof
 from armdyn.scenes.paper import five_dof_arm, three_dof_arm
 
 __all__ = [
@@ -17,6 +18,7 @@ __all__ = [
     "five_dof_arm",
     "four_bar",
     "free_body",
+    "geared_arm_6dof",
     "heavy_top",
     "simple_pendulum",
     "slider_crank",

@@ -24,6 +24,9 @@ struct SimResult {
   long n = 0;
   std::vector<double> t, u, v, q, qd, qdd, drive_forces, reaction_forces, reaction_torques;
   std::vector<double> position_residual, velocity_residual, kinetic_energy, potential_energy;
+  /// mesh force along the line of action of every gear pair, then every ideal gear [N]
+  /// (positive when s > 0: pushes q_a and q_b back), one row per output
+  std::vector<double> gear_forces;
   StepStats stats;
   long kkt_solves = 0, factorizations = 0, position_projections = 0, newton_iterations = 0;
   long singular_evaluations = 0;

@@ -59,8 +59,13 @@ class Engine {
   }
   /// Gear mesh displacement s, rate and penetration |s| - backlash/2 at the loaded state.
   void gear_mesh(int g, double& s, double& sd, double& penetration) const;
+  /// After a failure: when the constraint Jacobian at (u, v, t) is nearly singular (scaled
+  /// pivots below 1e-7), a sentence naming the nearly dependent rows; otherwise empty.
+  std::string diagnose_singularity(double t, const double* u, const double* v);
   /// Set the tracked angles' references from the loaded state (after each projection).
   void commit_tracking();
+  const VecX& tracking() const { return track_ref_; }
+  void set_tracking(const VecX& ref) { track_ref_ = ref; }
 
   const VecX& delta() const { return delta_; }
   const VecX& eta() const { return eta_; }

@@ -7,8 +7,9 @@
 //   A delta = zeta Gamma^-1 eta + xi,   vdot = Gamma^-1 (eta - zeta^T delta).
 // A is assembled block by block from the bodies each row block touches. It is factored by
 // Cholesky; when A is singular (redundant constraints) or nearly so, by a Cholesky factorisation
-// with diagonal pivoting that stops at the numerical rank r,
-//   P A P^T = [L11; L21] [L11; L21]^T,  L11 r x r,
+// with diagonal pivoting of the Jacobi-scaled S A S (S = diag(A)^-1/2) that stops at the
+// numerical rank r,
+//   P S A S P^T = [L11; L21] [L11; L21]^T,  L11 r x r,
 // and the minimum-norm multipliers are the basic solution minus its component in the null space
 // of A, spanned (in permuted coordinates) by Z = [-L11^-T L21^T; I] (Golub & Van Loan, 5.5.4 and
 // 4.2.9). vdot and zeta^T delta are unique either way. All storage is sized once in the
@@ -30,6 +31,10 @@ class KktSolver {
 
   /// Assemble A over rows [0, nrows) with metric W and factor it.
   void factor(const ConstraintEval& ce, int nrows, Metric metric);
+  /// Diagnosis: assemble A and factor it with pivoting at rank tolerance `tol` (relative to the
+  /// unit diagonal of the scaled matrix); rank() and dependent_rows() then tell which rows are
+  /// nearly dependent.
+  void factor_pivoted_at(const ConstraintEval& ce, int nrows, Metric metric, double tol);
   /// Solve A x = b (b, x sized >= nrows; only the first nrows entries are used).
   void solve_schur(const VecX& b, VecX& x) const;
   /// x = W^-1 y (blockwise).
@@ -55,7 +60,8 @@ class KktSolver {
   std::vector<Mat6> minv_;  // per-body Gamma^-1 blocks
   MatX A_;
   Eigen::LLT<MatX> llt_;
-  void factor_pivoted(int n);
+  void assemble(const ConstraintEval& ce, int nrows, Metric metric);
+  void factor_pivoted(int n, double tol = 1e-10);
   void solve_pivoted(const VecX& b, VecX& x) const;
   // pivoted path: factor of P A P^T in A_ (lower), permutation, M = L11^-T L21^T and the
   // Cholesky factor of G = I + M^T M
@@ -63,6 +69,8 @@ class KktSolver {
   MatX M_, G_;
   VecX tmp_nv_, b_;
   mutable VecX tmp_nc_, w_;  // scratch of the const solves
+  VecX scale_;               // Jacobi scaling diag(A)^-1/2, in pivot order
+  mutable VecX tmp2_;
   int nrows_ = 0, rank_ = 0;
   Metric metric_ = Metric::Mass;
   bool pinv_ = false;
