@@ -21,7 +21,8 @@ KktSolver::KktSolver(const Model& m)
       b_(VecX::Zero(m.nc)),
       w_(VecX::Zero(m.nc)),
       scale_(VecX::Zero(m.nc)),
-      tmp2_(VecX::Zero(m.nc)) {
+      tmp2_(VecX::Zero(m.nc)),
+      DM_(MatX::Zero(m.nc, m.nc)) {
   minv_.resize(m.nb);
   for (int i = 0; i < m.nb; ++i) {
     minv_[i].setZero();
@@ -144,7 +145,9 @@ void KktSolver::factor_pivoted(int n, double tol) {
   M = A.bottomLeftCorner(z, r).transpose();
   A.topLeftCorner(r, r).triangularView<Eigen::Lower>().adjoint().solveInPlace(M);
   auto G = G_.topLeftCorner(z, z);
-  G.noalias() = M.transpose() * scale_.head(r).cwiseAbs2().asDiagonal() * M;
+  auto DM = DM_.topLeftCorner(r, z);
+  DM = scale_.head(r).cwiseAbs2().asDiagonal() * M;
+  G.noalias() = M.transpose() * DM;
   G.diagonal() += scale_.segment(r, z).cwiseAbs2();
   Eigen::LLT<Eigen::Ref<MatX>> gfac(G);  // in place: G now holds its lower factor
 }

@@ -71,6 +71,7 @@ class KktSolver {
   mutable VecX tmp_nc_, w_;  // scratch of the const solves
   VecX scale_;               // Jacobi scaling diag(A)^-1/2, in pivot order
   mutable VecX tmp2_;
+  MatX DM_;  // S1^2 M
   int nrows_ = 0, rank_ = 0;
   Metric metric_ = Metric::Mass;
   bool pinv_ = false;
