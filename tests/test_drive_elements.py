@@ -112,3 +112,41 @@ def test_bad_friction_and_motor_input():
         b.add_motor("pitch", 0.0, kp=-1.0, kd=0.1)
     with pytest.raises(ad.ModelError, match="no_joint"):
         b.add_motor("no_joint", 0.0, kp=1.0, kd=0.1)
+
+
+def test_pi_motor_removes_the_static_sag():
+    """With an integral term the holding error vanishes (the sag of the PD motor is m g (l/2)
+    cos q / kp); the integral state is part of the simulation, not of q."""
+    m, length = 2.0, 0.5
+    b = ad.ModelBuilder(gravity=(0.0, 0.0, -G))
+    b.add_body(
+        "bar", m, [1e-3, m * length**2 / 12, m * length**2 / 12], position=(length / 2, 0, 0)
+    )
+    b.add_revolute("pitch", "ground", "bar", point=(0, 0, 0), axis=(0, -1, 0))
+    b.add_motor("pitch", 0.0, kp=200.0, kd=20.0, ki=400.0)
+    model = b.finalize()
+    res = ad.simulate(model, 20.0, rtol=1e-10, atol=1e-12, output_dt=1.0)
+    assert abs(res.q[1, 0]) > 1e-3  # it sags first
+    assert abs(res.q[-1, 0]) <= 1e-7
+    with pytest.raises(ad.ModelError, match="integral term"):
+        ad.LagrangeValidator(model)
+
+
+def test_saturated_pi_motor_does_not_wind_up():
+    """Saturated, the integral stops growing: when the load drops (here the torque limit is
+    generous but the reference starts far away) the bar reaches it without a wind-up overshoot
+    larger than the PD motor's."""
+    m, length = 2.0, 0.5
+
+    def bar(ki):
+        b = ad.ModelBuilder(gravity=(0.0, 0.0, -G))
+        b.add_body(
+            "bar", m, [1e-3, m * length**2 / 12, m * length**2 / 12], position=(length / 2, 0, 0)
+        )
+        b.add_revolute("pitch", "ground", "bar", point=(0, 0, 0), axis=(0, -1, 0))
+        b.add_motor("pitch", 1.0, kp=200.0, kd=20.0, ki=ki, torque_limit=8.0)
+        return b.finalize()
+
+    pid = ad.simulate(bar(200.0), 10.0, rtol=1e-10, atol=1e-12, output_dt=0.01)
+    assert np.max(pid.q[:, 0]) <= 1.0 + 0.05  # no large overshoot after the saturated climb
+    assert pid.q[-1, 0] == pytest.approx(1.0, abs=1e-4)

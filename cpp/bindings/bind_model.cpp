@@ -305,21 +305,23 @@ void bind_model(py::module_& m) {
       .def(
           "add_motor",
           [](ModelBuilder& b, const std::string& joint, py::object reference, double kp, double kd,
-             double torque_limit, py::object feedforward, int coord) {
+             double torque_limit, py::object feedforward, int coord, double ki) {
             const std::string who = "add_motor '" + joint + "'";
             const Profile ref = to_profile(reference, who + ": reference");
             if (feedforward.is_none()) {
-              b.add_motor(joint, ref, kp, kd, torque_limit, nullptr, coord);
+              b.add_motor(joint, ref, kp, kd, torque_limit, nullptr, coord, ki);
             } else {
               const Profile ff = to_profile(feedforward, who + ": feedforward");
-              b.add_motor(joint, ref, kp, kd, torque_limit, &ff, coord);
+              b.add_motor(joint, ref, kp, kd, torque_limit, &ff, coord, ki);
             }
           },
           py::arg("joint"), py::arg("reference"), py::arg("kp"), py::arg("kd"),
           py::arg("torque_limit") = 1e300, py::arg("feedforward") = py::none(),
-          py::arg("coord") = 0,
-          "PD motor on a joint coordinate: tau = clamp(kp (q_ref - q) + kd (qd_ref - qd), "
-          "+-torque_limit) + feedforward(t); the reference is a profile (armdyn.profiles.*, a "
+          py::arg("coord") = 0, py::arg("ki") = 0.0,
+          "PD or PID motor on a joint coordinate: tau = clamp(kp (q_ref - q) + kd (qd_ref - qd) "
+          "+ ki z, +-torque_limit) + feedforward(t), z the integral of q_ref - q (an auxiliary "
+          "state, not integrated while saturated); the reference is a profile (armdyn.profiles.*, "
+          "a "
           "number, or a callable).")
       .def(
           "add_joint_torque",

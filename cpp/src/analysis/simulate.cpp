@@ -17,21 +17,27 @@ class MbsSystem : public OdeSystem {
   MbsSystem(const Model& m, Metric metric, SimResult& out)
       : m_(m), e_(m), metric_(metric), out_(out), yo_(m.nq + m.nv), vd_(m.nv) {}
 
+  // y = (u, v, z): z the auxiliary states (PI integral terms), not projected
   void rhs(double t, const VecX& y, VecX& dy) override {
+    e_.set_aux(y.data() + m_.nq + m_.nv);
     e_.dynamics(t, y.data(), y.data() + m_.nq, dy.data() + m_.nq);
     e_.udot(y.data(), y.data() + m_.nq, dy.data());
+    if (m_.n_aux) e_.aux_rates(t, dy.data() + m_.nq + m_.nv);
   }
 
   void project_and_rhs(double t, VecX& y, VecX& dy) override {
+    e_.set_aux(y.data() + m_.nq + m_.nv);
     e_.project(t, y.data(), y.data() + m_.nq, metric_);
     e_.dynamics(t, y.data(), y.data() + m_.nq, dy.data() + m_.nq, true);
     e_.udot(y.data(), y.data() + m_.nq, dy.data());
+    if (m_.n_aux) e_.aux_rates(t, dy.data() + m_.nq + m_.nv);
   }
 
   void output(double t, const VecX& y) override {
     yo_ = y;
     double* u = yo_.data();
     double* v = yo_.data() + m_.nq;
+    e_.set_aux(yo_.data() + m_.nq + m_.nv);
     e_.project(t, u, v, metric_);
     e_.dynamics(t, u, v, vd_.data(), true);
     // joint coordinates (angles unwrapped along the run) and rates
@@ -232,9 +238,9 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
     out.v.reserve(n * m.nv);
   }
   MbsSystem sys(m, opt.projection, out);
-  VecX y(m.nq + m.nv);
+  VecX y = VecX::Zero(m.nq + m.nv + m.n_aux);
   y.head(m.nq) = u0;
-  y.tail(m.nv) = v0;
+  y.segment(m.nq, m.nv) = v0;
   const auto start = std::chrono::steady_clock::now();
   try {
     if (out.integrator == "dopri5")
@@ -247,6 +253,7 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
     out.error = err.what();
     // say why when the constraints are (nearly) singular at the last accepted state
     try {
+      sys.engine().set_aux(y.data() + m.nq + m.nv);
       const std::string why = sys.engine().diagnose_singularity(out.t.empty() ? 0.0 : out.t.back(),
                                                                 y.data(), y.data() + m.nq);
       if (!why.empty()) out.error += "; " + why;

@@ -402,8 +402,8 @@ void ModelBuilder::add_gear_pair(const std::string& name, const std::string& joi
 }
 
 void ModelBuilder::add_motor(const std::string& joint, const Profile& reference, double kp,
-                             double kd, double torque_limit, const Profile* feedforward,
-                             int coord) {
+                             double kd, double torque_limit, const Profile* feedforward, int coord,
+                             double ki) {
   const std::string who = msg("motor on '", joint, "'");
   auto it = m_.joint_index.find(joint);
   if (it == m_.joint_index.end()) throw ModelError(msg(who, ": unknown joint '", joint, "'"));
@@ -412,7 +412,8 @@ void ModelBuilder::add_motor(const std::string& joint, const Profile& reference,
     throw ModelError(msg(who, ": ", joint_type_name(j.type), " joint has no coordinate ", coord));
   require_finite(kp, who + ": kp");
   require_finite(kd, who + ": kd");
-  if (kp < 0 || kd < 0) throw ModelError(msg(who, ": kp and kd must be >= 0"));
+  require_finite(ki, who + ": ki");
+  if (kp < 0 || kd < 0 || ki < 0) throw ModelError(msg(who, ": kp, kd and ki must be >= 0"));
   if (!(torque_limit > 0) || std::isnan(torque_limit))
     throw ModelError(msg(who, ": torque_limit must be positive, got ", torque_limit));
   CoordForce cf;
@@ -422,6 +423,8 @@ void ModelBuilder::add_motor(const std::string& joint, const Profile& reference,
   cf.kp = kp;
   cf.kd = kd;
   cf.torque_limit = torque_limit;
+  cf.ki = ki;
+  if (ki > 0) cf.aux = m_.n_aux++;
   if (feedforward) {
     cf.has_input = true;
     cf.input = *feedforward;

@@ -150,7 +150,8 @@ double gear_force(const GearPair& g, double s, double sd, double& penetration) {
   return std::max(f, 0.0);
 }
 
-double coord_force_value(const CoordForce& cf, bool angular, double q, double qdot, double t) {
+double coord_force_value(const CoordForce& cf, bool angular, double q, double qdot, double t,
+                         double z, double* zdot) {
   auto diff = [&](double a, double b) {
     return angular ? std::remainder(a - b, 2.0 * M_PI) : a - b;
   };
@@ -159,8 +160,13 @@ double coord_force_value(const CoordForce& cf, bool angular, double q, double qd
   if (cf.has_input) tau += cf.input.eval(t).y;
   if (cf.motor) {
     const ProfileValue r = cf.reference.eval(t);
-    const double u = cf.kp * diff(r.y, q) + cf.kd * (r.yd - qdot);
-    tau += std::clamp(u, -cf.torque_limit, cf.torque_limit);
+    const double e = diff(r.y, q);
+    const double u = cf.kp * e + cf.kd * (r.yd - qdot) + cf.ki * z;
+    const double uc = std::clamp(u, -cf.torque_limit, cf.torque_limit);
+    tau += uc;
+    if (zdot) *zdot = (uc != u && e * u > 0) ? 0.0 : e;  // stop integrating into saturation
+  } else if (zdot) {
+    *zdot = 0.0;
   }
   return tau;
 }

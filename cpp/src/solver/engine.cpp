@@ -77,7 +77,8 @@ void Engine::forces(double t) {
     const Coord& c = m_.coords[cf.coord];
     double tau;
     try {
-      tau = coord_force_value(cf, c.angular, q.val, q.rate, t);
+      const double z = (cf.aux >= 0 && aux_) ? aux_[cf.aux] : 0.0;
+      tau = coord_force_value(cf, c.angular, q.val, q.rate, t, z);
     } catch (const SolverError& err) {
       throw SolverError(msg("force on joint coordinate '", c.name, "': ", err.what()));
     }
@@ -237,6 +238,15 @@ std::string Engine::diagnose_singularity(double t, const double* u, const double
   for (int r : kkt_.dependent_rows()) rows += (rows.empty() ? "" : "; ") + m_.row_name(r);
   return msg("the constraint Jacobian is nearly singular at t=", t, " (rank ", kkt_.rank(), " of ",
              expected, " at a 1e-7 threshold); nearly dependent rows: ", rows);
+}
+
+void Engine::aux_rates(double t, double* zdot) const {
+  for (const CoordForce& cf : m_.coord_forces) {
+    if (cf.aux < 0) continue;
+    const ScalarJet q = coord_jet(m_, kin_, cf.coord);
+    const double z = aux_ ? aux_[cf.aux] : 0.0;
+    coord_force_value(cf, m_.coords[cf.coord].angular, q.val, q.rate, t, z, &zdot[cf.aux]);
+  }
 }
 
 void Engine::commit_tracking() {

@@ -30,6 +30,11 @@ LagrangeValidator::LagrangeValidator(std::shared_ptr<const Model> m, bool rotati
     : m_(std::move(m)), rot_(rotational_inertia) {
   if (!m_) throw ModelError("LagrangeValidator: no model");
   require_joint_space(*m_, "LagrangeValidator");
+  for (const CoordForce& cf : m_->coord_forces)
+    if (cf.aux >= 0)
+      throw ModelError(msg("LagrangeValidator: ", cf.name,
+                           " has an integral term (ki > 0), a state outside the joint "
+                           "coordinates; validate the model without it"));
 }
 
 MatX LagrangeValidator::mass_matrix(const VecX& q) const {

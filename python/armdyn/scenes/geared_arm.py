@@ -15,7 +15,8 @@ Subsystems and bodies (``n_motors = 1``: 44 bodies):
     The stage-2 mesh between pinion_2 and the driven gear has the backlash (a gear pair with
     dead zone and Hunt–Crossley contact) when ``backlash > 0``, otherwise it is an ideal gear.
   * ``n_motors > 1`` adds trains (rotor, pinion_1, wheel_1, pinion_2: 4 bodies each) on the
-    shoulder's driven gear, spaced around it: the motors share that gear's load.
+    driven gear of ``shared_joint`` (default the waist, whose gear load reverses with the
+    acceleration), spaced around it: the motors share that gear's load.
 
 Joints (axes at the build pose): waist z at (0, 0, 0.1); shoulder −y at (0, 0, 0.3); elbow −y at
 (0.4, 0, 0.3); wrist roll x at (0.75, 0, 0.3); wrist pitch −y at (0.8, 0, 0.3); hand roll x at
@@ -83,6 +84,7 @@ def _gear_mass(radius, scale):
 
 def geared_arm_6dof(
     n_motors=1,
+    shared_joint="waist",
     backlash=0.0,
     control="motor",
     targets=(0.8, 0.6, -0.9, 0.5, 0.7, 1.0),
@@ -99,7 +101,8 @@ def geared_arm_6dof(
     """Build the geared arm (see the module docstring for every dimension).
 
     Args:
-        n_motors: motors (gear trains) on the shoulder's driven gear, 1…6.
+        n_motors: motors (gear trains) on the driven gear of ``shared_joint``, 1…6.
+        shared_joint: the joint whose driven gear the motors share.
         backlash: stage-2 clearance [m] (0: ideal stage-2 gears).
         control: ``"motor"`` (PD motors on the rotors, forward dynamics) or ``"drive"`` (rotor
             angles prescribed as drives: the drive efforts are the motor torques).
@@ -110,6 +113,10 @@ def geared_arm_6dof(
     """
     if not 1 <= int(n_motors) <= 6:
         raise _core.ModelError(f"geared_arm_6dof: n_motors must be 1..6, got {n_motors}")
+    if shared_joint not in RATIOS:
+        raise _core.ModelError(
+            f"geared_arm_6dof: unknown shared_joint {shared_joint!r} (one of {sorted(RATIOS)})"
+        )
     if control not in ("motor", "drive"):
         raise _core.ModelError(
             f"geared_arm_6dof: control must be 'motor' or 'drive', got {control!r}"
@@ -138,7 +145,7 @@ def geared_arm_6dof(
         references[name] = (0.0, float(target))
         if not trains:
             continue
-        n_trains = int(n_motors) if name == "shoulder" else 1
+        n_trains = int(n_motors) if name == shared_joint else 1
         for k in range(n_trains):
             # trains spaced around the driven gear: rotate e about the axis
             ang = 2 * np.pi * k / n_trains

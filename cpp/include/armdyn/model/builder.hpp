@@ -78,7 +78,7 @@ class ModelBuilder {
   /// PD motor on a joint coordinate tracking `reference` (angles wrapped), torque limited to
   /// +-torque_limit, plus an optional feed-forward profile.
   void add_motor(const std::string& joint, const Profile& reference, double kp, double kd,
-                 double torque_limit, const Profile* feedforward, int coord = 0);
+                 double torque_limit, const Profile* feedforward, int coord = 0, double ki = 0.0);
 
   /// Validate, analyse the topology and assemble the initial state. The builder is unchanged
   /// and may be finalized again.

@@ -79,7 +79,9 @@ struct SpringDamper {
 
 /// Generalised force on one joint coordinate:
 ///   tau = -k (q - q0) - c qdot - F_c tanh(qdot / v_s) + input(t) + motor,
-///   motor = clamp(kp (q_ref - q) + kd (qd_ref - qdot), -tau_max, tau_max).
+///   motor = clamp(kp (q_ref - q) + kd (qd_ref - qdot) + ki z, -tau_max, tau_max),
+/// z the integral of (q_ref - q): an auxiliary state of the simulation (PI(D) motors), integrated
+/// only while the motor is not saturated (conditional integration, no wind-up).
 /// Covers rotational/linear spring-dampers, viscous and smoothed Coulomb friction, torque/force
 /// inputs and PD motors with a torque limit.
 struct CoordForce {
@@ -90,12 +92,16 @@ struct CoordForce {
   Profile input;
   bool motor = false;  ///< PD motor tracking `reference`
   Profile reference;
-  double kp = 0.0, kd = 0.0, torque_limit = 1e300;
+  double kp = 0.0, kd = 0.0, ki = 0.0, torque_limit = 1e300;
+  int aux = -1;      ///< index of the integral state z (ki > 0)
   std::string name;  ///< for messages
 };
 
-/// Generalised force of a coordinate force element at (q, qdot, t), angle differences wrapped.
-double coord_force_value(const CoordForce& cf, bool angular, double q, double qdot, double t);
+/// Generalised force of a coordinate force element at (q, qdot, t), angle differences wrapped;
+/// z is the element's integral state (PI motors), 0 otherwise. When `zdot` is given it receives
+/// the rate of z (the tracking error, or 0 while saturated).
+double coord_force_value(const CoordForce& cf, bool angular, double q, double qdot, double t,
+                         double z = 0.0, double* zdot = nullptr);
 
 /// Gear pair with backlash between the angle coordinates of two revolute joints (external
 /// mesh): the mesh displacement along the line of action is s = r_a q_a + r_b q_b (zero when
@@ -144,6 +150,7 @@ class Model {
   std::vector<GearPair> gears;
   std::vector<GearConstraint> gear_constraints;
   std::vector<int> tracked_coords;  ///< angle coordinates unwrapped over turns (gears)
+  int n_aux = 0;  ///< auxiliary states of the simulation (integral terms of PI motors)
   std::vector<Coord> coords;
   Vec3 gravity = Vec3(0, 0, -9.81);
 

@@ -26,6 +26,10 @@ class Engine {
   /// Rows taking part: all (joints + drives) by default, or joints only (joint-space calls).
   void set_include_drives(bool on) { nrows_ = on ? m_.nc : m_.nc_joint; }
   int nrows() const { return nrows_; }
+  /// Auxiliary states z (model.n_aux: integral terms of PI motors) used by forces(); nullptr:
+  /// all zero. aux_rates() gives their rates at the loaded state.
+  void set_aux(const double* z) { aux_ = z; }
+  void aux_rates(double t, double* zdot) const;
   /// Optional joint-space generalised forces (n_coords), added to eta; nullptr for none.
   void set_joint_torques(const double* tau) { tau_ = tau; }
 
@@ -91,6 +95,7 @@ class Engine {
   VecX vd_;
   VecX track_ref_;  // unwrapped reference of tracked angle coordinates (by coordinate index)
   const double* tau_ = nullptr;
+  const double* aux_ = nullptr;
   int nrows_ = 0;
   double tol_f_ = 1e-13;
 };
