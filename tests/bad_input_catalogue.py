@@ -51,20 +51,8 @@ def _urdf(joint: str, links: str = URDF_LINKS) -> str:
 
 
 def _slider_crank_dead_centre():
-    r, length = 0.1, 0.35
-    a = np.array([0.0, r, 0.0])
-    x0 = np.sqrt(length**2 - r**2)
-    s = np.array([x0, 0.0, 0.0])
-    b = ad.ModelBuilder(gravity=(0.0, 0.0, 0.0))
-    b.add_body("crank", 1.0, [1e-3, 1e-4, 1e-3], position=a / 2)
-    b.add_body("rod", 0.5, [1e-4, 5e-3, 5e-3], position=(a + s) / 2)
-    b.add_body("slider", 2.0, [1e-3] * 3, position=s)
-    b.add_revolute("crank_pin", "ground", "crank", point=(0, 0, 0), axis=(0, 0, 1))
-    b.add_revolute("crank_rod", "crank", "rod", point=a, axis=(0, 0, 1))
-    b.add_revolute("rod_slider", "rod", "slider", point=s, axis=(0, 0, 1))
-    b.add_prismatic("guide", "ground", "slider", point=s, axis=(1, 0, 0))
-    b.add_drive("guide", _core.profiles.cubic(0.0, r + length - x0, 0.0, 1.0))
-    return ad.inverse_dynamics(b.finalize(), t=np.linspace(0.0, 1.0, 11))
+    model = ad.scenes.slider_driven_to_dead_centre()
+    return ad.inverse_dynamics(model, t=np.linspace(0.0, 1.0, 11))
 
 
 def _nan_force_run():

@@ -152,20 +152,7 @@ def test_under_driven_model_names_coordinates():
 def test_singular_driven_slider_crank_names_the_drive():
     """A slider-crank whose slider position is driven to the dead centre (x = r + l): the
     driven constraints lose rank there; the error names the drive."""
-    r, length = 0.1, 0.35
-    a = np.array([0.0, r, 0.0])  # crank at 90 degrees
-    x0 = np.sqrt(length**2 - r**2)
-    s = np.array([x0, 0.0, 0.0])
-    b = _core.ModelBuilder(gravity=(0.0, 0.0, 0.0))
-    b.add_body("crank", 1.0, [1e-3, 1e-4, 1e-3], position=a / 2)
-    b.add_body("rod", 0.5, [1e-4, 5e-3, 5e-3], position=(a + s) / 2)
-    b.add_body("slider", 2.0, [1e-3] * 3, position=s)
-    b.add_revolute("crank_pin", "ground", "crank", point=(0, 0, 0), axis=(0, 0, 1))
-    b.add_revolute("crank_rod", "crank", "rod", point=a, axis=(0, 0, 1))
-    b.add_revolute("rod_slider", "rod", "slider", point=s, axis=(0, 0, 1))
-    b.add_prismatic("guide", "ground", "slider", point=s, axis=(1, 0, 0))
-    b.add_drive("guide", _core.profiles.cubic(0.0, r + length - x0, 0.0, 1.0))
-    model = b.finalize()
+    model = ad.scenes.slider_driven_to_dead_centre()
     assert model.mobility_driven == 0
     # away from the dead centre it is fine
     ok = ad.inverse_dynamics(model, t=np.linspace(0.0, 0.5, 6))

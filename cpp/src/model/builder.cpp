@@ -326,11 +326,9 @@ void ModelBuilder::add_joint_friction(const std::string& joint, double viscous, 
   m_.coord_forces.push_back(cf);
 }
 
-void ModelBuilder::add_gear(const std::string& name, const std::string& joint_a,
-                            const std::string& joint_b, double r_a, double r_b) {
-  const std::string who = msg("gear '", name, "'");
-  for (const GearConstraint& g : m_.gear_constraints)
-    if (g.name == name) throw ModelError(msg(who, ": duplicate gear name"));
+std::pair<int, int> ModelBuilder::gear_coords(const std::string& who, const std::string& joint_a,
+                                              const std::string& joint_b, double r_a,
+                                              double r_b) const {
   auto coord_of = [&](const std::string& joint) {
     auto it = m_.joint_index.find(joint);
     if (it == m_.joint_index.end()) throw ModelError(msg(who, ": unknown joint '", joint, "'"));
@@ -346,6 +344,15 @@ void ModelBuilder::add_gear(const std::string& name, const std::string& joint_a,
     require_finite(v, who + ": " + n);
     if (!(v > 0)) throw ModelError(msg(who, ": pitch radius ", n, " must be positive, got ", v));
   }
+  return {ca, cb};
+}
+
+void ModelBuilder::add_gear(const std::string& name, const std::string& joint_a,
+                            const std::string& joint_b, double r_a, double r_b) {
+  const std::string who = msg("gear '", name, "'");
+  for (const GearConstraint& g : m_.gear_constraints)
+    if (g.name == name) throw ModelError(msg(who, ": duplicate gear name"));
+  const auto [ca, cb] = gear_coords(who, joint_a, joint_b, r_a, r_b);
   GearConstraint g;
   g.name = name;
   g.coord_a = ca;
@@ -362,21 +369,7 @@ void ModelBuilder::add_gear_pair(const std::string& name, const std::string& joi
   const std::string who = msg("gear pair '", name, "'");
   for (const GearPair& g : m_.gears)
     if (g.name == name) throw ModelError(msg(who, ": duplicate gear pair name"));
-  auto coord_of = [&](const std::string& joint) {
-    auto it = m_.joint_index.find(joint);
-    if (it == m_.joint_index.end()) throw ModelError(msg(who, ": unknown joint '", joint, "'"));
-    const Joint& j = m_.joints[it->second];
-    if (j.type != JointType::Revolute)
-      throw ModelError(msg(who, ": joint '", joint, "' is ", joint_type_name(j.type),
-                           ", a gear needs a revolute joint"));
-    return j.coord0;
-  };
-  const int ca = coord_of(joint_a), cb = coord_of(joint_b);
-  if (ca == cb) throw ModelError(msg(who, ": both gears are on joint '", joint_a, "'"));
-  for (auto [v, n] : {std::pair{r_a, "r_a"}, std::pair{r_b, "r_b"}}) {
-    require_finite(v, who + ": " + n);
-    if (!(v > 0)) throw ModelError(msg(who, ": pitch radius ", n, " must be positive, got ", v));
-  }
+  const auto [ca, cb] = gear_coords(who, joint_a, joint_b, r_a, r_b);
   require_finite(backlash, who + ": backlash");
   require_finite(stiffness, who + ": stiffness");
   require_finite(exponent, who + ": exponent");

@@ -6,6 +6,7 @@ from armdyn.scenes.basic import (
     free_body,
     simple_pendulum,
     slider_crank,
+    slider_driven_to_dead_centre,
     spring_mass_pendulum,
 )
 from armdyn.scenes.extreme import bricard, heavy_top
@@ -22,6 +23,7 @@ __all__ = [
     "heavy_top",
     "simple_pendulum",
     "slider_crank",
+    "slider_driven_to_dead_centre",
     "spring_mass_pendulum",
     "three_dof_arm",
 ]

@@ -148,3 +148,22 @@ def spring_mass_pendulum(stiffness=1e6, damping_ratio=0.2, mass=1.0, length=1.0,
         "slide", stiffness=stiffness, damping=damping_ratio * 2.0 * np.sqrt(stiffness * mass)
     )
     return b.finalize()
+
+
+def slider_driven_to_dead_centre(crank=0.1, rod=0.35):
+    """Slider-crank (axes along z, no gravity) started with the crank at 90° and its *slider*
+    driven by a cubic over 1 s to x = crank + rod, the dead centre, where the driven
+    constraints lose rank: the standard singular case of driven inverse dynamics."""
+    a = np.array([0.0, crank, 0.0])
+    x0 = np.sqrt(rod**2 - crank**2)
+    s = np.array([x0, 0.0, 0.0])
+    b = _core.ModelBuilder(gravity=(0.0, 0.0, 0.0))
+    b.add_body("crank", 1.0, [1e-3, 1e-4, 1e-3], position=a / 2)
+    b.add_body("rod", 0.5, [1e-4, 5e-3, 5e-3], position=(a + s) / 2)
+    b.add_body("slider", 2.0, [1e-3] * 3, position=s)
+    b.add_revolute("crank_pin", "ground", "crank", point=(0, 0, 0), axis=(0, 0, 1))
+    b.add_revolute("crank_rod", "crank", "rod", point=a, axis=(0, 0, 1))
+    b.add_revolute("rod_slider", "rod", "slider", point=s, axis=(0, 0, 1))
+    b.add_prismatic("guide", "ground", "slider", point=s, axis=(1, 0, 0))
+    b.add_drive("guide", _core.profiles.cubic(0.0, crank + rod - x0, 0.0, 1.0))
+    return b.finalize()

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "armdyn/model/model.hpp"
@@ -88,6 +89,11 @@ class ModelBuilder {
   const Model& draft() const { return m_; }
 
  private:
+  /// Coordinates of the two revolute joints of a gear, with the checks common to both gear
+  /// kinds (named `who` in the messages).
+  std::pair<int, int> gear_coords(const std::string& who, const std::string& joint_a,
+                                  const std::string& joint_b, double r_a, double r_b) const;
+
   int add_joint(const std::string& name, JointType type, const std::string& parent,
                 const std::string& child, const Vec3& point, const Vec3& axis, const Vec3* axis2);
   int resolve_body(const std::string& name, const std::string& context) const;
