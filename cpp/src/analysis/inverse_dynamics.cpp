@@ -14,15 +14,6 @@ namespace armdyn {
 
 namespace {
 
-// qdd of coordinate c from the Cartesian accelerations: J vdot + bias
-double coord_acceleration(const Model& m, const ScalarJet& s, int c, const VecX& vd) {
-  const Joint& j = m.joints[m.coords[c].joint];
-  double a = s.bias;
-  if (j.parent != kGround) a += s.J.segment<6>(0).dot(vd.segment<6>(6 * j.parent));
-  if (j.child != kGround) a += s.J.segment<6>(6).dot(vd.segment<6>(6 * j.child));
-  return a;
-}
-
 std::string undriven_coordinates(const Model& m) {
   std::vector<bool> driven(m.coords.size(), false);
   for (const Drive& d : m.drives) driven[m.joints[d.joint].coord0 + d.coord] = true;

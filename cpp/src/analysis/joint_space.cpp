@@ -114,12 +114,7 @@ VecX forward_dynamics(const Model& m, const VecX& q, const VecX& qd, const VecX&
   // qdd = J vdot + bias for every coordinate
   VecX qdd(nc);
   for (int c = 0; c < nc; ++c) {
-    const ScalarJet s = coord_jet(m, e.kin(), c);
-    const Joint& j = m.joints[m.coords[c].joint];
-    double a = s.bias;
-    if (j.parent != kGround) a += s.J.segment<6>(0).dot(vdot.segment<6>(6 * j.parent));
-    if (j.child != kGround) a += s.J.segment<6>(6).dot(vdot.segment<6>(6 * j.child));
-    qdd[c] = a;
+    qdd[c] = coord_acceleration(m, coord_jet(m, e.kin(), c), c, vdot);
   }
   return qdd;
 }

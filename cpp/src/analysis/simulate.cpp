@@ -48,12 +48,7 @@ class MbsSystem : public OdeSystem {
       const double qv = m_.coords[c].angular ? e_.tracked(static_cast<int>(c), q.val) : q.val;
       out_.q.push_back(qv);
       out_.qd.push_back(q.rate);
-      // qdd = J vdot + bias from the accelerations of this very state
-      const Joint& j = m_.joints[m_.coords[c].joint];
-      double a = q.bias;
-      if (j.parent != kGround) a += q.J.segment<6>(0).dot(vd_.segment<6>(6 * j.parent));
-      if (j.child != kGround) a += q.J.segment<6>(6).dot(vd_.segment<6>(6 * j.child));
-      out_.qdd.push_back(a);
+      out_.qdd.push_back(coord_acceleration(m_, q, static_cast<int>(c), vd_));
     }
     // gear mesh forces: contact law of the gear pairs, multipliers of the ideal gears
     for (int gi = 0; gi < static_cast<int>(m_.gears.size()); ++gi) {

@@ -281,14 +281,20 @@ void ModelBuilder::add_spring_damper(const std::string& name, const std::string&
   m_.springs.push_back(s);
 }
 
-void ModelBuilder::add_joint_spring_damper(const std::string& joint, double stiffness,
-                                           double damping, double rest, int coord) {
-  const std::string who = msg("joint spring-damper on '", joint, "'");
+const Joint& ModelBuilder::coord_joint(const std::string& who, const std::string& joint,
+                                       int coord) const {
   auto it = m_.joint_index.find(joint);
   if (it == m_.joint_index.end()) throw ModelError(msg(who, ": unknown joint '", joint, "'"));
   const Joint& j = m_.joints[it->second];
   if (coord < 0 || coord >= joint_coords(j.type))
     throw ModelError(msg(who, ": ", joint_type_name(j.type), " joint has no coordinate ", coord));
+  return j;
+}
+
+void ModelBuilder::add_joint_spring_damper(const std::string& joint, double stiffness,
+                                           double damping, double rest, int coord) {
+  const std::string who = msg("joint spring-damper on '", joint, "'");
+  const Joint& j = coord_joint(who, joint, coord);
   require_finite(stiffness, who + ": stiffness");
   require_finite(damping, who + ": damping");
   require_finite(rest, who + ": rest");
@@ -306,11 +312,7 @@ void ModelBuilder::add_joint_spring_damper(const std::string& joint, double stif
 void ModelBuilder::add_joint_friction(const std::string& joint, double viscous, double coulomb,
                                       double smoothing_velocity, int coord) {
   const std::string who = msg("joint friction on '", joint, "'");
-  auto it = m_.joint_index.find(joint);
-  if (it == m_.joint_index.end()) throw ModelError(msg(who, ": unknown joint '", joint, "'"));
-  const Joint& j = m_.joints[it->second];
-  if (coord < 0 || coord >= joint_coords(j.type))
-    throw ModelError(msg(who, ": ", joint_type_name(j.type), " joint has no coordinate ", coord));
+  const Joint& j = coord_joint(who, joint, coord);
   require_finite(viscous, who + ": viscous");
   require_finite(coulomb, who + ": coulomb");
   require_finite(smoothing_velocity, who + ": smoothing_velocity");
@@ -398,11 +400,7 @@ void ModelBuilder::add_motor(const std::string& joint, const Profile& reference,
                              double kd, double torque_limit, const Profile* feedforward, int coord,
                              double ki) {
   const std::string who = msg("motor on '", joint, "'");
-  auto it = m_.joint_index.find(joint);
-  if (it == m_.joint_index.end()) throw ModelError(msg(who, ": unknown joint '", joint, "'"));
-  const Joint& j = m_.joints[it->second];
-  if (coord < 0 || coord >= joint_coords(j.type))
-    throw ModelError(msg(who, ": ", joint_type_name(j.type), " joint has no coordinate ", coord));
+  const Joint& j = coord_joint(who, joint, coord);
   require_finite(kp, who + ": kp");
   require_finite(kd, who + ": kd");
   require_finite(ki, who + ": ki");
@@ -428,11 +426,7 @@ void ModelBuilder::add_motor(const std::string& joint, const Profile& reference,
 
 void ModelBuilder::add_joint_torque(const std::string& joint, const Profile& profile, int coord) {
   const std::string who = msg("joint torque on '", joint, "'");
-  auto it = m_.joint_index.find(joint);
-  if (it == m_.joint_index.end()) throw ModelError(msg(who, ": unknown joint '", joint, "'"));
-  const Joint& j = m_.joints[it->second];
-  if (coord < 0 || coord >= joint_coords(j.type))
-    throw ModelError(msg(who, ": ", joint_type_name(j.type), " joint has no coordinate ", coord));
+  const Joint& j = coord_joint(who, joint, coord);
   CoordForce cf;
   cf.coord = j.coord0 + coord;
   cf.has_input = true;

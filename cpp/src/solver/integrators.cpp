@@ -39,6 +39,14 @@ double err_norm(const VecX& e, const VecX& a, const VecX& b, double rtol, double
   return s;
 }
 
+// Signs of the event functions at (t, y) (a zero keeps the default +1).
+void init_event_signs(OdeSystem& sys, double t, const VecX& y, std::vector<int>& sgn, VecX& gbuf) {
+  if (sgn.empty()) return;
+  sys.events(t, y, gbuf.data());
+  for (size_t i = 0; i < sgn.size(); ++i)
+    if (gbuf[i] != 0.0) sgn[i] = gbuf[i] > 0 ? 1 : -1;
+}
+
 // Event location on a step [t, t + h] with dense output dense(theta, y_out). sgn holds the sign
 // of every event function at the start of the step; gend its values at the end. Returns the
 // theta in (0, 1] of the earliest crossing (on the side where g has its new sign), or -1.
@@ -147,13 +155,7 @@ void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
   const int ne = sys.n_events();
   std::vector<int> sgn(ne, 1), crossed;
   VecX gend(ne), gbuf(ne), ybuf(n);
-  auto reset_signs = [&]() {
-    if (ne == 0) return;
-    sys.events(t, y, gbuf.data());
-    for (int i = 0; i < ne; ++i)
-      if (gbuf[i] != 0.0) sgn[i] = gbuf[i] > 0 ? 1 : -1;
-  };
-  reset_signs();
+  init_event_signs(sys, t, y, sgn, gbuf);
 
   while (t < t1) {
     if (st.steps + st.rejected >= opt.max_steps)
@@ -371,11 +373,7 @@ void integrate_trbdf2(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
   const int ne = sys.n_events();
   std::vector<int> sgn(ne, 1), crossed;
   VecX gend(ne), gbuf(ne), ybuf(n), yh(n);
-  if (ne > 0) {
-    sys.events(t, y, gbuf.data());
-    for (int i = 0; i < ne; ++i)
-      if (gbuf[i] != 0.0) sgn[i] = gbuf[i] > 0 ? 1 : -1;
-  }
+  init_event_signs(sys, t, y, sgn, gbuf);
   weights(y);
   // initial step: a fraction of the span, limited by the first derivative
   double h = opt.dt > 0

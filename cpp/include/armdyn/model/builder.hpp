@@ -89,6 +89,8 @@ class ModelBuilder {
   const Model& draft() const { return m_; }
 
  private:
+  /// The joint named `joint`, checked to have coordinate `coord` (messages name `who`).
+  const Joint& coord_joint(const std::string& who, const std::string& joint, int coord) const;
   /// Coordinates of the two revolute joints of a gear, with the checks common to both gear
   /// kinds (named `who` in the messages).
   std::pair<int, int> gear_coords(const std::string& who, const std::string& joint_a,

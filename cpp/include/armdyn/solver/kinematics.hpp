@@ -58,4 +58,14 @@ VecJet joint_separation_jet(const Model& m, const std::vector<BodyKin>& kin, int
 /// joint's (parent, child).
 ScalarJet coord_jet(const Model& m, const std::vector<BodyKin>& kin, int coord);
 
+/// Acceleration of joint coordinate c from the Cartesian accelerations: J vdot + bias.
+inline double coord_acceleration(const Model& m, const ScalarJet& s, int c,
+                                 const Eigen::Ref<const VecX>& vdot) {
+  const Joint& j = m.joints[m.coords[c].joint];
+  double a = s.bias;
+  if (j.parent != kGround) a += s.J.segment<6>(0).dot(vdot.segment<6>(6 * j.parent));
+  if (j.child != kGround) a += s.J.segment<6>(6).dot(vdot.segment<6>(6 * j.child));
+  return a;
+}
+
 }  // namespace armdyn
