@@ -50,6 +50,18 @@ def test_contact_onset_is_located_at_the_closed_form_time(integrator):
     assert len(ev["t"]) >= 2
 
 
+def test_rk4_locates_the_onset_between_its_fixed_steps():
+    # before contact the pinion turns at constant acceleration, which RK4 and the cubic Hermite
+    # interpolant reproduce exactly, so the located time is exact although it falls between
+    # grid points (t_c = 2e-3, dt = 3e-4)
+    model = gear_pair()
+    res = ad.simulate(model, 0.004, integrator="rk4", dt=3e-4)
+    t_c = np.sqrt(GAP * IA / (RA * T))
+    assert res.events["onset"][0] and res.events["t"][0] == pytest.approx(t_c, rel=1e-10)
+    # the step was cut at the onset: it is one of the output (step) times
+    assert np.min(np.abs(res.t - t_c)) <= 1e-12
+
+
 def test_undamped_contact_conserves_energy_with_the_work_of_the_torque():
     model = gear_pair(hc_damping=0.0)
     res = ad.simulate(model, 0.02, rtol=1e-11, atol=1e-13, output_dt=0.0005)

@@ -246,7 +246,7 @@ void integrate_rk4(OdeSystem& sys, VecX& y, double t0, double t1, const StepOpti
                    StepStats& st) {
   if (!(opt.dt > 0)) throw ModelError("rk4: dt must be positive");
   const long n = y.size();
-  VecX k1(n), k2(n), k3(n), k4(n), yt(n);
+  VecX k1(n), k2(n), k3(n), k4(n), yt(n), y1(n), f1(n);
   const std::vector<double> touts = output_times(t0, t1, opt.output_dt);
   const bool every_step = touts.empty();
   size_t ko = 1;
@@ -254,6 +254,12 @@ void integrate_rk4(OdeSystem& sys, VecX& y, double t0, double t1, const StepOpti
   sys.project_and_rhs(t, y, k1);
   ++st.rhs_evals;
   sys.output(t, y);
+  // events: located on the cubic Hermite interpolant of (y, k1) and (y1, f(t + h, y1)), which
+  // costs extra right-hand sides only on steps where an event function changes sign
+  const int ne = sys.n_events();
+  std::vector<int> sgn(ne, 1), crossed;
+  VecX gend(ne), gbuf(ne), ybuf(n);
+  init_event_signs(sys, t, y, sgn, gbuf);
   const double eps = 1e-12 * std::max(1.0, std::abs(t1));
   while (t < t1 - eps) {
     if (st.steps >= opt.max_steps)
@@ -263,16 +269,53 @@ void integrate_rk4(OdeSystem& sys, VecX& y, double t0, double t1, const StepOpti
     double to = t1;
     if (!every_step && ko < touts.size()) to = touts[ko];
     if (t + h > to - eps) h = to - t;
-    yt = y + 0.5 * h * k1;
-    sys.rhs(t + 0.5 * h, yt, k2);
-    yt = y + 0.5 * h * k2;
-    sys.rhs(t + 0.5 * h, yt, k3);
-    yt = y + h * k3;
-    sys.rhs(t + h, yt, k4);
-    y += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
-    t = (std::abs(t + h - to) <= eps) ? to : t + h;
+    // a step across an event is redone up to the located crossing (at most twice), so that the
+    // final location uses stages on the near side of it (the Hermite interpolant of a step whose
+    // end already feels, e.g., a contact force is only a first guess)
+    double tn = t;
+    for (int round = 0;; ++round) {
+      yt = y + 0.5 * h * k1;
+      sys.rhs(t + 0.5 * h, yt, k2);
+      yt = y + 0.5 * h * k2;
+      sys.rhs(t + 0.5 * h, yt, k3);
+      yt = y + h * k3;
+      sys.rhs(t + h, yt, k4);
+      y1 = y + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+      tn = (std::abs(t + h - to) <= eps) ? to : t + h;
+      st.rhs_evals += 3;
+      if (ne == 0) break;
+      sys.events(tn, y1, gend.data());
+      bool any = false;
+      for (int i = 0; i < ne; ++i) any = any || gend[i] * sgn[i] < 0;
+      if (!any) break;
+      sys.rhs(tn, y1, f1);
+      ++st.rhs_evals;
+      auto dense = [&](double th, VecX& out) {
+        // cubic Hermite on [t, t + h] with end slopes k1 and f1
+        const double h00 = (1 + 2 * th) * (1 - th) * (1 - th), h10 = th * (1 - th) * (1 - th);
+        const double h01 = th * th * (3 - 2 * th), h11 = th * th * (th - 1);
+        out = h00 * y + (h10 * h) * k1 + h01 * y1 + (h11 * h) * f1;
+      };
+      const double th = locate_events(sys, t, h, dense, sgn, gend, gbuf, ybuf, crossed);
+      if (round < 2 && th > 0 && th < 1.0 - 1e-9) {
+        h *= th;
+        continue;
+      }
+      if (th > 0 && th < 1.0) {
+        tn = t + th * h;
+        dense(th, y1);
+      }
+      for (int i : crossed) {
+        sgn[i] = -sgn[i];
+        sys.on_event(tn, i, sgn[i]);
+        ++st.events;
+      }
+      break;
+    }
+    y = y1;
+    t = tn;
     sys.project_and_rhs(t, y, k1);
-    st.rhs_evals += 4;
+    ++st.rhs_evals;
     ++st.steps;
     if (every_step) {
       sys.output(t, y);

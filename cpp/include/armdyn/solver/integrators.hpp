@@ -31,7 +31,7 @@ class OdeSystem {
   virtual void output(double t, const VecX& y) = 0;
   /// Event functions g_i(t, y): a sign change inside a step is located on the dense output
   /// (Illinois method), the step is cut there and the integration restarts from that state
-  /// (DOPRI5 and TR-BDF2; RK4 does not locate events).
+  /// (DOPRI5: its 4th-order dense output; TR-BDF2 and RK4: cubic Hermite).
   virtual int n_events() const { return 0; }
   virtual void events(double /*t*/, const VecX& /*y*/, double* /*g*/) {}
   /// Called for each located crossing; direction +1 when g goes from negative to positive.
