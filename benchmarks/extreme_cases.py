@@ -17,6 +17,7 @@ import armdyn as ad
 import matplotlib
 import numpy as np
 from armdyn import _core
+from armdyn.reference import SerialChain
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
@@ -164,6 +165,148 @@ def heavy_top_case():
     }
 
 
+def _ratio_chain(ratio, n=5, seed=3):
+    """A spatial 5-revolute chain whose neighbouring links differ in mass by `ratio`, and the
+    same chain as the independent numpy RNEA/CRBA model (armdyn.reference.SerialChain)."""
+    rng = np.random.default_rng(seed)
+    masses = np.array([np.sqrt(ratio) if i % 2 == 0 else 1 / np.sqrt(ratio) for i in range(n)])
+    points, p, steps = np.zeros((n, 3)), np.array([0.0, 0.0, 0.1]), []
+    for i in range(n):
+        points[i] = p
+        s = rng.normal(size=3)
+        steps.append(0.3 * s / np.linalg.norm(s))
+        p = p + steps[-1]
+    axes = rng.normal(size=(n, 3))
+    axes /= np.linalg.norm(axes, axis=1)[:, None]
+    coms = points + 0.5 * np.array(steps)
+    inertias = np.array([np.diag(m * rng.uniform(0.5, 1.5, 3) * 1e-2) for m in masses])
+    b = ad.ModelBuilder(gravity=(0.0, 0.0, -9.81))
+    for i in range(n):
+        b.add_body(f"l{i}", float(masses[i]), inertias[i], position=coms[i])
+    for i in range(n):
+        b.add_revolute(f"j{i}", "ground" if i == 0 else f"l{i - 1}", f"l{i}", points[i], axes[i])
+    model = b.finalize()
+    chain = SerialChain(
+        ["R"] * n,
+        list(range(-1, n - 1)),
+        points,
+        axes,
+        coms,
+        masses,
+        inertias,
+        gravity=(0.0, 0.0, -9.81),
+    )
+    perm = np.array([list(model.coord_names).index(f"j{i}") for i in range(n)])
+    return model, chain, perm
+
+
+def mass_ratio_case():
+    rng = np.random.default_rng(0)
+    ratios = [1.0, 1e2, 1e4, 1e6, 1e8, 1e10]
+    fd_err = []
+    for r in ratios:
+        model, chain, perm = _ratio_chain(r)
+        worst = 0.0
+        for _ in range(5):
+            q_ref, qd_ref, tau_ref = rng.normal(size=(3, len(perm)))
+            q, qd, tau = (np.empty(len(perm)) for _ in range(3))
+            q[perm], qd[perm], tau[perm] = q_ref, qd_ref, tau_ref
+            qdd = ad.forward_dynamics(model, q, qd, tau)
+            ref = chain.forward(q_ref, qd_ref, tau_ref)
+            worst = max(worst, float(np.max(np.abs(qdd[perm] - ref)) / np.max(np.abs(ref))))
+        fd_err.append(worst)
+    model, _chain, _perm = _ratio_chain(1e6)
+    runs = {}
+    for integ in ("dopri5", "trbdf2"):
+        res, cpu = timed(
+            lambda integ=integ: ad.simulate(
+                model, 1.0, integrator=integ, rtol=1e-8, atol=1e-10, output_dt=0.005
+            ),
+            1,
+        )
+        e = res.total_energy
+        runs[integ] = {
+            "t": res.t,
+            "energy_error": np.abs(e - e[0]) / np.max(res.kinetic_energy),
+            "residual": res.position_residual,
+            "steps": res.stats["steps"],
+            "cpu_s": cpu,
+        }
+    fig, ax = plt.subplots(1, 2, figsize=(10, 3.4))
+    ax[0].loglog(ratios, np.maximum(fd_err, 1e-17), "o-")
+    ax[0].set_xlabel("mass ratio of neighbouring links")
+    ax[0].set_ylabel("forward dynamics: rel. error vs numpy RNEA/CRBA")
+    ax[0].grid(alpha=0.3, which="both")
+    for integ, r in runs.items():
+        ax[1].semilogy(r["t"], r["energy_error"] + 1e-18, label=f"{integ}: |ΔE| / max KE")
+        ax[1].semilogy(r["t"], r["residual"] + 1e-18, ":", label=f"{integ}: max |f|")
+    ax[1].set_xlabel("t [s]")
+    ax[1].set_title("mass ratio 1e6, 1 s free motion, rtol 1e-8", fontsize=9)
+    ax[1].legend(fontsize=7)
+    fig.suptitle("Chain of 5 revolute links with alternating masses")
+    fig.tight_layout()
+    fig.savefig(FIG / "mass_ratio.png", dpi=110)
+    plt.close(fig)
+    return {
+        "ratios": ratios,
+        "fd_rel_error": fd_err,
+        "runs_ratio_1e6": {
+            k: {
+                "steps": v["steps"],
+                "cpu_s": v["cpu_s"],
+                "max_energy_error": float(np.max(v["energy_error"])),
+                "max_residual": float(np.max(v["residual"])),
+            }
+            for k, v in runs.items()
+        },
+    }
+
+
+def nan_case():
+    """A user force that turns NaN after t = 0.31 s: each integrator stops with a SolverError
+    naming the body and the time, and returns the outputs before it."""
+
+    def model():
+        b = ad.ModelBuilder()
+        b.add_body("bob", 1.0, [1e-3] * 3, position=(0.0, 0.0, -1.0))
+        b.add_revolute("pivot", "ground", "bob", point=(0, 0, 0), axis=(0, 1, 0))
+        b.add_body_force(
+            "bob",
+            force=(1.0, 0.0, 0.0),
+            profile=lambda t: (float("nan") if t > 0.31 else 0.0, 0.0, 0.0),
+        )
+        return b.finalize()
+
+    full = ad.simulate(model(), 0.31, rtol=1e-10, atol=1e-12, output_dt=0.005)
+    out = {}
+    fig, ax = plt.subplots(figsize=(6, 3.4))
+    ax.plot(full.t, full.q[:, 0], "k-", lw=3, alpha=0.3, label="reference (stopped at 0.31 s)")
+    for integ, mark in (("dopri5", "o"), ("trbdf2", "s"), ("rk4", "^")):
+        try:
+            ad.simulate(model(), 1.0, integrator=integ, dt=0.01, output_dt=0.05)
+            raise RuntimeError("the NaN force was not caught")
+        except ad.SolverError as e:
+            res = e.result
+            out[integ] = {"message": str(e).splitlines()[0], "last_output_t": float(res.t[-1])}
+            ax.plot(
+                res.t,
+                res.q[:, 0],
+                mark,
+                ms=4,
+                label=f"{integ}: stops, last output t={res.t[-1]:.2f}",
+            )
+    ax.axvline(0.31, color="r", ls=":", label="force becomes NaN")
+    ax.set_xlabel("t [s]")
+    ax.set_ylabel("pendulum angle [rad]")
+    ax.set_xlim(0, 0.5)
+    ax.legend(fontsize=7)
+    ax.set_title("NaN force mid-run: SolverError + the result up to the last good output")
+    fig.tight_layout()
+    fig.savefig(FIG / "nan_force.png", dpi=110)
+    plt.close(fig)
+    return out
+
+
 def main():
     FIG.mkdir(parents=True, exist_ok=True)
     RES.mkdir(parents=True, exist_ok=True)
@@ -178,6 +321,8 @@ def main():
         "bricard": bricard_case(),
         "parallelogram": parallelogram_case(),
         "heavy_top": heavy_top_case(),
+        "mass_ratio": mass_ratio_case(),
+        "nan_force": nan_case(),
     }
     (RES / "extreme_cases.json").write_text(json.dumps(out, indent=1), encoding="utf-8")
     print("k | dopri5 steps, CPU s, error | trbdf2 steps, CPU s, error | auto")
@@ -187,7 +332,7 @@ def main():
             f"{r['k']:.0e} | {d['steps']}, {d['cpu_s']:.3f}, {d['error_angle']:.1e} | "
             f"{t['steps']}, {t['cpu_s']:.3f}, {t['error_angle']:.1e} | {r['auto']}"
         )
-    for key in ("bricard", "parallelogram", "heavy_top"):
+    for key in ("bricard", "parallelogram", "heavy_top", "mass_ratio", "nan_force"):
         print(key, json.dumps(out[key]))
 
 

@@ -1,7 +1,8 @@
 """Command line.
 
 * ``armdyn reproduce [--out DIR]`` regenerates the five-DOF validation paper's Tables 1–4 and
-  Figures 5–8 beside the paper's own figures (Markdown + PNG report).
+  Figures 5–8 beside the paper's own figures, and the six-DOF paper's geared-arm study (Fig. 3
+  style), as a Markdown + PNG report.
 * ``armdyn verify`` prints the solver's accuracy figures: pendulum period, energy and momentum
   conservation, constraint drift, and the cross-check against recursive Newton–Euler.
 """
@@ -18,9 +19,12 @@ def main(argv: list[str] | None = None) -> int:
     )
     sub = parser.add_subparsers(dest="command", required=True)
     sub.add_parser("verify", help="print accuracy figures against closed forms and RNEA")
-    rep = sub.add_parser("reproduce", help="regenerate the five-DOF paper's tables and figures")
+    rep = sub.add_parser("reproduce", help="regenerate the papers' tables and figures")
     rep.add_argument("--out", default="armdyn-report", help="report folder (Markdown + PNG)")
     rep.add_argument("--no-plots", action="store_true", help="skip the figures")
+    rep.add_argument(
+        "--no-geared", action="store_true", help="skip the geared-arm study (a few minutes)"
+    )
     args = parser.parse_args(argv)
     if args.command == "verify":
         from armdyn.verify import main as verify_main
@@ -29,7 +33,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.command == "reproduce":
         from armdyn.reproduce import run
 
-        run(args.out, plots=not args.no_plots)
+        run(args.out, plots=not args.no_plots, geared=not args.no_geared)
         return 0
     return 1
 

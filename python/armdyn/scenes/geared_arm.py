@@ -31,7 +31,8 @@ Gears (pitch radii [m]: driven R2, pinion r2, wheel R1, pinion r1; ratio N = (R1
 
 Motors: PD control of the rotor angle towards N × the joint's reference (a quintic rest-to-rest
 profile between ``t_start`` and ``t_end``), gains kp = 25 N m/rad and kd = 0.5 N m s/rad per
-rotor, torque limit 10 N m.
+rotor, torque limit 10 N m. Motors sharing a gear split the gains, and may be biased against
+each other (``preload``, anti-backlash).
 """
 
 from __future__ import annotations
@@ -97,6 +98,7 @@ def geared_arm_6dof(
     kp=25.0,
     kd=0.5,
     torque_limit=10.0,
+    preload=0.0,
 ):
     """Build the geared arm (see the module docstring for every dimension).
 
@@ -110,6 +112,11 @@ def geared_arm_6dof(
         gear_mass_scale: multiplies every gear and rotor mass (tiny: trains without inertia).
         trains: False builds the arm alone (links, housings, driven gears, tool) with drives on
             the arm joints (for inverse-dynamics comparisons).
+        preload: anti-backlash bias torque [N m] at the rotors of the trains sharing
+            ``shared_joint``'s gear: trains 1, 3, … add +preload and trains 2, 4, … −preload
+            (with an odd count the last train gets none), so the biases cancel on the gear
+            but hold the teeth of the two groups against opposite flanks. Ramped in by a
+            quintic over [0, t_start/2] so the teeth close before the motion starts.
     """
     if not 1 <= int(n_motors) <= 6:
         raise _core.ModelError(f"geared_arm_6dof: n_motors must be 1..6, got {n_motors}")
@@ -121,6 +128,8 @@ def geared_arm_6dof(
         raise _core.ModelError(
             f"geared_arm_6dof: control must be 'motor' or 'drive', got {control!r}"
         )
+    if not preload >= 0:
+        raise _core.ModelError(f"geared_arm_6dof: preload must be >= 0, got {preload}")
     if not backlash >= 0:
         raise _core.ModelError(f"geared_arm_6dof: backlash must be >= 0, got {backlash}")
     b = _core.ModelBuilder(gravity=(0.0, 0.0, -G))
@@ -197,12 +206,18 @@ def geared_arm_6dof(
             n_ratio = RATIOS[name]
             ref = _core.profiles.quintic(0.0, n_ratio * float(target), t_start, t_end)
             if control == "motor":
+                bias = 0.0
+                if n_trains > 1 and preload > 0 and not (n_trains % 2 == 1 and k == n_trains - 1):
+                    bias = preload if k % 2 == 0 else -preload
                 b.add_motor(
                     f"{tag}_motor",
                     ref,
                     kp=kp / n_trains,
                     kd=kd / n_trains,
                     torque_limit=torque_limit,
+                    feedforward=(
+                        None if bias == 0.0 else _core.profiles.quintic(0.0, bias, 0.0, t_start / 2)
+                    ),
                 )
             elif k == 0:
                 b.add_drive(f"{tag}_motor", ref)
