@@ -1,4 +1,5 @@
-"""Run N RK4 steps of a tree or a redundant scene (see alloc_per_step.sh)."""
+"""Run N RK4 steps of a small tree (dense KKT path), a redundant scene (pivoted dense path) or
+the 44-body geared arm (block-sparse tree path) (see alloc_per_step.sh)."""
 
 import sys
 
@@ -6,5 +7,9 @@ import armdyn as ad
 from armdyn import scenes
 
 kind, n = sys.argv[1], int(sys.argv[2])
-m = scenes.double_pendulum() if kind == "tree" else scenes.four_bar()
-ad.simulate(m, n * 1e-3, integrator="rk4", dt=1e-3, output_dt=n * 1e-3 / 10)
+if kind == "sparse":
+    m = scenes.geared_arm_6dof(backlash=0.0)
+    ad.simulate(m, n * 1e-5, integrator="rk4", dt=1e-5, output_dt=n * 1e-5 / 10)
+else:
+    m = scenes.double_pendulum() if kind == "tree" else scenes.four_bar()
+    ad.simulate(m, n * 1e-3, integrator="rk4", dt=1e-3, output_dt=n * 1e-3 / 10)

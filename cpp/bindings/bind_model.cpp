@@ -3,6 +3,7 @@
 
 #include "armdyn/io/urdf.hpp"
 #include "armdyn/model/builder.hpp"
+#include "armdyn/solver/block_sparse.hpp"
 #include "common.hpp"
 
 namespace armdyn::py_helpers {
@@ -156,6 +157,41 @@ void bind_model(py::module_& m) {
           },
           py::arg("joint"))
       .def("summary", &Model::summary, "Readable description: sizes, topology, solver path.")
+      .def_property_readonly(
+          "kkt_path", [](const Model& m) { return m.kkt_all.path; },
+          "KKT solver path chosen at finalize(): 'dense', 'tree', 'tree+loops' or 'sparse'.")
+      .def(
+          "with_kkt_path",
+          [](const Model& m, const std::string& path) {
+            if (path != "dense" && path != "auto")
+              throw ModelError("with_kkt_path: path must be 'dense' or 'auto', got '" + path + "'");
+            auto c = std::make_shared<Model>(m);
+            c->kkt_all = plan_kkt(*c, c->nc);
+            c->kkt_joint = c->nc_joint != c->nc ? plan_kkt(*c, c->nc_joint) : KktPlan();
+            if (path == "dense" || c->redundant)
+              for (KktPlan* p : {&c->kkt_all, &c->kkt_joint}) {
+                p->path = "dense";
+                p->description = "dense Schur complement (forced)";
+              }
+            return c;
+          },
+          py::arg("path"),
+          "A copy of the model on another KKT path: 'dense' (the reference: one dense Cholesky "
+          "of the Schur complement) or 'auto' (the plan finalize() picks).")
+      .def_property_readonly(
+          "kkt_plan",
+          [](const Model& m) {
+            py::dict d;
+            d["path"] = m.kkt_all.path;
+            d["description"] = m.kkt_all.description;
+            d["blocks"] = m.kkt_all.order.size();
+            d["factor_entries"] = m.kkt_all.factor_entries;
+            d["fill_blocks"] = m.kkt_all.fill_blocks;
+            d["loop_rows"] = m.kkt_all.loop_rows;
+            d["flops"] = m.kkt_all.flops;
+            return d;
+          },
+          "The KKT plan's statistics (path, row blocks, factor entries, fill, flops).")
       .def("__repr__", [](const Model& md) {
         return msg("<armdyn.Model nb=", md.nb, " joints=", md.joints.size(),
                    " drives=", md.drives.size(), " mobility=", md.mobility, ">");

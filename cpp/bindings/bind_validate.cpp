@@ -2,7 +2,10 @@
 // Bindings of inverse dynamics and the Lagrange and geometric validators.
 #include <pybind11/stl.h>
 
+#include <chrono>
+
 #include "armdyn/analysis/inverse_dynamics.hpp"
+#include "armdyn/analysis/joint_space.hpp"
 #include "armdyn/validate/validators.hpp"
 #include "common.hpp"
 
@@ -89,6 +92,49 @@ void bind_validate(py::module_& m) {
                 self.compute(to_vec(q, "q", n), to_vec(qd, "qd", n), to_vec(qdd, "qdd", n), t));
           },
           py::arg("q"), py::arg("qd"), py::arg("qdd"), py::arg("t") = 0.0);
+
+  py::class_<JointSpaceForwardDynamics>(
+      m, "JointSpaceForwardDynamics",
+      "Joint accelerations of a tree model for (q, qd, tau) through the Cartesian KKT path "
+      "(drives ignored). Keeps its workspace between calls.")
+      .def(py::init([](ModelHolder md) {
+             return std::make_unique<JointSpaceForwardDynamics>(
+                 std::const_pointer_cast<const Model>(md));
+           }),
+           py::arg("model"))
+      .def(
+          "__call__",
+          [](JointSpaceForwardDynamics& self, py::object q, py::object qd, py::object tau,
+             double t) {
+            const long n = static_cast<long>(self.model().coords.size());
+            VecX out(n);
+            self.compute(to_vec(q, "q", n), to_vec(qd, "qd", n), to_vec(tau, "tau", n), out, t);
+            return to_numpy(out);
+          },
+          py::arg("q"), py::arg("qd"), py::arg("tau"), py::arg("t") = 0.0);
+
+  // timing loops in C++ (benchmarks): seconds per call of `count` calls with fixed inputs
+  m.def("_time_forward_loop", [](JointSpaceForwardDynamics& self, py::object q, py::object qd,
+                                 py::object tau, long count) {
+    const long n = static_cast<long>(self.model().coords.size());
+    const VecX qv = to_vec(q, "q", n), qdv = to_vec(qd, "qd", n), tv = to_vec(tau, "tau", n);
+    VecX out(n);
+    py::gil_scoped_release nogil;
+    const auto t0 = std::chrono::steady_clock::now();
+    for (long i = 0; i < count; ++i) self.compute(qv, qdv, tv, out);
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() /
+           static_cast<double>(count);
+  });
+  m.def("_time_inverse_loop", [](JointSpaceInverseDynamics& self, py::object q, py::object qd,
+                                 py::object qdd, long count) {
+    const long n = static_cast<long>(self.model().coords.size());
+    const VecX qv = to_vec(q, "q", n), qdv = to_vec(qd, "qd", n), av = to_vec(qdd, "qdd", n);
+    py::gil_scoped_release nogil;
+    const auto t0 = std::chrono::steady_clock::now();
+    for (long i = 0; i < count; ++i) self.compute(qv, qdv, av);
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() /
+           static_cast<double>(count);
+  });
 
   py::class_<LagrangeValidator>(
       m, "LagrangeValidator",

@@ -7,6 +7,7 @@
 
 #include "armdyn/analysis/joint_space.hpp"
 #include "armdyn/errors.hpp"
+#include "armdyn/solver/block_sparse.hpp"
 #include "armdyn/solver/engine.hpp"
 #include "armdyn/solver/kinematics.hpp"
 
@@ -195,6 +196,9 @@ JointSpaceInverseDynamics::JointSpaceInverseDynamics(std::shared_ptr<const Model
   driven_.mobility_driven = driven_.mobility - nco;
   driven_.redundant = false;
   driven_.redundant_rows.clear();
+  // the drives changed the row blocks: plan the KKT factorisation afresh
+  driven_.kkt_all = plan_kkt(driven_, driven_.nc);
+  driven_.kkt_joint = plan_kkt(driven_, driven_.nc_joint);
   e_ = std::make_unique<Engine>(driven_);
   u_ = VecX::Zero(driven_.nq);
   v_ = VecX::Zero(driven_.nv);

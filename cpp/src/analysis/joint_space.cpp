@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "armdyn/analysis/joint_space.hpp"
 
+#include <utility>
+
 #include "armdyn/errors.hpp"
 #include "armdyn/math/quaternion.hpp"
 #include "armdyn/solver/engine.hpp"
@@ -98,6 +100,33 @@ void joint_coordinates(const Model& m, const VecX& u, const VecX& v, VecX& q, Ve
     q[c] = s.val;
     qd[c] = s.rate;
   }
+}
+
+JointSpaceForwardDynamics::JointSpaceForwardDynamics(std::shared_ptr<const Model> m)
+    : m_(std::move(m)) {
+  if (!m_) throw ModelError("forward_dynamics: no model");
+  require_joint_space(*m_, "forward_dynamics");
+  e_ = std::make_unique<Engine>(*m_);
+  e_->set_include_drives(false);
+  u_ = VecX::Zero(m_->nq);
+  v_ = VecX::Zero(m_->nv);
+  vd_ = VecX::Zero(m_->nv);
+  tau_ = VecX::Zero(static_cast<long>(m_->coords.size()));
+  e_->set_joint_torques(tau_.data());
+}
+
+JointSpaceForwardDynamics::~JointSpaceForwardDynamics() = default;
+
+void JointSpaceForwardDynamics::compute(const VecX& q, const VecX& qd, const VecX& tau, VecX& out,
+                                        double t) {
+  const Model& m = *m_;
+  const long nc = static_cast<long>(m.coords.size());
+  check_vec(tau, nc, "forward_dynamics", "tau");
+  state_from_joints(m, q, qd, u_, v_);
+  tau_ = tau;
+  e_->dynamics(t, u_.data(), v_.data(), vd_.data());
+  out.resize(nc);
+  for (int c = 0; c < nc; ++c) out[c] = coord_acceleration(m, coord_jet(m, e_->kin(), c), c, vd_);
 }
 
 VecX forward_dynamics(const Model& m, const VecX& q, const VecX& qd, const VecX& tau) {

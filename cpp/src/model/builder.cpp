@@ -11,6 +11,7 @@
 #include "armdyn/analysis/joint_space.hpp"
 #include "armdyn/errors.hpp"
 #include "armdyn/math/quaternion.hpp"
+#include "armdyn/solver/block_sparse.hpp"
 #include "armdyn/solver/engine.hpp"
 
 namespace armdyn {
@@ -521,6 +522,10 @@ ModelPtr ModelBuilder::finalize(const FinalizeOptions& options) const {
   }
   m.length_scale = std::max(ls, 1e-3);
 
+  // KKT solver plans (block order and fill), fixed here for the model's lifetime
+  m.kkt_all = plan_kkt(m, m.nc);
+  if (m.nc_joint != m.nc) m.kkt_joint = plan_kkt(m, m.nc_joint);
+
   // assembly: project the given poses onto f(u, 0) = 0, then rest velocities onto zeta v = rhs
   m.u0 = VecX(m.nq);
   for (int i = 0; i < m.nb; ++i) {
@@ -565,9 +570,10 @@ ModelPtr ModelBuilder::finalize(const FinalizeOptions& options) const {
     ConstraintEval ce;
     ce.init(m);
     eval_constraints(m, kin, 0.0, false, ce);
-    const MatX z = dense_zeta(m, ce);
+    MatX z;
     auto analyse = [&](int nrows, std::vector<std::string>* names) {
       if (nrows == 0) return 0;
+      if (z.size() == 0) z = dense_zeta(m, ce);
       Eigen::ColPivHouseholderQR<MatX> qr(z.topRows(nrows).transpose());
       qr.setThreshold(1e-10);
       const int r = static_cast<int>(qr.rank());
@@ -576,9 +582,22 @@ ModelPtr ModelBuilder::finalize(const FinalizeOptions& options) const {
           names->push_back(m.row_name(qr.colsPermutation().indices()[k]));
       return r;
     };
-    m.rank_joint = analyse(m.nc_joint, &m.redundant_rows);
+    // fast path: when the block-sparse Cholesky of zeta zeta^T succeeds on all rows, every row
+    // is independent (its pivots pass the same relative test the solver uses) and the dense
+    // QR below -- cubic in the rows -- is not needed
+    bool full_rank = false;
+    if (m.kkt_all.path != "dense" && m.nc > 0) {
+      BlockSparseSchur sp(m, m.kkt_all);
+      full_rank = sp.factor(ce, nullptr);
+    }
     std::vector<std::string> all;
-    m.rank_all = analyse(m.nc, &all);
+    if (full_rank) {
+      m.rank_joint = m.nc_joint;
+      m.rank_all = m.nc;
+    } else {
+      m.rank_joint = analyse(m.nc_joint, &m.redundant_rows);
+      m.rank_all = analyse(m.nc, &all);
+    }
     for (const auto& n : all)
       if (std::find(m.redundant_rows.begin(), m.redundant_rows.end(), n) ==
               m.redundant_rows.end() &&
@@ -589,6 +608,11 @@ ModelPtr ModelBuilder::finalize(const FinalizeOptions& options) const {
     m.redundant = m.rank_joint < m.nc_joint || m.rank_all < m.nc;
   }
   if (m.redundant) {
+    // redundant rows: the dense pivoted factorisation (minimum-norm multipliers) throughout
+    for (KktPlan* p : {&m.kkt_all, &m.kkt_joint}) {
+      p->path = "dense";
+      p->description = "dense Schur complement, pivoted Cholesky (minimum-norm multipliers)";
+    }
     Engine e(m);
     e.project(0.0, m.u0.data(), m.v0.data(), metric);
   }

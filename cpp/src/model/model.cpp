@@ -121,8 +121,7 @@ std::string Model::summary() const {
     for (const auto& r : redundant_rows) os << "\n    " << r;
     os << "\n  multipliers: minimum-norm (reactions of redundant joints are not unique)\n";
   }
-  os << "  KKT path: dense Schur complement, "
-     << (redundant ? "pivoted Cholesky (minimum-norm multipliers)" : "Cholesky") << "\n";
+  os << "  KKT path: " << kkt_all.path << " -- " << kkt_all.description << "\n";
   os << "  gravity: [" << gravity.x() << ", " << gravity.y() << ", " << gravity.z() << "]\n";
   os << "  bodies:\n";
   for (const Body& b : bodies) os << "    " << b.name << "  mass " << b.mass << " kg\n";

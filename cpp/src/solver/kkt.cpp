@@ -11,27 +11,39 @@ namespace armdyn {
 
 KktSolver::KktSolver(const Model& m)
     : m_(m),
-      A_(MatX::Zero(m.nc, m.nc)),
-      llt_(m.nc),
-      perm_(Eigen::VectorXi::Zero(m.nc)),
-      M_(MatX::Zero(m.nc, m.nc)),
-      G_(MatX::Zero(m.nc, m.nc)),
       tmp_nv_(VecX::Zero(m.nv)),
       tmp_nc_(VecX::Zero(m.nc)),
       b_(VecX::Zero(m.nc)),
       w_(VecX::Zero(m.nc)),
-      scale_(VecX::Zero(m.nc)),
-      tmp2_(VecX::Zero(m.nc)),
-      DM_(MatX::Zero(m.nc, m.nc)) {
+      tmp2_(VecX::Zero(m.nc)) {
   minv_.resize(m.nb);
   for (int i = 0; i < m.nb; ++i) {
     minv_[i].setZero();
     minv_[i].topLeftCorner<3, 3>() = Mat3::Identity() / m.bodies[i].mass;
     minv_[i].bottomRightCorner<3, 3>() = m.bodies[i].inertia.inverse();
   }
+  const bool sparse_all = !m.redundant && !m.kkt_all.path.empty() && m.kkt_all.path != "dense";
+  if (sparse_all) sp_all_ = std::make_unique<BlockSparseSchur>(m, m.kkt_all);
+  if (!m.redundant && m.nc_joint != m.nc && !m.kkt_joint.path.empty() &&
+      m.kkt_joint.path != "dense")
+    sp_joint_ = std::make_unique<BlockSparseSchur>(m, m.kkt_joint);
+  if (!sparse_all) ensure_dense();
+}
+
+void KktSolver::ensure_dense() {
+  const int n = m_.nc;
+  if (A_.rows() == n) return;
+  A_ = MatX::Zero(n, n);
+  llt_ = Eigen::LLT<MatX>(n);
+  perm_ = Eigen::VectorXi::Zero(n);
+  M_ = MatX::Zero(n, n);
+  G_ = MatX::Zero(n, n);
+  scale_ = VecX::Zero(n);
+  DM_ = MatX::Zero(n, n);
 }
 
 void KktSolver::factor_pivoted_at(const ConstraintEval& ce, int nrows, Metric metric, double tol) {
+  ensure_dense();
   assemble(ce, nrows, metric);
   if (nrows > 0) factor_pivoted(nrows, tol);
 }
@@ -40,6 +52,7 @@ void KktSolver::assemble(const ConstraintEval& ce, int nrows, Metric metric) {
   nrows_ = nrows;
   metric_ = metric;
   pinv_ = false;
+  sparse_ = false;
   rank_ = nrows;
   if (nrows == 0) return;
   auto A = A_.topLeftCorner(nrows, nrows);
@@ -68,6 +81,25 @@ void KktSolver::assemble(const ConstraintEval& ce, int nrows, Metric metric) {
 }
 
 void KktSolver::factor(const ConstraintEval& ce, int nrows, Metric metric) {
+  BlockSparseSchur* sp = nullptr;
+  if (nrows == m_.nc && sp_all_)
+    sp = sp_all_.get();
+  else if (nrows == m_.nc_joint && sp_joint_)
+    sp = sp_joint_.get();
+  else if (nrows == m_.nc_joint && m_.nc_joint == m_.nc && sp_all_)
+    sp = sp_all_.get();
+  if (sp && nrows > 0) {
+    if (sp->factor(ce, metric == Metric::Mass ? &minv_ : nullptr)) {
+      nrows_ = nrows;
+      metric_ = metric;
+      pinv_ = false;
+      rank_ = nrows;
+      sparse_ = true;
+      sp_ = sp;
+      return;
+    }
+  }
+  ensure_dense();
   assemble(ce, nrows, metric);
   if (nrows == 0) return;
   auto A = A_.topLeftCorner(nrows, nrows);
@@ -183,7 +215,11 @@ void KktSolver::solve_pivoted(const VecX& b, VecX& x) const {
 
 void KktSolver::solve_schur(const VecX& b, VecX& x) const {
   if (nrows_ == 0) return;
-  if (pinv_) {
+  if (sparse_) {
+    auto xh = x.head(nrows_);
+    xh = b.head(nrows_);
+    sp_->solve_in_place(x);
+  } else if (pinv_) {
     solve_pivoted(b, x);
   } else {
     // in place, so that the Cholesky path allocates nothing

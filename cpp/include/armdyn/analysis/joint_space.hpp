@@ -5,9 +5,13 @@
 // Cartesian KKT path (not a reduced-coordinate algorithm).
 #pragma once
 
+#include <memory>
+
 #include "armdyn/model/model.hpp"
 
 namespace armdyn {
+
+class Engine;
 
 /// Cartesian (u, v) from joint coordinates q and rates qd (n_coords each).
 /// @throws ModelError when the model is not a joint-space tree or sizes are wrong.
@@ -16,6 +20,23 @@ void state_from_joints(const Model& m, const VecX& q, const VecX& qd, VecX& u, V
 void joint_coordinates(const Model& m, const VecX& u, const VecX& v, VecX& q, VecX& qd);
 /// qdd for joint torques/forces tau; drives are ignored (joint rows only).
 VecX forward_dynamics(const Model& m, const VecX& q, const VecX& qd, const VecX& tau);
+
+/// forward_dynamics with a workspace kept between calls (the engine, its KKT plan and buffers):
+/// repeated calls allocate nothing beyond the returned vector.
+class JointSpaceForwardDynamics {
+ public:
+  /// @throws ModelError when the model is not a joint-space tree.
+  explicit JointSpaceForwardDynamics(std::shared_ptr<const Model> m);
+  ~JointSpaceForwardDynamics();
+  /// qdd into out (n_coords) for torques/forces tau at time t.
+  void compute(const VecX& q, const VecX& qd, const VecX& tau, VecX& out, double t = 0.0);
+  const Model& model() const { return *m_; }
+
+ private:
+  std::shared_ptr<const Model> m_;
+  std::unique_ptr<Engine> e_;
+  VecX u_, v_, vd_, tau_;
+};
 
 /// Check that the model supports joint-space calls; throws ModelError naming the reason.
 void require_joint_space(const Model& m, const char* what);

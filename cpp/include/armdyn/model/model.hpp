@@ -138,6 +138,19 @@ struct Coord {
   bool angular = true;
 };
 
+/// Symbolic plan of the block-sparse Schur factorisation (armdyn/solver/block_sparse.hpp).
+struct KktPlan {
+  std::string path;         ///< "dense", "tree", "tree+loops" or "sparse"
+  std::string description;  ///< one line for Model::summary()
+  std::vector<int> order;   ///< elimination position -> block index
+  std::vector<int> pos;     ///< block index -> elimination position
+  /// per position: the later positions with a nonzero block in its column of L (sorted)
+  std::vector<std::vector<int>> cols;
+  int nrows = 0;  ///< the plan covers the blocks with rows < nrows
+  long factor_entries = 0, fill_blocks = 0, flops = 0;
+  int loop_rows = 0;  ///< rows of the blocks that receive fill
+};
+
 class Model {
  public:
   // --- data (read-only after finalize) ---
@@ -171,6 +184,8 @@ class Model {
   std::vector<std::string> redundant_rows;  ///< named redundant constraint rows
   bool redundant = false;
   double length_scale = 1.0;  ///< characteristic length for tolerances [m]
+  /// KKT solver plans chosen at finalize(): all rows, and the joint rows alone
+  KktPlan kkt_all, kkt_joint;
 
   // --- assembled initial state ---
   VecX u0, v0;

@@ -14,11 +14,18 @@
 // of A, spanned (in permuted coordinates) by Z = [-L11^-T L21^T; I] (Golub & Van Loan, 5.5.4 and
 // 4.2.9). vdot and zeta^T delta are unique either way. All storage is sized once in the
 // constructor, so neither path allocates per step.
+//
+// Models whose plan (Model::kkt_all / kkt_joint, chosen at finalize) is not "dense" factor A with
+// the block-sparse Cholesky of block_sparse.hpp instead (linear in the bodies on trees); a
+// (nearly) singular A there falls back to the dense pivoted path, whose buffers are then sized
+// once, on first use.
 #pragma once
 
 #include <Eigen/Cholesky>
+#include <memory>
 #include <vector>
 
+#include "armdyn/solver/block_sparse.hpp"
 #include "armdyn/solver/constraints.hpp"
 
 namespace armdyn {
@@ -44,6 +51,8 @@ class KktSolver {
 
   int nrows() const { return nrows_; }
   Metric metric() const { return metric_; }
+  /// The last factorisation used the block-sparse path.
+  bool used_sparse() const { return sparse_; }
   bool used_pseudo_inverse() const { return pinv_; }
   int rank() const { return rank_; }
   /// Rows left out of the pivoted factor (dependent at this configuration); empty on the
@@ -58,6 +67,10 @@ class KktSolver {
  private:
   const Model& m_;
   std::vector<Mat6> minv_;  // per-body Gamma^-1 blocks
+  std::unique_ptr<BlockSparseSchur> sp_all_, sp_joint_;
+  const BlockSparseSchur* sp_ = nullptr;  // the factor in use when sparse_
+  bool sparse_ = false;
+  void ensure_dense();
   MatX A_;
   Eigen::LLT<MatX> llt_;
   void assemble(const ConstraintEval& ce, int nrows, Metric metric);

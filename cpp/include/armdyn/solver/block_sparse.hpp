@@ -1,0 +1,71 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Block-sparse Cholesky factorisation of the Schur complement A = zeta W^-1 zeta^T.
+//
+// The unknowns are the constraint row blocks (a joint's rows, an ideal gear's row, a drive's row);
+// A has a nonzero block (g, h) exactly when blocks g and h touch a common body. The blocks are
+// ordered once, at finalize(), by minimum (row-weighted) degree with the drive blocks last, and
+// the symbolic factorisation (the block pattern of L, with its fill) is fixed then; the numeric
+// factorisation and the solves only walk precomputed lists and touch no allocator.
+//
+// This is the block form of Baraff's linear-time elimination ("Linear-time dynamics using
+// Lagrange multipliers", SIGGRAPH 1996) on the range-space (Schur) form: on a tree of joints the
+// minimum-degree order eliminates leaves first and produces no fill, so the cost is linear in the
+// number of bodies (each body contributes the clique of the row blocks attached to it); a few
+// loop closures (ideal gears, closing joints) add fill confined to the blocks of their loops; any
+// other topology gets a general sparse factorisation in the same code.
+//
+// A plan covers the blocks with rows < nrows: one for all rows (forward dynamics, projection)
+// and one for the joint rows alone (joint-space solves) when the model has drives.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "armdyn/solver/constraints.hpp"
+
+namespace armdyn {
+
+/// Order the blocks with rows < nrows by minimum row-weighted degree and compute the fill.
+KktPlan plan_kkt(const Model& m, int nrows);
+
+class BlockSparseSchur {
+ public:
+  BlockSparseSchur(const Model& m, const KktPlan& plan);
+  /// Assemble A over the plan's blocks with the per-body metric blocks winv (nullptr: identity)
+  /// and factor it. Returns false, leaving the
+  /// factor invalid, when a pivot is not positive or falls below 1e-12 of its row's diagonal
+  /// (singular or nearly so: the caller then uses the dense pivoted path).
+  bool factor(const ConstraintEval& ce, const std::vector<Mat6>* winv);
+  /// Solve A x = b in place over the plan's rows with the last factor.
+  void solve_in_place(VecX& x) const;
+  int nrows() const { return nrows_; }
+
+ private:
+  struct Column {
+    int row0 = 0, size = 0;
+    int diag = 0;                 // offset of the diagonal block (size x size, column-major)
+    int sub_begin = 0, nsub = 0;  // entries of sub_ for the blocks below it
+    int upd_begin = 0, nupd = 0;  // entries of upd_
+  };
+  struct Sub {
+    int pos, off;  // position of the row block, offset of L(pos, k)
+  };
+  struct Update {
+    int a, b;    // indices into this column's subs (a >= b)
+    int target;  // offset of the target block (a, b) or diagonal of a
+  };
+  struct Assembly {
+    int body, g, sg, h, sh;  // blocks g (row side) and h (column side) through body, slots
+    int target;              // offset of the block (g, h) in L storage (diagonal when g == h)
+  };
+  const Model& m_;
+  std::vector<Column> col_;
+  std::vector<Sub> sub_;
+  std::vector<Update> upd_;
+  std::vector<Assembly> asm_;
+  std::vector<double> val_;
+  std::vector<double> diag0_;  // assembled diagonal of A (by row), for the relative pivot test
+  int nrows_ = 0;
+};
+
+}  // namespace armdyn

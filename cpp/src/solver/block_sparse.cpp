@@ -1,0 +1,279 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "armdyn/solver/block_sparse.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "armdyn/errors.hpp"
+
+namespace armdyn {
+
+namespace {
+// below this many rows the dense Schur Cholesky (one LLT of a small matrix) is cheaper than the
+// block bookkeeping (measured: benchmarks/kkt_paths.py)
+constexpr int kDenseMaxRows = 36;
+}  // namespace
+
+KktPlan plan_kkt(const Model& m, int nrows) {
+  ConstraintEval ce;
+  ce.init(m);
+  KktPlan p;
+  p.nrows = nrows;
+  const int nblk = static_cast<int>(ce.blocks.size());
+  std::vector<char> live(nblk, 0);
+  std::vector<int> size(nblk, 0);
+  for (int g = 0; g < nblk; ++g) {
+    live[g] = ce.blocks[g].row0 < nrows;
+    size[g] = ce.blocks[g].nrows;
+  }
+  std::vector<std::set<int>> nbr(nblk);
+  for (const auto& list : ce.body_blocks)
+    for (const auto& [g, sg] : list)
+      for (const auto& [h, sh] : list)
+        if (g != h && live[g] && live[h]) nbr[g].insert(h);
+  const std::vector<std::set<int>> original = nbr;
+  // greedy minimum degree, the degree weighted by the neighbours' row counts; ties by index
+  std::vector<int> order;
+  std::vector<std::vector<int>> cols_blk;
+  std::set<int> fill_rows_blocks;
+  int remaining = 0;
+  for (int g = 0; g < nblk; ++g) remaining += live[g];
+  std::vector<char> done(nblk, 0);
+  for (int step = 0; step < remaining; ++step) {
+    int best = -1;
+    long bestdeg = 0;
+    for (int g = 0; g < nblk; ++g) {
+      if (!live[g] || done[g]) continue;
+      long d = 0;
+      for (int h : nbr[g]) d += size[h];
+      if (best < 0 || d < bestdeg) {
+        best = g;
+        bestdeg = d;
+      }
+    }
+    done[best] = 1;
+    order.push_back(best);
+    const std::vector<int> nb(nbr[best].begin(), nbr[best].end());
+    cols_blk.push_back(nb);
+    for (int a : nb) nbr[a].erase(best);
+    for (int a : nb)
+      for (int b : nb)
+        if (a != b && nbr[a].insert(b).second && a < b && !original[a].count(b)) {
+          ++p.fill_blocks;
+          fill_rows_blocks.insert(a);
+          fill_rows_blocks.insert(b);
+        }
+  }
+  const int np = static_cast<int>(order.size());
+  p.order = order;
+  p.pos.assign(nblk, -1);
+  for (int k = 0; k < np; ++k) p.pos[order[k]] = k;
+  p.cols.resize(np);
+  for (int k = 0; k < np; ++k) {
+    for (int g : cols_blk[k]) p.cols[k].push_back(p.pos[g]);
+    std::sort(p.cols[k].begin(), p.cols[k].end());
+    const long s = size[order[k]];
+    long r = 0;
+    for (int i : p.cols[k]) r += size[order[i]];
+    p.factor_entries += s * (s + 1) / 2 + s * r;
+    p.flops += s * s * s / 3 + s * s * r + s * r * r;
+  }
+  for (int g : fill_rows_blocks) p.loop_rows += size[g];
+  std::ostringstream os;
+  if (nrows <= kDenseMaxRows) {
+    p.path = "dense";
+    os << "dense Schur complement (" << nrows << " rows; small enough that one dense Cholesky "
+       << "beats the block bookkeeping)";
+  } else {
+    if (p.fill_blocks == 0)
+      p.path = "tree";
+    else if (p.fill_blocks <= np)
+      p.path = "tree+loops";  // loop closures: fill along the loops, still linear in size
+    else
+      p.path = "sparse";
+    if (p.path == "tree")
+      os << "tree: block elimination leaves first, no fill (O(n))";
+    else if (p.path == "tree+loops")
+      os << "tree + loops: block elimination leaves first, fill of " << p.fill_blocks
+         << " blocks along the loops (" << p.loop_rows << " rows)";
+    else
+      os << "general sparse: minimum-degree block elimination, fill " << p.fill_blocks << " blocks";
+    os << "; " << np << " row blocks, " << p.factor_entries << " factor entries, ~" << p.flops
+       << " flops per factorisation";
+  }
+  p.description = os.str();
+  return p;
+}
+
+BlockSparseSchur::BlockSparseSchur(const Model& m, const KktPlan& plan) : m_(m) {
+  ConstraintEval ce;
+  ce.init(m);
+  nrows_ = plan.nrows;
+  if (plan.pos.size() != ce.blocks.size())
+    throw SolverError("internal: the KKT plan does not match the model's constraint blocks");
+  const int np = static_cast<int>(plan.order.size());
+  col_.resize(np);
+  std::map<std::pair<int, int>, int> off;  // (row position, column position) -> offset
+  int total = 0;
+  auto bsize = [&](int k) { return ce.blocks[plan.order[k]].nrows; };
+  for (int k = 0; k < np; ++k) {
+    Column& c = col_[k];
+    c.row0 = ce.blocks[plan.order[k]].row0;
+    c.size = bsize(k);
+    c.diag = total;
+    off[{k, k}] = total;
+    total += c.size * c.size;
+    c.sub_begin = static_cast<int>(sub_.size());
+    c.nsub = static_cast<int>(plan.cols[k].size());
+    for (int i : plan.cols[k]) {
+      sub_.push_back({i, total});
+      off[{i, k}] = total;
+      total += bsize(i) * c.size;
+    }
+  }
+  for (int k = 0; k < np; ++k) {
+    Column& c = col_[k];
+    c.upd_begin = static_cast<int>(upd_.size());
+    for (int a = 0; a < c.nsub; ++a)
+      for (int b = 0; b <= a; ++b) {
+        const int pa = sub_[c.sub_begin + a].pos, pb = sub_[c.sub_begin + b].pos;
+        upd_.push_back({a, b, off.at({pa, pb})});
+      }
+    c.nupd = static_cast<int>(upd_.size()) - c.upd_begin;
+  }
+  for (int b = 0; b < m.nb; ++b)
+    for (const auto& [g, sg] : ce.body_blocks[b])
+      for (const auto& [h, sh] : ce.body_blocks[b]) {
+        const int pg = plan.pos[g], ph = plan.pos[h];
+        if (pg < 0 || ph < 0 || pg < ph) continue;
+        asm_.push_back({b, g, sg, h, sh, off.at({pg, ph})});
+      }
+  val_.assign(total, 0.0);
+  diag0_.assign(m.nc, 0.0);
+}
+
+bool BlockSparseSchur::factor(const ConstraintEval& ce, const std::vector<Mat6>* winv) {
+  std::fill(val_.begin(), val_.end(), 0.0);
+  double* v = val_.data();
+  // assembly: A(g, h) += J_g,b W_b^-1 J_h,b^T over the bodies b the two blocks share
+  Eigen::Matrix<double, Eigen::Dynamic, 6, 0, 6, 6> jw;
+  for (const Assembly& a : asm_) {
+    const ConstraintBlock& bg = ce.blocks[a.g];
+    const ConstraintBlock& bh = ce.blocks[a.h];
+    if (winv)
+      jw.noalias() = bg.J.middleCols<6>(6 * a.sg) * (*winv)[a.body];
+    else
+      jw = bg.J.middleCols<6>(6 * a.sg);
+    const int sg = bg.nrows, sh = bh.nrows;
+    double* t = v + a.target;
+    for (int c = 0; c < sh; ++c)
+      for (int r = 0; r < sg; ++r) {
+        double s = 0.0;
+        for (int p = 0; p < 6; ++p) s += jw(r, p) * bh.J(c, 6 * a.sh + p);
+        t[r + c * sg] += s;
+      }
+  }
+  const int np = static_cast<int>(col_.size());
+  for (int k = 0; k < np; ++k) {
+    const Column& c = col_[k];
+    for (int j = 0; j < c.size; ++j) diag0_[c.row0 + j] = v[c.diag + j + j * c.size];
+  }
+  for (int k = 0; k < np; ++k) {
+    const Column& c = col_[k];
+    const int s = c.size;
+    double* L = v + c.diag;
+    // dense Cholesky of the diagonal block (lower triangle), pivots against the row's diagonal
+    for (int j = 0; j < s; ++j) {
+      double d = L[j + j * s];
+      for (int p = 0; p < j; ++p) d -= L[j + p * s] * L[j + p * s];
+      if (!(d > 1e-12 * diag0_[c.row0 + j])) return false;
+      const double l = std::sqrt(d);
+      L[j + j * s] = l;
+      for (int i = j + 1; i < s; ++i) {
+        double x = L[i + j * s];
+        for (int p = 0; p < j; ++p) x -= L[i + p * s] * L[j + p * s];
+        L[i + j * s] = x / l;
+      }
+    }
+    // blocks below: X <- X L_kk^-T (row by row, forward substitution)
+    for (int e = 0; e < c.nsub; ++e) {
+      const Sub& sb = sub_[c.sub_begin + e];
+      const int si = col_[sb.pos].size;
+      double* X = v + sb.off;
+      for (int r = 0; r < si; ++r)
+        for (int j = 0; j < s; ++j) {
+          double x = X[r + j * si];
+          for (int p = 0; p < j; ++p) x -= L[j + p * s] * X[r + p * si];
+          X[r + j * si] = x / L[j + j * s];
+        }
+    }
+    // Schur updates of the later blocks: T(a, b) -= L(a, k) L(b, k)^T
+    for (int e = 0; e < c.nupd; ++e) {
+      const Update& u = upd_[c.upd_begin + e];
+      const Sub& sa = sub_[c.sub_begin + u.a];
+      const Sub& sb = sub_[c.sub_begin + u.b];
+      const int na = col_[sa.pos].size, nb = col_[sb.pos].size;
+      const double* La = v + sa.off;
+      const double* Lb = v + sb.off;
+      double* T = v + u.target;
+      for (int cc = 0; cc < nb; ++cc)
+        for (int p = 0; p < s; ++p) {
+          const double lb = Lb[cc + p * nb];
+          if (lb == 0.0) continue;
+          for (int r = 0; r < na; ++r) T[r + cc * na] -= La[r + p * na] * lb;
+        }
+    }
+  }
+  return true;
+}
+
+void BlockSparseSchur::solve_in_place(VecX& x) const {
+  const double* v = val_.data();
+  const int np = static_cast<int>(col_.size());
+  for (int k = 0; k < np; ++k) {
+    const Column& c = col_[k];
+    const int s = c.size;
+    const double* L = v + c.diag;
+    double* xk = x.data() + c.row0;
+    for (int j = 0; j < s; ++j) {
+      double t = xk[j];
+      for (int p = 0; p < j; ++p) t -= L[j + p * s] * xk[p];
+      xk[j] = t / L[j + j * s];
+    }
+    for (int e = 0; e < c.nsub; ++e) {
+      const Sub& sb = sub_[c.sub_begin + e];
+      const Column& ci = col_[sb.pos];
+      const double* X = v + sb.off;
+      double* xi = x.data() + ci.row0;
+      for (int j = 0; j < s; ++j)
+        for (int r = 0; r < ci.size; ++r) xi[r] -= X[r + j * ci.size] * xk[j];
+    }
+  }
+  for (int k = np - 1; k >= 0; --k) {
+    const Column& c = col_[k];
+    const int s = c.size;
+    const double* L = v + c.diag;
+    double* xk = x.data() + c.row0;
+    for (int e = 0; e < c.nsub; ++e) {
+      const Sub& sb = sub_[c.sub_begin + e];
+      const Column& ci = col_[sb.pos];
+      const double* X = v + sb.off;
+      const double* xi = x.data() + ci.row0;
+      for (int j = 0; j < s; ++j) {
+        double t = 0.0;
+        for (int r = 0; r < ci.size; ++r) t += X[r + j * ci.size] * xi[r];
+        xk[j] -= t;
+      }
+    }
+    for (int j = s - 1; j >= 0; --j) {
+      double t = xk[j];
+      for (int p = j + 1; p < s; ++p) t -= L[p + j * s] * xk[p];
+      xk[j] = t / L[j + j * s];
+    }
+  }
+}
+
+}  // namespace armdyn
