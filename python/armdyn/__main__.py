@@ -3,6 +3,8 @@
 * ``armdyn reproduce [--out DIR]`` regenerates the five-DOF validation paper's Tables 1–4 and
   Figures 5–8 beside the paper's own figures, and the six-DOF paper's geared-arm study (Fig. 3
   style), as a Markdown + PNG report.
+* ``armdyn bench [--out DIR]`` times armdyn against Pinocchio and SciPy in one process (UR5,
+  Panda, a 5 s run, the 44-body geared arm, chains of 2–1000 bodies) and writes JSON + a plot.
 * ``armdyn verify`` prints the solver's accuracy figures: pendulum period, energy and momentum
   conservation, constraint drift, and the cross-check against recursive Newton–Euler.
 """
@@ -25,7 +27,15 @@ def main(argv: list[str] | None = None) -> int:
     rep.add_argument(
         "--no-geared", action="store_true", help="skip the geared-arm study (a few minutes)"
     )
+    bench = sub.add_parser("bench", help="speed against Pinocchio and SciPy, scaling (JSON + plot)")
+    bench.add_argument("--out", default="docs/results", help="folder for bench.json, bench.png")
+    bench.add_argument("--quick", action="store_true", help="chains up to 100 bodies only")
     args = parser.parse_args(argv)
+    if args.command == "bench":
+        from armdyn.bench import run as bench_run
+
+        bench_run(args.out, quick=args.quick)
+        return 0
     if args.command == "verify":
         from armdyn.verify import main as verify_main
 

@@ -1,0 +1,321 @@
+"""``armdyn bench``: speed against peers, measured in one process on one machine, as ratios.
+
+* Forward and inverse dynamics of real URDF arms (UR5 and Panda from ``example-robot-data``):
+  armdyn (Cartesian Newton–Euler KKT path) against Pinocchio's ``aba`` and ``rnea``, per call
+  from Python for both, and per call in a C++ loop for armdyn. The answers are cross-checked in
+  the same run (relative error of q̈ and τ; also a test, ``tests/test_pinocchio.py``).
+* A whole run: 5 s of the UR5 falling under gravity from rest, armdyn's DOPRI5 against SciPy's
+  ``solve_ivp`` (DOP853 and RK45) on Pinocchio's ABA, at the same tolerance, with the error of
+  each against a tight-tolerance reference.
+* One DOPRI5 step of the 44-body geared arm (the first paper's mechanism).
+* Scaling: spatial revolute chains of n = 2 … 1000 bodies, time per RK4 step against n, with the
+  fitted log-log slope.
+
+Peers come from the ``bench`` extra (``pip install .[bench]``); a missing peer is reported and
+skipped. Results: JSON and a plot into the output folder (default ``docs/results``), with the
+machine and the command. Timings are medians of repeated warm runs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import site
+import time
+from pathlib import Path
+
+import numpy as np
+
+from armdyn import _core
+from armdyn.scenes.geared_arm import geared_arm_6dof
+from armdyn.simulation import load_urdf, simulate
+
+SCALING_FULL = (2, 5, 10, 20, 50, 100, 200, 500, 1000)
+SCALING_QUICK = (2, 5, 10, 20, 50, 100)
+ROBOTS = {
+    "ur5": "ur_description/urdf/ur5_robot.urdf",
+    "panda": "panda_description/urdf/panda.urdf",
+}
+
+
+def robot_urdf(name: str) -> Path | None:
+    """Path of an example-robot-data URDF, or None when the package is not installed."""
+    for base in [*site.getsitepackages(), site.getusersitepackages()]:
+        p = Path(base) / "cmeel.prefix" / "share" / "example-robot-data" / "robots" / ROBOTS[name]
+        if p.is_file():
+            return p
+    return None
+
+
+def _median_time(fn, number: int, repeat: int = 7) -> float:
+    """Median over `repeat` runs of the time per call of `number` calls (after one warm-up)."""
+    fn()
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        for _ in range(number):
+            fn()
+        times.append((time.perf_counter() - t0) / number)
+    return float(np.median(times))
+
+
+def _cpp_time(loop, solver, a, b, c, number: int) -> float:
+    """Median of 5 C++ timing loops (seconds per call)."""
+    return float(np.median([loop(solver, a, b, c, number) for _ in range(5)]))
+
+
+class PinPair:
+    """The same URDF in armdyn and Pinocchio, with the coordinate map between them."""
+
+    def __init__(self, path: Path):
+        import pinocchio as pin
+
+        self.pin = pin
+        self.pm = pin.buildModelFromUrdf(str(path))
+        self.pd = self.pm.createData()
+        self.am = load_urdf(str(path))
+        names = list(self.am.coord_names)
+        pin_names = [self.pm.names[i] for i in range(1, self.pm.njoints)]
+        if self.pm.nq != self.pm.nv or self.pm.nq != len(names):
+            raise ValueError("only revolute/prismatic arms are compared")
+        self.perm = np.array([names.index(n) for n in pin_names])
+        self.fd = _core.JointSpaceForwardDynamics(self.am)
+        self.id = _core.JointSpaceInverseDynamics(self.am)
+
+    def to_armdyn(self, x):
+        out = np.empty(len(self.perm))
+        out[self.perm] = x
+        return out
+
+    def cross_check(self, n: int = 50, seed: int = 0) -> dict:
+        """Worst relative errors of armdyn against aba (q̈) and rnea (τ) over random states."""
+        rng = np.random.default_rng(seed)
+        worst_fd = worst_id = 0.0
+        for _ in range(n):
+            q, v, tau, acc = rng.uniform(-np.pi, np.pi, size=(4, self.pm.nq))
+            a_pin = self.pin.aba(self.pm, self.pd, q, v, tau)
+            a_ad = self.fd(self.to_armdyn(q), self.to_armdyn(v), self.to_armdyn(tau))[self.perm]
+            worst_fd = max(worst_fd, np.max(np.abs(a_ad - a_pin)) / np.max(np.abs(a_pin)))
+            t_pin = self.pin.rnea(self.pm, self.pd, q, v, acc)
+            t_ad = self.id(self.to_armdyn(q), self.to_armdyn(v), self.to_armdyn(acc))[self.perm]
+            worst_id = max(worst_id, np.max(np.abs(t_ad - t_pin)) / np.max(np.abs(t_pin)))
+        return {"fd_rel_error": float(worst_fd), "id_rel_error": float(worst_id)}
+
+    def timings(self, number: int = 2000) -> dict:
+        rng = np.random.default_rng(1)
+        q, v, tau = rng.uniform(-1, 1, size=(3, self.pm.nq))
+        qa, va, ta = (self.to_armdyn(x) for x in (q, v, tau))
+        pin, pm, pd = self.pin, self.pm, self.pd
+        r = {
+            "pin_aba_python_us": 1e6 * _median_time(lambda: pin.aba(pm, pd, q, v, tau), number),
+            "pin_rnea_python_us": 1e6 * _median_time(lambda: pin.rnea(pm, pd, q, v, tau), number),
+            "armdyn_fd_python_us": 1e6 * _median_time(lambda: self.fd(qa, va, ta), number),
+            "armdyn_id_python_us": 1e6 * _median_time(lambda: self.id(qa, va, ta), number),
+            "armdyn_fd_cpp_us": 1e6
+            * float(
+                np.median([_core._time_forward_loop(self.fd, qa, va, ta, number) for _ in range(5)])
+            ),
+            "armdyn_id_cpp_us": 1e6
+            * float(
+                np.median([_core._time_inverse_loop(self.id, qa, va, ta, number) for _ in range(5)])
+            ),
+        }
+        r["ratio_fd_python"] = r["armdyn_fd_python_us"] / r["pin_aba_python_us"]
+        r["ratio_id_python"] = r["armdyn_id_python_us"] / r["pin_rnea_python_us"]
+        return r
+
+
+def bench_arms() -> dict:
+    out = {}
+    try:
+        import pinocchio  # noqa: F401
+    except ImportError:
+        return {"skipped": "pinocchio (pip package 'pin') is not installed"}
+    for name in ROBOTS:
+        path = robot_urdf(name)
+        if path is None:
+            out[name] = {"skipped": "example-robot-data is not installed"}
+            continue
+        pair = PinPair(path)
+        out[name] = {
+            "dof": int(pair.pm.nq),
+            "bodies": int(pair.am.nb),
+            "kkt_path": pair.am.kkt_path,
+            **pair.cross_check(),
+            **pair.timings(),
+        }
+    return out
+
+
+def bench_whole_run(t_end: float = 5.0, rtol: float = 1e-8) -> dict:
+    """5 s of the UR5 released from a bent pose: armdyn DOPRI5 against SciPy on Pinocchio."""
+    path = robot_urdf("ur5")
+    try:
+        import pinocchio as pin
+        from scipy.integrate import solve_ivp
+    except ImportError as e:
+        return {"skipped": str(e)}
+    if path is None:
+        return {"skipped": "example-robot-data is not installed"}
+    pair = PinPair(path)
+    n = pair.pm.nq
+    q0 = np.array([0.3, -1.0, 1.2, -0.5, 0.8, 0.1])[:n]
+
+    def f(_t, y):
+        return np.concatenate([y[n:], pin.aba(pair.pm, pair.pd, y[:n], y[n:], np.zeros(n))])
+
+    y0 = np.concatenate([q0, np.zeros(n)])
+    ref = solve_ivp(f, (0, t_end), y0, method="DOP853", rtol=1e-13, atol=1e-13)
+    q_ref = ref.y[:n, -1]
+    u0, v0 = _core.state_from_joints(pair.am, pair.to_armdyn(q0))
+
+    def ours():
+        return simulate(pair.am, t_end, rtol=rtol, atol=rtol * 1e-2, u0=u0, v0=v0, output_dt=t_end)
+
+    res = ours()
+    err_ours = float(np.max(np.abs(np.unwrap(res.q[-1][pair.perm] - q_ref))))
+    out = {
+        "t_end_s": t_end,
+        "rtol": rtol,
+        "armdyn_dopri5": {
+            "cpu_s": _median_time(ours, 1, 5),
+            "steps": int(res.stats["steps"]),
+            "error_rad": err_ours,
+        },
+    }
+    for method in ("DOP853", "RK45"):
+
+        def peer(method=method):
+            return solve_ivp(f, (0, t_end), y0, method=method, rtol=rtol, atol=rtol * 1e-2)
+
+        sol = peer()
+        out[f"scipy_{method}_on_pin_aba"] = {
+            "cpu_s": _median_time(peer, 1, 5),
+            "steps": int(sol.t.size - 1),
+            "error_rad": float(np.max(np.abs(sol.y[:n, -1] - q_ref))),
+        }
+    return out
+
+
+def bench_geared_arm() -> dict:
+    """Time per DOPRI5 step of the 44-body geared arm with backlash (0.3 s into the motion)."""
+    model = geared_arm_6dof(n_motors=1, backlash=1e-4)
+
+    def run():
+        return simulate(model, 0.3, rtol=1e-6, atol=1e-8, output_dt=0.3)
+
+    res = run()
+    cpu = _median_time(run, 1, 3)
+    return {
+        "bodies": int(model.nb),
+        "kkt_path": model.kkt_path,
+        "steps": int(res.stats["steps"]),
+        "rhs_evals": int(res.stats["rhs_evals"]),
+        "us_per_step": 1e6 * cpu / res.stats["steps"],
+        "us_per_rhs": 1e6 * cpu / res.stats["rhs_evals"],
+        "target_us_per_step": 100.0,
+    }
+
+
+def chain(n: int, seed: int = 1):
+    rng = np.random.default_rng(seed)
+    b = _core.ModelBuilder(gravity=(0.0, 0.0, -9.81))
+    p = np.zeros(3)
+    for i in range(n):
+        step = np.array([0.2, 0.0, 0.0]) + 0.05 * rng.normal(size=3)
+        b.add_body(f"l{i}", 1.0, [1e-2, 1e-2, 1e-2], position=p + step / 2)
+        axis = rng.normal(size=3)
+        parent = "ground" if i == 0 else f"l{i - 1}"
+        b.add_revolute(f"j{i}", parent, f"l{i}", p, axis / np.linalg.norm(axis))
+        p = p + step
+    return b.finalize()
+
+
+def bench_scaling(ns=(2, 5, 10, 20, 50, 100, 200, 500, 1000), steps: int = 20) -> dict:
+    rows = []
+    for n in ns:
+        t0 = time.perf_counter()
+        model = chain(n)
+        build = time.perf_counter() - t0
+        dt = 1e-4
+
+        def run(model=model, dt=dt):
+            return simulate(model, steps * dt, integrator="rk4", dt=dt, output_dt=steps * dt)
+
+        per_step = _median_time(run, 1, 3) / steps
+        rows.append(
+            {"n": n, "kkt_path": model.kkt_path, "us_per_step": 1e6 * per_step, "finalize_s": build}
+        )
+    big = [r for r in rows if r["n"] >= 20]
+    slope = float(
+        np.polyfit(np.log([r["n"] for r in big]), np.log([r["us_per_step"] for r in big]), 1)[0]
+    )
+    return {"rows": rows, "slope_n_ge_20": slope, "target_slope": 1.1}
+
+
+def plot(results: dict, path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(1, 2, figsize=(11, 4))
+    rows = results["scaling"]["rows"]
+    ax[0].loglog([r["n"] for r in rows], [r["us_per_step"] for r in rows], "o-", label="armdyn")
+    n = np.array([r["n"] for r in rows], float)
+    ax[0].loglog(n, rows[-1]["us_per_step"] * n / n[-1], "k:", label="slope 1")
+    ax[0].set_xlabel("bodies in the chain")
+    ax[0].set_ylabel("µs per RK4 step")
+    ax[0].set_title(f"scaling, fitted slope {results['scaling']['slope_n_ge_20']:.2f}")
+    ax[0].legend()
+    arms = {k: v for k, v in results["arms"].items() if isinstance(v, dict) and "dof" in v}
+    labels, vals = [], []
+    for name, r in arms.items():
+        labels += [f"{name} FD", f"{name} ID"]
+        vals += [r["ratio_fd_python"], r["ratio_id_python"]]
+    if vals:
+        ax[1].bar(labels, vals)
+        ax[1].axhline(2.0, color="r", ls=":", label="target 2×")
+        ax[1].set_ylabel("armdyn time / Pinocchio time (per call from Python)")
+        ax[1].legend()
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def run(out="docs/results", quick: bool = False, echo: bool = True) -> dict:
+    results = {
+        "command": "armdyn bench" + (" --quick" if quick else ""),
+        "machine": {
+            "platform": platform.platform(),
+            "processor": platform.processor(),
+            "cpus": os.cpu_count(),
+            "python": platform.python_version(),
+        },
+        "arms": bench_arms(),
+        "whole_run": bench_whole_run(),
+        "geared_arm_step": bench_geared_arm(),
+        "scaling": bench_scaling(
+            (2, 5, 10, 20, 50, 100) if quick else (2, 5, 10, 20, 50, 100, 200, 500, 1000)
+        ),
+    }
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "bench.json").write_text(json.dumps(results, indent=1), encoding="utf-8")
+    plot(results, out / "bench.png")
+    if echo:
+        print(json.dumps(results, indent=1))
+        print(f"written: {out / 'bench.json'}, {out / 'bench.png'}")
+    return results
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(prog="armdyn bench", description=__doc__.splitlines()[0])
+    p.add_argument("--out", default="docs/results", help="folder for bench.json and bench.png")
+    p.add_argument("--quick", action="store_true", help="chains up to 100 bodies only")
+    a = p.parse_args(argv)
+    run(a.out, quick=a.quick)
+    return 0
