@@ -205,6 +205,85 @@ JointSpaceInverseDynamics::JointSpaceInverseDynamics(std::shared_ptr<const Model
   vd_ = VecX::Zero(driven_.nv);
   ref_ = VecX::Zero(3 * nco);
   e_->constraints().drive_ref = ref_.data();
+  // the sweep plan: joints in tree order, each with its rows and its drives' rows (6 in all)
+  const ConstraintEval& ce = e_->constraints();
+  std::vector<int> joint_block(driven_.joints.size(), -1);
+  for (int b = 0; b < static_cast<int>(ce.blocks.size()); ++b)
+    for (int ji = 0; ji < static_cast<int>(driven_.joints.size()); ++ji)
+      if (ce.blocks[b].row0 == driven_.joints[ji].row0 && ce.blocks[b].row0 < driven_.nc_joint &&
+          joint_rows(driven_.joints[ji].type) > 0)
+        joint_block[ji] = b;
+  sweep_ok_ = driven_.gear_constraints.empty();
+  for (int ji : driven_.tree_order) {
+    const Joint& j = driven_.joints[ji];
+    Sweep s{ji, j.parent, j.child, {joint_block[ji], -1, -1}, 1};
+    int rows = joint_rows(j.type);
+    for (int c = 0; c < joint_coords(j.type); ++c) {
+      if (s.nblocks >= 3) break;
+      const int drive = j.coord0 + c;  // drives are in coordinate order
+      for (int b = 0; b < static_cast<int>(ce.blocks.size()); ++b)
+        if (ce.blocks[b].row0 == driven_.nc_joint + drive) s.blocks[s.nblocks++] = b;
+      ++rows;
+    }
+    if (rows != 6 || s.blocks[0] < 0 || j.child == kGround) sweep_ok_ = false;
+    sweep_.push_back(s);
+  }
+  if (static_cast<int>(sweep_.size()) != driven_.nb) sweep_ok_ = false;
+  lu_.resize(sweep_.size());
+  delta_ = VecX::Zero(driven_.nc);
+  r_ = VecX::Zero(driven_.nv);
+}
+
+void JointSpaceInverseDynamics::compute_sweep(double t) {
+  // the same constraint and force evaluation as the KKT path, then two sweeps instead of the
+  // KKT solve: zeta vdot = -xi forward (parents first), zeta^T delta = eta - Gamma vdot backward
+  e_->load(u_.data(), v_.data());
+  eval_constraints(driven_, e_->kin(), t, true, e_->constraints());
+  e_->forces(t);
+  const ConstraintEval& ce = e_->constraints();
+  auto gather = [&](const Sweep& s, int slot, Mat6& Z, Vec6* rhs) {
+    int r = 0;
+    for (int k = 0; k < s.nblocks; ++k) {
+      const ConstraintBlock& b = ce.blocks[s.blocks[k]];
+      for (int i = 0; i < b.nrows; ++i, ++r) {
+        Z.row(r) = b.J.row(i).segment<6>(6 * slot);
+        if (rhs) (*rhs)[r] = -ce.xi[b.row0 + i];
+      }
+    }
+  };
+  Mat6 Zc, Zp;
+  Vec6 rhs;
+  for (size_t k = 0; k < sweep_.size(); ++k) {
+    const Sweep& s = sweep_[k];
+    gather(s, 1, Zc, &rhs);
+    if (s.parent != kGround) {
+      gather(s, 0, Zp, nullptr);
+      rhs.noalias() -= Zp * vd_.segment<6>(6 * s.parent);
+    }
+    lu_[k].compute(Zc);
+    vd_.segment<6>(6 * s.child) = lu_[k].solve(rhs);
+  }
+  // r = eta - Gamma vdot
+  const VecX& eta = e_->eta();
+  for (int i = 0; i < driven_.nb; ++i) {
+    const Body& b = driven_.bodies[i];
+    r_.segment<3>(6 * i) = eta.segment<3>(6 * i) - b.mass * vd_.segment<3>(6 * i);
+    r_.segment<3>(6 * i + 3) = eta.segment<3>(6 * i + 3) - b.inertia * vd_.segment<3>(6 * i + 3);
+  }
+  for (size_t k = sweep_.size(); k-- > 0;) {
+    const Sweep& s = sweep_[k];
+    // delta of this joint's rows from its child's balance (its children's shares already out)
+    Vec6 d = lu_[k].transpose().solve(r_.segment<6>(6 * s.child));
+    int r = 0;
+    for (int q = 0; q < s.nblocks; ++q) {
+      const ConstraintBlock& b = ce.blocks[s.blocks[q]];
+      for (int i = 0; i < b.nrows; ++i, ++r) delta_[b.row0 + i] = d[r];
+    }
+    if (s.parent != kGround) {
+      gather(s, 0, Zp, nullptr);
+      r_.segment<6>(6 * s.parent).noalias() -= Zp.transpose() * d;
+    }
+  }
 }
 
 JointSpaceInverseDynamics::~JointSpaceInverseDynamics() = default;
@@ -221,8 +300,13 @@ VecX JointSpaceInverseDynamics::compute(const VecX& q, const VecX& qd, const Vec
     ref_[3 * c + 1] = qd[c];
     ref_[3 * c + 2] = qdd[c];
   }
-  e_->dynamics(t, u_.data(), v_.data(), vd_.data());
   VecX tau(nco);
+  if (sweep_ok_) {
+    compute_sweep(t);
+    for (long c = 0; c < nco; ++c) tau[c] = -delta_[driven_.nc_joint + c];
+    if (tau.allFinite()) return tau;
+  }
+  e_->dynamics(t, u_.data(), v_.data(), vd_.data());
   for (long c = 0; c < nco; ++c) tau[c] = -e_->delta()[driven_.nc_joint + c];
   return tau;
 }

@@ -12,6 +12,7 @@
 // axis (the RNEA / URDF effort convention).
 #pragma once
 
+#include <Eigen/LU>
 #include <memory>
 #include <vector>
 
@@ -51,6 +52,19 @@ class JointSpaceInverseDynamics {
   Model driven_;  // src_ with one drive per joint coordinate, in coordinate order
   std::unique_ptr<Engine> e_;
   VecX u_, v_, vd_, ref_;
+  // O(n) path: with every coordinate driven, each tree joint's rows plus its drive rows are six
+  // rows on its child's six velocities, so zeta is square and block-triangular in tree order:
+  // vdot by a forward sweep and delta by a backward sweep of 6x6 solves
+  struct Sweep {
+    int joint, parent, child;
+    int blocks[3];  // the joint's block and its drives' blocks (-1: unused)
+    int nblocks;
+  };
+  std::vector<Sweep> sweep_;
+  std::vector<Eigen::PartialPivLU<Mat6>> lu_;
+  VecX delta_, r_;
+  bool sweep_ok_ = false;
+  void compute_sweep(double t);
 };
 
 }  // namespace armdyn
