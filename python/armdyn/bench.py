@@ -7,7 +7,8 @@
 * A whole run: 5 s of the UR5 falling under gravity from rest, armdyn's DOPRI5 against SciPy's
   ``solve_ivp`` (DOP853 and RK45) on Pinocchio's ABA, at the same tolerance, with the error of
   each against a tight-tolerance reference.
-* One DOPRI5 step of the 44-body geared arm (the first paper's mechanism).
+* One DOPRI5 step of the 44-body geared arm (the first paper's mechanism), and 5 s of the
+  five-DOF validation run at rtol 1e-8 (outputs every 0.01 s).
 * Scaling: spatial revolute chains of n = 2 … 1000 bodies, time per RK4 step against n, with the
   fitted log-log slope.
 
@@ -219,6 +220,25 @@ def bench_geared_arm() -> dict:
     }
 
 
+def bench_five_dof() -> dict:
+    """5 s of the five-DOF validation arm (driven, the paper's trajectories), DOPRI5 rtol 1e-8."""
+    from armdyn.scenes.paper import five_dof_arm
+
+    model = five_dof_arm()
+
+    def run():
+        return simulate(model, 5.0, rtol=1e-8, atol=1e-10, output_dt=0.01)
+
+    res = run()
+    return {
+        "kkt_path": model.kkt_path,
+        "steps": int(res.stats["steps"]),
+        "rhs_evals": int(res.stats["rhs_evals"]),
+        "ms": 1e3 * _median_time(run, 1, 5),
+        "target_ms": 5.0,
+    }
+
+
 def chain(n: int, seed: int = 1):
     rng = np.random.default_rng(seed)
     b = _core.ModelBuilder(gravity=(0.0, 0.0, -9.81))
@@ -298,6 +318,7 @@ def run(out="docs/results", quick: bool = False, echo: bool = True) -> dict:
         "arms": bench_arms(),
         "whole_run": bench_whole_run(),
         "geared_arm_step": bench_geared_arm(),
+        "five_dof_run": bench_five_dof(),
         "scaling": bench_scaling(
             (2, 5, 10, 20, 50, 100) if quick else (2, 5, 10, 20, 50, 100, 200, 500, 1000)
         ),
