@@ -1,5 +1,5 @@
-"""Run N RK4 steps of a small tree (dense KKT path), a redundant scene (pivoted dense path) or
-the 44-body geared arm (block-sparse tree path) (see alloc_per_step.sh)."""
+"""Run N RK4 steps of a small tree (block elimination), a redundant scene (pivoted dense path)
+or the 44-body geared arm (block elimination with gears) (see alloc_per_step.sh)."""
 
 import sys
 

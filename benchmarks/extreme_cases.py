@@ -17,7 +17,6 @@ import armdyn as ad
 import matplotlib
 import numpy as np
 from armdyn import _core
-from armdyn.reference import SerialChain
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
@@ -165,57 +164,23 @@ def heavy_top_case():
     }
 
 
-def _ratio_chain(ratio, n=5, seed=3):
-    """A spatial 5-revolute chain whose neighbouring links differ in mass by `ratio`, and the
-    same chain as the independent numpy RNEA/CRBA model (armdyn.reference.SerialChain)."""
-    rng = np.random.default_rng(seed)
-    masses = np.array([np.sqrt(ratio) if i % 2 == 0 else 1 / np.sqrt(ratio) for i in range(n)])
-    points, p, steps = np.zeros((n, 3)), np.array([0.0, 0.0, 0.1]), []
-    for i in range(n):
-        points[i] = p
-        s = rng.normal(size=3)
-        steps.append(0.3 * s / np.linalg.norm(s))
-        p = p + steps[-1]
-    axes = rng.normal(size=(n, 3))
-    axes /= np.linalg.norm(axes, axis=1)[:, None]
-    coms = points + 0.5 * np.array(steps)
-    inertias = np.array([np.diag(m * rng.uniform(0.5, 1.5, 3) * 1e-2) for m in masses])
-    b = ad.ModelBuilder(gravity=(0.0, 0.0, -9.81))
-    for i in range(n):
-        b.add_body(f"l{i}", float(masses[i]), inertias[i], position=coms[i])
-    for i in range(n):
-        b.add_revolute(f"j{i}", "ground" if i == 0 else f"l{i - 1}", f"l{i}", points[i], axes[i])
-    model = b.finalize()
-    chain = SerialChain(
-        ["R"] * n,
-        list(range(-1, n - 1)),
-        points,
-        axes,
-        coms,
-        masses,
-        inertias,
-        gravity=(0.0, 0.0, -9.81),
-    )
-    perm = np.array([list(model.coord_names).index(f"j{i}") for i in range(n)])
-    return model, chain, perm
-
-
 def mass_ratio_case():
     rng = np.random.default_rng(0)
     ratios = [1.0, 1e2, 1e4, 1e6, 1e8, 1e10]
     fd_err = []
     for r in ratios:
-        model, chain, perm = _ratio_chain(r)
+        arm = ad.scenes.mass_ratio_chain(r)
+        chain, perm = arm.chain, arm.perm
         worst = 0.0
         for _ in range(5):
             q_ref, qd_ref, tau_ref = rng.normal(size=(3, len(perm)))
             q, qd, tau = (np.empty(len(perm)) for _ in range(3))
             q[perm], qd[perm], tau[perm] = q_ref, qd_ref, tau_ref
-            qdd = ad.forward_dynamics(model, q, qd, tau)
+            qdd = ad.forward_dynamics(arm.model, q, qd, tau)
             ref = chain.forward(q_ref, qd_ref, tau_ref)
             worst = max(worst, float(np.max(np.abs(qdd[perm] - ref)) / np.max(np.abs(ref))))
         fd_err.append(worst)
-    model, _chain, _perm = _ratio_chain(1e6)
+    model = ad.scenes.mass_ratio_chain(1e6).model
     runs = {}
     for integ in ("dopri5", "trbdf2"):
         res, cpu = timed(
@@ -266,24 +231,17 @@ def nan_case():
     """A user force that turns NaN after t = 0.31 s: each integrator stops with a SolverError
     naming the body and the time, and returns the outputs before it."""
 
-    def model():
-        b = ad.ModelBuilder()
-        b.add_body("bob", 1.0, [1e-3] * 3, position=(0.0, 0.0, -1.0))
-        b.add_revolute("pivot", "ground", "bob", point=(0, 0, 0), axis=(0, 1, 0))
-        b.add_body_force(
-            "bob",
-            force=(1.0, 0.0, 0.0),
-            profile=lambda t: (float("nan") if t > 0.31 else 0.0, 0.0, 0.0),
-        )
-        return b.finalize()
-
-    full = ad.simulate(model(), 0.31, rtol=1e-10, atol=1e-12, output_dt=0.005)
+    full = ad.simulate(
+        ad.scenes.nan_force_pendulum(), 0.31, rtol=1e-10, atol=1e-12, output_dt=0.005
+    )
     out = {}
     fig, ax = plt.subplots(figsize=(6, 3.4))
     ax.plot(full.t, full.q[:, 0], "k-", lw=3, alpha=0.3, label="reference (stopped at 0.31 s)")
     for integ, mark in (("dopri5", "o"), ("trbdf2", "s"), ("rk4", "^")):
         try:
-            ad.simulate(model(), 1.0, integrator=integ, dt=0.01, output_dt=0.05)
+            ad.simulate(
+                ad.scenes.nan_force_pendulum(), 1.0, integrator=integ, dt=0.01, output_dt=0.05
+            )
             raise RuntimeError("the NaN force was not caught")
         except ad.SolverError as e:
             res = e.result

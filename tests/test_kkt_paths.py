@@ -7,27 +7,7 @@ import armdyn as ad
 import numpy as np
 import pytest
 
-
-def chain(n, close_loop=False, seed=1):
-    """A spatial chain of n revolute links with random axes; close_loop ties its tip back to the
-    first link with a spherical joint (one loop closure between moving bodies, mobility n - 3;
-    a closure to ground would couple no moving bodies and add no fill)."""
-    rng = np.random.default_rng(seed)
-    b = ad.ModelBuilder(gravity=(0.0, 0.0, -9.81))
-    p = np.zeros(3)
-    for i in range(n):
-        step = np.array([0.2, 0.0, 0.0]) + 0.05 * rng.normal(size=3)
-        b.add_body(
-            f"l{i}", 1.0 + rng.uniform(), 1e-2 * (1 + rng.uniform(size=3)), position=p + step / 2
-        )
-        axis = rng.normal(size=3)
-        b.add_revolute(
-            f"j{i}", "ground" if i == 0 else f"l{i - 1}", f"l{i}", p, axis / np.linalg.norm(axis)
-        )
-        p = p + step
-    if close_loop:
-        b.add_spherical("close", f"l{n - 1}", "l0", point=p)
-    return b.finalize()
+chain = ad.scenes.random_chain
 
 
 def run(model, t_end, dt):
@@ -89,9 +69,12 @@ def test_driven_model_and_joint_only_solves_match_dense():
     assert np.max(np.abs(a.drive_forces - b.drive_forces)) <= 1e-9 * np.max(np.abs(b.drive_forces))
 
 
-def test_small_and_redundant_models_stay_dense():
+def test_small_models_take_the_block_path_and_redundant_ones_stay_dense():
+    # the block elimination is faster than the dense Cholesky down to 15 rows
+    # (benchmarks/kkt_paths.py), so even the 5-link paper arm takes it, with the dense answers
     five = ad.scenes.five_dof_arm()
-    assert five.kkt_path == "dense"
+    assert five.kkt_path == "tree"
+    assert_same_run(five, t_end=0.5, dt=1e-3)
     four_bar = ad.scenes.four_bar()
     assert four_bar.redundant_rows and four_bar.kkt_path == "dense"
 

@@ -70,15 +70,7 @@ def test_nan_force_mid_run_stops_with_the_result(tmp_path):
     """A user force that turns NaN after t = 0.31 s: the run stops with a SolverError naming the
     body and the time, for every integrator, and keeps the outputs before it."""
     for integrator in ("dopri5", "trbdf2", "rk4"):
-        b = ad.ModelBuilder()
-        b.add_body("bob", 1.0, [1e-3] * 3, position=(0.0, 0.0, -1.0))
-        b.add_revolute("pivot", "ground", "bob", point=(0, 0, 0), axis=(0, 1, 0))
-        b.add_body_force(
-            "bob",
-            force=(1.0, 0.0, 0.0),
-            profile=lambda t: (float("nan") if t > 0.31 else 0.0, 0.0, 0.0),
-        )
-        model = b.finalize()
+        model = ad.scenes.nan_force_pendulum(t_nan=0.31)
         where = r"body 'bob'.*non-finite value at t=0\.[3-9]"
         with pytest.raises(ad.SolverError, match=where) as e:
             ad.simulate(model, 1.0, integrator=integrator, dt=0.01, output_dt=0.05)

@@ -159,7 +159,8 @@ void bind_model(py::module_& m) {
       .def("summary", &Model::summary, "Readable description: sizes, topology, solver path.")
       .def_property_readonly(
           "kkt_path", [](const Model& m) { return m.kkt_all.path; },
-          "KKT solver path chosen at finalize(): 'dense', 'tree', 'tree+loops' or 'sparse'.")
+          "KKT solver path chosen at finalize(): 'tree', 'tree+loops', 'sparse', or 'dense' "
+          "(redundant rows).")
       .def(
           "with_kkt_path",
           [](const Model& m, const std::string& path) {

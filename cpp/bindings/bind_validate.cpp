@@ -12,6 +12,18 @@
 namespace armdyn {
 
 namespace py = pybind11;
+
+namespace {
+/// Seconds per call of fn over `count` calls, without the GIL.
+template <class Fn>
+double time_loop(long count, Fn&& fn) {
+  py::gil_scoped_release nogil;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (long i = 0; i < count; ++i) fn();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() /
+         static_cast<double>(count);
+}
+}  // namespace
 using namespace py_helpers;
 
 namespace {
@@ -119,21 +131,13 @@ void bind_validate(py::module_& m) {
     const long n = static_cast<long>(self.model().coords.size());
     const VecX qv = to_vec(q, "q", n), qdv = to_vec(qd, "qd", n), tv = to_vec(tau, "tau", n);
     VecX out(n);
-    py::gil_scoped_release nogil;
-    const auto t0 = std::chrono::steady_clock::now();
-    for (long i = 0; i < count; ++i) self.compute(qv, qdv, tv, out);
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() /
-           static_cast<double>(count);
+    return time_loop(count, [&] { self.compute(qv, qdv, tv, out); });
   });
   m.def("_time_inverse_loop", [](JointSpaceInverseDynamics& self, py::object q, py::object qd,
                                  py::object qdd, long count) {
     const long n = static_cast<long>(self.model().coords.size());
     const VecX qv = to_vec(q, "q", n), qdv = to_vec(qd, "qd", n), av = to_vec(qdd, "qdd", n);
-    py::gil_scoped_release nogil;
-    const auto t0 = std::chrono::steady_clock::now();
-    for (long i = 0; i < count; ++i) self.compute(qv, qdv, av);
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() /
-           static_cast<double>(count);
+    return time_loop(count, [&] { self.compute(qv, qdv, av); });
   });
 
   py::class_<LagrangeValidator>(

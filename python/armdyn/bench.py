@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from armdyn import _core
+from armdyn.scenes.extreme import random_chain
 from armdyn.scenes.geared_arm import geared_arm_6dof
 from armdyn.simulation import load_urdf, simulate
 
@@ -239,25 +240,11 @@ def bench_five_dof() -> dict:
     }
 
 
-def chain(n: int, seed: int = 1):
-    rng = np.random.default_rng(seed)
-    b = _core.ModelBuilder(gravity=(0.0, 0.0, -9.81))
-    p = np.zeros(3)
-    for i in range(n):
-        step = np.array([0.2, 0.0, 0.0]) + 0.05 * rng.normal(size=3)
-        b.add_body(f"l{i}", 1.0, [1e-2, 1e-2, 1e-2], position=p + step / 2)
-        axis = rng.normal(size=3)
-        parent = "ground" if i == 0 else f"l{i - 1}"
-        b.add_revolute(f"j{i}", parent, f"l{i}", p, axis / np.linalg.norm(axis))
-        p = p + step
-    return b.finalize()
-
-
 def bench_scaling(ns=(2, 5, 10, 20, 50, 100, 200, 500, 1000), steps: int = 20) -> dict:
     rows = []
     for n in ns:
         t0 = time.perf_counter()
-        model = chain(n)
+        model = random_chain(n, masses=np.ones(n))
         build = time.perf_counter() - t0
         dt = 1e-4
 

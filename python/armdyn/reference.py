@@ -350,12 +350,15 @@ def random_inertia(rng, mass: float, lo: float = 0.002, hi: float = 0.03):
     return 0.5 * (inertia + inertia.T)
 
 
-def random_serial_arm(rng, n: int = 6, prismatic: bool = False, gravity=(0.0, 0.0, -9.81)):
+def random_serial_arm(
+    rng, n: int = 6, prismatic: bool = False, gravity=(0.0, 0.0, -9.81), masses=None
+):
     """Random spatial serial arm ground - link1 - ... - linkn built with the builder.
 
     Random link masses, random FULL inertias (R diag R^T, SPD, triangle inequality), random CoM
     offsets, random body orientations, random joint points and random joint axes. With
     prismatic=True every joint with index % 3 == 1 is prismatic (e.g. R P R R P R for n = 6).
+    ``masses`` (n values) replaces the random link masses.
 
     Returns a namespace with the model and everything the numpy reference needs (world frame at
     q = 0): types, points, axes, coms, masses, inertias_body (body axes), inertias_world,
@@ -376,7 +379,8 @@ def random_serial_arm(rng, n: int = 6, prismatic: bool = False, gravity=(0.0, 0.
     # guarantee the axes are not all parallel (random ones never are, but be explicit)
     assert np.linalg.matrix_rank(axes, tol=1e-3) >= 2
     coms = points + 0.5 * steps + 0.05 * rng.normal(size=(n, 3))
-    masses = rng.uniform(0.5, 3.0, size=n)
+    drawn = rng.uniform(0.5, 3.0, size=n)  # drawn either way: the same geometry for a seed
+    masses = drawn if masses is None else np.asarray(masses, dtype=float)
     inertias_body = np.array([random_inertia(rng, m) for m in masses])
     quats = np.array([random_quat(rng) for _ in range(n)])
     rotations = np.array([quat_to_rot(e) for e in quats])

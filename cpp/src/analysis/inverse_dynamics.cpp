@@ -207,25 +207,18 @@ JointSpaceInverseDynamics::JointSpaceInverseDynamics(std::shared_ptr<const Model
   e_->constraints().drive_ref = ref_.data();
   // the sweep plan: joints in tree order, each with its rows and its drives' rows (6 in all)
   const ConstraintEval& ce = e_->constraints();
-  std::vector<int> joint_block(driven_.joints.size(), -1);
-  for (int b = 0; b < static_cast<int>(ce.blocks.size()); ++b)
-    for (int ji = 0; ji < static_cast<int>(driven_.joints.size()); ++ji)
-      if (ce.blocks[b].row0 == driven_.joints[ji].row0 && ce.blocks[b].row0 < driven_.nc_joint &&
-          joint_rows(driven_.joints[ji].type) > 0)
-        joint_block[ji] = b;
+  std::vector<int> block_at_row(driven_.nc, -1);  // block starting at each row
+  for (int b = 0; b < static_cast<int>(ce.blocks.size()); ++b) block_at_row[ce.blocks[b].row0] = b;
   sweep_ok_ = driven_.gear_constraints.empty();
   for (int ji : driven_.tree_order) {
     const Joint& j = driven_.joints[ji];
-    Sweep s{ji, j.parent, j.child, {joint_block[ji], -1, -1}, 1};
-    int rows = joint_rows(j.type);
-    for (int c = 0; c < joint_coords(j.type); ++c) {
-      if (s.nblocks >= 3) break;
-      const int drive = j.coord0 + c;  // drives are in coordinate order
-      for (int b = 0; b < static_cast<int>(ce.blocks.size()); ++b)
-        if (ce.blocks[b].row0 == driven_.nc_joint + drive) s.blocks[s.nblocks++] = b;
-      ++rows;
-    }
-    if (rows != 6 || s.blocks[0] < 0 || j.child == kGround) sweep_ok_ = false;
+    const int nco_j = joint_coords(j.type);
+    Sweep s{ji, j.parent, j.child, {-1, -1, -1}, 0};
+    if (joint_rows(j.type) > 0) s.blocks[s.nblocks++] = block_at_row[j.row0];
+    for (int c = 0; c < nco_j && s.nblocks < 3; ++c)  // drives are in coordinate order
+      s.blocks[s.nblocks++] = block_at_row[driven_.nc_joint + j.coord0 + c];
+    if (joint_rows(j.type) + nco_j != 6 || s.nblocks != 1 + nco_j || j.child == kGround)
+      sweep_ok_ = false;
     sweep_.push_back(s);
   }
   if (static_cast<int>(sweep_.size()) != driven_.nb) sweep_ok_ = false;

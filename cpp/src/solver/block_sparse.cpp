@@ -11,12 +11,6 @@
 
 namespace armdyn {
 
-namespace {
-// below this many rows the dense Schur Cholesky (one LLT of a small matrix) is cheaper than the
-// block bookkeeping (measured: benchmarks/kkt_paths.py)
-constexpr int kDenseMaxRows = 36;
-}  // namespace
-
 KktPlan plan_kkt(const Model& m, int nrows) {
   ConstraintEval ce;
   ce.init(m);
@@ -83,10 +77,9 @@ KktPlan plan_kkt(const Model& m, int nrows) {
   }
   for (int g : fill_rows_blocks) p.loop_rows += size[g];
   std::ostringstream os;
-  if (nrows <= kDenseMaxRows) {
+  if (nrows == 0) {
     p.path = "dense";
-    os << "dense Schur complement (" << nrows << " rows; small enough that one dense Cholesky "
-       << "beats the block bookkeeping)";
+    os << "no constraint rows";
   } else {
     if (p.fill_blocks == 0)
       p.path = "tree";

@@ -95,6 +95,32 @@ double locate_events(OdeSystem& sys, double t, double h, const Dense& dense,
   return best;
 }
 
+// After locate_events returned th: when the crossing lies inside the step, end the step there
+// (tn and y1 from the dense output); flip the crossed functions' signs and report them.
+template <class Dense>
+void take_events(OdeSystem& sys, double t, double h, double th, const Dense& dense,
+                 const std::vector<int>& crossed, std::vector<int>& sgn, StepStats& st, double& tn,
+                 VecX& y1) {
+  if (th > 0 && th < 1.0) {
+    tn = t + th * h;
+    dense(th, y1);
+  }
+  for (int i : crossed) {
+    sgn[i] = -sgn[i];
+    sys.on_event(tn, i, sgn[i]);
+    ++st.events;
+  }
+}
+
+// Cubic Hermite interpolant on [t, t + h] through (y0, f0) and (y1, f1), at theta. The
+// expression is coefficient-wise, so out may be y1 itself.
+inline void hermite(double th, double h, const VecX& y0, const VecX& f0, const VecX& y1,
+                    const VecX& f1, VecX& out) {
+  const double h00 = (1 + 2 * th) * (1 - th) * (1 - th), h10 = th * (1 - th) * (1 - th);
+  const double h01 = th * th * (3 - 2 * th), h11 = th * th * (th - 1);
+  out = h00 * y0 + (h10 * h) * f0 + h01 * y1 + (h11 * h) * f1;
+}
+
 }  // namespace
 
 void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepOptions& opt,
@@ -204,20 +230,10 @@ void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
         out = r1 + th * (r2 + th1 * (r3 + th * (r4 + th1 * r5)));
       };
       // events: cut the step at the earliest crossing and restart from there
-      bool cut = false;
       if (ne > 0) {
         sys.events(tn, y1, gend.data());
         const double th = locate_events(sys, t, h, dense, sgn, gend, gbuf, ybuf, crossed);
-        if (th > 0 && th < 1.0) {
-          tn = t + th * h;
-          dense(th, y1);
-          cut = true;
-        }
-        for (int i : crossed) {
-          sgn[i] = -sgn[i];
-          sys.on_event(tn, i, sgn[i]);
-          ++st.events;
-        }
+        take_events(sys, t, h, th, dense, crossed, sgn, st, tn, y1);
       }
       if (!every_step && ko < touts.size() && touts[ko] <= tn) {
         for (; ko < touts.size() && touts[ko] <= tn; ++ko) {
@@ -225,7 +241,6 @@ void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
           sys.output(touts[ko], yo);
         }
       }
-      (void)cut;
       y = y1;
       sys.project_and_rhs(tn, y, k1);
       ++st.rhs_evals;
@@ -290,26 +305,13 @@ void integrate_rk4(OdeSystem& sys, VecX& y, double t0, double t1, const StepOpti
       if (!any) break;
       sys.rhs(tn, y1, f1);
       ++st.rhs_evals;
-      auto dense = [&](double th, VecX& out) {
-        // cubic Hermite on [t, t + h] with end slopes k1 and f1
-        const double h00 = (1 + 2 * th) * (1 - th) * (1 - th), h10 = th * (1 - th) * (1 - th);
-        const double h01 = th * th * (3 - 2 * th), h11 = th * th * (th - 1);
-        out = h00 * y + (h10 * h) * k1 + h01 * y1 + (h11 * h) * f1;
-      };
+      auto dense = [&](double th, VecX& out) { hermite(th, h, y, k1, y1, f1, out); };
       const double th = locate_events(sys, t, h, dense, sgn, gend, gbuf, ybuf, crossed);
       if (round < 2 && th > 0 && th < 1.0 - 1e-9) {
         h *= th;
         continue;
       }
-      if (th > 0 && th < 1.0) {
-        tn = t + th * h;
-        dense(th, y1);
-      }
-      for (int i : crossed) {
-        sgn[i] = -sgn[i];
-        sys.on_event(tn, i, sgn[i]);
-        ++st.events;
-      }
+      take_events(sys, t, h, th, dense, crossed, sgn, st, tn, y1);
       break;
     }
     y = y1;
@@ -468,25 +470,14 @@ void integrate_trbdf2(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
     double fac = std::clamp(safe * std::pow(std::max(en, 1e-10), -1.0 / 3.0), fac_min, fac_max);
     if (en <= 1.0) {
       double tn = (t + h >= t1 - 1e-14 * std::max(1.0, std::abs(t1))) ? t1 : t + h;
-      // dense output: cubic Hermite between (y, K1) and (y1, K3)
+      // dense output: cubic Hermite between (y, K1) and (y1, K3); on a copy of y1, which an
+      // event cut overwrites before the outputs inside the step are served
       yh = y1;
-      auto dense = [&](double th, VecX& out) {
-        const double s2 = th * th, s3 = s2 * th;
-        out = (2 * s3 - 3 * s2 + 1) * y + (s3 - 2 * s2 + th) * h * K1 + (-2 * s3 + 3 * s2) * yh +
-              (s3 - s2) * h * K3;
-      };
+      auto dense = [&](double th, VecX& out) { hermite(th, h, y, K1, yh, K3, out); };
       if (ne > 0) {
         sys.events(tn, y1, gend.data());
         const double th = locate_events(sys, t, h, dense, sgn, gend, gbuf, ybuf, crossed);
-        if (th > 0 && th < 1.0) {
-          tn = t + th * h;
-          dense(th, y1);
-        }
-        for (int i : crossed) {
-          sgn[i] = -sgn[i];
-          sys.on_event(tn, i, sgn[i]);
-          ++st.events;
-        }
+        take_events(sys, t, h, th, dense, crossed, sgn, st, tn, y1);
       }
       for (; !every_step && ko < touts.size() && touts[ko] <= tn; ++ko) {
         dense((touts[ko] - t) / h, yo);

@@ -86,8 +86,6 @@ void KktSolver::factor(const ConstraintEval& ce, int nrows, Metric metric) {
     sp = sp_all_.get();
   else if (nrows == m_.nc_joint && sp_joint_)
     sp = sp_joint_.get();
-  else if (nrows == m_.nc_joint && m_.nc_joint == m_.nc && sp_all_)
-    sp = sp_all_.get();
   if (sp && nrows > 0) {
     if (sp->factor(ce, metric == Metric::Mass ? &minv_ : nullptr)) {
       nrows_ = nrows;

@@ -9,7 +9,13 @@ from armdyn.scenes.basic import (
     slider_driven_to_dead_centre,
     spring_mass_pendulum,
 )
-from armdyn.scenes.extreme import bricard, heavy_top
+from armdyn.scenes.extreme import (
+    bricard,
+    heavy_top,
+    mass_ratio_chain,
+    nan_force_pendulum,
+    random_chain,
+)
 from armdyn.scenes.geared_arm import geared_arm_6dof
 from armdyn.scenes.paper import five_dof_arm, three_dof_arm
 
@@ -21,6 +27,9 @@ __all__ = [
     "free_body",
     "geared_arm_6dof",
     "heavy_top",
+    "mass_ratio_chain",
+    "nan_force_pendulum",
+    "random_chain",
     "simple_pendulum",
     "slider_crank",
     "slider_driven_to_dead_centre",

@@ -140,7 +140,7 @@ struct Coord {
 
 /// Symbolic plan of the block-sparse Schur factorisation (armdyn/solver/block_sparse.hpp).
 struct KktPlan {
-  std::string path;         ///< "dense", "tree", "tree+loops" or "sparse"
+  std::string path;         ///< "tree", "tree+loops", "sparse", or "dense" (redundant rows)
   std::string description;  ///< one line for Model::summary()
   std::vector<int> order;   ///< elimination position -> block index
   std::vector<int> pos;     ///< block index -> elimination position

@@ -26,6 +26,10 @@
 namespace armdyn {
 
 /// Order the blocks with rows < nrows by minimum row-weighted degree and compute the fill.
+/// There is no size below which the plan turns dense: the block elimination ties with the dense
+/// Schur Cholesky at 3 links (15 rows) and is faster from 4 links up
+/// (python benchmarks/kkt_paths.py). The dense path is kept for redundant models, as the
+/// fallback of a near-singular factor and as the reference (Model::with_kkt_path("dense")).
 KktPlan plan_kkt(const Model& m, int nrows);
 
 class BlockSparseSchur {
