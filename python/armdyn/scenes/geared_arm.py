@@ -174,7 +174,12 @@ def geared_arm_6dof(
             b.add_revolute(f"{tag}_motor", parent, f"{tag}_rotor", point=c1, axis=axis)
             b.add_fixed(f"{tag}_p1_key", f"{tag}_rotor", f"{tag}_pinion_1", point=c1)
             b.add_gear(f"{tag}_stage_1", f"{tag}_motor", f"{tag}_shaft", r1, R1)
-            if backlash > 0:
+            # without backlash, one ideal stage-2 mesh per joint: further trains on the same
+            # gear would be redundant constraints, so they mesh through a stiff contact with
+            # zero clearance
+            if backlash == 0 and k == 0:
+                b.add_gear(f"{tag}_stage_2", f"{tag}_shaft", name, r2, R2)
+            else:
                 b.add_gear_pair(
                     f"{tag}_stage_2",
                     f"{tag}_shaft",
@@ -186,23 +191,6 @@ def geared_arm_6dof(
                     exponent=1.5,
                     hc_damping=hc_damping,
                 )
-            else:
-                # one ideal stage-2 mesh per joint: further trains on the same gear would be
-                # redundant constraints, so they mesh through a stiff backlash-free contact
-                if k == 0:
-                    b.add_gear(f"{tag}_stage_2", f"{tag}_shaft", name, r2, R2)
-                else:
-                    b.add_gear_pair(
-                        f"{tag}_stage_2",
-                        f"{tag}_shaft",
-                        name,
-                        r2,
-                        R2,
-                        backlash=0.0,
-                        stiffness=mesh_stiffness,
-                        exponent=1.5,
-                        hc_damping=hc_damping,
-                    )
             n_ratio = RATIOS[name]
             ref = _core.profiles.quintic(0.0, n_ratio * float(target), t_start, t_end)
             if control == "motor":
