@@ -243,6 +243,28 @@ void bind_model(py::module_& m) {
           },
           py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point"), py::arg("axis"))
       .def(
+          "add_inline",
+          [](ModelBuilder& b, const std::string& n, const std::string& p, const std::string& c,
+             py::object point, py::object axis) {
+            return b.add_inline(n, p, c, to_vec3(point, "joint '" + n + "': point"),
+                                to_vec3(axis, "joint '" + n + "': axis"));
+          },
+          py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point"), py::arg("axis"),
+          "Inline (point-on-line) joint, 2 rows: the child's point stays on the parent's line "
+          "through `point` along `axis`. Closes a planar loop without redundant rows.")
+      .def(
+          "add_distance",
+          [](ModelBuilder& b, const std::string& n, const std::string& ba, py::object pa,
+             const std::string& bb, py::object pb) {
+            const std::string who = "joint '" + n + "'";
+            return b.add_distance(n, ba, to_vec3(pa, who + ": point_a"), bb,
+                                  to_vec3(pb, who + ": point_b"));
+          },
+          py::arg("name"), py::arg("body_a"), py::arg("point_a"), py::arg("body_b"),
+          py::arg("point_b"),
+          "Distance joint, 1 row: a massless rod with ball ends between point_a of body_a and "
+          "point_b of body_b (world coordinates at assembly); it holds their assembly distance.")
+      .def(
           "add_spherical",
           [](ModelBuilder& b, const std::string& n, const std::string& p, const std::string& c,
              py::object point) {

@@ -5,6 +5,9 @@
   style), as a Markdown + PNG report.
 * ``armdyn bench [--out DIR]`` times armdyn against Pinocchio and SciPy in one process (UR5,
   Panda, a 5 s run, the 44-body geared arm, chains of 2–1000 bodies) and writes JSON + a plot.
+* ``armdyn workprecision [PROBLEM ...] [--quick] [--out DIR]`` sweeps tolerances on the standard
+  problems (IFToMM A01, A02, Andrews' squeezer) and records error against CPU time for armdyn's
+  integrators and the peers (SciPy, MuJoCo), as JSON + a log-log plot per problem.
 * ``armdyn verify`` prints the solver's accuracy figures: pendulum period, energy and momentum
   conservation, constraint drift, and the cross-check against recursive Newton–Euler.
 """
@@ -30,7 +33,17 @@ def main(argv: list[str] | None = None) -> int:
     bench = sub.add_parser("bench", help="speed against Pinocchio and SciPy, scaling (JSON + plot)")
     bench.add_argument("--out", default="docs/results", help="folder for bench.json, bench.png")
     bench.add_argument("--quick", action="store_true", help="chains up to 100 bodies only")
+    wp = sub.add_parser("workprecision", help="error against CPU time on the standard problems")
+    wp.add_argument("problems", nargs="*", default=["all"], help="a01, a02, squeezer or all")
+    wp.add_argument("--out", default="docs/results/workprecision", help="folder for JSON + PNG")
+    wp.add_argument("--quick", action="store_true", help="two points per curve")
+    wp.add_argument("--no-peers", action="store_true", help="armdyn's curves only")
     args = parser.parse_args(argv)
+    if args.command == "workprecision":
+        from armdyn.workprecision import run as wp_run
+
+        wp_run(args.problems, out=args.out, quick=args.quick, peers=not args.no_peers)
+        return 0
     if args.command == "bench":
         from armdyn.bench import run as bench_run
 

@@ -99,7 +99,7 @@ int ModelBuilder::add_joint(const std::string& name, JointType type, const std::
   require_finite(point, who + ": point");
   Mat3 fw_parent = Mat3::Identity(), fw_child = Mat3::Identity();
   if (type == JointType::Revolute || type == JointType::Prismatic ||
-      type == JointType::Cylindrical) {
+      type == JointType::Cylindrical || type == JointType::Inline) {
     fw_parent = fw_child = frame_from_z(unit_axis(axis, who + ": axis"));
   } else if (type == JointType::Universal) {
     const Vec3 a1 = unit_axis(axis, who + ": axis1");
@@ -172,6 +172,31 @@ int ModelBuilder::add_universal(const std::string& name, const std::string& pare
                                 const std::string& child, const Vec3& point, const Vec3& axis1,
                                 const Vec3& axis2) {
   return add_joint(name, JointType::Universal, parent, child, point, axis1, &axis2);
+}
+int ModelBuilder::add_inline(const std::string& name, const std::string& parent,
+                             const std::string& child, const Vec3& point, const Vec3& axis) {
+  return add_joint(name, JointType::Inline, parent, child, point, axis, nullptr);
+}
+int ModelBuilder::add_distance(const std::string& name, const std::string& body_a,
+                               const Vec3& point_a, const std::string& body_b,
+                               const Vec3& point_b) {
+  const std::string who = msg("distance joint '", name, "'");
+  require_finite(point_b, who + ": point_b");
+  const double len = (point_b - point_a).norm();
+  if (!(len > 1e-9))
+    throw ModelError(msg(who, ": the points coincide (length ", len,
+                         " m); use a spherical joint for a zero-length link"));
+  const int idx =
+      add_joint(name, JointType::Distance, body_a, body_b, point_a, Vec3::UnitZ(), nullptr);
+  Joint& j = m_.joints[idx];
+  j.length = len;
+  if (j.child != kGround) {
+    const Body& bd = m_.bodies[j.child];
+    j.point_child = quat_to_rot(bd.orientation).transpose() * (point_b - bd.position);
+  } else {
+    j.point_child = point_b;
+  }
+  return idx;
 }
 int ModelBuilder::add_free(const std::string& name, const std::string& child) {
   const int c = resolve_body(child, msg("free joint '", name, "'"));
@@ -497,7 +522,8 @@ ModelPtr ModelBuilder::finalize(const FinalizeOptions& options) const {
     }
     for (const Joint& j : m.joints) {
       if (j.type == JointType::Spherical || j.type == JointType::Universal ||
-          j.type == JointType::Free) {
+          j.type == JointType::Free || j.type == JointType::Inline ||
+          j.type == JointType::Distance) {
         if (ok)
           m.joint_space_reason =
               msg(joint_type_name(j.type), " joint '", j.name, "' has no joint coordinates");

@@ -25,6 +25,10 @@ const char* joint_type_name(JointType t) {
       return "universal";
     case JointType::Free:
       return "free";
+    case JointType::Inline:
+      return "inline";
+    case JointType::Distance:
+      return "distance";
   }
   return "?";
 }
@@ -45,6 +49,10 @@ int joint_rows(JointType t) {
       return 4;
     case JointType::Free:
       return 0;
+    case JointType::Inline:
+      return 2;
+    case JointType::Distance:
+      return 1;
   }
   return 0;
 }

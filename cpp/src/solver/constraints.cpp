@@ -113,6 +113,22 @@ void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t,
         }
         break;
       }
+      case JointType::Distance: {
+        // (|d|^2 - L^2) / (2 L): zero on the sphere, gradient the unit direction there
+        ScalarJet s = dot(d, d);
+        const double k = 0.5 / j.length;
+        s.val = k * (s.val - j.length * j.length);
+        s.rate *= k;
+        s.J *= k;
+        s.bias *= k;
+        put_row(ce, b, r++, s, with_xi);
+        break;
+      }
+      case JointType::Inline:
+        // the child's point on the parent's axis line: no separation across the axis
+        put_row(ce, b, r++, dot(ax(0, 0), d), with_xi);
+        put_row(ce, b, r++, dot(ax(0, 1), d), with_xi);
+        break;
       case JointType::Cylindrical: {
         const VecJet za = ax(0, 2);
         put_row(ce, b, r++, dot(za, ax(1, 0)), with_xi);

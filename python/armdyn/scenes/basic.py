@@ -91,6 +91,7 @@ def four_bar(
     crank_angle=np.pi / 3,
     crank_drive=None,
     gravity=9.81,
+    closure="revolute",
 ):
     """Planar four-bar (crank a, coupler b, rocker c, ground d) modelled in 3-D with revolute
     joints, all axes along z, gravity along -y: 3 moving bodies, 4 revolutes = 20 rows of rank 17,
@@ -98,7 +99,9 @@ def four_bar(
     second, coaxial revolute "A2" between ground and crank, as real bearings often are): 25 rows,
     still rank 17 and mobility 1. `crank_drive` (a profile of the crank joint "A", relative to the
     start angle) prescribes the crank. With a = c and b = d the linkage is a parallelogram whose
-    links all become collinear at crank angles 0 and π (its change points)."""
+    links all become collinear at crank angles 0 and π (its change points). ``closure="inline"``
+    closes the loop at D with an inline joint (2 rows) instead of a revolute: 17 independent
+    rows, no redundancy, the same motion."""
     bld = _core.ModelBuilder(gravity=(0.0, -gravity, 0.0))
     pa = np.array([a * np.cos(crank_angle), a * np.sin(crank_angle), 0.0])
     pd = np.array([d, 0.0, 0.0])
@@ -117,7 +120,10 @@ def four_bar(
         bld.add_revolute("A2", "ground", "crank", point=(0, 0, 0.05), axis=z)
     bld.add_revolute("B", "crank", "coupler", point=pa, axis=z)
     bld.add_revolute("C", "coupler", "rocker", point=pb, axis=z)
-    bld.add_revolute("D", "rocker", "ground", point=pd, axis=z)
+    if closure == "inline":
+        bld.add_inline("D", "rocker", "ground", point=pd, axis=z)
+    else:
+        bld.add_revolute("D", "rocker", "ground", point=pd, axis=z)
     if crank_drive is not None:
         bld.add_drive("A", crank_drive)
     return bld.finalize()

@@ -41,6 +41,15 @@ class ModelBuilder {
   /// Universal (Cardan) joint: axis1 fixed in parent, axis2 fixed in child, perpendicular.
   int add_universal(const std::string& name, const std::string& parent, const std::string& child,
                     const Vec3& point, const Vec3& axis1, const Vec3& axis2);
+  /// Inline (point-on-line) joint: the child's point stays on the line through `point` along
+  /// `axis` fixed in the parent; 2 rows. Closing a planar loop with it instead of a revolute
+  /// keeps the rows independent (a revolute there adds 3 rows the loop already implies).
+  int add_inline(const std::string& name, const std::string& parent, const std::string& child,
+                 const Vec3& point, const Vec3& axis);
+  /// Distance joint (a massless rod with ball ends): |P_b - P_a| stays at its assembly value;
+  /// points in world coordinates at the assembly pose; 1 row.
+  int add_distance(const std::string& name, const std::string& body_a, const Vec3& point_a,
+                   const std::string& body_b, const Vec3& point_b);
   /// Declares a body free (6 DOF, no constraint rows) so that it counts as connected to ground.
   int add_free(const std::string& name, const std::string& child);
 

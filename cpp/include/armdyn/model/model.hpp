@@ -28,7 +28,19 @@ struct Body {
   Vec4 orientation;   ///< Euler parameters at assembly (body -> world)
 };
 
-enum class JointType { Revolute, Prismatic, Spherical, Fixed, Cylindrical, Universal, Free };
+enum class JointType {
+  Revolute,
+  Prismatic,
+  Spherical,
+  Fixed,
+  Cylindrical,
+  Universal,
+  Free,
+  /// a point of the child stays on the parent's axis line (2 rows; Adams' "inline" primitive)
+  Inline,
+  /// the distance between a point of each body stays at its assembly value (1 row)
+  Distance
+};
 
 const char* joint_type_name(JointType t);
 
@@ -47,6 +59,7 @@ struct Joint {
   Mat3 frame_parent = Mat3::Identity(), frame_child = Mat3::Identity();
   double lower = -1e300, upper = 1e300;       ///< position limits (URDF; reported, not enforced)
   double effort = 0.0, velocity_limit = 0.0;  ///< URDF limits, informative
+  double length = 0.0;                        ///< distance joint: the held distance [m]
   int row0 = 0;                               ///< first constraint row
   int coord0 = -1;                            ///< first joint coordinate index, -1 if none
 };

@@ -1,0 +1,438 @@
+"""Error against run time (work–precision) on standard problems, with peers on the same axes.
+
+``armdyn workprecision <problem> [--quick] [--out DIR]`` or :func:`run`. For each problem and
+integrator the tolerance (DOPRI5, TR-BDF2) or step (RK4, MuJoCo) is swept; each point records the
+error against an independent reference (:mod:`armdyn.references`, derived by a different method
+in minimal coordinates), the CPU time of the whole solve (median of warm repeats, one warm-up
+run first) and the counters (steps, right-hand sides, KKT solves, factorisations). Peers run the
+same problem in the same process:
+
+- SciPy ``solve_ivp`` (DOP853, RK45) on the minimal-coordinate equations of the reference;
+- MuJoCo (RK4 and implicit Euler at fixed steps, ``mj_step`` looping in C between outputs)
+  where the problem is a tree (A01).
+
+Errors are measured as in the IFToMM benchmark: the largest absolute deviation over the output
+grid of the problem's reference quantity (positions of a point [m], or angles [rad]).
+Protocol: ``../shared/design/methods.md`` §8 (Hairer–Wanner work–precision diagrams).
+"""
+
+from __future__ import annotations
+
+import json
+import platform
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from armdyn import _core, references
+from armdyn.scenes import standard
+from armdyn.simulation import simulate
+
+
+def _quat_angle_z(u: np.ndarray, body: int) -> np.ndarray:
+    """Rotation angle about world z of a body that only turns about z (from its quaternion)."""
+    e = u[:, 7 * body + 3 : 7 * body + 7]
+    return 2.0 * np.arctan2(e[:, 3], e[:, 0])
+
+
+def _wrap(a):
+    return np.remainder(np.asarray(a) + np.pi, 2 * np.pi) - np.pi
+
+
+@dataclass
+class Problem:
+    name: str
+    title: str
+    source: str
+    t_end: float
+    n_out: int  # output intervals
+    quantity: str  # what the error measures
+    build: Callable
+    observe: Callable  # (model, SimulationResult) -> (n_out + 1, k)
+    reference: Callable  # t -> (n, k)
+    angular: bool = False  # errors of angles are wrapped
+    init: Callable | None = None  # model -> simulate kwargs
+    sweeps: dict = field(default_factory=dict)
+    quick_sweeps: dict = field(default_factory=dict)
+    required: tuple | None = None  # (low, high) precision of the benchmark
+    scipy_rhs: Callable | None = None  # () -> (f, y0)
+    scipy_observe: Callable | None = None  # y (k, n) -> (n, kq)
+    mujoco_xml: str | None = None
+    mujoco_observe: Callable | None = None  # qpos (n, nq) -> (n, kq)
+
+
+def _a01_observe(_model, res):
+    return res.u[:, :2]
+
+
+def _a02_observe(model, res):
+    # B0 is the top of crank 0, whose body x axis is the crank's direction (world angle)
+    phi = _quat_angle_z(res.u, model.body_names.index("crank0"))
+    return np.column_stack([np.cos(phi), np.sin(phi)])
+
+
+def _squeezer_observe(model, res):
+    q0 = np.array(standard.SQUEEZER["q0"])
+    a = np.column_stack(
+        [_quat_angle_z(res.u, model.body_names.index(f"K{k}")) for k in range(1, 8)]
+    )
+    rel = np.column_stack(
+        [
+            a[:, 0],
+            a[:, 1] - a[:, 0],
+            a[:, 2],
+            a[:, 3] - a[:, 4],
+            a[:, 4],
+            a[:, 5] - a[:, 6],
+            a[:, 6],
+        ]
+    )
+    return q0 + rel
+
+
+_A01_XML = """<mujoco><option gravity="0 -9.81 0" timestep="0.001"/>
+<worldbody><body name="p"><joint name="pivot" type="hinge" axis="0 0 1"/>
+<inertial pos="1 0 0" mass="1" diaginertia="1e-12 1e-12 1e-12"/></body></worldbody></mujoco>"""
+
+PROBLEMS: dict[str, Problem] = {
+    "a01": Problem(
+        name="a01",
+        title="IFToMM A01 simple pendulum (2000 s)",
+        source="IFToMM benchmark library, A01_specification.xml (González et al. 2006); "
+        "reference: closed form with Jacobi elliptic functions",
+        t_end=2000.0,
+        n_out=4000,
+        quantity="max |P1 - P1_ref| over 4000 outputs [m]",
+        build=standard.iftomm_a01_pendulum,
+        observe=_a01_observe,
+        reference=references.a01_points,
+        required=(1e-1, 1e-3),
+        sweeps={
+            "dopri5": [1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11],
+            "rk4": [1e-2, 5e-3, 2.5e-3, 1.25e-3, 6.25e-4],
+        },
+        quick_sweeps={"dopri5": [1e-6, 1e-8], "rk4": [2.5e-3]},
+        scipy_rhs=references.a01_rhs,
+        scipy_observe=lambda y: np.column_stack([np.sin(y[0]), -np.cos(y[0])]),
+        mujoco_xml=_A01_XML,
+        mujoco_observe=lambda qpos: np.column_stack([np.cos(qpos[:, 0]), np.sin(qpos[:, 0])]),
+    ),
+    "a02": Problem(
+        name="a02",
+        title="IFToMM A02 N-four-bar, N = 40 (20 s)",
+        source="IFToMM benchmark library, A02_specification.xml (González et al. 2006); "
+        "reference: the one-DOF parallel branch in the crank angle, DOP853 at rtol 1e-13",
+        t_end=20.0,
+        n_out=400,
+        quantity="max |B0 - B0_ref| over 400 outputs [m]",
+        build=lambda: standard.iftomm_a02_four_bar(40),
+        observe=_a02_observe,
+        reference=lambda t: references.a02_points(t, 40),
+        init=lambda model: {"v0": standard.a02_initial_velocity(model, 40)},
+        required=(1e-1, 1e-3),
+        sweeps={"dopri5": [1e-5, 1e-6, 1e-7, 1e-8]},
+        quick_sweeps={"dopri5": [1e-6]},
+        scipy_rhs=lambda: references.a02_rhs(40),
+        scipy_observe=lambda y: np.column_stack([np.cos(y[0]), np.sin(y[0])]),
+    ),
+    "squeezer": Problem(
+        name="squeezer",
+        title="Andrews' squeezer (Hairer–Wanner / Test Set; IFToMM A03), 0.03 s",
+        source="Hairer & Wanner, Solving ODEs II (1996) §VII.7; Mazzia & Magherini, Test Set for "
+        "IVP solvers (2008), problem 'andrews'; reference: the seven-angle index-1 equations, "
+        "DOP853 at rtol 1e-13 (agrees with the Test Set's t = 0.03 values to 1.4e-9 rad)",
+        t_end=0.03,
+        n_out=300,
+        quantity="max |angle - angle_ref| of the 7 angles over 300 outputs [rad]",
+        build=standard.andrews_squeezer,
+        observe=_squeezer_observe,
+        reference=references.squeezer_angles,
+        angular=True,
+        sweeps={
+            "dopri5": [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11],
+            "rk4": [1e-4, 5e-5, 2.5e-5, 1.25e-5, 6.25e-6],
+            "trbdf2": [1e-4, 1e-5, 1e-6, 1e-7],
+        },
+        quick_sweeps={"dopri5": [1e-6, 1e-8], "rk4": [2.5e-5]},
+        scipy_rhs=references.squeezer_rhs,
+        scipy_observe=lambda y: y[:7].T,
+    ),
+}
+
+
+def _error(problem: Problem, obs: np.ndarray, ref: np.ndarray) -> float:
+    if obs.shape != ref.shape or not np.all(np.isfinite(obs)):
+        return float("nan")
+    d = obs - ref
+    if problem.angular:
+        d = _wrap(d)
+    return float(np.abs(d).max())
+
+
+def _cpu(fn, repeats: int):
+    """Median CPU time of ``repeats`` warm calls (after one warm-up) and the last result. A
+    first call longer than 2 s is itself the measurement: warm-up effects are below the noise
+    there, and repeating it would only cost time."""
+    t0 = time.process_time()
+    out = fn()
+    first = time.process_time() - t0
+    if first > 2.0:
+        return first, 1, out
+    times = []
+    for _ in range(repeats):
+        t0 = time.process_time()
+        out = fn()
+        times.append(time.process_time() - t0)
+    return float(np.median(times)), len(times), out
+
+
+def _repeats_for(quick: bool) -> int:
+    return 3 if quick else 5
+
+
+def sweep_armdyn(problem: Problem, integrator: str, settings, repeats: int = 5) -> list[dict]:
+    model = problem.build()
+    t_out = np.linspace(0.0, problem.t_end, problem.n_out + 1)
+    ref = problem.reference(t_out)
+    kwargs = problem.init(model) if problem.init else {}
+    points = []
+    for s in settings:
+        opts = dict(kwargs, output_dt=problem.t_end / problem.n_out)
+        if integrator == "rk4":
+            opts["dt"] = s
+        else:
+            opts.update(rtol=s, atol=s)
+
+        def call(opts=opts):
+            return simulate(model, problem.t_end, integrator=integrator, **opts)
+
+        point = {"setting": s}
+        try:
+            sec, reps, res = _cpu(call, repeats)
+            obs = problem.observe(model, res)
+            point.update(
+                cpu_s=sec,
+                repeats=reps,
+                error=_error(problem, obs[: len(ref)], ref[: len(obs)]),
+                **{
+                    k: res.stats[k]
+                    for k in ("steps", "rejected", "rhs_evals", "kkt_solves", "factorizations")
+                },
+                singular_evaluations=res.stats.get("singular_evaluations", 0),
+                max_position_residual=float(res.position_residual.max()),
+            )
+        except _core.SolverError as exc:
+            point.update(failed=str(exc).split(";")[0][:200], error=float("nan"))
+        points.append(point)
+    return points
+
+
+def sweep_scipy(problem: Problem, method: str, rtols, repeats: int = 5) -> list[dict]:
+    from scipy.integrate import solve_ivp
+
+    f, y0 = problem.scipy_rhs()
+    t_out = np.linspace(0.0, problem.t_end, problem.n_out + 1)
+    ref = problem.reference(t_out)
+    points = []
+    for rtol in rtols:
+
+        def call(rtol=rtol):
+            return solve_ivp(
+                f, (0.0, problem.t_end), y0, method=method, rtol=rtol, atol=rtol, t_eval=t_out
+            )
+
+        sec, reps, sol = _cpu(call, repeats)
+        obs = problem.scipy_observe(sol.y)
+        points.append(
+            {
+                "setting": rtol,
+                "cpu_s": sec,
+                "repeats": reps,
+                "error": _error(problem, obs, ref) if sol.success else float("nan"),
+                "rhs_evals": int(sol.nfev),
+            }
+        )
+    return points
+
+
+def sweep_mujoco(problem: Problem, integrator: str, steps, repeats: int = 5) -> list[dict]:
+    import mujoco
+
+    t_out = np.linspace(0.0, problem.t_end, problem.n_out + 1)
+    ref = problem.reference(t_out)
+    spacing = problem.t_end / problem.n_out
+    points = []
+    for h in steps:
+        model = mujoco.MjModel.from_xml_string(problem.mujoco_xml)
+        model.opt.timestep = h
+        model.opt.integrator = {
+            "rk4": mujoco.mjtIntegrator.mjINT_RK4,
+            "implicit": mujoco.mjtIntegrator.mjINT_IMPLICIT,
+        }[integrator]
+        data = mujoco.MjData(model)
+        per = round(spacing / h)
+
+        def call(model=model, data=data, per=per):
+            # the stepping loop runs in C: mj_step(..., nstep) between outputs
+            mujoco.mj_resetData(model, data)
+            qpos = np.empty((problem.n_out + 1, model.nq))
+            qpos[0] = data.qpos
+            for k in range(problem.n_out):
+                mujoco.mj_step(model, data, nstep=per)
+                qpos[k + 1] = data.qpos
+            return qpos
+
+        sec, reps, qpos = _cpu(call, repeats)
+        obs = problem.mujoco_observe(qpos)
+        points.append(
+            {
+                "setting": h,
+                "cpu_s": sec,
+                "repeats": reps,
+                "error": _error(problem, obs, ref),
+                "steps": per * problem.n_out,
+            }
+        )
+    return points
+
+
+SCIPY_RTOLS = [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11]
+SCIPY_QUICK = [1e-6, 1e-8]
+
+
+def run_problem(name: str, quick: bool = False, peers: bool = True, echo: bool = True) -> dict:
+    if name not in PROBLEMS:
+        raise _core.ModelError(
+            f"workprecision: unknown problem '{name}'; choose from {sorted(PROBLEMS)}"
+        )
+    p = PROBLEMS[name]
+    reps = _repeats_for(quick)
+    sweeps = p.quick_sweeps if quick else p.sweeps
+    curves = {}
+    for integ, settings in sweeps.items():
+        curves[f"armdyn {integ}"] = sweep_armdyn(p, integ, settings, reps)
+        if echo:
+            _echo(f"armdyn {integ}", curves[f"armdyn {integ}"])
+    if peers and p.scipy_rhs is not None:
+        for method in ("DOP853", "RK45"):
+            key = f"SciPy {method} (minimal coordinates)"
+            curves[key] = sweep_scipy(p, method, SCIPY_QUICK if quick else SCIPY_RTOLS, reps)
+            if echo:
+                _echo(key, curves[key])
+    if peers and p.mujoco_xml is not None:
+        try:
+            import mujoco  # noqa: F401
+        except ImportError:
+            pass
+        else:
+            for integ in ("rk4", "implicit"):
+                hs = [1e-3] if quick else [4e-3, 2e-3, 1e-3, 5e-4, 2.5e-4, 1.25e-4]
+                if integ == "implicit" and not quick:
+                    hs = [1e-3, 1e-4, 1e-5]
+                key = f"MuJoCo {integ}"
+                curves[key] = sweep_mujoco(p, integ, hs, reps)
+                if echo:
+                    _echo(key, curves[key])
+    return {
+        "problem": p.name,
+        "title": p.title,
+        "source": p.source,
+        "t_end": p.t_end,
+        "outputs": p.n_out,
+        "error": p.quantity,
+        "required_precision": p.required,
+        "curves": curves,
+        "fastest_to": _fastest(curves),
+    }
+
+
+def _fastest(curves: dict) -> dict:
+    """For target errors 1e-3 and 1e-6: the cheapest point of each curve reaching it."""
+    out = {}
+    for target in (1e-3, 1e-6):
+        best = {}
+        for key, pts in curves.items():
+            ok = [q["cpu_s"] for q in pts if q.get("error", np.nan) <= target]
+            if ok:
+                best[key] = min(ok)
+        out[f"{target:g}"] = dict(sorted(best.items(), key=lambda kv: kv[1]))
+    return out
+
+
+def _echo(key, pts):
+    for q in pts:
+        if "failed" in q:
+            print(f"  {key:42s} {q['setting']:9.2e}  failed: {q['failed']}")
+        else:
+            print(
+                f"  {key:42s} {q['setting']:9.2e}  error {q['error']:9.2e}  "
+                f"cpu {q['cpu_s'] * 1e3:9.2f} ms"
+            )
+
+
+def plot(result: dict, path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.6))
+    for key, pts in result["curves"].items():
+        e = [q["error"] for q in pts if np.isfinite(q.get("error", np.nan))]
+        c = [q["cpu_s"] for q in pts if np.isfinite(q.get("error", np.nan))]
+        if e:
+            style = "-o" if key.startswith("armdyn") else "--s"
+            ax.loglog(e, c, style, label=key, ms=4)
+    if result.get("required_precision"):
+        for r in result["required_precision"]:
+            ax.axvline(r, color="grey", lw=0.8, ls=":")
+    ax.set_xlabel(f"error: {result['error']}")
+    ax.set_ylabel("CPU time [s] (median of warm runs)")
+    ax.set_title(result["title"], fontsize=10)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def machine() -> dict:
+    import os
+
+    cpu = platform.processor()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return {
+        "cpu": cpu,
+        "cores": os.cpu_count(),
+        "python": platform.python_version(),
+        "system": platform.platform(),
+    }
+
+
+def run(problems=None, out="docs/results/workprecision", quick=False, peers=True, echo=True):
+    names = list(PROBLEMS) if not problems or problems == ["all"] else list(problems)
+    outdir = Path(out)
+    outdir.mkdir(parents=True, exist_ok=True)
+    results = {}
+    for name in names:
+        if echo:
+            print(f"{name}: {PROBLEMS[name].title if name in PROBLEMS else name}")
+        r = run_problem(name, quick=quick, peers=peers, echo=echo)
+        r["machine"] = machine()
+        r["command"] = "armdyn workprecision " + name + (" --quick" if quick else "")
+        (outdir / f"{name}.json").write_text(json.dumps(r, indent=1, default=float))
+        try:
+            plot(r, outdir / f"{name}.png")
+        except ImportError:
+            pass
+        results[name] = r
+    return results
