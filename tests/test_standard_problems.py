@@ -111,6 +111,14 @@ def test_workprecision_sweep_writes_curves(tmp_path):
     assert (tmp_path / "squeezer.png").stat().st_size > 0
 
 
+def test_five_dof_driven_run_matches_the_complete_lagrange_torques_at_any_tolerance():
+    # fully driven: the motion is prescribed, so the efforts are round-off exact however loose
+    # the integrator's tolerance
+    r = run_problem("five_dof", quick=True, peers=False, echo=False)
+    for pts in r["curves"].values():
+        assert all(p["error"] < 1e-10 for p in pts)
+
+
 def test_mujoco_peer_solves_the_same_a01():
     mujoco = pytest.importorskip("mujoco")
     from armdyn.workprecision import _A01_XML
