@@ -34,7 +34,12 @@ def main(argv: list[str] | None = None) -> int:
     bench.add_argument("--out", default="docs/results", help="folder for bench.json, bench.png")
     bench.add_argument("--quick", action="store_true", help="chains up to 100 bodies only")
     wp = sub.add_parser("workprecision", help="error against CPU time on the standard problems")
-    wp.add_argument("problems", nargs="*", default=["all"], help="a01, a02, squeezer or all")
+    wp.add_argument(
+        "problems",
+        nargs="*",
+        default=["all"],
+        help="squeezer, a01, five_dof, a02 (slow), or all (all but a02)",
+    )
     wp.add_argument("--out", default="docs/results/workprecision", help="folder for JSON + PNG")
     wp.add_argument("--quick", action="store_true", help="two points per curve")
     wp.add_argument("--no-peers", action="store_true", help="armdyn's curves only")
