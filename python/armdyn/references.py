@@ -104,7 +104,7 @@ def squeezer_terms(q, qd):
     m1, m2, m3, m4, m5, m6, m7 = p["m"]
     i1, i2, i3, i4, i5, i6, i7 = p["I"]
     be, th, ga, ph, de, om, ep = q
-    bed, thd, _gad, phd, ded, omd, epd = qd
+    bed, thd, gad, phd, ded, omd, epd = qd
     d, da, e, ea, rr, ra = p["d"], p["da"], p["e"], p["ea"], p["rr"], p["ra"]
     ss, sa, sb, sc, sd = p["ss"], p["sa"], p["sb"], p["sc"], p["sd"]
     ta, tb, u, ua, ub, zf, zt, fa = (p[k] for k in ("ta", "tb", "u", "ua", "ub", "zf", "zt", "fa"))
@@ -179,8 +179,8 @@ def squeezer_terms(q, qd):
     common_y = -rr * np.sin(be) * bed**2 + d * np.sin(bt) * btd**2
     gqq = np.array(
         [
-            common_x + ss * sga * _gad**2,
-            common_y - ss * cga * _gad**2,
+            common_x + ss * sga * gad**2,
+            common_y - ss * cga * gad**2,
             common_x + e * np.sin(pd) * pdd**2 + zt * np.cos(de) * ded**2,
             common_y - e * np.cos(pd) * pdd**2 + zt * np.sin(de) * ded**2,
             common_x + zf * np.cos(oe) * oed**2 + u * np.sin(ep) * epd**2,

@@ -41,7 +41,8 @@ from armdyn.validation import (
 RTOL, ATOL, OUTPUT_DT = 1e-10, 1e-12, 0.01
 
 
-def _efforts_in_coord_order(model, result):
+def efforts_in_coord_order(model, result):
+    """Drive efforts (n, n_drives) rearranged into joint-coordinate order."""
     mb = np.empty_like(result.drive_forces)
     mb[:, list(model.drive_coords)] = result.drive_forces
     return mb
@@ -51,7 +52,7 @@ def three_dof_study():
     """Stage 1: the planar 3-DOF arm over 1 s."""
     model = paper.three_dof_arm()
     res = simulate(model, paper.ARM3.duration, rtol=RTOL, atol=ATOL, output_dt=OUTPUT_DT)
-    mb = _efforts_in_coord_order(model, res)
+    mb = efforts_in_coord_order(model, res)
     complete = LagrangeValidator(model).torques(res.q, res.qd, res.qdd, res.t)
     th, thd = paper.three_dof_absolute(res.q, res.qd)
     printed_abs = paper_model_3dof(paper.ARM3.lengths, paper.ARM3.masses, th, thd, g=paper.G)
@@ -76,7 +77,7 @@ def five_dof_study():
     """Stage 2: the 5-DOF light-lifting arm over 5 s."""
     model = paper.five_dof_arm()
     res = simulate(model, paper.ARM5.duration, rtol=RTOL, atol=ATOL, output_dt=OUTPUT_DT)
-    mb = _efforts_in_coord_order(model, res)
+    mb = efforts_in_coord_order(model, res)
     complete = LagrangeValidator(model).torques(res.q, res.qd, res.qdd, res.t)
     pm_model = paper.five_dof_arm(point_masses=True)
     point_mass = LagrangeValidator(pm_model, rotational_inertia=False).torques(

@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from armdyn import _core, references
+from armdyn.reproduce import efforts_in_coord_order
 from armdyn.scenes import paper, standard
 from armdyn.simulation import simulate
 
@@ -62,6 +63,9 @@ class Problem:
     scipy_observe: Callable | None = None  # y (k, n) -> (n, kq)
     mujoco_xml: str | None = None
     mujoco_observe: Callable | None = None  # qpos (n, nq) -> (n, kq)
+    # (reference on the output times) -> {name: value}: the reference against published values
+    # or a second method, recorded with the curves
+    reference_check: Callable | None = None
 
 
 def _a01_observe(_model, res):
@@ -93,13 +97,6 @@ def _squeezer_observe(model, res):
     return q0 + rel
 
 
-def _five_dof_observe(model, res):
-    """Drive efforts in joint-coordinate order (N m, N)."""
-    out = np.empty_like(res.drive_forces)
-    out[:, list(model.drive_coords)] = res.drive_forces
-    return out
-
-
 def _five_dof_reference(t):
     """The complete Euler–Lagrange torques (:class:`armdyn.LagrangeValidator`, derived by
     automatic differentiation, independent of the Newton–Euler solver) on the prescribed
@@ -117,6 +114,22 @@ def _five_dof_reference(t):
     # the rest outside (0, T) there
     qdd[(s <= 0.0) | (s >= 1.0)] = 0.0
     return LagrangeValidator(paper.five_dof_arm()).torques(q, qd, qdd, t)
+
+
+def _a01_check(ref):
+    """The closed form against a second method: SciPy DOP853 at rtol 1e-13 on θ'' = -g sin θ."""
+    from scipy.integrate import solve_ivp
+
+    f, y0 = references.a01_rhs()
+    t = np.linspace(0.0, 2000.0, len(ref))
+    y = solve_ivp(f, (0, t[-1]), y0, method="DOP853", rtol=1e-13, atol=1e-13, t_eval=t).y[0]
+    pts = np.column_stack([np.sin(y), -np.cos(y)])
+    return {"closed_form_vs_dop853_1e-13_m": float(np.abs(pts - ref).max())}
+
+
+def _squeezer_check(ref):
+    d = _wrap(ref[-1] - references.ANDREWS_TEST_SET_T003)
+    return {"reference_vs_test_set_at_0.03_rad": float(np.abs(d).max())}
 
 
 _A01_XML = """<mujoco><option gravity="0 -9.81 0" timestep="0.001"/>
@@ -145,6 +158,7 @@ PROBLEMS: dict[str, Problem] = {
         scipy_observe=lambda y: np.column_stack([np.sin(y[0]), -np.cos(y[0])]),
         mujoco_xml=_A01_XML,
         mujoco_observe=lambda qpos: np.column_stack([np.cos(qpos[:, 0]), np.sin(qpos[:, 0])]),
+        reference_check=_a01_check,
     ),
     "a02": Problem(
         name="a02",
@@ -175,7 +189,7 @@ PROBLEMS: dict[str, Problem] = {
         n_out=500,
         quantity="max |tau - tau_Lagrange| of the 5 drive efforts over 500 outputs [N m, N]",
         build=paper.five_dof_arm,
-        observe=_five_dof_observe,
+        observe=efforts_in_coord_order,
         reference=_five_dof_reference,
         sweeps={"dopri5": [1e-4, 1e-6, 1e-8, 1e-10], "rk4": [0.1, 0.05, 0.025, 0.0125]},
         quick_sweeps={"dopri5": [1e-6], "rk4": [0.05]},
@@ -200,6 +214,7 @@ PROBLEMS: dict[str, Problem] = {
         },
         quick_sweeps={"dopri5": [1e-6, 1e-8], "rk4": [2.5e-5]},
         scipy_rhs=references.squeezer_rhs,
+        reference_check=_squeezer_check,
         scipy_observe=lambda y: y[:7].T,
     ),
 }
@@ -235,10 +250,13 @@ def _repeats_for(quick: bool) -> int:
     return 3 if quick else 5
 
 
-def sweep_armdyn(problem: Problem, integrator: str, settings, repeats: int = 5) -> list[dict]:
+def _output_times(problem: Problem) -> np.ndarray:
+    return np.linspace(0.0, problem.t_end, problem.n_out + 1)
+
+
+def sweep_armdyn(problem: Problem, integrator: str, settings, ref, repeats: int = 5) -> list[dict]:
+    """armdyn's curve; ``ref`` is the reference on the output times."""
     model = problem.build()
-    t_out = np.linspace(0.0, problem.t_end, problem.n_out + 1)
-    ref = problem.reference(t_out)
     kwargs = problem.init(model) if problem.init else {}
     points = []
     for s in settings:
@@ -258,7 +276,7 @@ def sweep_armdyn(problem: Problem, integrator: str, settings, repeats: int = 5) 
             point.update(
                 cpu_s=sec,
                 repeats=reps,
-                error=_error(problem, obs[: len(ref)], ref[: len(obs)]),
+                error=_error(problem, obs, ref),
                 **{
                     k: res.stats[k]
                     for k in ("steps", "rejected", "rhs_evals", "kkt_solves", "factorizations")
@@ -272,12 +290,11 @@ def sweep_armdyn(problem: Problem, integrator: str, settings, repeats: int = 5) 
     return points
 
 
-def sweep_scipy(problem: Problem, method: str, rtols, repeats: int = 5) -> list[dict]:
+def sweep_scipy(problem: Problem, method: str, rtols, ref, repeats: int = 5) -> list[dict]:
     from scipy.integrate import solve_ivp
 
     f, y0 = problem.scipy_rhs()
-    t_out = np.linspace(0.0, problem.t_end, problem.n_out + 1)
-    ref = problem.reference(t_out)
+    t_out = _output_times(problem)
     points = []
     for rtol in rtols:
 
@@ -300,11 +317,9 @@ def sweep_scipy(problem: Problem, method: str, rtols, repeats: int = 5) -> list[
     return points
 
 
-def sweep_mujoco(problem: Problem, integrator: str, steps, repeats: int = 5) -> list[dict]:
+def sweep_mujoco(problem: Problem, integrator: str, steps, ref, repeats: int = 5) -> list[dict]:
     import mujoco
 
-    t_out = np.linspace(0.0, problem.t_end, problem.n_out + 1)
-    ref = problem.reference(t_out)
     spacing = problem.t_end / problem.n_out
     points = []
     for h in steps:
@@ -353,15 +368,16 @@ def run_problem(name: str, quick: bool = False, peers: bool = True, echo: bool =
     p = PROBLEMS[name]
     reps = _repeats_for(quick)
     sweeps = p.quick_sweeps if quick else p.sweeps
+    ref = p.reference(_output_times(p))
     curves = {}
     for integ, settings in sweeps.items():
-        curves[f"armdyn {integ}"] = sweep_armdyn(p, integ, settings, reps)
+        curves[f"armdyn {integ}"] = sweep_armdyn(p, integ, settings, ref, reps)
         if echo:
             _echo(f"armdyn {integ}", curves[f"armdyn {integ}"])
     if peers and p.scipy_rhs is not None:
         for method in ("DOP853", "RK45"):
             key = f"SciPy {method} (minimal coordinates)"
-            curves[key] = sweep_scipy(p, method, SCIPY_QUICK if quick else SCIPY_RTOLS, reps)
+            curves[key] = sweep_scipy(p, method, SCIPY_QUICK if quick else SCIPY_RTOLS, ref, reps)
             if echo:
                 _echo(key, curves[key])
     if peers and p.mujoco_xml is not None:
@@ -376,7 +392,7 @@ def run_problem(name: str, quick: bool = False, peers: bool = True, echo: bool =
                 if integ == "implicit" and not quick:
                     hs = [1e-3, 2.5e-4, 6.25e-5]
                 key = f"MuJoCo {integ}"
-                curves[key] = sweep_mujoco(p, integ, hs, reps)
+                curves[key] = sweep_mujoco(p, integ, hs, ref, reps)
                 if echo:
                     _echo(key, curves[key])
     return {
@@ -387,6 +403,7 @@ def run_problem(name: str, quick: bool = False, peers: bool = True, echo: bool =
         "outputs": p.n_out,
         "error": p.quantity,
         "required_precision": p.required,
+        "reference_check": p.reference_check(ref) if p.reference_check and not quick else {},
         "curves": curves,
         "fastest_to": _fastest(curves),
     }
@@ -473,6 +490,8 @@ def summary_markdown(results: dict) -> str:
             f"## {r['title']}",
             "",
             f"Command: `{r['command']}`. Error: {r['error']}. Source: {r['source']}.",
+            "",
+            *[f"Reference check: {k} = {v:.2g}." for k, v in r.get("reference_check", {}).items()],
             "",
             "| curve | CPU to error 1e-3 [s] | to 1e-6 [s] | smallest error | failed runs |",
             "|---|---|---|---|---|",

@@ -89,7 +89,7 @@ int ModelBuilder::resolve_body(const std::string& name, const std::string& conte
 
 int ModelBuilder::add_joint(const std::string& name, JointType type, const std::string& parent,
                             const std::string& child, const Vec3& point, const Vec3& axis,
-                            const Vec3* axis2) {
+                            const Vec3* axis2, const Vec3* point_child) {
   const std::string who = msg(joint_type_name(type), " joint '", name, "'");
   if (name.empty()) throw ModelError(msg(joint_type_name(type), " joint: name must not be empty"));
   if (m_.joint_index.count(name)) throw ModelError(msg(who, ": duplicate joint name"));
@@ -116,19 +116,20 @@ int ModelBuilder::add_joint(const std::string& name, JointType type, const std::
   j.parent = pa;
   j.child = ch;
   // joint point and frame in each body's frame at the assembly pose
-  auto local = [&](int b, const Mat3& fw, Vec3& s, Mat3& f) {
+  // (the child's point is `point` too, except for joints between two points: distance)
+  auto local = [&](int b, const Vec3& p, const Mat3& fw, Vec3& s, Mat3& f) {
     if (b == kGround) {
-      s = point;
+      s = p;
       f = fw;
     } else {
       const Body& bd = m_.bodies[b];
       const Mat3 R = quat_to_rot(bd.orientation);
-      s = R.transpose() * (point - bd.position);
+      s = R.transpose() * (p - bd.position);
       f = R.transpose() * fw;
     }
   };
-  local(pa, fw_parent, j.point_parent, j.frame_parent);
-  local(ch, fw_child, j.point_child, j.frame_child);
+  local(pa, point, fw_parent, j.point_parent, j.frame_parent);
+  local(ch, point_child ? *point_child : point, fw_child, j.point_child, j.frame_child);
   j.row0 = m_.nc_joint;
   const int nq = joint_coords(type);
   j.coord0 = nq ? static_cast<int>(m_.coords.size()) : -1;
@@ -181,21 +182,15 @@ int ModelBuilder::add_distance(const std::string& name, const std::string& body_
                                const Vec3& point_a, const std::string& body_b,
                                const Vec3& point_b) {
   const std::string who = msg("distance joint '", name, "'");
+  require_finite(point_a, who + ": point_a");
   require_finite(point_b, who + ": point_b");
   const double len = (point_b - point_a).norm();
   if (!(len > 1e-9))
     throw ModelError(msg(who, ": the points coincide (length ", len,
                          " m); use a spherical joint for a zero-length link"));
-  const int idx =
-      add_joint(name, JointType::Distance, body_a, body_b, point_a, Vec3::UnitZ(), nullptr);
-  Joint& j = m_.joints[idx];
-  j.length = len;
-  if (j.child != kGround) {
-    const Body& bd = m_.bodies[j.child];
-    j.point_child = quat_to_rot(bd.orientation).transpose() * (point_b - bd.position);
-  } else {
-    j.point_child = point_b;
-  }
+  const int idx = add_joint(name, JointType::Distance, body_a, body_b, point_a, Vec3::UnitZ(),
+                            nullptr, &point_b);
+  m_.joints[idx].length = len;
   return idx;
 }
 int ModelBuilder::add_free(const std::string& name, const std::string& child) {

@@ -106,7 +106,8 @@ class ModelBuilder {
                                   const std::string& joint_b, double r_a, double r_b) const;
 
   int add_joint(const std::string& name, JointType type, const std::string& parent,
-                const std::string& child, const Vec3& point, const Vec3& axis, const Vec3* axis2);
+                const std::string& child, const Vec3& point, const Vec3& axis, const Vec3* axis2,
+                const Vec3* point_child = nullptr);
   int resolve_body(const std::string& name, const std::string& context) const;
   Model m_;
 };
