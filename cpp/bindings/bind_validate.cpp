@@ -100,8 +100,11 @@ void bind_validate(py::module_& m) {
           [](JointSpaceInverseDynamics& self, py::object q, py::object qd, py::object qdd,
              double t) {
             const long n = static_cast<long>(self.model().coords.size());
-            return to_numpy(
-                self.compute(to_vec(q, "q", n), to_vec(qd, "qd", n), to_vec(qdd, "qdd", n), t));
+            const VecArg qa(q, "q", n), qda(qd, "qd", n), qdda(qdd, "qdd", n);
+            py::array_t<double> out(n);
+            Eigen::Map<VecX> o(out.mutable_data(), n);
+            self.compute(*qa, *qda, *qdda, o, t);
+            return out;
           },
           py::arg("q"), py::arg("qd"), py::arg("qdd"), py::arg("t") = 0.0);
 
@@ -119,9 +122,11 @@ void bind_validate(py::module_& m) {
           [](JointSpaceForwardDynamics& self, py::object q, py::object qd, py::object tau,
              double t) {
             const long n = static_cast<long>(self.model().coords.size());
-            VecX out(n);
-            self.compute(to_vec(q, "q", n), to_vec(qd, "qd", n), to_vec(tau, "tau", n), out, t);
-            return to_numpy(out);
+            const VecArg qa(q, "q", n), qda(qd, "qd", n), ta(tau, "tau", n);
+            py::array_t<double> out(n);
+            Eigen::Map<VecX> o(out.mutable_data(), n);
+            self.compute(*qa, *qda, *ta, o, t);
+            return out;
           },
           py::arg("q"), py::arg("qd"), py::arg("tau"), py::arg("t") = 0.0);
 
@@ -137,7 +142,8 @@ void bind_validate(py::module_& m) {
                                  py::object qdd, long count) {
     const long n = static_cast<long>(self.model().coords.size());
     const VecX qv = to_vec(q, "q", n), qdv = to_vec(qd, "qd", n), av = to_vec(qdd, "qdd", n);
-    return time_loop(count, [&] { self.compute(qv, qdv, av); });
+    VecX out(n);
+    return time_loop(count, [&] { self.compute(qv, qdv, av, out); });
   });
 
   py::class_<LagrangeValidator>(

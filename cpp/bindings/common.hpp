@@ -42,6 +42,28 @@ inline VecX to_vec(const py::handle& obj, const std::string& name, long n = -1) 
   return v;
 }
 
+/// A read-only vector argument: a view of a float64 C-contiguous numpy array of the right length
+/// (no copy), otherwise converted (and checked) by to_vec.
+class VecArg {
+ public:
+  VecArg(const py::handle& obj, const char* name, long n) : map_(nullptr, 0) {
+    if (py::array_t<double, py::array::c_style>::check_(obj)) {
+      auto a = py::reinterpret_borrow<py::array>(obj);
+      if (a.ndim() == 1 && a.shape(0) == n) {
+        new (&map_) Eigen::Map<const VecX>(static_cast<const double*>(a.data()), n);
+        return;
+      }
+    }
+    own_ = to_vec(obj, name, n);
+    new (&map_) Eigen::Map<const VecX>(own_.data(), n);
+  }
+  const Eigen::Map<const VecX>& operator*() const { return map_; }
+
+ private:
+  VecX own_;
+  Eigen::Map<const VecX> map_;
+};
+
 inline Vec3 to_vec3(const py::handle& obj, const std::string& name) { return to_vec(obj, name, 3); }
 
 inline Vec4 to_vec4(const py::handle& obj, const std::string& name) { return to_vec(obj, name, 4); }

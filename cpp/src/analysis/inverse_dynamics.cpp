@@ -282,26 +282,34 @@ void JointSpaceInverseDynamics::compute_sweep(double t) {
 JointSpaceInverseDynamics::~JointSpaceInverseDynamics() = default;
 
 VecX JointSpaceInverseDynamics::compute(const VecX& q, const VecX& qd, const VecX& qdd, double t) {
+  VecX tau(static_cast<long>(driven_.coords.size()));
+  compute(q, qd, qdd, tau, t);
+  return tau;
+}
+
+void JointSpaceInverseDynamics::compute(Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
+                                        Eigen::Ref<const VecX> qdd, Eigen::Ref<VecX> tau,
+                                        double t) {
   const long nco = static_cast<long>(driven_.coords.size());
   if (qdd.size() != nco)
     throw ModelError(msg("inverse_dynamics: qdd has length ", qdd.size(), ", expected ", nco));
   if (!qdd.allFinite()) throw ModelError("inverse_dynamics: qdd contains NaN or inf");
   if (!std::isfinite(t)) throw ModelError("inverse_dynamics: t is not finite");
-  state_from_joints(*src_, q, qd, u_, v_);  // checks q, qd
+  if (tau.size() != nco)
+    throw ModelError(msg("inverse_dynamics: tau has length ", tau.size(), ", expected ", nco));
+  state_from_joints(*src_, q, qd, u_, v_, fk_);  // checks q, qd
   for (long c = 0; c < nco; ++c) {
     ref_[3 * c] = q[c];
     ref_[3 * c + 1] = qd[c];
     ref_[3 * c + 2] = qdd[c];
   }
-  VecX tau(nco);
   if (sweep_ok_) {
     compute_sweep(t);
     for (long c = 0; c < nco; ++c) tau[c] = -delta_[driven_.nc_joint + c];
-    if (tau.allFinite()) return tau;
+    if (tau.allFinite()) return;
   }
   e_->dynamics(t, u_.data(), v_.data(), vd_.data());
   for (long c = 0; c < nco; ++c) tau[c] = -e_->delta()[driven_.nc_joint + c];
-  return tau;
 }
 
 }  // namespace armdyn

@@ -18,7 +18,7 @@ void require_joint_space(const Model& m, const char* what) {
 }
 
 namespace {
-void check_vec(const VecX& x, long n, const char* fn, const char* name) {
+void check_vec(Eigen::Ref<const VecX> x, long n, const char* fn, const char* name) {
   if (x.size() != n)
     throw ModelError(msg(fn, ": ", name, " has length ", x.size(), ", expected ", n));
   if (!x.allFinite()) throw ModelError(msg(fn, ": ", name, " contains NaN or inf"));
@@ -26,6 +26,12 @@ void check_vec(const VecX& x, long n, const char* fn, const char* name) {
 }  // namespace
 
 void state_from_joints(const Model& m, const VecX& q, const VecX& qd, VecX& u, VecX& v) {
+  TreeFkWork work;
+  state_from_joints(m, q, qd, u, v, work);
+}
+
+void state_from_joints(const Model& m, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd, VecX& u,
+                       VecX& v, TreeFkWork& work) {
   require_joint_space(m, "state_from_joints");
   const long nc = static_cast<long>(m.coords.size());
   check_vec(q, nc, "state_from_joints", "q");
@@ -33,8 +39,12 @@ void state_from_joints(const Model& m, const VecX& q, const VecX& qd, VecX& u, V
   u.resize(m.nq);
   v.resize(m.nv);
   // world pose and velocity of each body, filled parent before child
-  std::vector<Mat3> R(m.nb);
-  std::vector<Vec3> x(m.nb), xd(m.nb), ww(m.nb);
+  work.R.resize(m.nb);
+  work.x.resize(m.nb);
+  work.xd.resize(m.nb);
+  work.w.resize(m.nb);
+  std::vector<Mat3>& R = work.R;
+  std::vector<Vec3>&x = work.x, &xd = work.xd, &ww = work.w;
   for (int ji : m.tree_order) {
     const Joint& j = m.joints[ji];
     Mat3 Rp = Mat3::Identity();
@@ -68,9 +78,12 @@ void state_from_joints(const Model& m, const VecX& q, const VecX& qd, VecX& u, V
         break;
     }
     // child joint frame B = A Rz(th), placed at P + d z
-    Mat3 Rz;
-    Rz << std::cos(th), -std::sin(th), 0, std::sin(th), std::cos(th), 0, 0, 0, 1;
-    const Mat3 B = A * Rz;
+    // B = A Rz(th)
+    const double ct = std::cos(th), st = std::sin(th);
+    Mat3 B;
+    B.col(0) = ct * A.col(0) + st * A.col(1);
+    B.col(1) = ct * A.col(1) - st * A.col(0);
+    B.col(2) = z;
     const Vec3 Pc = P + d * z;
     const int c = j.child;
     R[c] = B * j.frame_child.transpose();
@@ -117,16 +130,19 @@ JointSpaceForwardDynamics::JointSpaceForwardDynamics(std::shared_ptr<const Model
 
 JointSpaceForwardDynamics::~JointSpaceForwardDynamics() = default;
 
-void JointSpaceForwardDynamics::compute(const VecX& q, const VecX& qd, const VecX& tau, VecX& out,
+void JointSpaceForwardDynamics::compute(Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
+                                        Eigen::Ref<const VecX> tau, Eigen::Ref<VecX> out,
                                         double t) {
   const Model& m = *m_;
   const long nc = static_cast<long>(m.coords.size());
   check_vec(tau, nc, "forward_dynamics", "tau");
-  state_from_joints(m, q, qd, u_, v_);
+  if (out.size() != nc)
+    throw ModelError(msg("forward_dynamics: out has length ", out.size(), ", expected ", nc));
+  state_from_joints(m, q, qd, u_, v_, fk_);
   tau_ = tau;
   e_->dynamics(t, u_.data(), v_.data(), vd_.data());
-  out.resize(nc);
-  for (int c = 0; c < nc; ++c) out[c] = coord_acceleration(m, coord_jet(m, e_->kin(), c), c, vd_);
+  for (int c = 0; c < nc; ++c)
+    out[c] = coord_acceleration(m, coord_jet(m, e_->kin(), c, false), c, vd_);
 }
 
 VecX forward_dynamics(const Model& m, const VecX& q, const VecX& qd, const VecX& tau) {

@@ -141,7 +141,7 @@ double stiffness_estimate(const Model& m, std::string& culprit) {
                                 point_jet(kin_of(e.kin(), sd.body_a), sd.point_a, 0));
     const double L = d.val.norm();
     if (!(L > 0)) continue;
-    const double im = inv_mass((d.val / L).transpose() * d.J, sd.body_a, sd.body_b);
+    const double im = inv_mass(d.left(d.val / L), sd.body_a, sd.body_b);
     consider(std::sqrt(sd.stiffness * im), msg("spring-damper '", sd.name, "' (stiffness)"));
     consider(sd.damping * im, msg("spring-damper '", sd.name, "' (damping)"));
   }

@@ -137,37 +137,65 @@ BlockSparseSchur::BlockSparseSchur(const Model& m, const KktPlan& plan) : m_(m) 
       }
     c.nupd = static_cast<int>(upd_.size()) - c.upd_begin;
   }
+  scaled_off_.assign(ce.blocks.size() * kMaxBlockBodies, -1);
+  int njw = 0;
+  for (int g = 0; g < static_cast<int>(ce.blocks.size()); ++g) {
+    if (plan.pos[g] < 0) continue;
+    const ConstraintBlock& b = ce.blocks[g];
+    for (int sl = 0; sl < b.nbody; ++sl) {
+      if (b.body[sl] == kGround) continue;
+      scaled_off_[g * kMaxBlockBodies + sl] = njw;
+      scaled_.push_back({g, sl, njw});
+      njw += 6 * b.nrows;
+    }
+  }
+  jw_.assign(njw, 0.0);
   for (int b = 0; b < m.nb; ++b)
     for (const auto& [g, sg] : ce.body_blocks[b])
       for (const auto& [h, sh] : ce.body_blocks[b]) {
         const int pg = plan.pos[g], ph = plan.pos[h];
         if (pg < 0 || ph < 0 || pg < ph) continue;
-        asm_.push_back({b, g, sg, h, sh, off.at({pg, ph})});
+        asm_.push_back({b, g, sg, h, sh, scaled_off_[g * kMaxBlockBodies + sg], off.at({pg, ph})});
       }
   val_.assign(total, 0.0);
   diag0_.assign(m.nc, 0.0);
+  inv_diag_.assign(m.nc, 0.0);
 }
 
 bool BlockSparseSchur::factor(const ConstraintEval& ce, const std::vector<Mat6>* winv) {
   std::fill(val_.begin(), val_.end(), 0.0);
   double* v = val_.data();
-  // assembly: A(g, h) += J_g,b W_b^-1 J_h,b^T over the bodies b the two blocks share
-  Eigen::Matrix<double, Eigen::Dynamic, 6, 0, 6, 6> jw;
+  // J_g,s W_b^-1 once per (block, slot), with W^-1 = diag(W_xx, W_ww) per body
+  for (const Scaled& sc : scaled_) {
+    const ConstraintBlock& b = ce.blocks[sc.g];
+    Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor, 6, 6>> jw(
+        jw_.data() + sc.off, b.nrows, 6);
+    const auto J = b.J.middleCols<6>(6 * sc.slot);
+    if (winv) {
+      const Mat6& w = (*winv)[b.body[sc.slot]];
+      jw.leftCols<3>().noalias() = J.leftCols<3>() * w.topLeftCorner<3, 3>();
+      jw.rightCols<3>().noalias() = J.rightCols<3>() * w.bottomRightCorner<3, 3>();
+    } else {
+      jw = J;
+    }
+  }
+  // assembly: A(g, h) += (J_g,b W_b^-1) J_h,b^T over the bodies b the two blocks share (lower
+  // triangle only on the diagonal blocks)
   for (const Assembly& a : asm_) {
     const ConstraintBlock& bg = ce.blocks[a.g];
     const ConstraintBlock& bh = ce.blocks[a.h];
-    if (winv)
-      jw.noalias() = bg.J.middleCols<6>(6 * a.sg) * (*winv)[a.body];
-    else
-      jw = bg.J.middleCols<6>(6 * a.sg);
+    const double* jw = jw_.data() + a.jw;
     const int sg = bg.nrows, sh = bh.nrows;
+    const bool diag = a.g == a.h;
     double* t = v + a.target;
-    for (int c = 0; c < sh; ++c)
-      for (int r = 0; r < sg; ++r) {
-        double s = 0.0;
-        for (int p = 0; p < 6; ++p) s += jw(r, p) * bh.J(c, 6 * a.sh + p);
-        t[r + c * sg] += s;
+    for (int c = 0; c < sh; ++c) {
+      const double* jh = bh.J.data() + c * bh.J.cols() + 6 * a.sh;
+      for (int r = diag ? c : 0; r < sg; ++r) {
+        const double* jr = jw + 6 * r;
+        t[r + c * sg] += jr[0] * jh[0] + jr[1] * jh[1] + jr[2] * jh[2] + jr[3] * jh[3] +
+                         jr[4] * jh[4] + jr[5] * jh[5];
       }
+    }
   }
   const int np = static_cast<int>(col_.size());
   for (int k = 0; k < np; ++k) {
@@ -175,50 +203,87 @@ bool BlockSparseSchur::factor(const ConstraintEval& ce, const std::vector<Mat6>*
     for (int j = 0; j < c.size; ++j) diag0_[c.row0 + j] = v[c.diag + j + j * c.size];
   }
   for (int k = 0; k < np; ++k) {
-    const Column& c = col_[k];
-    const int s = c.size;
-    double* L = v + c.diag;
-    // dense Cholesky of the diagonal block (lower triangle), pivots against the row's diagonal
+    bool ok;
+    switch (col_[k].size) {  // the block sizes of joints (1..6 rows) get unrolled kernels
+      case 1:
+        ok = factor_column<1>(k);
+        break;
+      case 2:
+        ok = factor_column<2>(k);
+        break;
+      case 3:
+        ok = factor_column<3>(k);
+        break;
+      case 4:
+        ok = factor_column<4>(k);
+        break;
+      case 5:
+        ok = factor_column<5>(k);
+        break;
+      case 6:
+        ok = factor_column<6>(k);
+        break;
+      default:
+        ok = factor_column<0>(k);
+        break;
+    }
+    if (!ok) return false;
+  }
+  return true;
+}
+
+template <int S>
+bool BlockSparseSchur::factor_column(int k) {
+  const Column& c = col_[k];
+  const int s = S > 0 ? S : c.size;
+  double* __restrict__ v = val_.data();
+  double* __restrict__ L = v + c.diag;
+  double* __restrict__ inv = inv_diag_.data() + c.row0;
+  // dense Cholesky of the diagonal block (lower triangle), pivots against the row's diagonal
+  for (int j = 0; j < s; ++j) {
+    double d = L[j + j * s];
+    for (int p = 0; p < j; ++p) d -= L[j + p * s] * L[j + p * s];
+    if (!(d > 1e-12 * diag0_[c.row0 + j])) return false;
+    const double l = std::sqrt(d);
+    L[j + j * s] = l;
+    inv[j] = 1.0 / l;
+    for (int i = j + 1; i < s; ++i) {
+      double x = L[i + j * s];
+      for (int p = 0; p < j; ++p) x -= L[i + p * s] * L[j + p * s];
+      L[i + j * s] = x * inv[j];
+    }
+  }
+  // blocks below: X <- X L_kk^-T, column by column
+  for (int e = 0; e < c.nsub; ++e) {
+    const Sub& sb = sub_[c.sub_begin + e];
+    const int si = col_[sb.pos].size;
+    double* __restrict__ X = v + sb.off;
     for (int j = 0; j < s; ++j) {
-      double d = L[j + j * s];
-      for (int p = 0; p < j; ++p) d -= L[j + p * s] * L[j + p * s];
-      if (!(d > 1e-12 * diag0_[c.row0 + j])) return false;
-      const double l = std::sqrt(d);
-      L[j + j * s] = l;
-      for (int i = j + 1; i < s; ++i) {
-        double x = L[i + j * s];
-        for (int p = 0; p < j; ++p) x -= L[i + p * s] * L[j + p * s];
-        L[i + j * s] = x / l;
+      double* __restrict__ xj = X + j * si;
+      for (int p = 0; p < j; ++p) {
+        const double l = L[j + p * s];
+        const double* __restrict__ xp = X + p * si;
+        for (int r = 0; r < si; ++r) xj[r] -= l * xp[r];
       }
+      for (int r = 0; r < si; ++r) xj[r] *= inv[j];
     }
-    // blocks below: X <- X L_kk^-T (row by row, forward substitution)
-    for (int e = 0; e < c.nsub; ++e) {
-      const Sub& sb = sub_[c.sub_begin + e];
-      const int si = col_[sb.pos].size;
-      double* X = v + sb.off;
-      for (int r = 0; r < si; ++r)
-        for (int j = 0; j < s; ++j) {
-          double x = X[r + j * si];
-          for (int p = 0; p < j; ++p) x -= L[j + p * s] * X[r + p * si];
-          X[r + j * si] = x / L[j + j * s];
-        }
-    }
-    // Schur updates of the later blocks: T(a, b) -= L(a, k) L(b, k)^T
-    for (int e = 0; e < c.nupd; ++e) {
-      const Update& u = upd_[c.upd_begin + e];
-      const Sub& sa = sub_[c.sub_begin + u.a];
-      const Sub& sb = sub_[c.sub_begin + u.b];
-      const int na = col_[sa.pos].size, nb = col_[sb.pos].size;
-      const double* La = v + sa.off;
-      const double* Lb = v + sb.off;
-      double* T = v + u.target;
-      for (int cc = 0; cc < nb; ++cc)
-        for (int p = 0; p < s; ++p) {
-          const double lb = Lb[cc + p * nb];
-          if (lb == 0.0) continue;
-          for (int r = 0; r < na; ++r) T[r + cc * na] -= La[r + p * na] * lb;
-        }
-    }
+  }
+  // Schur updates of the later blocks: T(a, b) -= L(a, k) L(b, k)^T (lower triangle of the
+  // diagonal blocks)
+  for (int e = 0; e < c.nupd; ++e) {
+    const Update& u = upd_[c.upd_begin + e];
+    const Sub& sa = sub_[c.sub_begin + u.a];
+    const Sub& sb = sub_[c.sub_begin + u.b];
+    const int na = col_[sa.pos].size, nb = col_[sb.pos].size;
+    const double* __restrict__ La = v + sa.off;
+    const double* __restrict__ Lb = v + sb.off;
+    double* __restrict__ T = v + u.target;
+    const bool diag = u.a == u.b;
+    for (int cc = 0; cc < nb; ++cc)
+      for (int p = 0; p < s; ++p) {
+        const double lb = Lb[cc + p * nb];
+        for (int r = diag ? cc : 0; r < na; ++r) T[r + cc * na] -= La[r + p * na] * lb;
+      }
   }
   return true;
 }
@@ -231,10 +296,11 @@ void BlockSparseSchur::solve_in_place(VecX& x) const {
     const int s = c.size;
     const double* L = v + c.diag;
     double* xk = x.data() + c.row0;
+    const double* inv = inv_diag_.data() + c.row0;
     for (int j = 0; j < s; ++j) {
       double t = xk[j];
       for (int p = 0; p < j; ++p) t -= L[j + p * s] * xk[p];
-      xk[j] = t / L[j + j * s];
+      xk[j] = t * inv[j];
     }
     for (int e = 0; e < c.nsub; ++e) {
       const Sub& sb = sub_[c.sub_begin + e];
@@ -261,10 +327,11 @@ void BlockSparseSchur::solve_in_place(VecX& x) const {
         xk[j] -= t;
       }
     }
+    const double* inv = inv_diag_.data() + c.row0;
     for (int j = s - 1; j >= 0; --j) {
       double t = xk[j];
       for (int p = j + 1; p < s; ++p) t -= L[p + j * s] * xk[p];
-      xk[j] = t / L[j + j * s];
+      xk[j] = t * inv[j];
     }
   }
 }

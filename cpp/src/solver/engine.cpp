@@ -69,7 +69,7 @@ void Engine::forces(double t) {
     const Vec3 n = d.val / L;
     const double Ld = n.dot(d.rate);
     const double tension = sd.stiffness * (L - sd.rest_length) + sd.damping * Ld;
-    scatter(-tension * (n.transpose() * d.J), sd.body_a, sd.body_b);
+    scatter(-tension * d.left(n), sd.body_a, sd.body_b);
   }
   // joint-coordinate forces: springs, dampers, friction, inputs
   for (const CoordForce& cf : m_.coord_forces) {
@@ -106,7 +106,7 @@ void Engine::forces(double t) {
   if (tau_) {
     for (int c = 0; c < static_cast<int>(m_.coords.size()); ++c) {
       if (tau_[c] == 0.0) continue;
-      const ScalarJet q = coord_jet(m_, kin_, c);
+      const ScalarJet q = coord_jet(m_, kin_, c, false);
       const Joint& j = m_.joints[m_.coords[c].joint];
       scatter(tau_[c] * q.J, j.parent, j.child);
     }

@@ -30,26 +30,54 @@ const BodyKin& kin_of(const std::vector<BodyKin>& kin, int b) {
   return b == kGround ? ground : kin[b];
 }
 
+Mat3x12 VecJet::full() const {
+  Mat3x12 J = Mat3x12::Zero();
+  for (int s = 0; s < 2; ++s) {
+    J.block<3, 3>(0, 6 * s).diagonal().setConstant(lin[s]);
+    if (has_ang[s]) J.block<3, 3>(0, 6 * s + 3) = ang[s];
+  }
+  return J;
+}
+
+Row12 VecJet::left(const Vec3& n) const {
+  Row12 r;
+  for (int s = 0; s < 2; ++s) {
+    r.segment<3>(6 * s) = lin[s] * n.transpose();
+    if (has_ang[s])
+      r.segment<3>(6 * s + 3).noalias() = n.transpose() * ang[s];
+    else
+      r.segment<3>(6 * s + 3).setZero();
+  }
+  return r;
+}
+
+namespace {
+// -R skew(a), column by column: -R (a x e_k) = R (e_k x a)
+inline Mat3 minus_r_skew(const Mat3& R, const Vec3& a) {
+  Mat3 M;
+  M.col(0) = a[1] * R.col(2) - a[2] * R.col(1);
+  M.col(1) = a[2] * R.col(0) - a[0] * R.col(2);
+  M.col(2) = a[0] * R.col(1) - a[1] * R.col(0);
+  return M;
+}
+}  // namespace
+
 VecJet direction_jet(const BodyKin& k, const Vec3& a, int slot) {
   VecJet j;
   const Vec3 wa = k.w.cross(a);
-  j.val = k.R * a;
-  j.rate = k.R * wa;
-  j.bias = k.R * k.w.cross(wa);
-  j.J.setZero();
-  j.J.block<3, 3>(0, 6 * slot + 3) = -k.R * skew(a);
+  j.val.noalias() = k.R * a;
+  j.rate.noalias() = k.R * wa;
+  j.bias.noalias() = k.R * k.w.cross(wa);
+  j.has_ang[slot] = true;
+  j.ang[slot] = minus_r_skew(k.R, a);
   return j;
 }
 
 VecJet point_jet(const BodyKin& k, const Vec3& s, int slot) {
-  VecJet j;
-  const Vec3 ws = k.w.cross(s);
-  j.val = k.x + k.R * s;
-  j.rate = k.xd + k.R * ws;
-  j.bias = k.R * k.w.cross(ws);
-  j.J.setZero();
-  j.J.block<3, 3>(0, 6 * slot).setIdentity();
-  j.J.block<3, 3>(0, 6 * slot + 3) = -k.R * skew(s);
+  VecJet j = direction_jet(k, s, slot);
+  j.val += k.x;
+  j.rate += k.xd;
+  j.lin[slot] = 1.0;
   return j;
 }
 
@@ -58,7 +86,16 @@ VecJet difference(const VecJet& p, const VecJet& q) {
   j.val = p.val - q.val;
   j.rate = p.rate - q.rate;
   j.bias = p.bias - q.bias;
-  j.J = p.J - q.J;
+  for (int s = 0; s < 2; ++s) {
+    j.lin[s] = p.lin[s] - q.lin[s];
+    j.has_ang[s] = p.has_ang[s] || q.has_ang[s];
+    if (p.has_ang[s] && q.has_ang[s])
+      j.ang[s] = p.ang[s] - q.ang[s];
+    else if (p.has_ang[s])
+      j.ang[s] = p.ang[s];
+    else if (q.has_ang[s])
+      j.ang[s] = -q.ang[s];
+  }
   return j;
 }
 
@@ -66,8 +103,19 @@ ScalarJet dot(const VecJet& a, const VecJet& b) {
   ScalarJet s;
   s.val = a.val.dot(b.val);
   s.rate = a.rate.dot(b.val) + a.val.dot(b.rate);
-  s.J = b.val.transpose() * a.J + a.val.transpose() * b.J;
   s.bias = a.bias.dot(b.val) + 2.0 * a.rate.dot(b.rate) + a.val.dot(b.bias);
+  for (int k = 0; k < 2; ++k) {
+    s.J.segment<3>(6 * k) = a.lin[k] * b.val.transpose() + b.lin[k] * a.val.transpose();
+    auto w = s.J.segment<3>(6 * k + 3);
+    if (a.has_ang[k] && b.has_ang[k])
+      w.noalias() = b.val.transpose() * a.ang[k] + a.val.transpose() * b.ang[k];
+    else if (a.has_ang[k])
+      w.noalias() = b.val.transpose() * a.ang[k];
+    else if (b.has_ang[k])
+      w.noalias() = a.val.transpose() * b.ang[k];
+    else
+      w.setZero();
+  }
   return s;
 }
 
@@ -75,17 +123,24 @@ ScalarJet component(const VecJet& a, int k) {
   ScalarJet s;
   s.val = a.val[k];
   s.rate = a.rate[k];
-  s.J = a.J.row(k);
   s.bias = a.bias[k];
+  for (int sl = 0; sl < 2; ++sl) {
+    s.J.segment<3>(6 * sl).setZero();
+    s.J[6 * sl + k] = a.lin[sl];
+    if (a.has_ang[sl])
+      s.J.segment<3>(6 * sl + 3) = a.ang[sl].row(k);
+    else
+      s.J.segment<3>(6 * sl + 3).setZero();
+  }
   return s;
 }
 
-ScalarJet atan2_jet(const ScalarJet& s, const ScalarJet& c) {
+ScalarJet atan2_jet(const ScalarJet& s, const ScalarJet& c, bool value) {
   // theta = atan2(s, c): theta' = (c s' - s c') / r^2, and the bias follows from differentiating
   // once more: (c s_bias - s c_bias) / r^2 - 2 theta' (c c' + s s') / r^2
   ScalarJet t;
   const double r2 = s.val * s.val + c.val * c.val;
-  t.val = std::atan2(s.val, c.val);
+  t.val = value ? std::atan2(s.val, c.val) : 0.0;
   t.rate = (c.val * s.rate - s.val * c.rate) / r2;
   t.J = (c.val * s.J - s.val * c.J) / r2;
   t.bias = (c.val * s.bias - s.val * c.bias) / r2 -
@@ -106,14 +161,14 @@ VecJet joint_separation_jet(const Model& m, const std::vector<BodyKin>& kin, int
                     point_jet(kin_of(kin, jt.parent), jt.point_parent, 0));
 }
 
-ScalarJet coord_jet(const Model& m, const std::vector<BodyKin>& kin, int coord) {
+ScalarJet coord_jet(const Model& m, const std::vector<BodyKin>& kin, int coord, bool value) {
   const Coord& c = m.coords[coord];
   if (c.angular) {
     // angle of the child frame's x axis in the parent frame's (x, y) plane
     const VecJet xa = joint_axis_jet(m, kin, c.joint, 0, 0);
     const VecJet ya = joint_axis_jet(m, kin, c.joint, 0, 1);
     const VecJet xb = joint_axis_jet(m, kin, c.joint, 1, 0);
-    return atan2_jet(dot(ya, xb), dot(xa, xb));
+    return atan2_jet(dot(ya, xb), dot(xa, xb), value);
   }
   // displacement along the parent's joint axis
   return dot(joint_axis_jet(m, kin, c.joint, 0, 2), joint_separation_jet(m, kin, c.joint));

@@ -16,6 +16,7 @@
 #include <memory>
 #include <vector>
 
+#include "armdyn/analysis/joint_space.hpp"
 #include "armdyn/model/model.hpp"
 
 namespace armdyn {
@@ -45,6 +46,9 @@ class JointSpaceInverseDynamics {
   ~JointSpaceInverseDynamics();
   /// Joint torques/forces for (q, qd, qdd) at time t (t matters for profiled force elements).
   VecX compute(const VecX& q, const VecX& qd, const VecX& qdd, double t = 0.0);
+  /// The same into tau (n_coords), allocating nothing.
+  void compute(Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd, Eigen::Ref<const VecX> qdd,
+               Eigen::Ref<VecX> tau, double t = 0.0);
   const Model& model() const { return *src_; }
 
  private:
@@ -52,6 +56,7 @@ class JointSpaceInverseDynamics {
   Model driven_;  // src_ with one drive per joint coordinate, in coordinate order
   std::unique_ptr<Engine> e_;
   VecX u_, v_, vd_, ref_;
+  TreeFkWork fk_;
   // O(n) path: with every coordinate driven, each tree joint's rows plus its drive rows are six
   // rows on its child's six velocities, so zeta is square and block-triangular in tree order:
   // vdot by a forward sweep and delta by a backward sweep of 6x6 solves

@@ -13,9 +13,19 @@ namespace armdyn {
 
 class Engine;
 
+/// Per-body scratch of state_from_joints (world rotation, position, velocity, angular velocity),
+/// kept by callers that evaluate repeatedly so that no call allocates.
+struct TreeFkWork {
+  std::vector<Mat3> R;
+  std::vector<Vec3> x, xd, w;
+};
+
 /// Cartesian (u, v) from joint coordinates q and rates qd (n_coords each).
 /// @throws ModelError when the model is not a joint-space tree or sizes are wrong.
 void state_from_joints(const Model& m, const VecX& q, const VecX& qd, VecX& u, VecX& v);
+/// The same with caller-owned scratch (no allocation once u, v and work are sized).
+void state_from_joints(const Model& m, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd, VecX& u,
+                       VecX& v, TreeFkWork& work);
 /// Joint coordinates (angles in (-pi, pi]) and rates at (u, v).
 void joint_coordinates(const Model& m, const VecX& u, const VecX& v, VecX& q, VecX& qd);
 /// qdd for joint torques/forces tau; drives are ignored (joint rows only).
@@ -29,13 +39,16 @@ class JointSpaceForwardDynamics {
   explicit JointSpaceForwardDynamics(std::shared_ptr<const Model> m);
   ~JointSpaceForwardDynamics();
   /// qdd into out (n_coords) for torques/forces tau at time t.
-  void compute(const VecX& q, const VecX& qd, const VecX& tau, VecX& out, double t = 0.0);
+  /// @throws ModelError on wrong sizes or non-finite inputs.
+  void compute(Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd, Eigen::Ref<const VecX> tau,
+               Eigen::Ref<VecX> out, double t = 0.0);
   const Model& model() const { return *m_; }
 
  private:
   std::shared_ptr<const Model> m_;
   std::unique_ptr<Engine> e_;
   VecX u_, v_, vd_, tau_;
+  TreeFkWork fk_;
 };
 
 /// Check that the model supports joint-space calls; throws ModelError naming the reason.

@@ -35,8 +35,9 @@ KktPlan plan_kkt(const Model& m, int nrows);
 class BlockSparseSchur {
  public:
   BlockSparseSchur(const Model& m, const KktPlan& plan);
-  /// Assemble A over the plan's blocks with the per-body metric blocks winv (nullptr: identity)
-  /// and factor it. Returns false, leaving the
+  /// Assemble A over the plan's blocks with the per-body metric blocks winv (nullptr: identity;
+  /// otherwise block-diagonal per body, diag(W_xx, W_ww), as Gamma^-1 about the centre of mass
+  /// is, and only those two 3 x 3 blocks are read) and factor it. Returns false, leaving the
   /// factor invalid, when a pivot is not positive or falls below 1e-12 of its row's diagonal
   /// (singular or nearly so: the caller then uses the dense pivoted path).
   bool factor(const ConstraintEval& ce, const std::vector<Mat6>* winv);
@@ -60,6 +61,7 @@ class BlockSparseSchur {
   };
   struct Assembly {
     int body, g, sg, h, sh;  // blocks g (row side) and h (column side) through body, slots
+    int jw;                  // offset of J_g,sg W_body^-1 in jw_
     int target;              // offset of the block (g, h) in L storage (diagonal when g == h)
   };
   const Model& m_;
@@ -67,8 +69,19 @@ class BlockSparseSchur {
   std::vector<Sub> sub_;
   std::vector<Update> upd_;
   std::vector<Assembly> asm_;
+  // J_g,s W_b^-1 of each live (block, slot), 6 doubles per row, computed once per factor
+  struct Scaled {
+    int g, slot, off;
+  };
+  std::vector<Scaled> scaled_;
+  std::vector<int> scaled_off_;  // (block, slot) -> offset in jw_ (-1: not live)
+  std::vector<double> jw_;
   std::vector<double> val_;
-  std::vector<double> diag0_;  // assembled diagonal of A (by row), for the relative pivot test
+  std::vector<double> diag0_;     // assembled diagonal of A (by row), for the relative pivot test
+  std::vector<double> inv_diag_;  // 1 / L(i, i) by row
+  /// Factor block column k (S: its size at compile time, 0: at run time).
+  template <int S>
+  bool factor_column(int k);
   int nrows_ = 0;
 };
 

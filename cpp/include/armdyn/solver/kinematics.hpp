@@ -22,9 +22,18 @@ struct BodyKin {
   Vec3 w = Vec3::Zero();   ///< angular velocity, body frame
 };
 
+/// A vector's jet. Its 3 x 12 Jacobian is stored by structure: per slot s, the linear-velocity
+/// columns are lin[s] * I (points: +-1, directions: 0) and the angular-velocity columns ang[s]
+/// (present when has_ang[s]). Dot products and components then touch only what is nonzero.
 struct VecJet {
   Vec3 val, rate, bias;
-  Mat3x12 J;
+  double lin[2] = {0.0, 0.0};
+  bool has_ang[2] = {false, false};
+  Mat3 ang[2];
+  /// The full 3 x 12 Jacobian.
+  Mat3x12 full() const;
+  /// n^T J (the Jacobian of n . vector for a fixed n).
+  Row12 left(const Vec3& n) const;
 };
 
 struct ScalarJet {
@@ -45,8 +54,8 @@ VecJet point_jet(const BodyKin& k, const Vec3& s, int slot);
 VecJet difference(const VecJet& p, const VecJet& q);  ///< p - q
 ScalarJet dot(const VecJet& a, const VecJet& b);
 ScalarJet component(const VecJet& a, int k);
-/// atan2(s, c) of two scalar jets.
-ScalarJet atan2_jet(const ScalarJet& s, const ScalarJet& c);
+/// atan2(s, c) of two scalar jets (value left 0 when !value: rate, Jacobian and bias only).
+ScalarJet atan2_jet(const ScalarJet& s, const ScalarJet& c, bool value = true);
 
 /// Joint frame axes of joint j in world, on the parent (side 0) or child (side 1) body.
 VecJet joint_axis_jet(const Model& m, const std::vector<BodyKin>& kin, int joint, int side,
@@ -56,7 +65,8 @@ VecJet joint_separation_jet(const Model& m, const std::vector<BodyKin>& kin, int
 
 /// Jet of joint coordinate c (angle in (-pi, pi] or displacement) in the Jacobian slots of its
 /// joint's (parent, child).
-ScalarJet coord_jet(const Model& m, const std::vector<BodyKin>& kin, int coord);
+/// value = false skips the angle itself (rate, Jacobian and bias only).
+ScalarJet coord_jet(const Model& m, const std::vector<BodyKin>& kin, int coord, bool value = true);
 
 /// Acceleration of joint coordinate c from the Cartesian accelerations: J vdot + bias.
 inline double coord_acceleration(const Model& m, const ScalarJet& s, int c,
