@@ -4,9 +4,11 @@
   armdyn (Cartesian Newton–Euler KKT path) against Pinocchio's ``aba`` and ``rnea``, per call
   from Python for both, and per call in a C++ loop for armdyn. The answers are cross-checked in
   the same run (relative error of q̈ and τ; also a test, ``tests/test_pinocchio.py``).
-* A whole run: 5 s of the UR5 falling under gravity from rest, armdyn's DOPRI5 against SciPy's
-  ``solve_ivp`` (DOP853 and RK45) on Pinocchio's ABA, at the same tolerance, with the error of
-  each against a tight-tolerance reference.
+* A whole run: 5 s of the UR5 falling under gravity from rest (``armdyn workprecision ur5``):
+  armdyn's DOPRI5 and RK4 against MuJoCo's import of the same URDF (RK4), Exudyn's redundant-
+  coordinate model of it, and SciPy's ``solve_ivp`` (DOP853, RK45) on Pinocchio's ABA, each
+  swept over tolerances or step sizes, with the error of each against a tight-tolerance
+  reference; the summary gives the CPU time per step and to errors 1e-4 and 1e-6 rad.
 * One DOPRI5 step of the 44-body geared arm (the first paper's mechanism), and 5 s of the
   five-DOF validation run at rtol 1e-8 (outputs every 0.01 s).
 * Scaling: spatial revolute chains of n = 2 … 1000 bodies, time per RK4 step against n, with the
@@ -49,6 +51,39 @@ def robot_urdf(name: str) -> Path | None:
         if p.is_file():
             return p
     return None
+
+
+def mujoco_from_urdf(path: Path, pair: PinPair | None = None):
+    """MuJoCo's own URDF import of the arm, for the same-URDF comparison: visual and collision
+    elements removed (no meshes are needed and no contacts exist), static bodies fused, joint
+    limits, damping, armature and friction off (Pinocchio's ABA and armdyn have none).
+    Returns the MjModel and, with ``pair``, the map from Pinocchio's joint order to qpos."""
+    import re
+
+    import mujoco
+
+    txt = Path(path).read_text()
+    txt = re.sub(r"<(visual|collision)\b.*?</\1>", "", txt, flags=re.S)
+    txt = re.sub(
+        r"(<robot\b[^>]*>)",
+        r'\1<mujoco><compiler discardvisual="true" fusestatic="true" balanceinertia="false"/>'
+        r"</mujoco>",
+        txt,
+        count=1,
+    )
+    model = mujoco.MjModel.from_xml_string(txt)
+    model.jnt_limited[:] = 0
+    model.dof_damping[:] = 0.0
+    model.dof_armature[:] = 0.0
+    model.dof_frictionloss[:] = 0.0
+    model.opt.gravity[:] = (0.0, 0.0, -9.81)
+    if pair is None:
+        return model, None
+    names = [model.joint(i).name for i in range(model.njnt)]
+    perm = np.array(
+        [model.jnt_qposadr[names.index(pair.pm.names[i])] for i in range(1, pair.pm.njoints)]
+    )
+    return model, perm
 
 
 def _median_time(fn, number: int, repeat: int = 7) -> float:
@@ -151,53 +186,36 @@ def bench_arms() -> dict:
     return out
 
 
-def bench_whole_run(t_end: float = 5.0, rtol: float = 1e-8) -> dict:
-    """5 s of the UR5 released from a bent pose: armdyn DOPRI5 against SciPy on Pinocchio."""
-    path = robot_urdf("ur5")
+def bench_whole_run(quick: bool = False) -> dict:
+    """5 s of the UR5 released from a bent pose (``armdyn workprecision ur5``): armdyn (DOPRI5,
+    RK4) against MuJoCo (its URDF import, RK4), Exudyn (redundant coordinates) and SciPy's
+    ``solve_ivp`` on Pinocchio's ABA, each swept over tolerances or steps, with the error against
+    a DOP853 (rtol 1e-13) reference on Pinocchio. Summary: per integrator the CPU time of one
+    step and the cheapest run reaching max angle errors 1e-4 and 1e-6 rad over the 100 outputs,
+    and each peer's time over armdyn's best."""
+    from armdyn import workprecision as wp
+
     try:
-        import pinocchio as pin
-        from scipy.integrate import solve_ivp
-    except ImportError as e:
+        r = wp.run_problem("ur5", quick=quick, echo=False)
+    except (ImportError, _core.ModelError) as e:
         return {"skipped": str(e)}
-    if path is None:
-        return {"skipped": "example-robot-data is not installed"}
-    pair = PinPair(path)
-    n = pair.pm.nq
-    q0 = np.array([0.3, -1.0, 1.2, -0.5, 0.8, 0.1])[:n]
-
-    def f(_t, y):
-        return np.concatenate([y[n:], pin.aba(pair.pm, pair.pd, y[:n], y[n:], np.zeros(n))])
-
-    y0 = np.concatenate([q0, np.zeros(n)])
-    ref = solve_ivp(f, (0, t_end), y0, method="DOP853", rtol=1e-13, atol=1e-13)
-    q_ref = ref.y[:n, -1]
-    u0, v0 = _core.state_from_joints(pair.am, pair.to_armdyn(q0))
-
-    def ours():
-        return simulate(pair.am, t_end, rtol=rtol, atol=rtol * 1e-2, u0=u0, v0=v0, output_dt=t_end)
-
-    res = ours()
-    err_ours = float(np.max(np.abs(np.unwrap(res.q[-1][pair.perm] - q_ref))))
-    out = {
-        "t_end_s": t_end,
-        "rtol": rtol,
-        "armdyn_dopri5": {
-            "cpu_s": _median_time(ours, 1, 5),
-            "steps": int(res.stats["steps"]),
-            "error_rad": err_ours,
-        },
-    }
-    for method in ("DOP853", "RK45"):
-
-        def peer(method=method):
-            return solve_ivp(f, (0, t_end), y0, method=method, rtol=rtol, atol=rtol * 1e-2)
-
-        sol = peer()
-        out[f"scipy_{method}_on_pin_aba"] = {
-            "cpu_s": _median_time(peer, 1, 5),
-            "steps": int(sol.t.size - 1),
-            "error_rad": float(np.max(np.abs(sol.y[:n, -1] - q_ref))),
-        }
+    out = {"problem": r["title"], "error": r["error"], "reference_check": r["reference_check"]}
+    per_step = {}
+    for key, pts in r["curves"].items():
+        ok = [p for p in pts if "steps" in p and np.isfinite(p.get("error", np.nan))]
+        if ok:
+            per_step[key] = float(np.median([1e6 * p["cpu_s"] / p["steps"] for p in ok]))
+    out["us_per_step"] = per_step
+    for target in (1e-4, 1e-6):
+        best = {k: wp.cpu_to(pts, target) for k, pts in r["curves"].items()}
+        best = {k: v for k, v in best.items() if v is not None}
+        ours = min((v for k, v in best.items() if k.startswith("armdyn")), default=None)
+        out[f"cpu_s_to_{target:g}"] = dict(sorted(best.items(), key=lambda kv: kv[1]))
+        if ours:
+            out[f"peer_over_armdyn_to_{target:g}"] = {
+                k: v / ours for k, v in best.items() if not k.startswith("armdyn")
+            }
+    out["curves"] = r["curves"]
     return out
 
 
@@ -303,7 +321,7 @@ def run(out="docs/results", quick: bool = False, echo: bool = True) -> dict:
             "python": platform.python_version(),
         },
         "arms": bench_arms(),
-        "whole_run": bench_whole_run(),
+        "whole_run": bench_whole_run(quick),
         "geared_arm_step": bench_geared_arm(),
         "five_dof_run": bench_five_dof(),
         "scaling": bench_scaling(

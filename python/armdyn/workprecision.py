@@ -62,7 +62,11 @@ class Problem:
     scipy_rhs: Callable | None = None  # () -> (f, y0)
     scipy_observe: Callable | None = None  # y (k, n) -> (n, kq)
     mujoco_xml: str | None = None
+    mujoco_model: Callable | None = None  # () -> (MjModel, qpos0) instead of mujoco_xml
     mujoco_observe: Callable | None = None  # qpos (n, nq) -> (n, kq)
+    scipy_label: str = "minimal coordinates"
+    # further peers: (problem, ref, quick, repeats) -> {curve name: points}
+    more_peers: Callable | None = None
     # (reference on the output times) -> {name: value}: the reference against published values
     # or a second method, recorded with the curves
     reference_check: Callable | None = None
@@ -132,6 +136,95 @@ def _squeezer_check(ref):
     return {"reference_vs_test_set_at_0.03_rad": float(np.abs(d).max())}
 
 
+UR5_Q0 = (0.3, -1.0, 1.2, -0.5, 0.8, 0.1)  # Pinocchio joint order, released at rest
+
+
+class _Ur5:
+    """The UR5 of example-robot-data in armdyn, Pinocchio and MuJoCo, built once, with the maps
+    between their joint orders."""
+
+    _cache = None
+
+    @classmethod
+    def get(cls):
+        if cls._cache is None:
+            cls._cache = cls()
+        return cls._cache
+
+    def __init__(self):
+        from armdyn import bench
+
+        path = bench.robot_urdf("ur5")
+        if path is None:
+            raise _core.ModelError("workprecision ur5: example-robot-data is not installed")
+        self.pair = bench.PinPair(path)
+        self.path = path
+        self.q0 = np.array(UR5_Q0)
+
+    def rhs(self):
+        pin, pm, pd = self.pair.pin, self.pair.pm, self.pair.pd
+        n = pm.nq
+        tau = np.zeros(n)
+
+        def f(_t, y):
+            return np.concatenate([y[n:], pin.aba(pm, pd, y[:n], y[n:], tau)])
+
+        return f, np.concatenate([self.q0, np.zeros(n)])
+
+    def reference(self, t):
+        from scipy.integrate import solve_ivp
+
+        f, y0 = self.rhs()
+        sol = solve_ivp(f, (0, t[-1]), y0, method="DOP853", rtol=1e-13, atol=1e-13, t_eval=t)
+        return sol.y[: len(self.q0)].T
+
+    def init(self, model):
+        u0, v0 = _core.state_from_joints(model, self.pair.to_armdyn(self.q0))
+        return {"u0": u0, "v0": v0}
+
+    def observe(self, _model, res):
+        return res.q[:, self.pair.perm]
+
+    def mujoco(self):
+        from armdyn import bench
+
+        mj, perm = bench.mujoco_from_urdf(self.path, self.pair)
+        qpos0 = np.zeros(mj.nq)
+        qpos0[perm] = self.q0
+        self.mj_perm = perm
+        return mj, qpos0
+
+    def check(self, _ref):
+        """The three models are the same mechanism: armdyn's and MuJoCo's accelerations against
+        Pinocchio's ABA at 50 random states (relative to the largest acceleration)."""
+        import mujoco
+
+        mj, _ = self.mujoco()
+        data = mujoco.MjData(mj)
+        pin, pm, pd = self.pair.pin, self.pair.pm, self.pair.pd
+        rng = np.random.default_rng(0)
+        worst = 0.0
+        for _ in range(50):
+            q, v = rng.uniform(-np.pi, np.pi, size=(2, pm.nq))
+            a = pin.aba(pm, pd, q, v, np.zeros(pm.nq))
+            data.qpos[self.mj_perm] = q
+            data.qvel[self.mj_perm] = v
+            mujoco.mj_forward(mj, data)
+            worst = max(worst, np.abs(data.qacc[self.mj_perm] - a).max() / np.abs(a).max())
+        return {
+            "armdyn_qdd_vs_pin_aba_rel": self.pair.cross_check()["fd_rel_error"],
+            "mujoco_qacc_vs_pin_aba_rel": float(worst),
+        }
+
+
+def _ur5_more_peers(problem, ref, quick, repeats):
+    try:
+        from armdyn import peer_exudyn
+    except ImportError:
+        return {}
+    return peer_exudyn.workprecision_curves(problem, ref, quick, repeats)
+
+
 _A01_XML = """<mujoco><option gravity="0 -9.81 0" timestep="0.001"/>
 <worldbody><body name="p"><joint name="pivot" type="hinge" axis="0 0 1"/>
 <inertial pos="1 0 0" mass="1" diaginertia="1e-12 1e-12 1e-12"/></body></worldbody></mujoco>"""
@@ -193,6 +286,32 @@ PROBLEMS: dict[str, Problem] = {
         reference=_five_dof_reference,
         sweeps={"dopri5": [1e-4, 1e-6, 1e-8, 1e-10], "rk4": [0.1, 0.05, 0.025, 0.0125]},
         quick_sweeps={"dopri5": [1e-6], "rk4": [0.05]},
+    ),
+    "ur5": Problem(
+        name="ur5",
+        title="UR5 (example-robot-data URDF) released from a bent pose, 5 s",
+        source="example-robot-data ur5_robot.urdf; reference: SciPy DOP853 at rtol 1e-13 on "
+        "Pinocchio's ABA (reduced coordinates, a different method)",
+        t_end=5.0,
+        n_out=100,
+        quantity="max |q - q_ref| of the 6 joint angles over 100 outputs [rad]",
+        build=lambda: _Ur5.get().pair.am,
+        observe=lambda model, res: _Ur5.get().observe(model, res),
+        reference=lambda t: _Ur5.get().reference(t),
+        init=lambda model: _Ur5.get().init(model),
+        angular=True,
+        sweeps={
+            "dopri5": [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10],
+            "rk4": [4e-3, 2e-3, 1e-3, 5e-4, 2.5e-4],
+        },
+        quick_sweeps={"dopri5": [1e-6, 1e-8], "rk4": [1e-3]},
+        scipy_rhs=lambda: _Ur5.get().rhs(),
+        scipy_observe=lambda y: y[:6].T,
+        scipy_label="on Pinocchio's ABA",
+        mujoco_model=lambda: _Ur5.get().mujoco(),
+        mujoco_observe=lambda qpos: qpos[:, _Ur5.get().mj_perm],
+        more_peers=_ur5_more_peers,
+        reference_check=lambda ref: _Ur5.get().check(ref),
     ),
     "squeezer": Problem(
         name="squeezer",
@@ -323,7 +442,10 @@ def sweep_mujoco(problem: Problem, integrator: str, steps, ref, repeats: int = 5
     spacing = problem.t_end / problem.n_out
     points = []
     for h in steps:
-        model = mujoco.MjModel.from_xml_string(problem.mujoco_xml)
+        if problem.mujoco_model is not None:
+            model, qpos0 = problem.mujoco_model()
+        else:
+            model, qpos0 = mujoco.MjModel.from_xml_string(problem.mujoco_xml), None
         model.opt.timestep = h
         model.opt.integrator = {
             "rk4": mujoco.mjtIntegrator.mjINT_RK4,
@@ -332,9 +454,11 @@ def sweep_mujoco(problem: Problem, integrator: str, steps, ref, repeats: int = 5
         data = mujoco.MjData(model)
         per = round(spacing / h)
 
-        def call(model=model, data=data, per=per):
+        def call(model=model, data=data, per=per, qpos0=qpos0):
             # the stepping loop runs in C: mj_step(..., nstep) between outputs
             mujoco.mj_resetData(model, data)
+            if qpos0 is not None:
+                data.qpos[:] = qpos0
             qpos = np.empty((problem.n_out + 1, model.nq))
             qpos[0] = data.qpos
             for k in range(problem.n_out):
@@ -376,11 +500,11 @@ def run_problem(name: str, quick: bool = False, peers: bool = True, echo: bool =
             _echo(f"armdyn {integ}", curves[f"armdyn {integ}"])
     if peers and p.scipy_rhs is not None:
         for method in ("DOP853", "RK45"):
-            key = f"SciPy {method} (minimal coordinates)"
+            key = f"SciPy {method} ({p.scipy_label})"
             curves[key] = sweep_scipy(p, method, SCIPY_QUICK if quick else SCIPY_RTOLS, ref, reps)
             if echo:
                 _echo(key, curves[key])
-    if peers and p.mujoco_xml is not None:
+    if peers and (p.mujoco_xml is not None or p.mujoco_model is not None):
         try:
             import mujoco  # noqa: F401
         except ImportError:
@@ -395,6 +519,11 @@ def run_problem(name: str, quick: bool = False, peers: bool = True, echo: bool =
                 curves[key] = sweep_mujoco(p, integ, hs, ref, reps)
                 if echo:
                     _echo(key, curves[key])
+    if peers and p.more_peers is not None:
+        for key, pts in p.more_peers(p, ref, quick, reps).items():
+            curves[key] = pts
+            if echo:
+                _echo(key, pts)
     return {
         "problem": p.name,
         "title": p.title,
@@ -414,7 +543,7 @@ def _fastest(curves: dict) -> dict:
     curve first."""
     out = {}
     for target in (1e-3, 1e-6):
-        best = {k: _at(pts, target) for k, pts in curves.items()}
+        best = {k: cpu_to(pts, target) for k, pts in curves.items()}
         best = {k: v for k, v in best.items() if v is not None}
         out[f"{target:g}"] = dict(sorted(best.items(), key=lambda kv: kv[1]))
     return out
@@ -476,7 +605,7 @@ def machine() -> dict:
     }
 
 
-def _at(pts, target):
+def cpu_to(pts, target):
     """CPU time of the cheapest point of a curve with error <= target (None if none)."""
     ok = [q["cpu_s"] for q in pts if q.get("error", np.nan) <= target]
     return min(ok) if ok else None
@@ -501,7 +630,7 @@ def summary_markdown(results: dict) -> str:
             fails = [f"{q['setting']:g}: {q['failed']}" for q in pts if "failed" in q]
             cells = []
             for target in (1e-3, 1e-6):
-                v = _at(pts, target)
+                v = cpu_to(pts, target)
                 cells.append("—" if v is None else f"{v:.3g}")
             best = f"{min(fin):.2g}" if fin else "—"
             lines.append(f"| {key} | {cells[0]} | {cells[1]} | {best} | {'; '.join(fails)} |")
