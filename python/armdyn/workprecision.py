@@ -7,9 +7,12 @@ in minimal coordinates), the CPU time of the whole solve (median of warm repeats
 run first) and the counters (steps, right-hand sides, KKT solves, factorisations). Peers run the
 same problem in the same process:
 
-- SciPy ``solve_ivp`` (DOP853, RK45) on the minimal-coordinate equations of the reference;
+- SciPy ``solve_ivp`` (DOP853, RK45) on the minimal-coordinate equations of the reference
+  (for the UR5: on Pinocchio's ABA);
 - MuJoCo (RK4 and implicit Euler at fixed steps, ``mj_step`` looping in C between outputs)
-  where the problem is a tree (A01).
+  where the problem is a tree (A01; the UR5 through MuJoCo's own URDF import);
+- Exudyn (generalized-alpha, fixed steps) on a redundant-coordinate model of the UR5
+  (:mod:`armdyn.peer_exudyn`; Exudyn's explicit solvers do not take its joint constraints).
 
 Errors are measured as in the IFToMM benchmark: the largest absolute deviation over the output
 grid of the problem's reference quantity (positions of a point [m], or angles [rad]).
@@ -643,7 +646,7 @@ def summary_markdown(results: dict) -> str:
 # "all": the problems whose sweeps finish in minutes. A02 runs only when named: near its
 # singular position each evaluation falls back to the dense pivoted KKT path (485 rows), and a
 # 20 s run took over 7 CPU minutes in session 9 (issue 5's note).
-ALL = ("squeezer", "a01", "five_dof")
+ALL = ("squeezer", "a01", "five_dof", "ur5")
 
 
 def run(problems=None, out="docs/results/workprecision", quick=False, peers=True, echo=True):
