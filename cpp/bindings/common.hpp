@@ -57,6 +57,8 @@ class VecArg {
     own_ = to_vec(obj, name, n);
     new (&map_) Eigen::Map<const VecX>(own_.data(), n);
   }
+  VecArg(const VecArg&) = delete;  // map_ may point into own_
+  VecArg& operator=(const VecArg&) = delete;
   const Eigen::Map<const VecX>& operator*() const { return map_; }
 
  private:

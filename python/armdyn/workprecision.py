@@ -163,6 +163,7 @@ class _Ur5:
         self.pair = bench.PinPair(path)
         self.path = path
         self.q0 = np.array(UR5_Q0)
+        self._mj_perm = None
 
     def rhs(self):
         pin, pm, pd = self.pair.pin, self.pair.pm, self.pair.pd
@@ -194,8 +195,15 @@ class _Ur5:
         mj, perm = bench.mujoco_from_urdf(self.path, self.pair)
         qpos0 = np.zeros(mj.nq)
         qpos0[perm] = self.q0
-        self.mj_perm = perm
+        self._mj_perm = perm
         return mj, qpos0
+
+    @property
+    def mj_perm(self):
+        """MuJoCo qpos index of each Pinocchio joint."""
+        if self._mj_perm is None:
+            self.mujoco()
+        return self._mj_perm
 
     def check(self, _ref):
         """The three models are the same mechanism: armdyn's and MuJoCo's accelerations against
