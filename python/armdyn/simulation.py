@@ -59,7 +59,7 @@ class SimulationResult:
 def simulate(
     model: _core.Model,
     t_end: float,
-    integrator: str = "dopri5",
+    integrator: str | None = None,
     rtol: float = 1e-6,
     atol: float = 1e-8,
     dt: float | None = None,
@@ -79,9 +79,15 @@ def simulate(
         t_end: end time [s] (> 0).
         integrator: ``"dopri5"`` (Dormand–Prince 5(4), error control, dense output),
             ``"rk4"`` (classical fixed step ``dt``), ``"trbdf2"`` (L-stable implicit TR-BDF2
-            with error control, for stiff scenes), or ``"auto"``: TR-BDF2 when the stiffness
-            estimate of the force elements says an explicit method would need more than 5000
-            steps for stability alone, else DOPRI5. ``stats["integrator"]`` and
+            with error control, for stiff scenes), ``"kinematic"`` (a fully driven model:
+            each output state is solved from the constraints, nothing is integrated), or
+            ``"auto"``: kinematic when the drives leave no degree of freedom (and outputs are
+            on an ``output_dt`` grid), else TR-BDF2 when the stiffness estimate of the force
+            elements says an explicit method would need more than 5000 steps for stability
+            alone, else DOPRI5. Default (``None``): kinematic for a fully driven model with
+            ``output_dt``, else DOPRI5. A fully driven model has nothing to integrate: its
+            DOPRI5 run only supplies starting guesses to the same position, velocity and
+            acceleration problems, so both give the same outputs. ``stats["integrator"]`` and
             ``stats["integrator_reason"]`` say which was used and why.
         rtol, atol: DOPRI5 tolerances on every component of (u, v).
         dt: RK4 step (required for rk4); DOPRI5/TR-BDF2 initial step (optional).
@@ -119,7 +125,7 @@ def simulate(
     raw = _core._simulate(
         model,
         float(t_end),
-        integrator,
+        "default" if integrator is None else integrator,
         float(rtol),
         float(atol),
         float(dt or 0.0),

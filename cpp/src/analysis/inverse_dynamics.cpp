@@ -26,12 +26,141 @@ std::string undriven_coordinates(const Model& m) {
 
 }  // namespace
 
-InverseDynamicsResult inverse_dynamics_driven(const Model& m, const std::vector<double>& times) {
+DrivenSolver::DrivenSolver(const Model& m, Engine& e, const char* who, double t0)
+    : t_good(t0), m_(m), e_(e), who_(who), t_prev_(t0), fk_(m.joint_space_ok) {
   if (m.mobility_driven > 0)
     throw ModelError(
-        msg("inverse_dynamics: the drives leave ", m.mobility_driven,
+        msg(who, ": the drives leave ", m.mobility_driven,
             " degree(s) of freedom unprescribed; undriven coordinates: ", undriven_coordinates(m),
             " (add drives, or use inverse_dynamics(model, q, qd, qdd) on a tree)"));
+  const long nco = static_cast<long>(m.coords.size());
+  qc_ = VecX::Zero(nco);
+  qdc_ = VecX::Zero(nco);
+  ud_ = VecX::Zero(m.nq);
+  u_save_ = VecX::Zero(m.nq);
+  v_save_ = VecX::Zero(m.nv);
+  u_pred_ = VecX::Zero(m.nq);
+  track_save_ = e.tracking();
+}
+
+void DrivenSolver::predict(double t_from, double t, VecX& u, VecX& v, const VecX& vd) {
+  if (fk_) {
+    // every coordinate is driven: the state follows from the drive values
+    joint_coordinates(m_, u, v, qc_, qdc_);
+    for (const Drive& d : m_.drives) {
+      const ProfileValue p = d.profile.eval(t);
+      const int c = m_.joints[d.joint].coord0 + d.coord;
+      qc_[c] = p.y;
+      qdc_[c] = p.yd;
+    }
+    state_from_joints(m_, qc_, qdc_, u, v, fkw_);
+  } else if (t != t_from) {
+    const double h = t - t_from;
+    e_.udot(u.data(), v.data(), ud_.data());
+    u += h * ud_;
+    v += h * vd;
+  }
+}
+
+std::string DrivenSolver::singular_rows() const {
+  KktSolver& kkt = e_.kkt();
+  if (!(kkt.used_pseudo_inverse() && kkt.rank() < m_.rank_all)) return "";
+  std::string rows;
+  for (int r : kkt.dependent_rows()) rows += (rows.empty() ? "" : "; ") + m_.row_name(r);
+  return msg(" The driven constraints are kinematically singular there: rank ", kkt.rank(),
+             " instead of ", m_.rank_all, "; dependent rows: ", rows, ".");
+}
+
+void DrivenSolver::solve(double t, VecX& u, VecX& v, VecX& vd, double& rf, double& rv) {
+  // configuration distance: per body max(|dx| / length scale, rotation angle), max over bodies
+  auto distance = [&](const VecX& a, const VecX& b) {
+    double d = 0.0;
+    for (int i = 0; i < m_.nb; ++i) {
+      const double dx = (a.segment<3>(7 * i) - b.segment<3>(7 * i)).norm() / m_.length_scale;
+      const double c =
+          std::min(1.0, std::abs(a.segment<4>(7 * i + 3).dot(b.segment<4>(7 * i + 3))));
+      d = std::max({d, dx, 2.0 * std::acos(c)});
+    }
+    return d;
+  };
+  bool solved = false;
+  if (fk_) {
+    // closed form, accepted when it meets the constraints to round-off: one factorisation
+    u_save_ = u;
+    v_save_ = v;
+    predict(t_prev_, t, u, v, vd);
+    e_.dynamics(t, u.data(), v.data(), vd.data());
+    e_.loaded_residuals(v.data(), rf, rv);
+    const double tol_f = 1e-13 * std::max(1.0, m_.length_scale);
+    const double tol_v = 1e-13 * std::max(1.0, v.cwiseAbs().maxCoeff());
+    solved = rf <= tol_f && rv <= tol_v && flipped_joint(m_, e_.kin()) < 0;
+    if (solved) {
+      e_.commit_tracking();
+      ++exact_states;
+    } else {
+      u = u_save_;
+      v = v_save_;
+    }
+  }
+  if (!solved) {
+    // position and velocity problems (Newton; exact solves when zeta is square), by
+    // continuation: when Newton fails from the prediction, halve the step towards t
+    double t_cur = t_prev_, h = t - t_prev_;
+    const double h_min = std::ldexp(std::max(std::abs(h), 1e-300), -12);
+    do {
+      const double t_next = std::min(t_cur + h, t);
+      u_save_ = u;
+      v_save_ = v;
+      track_save_ = e_.tracking();
+      std::string failure;
+      try {
+        predict(t_cur, t_next, u, v, vd);
+        u_pred_ = u;
+        e_.project(t_next, u.data(), v.data(), Metric::Mass);
+        if (const int bad = flipped_joint(m_, e_.kin()); bad >= 0)
+          failure = msg("the position problem converged to a flipped configuration of joint '",
+                        m_.joints[bad].name, "'");
+        // Newton must stay on the branch it was predicted on: a correction much larger than
+        // the predicted motion means it may have jumped to another assembly mode
+        if (!fk_ && failure.empty() &&
+            distance(u, u_pred_) > std::max(0.25 * distance(u_pred_, u_save_), 1e-3))
+          failure = "the position correction is large against the predicted motion";
+      } catch (const SolverError& err) {
+        failure = err.what();
+      }
+      if (failure.empty()) {
+        t_cur = t_next;
+        t_good = t_cur;
+        if (t_cur < t) e_.dynamics(t_cur, u.data(), v.data(), vd.data(), true);
+        continue;
+      }
+      u = u_save_;
+      v = v_save_;
+      e_.set_tracking(track_save_);
+      h *= 0.5;
+      if (fk_ || !(h >= h_min))
+        throw SolverError(msg(who_, " at t=", t_next, ": ", failure, ".", singular_rows()));
+    } while (t_cur < t);
+    // acceleration problem and multipliers, with the factor left by the projection
+    e_.dynamics(t, u.data(), v.data(), vd.data(), true);
+    e_.loaded_residuals(v.data(), rf, rv);
+  }
+  t_prev_ = t;
+  t_good = t;
+  KktSolver& kkt = e_.kkt();
+  if (throw_on_singular && !e_.swept() && kkt.used_pseudo_inverse() && kkt.rank() < m_.rank_all) {
+    std::string rows;
+    for (int r : kkt.dependent_rows()) rows += (rows.empty() ? "" : "; ") + m_.row_name(r);
+    throw SolverError(msg(who_, ": kinematically singular at t=", t,
+                          ": the driven constraints have rank ", kkt.rank(), " instead of ",
+                          m_.rank_all, "; dependent rows: ", rows));
+  }
+}
+
+InverseDynamicsResult inverse_dynamics_driven(const Model& m, const std::vector<double>& times) {
+  Engine e(m);
+  const double t0 = (!times.empty() && times.front() < 0.0) ? times.front() : 0.0;
+  DrivenSolver solver(m, e, "inverse_dynamics", t0);  // u0 is assembled at t = 0
   if (times.empty()) throw ModelError("inverse_dynamics: no times given");
   for (size_t k = 0; k < times.size(); ++k) {
     if (!std::isfinite(times[k]))
@@ -41,104 +170,28 @@ InverseDynamicsResult inverse_dynamics_driven(const Model& m, const std::vector<
   }
   const auto start = std::chrono::steady_clock::now();
   InverseDynamicsResult out;
-  Engine e(m);
   const int nco = static_cast<int>(m.coords.size());
-  VecX u = m.u0, v = VecX::Zero(m.nv), vd = VecX::Zero(m.nv), ud = VecX::Zero(m.nq);
+  const size_t nt = times.size();
+  out.t.reserve(nt);
+  out.u.reserve(nt * m.nq);
+  out.v.reserve(nt * m.nv);
+  out.q.reserve(nt * nco);
+  out.qd.reserve(nt * nco);
+  out.qdd.reserve(nt * nco);
+  out.efforts.reserve(nt * m.drives.size());
+  out.reaction_forces.reserve(nt * 3 * m.joints.size());
+  out.reaction_torques.reserve(nt * 3 * m.joints.size());
+  out.position_residual.reserve(nt);
+  out.velocity_residual.reserve(nt);
+  VecX u = m.u0, v = VecX::Zero(m.nv), vd = VecX::Zero(m.nv);
   std::vector<double> qprev(nco, 0.0);
-  const bool fk_predictor = m.joint_space_ok;  // a driven tree: all coordinates are driven
-  VecX qc = VecX::Zero(nco), qdc = VecX::Zero(nco), u_save(m.nq), v_save(m.nv), u_pred(m.nq);
-  VecX track_save = e.tracking();
-  // configuration distance: per body max(|dx| / length scale, rotation angle), max over bodies
-  auto distance = [&](const VecX& a, const VecX& b) {
-    double d = 0.0;
-    for (int i = 0; i < m.nb; ++i) {
-      const double dx = (a.segment<3>(7 * i) - b.segment<3>(7 * i)).norm() / m.length_scale;
-      const double c =
-          std::min(1.0, std::abs(a.segment<4>(7 * i + 3).dot(b.segment<4>(7 * i + 3))));
-      d = std::max({d, dx, 2.0 * std::acos(c)});
-    }
-    return d;
-  };
-  // predicted state at time t from the solution (u, v, vd) at t_from
-  auto predict = [&](double t_from, double t) {
-    if (fk_predictor) {
-      joint_coordinates(m, u, v, qc, qdc);
-      for (const Drive& d : m.drives) {
-        const ProfileValue p = d.profile.eval(t);
-        const int c = m.joints[d.joint].coord0 + d.coord;
-        qc[c] = p.y;
-        qdc[c] = p.yd;
-      }
-      state_from_joints(m, qc, qdc, u, v);
-    } else if (t != t_from) {
-      const double h = t - t_from;
-      e.udot(u.data(), v.data(), ud.data());
-      u += h * ud;
-      v += h * vd;
-    }
-  };
-  auto singular_rows = [&]() {
-    KktSolver& kkt = e.kkt();
-    std::string why;
-    if (kkt.used_pseudo_inverse() && kkt.rank() < m.rank_all) {
-      std::string rows;
-      for (int r : kkt.dependent_rows()) rows += (rows.empty() ? "" : "; ") + m.row_name(r);
-      why = msg(" The driven constraints are kinematically singular there: rank ", kkt.rank(),
-                " instead of ", m.rank_all, "; dependent rows: ", rows, ".");
-    }
-    return why;
-  };
-  double t_prev = times.front() >= 0.0 ? 0.0 : times.front();  // u0 is assembled at t = 0
-  for (size_t k = 0; k < times.size(); ++k) {
+  for (size_t k = 0; k < nt; ++k) {
     const double t = times[k];
-    // position and velocity problems (Newton; exact solves when zeta is square), by
-    // continuation: when Newton fails from the prediction, halve the step towards t
-    double t_cur = t_prev, h = t - t_prev;
-    const double h_min = std::ldexp(std::max(std::abs(h), 1e-300), -12);
-    do {
-      const double t_next = std::min(t_cur + h, t);
-      u_save = u;
-      v_save = v;
-      track_save = e.tracking();
-      std::string failure;
-      try {
-        predict(t_cur, t_next);
-        u_pred = u;
-        e.project(t_next, u.data(), v.data(), Metric::Mass);
-        if (const int bad = flipped_joint(m, e.kin()); bad >= 0)
-          failure = msg("the position problem converged to a flipped configuration of joint '",
-                        m.joints[bad].name, "'");
-        // Newton must stay on the branch it was predicted on: a correction much larger than
-        // the predicted motion means it may have jumped to another assembly mode
-        if (!fk_predictor && failure.empty() &&
-            distance(u, u_pred) > std::max(0.25 * distance(u_pred, u_save), 1e-3))
-          failure = "the position correction is large against the predicted motion";
-      } catch (const SolverError& err) {
-        failure = err.what();
-      }
-      if (failure.empty()) {
-        t_cur = t_next;
-        if (t_cur < t) e.dynamics(t_cur, u.data(), v.data(), vd.data(), true);
-        continue;
-      }
-      u = u_save;
-      v = v_save;
-      e.set_tracking(track_save);
-      h *= 0.5;
-      if (fk_predictor || !(h >= h_min))
-        throw SolverError(msg("inverse_dynamics at t=", t_next, ": ", failure, ".", singular_rows(),
-                              " Times solved before this one: ", k));
-    } while (t_cur < t);
-    t_prev = t;
-    // acceleration problem and multipliers, with the factor left by the projection
-    e.dynamics(t, u.data(), v.data(), vd.data(), true);
-    KktSolver& kkt = e.kkt();
-    if (kkt.used_pseudo_inverse() && kkt.rank() < m.rank_all) {
-      std::string rows;
-      for (int r : kkt.dependent_rows()) rows += (rows.empty() ? "" : "; ") + m.row_name(r);
-      throw SolverError(msg("inverse_dynamics: kinematically singular at t=", t,
-                            ": the driven constraints have rank ", kkt.rank(), " instead of ",
-                            m.rank_all, "; dependent rows: ", rows));
+    double rf, rv;
+    try {
+      solver.solve(t, u, v, vd, rf, rv);
+    } catch (const SolverError& err) {
+      throw SolverError(msg(err.what(), " Times solved before this one: ", k));
     }
     for (int c = 0; c < nco; ++c) {
       const ScalarJet s = coord_jet(m, e.kin(), c);
@@ -158,8 +211,6 @@ InverseDynamicsResult inverse_dynamics_driven(const Model& m, const std::vector<
         out.reaction_torques.push_back(tq[i]);
       }
     }
-    double rf, rv;
-    e.residuals(t, u.data(), v.data(), rf, rv);
     out.t.push_back(t);
     out.u.insert(out.u.end(), u.data(), u.data() + m.nq);
     out.v.insert(out.v.end(), v.data(), v.data() + m.nv);
@@ -205,78 +256,6 @@ JointSpaceInverseDynamics::JointSpaceInverseDynamics(std::shared_ptr<const Model
   vd_ = VecX::Zero(driven_.nv);
   ref_ = VecX::Zero(3 * nco);
   e_->constraints().drive_ref = ref_.data();
-  // the sweep plan: joints in tree order, each with its rows and its drives' rows (6 in all)
-  const ConstraintEval& ce = e_->constraints();
-  std::vector<int> block_at_row(driven_.nc, -1);  // block starting at each row
-  for (int b = 0; b < static_cast<int>(ce.blocks.size()); ++b) block_at_row[ce.blocks[b].row0] = b;
-  sweep_ok_ = driven_.gear_constraints.empty();
-  for (int ji : driven_.tree_order) {
-    const Joint& j = driven_.joints[ji];
-    const int nco_j = joint_coords(j.type);
-    Sweep s{ji, j.parent, j.child, {-1, -1, -1}, 0};
-    if (joint_rows(j.type) > 0) s.blocks[s.nblocks++] = block_at_row[j.row0];
-    for (int c = 0; c < nco_j && s.nblocks < 3; ++c)  // drives are in coordinate order
-      s.blocks[s.nblocks++] = block_at_row[driven_.nc_joint + j.coord0 + c];
-    if (joint_rows(j.type) + nco_j != 6 || s.nblocks != 1 + nco_j || j.child == kGround)
-      sweep_ok_ = false;
-    sweep_.push_back(s);
-  }
-  if (static_cast<int>(sweep_.size()) != driven_.nb) sweep_ok_ = false;
-  lu_.resize(sweep_.size());
-  delta_ = VecX::Zero(driven_.nc);
-  r_ = VecX::Zero(driven_.nv);
-}
-
-void JointSpaceInverseDynamics::compute_sweep(double t) {
-  // the same constraint and force evaluation as the KKT path, then two sweeps instead of the
-  // KKT solve: zeta vdot = -xi forward (parents first), zeta^T delta = eta - Gamma vdot backward
-  e_->load(u_.data(), v_.data());
-  eval_constraints(driven_, e_->kin(), t, true, e_->constraints());
-  e_->forces(t);
-  const ConstraintEval& ce = e_->constraints();
-  auto gather = [&](const Sweep& s, int slot, Mat6& Z, Vec6* rhs) {
-    int r = 0;
-    for (int k = 0; k < s.nblocks; ++k) {
-      const ConstraintBlock& b = ce.blocks[s.blocks[k]];
-      for (int i = 0; i < b.nrows; ++i, ++r) {
-        Z.row(r) = b.J.row(i).segment<6>(6 * slot);
-        if (rhs) (*rhs)[r] = -ce.xi[b.row0 + i];
-      }
-    }
-  };
-  Mat6 Zc, Zp;
-  Vec6 rhs;
-  for (size_t k = 0; k < sweep_.size(); ++k) {
-    const Sweep& s = sweep_[k];
-    gather(s, 1, Zc, &rhs);
-    if (s.parent != kGround) {
-      gather(s, 0, Zp, nullptr);
-      rhs.noalias() -= Zp * vd_.segment<6>(6 * s.parent);
-    }
-    lu_[k].compute(Zc);
-    vd_.segment<6>(6 * s.child) = lu_[k].solve(rhs);
-  }
-  // r = eta - Gamma vdot
-  const VecX& eta = e_->eta();
-  for (int i = 0; i < driven_.nb; ++i) {
-    const Body& b = driven_.bodies[i];
-    r_.segment<3>(6 * i) = eta.segment<3>(6 * i) - b.mass * vd_.segment<3>(6 * i);
-    r_.segment<3>(6 * i + 3) = eta.segment<3>(6 * i + 3) - b.inertia * vd_.segment<3>(6 * i + 3);
-  }
-  for (size_t k = sweep_.size(); k-- > 0;) {
-    const Sweep& s = sweep_[k];
-    // delta of this joint's rows from its child's balance (its children's shares already out)
-    Vec6 d = lu_[k].transpose().solve(r_.segment<6>(6 * s.child));
-    int r = 0;
-    for (int q = 0; q < s.nblocks; ++q) {
-      const ConstraintBlock& b = ce.blocks[s.blocks[q]];
-      for (int i = 0; i < b.nrows; ++i, ++r) delta_[b.row0 + i] = d[r];
-    }
-    if (s.parent != kGround) {
-      gather(s, 0, Zp, nullptr);
-      r_.segment<6>(6 * s.parent).noalias() -= Zp.transpose() * d;
-    }
-  }
 }
 
 JointSpaceInverseDynamics::~JointSpaceInverseDynamics() = default;
@@ -303,11 +282,7 @@ void JointSpaceInverseDynamics::compute(Eigen::Ref<const VecX> q, Eigen::Ref<con
     ref_[3 * c + 1] = qd[c];
     ref_[3 * c + 2] = qdd[c];
   }
-  if (sweep_ok_) {
-    compute_sweep(t);
-    for (long c = 0; c < nco; ++c) tau[c] = -delta_[driven_.nc_joint + c];
-    if (tau.allFinite()) return;
-  }
+  // square zeta: the engine takes its O(n) tree sweep (KKT factorisation only when singular)
   e_->dynamics(t, u_.data(), v_.data(), vd_.data());
   for (long c = 0; c < nco; ++c) tau[c] = -e_->delta()[driven_.nc_joint + c];
 }

@@ -1,9 +1,11 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "armdyn/analysis/simulate.hpp"
 
+#include <cctype>
 #include <chrono>
 #include <cmath>
 
+#include "armdyn/analysis/inverse_dynamics.hpp"
 #include "armdyn/errors.hpp"
 #include "armdyn/solver/engine.hpp"
 
@@ -40,6 +42,13 @@ class MbsSystem : public OdeSystem {
     e_.set_aux(yo_.data() + m_.nq + m_.nv);
     e_.project(t, u, v, metric_);
     e_.dynamics(t, u, v, vd_.data(), true);
+    double rf, rv;
+    e_.loaded_residuals(v, rf, rv);
+    record(t, u, v, vd_, rf, rv);
+  }
+
+  /// Record the outputs at (u, v, t); the engine holds the dynamics evaluated there.
+  void record(double t, const double* u, const double* v, const VecX& vd, double rf, double rv) {
     // joint coordinates (angles unwrapped along the run) and rates
     const long row = out_.n;
     for (size_t c = 0; c < m_.coords.size(); ++c) {
@@ -48,7 +57,7 @@ class MbsSystem : public OdeSystem {
       const double qv = m_.coords[c].angular ? e_.tracked(static_cast<int>(c), q.val) : q.val;
       out_.q.push_back(qv);
       out_.qd.push_back(q.rate);
-      out_.qdd.push_back(coord_acceleration(m_, q, static_cast<int>(c), vd_));
+      out_.qdd.push_back(coord_acceleration(m_, q, static_cast<int>(c), vd));
     }
     // gear mesh forces: contact law of the gear pairs, multipliers of the ideal gears
     for (int gi = 0; gi < static_cast<int>(m_.gears.size()); ++gi) {
@@ -69,8 +78,7 @@ class MbsSystem : public OdeSystem {
         out_.reaction_torques.push_back(tq[k]);
       }
     }
-    double rf, rv, ke, pe;
-    e_.residuals(t, u, v, rf, rv);
+    double ke, pe;
     e_.energy(u, v, ke, pe);
     out_.t.push_back(t);
     out_.u.insert(out_.u.end(), u, u + m_.nq);
@@ -200,9 +208,9 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
   if (!(t_end > 0) || !std::isfinite(t_end))
     throw ModelError(msg("simulate: t_end must be positive and finite, got ", t_end));
   if (opt.integrator != "dopri5" && opt.integrator != "rk4" && opt.integrator != "trbdf2" &&
-      opt.integrator != "auto")
+      opt.integrator != "auto" && opt.integrator != "kinematic" && opt.integrator != "default")
     throw ModelError(msg("simulate: unknown integrator '", opt.integrator,
-                         "' (expected 'dopri5', 'rk4', 'trbdf2' or 'auto')"));
+                         "' (expected 'dopri5', 'rk4', 'trbdf2', 'kinematic' or 'auto')"));
   const StepOptions& s = opt.step;
   if (!(s.rtol > 0) || !std::isfinite(s.rtol))
     throw ModelError(msg("simulate: rtol must be positive, got ", s.rtol));
@@ -223,8 +231,28 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
 
   SimResult out;
   out.integrator = opt.integrator;
-  if (opt.integrator == "auto") {
+  // zero freedom left by the drives: every state follows from the constraints, no integration
+  // (not with PI-motor states or gear contact, which have states or events of their own)
+  const bool prescribed = m.mobility_driven == 0 && m.n_aux == 0 && m.gears.empty();
+  if (opt.integrator == "kinematic") {
+    if (!prescribed)
+      throw ModelError(
+          msg("simulate: integrator 'kinematic' needs a fully driven model; ",
+              m.mobility_driven > 0
+                  ? msg("the drives leave ", m.mobility_driven, " degree(s) of freedom")
+                  : std::string("the model has motor or gear-contact states")));
+    if (!(s.output_dt > 0)) throw ModelError("simulate: integrator 'kinematic' needs output_dt");
+    out.integrator_reason = "kinematic: requested";
+  } else if ((opt.integrator == "default" || opt.integrator == "auto") && prescribed &&
+             s.output_dt > 0) {
+    out.integrator = "kinematic";
+    out.integrator_reason =
+        "kinematic: the drives leave no degree of freedom, so each output state follows from "
+        "the constraints (position, velocity and acceleration problems); nothing to integrate";
+  } else if (opt.integrator == "auto") {
     out.integrator = choose_integrator(m, t_end, out.integrator_reason);
+  } else if (opt.integrator == "default") {
+    out.integrator = "dopri5";
   }
   if (s.output_dt > 0) {
     const size_t n = static_cast<size_t>(t_end / s.output_dt) + 2;
@@ -237,8 +265,27 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
   y.head(m.nq) = u0;
   y.segment(m.nq, m.nv) = v0;
   const auto start = std::chrono::steady_clock::now();
+  double t_last = 0.0;  // the time of the last good state y
   try {
-    if (out.integrator == "dopri5")
+    if (out.integrator == "kinematic") {
+      Engine& e = sys.engine();
+      DrivenSolver solver(m, e, "simulate", 0.0);
+      solver.throw_on_singular = false;  // counted and noted, as by the integrators
+      VecX u = u0, v = v0, vd = VecX::Zero(m.nv);
+      try {
+        for (const double t : output_times(0.0, t_end, s.output_dt)) {
+          double rf, rv;
+          solver.solve(t, u, v, vd, rf, rv);
+          ++out.stats.rhs_evals;
+          sys.record(t, u.data(), v.data(), vd, rf, rv);
+        }
+      } catch (const SolverError&) {
+        y.head(m.nq) = u;  // the last state solved, for the diagnosis below
+        y.segment(m.nq, m.nv) = v;
+        t_last = solver.t_good;
+        throw;
+      }
+    } else if (out.integrator == "dopri5")
       integrate_dopri5(sys, y, 0.0, t_end, s, out.stats);
     else if (out.integrator == "trbdf2")
       integrate_trbdf2(sys, y, 0.0, t_end, s, out.stats);
@@ -247,11 +294,22 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
   } catch (const SolverError& err) {
     out.error = err.what();
     // say why when the constraints are (nearly) singular at the last accepted state
+    if (out.integrator != "kinematic") t_last = out.t.empty() ? 0.0 : out.t.back();
     try {
       sys.engine().set_aux(y.data() + m.nq + m.nv);
-      const std::string why = sys.engine().diagnose_singularity(out.t.empty() ? 0.0 : out.t.back(),
-                                                                y.data(), y.data() + m.nq);
-      if (!why.empty()) out.error += "; " + why;
+      // the kinematic path stops short of a limit point (no solution beyond it) by its
+      // continuation's smallest step, where the rank loss shows only at looser thresholds
+      std::string why;
+      for (const double threshold : {1e-7, 1e-5, 1e-3}) {
+        why = sys.engine().diagnose_singularity(t_last, y.data(), y.data() + m.nq, threshold);
+        if (!why.empty() || out.integrator != "kinematic") break;
+      }
+      if (!why.empty() && out.error.back() == '.') {
+        why[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(why[0])));
+        out.error += " " + why;
+      } else if (!why.empty()) {
+        out.error += "; " + why;
+      }
     } catch (const std::exception&) {
     }
   }

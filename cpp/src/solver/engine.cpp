@@ -2,6 +2,7 @@
 #include "armdyn/solver/engine.hpp"
 
 #include <cmath>
+#include <cstdio>
 
 #include "armdyn/errors.hpp"
 #include "armdyn/math/quaternion.hpp"
@@ -10,6 +11,11 @@ namespace armdyn {
 
 namespace {
 inline double wrap_angle(double a) { return std::remainder(a, 2.0 * M_PI); }
+std::string short_number(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", x);
+  return buf;
+}
 }  // namespace
 
 Engine::Engine(const Model& m)
@@ -25,6 +31,7 @@ Engine::Engine(const Model& m)
       nrows_(m.nc) {
   kin_.resize(m.nb);
   ce_.init(m);
+  sweep_.plan(m, ce_);
   ce_.track_ref = &track_ref_;
   tol_f_ = 1e-13 * std::max(1.0, m.length_scale);
 }
@@ -123,6 +130,18 @@ void Engine::dynamics(double t, const double* u, const double* v, double* vdot, 
   load(u, v);
   eval_constraints(m_, kin_, t, true, ce_);
   forces(t);
+  Eigen::Map<VecX> vd(vdot, m_.nv);
+  swept_ = false;
+  if (sweep_.ok() && nrows_ == m_.nc) {
+    // square zeta of a fully driven tree: two O(n) sweeps, no KKT factorisation
+    swept_ = sweep_.solve(m_, ce_, eta_, vd_, delta_);
+    if (swept_) {
+      ++factorizations;
+      ++kkt_solves;
+      vd = vd_;
+      return;
+    }
+  }
   if (!(reuse_factor && kkt_.metric() == Metric::Mass && kkt_.nrows() == nrows_)) {
     kkt_.factor(ce_, nrows_, Metric::Mass);
     ++factorizations;
@@ -138,7 +157,6 @@ void Engine::dynamics(double t, const double* u, const double* v, double* vdot, 
       }
     }
   }
-  Eigen::Map<VecX> vd(vdot, m_.nv);
   kkt_.accelerations(ce_, eta_, vd_, delta_);
   ++kkt_solves;
   if (!vd_.allFinite())
@@ -228,16 +246,18 @@ void Engine::project(double t, double* u, double* v, Metric metric) {
   ++pstats.velocity_projections;
 }
 
-std::string Engine::diagnose_singularity(double t, const double* u, const double* v) {
+std::string Engine::diagnose_singularity(double t, const double* u, const double* v,
+                                         double threshold) {
   load(u, v);
   eval_constraints(m_, kin_, t, false, ce_);
-  kkt_.factor_pivoted_at(ce_, nrows_, Metric::Mass, 1e-7);
+  kkt_.factor_pivoted_at(ce_, nrows_, Metric::Mass, threshold);
   const int expected = nrows_ == m_.nc ? m_.rank_all : m_.rank_joint;
   if (kkt_.rank() >= expected) return "";
   std::string rows;
   for (int r : kkt_.dependent_rows()) rows += (rows.empty() ? "" : "; ") + m_.row_name(r);
   return msg("the constraint Jacobian is nearly singular at t=", t, " (rank ", kkt_.rank(), " of ",
-             expected, " at a 1e-7 threshold); nearly dependent rows: ", rows);
+             expected, " at a ", short_number(threshold),
+             " threshold); nearly dependent rows: ", rows);
 }
 
 void Engine::aux_rates(double t, double* zdot) const {
@@ -266,6 +286,10 @@ void Engine::gear_mesh(int gi, double& s, double& sd, double& penetration) const
 void Engine::residuals(double t, const double* u, const double* v, double& rf, double& rv) {
   load(u, v);
   eval_constraints(m_, kin_, t, false, ce_);
+  loaded_residuals(v, rf, rv);
+}
+
+void Engine::loaded_residuals(const double* v, double& rf, double& rv) {
   if (nrows_ == 0) {
     rf = rv = 0.0;
     return;

@@ -10,9 +10,6 @@
 
 namespace armdyn {
 
-namespace {
-
-// output times t0 + k dt strictly before t1, then t1 (empty when dt <= 0: every step)
 std::vector<double> output_times(double t0, double t1, double dt) {
   std::vector<double> ts;
   if (!(dt > 0)) return ts;
@@ -25,6 +22,8 @@ std::vector<double> output_times(double t0, double t1, double dt) {
   ts.push_back(t1);
   return ts;
 }
+
+namespace {
 
 // Scaled max-norm of the error, sc_i = atol + rtol max(|a_i|, |b_i|) (as ode45). An RMS norm
 // would divide by the 13 nb Cartesian components, most of them fixed by constraints, and so

@@ -12,8 +12,8 @@
 // axis (the RNEA / URDF effort convention).
 #pragma once
 
-#include <Eigen/LU>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "armdyn/analysis/joint_space.hpp"
@@ -22,6 +22,43 @@
 namespace armdyn {
 
 class Engine;
+
+/// The state of a driven model (drives leave no freedom) at increasing times: the position
+/// problem f(u, t) = 0, the velocity problem zeta v = rhs, then the acceleration problem and the
+/// multipliers (Engine::dynamics), so that no time integration is needed.
+///  - a tree with every coordinate driven: the state is the forward kinematics of the drive
+///    values (q, qd), checked by its residuals (Newton only when they exceed round-off);
+///  - otherwise Newton from a prediction (the last state moved by its rates), with continuation
+///    (halving the step towards t) when Newton fails or jumps to another assembly branch.
+class DrivenSolver {
+ public:
+  /// who names the caller in messages. t0: the time of the state passed to the first solve().
+  /// @throws ModelError naming the undriven coordinates when the drives leave freedom.
+  DrivenSolver(const Model& m, Engine& e, const char* who, double t0);
+  /// (u, v) at the last solved time (or t0) in, at t out; vd the accelerations; the engine is
+  /// left loaded at (u, v, t) with its multipliers; rf, rv the position and velocity residuals.
+  /// On failure (u, v) hold the last state solved on the way to t, at time t_good.
+  /// @throws SolverError when the position problem fails or (throw_on_singular) the driven
+  ///   constraints are kinematically singular at t (naming the dependent rows).
+  void solve(double t, VecX& u, VecX& v, VecX& vd, double& rf, double& rv);
+  long exact_states = 0;  ///< states taken from the forward kinematics without Newton
+  /// false: a kinematically singular time is not an error; the engine counts it
+  /// (Engine::singular_evaluations) and its minimum-norm multipliers are kept, as in a run.
+  bool throw_on_singular = true;
+  /// The time of the state left in (u, v) after a failed solve(): the last one solved.
+  double t_good;
+
+ private:
+  const Model& m_;
+  Engine& e_;
+  const char* who_;
+  double t_prev_;
+  bool fk_;
+  VecX qc_, qdc_, ud_, u_save_, v_save_, u_pred_, track_save_;
+  TreeFkWork fkw_;
+  void predict(double t_from, double t, VecX& u, VecX& v, const VecX& vd);
+  std::string singular_rows() const;
+};
 
 struct InverseDynamicsResult {
   long n = 0;
@@ -57,19 +94,6 @@ class JointSpaceInverseDynamics {
   std::unique_ptr<Engine> e_;
   VecX u_, v_, vd_, ref_;
   TreeFkWork fk_;
-  // O(n) path: with every coordinate driven, each tree joint's rows plus its drive rows are six
-  // rows on its child's six velocities, so zeta is square and block-triangular in tree order:
-  // vdot by a forward sweep and delta by a backward sweep of 6x6 solves
-  struct Sweep {
-    int joint, parent, child;
-    int blocks[3];  // the joint's block and its drives' blocks (-1: unused)
-    int nblocks;
-  };
-  std::vector<Sweep> sweep_;
-  std::vector<Eigen::PartialPivLU<Mat6>> lu_;
-  VecX delta_, r_;
-  bool sweep_ok_ = false;
-  void compute_sweep(double t);
 };
 
 }  // namespace armdyn

@@ -6,10 +6,12 @@
 #pragma once
 
 #include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "armdyn/solver/kkt.hpp"
+#include "armdyn/solver/tree_sweep.hpp"
 
 namespace armdyn {
 
@@ -40,6 +42,8 @@ class Engine {
   void forces(double t);
   /// Forward dynamics: vdot (nv) and multipliers (stored, see delta()).
   /// reuse_factor: the last projection factored A at this very u with the mass metric.
+  /// A fully driven tree (square zeta) takes the O(n) sweep instead of the KKT factorisation
+  /// (swept() is then true), unless a block is singular.
   void dynamics(double t, const double* u, const double* v, double* vdot,
                 bool reuse_factor = false);
   /// u' = S(u) v: xdot and 1/2 e (x) [0, omega].
@@ -50,6 +54,8 @@ class Engine {
   void project(double t, double* u, double* v, Metric metric);
   /// ||f||_inf and ||zeta v - rhs||_inf over the active rows at (u, v, t).
   void residuals(double t, const double* u, const double* v, double& rf, double& rv);
+  /// The same from the last constraint evaluation (at the loaded u and t), for velocities v.
+  void loaded_residuals(const double* v, double& rf, double& rv);
   /// Kinetic and potential (gravity + springs) energy.
   void energy(const double* u, const double* v, double& ke, double& pe);
   /// Reaction on joint j's child at the joint point, in the child's joint frame, from the
@@ -64,8 +70,9 @@ class Engine {
   /// Gear mesh displacement s, rate and penetration |s| - backlash/2 at the loaded state.
   void gear_mesh(int g, double& s, double& sd, double& penetration) const;
   /// After a failure: when the constraint Jacobian at (u, v, t) is nearly singular (scaled
-  /// pivots below 1e-7), a sentence naming the nearly dependent rows; otherwise empty.
-  std::string diagnose_singularity(double t, const double* u, const double* v);
+  /// pivots below threshold), a sentence naming the nearly dependent rows; otherwise empty.
+  std::string diagnose_singularity(double t, const double* u, const double* v,
+                                   double threshold = 1e-7);
   /// Set the tracked angles' references from the loaded state (after each projection).
   void commit_tracking();
   const VecX& tracking() const { return track_ref_; }
@@ -77,6 +84,8 @@ class Engine {
   ConstraintEval& constraints() { return ce_; }
   const std::vector<BodyKin>& kin() const { return kin_; }
   KktSolver& kkt() { return kkt_; }
+  /// The last dynamics() solved the square system by the tree sweep (kkt() was not used).
+  bool swept() const { return swept_; }
   const Model& model() const { return m_; }
   ProjectionStats pstats;
   long kkt_solves = 0, factorizations = 0;
@@ -98,6 +107,8 @@ class Engine {
   const double* aux_ = nullptr;
   int nrows_ = 0;
   double tol_f_ = 1e-13;
+  TreeSweep sweep_;
+  bool swept_ = false;
 };
 
 }  // namespace armdyn

@@ -51,6 +51,10 @@ struct StepOptions {
   long max_steps = 10000000;
 };
 
+/// Output times t0 + k dt strictly before t1 (within 1e-9 dt), then t1; empty when dt <= 0
+/// (an output at every accepted step).
+std::vector<double> output_times(double t0, double t1, double dt);
+
 /// Integrate from t0 to t1; y holds the projected initial state on entry, the final on exit.
 /// @throws SolverError on step-size underflow, too many steps or non-finite values.
 void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepOptions& opt,

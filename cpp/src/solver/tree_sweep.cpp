@@ -1,0 +1,96 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "armdyn/solver/tree_sweep.hpp"
+
+#include <cmath>
+
+namespace armdyn {
+
+void TreeSweep::plan(const Model& m, const ConstraintEval& ce) {
+  ok_ = false;
+  steps_.clear();
+  if (!m.is_tree || !m.joint_space_ok || !m.gear_constraints.empty() || m.nc != m.nv) return;
+  if (static_cast<int>(m.tree_order.size()) != m.nb) return;
+  std::vector<int> block_at_row(m.nc, -1);  // the block starting at each row
+  for (int b = 0; b < static_cast<int>(ce.blocks.size()); ++b) block_at_row[ce.blocks[b].row0] = b;
+  std::vector<int> drive_of_coord(m.coords.size(), -1);
+  for (const Drive& d : m.drives) {
+    int& slot = drive_of_coord[m.joints[d.joint].coord0 + d.coord];
+    if (slot >= 0) return;  // two drives on one coordinate
+    slot = d.row;
+  }
+  for (int ji : m.tree_order) {
+    const Joint& j = m.joints[ji];
+    const int nco = joint_coords(j.type);
+    if (j.child == kGround || joint_rows(j.type) + nco != 6) return;
+    Step s{j.parent, j.child, {-1, -1, -1, -1}, 0};
+    if (joint_rows(j.type) > 0) s.blocks[s.nblocks++] = block_at_row[j.row0];
+    for (int c = 0; c < nco; ++c) {
+      const int row = drive_of_coord[j.coord0 + c];
+      if (row < 0 || s.nblocks >= 4) return;
+      s.blocks[s.nblocks++] = block_at_row[row];
+    }
+    for (int k = 0; k < s.nblocks; ++k) {
+      if (s.blocks[k] < 0) return;
+      const ConstraintBlock& b = ce.blocks[s.blocks[k]];
+      if (b.nbody != 2 || b.body[0] != j.parent || b.body[1] != j.child) return;
+    }
+    steps_.push_back(s);
+  }
+  lu_.resize(steps_.size());
+  r_ = VecX::Zero(m.nv);
+  ok_ = true;
+}
+
+void TreeSweep::gather(const ConstraintEval& ce, const Step& s, int slot, Mat6& Z,
+                       Vec6* rhs) const {
+  int r = 0;
+  for (int k = 0; k < s.nblocks; ++k) {
+    const ConstraintBlock& b = ce.blocks[s.blocks[k]];
+    for (int i = 0; i < b.nrows; ++i, ++r) {
+      Z.row(r) = b.J.row(i).segment<6>(6 * slot);
+      if (rhs) (*rhs)[r] = -ce.xi[b.row0 + i];
+    }
+  }
+}
+
+bool TreeSweep::solve(const Model& m, const ConstraintEval& ce, const VecX& eta, VecX& vd,
+                      VecX& delta) {
+  Mat6 Zc, Zp;
+  Vec6 rhs;
+  for (size_t k = 0; k < steps_.size(); ++k) {
+    const Step& s = steps_[k];
+    gather(ce, s, 1, Zc, &rhs);
+    if (s.parent != kGround) {
+      gather(ce, s, 0, Zp, nullptr);
+      rhs.noalias() -= Zp * vd.segment<6>(6 * s.parent);
+    }
+    lu_[k].compute(Zc);
+    const auto d = lu_[k].matrixLU().diagonal().cwiseAbs();
+    if (!(d.minCoeff() > 1e-10 * d.maxCoeff())) return false;
+    vd.segment<6>(6 * s.child) = lu_[k].solve(rhs);
+  }
+  // r = eta - Gamma vdot
+  for (int i = 0; i < m.nb; ++i) {
+    const Body& b = m.bodies[i];
+    r_.segment<3>(6 * i) = eta.segment<3>(6 * i) - b.mass * vd.segment<3>(6 * i);
+    r_.segment<3>(6 * i + 3) = eta.segment<3>(6 * i + 3) - b.inertia * vd.segment<3>(6 * i + 3);
+  }
+  for (size_t k = steps_.size(); k-- > 0;) {
+    const Step& s = steps_[k];
+    // this joint's and its drives' multipliers from its child's balance (its children's
+    // shares already taken out)
+    const Vec6 d = lu_[k].transpose().solve(r_.segment<6>(6 * s.child));
+    int r = 0;
+    for (int q = 0; q < s.nblocks; ++q) {
+      const ConstraintBlock& b = ce.blocks[s.blocks[q]];
+      for (int i = 0; i < b.nrows; ++i, ++r) delta[b.row0 + i] = d[r];
+    }
+    if (s.parent != kGround) {
+      gather(ce, s, 0, Zp, nullptr);
+      r_.segment<6>(6 * s.parent).noalias() -= Zp.transpose() * d;
+    }
+  }
+  return vd.allFinite() && delta.allFinite();
+}
+
+}  // namespace armdyn
