@@ -72,6 +72,8 @@ py::dict result_dict(const Model& md, const SimResult& r) {
   s["singular_note"] = r.singular_note;
   s["integrator"] = r.integrator;
   s["integrator_reason"] = r.integrator_reason;
+  s["solver_bodies"] = r.solver_bodies;
+  s["solver_rows"] = r.solver_rows;
   d["stats"] = s;
   py::dict ev;
   ev["t"] = to_numpy(r.event_t.data(), {static_cast<py::ssize_t>(r.event_t.size())});
@@ -93,8 +95,9 @@ void bind_dynamics(py::module_& m) {
       "_simulate",
       [](const Model& md, double t_end, const std::string& integrator, double rtol, double atol,
          double dt, double output_dt, py::object u0, py::object v0, const std::string& projection,
-         long max_steps, double max_step) {
+         long max_steps, double max_step, bool merge_welded) {
         SimOptions o;
+        o.merge_welded = merge_welded;
         o.step.max_step = max_step;
         o.integrator = integrator;
         o.step.rtol = rtol;
@@ -114,7 +117,7 @@ void bind_dynamics(py::module_& m) {
       },
       py::arg("model"), py::arg("t_end"), py::arg("integrator"), py::arg("rtol"), py::arg("atol"),
       py::arg("dt"), py::arg("output_dt"), py::arg("u0"), py::arg("v0"), py::arg("projection"),
-      py::arg("max_steps"), py::arg("max_step") = 0.0);
+      py::arg("max_steps"), py::arg("max_step") = 0.0, py::arg("merge_welded") = true);
 
   m.def(
       "state_from_joints",

@@ -174,6 +174,14 @@ void bind_model(py::module_& m) {
                 p->path = "dense";
                 p->description = "dense Schur complement (forced)";
               }
+            if (c->welded && path == "dense") {  // the model simulate() integrates, too
+              auto w = std::make_shared<Model>(*c->welded);
+              for (KktPlan* p : {&w->kkt_all, &w->kkt_joint}) {
+                p->path = "dense";
+                p->description = "dense Schur complement (forced)";
+              }
+              c->welded = w;
+            }
             return c;
           },
           py::arg("path"),

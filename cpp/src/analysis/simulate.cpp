@@ -4,14 +4,142 @@
 #include <cctype>
 #include <chrono>
 #include <cmath>
+#include <memory>
 
 #include "armdyn/analysis/inverse_dynamics.hpp"
 #include "armdyn/errors.hpp"
+#include "armdyn/math/quaternion.hpp"
 #include "armdyn/solver/engine.hpp"
 
 namespace armdyn {
 
 namespace {
+
+// Reports a run of the welded model (Model::welded) in the bodies and joints of the full model.
+class WeldExpander {
+ public:
+  explicit WeldExpander(const Model& full)
+      : m_(full),
+        w_(*full.welded),
+        e_(full),
+        u_(VecX::Zero(full.nq)),
+        v_(VecX::Zero(full.nv)),
+        vd_(VecX::Zero(full.nv)),
+        delta_(VecX::Zero(full.nc)),
+        r_(VecX::Zero(full.nv)),
+        tmp_(VecX::Zero(full.nv)) {
+    for (const Model::Weld& w : m_.weld) qrel_.push_back(rot_to_quat(w.rotation));
+    // rows of the full model -> rows of the welded one (-1: a merged fixed joint)
+    row_map_.assign(m_.nc, -1);
+    for (size_t j = 0; j < m_.joints.size(); ++j) {
+      const int jw = m_.weld_joint[j];
+      if (jw < 0) continue;
+      for (int k = 0; k < joint_rows(m_.joints[j].type); ++k)
+        row_map_[m_.joints[j].row0 + k] = w_.joints[jw].row0 + k;
+    }
+    for (size_t g = 0; g < m_.gear_constraints.size(); ++g)
+      row_map_[m_.gear_constraints[g].row] = w_.gear_constraints[g].row;
+    for (size_t k = 0; k < m_.drives.size(); ++k) row_map_[m_.drives[k].row] = w_.drives[k].row;
+    // the block of each merged joint
+    block_of_.assign(m_.joints.size(), -1);
+    const ConstraintEval& ce = e_.constraints();
+    for (size_t j = 0; j < m_.joints.size(); ++j)
+      for (size_t b = 0; b < ce.blocks.size(); ++b)
+        if (joint_rows(m_.joints[j].type) > 0 && ce.blocks[b].row0 == m_.joints[j].row0)
+          block_of_[j] = static_cast<int>(b);
+  }
+
+  /// The composites' state (uw, vw) from a full state: each from its root body.
+  void contract(const VecX& u, const VecX& v, VecX& uw, VecX& vw) const {
+    for (int c = 0; c < w_.nb; ++c) {
+      const int r = m_.weld_root[c];
+      const Model::Weld& w = m_.weld[r];
+      const Vec4 qr = u.segment<4>(7 * r + 3).normalized();
+      const Vec4& e = qrel_[r];
+      const Vec4 qc = quat_mul(qr, Vec4(e[0], -e[1], -e[2], -e[3]));
+      const Mat3 Rc = quat_to_rot(qc);
+      const Vec3 wc = w.rotation * v.segment<3>(6 * r + 3);
+      uw.segment<3>(7 * c) = u.segment<3>(7 * r) - Rc * w.offset;
+      uw.segment<4>(7 * c + 3) = qc;
+      vw.segment<3>(6 * c) = v.segment<3>(6 * r) - Rc * wc.cross(w.offset);
+      vw.segment<3>(6 * c + 3) = wc;
+    }
+  }
+
+  /// The full state (and accelerations, when vdw is given) from the composites'.
+  void expand(const double* uw, const double* vw, const double* vdw) {
+    for (int b = 0; b < m_.nb; ++b) {
+      const Model::Weld& w = m_.weld[b];
+      if (w.composite == kGround) {
+        u_.segment<3>(7 * b) = w.offset;
+        u_.segment<4>(7 * b + 3) = qrel_[b];
+        v_.segment<6>(6 * b).setZero();
+        vd_.segment<6>(6 * b).setZero();
+        continue;
+      }
+      const int c = w.composite;
+      const Vec4 qc(uw[7 * c + 3], uw[7 * c + 4], uw[7 * c + 5], uw[7 * c + 6]);
+      const Mat3 Rc = quat_to_rot(qc);
+      const Vec3 wc(vw[6 * c + 3], vw[6 * c + 4], vw[6 * c + 5]);
+      const Vec3 wxo = wc.cross(w.offset);
+      u_.segment<3>(7 * b) = Vec3(uw[7 * c], uw[7 * c + 1], uw[7 * c + 2]) + Rc * w.offset;
+      u_.segment<4>(7 * b + 3) = quat_mul(qc, qrel_[b]);
+      v_.segment<3>(6 * b) = Vec3(vw[6 * c], vw[6 * c + 1], vw[6 * c + 2]) + Rc * wxo;
+      v_.segment<3>(6 * b + 3) = w.rotation.transpose() * wc;
+      if (vdw) {
+        const Vec3 al(vdw[6 * c + 3], vdw[6 * c + 4], vdw[6 * c + 5]);
+        vd_.segment<3>(6 * b) = Vec3(vdw[6 * c], vdw[6 * c + 1], vdw[6 * c + 2]) +
+                                Rc * (al.cross(w.offset) + wc.cross(wxo));
+        vd_.segment<3>(6 * b + 3) = w.rotation.transpose() * al;
+      }
+    }
+  }
+
+  /// Multipliers of the full model at the expanded state: the welded run's for its rows, the
+  /// merged fixed joints' from each member's Newton-Euler balance, far members first
+  /// (zeta_far^T delta_j = eta - Gamma vdot - the other rows' forces). Leaves the engine loaded
+  /// for joint_reaction() and the residuals.
+  void reactions(double t, const VecX& delta_w, const double* aux) {
+    e_.set_aux(aux);
+    e_.load(u_.data(), v_.data());
+    ConstraintEval& ce = e_.constraints();
+    eval_constraints(m_, e_.kin(), t, false, ce);
+    e_.forces(t);
+    for (int r = 0; r < m_.nc; ++r) delta_[r] = row_map_[r] >= 0 ? delta_w[row_map_[r]] : 0.0;
+    const VecX& eta = e_.eta();
+    for (int b = 0; b < m_.nb; ++b) {
+      const Body& bd = m_.bodies[b];
+      r_.segment<3>(6 * b) = eta.segment<3>(6 * b) - bd.mass * vd_.segment<3>(6 * b);
+      r_.segment<3>(6 * b + 3) = eta.segment<3>(6 * b + 3) - bd.inertia * vd_.segment<3>(6 * b + 3);
+    }
+    zeta_transpose_times(ce, m_.nc, delta_, tmp_);
+    r_ -= tmp_;
+    for (const auto& [j, far] : m_.weld_sweep) {
+      const Joint& jt = m_.joints[j];
+      const ConstraintBlock& blk = ce.blocks[block_of_[j]];
+      const int sf = jt.child == far ? 1 : 0;
+      const Mat6 Zf = blk.J.block<6, 6>(0, 6 * sf);
+      const Vec6 d = Zf.transpose().partialPivLu().solve(Vec6(r_.segment<6>(6 * far)));
+      delta_.segment<6>(jt.row0) = d;
+      const int near = sf == 1 ? jt.parent : jt.child;
+      if (near != kGround)
+        r_.segment<6>(6 * near).noalias() -= blk.J.block<6, 6>(0, 6 * (1 - sf)).transpose() * d;
+    }
+    e_.set_multipliers(delta_);
+  }
+
+  Engine& engine() { return e_; }
+  const VecX& u() const { return u_; }
+  const VecX& v() const { return v_; }
+
+ private:
+  const Model& m_;
+  const Model& w_;
+  Engine e_;
+  VecX u_, v_, vd_, delta_, r_, tmp_;
+  std::vector<Vec4> qrel_;
+  std::vector<int> row_map_, block_of_;
+};
 
 // the constrained equations of motion as an ODE on y = (u, v), with projection and recording
 class MbsSystem : public OdeSystem {
@@ -44,11 +172,15 @@ class MbsSystem : public OdeSystem {
     e_.dynamics(t, u, v, vd_.data(), true);
     double rf, rv;
     e_.loaded_residuals(v, rf, rv);
-    record(t, u, v, vd_, rf, rv);
+    record(t, u, v, vd_, rf, rv, yo_.data() + m_.nq + m_.nv);
   }
 
+  /// Report in the bodies and joints of the full model (a welded run).
+  void set_expander(WeldExpander* ex) { ex_ = ex; }
+
   /// Record the outputs at (u, v, t); the engine holds the dynamics evaluated there.
-  void record(double t, const double* u, const double* v, const VecX& vd, double rf, double rv) {
+  void record(double t, const double* u, const double* v, const VecX& vd, double rf, double rv,
+              const double* aux = nullptr) {
     // joint coordinates (angles unwrapped along the run) and rates
     const long row = out_.n;
     for (size_t c = 0; c < m_.coords.size(); ++c) {
@@ -70,19 +202,29 @@ class MbsSystem : public OdeSystem {
       out_.gear_forces.push_back(e_.delta()[g.row]);
     // actuator efforts: tau = -delta of the drive rows
     for (const Drive& d : m_.drives) out_.drive_forces.push_back(-e_.delta()[d.row]);
-    for (size_t j = 0; j < m_.joints.size(); ++j) {
+    Engine* re = &e_;  // the engine of the bodies and joints reported
+    if (ex_) {
+      ex_->expand(u, v, vd.data());
+      ex_->reactions(t, e_.delta(), aux);
+      re = &ex_->engine();
+      re->loaded_residuals(ex_->v().data(), rf, rv);
+      u = ex_->u().data();
+      v = ex_->v().data();
+    }
+    double ke, pe;  // of every body (those welded to ground too)
+    re->energy(u, v, ke, pe);
+    const Model& rm = re->model();
+    for (size_t j = 0; j < rm.joints.size(); ++j) {
       Vec3 f, tq;
-      e_.joint_reaction(static_cast<int>(j), f, tq);
+      re->joint_reaction(static_cast<int>(j), f, tq);
       for (int k = 0; k < 3; ++k) {
         out_.reaction_forces.push_back(f[k]);
         out_.reaction_torques.push_back(tq[k]);
       }
     }
-    double ke, pe;
-    e_.energy(u, v, ke, pe);
     out_.t.push_back(t);
-    out_.u.insert(out_.u.end(), u, u + m_.nq);
-    out_.v.insert(out_.v.end(), v, v + m_.nv);
+    out_.u.insert(out_.u.end(), u, u + rm.nq);
+    out_.v.insert(out_.v.end(), v, v + rm.nv);
     out_.position_residual.push_back(rf);
     out_.velocity_residual.push_back(rv);
     out_.kinetic_energy.push_back(ke);
@@ -112,6 +254,7 @@ class MbsSystem : public OdeSystem {
   Metric metric_;
   SimResult& out_;
   VecX yo_, vd_;
+  WeldExpander* ex_ = nullptr;
 };
 
 }  // namespace
@@ -234,6 +377,10 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
   // zero freedom left by the drives: every state follows from the constraints, no integration
   // (not with PI-motor states or gear contact, which have states or events of their own)
   const bool prescribed = m.mobility_driven == 0 && m.n_aux == 0 && m.gears.empty();
+  // bodies joined by fixed joints integrate as one composite body (Model::welded); the outputs
+  // are reported for every body and joint of m
+  const bool welded = m.welded != nullptr && opt.merge_welded;
+  const Model& ms = welded ? *m.welded : m;  // the model integrated
   if (opt.integrator == "kinematic") {
     if (!prescribed)
       throw ModelError(
@@ -250,7 +397,7 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
         "kinematic: the drives leave no degree of freedom, so each output state follows from "
         "the constraints (position, velocity and acceleration problems); nothing to integrate";
   } else if (opt.integrator == "auto") {
-    out.integrator = choose_integrator(m, t_end, out.integrator_reason);
+    out.integrator = choose_integrator(ms, t_end, out.integrator_reason);
   } else if (opt.integrator == "default") {
     out.integrator = "dopri5";
   }
@@ -260,18 +407,28 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
     out.u.reserve(n * m.nq);
     out.v.reserve(n * m.nv);
   }
-  MbsSystem sys(m, opt.projection, out);
-  VecX y = VecX::Zero(m.nq + m.nv + m.n_aux);
-  y.head(m.nq) = u0;
-  y.segment(m.nq, m.nv) = v0;
+  MbsSystem sys(ms, opt.projection, out);
+  std::unique_ptr<WeldExpander> expander;
+  VecX y = VecX::Zero(ms.nq + ms.nv + ms.n_aux);
+  if (welded) {
+    expander = std::make_unique<WeldExpander>(m);
+    sys.set_expander(expander.get());
+    VecX uw(ms.nq), vw(ms.nv);
+    expander->contract(u0, v0, uw, vw);
+    y.head(ms.nq) = uw;
+    y.segment(ms.nq, ms.nv) = vw;
+  } else {
+    y.head(m.nq) = u0;
+    y.segment(m.nq, m.nv) = v0;
+  }
   const auto start = std::chrono::steady_clock::now();
   double t_last = 0.0;  // the time of the last good state y
   try {
     if (out.integrator == "kinematic") {
       Engine& e = sys.engine();
-      DrivenSolver solver(m, e, "simulate", 0.0);
+      DrivenSolver solver(ms, e, "simulate", 0.0);
       solver.throw_on_singular = false;  // counted and noted, as by the integrators
-      VecX u = u0, v = v0, vd = VecX::Zero(m.nv);
+      VecX u = y.head(ms.nq), v = y.segment(ms.nq, ms.nv), vd = VecX::Zero(ms.nv);
       try {
         for (const double t : output_times(0.0, t_end, s.output_dt)) {
           double rf, rv;
@@ -280,8 +437,8 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
           sys.record(t, u.data(), v.data(), vd, rf, rv);
         }
       } catch (const SolverError&) {
-        y.head(m.nq) = u;  // the last state solved, for the diagnosis below
-        y.segment(m.nq, m.nv) = v;
+        y.head(ms.nq) = u;  // the last state solved, for the diagnosis below
+        y.segment(ms.nq, ms.nv) = v;
         t_last = solver.t_good;
         throw;
       }
@@ -296,12 +453,12 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
     // say why when the constraints are (nearly) singular at the last accepted state
     if (out.integrator != "kinematic") t_last = out.t.empty() ? 0.0 : out.t.back();
     try {
-      sys.engine().set_aux(y.data() + m.nq + m.nv);
+      sys.engine().set_aux(y.data() + ms.nq + ms.nv);
       // the kinematic path stops short of a limit point (no solution beyond it) by its
       // continuation's smallest step, where the rank loss shows only at looser thresholds
       std::string why;
       for (const double threshold : {1e-7, 1e-5, 1e-3}) {
-        why = sys.engine().diagnose_singularity(t_last, y.data(), y.data() + m.nq, threshold);
+        why = sys.engine().diagnose_singularity(t_last, y.data(), y.data() + ms.nq, threshold);
         if (!why.empty() || out.integrator != "kinematic") break;
       }
       if (!why.empty() && out.error.back() == '.') {
@@ -314,6 +471,8 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
     }
   }
   out.cpu_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  out.solver_bodies = ms.nb;
+  out.solver_rows = ms.nc;
   Engine& e = sys.engine();
   out.kkt_solves = e.kkt_solves;
   out.factorizations = e.factorizations;

@@ -130,6 +130,14 @@ std::string Model::summary() const {
     os << "\n  multipliers: minimum-norm (reactions of redundant joints are not unique)\n";
   }
   os << "  KKT path: " << kkt_all.path << " -- " << kkt_all.description << "\n";
+  if (welded) {
+    int merged = 0;
+    for (int jw : weld_joint) merged += jw < 0;
+    os << "  welded: " << merged << " fixed joints merged into composite bodies; simulate() "
+       << "integrates " << welded->nb << " bodies and " << welded->nc << " rows (KKT path "
+       << welded->kkt_all.path << ", ~" << welded->kkt_all.flops
+       << " flops per factorisation) and reports all " << nb << " bodies\n";
+  }
   os << "  gravity: [" << gravity.x() << ", " << gravity.y() << ", " << gravity.z() << "]\n";
   os << "  bodies:\n";
   for (const Body& b : bodies) os << "    " << b.name << "  mass " << b.mass << " kg\n";

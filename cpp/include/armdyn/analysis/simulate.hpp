@@ -17,6 +17,8 @@ struct SimOptions {
   std::string integrator = "dopri5";  ///< "dopri5" | "rk4" | "trbdf2" | "auto"
   StepOptions step;
   Metric projection = Metric::Mass;
+  /// integrate bodies joined by fixed joints as one composite body (Model::welded)
+  bool merge_welded = true;
 };
 
 /// Row-major output tables: one row per output time.
@@ -37,6 +39,7 @@ struct SimResult {
   double cpu_seconds = 0.0;
   std::string error;  ///< non-empty when the run stopped early (SolverError message)
   std::string integrator, integrator_reason;  ///< the method used, and why (for "auto")
+  int solver_bodies = 0, solver_rows = 0;     ///< bodies and rows of the model integrated
 };
 
 /// Stiffness estimate for integrator="auto": the fastest rate |lambda| [1/s] of the force

@@ -205,6 +205,25 @@ class Model {
 
   std::map<std::string, int> body_index, joint_index, drive_index;
 
+  // --- welded bodies (simulate's solver model) ---
+  /// Bodies joined by fixed joints form one rigid composite (welded to ground: part of ground).
+  /// `welded` is this model with each composite as one body and those fixed joints removed: the
+  /// same motion with fewer bodies and rows. simulate() integrates it and reports every body and
+  /// joint of this model (poses from the composites, fixed-joint reactions from the members'
+  /// Newton-Euler balances). nullptr when no fixed joint can be merged.
+  std::shared_ptr<const Model> welded;
+  struct Weld {
+    int composite = kGround;           ///< body of `welded` (kGround: welded to ground)
+    Vec3 offset = Vec3::Zero();        ///< the body's centre of mass in the composite's frame
+    Mat3 rotation = Mat3::Identity();  ///< the body's axes in the composite's frame
+  };
+  std::vector<Weld> weld;       ///< per body of this model
+  std::vector<int> weld_joint;  ///< per joint: its index in `welded`, -1 when merged away
+  /// the merged fixed joints, each body farther from its composite's root first:
+  /// (joint, the body on the far side)
+  std::vector<std::pair<int, int>> weld_sweep;
+  std::vector<int> weld_root;  ///< per composite: the body whose state defines it
+
   int find_body(const std::string& name) const;   ///< -1 for "ground"; throws ModelError
   int find_joint(const std::string& name) const;  ///< throws ModelError
   std::string row_name(int row) const;            ///< e.g. "joint 'elbow' row 4 (rotation)"

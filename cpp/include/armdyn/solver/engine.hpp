@@ -79,6 +79,8 @@ class Engine {
   void set_tracking(const VecX& ref) { track_ref_ = ref; }
 
   const VecX& delta() const { return delta_; }
+  /// Set the multipliers (all rows) that joint_reaction() reports.
+  void set_multipliers(const VecX& delta) { delta_ = delta; }
   const VecX& eta() const { return eta_; }
   const ConstraintEval& constraints() const { return ce_; }
   ConstraintEval& constraints() { return ce_; }

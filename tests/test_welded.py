@@ -1,0 +1,125 @@
+"""Welded bodies: simulate integrates bodies joined by fixed joints as one composite body
+(Model.welded) and reports every body and joint of the model. Checked against the same run
+without merging (every body and fixed joint integrated: a second formulation of the same
+mechanism) and against a closed-form fixed-joint reaction."""
+
+import armdyn as ad
+import numpy as np
+import pytest
+from armdyn import _core
+from armdyn.scenes.geared_arm import geared_arm_6dof
+from conftest import rel_err
+
+FIELDS = (
+    "q",
+    "qd",
+    "qdd",
+    "u",
+    "v",
+    "drive_forces",
+    "reaction_forces",
+    "reaction_torques",
+    "kinetic_energy",
+    "potential_energy",
+)
+
+
+def _compare(a, b, rel_first, rel_run):
+    """Row 0 is the same state in both runs (formulation only); later rows add each run's own
+    integration error (different step sequences)."""
+    for name in FIELDS:
+        x, y = getattr(a, name), getattr(b, name)
+        assert x.shape == y.shape, name
+        if x.size == 0:
+            continue
+        assert rel_err(x[0], y[0], floor=1e-9) <= rel_first, name
+        assert rel_err(x, y, floor=1e-9) <= rel_run, name
+
+
+def _pair(model, t_end, **kw):
+    merged = ad.simulate(model, t_end, **kw)
+    full = ad.simulate(model, t_end, merge_welded=False, **kw)
+    assert full.stats["solver_bodies"] == model.nb
+    return merged, full
+
+
+def _quat(axis, angle):
+    axis = np.asarray(axis, float) / np.linalg.norm(axis)
+    return np.concatenate([[np.cos(angle / 2)], np.sin(angle / 2) * axis])
+
+
+def _welded_pendulums():
+    """Two links on revolutes with welded parts at odd angles: a bracket welded to ground
+    carrying the first pivot, a weight and a sensor welded (in a chain) to link 1, a spring
+    and a load on welded members, and a PI motor on the second joint (an auxiliary state)."""
+    b = ad.ModelBuilder(gravity=(0.0, 0.0, -9.81))
+    b.add_body(
+        "bracket", 2.0, [0.02, 0.03, 0.04], position=(0, 0, 0.1), orientation=_quat((1, 1, 0), 0.4)
+    )
+    b.add_fixed("bracket_mount", "ground", "bracket", point=(0, 0, 0))
+    b.add_body("link1", 1.0, [0.001, 0.02, 0.02], position=(0.2, 0, 0.2))
+    b.add_revolute("pivot1", "bracket", "link1", point=(0, 0, 0.2), axis=(0, 1, 0))
+    b.add_body(
+        "weight",
+        0.5,
+        [1e-3, 2e-3, 3e-3],
+        position=(0.4, 0.05, 0.2),
+        orientation=_quat((0, 0.3, 1), 1.1),
+    )
+    b.add_fixed("weight_mount", "link1", "weight", point=(0.4, 0, 0.2))
+    b.add_body(
+        "sensor",
+        0.1,
+        [1e-4, 1e-4, 2e-4],
+        position=(0.45, 0.1, 0.25),
+        orientation=_quat((1, 0, 0), -0.7),
+    )
+    b.add_fixed("sensor_mount", "weight", "sensor", point=(0.45, 0.1, 0.2))
+    b.add_body("link2", 0.8, [0.001, 0.015, 0.015], position=(0.55, 0, 0.2))
+    b.add_revolute("pivot2", "link1", "link2", point=(0.4, 0, 0.2), axis=(0, 0, 1))
+    b.add_body("tip", 0.2, [1e-4, 1e-4, 1e-4], position=(0.7, 0, 0.2))
+    b.add_fixed("tip_mount", "link2", "tip", point=(0.7, 0, 0.2))
+    b.add_spring_damper("spring", "ground", (0.5, 0.3, 0.6), "sensor", (0.45, 0.1, 0.25), 40.0, 0.5)
+    b.add_body_force("tip", force=(0.0, 1.5, 0.0), point=(0.72, 0.0, 0.21))
+    b.add_motor("pivot2", _core.profiles.sine(0.5, 1.0, 0.0, 0.0), 20.0, 1.0, ki=5.0)
+    return b.finalize()
+
+
+def test_welded_model_is_the_same_mechanism_with_fewer_bodies():
+    model = _welded_pendulums()
+    merged, full = _pair(model, 1.0, rtol=1e-11, atol=1e-12, output_dt=0.02)
+    # bracket -> ground; weight and sensor -> link1; tip -> link2
+    assert merged.stats["solver_bodies"] == 2 and merged.stats["solver_rows"] == 10
+    assert full.stats["solver_rows"] == 5 * 2 + 6 * 4
+    _compare(merged, full, 1e-12, 1e-10)
+    assert np.max(merged.position_residual) <= 1e-12  # every fixed joint of the full model
+    assert np.max(merged.velocity_residual) <= 1e-12
+
+
+def test_geared_arm_welded_run_matches_the_full_run():
+    model = geared_arm_6dof(n_motors=1, backlash=1e-4)
+    merged, full = _pair(model, 0.1, rtol=1e-10, atol=1e-12, output_dt=0.02)
+    assert merged.stats["solver_bodies"] == 18 and full.stats["solver_bodies"] == 44
+    _compare(merged, full, 1e-12, 5e-7)
+    np.testing.assert_array_equal(merged.events["t"].shape, full.events["t"].shape)
+
+
+def test_fixed_joint_reaction_of_a_hanging_weight_is_its_weight():
+    """A pendulum hanging at rest with a weight welded below its tip: the weld carries the
+    weight's gravity, m g upwards on the weight, and no torque about the weld point when the
+    weight's centre of mass is below it."""
+    b = ad.ModelBuilder(gravity=(0.0, 0.0, -9.81))
+    b.add_body("rod", 1.0, [0.01, 0.01, 1e-4], position=(0, 0, -0.5))
+    b.add_revolute("pivot", "ground", "rod", point=(0, 0, 0), axis=(0, 1, 0))
+    b.add_body("weight", 2.5, [1e-3, 1e-3, 1e-3], position=(0, 0, -1.1))
+    b.add_fixed("weld", "rod", "weight", point=(0, 0, -1.0))
+    model = b.finalize()
+    res = ad.simulate(model, 0.5, output_dt=0.25)
+    assert res.stats["solver_bodies"] == 1
+    j = list(model.joint_names).index("weld")
+    # child joint frame of a fixed joint: the world axes here (bodies unrotated)
+    f = res.reaction_forces[:, j, :]
+    assert np.abs(f - [0.0, 0.0, 2.5 * 9.81]).max() <= 1e-9
+    assert np.abs(res.reaction_torques[:, j, :]).max() <= 1e-9
+    pivot = res.reaction_forces[:, list(model.joint_names).index("pivot"), :]
+    assert np.linalg.norm(pivot, axis=1) == pytest.approx(3.5 * 9.81, rel=1e-12)
