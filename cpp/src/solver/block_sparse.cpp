@@ -158,11 +158,69 @@ BlockSparseSchur::BlockSparseSchur(const Model& m, const KktPlan& plan) : m_(m) 
         asm_.push_back({b, g, sg, h, sh, scaled_off_[g * kMaxBlockBodies + sg], off.at({pg, ph})});
       }
   val_.assign(total, 0.0);
+  weak_.reserve(m.nc);
   diag0_.assign(m.nc, 0.0);
   inv_diag_.assign(m.nc, 0.0);
 }
 
-bool BlockSparseSchur::factor(const ConstraintEval& ce, const std::vector<Mat6>* winv) {
+namespace {
+// T(sg x sh) += JW(sg x 6, row-major) Jh(sh x 6, rows `stride` apart)^T, column-major T;
+// diag: lower triangle only. SG > 0 fixes sg at compile time.
+template <int SG, bool DIAG>
+inline void assemble(double* __restrict__ t, const double* __restrict__ jw,
+                     const double* __restrict__ jh0, long stride, int sg_rt, int sh) {
+  const int sg = SG > 0 ? SG : sg_rt;
+  for (int c = 0; c < sh; ++c) {
+    const double* __restrict__ jh = jh0 + c * stride;
+    for (int r = DIAG ? c : 0; r < sg; ++r) {
+      const double* jr = jw + 6 * r;
+      t[r + c * sg] += jr[0] * jh[0] + jr[1] * jh[1] + jr[2] * jh[2] + jr[3] * jh[3] +
+                       jr[4] * jh[4] + jr[5] * jh[5];
+    }
+  }
+}
+
+// T(na x nb) -= La(na x s) Lb(nb x s)^T, column-major; diag: lower triangle only (na == nb).
+// NA > 0 fixes na at compile time.
+template <int NA>
+inline void schur_update(double* __restrict__ T, const double* __restrict__ La,
+                         const double* __restrict__ Lb, int na_rt, int nb, int s, bool diag) {
+  const int na = NA > 0 ? NA : na_rt;
+  for (int cc = 0; cc < nb; ++cc) {
+    double* __restrict__ t = T + cc * na;
+    for (int p = 0; p < s; ++p) {
+      const double lb = Lb[cc + p * nb];
+      const double* __restrict__ la = La + p * na;
+      if (diag) {
+        for (int r = cc; r < na; ++r) t[r] -= la[r] * lb;
+      } else {
+        for (int r = 0; r < na; ++r) t[r] -= la[r] * lb;
+      }
+    }
+  }
+}
+// X(si x s) <- X L^-T with L (s x s) lower triangular, inv its reciprocal diagonal.
+template <int SI>
+inline void trsm_right(double* __restrict__ X, const double* __restrict__ L,
+                       const double* __restrict__ inv, int si_rt, int s) {
+  const int si = SI > 0 ? SI : si_rt;
+  for (int j = 0; j < s; ++j) {
+    double* __restrict__ xj = X + j * si;
+    for (int p = 0; p < j; ++p) {
+      const double l = L[j + p * s];
+      const double* __restrict__ xp = X + p * si;
+      for (int r = 0; r < si; ++r) xj[r] -= l * xp[r];
+    }
+    for (int r = 0; r < si; ++r) xj[r] *= inv[j];
+  }
+}
+}  // namespace
+
+bool BlockSparseSchur::factor(const ConstraintEval& ce, const std::vector<Mat6>* winv,
+                              double shift) {
+  shift_ = shift;
+  min_rel_ = 1.0;
+  weak_.clear();
   std::fill(val_.begin(), val_.end(), 0.0);
   double* v = val_.data();
   // J_g,s W_b^-1 once per (block, slot), with W^-1 = diag(W_xx, W_ww) per body
@@ -185,22 +243,31 @@ bool BlockSparseSchur::factor(const ConstraintEval& ce, const std::vector<Mat6>*
     const ConstraintBlock& bg = ce.blocks[a.g];
     const ConstraintBlock& bh = ce.blocks[a.h];
     const double* jw = jw_.data() + a.jw;
-    const int sg = bg.nrows, sh = bh.nrows;
-    const bool diag = a.g == a.h;
+    const int sg = bg.nrows;
+    const double* jh = bh.J.data() + 6 * a.sh;
+    const long stride = bh.J.cols();
     double* t = v + a.target;
-    for (int c = 0; c < sh; ++c) {
-      const double* jh = bh.J.data() + c * bh.J.cols() + 6 * a.sh;
-      for (int r = diag ? c : 0; r < sg; ++r) {
-        const double* jr = jw + 6 * r;
-        t[r + c * sg] += jr[0] * jh[0] + jr[1] * jh[1] + jr[2] * jh[2] + jr[3] * jh[3] +
-                         jr[4] * jh[4] + jr[5] * jh[5];
-      }
+    if (a.g == a.h) {
+      assemble<0, true>(t, jw, jh, stride, sg, bh.nrows);
+      continue;
+    }
+    switch (sg) {  // joint blocks of 5 rows (revolute, prismatic) against any
+      case 5:
+        assemble<5, false>(t, jw, jh, stride, 5, bh.nrows);
+        break;
+      default:
+        assemble<0, false>(t, jw, jh, stride, sg, bh.nrows);
+        break;
     }
   }
   const int np = static_cast<int>(col_.size());
   for (int k = 0; k < np; ++k) {
     const Column& c = col_[k];
-    for (int j = 0; j < c.size; ++j) diag0_[c.row0 + j] = v[c.diag + j + j * c.size];
+    for (int j = 0; j < c.size; ++j) {
+      double& d = v[c.diag + j + j * c.size];
+      diag0_[c.row0 + j] = d;
+      d += shift * d;
+    }
   }
   for (int k = 0; k < np; ++k) {
     bool ok;
@@ -244,6 +311,9 @@ bool BlockSparseSchur::factor_column(int k) {
     double d = L[j + j * s];
     for (int p = 0; p < j; ++p) d -= L[j + p * s] * L[j + p * s];
     if (!(d > 1e-12 * diag0_[c.row0 + j])) return false;
+    min_rel_ = std::min(min_rel_, d / diag0_[c.row0 + j]);
+    // nearly dependent: the pivot at the shift's level (relative to the diagonal)
+    if (shift_ > 0.0 && d < 10.0 * shift_ * diag0_[c.row0 + j]) weak_.push_back(c.row0 + j);
     const double l = std::sqrt(d);
     L[j + j * s] = l;
     inv[j] = 1.0 / l;
@@ -257,33 +327,47 @@ bool BlockSparseSchur::factor_column(int k) {
   for (int e = 0; e < c.nsub; ++e) {
     const Sub& sb = sub_[c.sub_begin + e];
     const int si = col_[sb.pos].size;
-    double* __restrict__ X = v + sb.off;
-    for (int j = 0; j < s; ++j) {
-      double* __restrict__ xj = X + j * si;
-      for (int p = 0; p < j; ++p) {
-        const double l = L[j + p * s];
-        const double* __restrict__ xp = X + p * si;
-        for (int r = 0; r < si; ++r) xj[r] -= l * xp[r];
-      }
-      for (int r = 0; r < si; ++r) xj[r] *= inv[j];
+    double* X = v + sb.off;
+    switch (si) {
+      case 1:
+        trsm_right<1>(X, L, inv, 1, s);
+        break;
+      case 5:
+        trsm_right<5>(X, L, inv, 5, s);
+        break;
+      case 6:
+        trsm_right<6>(X, L, inv, 6, s);
+        break;
+      default:
+        trsm_right<0>(X, L, inv, si, s);
+        break;
     }
   }
   // Schur updates of the later blocks: T(a, b) -= L(a, k) L(b, k)^T (lower triangle of the
-  // diagonal blocks)
+  // diagonal blocks), with the row count of the common joint blocks fixed at compile time
   for (int e = 0; e < c.nupd; ++e) {
     const Update& u = upd_[c.upd_begin + e];
     const Sub& sa = sub_[c.sub_begin + u.a];
     const Sub& sb = sub_[c.sub_begin + u.b];
     const int na = col_[sa.pos].size, nb = col_[sb.pos].size;
-    const double* __restrict__ La = v + sa.off;
-    const double* __restrict__ Lb = v + sb.off;
-    double* __restrict__ T = v + u.target;
+    const double* La = v + sa.off;
+    const double* Lb = v + sb.off;
+    double* T = v + u.target;
     const bool diag = u.a == u.b;
-    for (int cc = 0; cc < nb; ++cc)
-      for (int p = 0; p < s; ++p) {
-        const double lb = Lb[cc + p * nb];
-        for (int r = diag ? cc : 0; r < na; ++r) T[r + cc * na] -= La[r + p * na] * lb;
-      }
+    switch (na) {
+      case 1:
+        schur_update<1>(T, La, Lb, 1, nb, s, diag);
+        break;
+      case 5:
+        schur_update<5>(T, La, Lb, 5, nb, s, diag);
+        break;
+      case 6:
+        schur_update<6>(T, La, Lb, 6, nb, s, diag);
+        break;
+      default:
+        schur_update<0>(T, La, Lb, na, nb, s, diag);
+        break;
+    }
   }
   return true;
 }

@@ -40,7 +40,14 @@ class BlockSparseSchur {
   /// is, and only those two 3 x 3 blocks are read) and factor it. Returns false, leaving the
   /// factor invalid, when a pivot is not positive or falls below 1e-12 of its row's diagonal
   /// (singular or nearly so: the caller then uses the dense pivoted path).
-  bool factor(const ConstraintEval& ce, const std::vector<Mat6>* winv);
+  /// shift > 0 factors A + shift diag(A) instead (Tikhonov, scaled per row): positive
+  /// definite near singular configurations too; the rows whose pivots fall to the shift's
+  /// level (below 10 shift of their diagonal: nearly dependent) are listed in weak_rows().
+  bool factor(const ConstraintEval& ce, const std::vector<Mat6>* winv, double shift = 0.0);
+  /// Rows of the last shifted factor whose constraints are (nearly) dependent on earlier ones.
+  const std::vector<int>& weak_rows() const { return weak_; }
+  /// Smallest pivot of the last factor relative to its row's diagonal (1: orthogonal rows).
+  double min_relative_pivot() const { return min_rel_; }
   /// Solve A x = b in place over the plan's rows with the last factor.
   void solve_in_place(VecX& x) const;
   int nrows() const { return nrows_; }
@@ -79,6 +86,8 @@ class BlockSparseSchur {
   std::vector<double> val_;
   std::vector<double> diag0_;     // assembled diagonal of A (by row), for the relative pivot test
   std::vector<double> inv_diag_;  // 1 / L(i, i) by row
+  std::vector<int> weak_;         // rows with pivots at the shift's level (capacity nc)
+  double shift_ = 0.0, min_rel_ = 1.0;
   /// Factor block column k (S: its size at compile time, 0: at run time).
   template <int S>
   bool factor_column(int k);

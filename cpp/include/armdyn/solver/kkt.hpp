@@ -16,9 +16,16 @@
 // constructor, so neither path allocates per step.
 //
 // Models whose plan (Model::kkt_all / kkt_joint, chosen at finalize) is not "dense" factor A with
-// the block-sparse Cholesky of block_sparse.hpp instead (linear in the bodies on trees); a
-// (nearly) singular A there falls back to the dense pivoted path, whose buffers are then sized
-// once, on first use.
+// the block-sparse Cholesky of block_sparse.hpp instead (linear in the bodies on trees). A
+// singular configuration ahead (a pivot below 1e-4 of its diagonal, in a non-redundant model,
+// confirmed on the unweighted A so that mass ratios alone do not count) switches the solver,
+// for the rest of its life, to the regularised A + 1e-7 diag(A) on the
+// same block-sparse path, each solve refined once against A (iterated Tikhonov): the
+// well-determined rows' components are exact to round-off, the nearly dependent rows' are
+// damped (the constraints act as slightly compliant near the singularity, which keeps the
+// motion on its branch), and the solution stays a smooth function of the state (a switch per
+// evaluation would make the right-hand side jump). Only when that factor fails too
+// does it fall back to the dense pivoted path, whose buffers are then sized once, on first use.
 #pragma once
 
 #include <Eigen/Cholesky>
@@ -59,10 +66,14 @@ class KktSolver {
   /// Cholesky path.
   std::vector<int> dependent_rows() const {
     std::vector<int> r;
+    if (pinv_ && regularized_) return sp_->weak_rows();
     if (pinv_)
       for (int i = rank_; i < nrows_; ++i) r.push_back(perm_[i]);
     return r;
   }
+  /// The last factorisation is the block-sparse one of the regularised A + 1e-10 diag(A)
+  /// (a near-singular configuration); solves refine it against A.
+  bool regularized() const { return regularized_; }
 
  private:
   const Model& m_;
@@ -70,7 +81,15 @@ class KktSolver {
   std::unique_ptr<BlockSparseSchur> sp_all_, sp_joint_;
   const BlockSparseSchur* sp_ = nullptr;  // the factor in use when sparse_
   bool sparse_ = false;
+  bool regularized_ = false;
+  bool regularize_ = false;  // sticky: a near-singular factor was met
+  static constexpr double kShift = 1e-7;
+  static constexpr double kTrigger = 1e-4;
+  double mass_floor_ = 10.0 * kTrigger;  // pivot level whose geometry was last found sound
+  const ConstraintEval* ce_ = nullptr;   // the evaluation A was assembled from (refinement)
   void ensure_dense();
+  /// y = A x over the factor's rows, with the current evaluation
+  void apply_a(const VecX& x, VecX& y) const;
   MatX A_;
   Eigen::LLT<MatX> llt_;
   void assemble(const ConstraintEval& ce, int nrows, Metric metric);
@@ -83,7 +102,8 @@ class KktSolver {
   VecX tmp_nv_, b_;
   mutable VecX tmp_nc_, w_;  // scratch of the const solves
   VecX scale_;               // Jacobi scaling diag(A)^-1/2, in pivot order
-  mutable VecX tmp2_;
+  mutable VecX tmp2_, ref_r_, ref_d_;
+  mutable VecX ref_nv_, ref_nv2_;
   MatX DM_;  // S1^2 M
   int nrows_ = 0, rank_ = 0;
   Metric metric_ = Metric::Mass;
