@@ -151,7 +151,7 @@ void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
 
   const long n = y.size();
   VecX k1(n), k2(n), k3(n), k4(n), k5(n), k6(n), k7(n), yt(n), y1(n), err(n);
-  VecX r1(n), r2(n), r3(n), r4(n), r5(n), yo(n);
+  VecX r1(n), r2(n), r3(n), r4(n), r5(n), yo(n), yp(n);
   const std::vector<double> touts = output_times(t0, t1, opt.output_dt);
   const bool every_step = touts.empty();
   size_t ko = 1;
@@ -208,8 +208,26 @@ void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
     yt = y + h * (a61 * k1 + a62 * k2 + a63 * k3 + a64 * k4 + a65 * k5);
     sys.rhs(t + h, yt, k6);
     y1 = y + h * (a71 * k1 + a73 * k3 + a74 * k4 + a75 * k5 + a76 * k6);
-    sys.rhs(t + h, y1, k7);
+    // the last stage at the projected y1: FSAL with the projection folded in, so that an
+    // accepted step needs no re-evaluation at its projected end point (the projection moves y1
+    // by the order of the local error, which changes the estimate below by O(h) of that). A
+    // projection that fails rejects the step.
+    yp = y1;
+    bool projected = true;
+    try {
+      sys.project_and_rhs(t + h, yp, k7);
+    } catch (const SolverError&) {
+      projected = false;
+    }
     st.rhs_evals += 6;
+    if (!projected) {
+      if (!(h * fac_min >= hmin))
+        throw SolverError(msg("dopri5: the projection fails for every step from t=", t));
+      h *= fac_min;
+      ++st.rejected;
+      last_rejected = true;
+      continue;
+    }
     err = h * (e1 * k1 + e3 * k3 + e4 * k4 + e5 * k5 + e6 * k6 + e7 * k7);
     const double en = err_norm(err, y, y1, opt.rtol, opt.atol);
     if (!std::isfinite(en)) throw SolverError(msg("dopri5: non-finite error estimate at t=", t));
@@ -223,6 +241,7 @@ void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
       facold = std::max(en, 1e-4);
       double tn = (t + h >= t1 - 1e-14 * std::max(1.0, std::abs(t1))) ? t1 : t + h;
       const bool need_dense = ne > 0 || (!every_step && ko < touts.size() && touts[ko] <= tn);
+      y1 = yp;  // the dense output ends at the projected point, where the next step starts
       if (need_dense) {
         r1 = y;
         r2 = y1 - y;
@@ -235,6 +254,7 @@ void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
         out = r1 + th * (r2 + th1 * (r3 + th * (r4 + th1 * r5)));
       };
       // events: cut the step at the earliest crossing and restart from there
+      const double t_end_step = tn;
       if (ne > 0) {
         sys.events(tn, y1, gend.data());
         const double th = locate_events(sys, t, h, dense, sgn, gend, gbuf, ybuf, crossed);
@@ -246,9 +266,15 @@ void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
           sys.output(touts[ko], yo);
         }
       }
+      // an event cut moved y1: project and evaluate there; otherwise k7 is already f(tn, y1)
+      const bool cut = tn != t_end_step;
       y = y1;
-      sys.project_and_rhs(tn, y, k1);
-      ++st.rhs_evals;
+      if (cut) {
+        sys.project_and_rhs(tn, y, k1);
+        ++st.rhs_evals;
+      } else {
+        k1 = k7;
+      }
       t = tn;
       ++st.steps;
       if (every_step) sys.output(t, y);
