@@ -372,14 +372,41 @@ bool BlockSparseSchur::factor_column(int k) {
   return true;
 }
 
+namespace {
+// y(ni) -= X(ni x s) x(s), X column-major
+template <int NI>
+inline void sub_gemv(double* __restrict__ y, const double* __restrict__ X,
+                     const double* __restrict__ xk, int ni_rt, int s) {
+  const int ni = NI > 0 ? NI : ni_rt;
+  for (int j = 0; j < s; ++j) {
+    const double xj = xk[j];
+    const double* __restrict__ col = X + j * ni;
+    for (int r = 0; r < ni; ++r) y[r] -= col[r] * xj;
+  }
+}
+// xk(s) -= X(ni x s)^T y(ni)
+template <int NI>
+inline void sub_gemv_t(double* __restrict__ xk, const double* __restrict__ X,
+                       const double* __restrict__ y, int ni_rt, int s) {
+  const int ni = NI > 0 ? NI : ni_rt;
+  for (int j = 0; j < s; ++j) {
+    const double* __restrict__ col = X + j * ni;
+    double t = 0.0;
+    for (int r = 0; r < ni; ++r) t += col[r] * y[r];
+    xk[j] -= t;
+  }
+}
+}  // namespace
+
 void BlockSparseSchur::solve_in_place(VecX& x) const {
   const double* v = val_.data();
+  double* xd = x.data();
   const int np = static_cast<int>(col_.size());
   for (int k = 0; k < np; ++k) {
     const Column& c = col_[k];
     const int s = c.size;
     const double* L = v + c.diag;
-    double* xk = x.data() + c.row0;
+    double* xk = xd + c.row0;
     const double* inv = inv_diag_.data() + c.row0;
     for (int j = 0; j < s; ++j) {
       double t = xk[j];
@@ -389,26 +416,45 @@ void BlockSparseSchur::solve_in_place(VecX& x) const {
     for (int e = 0; e < c.nsub; ++e) {
       const Sub& sb = sub_[c.sub_begin + e];
       const Column& ci = col_[sb.pos];
-      const double* X = v + sb.off;
-      double* xi = x.data() + ci.row0;
-      for (int j = 0; j < s; ++j)
-        for (int r = 0; r < ci.size; ++r) xi[r] -= X[r + j * ci.size] * xk[j];
+      double* xi = xd + ci.row0;
+      switch (ci.size) {
+        case 1:
+          sub_gemv<1>(xi, v + sb.off, xk, 1, s);
+          break;
+        case 5:
+          sub_gemv<5>(xi, v + sb.off, xk, 5, s);
+          break;
+        case 6:
+          sub_gemv<6>(xi, v + sb.off, xk, 6, s);
+          break;
+        default:
+          sub_gemv<0>(xi, v + sb.off, xk, ci.size, s);
+          break;
+      }
     }
   }
   for (int k = np - 1; k >= 0; --k) {
     const Column& c = col_[k];
     const int s = c.size;
     const double* L = v + c.diag;
-    double* xk = x.data() + c.row0;
+    double* xk = xd + c.row0;
     for (int e = 0; e < c.nsub; ++e) {
       const Sub& sb = sub_[c.sub_begin + e];
       const Column& ci = col_[sb.pos];
-      const double* X = v + sb.off;
-      const double* xi = x.data() + ci.row0;
-      for (int j = 0; j < s; ++j) {
-        double t = 0.0;
-        for (int r = 0; r < ci.size; ++r) t += X[r + j * ci.size] * xi[r];
-        xk[j] -= t;
+      const double* xi = xd + ci.row0;
+      switch (ci.size) {
+        case 1:
+          sub_gemv_t<1>(xk, v + sb.off, xi, 1, s);
+          break;
+        case 5:
+          sub_gemv_t<5>(xk, v + sb.off, xi, 5, s);
+          break;
+        case 6:
+          sub_gemv_t<6>(xk, v + sb.off, xi, 6, s);
+          break;
+        default:
+          sub_gemv_t<0>(xk, v + sb.off, xi, ci.size, s);
+          break;
       }
     }
     const double* inv = inv_diag_.data() + c.row0;
