@@ -175,6 +175,8 @@ class MbsSystem : public OdeSystem {
     record(t, u, v, vd_, rf, rv, yo_.data() + m_.nq + m_.nv);
   }
 
+  bool project_last_stage() const override { return !e_.kkt().near_singular(); }
+
   /// Report in the bodies and joints of the full model (a welded run).
   void set_expander(WeldExpander* ex) { ex_ = ex; }
 

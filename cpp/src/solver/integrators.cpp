@@ -212,11 +212,16 @@ void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
     // accepted step needs no re-evaluation at its projected end point (the projection moves y1
     // by the order of the local error, which changes the estimate below by O(h) of that). A
     // projection that fails rejects the step.
+    const bool fsal_projected = sys.project_last_stage();
     yp = y1;
     bool projected = true;
     try {
-      sys.project_and_rhs(t + h, yp, k7);
+      if (fsal_projected)
+        sys.project_and_rhs(t + h, yp, k7);
+      else
+        sys.rhs(t + h, y1, k7);
     } catch (const SolverError&) {
+      if (!fsal_projected) throw;
       projected = false;
     }
     st.rhs_evals += 6;
@@ -241,7 +246,7 @@ void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
       facold = std::max(en, 1e-4);
       double tn = (t + h >= t1 - 1e-14 * std::max(1.0, std::abs(t1))) ? t1 : t + h;
       const bool need_dense = ne > 0 || (!every_step && ko < touts.size() && touts[ko] <= tn);
-      y1 = yp;  // the dense output ends at the projected point, where the next step starts
+      if (fsal_projected) y1 = yp;  // the dense output ends where the next step starts
       if (need_dense) {
         r1 = y;
         r2 = y1 - y;
@@ -269,7 +274,7 @@ void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
       // an event cut moved y1: project and evaluate there; otherwise k7 is already f(tn, y1)
       const bool cut = tn != t_end_step;
       y = y1;
-      if (cut) {
+      if (cut || !fsal_projected) {
         sys.project_and_rhs(tn, y, k1);
         ++st.rhs_evals;
       } else {

@@ -86,6 +86,7 @@ class Engine {
   ConstraintEval& constraints() { return ce_; }
   const std::vector<BodyKin>& kin() const { return kin_; }
   KktSolver& kkt() { return kkt_; }
+  const KktSolver& kkt() const { return kkt_; }
   /// The last dynamics() solved the square system by the tree sweep (kkt() was not used).
   bool swept() const { return swept_; }
   const Model& model() const { return m_; }

@@ -27,6 +27,11 @@ class OdeSystem {
   virtual void rhs(double t, const VecX& y, VecX& dy) = 0;
   /// Project an accepted y in place, then dy = f(t, y) at the projected state.
   virtual void project_and_rhs(double t, VecX& y, VecX& dy) = 0;
+  /// Whether DOPRI5 may evaluate its last stage at the projected end point (FSAL with the
+  /// projection folded in). Near singular configurations the projection is ill-conditioned and
+  /// the right-hand side changes fast under it, so the error estimate then needs the classic
+  /// last stage at the unprojected point.
+  virtual bool project_last_stage() const { return true; }
   /// Record an output at t (y is a state to be projected by the system, not yet recorded).
   virtual void output(double t, const VecX& y) = 0;
   /// Event functions g_i(t, y): a sign change inside a step is located on the dense output

@@ -74,6 +74,8 @@ class KktSolver {
   /// The last factorisation is the block-sparse one of the regularised A + 1e-10 diag(A)
   /// (a near-singular configuration); solves refine it against A.
   bool regularized() const { return regularized_; }
+  /// A singular configuration was met: the solver runs regularised from then on.
+  bool near_singular() const { return regularize_; }
 
  private:
   const Model& m_;
