@@ -283,6 +283,7 @@ PROBLEMS: dict[str, Problem] = {
         sweeps={"dopri5": [1e-6, 1e-7, 1e-8, 1e-9, 1e-10]},
         quick_sweeps={"dopri5": [1e-6, 1e-8]},
         scipy_rhs=lambda: references.a02_rhs(40),
+        scipy_label="the reference's one-DOF branch ODE",
         scipy_observe=lambda y: np.column_stack([np.cos(y[0]), np.sin(y[0])]),
     ),
     "five_dof": Problem(
