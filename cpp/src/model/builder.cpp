@@ -773,7 +773,7 @@ void attach_welded(Model& m, const Model& draft, const FinalizeOptions& options)
   std::shared_ptr<Model> w;
   try {
     w = finalize_draft(d, options);
-  } catch (const ModelError&) {
+  } catch (const std::exception&) {
     return;  // keep the model unmerged rather than fail a valid model
   }
   // the merged joints, far bodies first: breadth-first from each composite's root (and ground)
