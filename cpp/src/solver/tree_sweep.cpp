@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "armdyn/solver/tree_sweep.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace armdyn {
@@ -37,6 +38,10 @@ void TreeSweep::plan(const Model& m, const ConstraintEval& ce) {
     steps_.push_back(s);
   }
   lu_.resize(steps_.size());
+  tri_.assign(steps_.size(), 0);
+  a_.assign(steps_.size(), 1.0);
+  b_.assign(steps_.size(), Mat3::Zero());
+  lu3_.resize(steps_.size());
   r_ = VecX::Zero(m.nv);
   ok_ = true;
 }
@@ -64,6 +69,22 @@ bool TreeSweep::solve(const Model& m, const ConstraintEval& ce, const VecX& eta,
       gather(ce, s, 0, Zp, nullptr);
       rhs.noalias() -= Zp * vd.segment<6>(6 * s.parent);
     }
+    const double a = Zc(0, 0);
+    const bool tri = (a == 1.0 || a == -1.0) && Zc.block<3, 3>(3, 0).isZero(0.0) &&
+                     Zc.block<3, 3>(0, 0) == a * Mat3::Identity();
+    tri_[k] = tri;
+    if (tri) {
+      // [a I, B; 0, C] x = rhs: x_w = C^-1 rhs_w, x_v = (rhs_v - B x_w) / a
+      a_[k] = a;
+      b_[k] = Zc.block<3, 3>(0, 3);
+      lu3_[k].compute(Zc.block<3, 3>(3, 3));
+      const auto d = lu3_[k].matrixLU().diagonal().cwiseAbs();
+      if (!(d.minCoeff() > 1e-10 * std::max(d.maxCoeff(), 1.0))) return false;
+      const Vec3 xw = lu3_[k].solve(Vec3(rhs.tail<3>()));
+      vd.segment<3>(6 * s.child + 3) = xw;
+      vd.segment<3>(6 * s.child) = (rhs.head<3>() - b_[k] * xw) / a;
+      continue;
+    }
     lu_[k].compute(Zc);
     const auto d = lu_[k].matrixLU().diagonal().cwiseAbs();
     if (!(d.minCoeff() > 1e-10 * d.maxCoeff())) return false;
@@ -79,7 +100,15 @@ bool TreeSweep::solve(const Model& m, const ConstraintEval& ce, const VecX& eta,
     const Step& s = steps_[k];
     // this joint's and its drives' multipliers from its child's balance (its children's
     // shares already taken out)
-    const Vec6 d = lu_[k].transpose().solve(r_.segment<6>(6 * s.child));
+    Vec6 d;
+    if (tri_[k]) {
+      // [a I, 0; B^T, C^T] d = r: d_v = r_v / a, d_w = C^-T (r_w - B^T d_v)
+      d.head<3>() = r_.segment<3>(6 * s.child) / a_[k];
+      d.tail<3>() = lu3_[k].transpose().solve(
+          Vec3(r_.segment<3>(6 * s.child + 3) - b_[k].transpose() * d.head<3>()));
+    } else {
+      d = lu_[k].transpose().solve(r_.segment<6>(6 * s.child));
+    }
     int r = 0;
     for (int q = 0; q < s.nblocks; ++q) {
       const ConstraintBlock& b = ce.blocks[s.blocks[q]];

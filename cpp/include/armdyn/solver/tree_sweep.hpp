@@ -33,6 +33,12 @@ class TreeSweep {
   };
   std::vector<Step> steps_;
   std::vector<Eigen::PartialPivLU<Mat6>> lu_;
+  // block-triangular steps (revolute joint plus drive, fixed joint): the child's block is
+  // [a I, B; 0, C] (position rows first), solved through C alone
+  std::vector<char> tri_;
+  std::vector<double> a_;
+  std::vector<Mat3> b_;
+  std::vector<Eigen::PartialPivLU<Mat3>> lu3_;
   VecX r_;
   bool ok_ = false;
   void gather(const ConstraintEval& ce, const Step& s, int slot, Mat6& Z, Vec6* rhs) const;
