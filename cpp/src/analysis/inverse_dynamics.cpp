@@ -45,8 +45,8 @@ DrivenSolver::DrivenSolver(const Model& m, Engine& e, const char* who, double t0
 
 void DrivenSolver::predict(double t_from, double t, VecX& u, VecX& v, const VecX& vd) {
   if (fk_) {
-    // every coordinate is driven: the state follows from the drive values
-    joint_coordinates(m_, u, v, qc_, qdc_);
+    // a tree with no freedom left has every coordinate driven: the state follows from the
+    // drive values alone
     for (const Drive& d : m_.drives) {
       const ProfileValue p = d.profile.eval(t);
       const int c = m_.joints[d.joint].coord0 + d.coord;
@@ -62,13 +62,17 @@ void DrivenSolver::predict(double t_from, double t, VecX& u, VecX& v, const VecX
   }
 }
 
+std::string DrivenSolver::dependent_rows() const {
+  std::string rows;
+  for (int r : e_.kkt().dependent_rows()) rows += (rows.empty() ? "" : "; ") + m_.row_name(r);
+  return rows;
+}
+
 std::string DrivenSolver::singular_rows() const {
   KktSolver& kkt = e_.kkt();
   if (!(kkt.used_pseudo_inverse() && kkt.rank() < m_.rank_all)) return "";
-  std::string rows;
-  for (int r : kkt.dependent_rows()) rows += (rows.empty() ? "" : "; ") + m_.row_name(r);
   return msg(" The driven constraints are kinematically singular there: rank ", kkt.rank(),
-             " instead of ", m_.rank_all, "; dependent rows: ", rows, ".");
+             " instead of ", m_.rank_all, "; dependent rows: ", dependent_rows(), ".");
 }
 
 void DrivenSolver::solve(double t, VecX& u, VecX& v, VecX& vd, double& rf, double& rv) {
@@ -96,7 +100,6 @@ void DrivenSolver::solve(double t, VecX& u, VecX& v, VecX& vd, double& rf, doubl
     solved = rf <= tol_f && rv <= tol_v && flipped_joint(m_, e_.kin()) < 0;
     if (solved) {
       e_.commit_tracking();
-      ++exact_states;
     } else {
       u = u_save_;
       v = v_save_;
@@ -148,13 +151,10 @@ void DrivenSolver::solve(double t, VecX& u, VecX& v, VecX& vd, double& rf, doubl
   t_prev_ = t;
   t_good = t;
   KktSolver& kkt = e_.kkt();
-  if (throw_on_singular && !e_.swept() && kkt.used_pseudo_inverse() && kkt.rank() < m_.rank_all) {
-    std::string rows;
-    for (int r : kkt.dependent_rows()) rows += (rows.empty() ? "" : "; ") + m_.row_name(r);
+  if (throw_on_singular && !e_.swept() && kkt.used_pseudo_inverse() && kkt.rank() < m_.rank_all)
     throw SolverError(msg(who_, ": kinematically singular at t=", t,
                           ": the driven constraints have rank ", kkt.rank(), " instead of ",
-                          m_.rank_all, "; dependent rows: ", rows));
-  }
+                          m_.rank_all, "; dependent rows: ", dependent_rows()));
 }
 
 InverseDynamicsResult inverse_dynamics_driven(const Model& m, const std::vector<double>& times) {

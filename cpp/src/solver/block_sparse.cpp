@@ -6,6 +6,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <type_traits>
 
 #include "armdyn/errors.hpp"
 
@@ -164,6 +165,26 @@ BlockSparseSchur::BlockSparseSchur(const Model& m, const KktPlan& plan) : m_(m) 
 }
 
 namespace {
+// f(std::integral_constant<int, N>{}) with N the row count of the common joint and gear blocks
+// (1, 5, 6), for kernels unrolled at compile time; N = 0 (the size at run time) otherwise
+template <class F>
+inline void with_rows(int n, F&& f) {
+  switch (n) {
+    case 1:
+      f(std::integral_constant<int, 1>{});
+      break;
+    case 5:
+      f(std::integral_constant<int, 5>{});
+      break;
+    case 6:
+      f(std::integral_constant<int, 6>{});
+      break;
+    default:
+      f(std::integral_constant<int, 0>{});
+      break;
+  }
+}
+
 // T(sg x sh) += JW(sg x 6, row-major) Jh(sh x 6, rows `stride` apart)^T, column-major T;
 // diag: lower triangle only. SG > 0 fixes sg at compile time.
 template <int SG, bool DIAG>
@@ -328,20 +349,7 @@ bool BlockSparseSchur::factor_column(int k) {
     const Sub& sb = sub_[c.sub_begin + e];
     const int si = col_[sb.pos].size;
     double* X = v + sb.off;
-    switch (si) {
-      case 1:
-        trsm_right<1>(X, L, inv, 1, s);
-        break;
-      case 5:
-        trsm_right<5>(X, L, inv, 5, s);
-        break;
-      case 6:
-        trsm_right<6>(X, L, inv, 6, s);
-        break;
-      default:
-        trsm_right<0>(X, L, inv, si, s);
-        break;
-    }
+    with_rows(si, [&](auto N) { trsm_right<N>(X, L, inv, si, s); });
   }
   // Schur updates of the later blocks: T(a, b) -= L(a, k) L(b, k)^T (lower triangle of the
   // diagonal blocks), with the row count of the common joint blocks fixed at compile time
@@ -354,20 +362,7 @@ bool BlockSparseSchur::factor_column(int k) {
     const double* Lb = v + sb.off;
     double* T = v + u.target;
     const bool diag = u.a == u.b;
-    switch (na) {
-      case 1:
-        schur_update<1>(T, La, Lb, 1, nb, s, diag);
-        break;
-      case 5:
-        schur_update<5>(T, La, Lb, 5, nb, s, diag);
-        break;
-      case 6:
-        schur_update<6>(T, La, Lb, 6, nb, s, diag);
-        break;
-      default:
-        schur_update<0>(T, La, Lb, na, nb, s, diag);
-        break;
-    }
+    with_rows(na, [&](auto N) { schur_update<N>(T, La, Lb, na, nb, s, diag); });
   }
   return true;
 }
@@ -417,20 +412,7 @@ void BlockSparseSchur::solve_in_place(VecX& x) const {
       const Sub& sb = sub_[c.sub_begin + e];
       const Column& ci = col_[sb.pos];
       double* xi = xd + ci.row0;
-      switch (ci.size) {
-        case 1:
-          sub_gemv<1>(xi, v + sb.off, xk, 1, s);
-          break;
-        case 5:
-          sub_gemv<5>(xi, v + sb.off, xk, 5, s);
-          break;
-        case 6:
-          sub_gemv<6>(xi, v + sb.off, xk, 6, s);
-          break;
-        default:
-          sub_gemv<0>(xi, v + sb.off, xk, ci.size, s);
-          break;
-      }
+      with_rows(ci.size, [&](auto N) { sub_gemv<N>(xi, v + sb.off, xk, ci.size, s); });
     }
   }
   for (int k = np - 1; k >= 0; --k) {
@@ -442,20 +424,7 @@ void BlockSparseSchur::solve_in_place(VecX& x) const {
       const Sub& sb = sub_[c.sub_begin + e];
       const Column& ci = col_[sb.pos];
       const double* xi = xd + ci.row0;
-      switch (ci.size) {
-        case 1:
-          sub_gemv_t<1>(xk, v + sb.off, xi, 1, s);
-          break;
-        case 5:
-          sub_gemv_t<5>(xk, v + sb.off, xi, 5, s);
-          break;
-        case 6:
-          sub_gemv_t<6>(xk, v + sb.off, xi, 6, s);
-          break;
-        default:
-          sub_gemv_t<0>(xk, v + sb.off, xi, ci.size, s);
-          break;
-      }
+      with_rows(ci.size, [&](auto N) { sub_gemv_t<N>(xk, v + sb.off, xi, ci.size, s); });
     }
     const double* inv = inv_diag_.data() + c.row0;
     for (int j = s - 1; j >= 0; --j) {

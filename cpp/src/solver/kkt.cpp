@@ -97,7 +97,7 @@ void KktSolver::factor(const ConstraintEval& ce, int nrows, Metric metric) {
     // solver's lifetime, the regularised one, so that the solution stays a smooth function of
     // the state for the step-size control (the switch itself changes it by about
     // (kShift / kTrigger)^2 relatively, after the refinement)
-    if (!regularize_ && sp->factor(ce, winv)) {
+    if (!singular_met_ && sp->factor(ce, winv)) {
       // a pivot below kTrigger of its diagonal: a singular configuration ahead, or only mass
       // ratios (a light body between heavy ones gives small pivots in the mass metric). The
       // unweighted A tells them apart; after a check that found the geometry sound, the next
@@ -121,7 +121,7 @@ void KktSolver::factor(const ConstraintEval& ce, int nrows, Metric metric) {
         return;
       }
     }
-    regularize_ = true;
+    singular_met_ = true;
     if (sp->factor(ce, winv, kShift)) {
       nrows_ = nrows;
       metric_ = metric;
@@ -268,13 +268,11 @@ void KktSolver::solve_schur(const VecX& b, VecX& x) const {
       // act as slightly compliant ones (compliance e), which keeps the motion on its branch
       // (IFToMM A02). More refinement steps let the bifurcation modes in: measured on A02 (20 s,
       // DOPRI5 rtol 1e-8), the B0 error is 3e-6 with one step and 8e-4 with four.
-      for (int it = 0; it < 1; ++it) {
-        apply_a(x, ref_r_);
-        auto r = ref_d_.head(nrows_);
-        r = b.head(nrows_) - ref_r_.head(nrows_);
-        sp_->solve_in_place(ref_d_);
-        xh += r;
-      }
+      apply_a(x, ref_r_);
+      auto r = ref_d_.head(nrows_);
+      r = b.head(nrows_) - ref_r_.head(nrows_);
+      sp_->solve_in_place(ref_d_);
+      xh += r;
     }
   } else if (pinv_) {
     solve_pivoted(b, x);

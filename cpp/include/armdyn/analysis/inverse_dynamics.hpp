@@ -41,7 +41,6 @@ class DrivenSolver {
   /// @throws SolverError when the position problem fails or (throw_on_singular) the driven
   ///   constraints are kinematically singular at t (naming the dependent rows).
   void solve(double t, VecX& u, VecX& v, VecX& vd, double& rf, double& rv);
-  long exact_states = 0;  ///< states taken from the forward kinematics without Newton
   /// false: a kinematically singular time is not an error; the engine counts it
   /// (Engine::singular_evaluations) and its minimum-norm multipliers are kept, as in a run.
   bool throw_on_singular = true;
@@ -57,7 +56,8 @@ class DrivenSolver {
   VecX qc_, qdc_, ud_, u_save_, v_save_, u_pred_, track_save_;
   TreeFkWork fkw_;
   void predict(double t_from, double t, VecX& u, VecX& v, const VecX& vd);
-  std::string singular_rows() const;
+  std::string dependent_rows() const;  ///< names of the KKT factor's dependent rows
+  std::string singular_rows() const;   ///< a sentence when the factor lost rank, else empty
 };
 
 struct InverseDynamicsResult {

@@ -71,11 +71,8 @@ class KktSolver {
       for (int i = rank_; i < nrows_; ++i) r.push_back(perm_[i]);
     return r;
   }
-  /// The last factorisation is the block-sparse one of the regularised A + 1e-10 diag(A)
-  /// (a near-singular configuration); solves refine it against A.
-  bool regularized() const { return regularized_; }
   /// A singular configuration was met: the solver runs regularised from then on.
-  bool near_singular() const { return regularize_; }
+  bool near_singular() const { return singular_met_; }
 
  private:
   const Model& m_;
@@ -83,8 +80,8 @@ class KktSolver {
   std::unique_ptr<BlockSparseSchur> sp_all_, sp_joint_;
   const BlockSparseSchur* sp_ = nullptr;  // the factor in use when sparse_
   bool sparse_ = false;
-  bool regularized_ = false;
-  bool regularize_ = false;  // sticky: a near-singular factor was met
+  bool regularized_ = false;   // the factor in use is the regularised one (solves refine)
+  bool singular_met_ = false;  // sticky: every factor is regularised from then on
   static constexpr double kShift = 1e-7;
   static constexpr double kTrigger = 1e-4;
   double mass_floor_ = 10.0 * kTrigger;  // pivot level whose geometry was last found sound
