@@ -251,11 +251,11 @@ JointSpaceInverseDynamics::JointSpaceInverseDynamics(std::shared_ptr<const Model
   driven_.kkt_all = plan_kkt(driven_, driven_.nc);
   driven_.kkt_joint = plan_kkt(driven_, driven_.nc_joint);
   e_ = std::make_unique<Engine>(driven_);
-  u_ = VecX::Zero(driven_.nq);
-  v_ = VecX::Zero(driven_.nv);
   vd_ = VecX::Zero(driven_.nv);
   ref_ = VecX::Zero(3 * nco);
   e_->constraints().drive_ref = ref_.data();
+  // the state is built on the manifold from (q, qd): only zeta, rhs and xi are wanted
+  e_->constraints().drive_values = false;
 }
 
 JointSpaceInverseDynamics::~JointSpaceInverseDynamics() = default;
@@ -276,14 +276,19 @@ void JointSpaceInverseDynamics::compute(Eigen::Ref<const VecX> q, Eigen::Ref<con
   if (!std::isfinite(t)) throw ModelError("inverse_dynamics: t is not finite");
   if (tau.size() != nco)
     throw ModelError(msg("inverse_dynamics: tau has length ", tau.size(), ", expected ", nco));
-  state_from_joints(*src_, q, qd, u_, v_, fk_);  // checks q, qd
+  if (q.size() != nco || qd.size() != nco)
+    throw ModelError(msg("inverse_dynamics: q and qd need length ", nco, ", got ", q.size(),
+                         " and ", qd.size()));
+  if (!q.allFinite() || !qd.allFinite())
+    throw ModelError("inverse_dynamics: q or qd contains NaN or inf");
+  joint_space_kinematics(*src_, q, qd, e_->kin_in());
   for (long c = 0; c < nco; ++c) {
     ref_[3 * c] = q[c];
     ref_[3 * c + 1] = qd[c];
     ref_[3 * c + 2] = qdd[c];
   }
   // square zeta: the engine takes its O(n) tree sweep (KKT factorisation only when singular)
-  e_->dynamics(t, u_.data(), v_.data(), vd_.data());
+  e_->dynamics_loaded(t, vd_.data());
   for (long c = 0; c < nco; ++c) tau[c] = -e_->delta()[driven_.nc_joint + c];
 }
 

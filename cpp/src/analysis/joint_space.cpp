@@ -30,33 +30,15 @@ void state_from_joints(const Model& m, const VecX& q, const VecX& qd, VecX& u, V
   state_from_joints(m, q, qd, u, v, work);
 }
 
-void state_from_joints(const Model& m, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd, VecX& u,
-                       VecX& v, TreeFkWork& work) {
-  require_joint_space(m, "state_from_joints");
-  const long nc = static_cast<long>(m.coords.size());
-  check_vec(q, nc, "state_from_joints", "q");
-  check_vec(qd, nc, "state_from_joints", "qd");
-  u.resize(m.nq);
-  v.resize(m.nv);
-  // world pose and velocity of each body, filled parent before child
-  work.R.resize(m.nb);
-  work.x.resize(m.nb);
-  work.xd.resize(m.nb);
-  work.w.resize(m.nb);
-  std::vector<Mat3>& R = work.R;
-  std::vector<Vec3>&x = work.x, &xd = work.xd, &ww = work.w;
+void joint_space_kinematics(const Model& m, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
+                            std::vector<BodyKin>& kin) {
+  // world pose and velocity of each body, parent before child
+  kin.resize(m.nb);
+  const BodyKin ground{};
   for (int ji : m.tree_order) {
     const Joint& j = m.joints[ji];
-    Mat3 Rp = Mat3::Identity();
-    Vec3 xp = Vec3::Zero(), xdp = Vec3::Zero(), wp = Vec3::Zero();
-    if (j.parent != kGround) {
-      Rp = R[j.parent];
-      xp = x[j.parent];
-      xdp = xd[j.parent];
-      wp = ww[j.parent];
-    }
-    const Vec3 P = xp + Rp * j.point_parent;
-    const Mat3 A = Rp * j.frame_parent;
+    const BodyKin& p = j.parent != kGround ? kin[j.parent] : ground;
+    const Mat3 A = p.R * j.frame_parent;
     const Vec3 z = A.col(2);
     double th = 0, thd = 0, d = 0, dd = 0;
     switch (j.type) {
@@ -78,25 +60,38 @@ void state_from_joints(const Model& m, Eigen::Ref<const VecX> q, Eigen::Ref<cons
         break;
     }
     // child joint frame B = A Rz(th), placed at P + d z
-    // B = A Rz(th)
     const double ct = std::cos(th), st = std::sin(th);
     Mat3 B;
     B.col(0) = ct * A.col(0) + st * A.col(1);
     B.col(1) = ct * A.col(1) - st * A.col(0);
     B.col(2) = z;
+    const Vec3 P = p.x + p.R * j.point_parent;
     const Vec3 Pc = P + d * z;
-    const int c = j.child;
-    R[c] = B * j.frame_child.transpose();
-    x[c] = Pc - R[c] * j.point_child;
-    ww[c] = wp + thd * z;
-    const Vec3 Pcd = xdp + wp.cross(Pc - xp) + dd * z;
-    xd[c] = Pcd + ww[c].cross(x[c] - Pc);
+    BodyKin& c = kin[j.child];
+    c.R.noalias() = B * j.frame_child.transpose();
+    c.x = Pc - c.R * j.point_child;
+    c.W = p.W + thd * z;
+    const Vec3 Pcd = p.xd + p.W.cross(Pc - p.x) + dd * z;
+    c.xd = Pcd + c.W.cross(c.x - Pc);
+    c.w.noalias() = c.R.transpose() * c.W;
   }
+}
+
+void state_from_joints(const Model& m, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd, VecX& u,
+                       VecX& v, TreeFkWork& work) {
+  require_joint_space(m, "state_from_joints");
+  const long nc = static_cast<long>(m.coords.size());
+  check_vec(q, nc, "state_from_joints", "q");
+  check_vec(qd, nc, "state_from_joints", "qd");
+  u.resize(m.nq);
+  v.resize(m.nv);
+  joint_space_kinematics(m, q, qd, work.kin);
   for (int i = 0; i < m.nb; ++i) {
-    u.segment<3>(7 * i) = x[i];
-    u.segment<4>(7 * i + 3) = rot_to_quat(R[i]);
-    v.segment<3>(6 * i) = xd[i];
-    v.segment<3>(6 * i + 3) = R[i].transpose() * ww[i];
+    const BodyKin& k = work.kin[i];
+    u.segment<3>(7 * i) = k.x;
+    u.segment<4>(7 * i + 3) = rot_to_quat(k.R);
+    v.segment<3>(6 * i) = k.xd;
+    v.segment<3>(6 * i + 3) = k.w;
   }
 }
 
@@ -121,8 +116,6 @@ JointSpaceForwardDynamics::JointSpaceForwardDynamics(std::shared_ptr<const Model
   require_joint_space(*m_, "forward_dynamics");
   e_ = std::make_unique<Engine>(*m_);
   e_->set_include_drives(false);
-  u_ = VecX::Zero(m_->nq);
-  v_ = VecX::Zero(m_->nv);
   vd_ = VecX::Zero(m_->nv);
   tau_ = VecX::Zero(static_cast<long>(m_->coords.size()));
   e_->set_joint_torques(tau_.data());
@@ -138,11 +131,13 @@ void JointSpaceForwardDynamics::compute(Eigen::Ref<const VecX> q, Eigen::Ref<con
   check_vec(tau, nc, "forward_dynamics", "tau");
   if (out.size() != nc)
     throw ModelError(msg("forward_dynamics: out has length ", out.size(), ", expected ", nc));
-  state_from_joints(m, q, qd, u_, v_, fk_);
+  check_vec(q, nc, "forward_dynamics", "q");
+  check_vec(qd, nc, "forward_dynamics", "qd");
+  joint_space_kinematics(m, q, qd, e_->kin_in());
   tau_ = tau;
-  e_->dynamics(t, u_.data(), v_.data(), vd_.data());
-  for (int c = 0; c < nc; ++c)
-    out[c] = coord_acceleration(m, coord_jet(m, e_->kin(), c, false), c, vd_);
+  e_->dynamics_loaded(t, vd_.data());
+  // the coordinate jets of the torques, at this state
+  for (int c = 0; c < nc; ++c) out[c] = coord_acceleration(m, e_->torque_jets()[c], c, vd_);
 }
 
 VecX forward_dynamics(const Model& m, const VecX& q, const VecX& qd, const VecX& tau) {

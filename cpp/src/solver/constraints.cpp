@@ -17,6 +17,31 @@ inline void put_row(ConstraintEval& ce, ConstraintBlock& b, int r, const ScalarJ
   if (with_xi) ce.xi[b.row0 + r] = s.bias;
 }
 
+// the three rows x_b + R_b s_b - x_a - R_a s_a = 0 (coincident joint points) in block rows 0..2:
+// Jacobian [-I, skew(r_a) R_a | I, -skew(r_b) R_b] with the world levers r = R s
+inline void put_point_rows(ConstraintEval& ce, ConstraintBlock& b, const BodyKin& ka,
+                           const BodyKin& kb, const Vec3& sa, const Vec3& sb, bool with_xi) {
+  const Vec3 ra = ka.R * sa, rb = kb.R * sb;
+  const Vec3 wra = ka.W.cross(ra), wrb = kb.W.cross(rb);
+  const Vec3 d = kb.x + rb - ka.x - ra;
+  Mat3 Ma, Mb;
+  for (int c = 0; c < 3; ++c) {
+    Ma.col(c) = ra.cross(ka.R.col(c));
+    Mb.col(c) = kb.R.col(c).cross(rb);
+  }
+  for (int k = 0; k < 3; ++k) {
+    auto row = b.J.row(k);
+    row.head<12>().setZero();
+    row[k] = -1.0;
+    row.segment<3>(3) = Ma.row(k);
+    row[6 + k] = 1.0;
+    row.segment<3>(9) = Mb.row(k);
+    ce.f[b.row0 + k] = d[k];
+    ce.rhs[b.row0 + k] = 0.0;
+  }
+  if (with_xi) ce.xi.segment<3>(b.row0) = kb.W.cross(wrb) - ka.W.cross(wra);
+}
+
 inline double wrap_angle(double a) { return std::remainder(a, 2.0 * M_PI); }
 
 }  // namespace
@@ -71,11 +96,20 @@ void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t,
     ConstraintBlock& b = ce.blocks[bi++];
     const BodyKin& ka = kin_of(kin, j.parent);
     const BodyKin& kb = kin_of(kin, j.child);
+    // generic jets, for the rows that mix the separation with an axis
     auto ax = [&](int side, int k) {
       return side == 0 ? direction_jet(ka, j.frame_parent.col(k), 0)
                        : direction_jet(kb, j.frame_child.col(k), 1);
     };
-    const VecJet d = difference(point_jet(kb, j.point_child, 1), point_jet(ka, j.point_parent, 0));
+    auto sep = [&] {
+      return difference(point_jet(kb, j.point_child, 1), point_jet(ka, j.point_parent, 0));
+    };
+    // rows dotting an axis of the parent's joint frame with one of the child's
+    auto pa = [&](int k) { return axis_jet(ka, j.frame_parent.col(k)); };
+    auto pb = [&](int k) { return axis_jet(kb, j.frame_child.col(k)); };
+    auto axes_row = [&](int r, const AxisJet& p, const AxisJet& q) {
+      put_row(ce, b, r, dot_axes(p, ka.R, q, kb.R), with_xi);
+    };
     int r = 0;
     switch (j.type) {
       case JointType::Spherical:
@@ -83,38 +117,48 @@ void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t,
       case JointType::Universal:
       case JointType::Fixed:
         // coincident joint points: 3 rows
-        for (int k = 0; k < 3; ++k) put_row(ce, b, r++, component(d, k), with_xi);
+        put_point_rows(ce, b, ka, kb, j.point_parent, j.point_child, with_xi);
+        r = 3;
         break;
       default:
         break;
     }
     switch (j.type) {
-      case JointType::Revolute: {
+      case JointType::Revolute:
+      case JointType::Cylindrical: {
         // child x and y axes perpendicular to the parent's z axis
-        const VecJet za = ax(0, 2);
-        put_row(ce, b, r++, dot(za, ax(1, 0)), with_xi);
-        put_row(ce, b, r++, dot(za, ax(1, 1)), with_xi);
+        const AxisJet za = pa(2);
+        axes_row(r++, za, pb(0));
+        axes_row(r++, za, pb(1));
+        if (j.type == JointType::Cylindrical) {
+          // the child's joint point on the parent's axis line
+          const VecJet d = sep();
+          put_row(ce, b, r++, dot(ax(0, 0), d), with_xi);
+          put_row(ce, b, r++, dot(ax(0, 1), d), with_xi);
+        }
         break;
       }
       case JointType::Universal:
-        put_row(ce, b, r++, dot(ax(0, 2), ax(1, 2)), with_xi);
+        axes_row(r++, pa(2), pb(2));
         break;
       case JointType::Fixed:
       case JointType::Prismatic: {
         // relative rotation locked: z_a.x_b = z_a.y_b = x_a.y_b = 0
-        const VecJet za = ax(0, 2), xa = ax(0, 0);
-        put_row(ce, b, r++, dot(za, ax(1, 0)), with_xi);
-        put_row(ce, b, r++, dot(za, ax(1, 1)), with_xi);
-        put_row(ce, b, r++, dot(xa, ax(1, 1)), with_xi);
+        const AxisJet za = pa(2), yb = pb(1);
+        axes_row(r++, za, pb(0));
+        axes_row(r++, za, yb);
+        axes_row(r++, pa(0), yb);
         if (j.type == JointType::Prismatic) {
           // separation along the parent's z axis only
-          put_row(ce, b, r++, dot(xa, d), with_xi);
+          const VecJet d = sep();
+          put_row(ce, b, r++, dot(ax(0, 0), d), with_xi);
           put_row(ce, b, r++, dot(ax(0, 1), d), with_xi);
         }
         break;
       }
       case JointType::Distance: {
         // (|d|^2 - L^2) / (2 L): zero on the sphere, gradient the unit direction there
+        const VecJet d = sep();
         ScalarJet s = dot(d, d);
         const double k = 0.5 / j.length;
         s.val = k * (s.val - j.length * j.length);
@@ -124,15 +168,9 @@ void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t,
         put_row(ce, b, r++, s, with_xi);
         break;
       }
-      case JointType::Inline:
+      case JointType::Inline: {
         // the child's point on the parent's axis line: no separation across the axis
-        put_row(ce, b, r++, dot(ax(0, 0), d), with_xi);
-        put_row(ce, b, r++, dot(ax(0, 1), d), with_xi);
-        break;
-      case JointType::Cylindrical: {
-        const VecJet za = ax(0, 2);
-        put_row(ce, b, r++, dot(za, ax(1, 0)), with_xi);
-        put_row(ce, b, r++, dot(za, ax(1, 1)), with_xi);
+        const VecJet d = sep();
         put_row(ce, b, r++, dot(ax(0, 0), d), with_xi);
         put_row(ce, b, r++, dot(ax(0, 1), d), with_xi);
         break;
@@ -170,7 +208,7 @@ void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t,
   for (size_t di = 0; di < m.drives.size(); ++di) {
     const Drive& dr = m.drives[di];
     ConstraintBlock& b = ce.blocks[bi++];
-    const ScalarJet q = coord_jet(m, kin, m.joints[dr.joint].coord0 + dr.coord);
+    const ScalarJet q = coord_jet(m, kin, m.joints[dr.joint].coord0 + dr.coord, ce.drive_values);
     ProfileValue p;
     if (ce.drive_ref) {
       p.y = ce.drive_ref[3 * di];
@@ -180,7 +218,10 @@ void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t,
       p = dr.profile.eval(t);
     }
     const bool angular = m.coords[m.joints[dr.joint].coord0 + dr.coord].angular;
-    ce.f[b.row0] = angular ? wrap_angle(q.val - p.y) : q.val - p.y;
+    if (!ce.drive_values)
+      ce.f[b.row0] = 0.0;
+    else
+      ce.f[b.row0] = angular ? wrap_angle(q.val - p.y) : q.val - p.y;
     ce.rhs[b.row0] = p.yd;
     b.J.row(0).head<12>() = q.J;
     if (with_xi) ce.xi[b.row0] = q.bias - p.ydd;

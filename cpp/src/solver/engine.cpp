@@ -112,8 +112,8 @@ void Engine::forces(double t) {
   // joint-space torques of a joint-space call
   if (tau_) {
     for (int c = 0; c < static_cast<int>(m_.coords.size()); ++c) {
+      const ScalarJet& q = tau_jets_[c] = coord_jet(m_, kin_, c, false);
       if (tau_[c] == 0.0) continue;
-      const ScalarJet q = coord_jet(m_, kin_, c, false);
       const Joint& j = m_.joints[m_.coords[c].joint];
       scatter(tau_[c] * q.J, j.parent, j.child);
     }
@@ -128,6 +128,10 @@ void Engine::forces(double t) {
 
 void Engine::dynamics(double t, const double* u, const double* v, double* vdot, bool reuse_factor) {
   load(u, v);
+  dynamics_loaded(t, vdot, reuse_factor);
+}
+
+void Engine::dynamics_loaded(double t, double* vdot, bool reuse_factor) {
   eval_constraints(m_, kin_, t, true, ce_);
   forces(t);
   Eigen::Map<VecX> vd(vdot, m_.nv);

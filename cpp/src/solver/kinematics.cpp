@@ -18,9 +18,11 @@ void body_kinematics(const Model& m, const double* u, const double* v, std::vect
       const double* vi = v + 6 * i;
       k.xd = Vec3(vi[0], vi[1], vi[2]);
       k.w = Vec3(vi[3], vi[4], vi[5]);
+      k.W.noalias() = k.R * k.w;
     } else {
       k.xd.setZero();
       k.w.setZero();
+      k.W.setZero();
     }
   }
 }
@@ -30,11 +32,23 @@ const BodyKin& kin_of(const std::vector<BodyKin>& kin, int b) {
   return b == kGround ? ground : kin[b];
 }
 
+namespace {
+// (R^T (arm x n))^T: n^T times the angular block -skew(arm) R
+inline Eigen::Matrix<double, 1, 3> ang_left(const Mat3& R, const Vec3& arm, const Vec3& n) {
+  return (R.transpose() * arm.cross(n)).transpose();
+}
+}  // namespace
+
 Mat3x12 VecJet::full() const {
   Mat3x12 J = Mat3x12::Zero();
   for (int s = 0; s < 2; ++s) {
     J.block<3, 3>(0, 6 * s).diagonal().setConstant(lin[s]);
-    if (has_ang[s]) J.block<3, 3>(0, 6 * s + 3) = ang[s];
+    if (has_ang[s]) {
+      const Vec3& a = arm[s];
+      Mat3 sk;
+      sk << 0, -a[2], a[1], a[2], 0, -a[0], -a[1], a[0], 0;
+      J.block<3, 3>(0, 6 * s + 3).noalias() = -sk * *R[s];
+    }
   }
   return J;
 }
@@ -44,32 +58,22 @@ Row12 VecJet::left(const Vec3& n) const {
   for (int s = 0; s < 2; ++s) {
     r.segment<3>(6 * s) = lin[s] * n.transpose();
     if (has_ang[s])
-      r.segment<3>(6 * s + 3).noalias() = n.transpose() * ang[s];
+      r.segment<3>(6 * s + 3) = ang_left(*R[s], arm[s], n);
     else
       r.segment<3>(6 * s + 3).setZero();
   }
   return r;
 }
 
-namespace {
-// -R skew(a), column by column: -R (a x e_k) = R (e_k x a)
-inline Mat3 minus_r_skew(const Mat3& R, const Vec3& a) {
-  Mat3 M;
-  M.col(0) = a[1] * R.col(2) - a[2] * R.col(1);
-  M.col(1) = a[2] * R.col(0) - a[0] * R.col(2);
-  M.col(2) = a[0] * R.col(1) - a[1] * R.col(0);
-  return M;
-}
-}  // namespace
-
 VecJet direction_jet(const BodyKin& k, const Vec3& a, int slot) {
+  // world vector p = R a: p' = W x p, p'' (zero accelerations) = W x (W x p)
   VecJet j;
-  const Vec3 wa = k.w.cross(a);
   j.val.noalias() = k.R * a;
-  j.rate.noalias() = k.R * wa;
-  j.bias.noalias() = k.R * k.w.cross(wa);
+  j.rate = k.W.cross(j.val);
+  j.bias = k.W.cross(j.rate);
   j.has_ang[slot] = true;
-  j.ang[slot] = minus_r_skew(k.R, a);
+  j.arm[slot] = j.val;
+  j.R[slot] = &k.R;
   return j;
 }
 
@@ -89,12 +93,16 @@ VecJet difference(const VecJet& p, const VecJet& q) {
   for (int s = 0; s < 2; ++s) {
     j.lin[s] = p.lin[s] - q.lin[s];
     j.has_ang[s] = p.has_ang[s] || q.has_ang[s];
-    if (p.has_ang[s] && q.has_ang[s])
-      j.ang[s] = p.ang[s] - q.ang[s];
-    else if (p.has_ang[s])
-      j.ang[s] = p.ang[s];
-    else if (q.has_ang[s])
-      j.ang[s] = -q.ang[s];
+    if (p.has_ang[s] && q.has_ang[s]) {
+      j.arm[s] = p.arm[s] - q.arm[s];
+      j.R[s] = p.R[s];
+    } else if (p.has_ang[s]) {
+      j.arm[s] = p.arm[s];
+      j.R[s] = p.R[s];
+    } else if (q.has_ang[s]) {
+      j.arm[s] = -q.arm[s];
+      j.R[s] = q.R[s];
+    }
   }
   return j;
 }
@@ -107,12 +115,13 @@ ScalarJet dot(const VecJet& a, const VecJet& b) {
   for (int k = 0; k < 2; ++k) {
     s.J.segment<3>(6 * k) = a.lin[k] * b.val.transpose() + b.lin[k] * a.val.transpose();
     auto w = s.J.segment<3>(6 * k + 3);
+    // b^T (-skew(arm_a) R) + a^T (-skew(arm_b) R) = (R^T (arm_a x b + arm_b x a))^T
     if (a.has_ang[k] && b.has_ang[k])
-      w.noalias() = b.val.transpose() * a.ang[k] + a.val.transpose() * b.ang[k];
+      w = (a.R[k]->transpose() * (a.arm[k].cross(b.val) + b.arm[k].cross(a.val))).transpose();
     else if (a.has_ang[k])
-      w.noalias() = b.val.transpose() * a.ang[k];
+      w = ang_left(*a.R[k], a.arm[k], b.val);
     else if (b.has_ang[k])
-      w.noalias() = a.val.transpose() * b.ang[k];
+      w = ang_left(*b.R[k], b.arm[k], a.val);
     else
       w.setZero();
   }
@@ -127,10 +136,20 @@ ScalarJet component(const VecJet& a, int k) {
   for (int sl = 0; sl < 2; ++sl) {
     s.J.segment<3>(6 * sl).setZero();
     s.J[6 * sl + k] = a.lin[sl];
-    if (a.has_ang[sl])
-      s.J.segment<3>(6 * sl + 3) = a.ang[sl].row(k);
-    else
+    if (a.has_ang[sl]) {
+      // arm x e_k
+      const Vec3& r = a.arm[sl];
+      Vec3 c;
+      if (k == 0)
+        c = Vec3(0.0, r[2], -r[1]);
+      else if (k == 1)
+        c = Vec3(-r[2], 0.0, r[0]);
+      else
+        c = Vec3(r[1], -r[0], 0.0);
+      s.J.segment<3>(6 * sl + 3) = (a.R[sl]->transpose() * c).transpose();
+    } else {
       s.J.segment<3>(6 * sl + 3).setZero();
+    }
   }
   return s;
 }
@@ -165,10 +184,28 @@ ScalarJet coord_jet(const Model& m, const std::vector<BodyKin>& kin, int coord, 
   const Coord& c = m.coords[coord];
   if (c.angular) {
     // angle of the child frame's x axis in the parent frame's (x, y) plane
-    const VecJet xa = joint_axis_jet(m, kin, c.joint, 0, 0);
-    const VecJet ya = joint_axis_jet(m, kin, c.joint, 0, 1);
-    const VecJet xb = joint_axis_jet(m, kin, c.joint, 1, 0);
-    return atan2_jet(dot(ya, xb), dot(xa, xb), value);
+    const Joint& jt = m.joints[c.joint];
+    const BodyKin& ka = kin_of(kin, jt.parent);
+    const BodyKin& kb = kin_of(kin, jt.child);
+    const AxisJet xa = axis_jet(ka, jt.frame_parent.col(0));
+    const AxisJet ya = axis_jet(ka, jt.frame_parent.col(1));
+    const AxisJet xb = axis_jet(kb, jt.frame_child.col(0));
+    // theta = atan2(s, c) with s = ya . xb, c = xa . xb (atan2_jet of the two dot_axes jets,
+    // with both Jacobians folded into one R^T product per side)
+    const double sv = ya.val.dot(xb.val), cv = xa.val.dot(xb.val);
+    const double sr = ya.rate.dot(xb.val) + ya.val.dot(xb.rate);
+    const double cr = xa.rate.dot(xb.val) + xa.val.dot(xb.rate);
+    const double sb = ya.bias.dot(xb.val) + 2.0 * ya.rate.dot(xb.rate) + ya.val.dot(xb.bias);
+    const double cb = xa.bias.dot(xb.val) + 2.0 * xa.rate.dot(xb.rate) + xa.val.dot(xb.bias);
+    const double ir2 = 1.0 / (sv * sv + cv * cv);
+    ScalarJet t;
+    t.val = value ? std::atan2(sv, cv) : 0.0;
+    t.rate = (cv * sr - sv * cr) * ir2;
+    t.bias = (cv * sb - sv * cb) * ir2 - 2.0 * t.rate * (cv * cr + sv * sr) * ir2;
+    const Vec3 g = ((cv * ir2) * ya.val - (sv * ir2) * xa.val).cross(xb.val);
+    t.J.segment<3>(3) = (ka.R.transpose() * g).transpose();
+    t.J.segment<3>(9) = -(kb.R.transpose() * g).transpose();
+    return t;
   }
   // displacement along the parent's joint axis
   return dot(joint_axis_jet(m, kin, c.joint, 0, 2), joint_separation_jet(m, kin, c.joint));

@@ -41,46 +41,62 @@ void TreeSweep::plan(const Model& m, const ConstraintEval& ce) {
   tri_.assign(steps_.size(), 0);
   a_.assign(steps_.size(), 1.0);
   b_.assign(steps_.size(), Mat3::Zero());
-  lu3_.resize(steps_.size());
+  ci_.assign(steps_.size(), Mat3::Identity());
   r_ = VecX::Zero(m.nv);
   ok_ = true;
 }
 
-void TreeSweep::gather(const ConstraintEval& ce, const Step& s, int slot, Mat6& Z,
-                       Vec6* rhs) const {
+void TreeSweep::gather_child(const ConstraintEval& ce, const Step& s, Mat6& Z, Vec6& rhs) const {
   int r = 0;
   for (int k = 0; k < s.nblocks; ++k) {
     const ConstraintBlock& b = ce.blocks[s.blocks[k]];
     for (int i = 0; i < b.nrows; ++i, ++r) {
-      Z.row(r) = b.J.row(i).segment<6>(6 * slot);
-      if (rhs) (*rhs)[r] = -ce.xi[b.row0 + i];
+      Z.row(r) = b.J.row(i).segment<6>(6);
+      rhs[r] = -ce.xi[b.row0 + i];
     }
+  }
+}
+
+void TreeSweep::sub_parent_times(const ConstraintEval& ce, const Step& s, const Vec6& x,
+                                 Vec6& y) const {
+  int r = 0;
+  for (int k = 0; k < s.nblocks; ++k) {
+    const ConstraintBlock& b = ce.blocks[s.blocks[k]];
+    for (int i = 0; i < b.nrows; ++i, ++r) y[r] -= b.J.row(i).head<6>().dot(x.transpose());
+  }
+}
+
+void TreeSweep::sub_parent_transpose_times(const ConstraintEval& ce, const Step& s, const Vec6& d,
+                                           Eigen::Ref<Vec6> y) const {
+  int r = 0;
+  for (int k = 0; k < s.nblocks; ++k) {
+    const ConstraintBlock& b = ce.blocks[s.blocks[k]];
+    for (int i = 0; i < b.nrows; ++i, ++r) y.noalias() -= d[r] * b.J.row(i).head<6>().transpose();
   }
 }
 
 bool TreeSweep::solve(const Model& m, const ConstraintEval& ce, const VecX& eta, VecX& vd,
                       VecX& delta) {
-  Mat6 Zc, Zp;
+  Mat6 Zc;
   Vec6 rhs;
   for (size_t k = 0; k < steps_.size(); ++k) {
     const Step& s = steps_[k];
-    gather(ce, s, 1, Zc, &rhs);
-    if (s.parent != kGround) {
-      gather(ce, s, 0, Zp, nullptr);
-      rhs.noalias() -= Zp * vd.segment<6>(6 * s.parent);
-    }
+    gather_child(ce, s, Zc, rhs);
+    if (s.parent != kGround) sub_parent_times(ce, s, vd.segment<6>(6 * s.parent), rhs);
     const double a = Zc(0, 0);
     const bool tri = (a == 1.0 || a == -1.0) && Zc.block<3, 3>(3, 0).isZero(0.0) &&
                      Zc.block<3, 3>(0, 0) == a * Mat3::Identity();
     tri_[k] = tri;
     if (tri) {
       // [a I, B; 0, C] x = rhs: x_w = C^-1 rhs_w, x_v = (rhs_v - B x_w) / a
+      const Mat3 C = Zc.block<3, 3>(3, 3);
+      const double det = C.determinant();
+      if (!(std::abs(det) > 1e-10 * C.row(0).norm() * C.row(1).norm() * C.row(2).norm()))
+        return false;
       a_[k] = a;
       b_[k] = Zc.block<3, 3>(0, 3);
-      lu3_[k].compute(Zc.block<3, 3>(3, 3));
-      const auto d = lu3_[k].matrixLU().diagonal().cwiseAbs();
-      if (!(d.minCoeff() > 1e-10 * std::max(d.maxCoeff(), 1.0))) return false;
-      const Vec3 xw = lu3_[k].solve(Vec3(rhs.tail<3>()));
+      ci_[k] = C.inverse();
+      const Vec3 xw = ci_[k] * rhs.tail<3>();
       vd.segment<3>(6 * s.child + 3) = xw;
       vd.segment<3>(6 * s.child) = (rhs.head<3>() - b_[k] * xw) / a;
       continue;
@@ -104,8 +120,8 @@ bool TreeSweep::solve(const Model& m, const ConstraintEval& ce, const VecX& eta,
     if (tri_[k]) {
       // [a I, 0; B^T, C^T] d = r: d_v = r_v / a, d_w = C^-T (r_w - B^T d_v)
       d.head<3>() = r_.segment<3>(6 * s.child) / a_[k];
-      d.tail<3>() = lu3_[k].transpose().solve(
-          Vec3(r_.segment<3>(6 * s.child + 3) - b_[k].transpose() * d.head<3>()));
+      d.tail<3>().noalias() =
+          ci_[k].transpose() * (r_.segment<3>(6 * s.child + 3) - b_[k].transpose() * d.head<3>());
     } else {
       d = lu_[k].transpose().solve(r_.segment<6>(6 * s.child));
     }
@@ -114,10 +130,7 @@ bool TreeSweep::solve(const Model& m, const ConstraintEval& ce, const VecX& eta,
       const ConstraintBlock& b = ce.blocks[s.blocks[q]];
       for (int i = 0; i < b.nrows; ++i, ++r) delta[b.row0 + i] = d[r];
     }
-    if (s.parent != kGround) {
-      gather(ce, s, 0, Zp, nullptr);
-      r_.segment<6>(6 * s.parent).noalias() -= Zp.transpose() * d;
-    }
+    if (s.parent != kGround) sub_parent_transpose_times(ce, s, d, r_.segment<6>(6 * s.parent));
   }
   return vd.allFinite() && delta.allFinite();
 }

@@ -92,8 +92,7 @@ class JointSpaceInverseDynamics {
   std::shared_ptr<const Model> src_;
   Model driven_;  // src_ with one drive per joint coordinate, in coordinate order
   std::unique_ptr<Engine> e_;
-  VecX u_, v_, vd_, ref_;
-  TreeFkWork fk_;
+  VecX vd_, ref_;
 };
 
 }  // namespace armdyn

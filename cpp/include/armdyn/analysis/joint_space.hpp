@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "armdyn/model/model.hpp"
+#include "armdyn/solver/kinematics.hpp"
 
 namespace armdyn {
 
@@ -16,9 +17,13 @@ class Engine;
 /// Per-body scratch of state_from_joints (world rotation, position, velocity, angular velocity),
 /// kept by callers that evaluate repeatedly so that no call allocates.
 struct TreeFkWork {
-  std::vector<Mat3> R;
-  std::vector<Vec3> x, xd, w;
+  std::vector<BodyKin> kin;
 };
+
+/// Body poses and velocities (R, x, xd, w, W) of a joint-space tree from joint coordinates q and
+/// rates qd, straight into a kinematic cache (size nb). Sizes and values are not checked.
+void joint_space_kinematics(const Model& m, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
+                            std::vector<BodyKin>& kin);
 
 /// Cartesian (u, v) from joint coordinates q and rates qd (n_coords each).
 /// @throws ModelError when the model is not a joint-space tree or sizes are wrong.
@@ -47,8 +52,7 @@ class JointSpaceForwardDynamics {
  private:
   std::shared_ptr<const Model> m_;
   std::unique_ptr<Engine> e_;
-  VecX u_, v_, vd_, tau_;
-  TreeFkWork fk_;
+  VecX vd_, tau_;
 };
 
 /// Check that the model supports joint-space calls; throws ModelError naming the reason.

@@ -29,6 +29,9 @@ struct ConstraintEval {
   /// Optional drive references overriding the drives' profiles: 3 * n_drives values laid out
   /// (q, qd, qdd) per drive; nullptr to use the profiles (joint-space inverse dynamics).
   const double* drive_ref = nullptr;
+  /// false: drive rows get no residual (f = 0, no angle evaluated), for callers that only want
+  /// zeta, rhs and xi at states built on the manifold (joint-space inverse dynamics).
+  bool drive_values = true;
   /// Optional unwrapped references of angle coordinates (by coordinate index), so that ideal
   /// gear rows see multi-turn angles; nullptr: wrapped angles.
   const VecX* track_ref = nullptr;

@@ -33,7 +33,13 @@ class Engine {
   void set_aux(const double* z) { aux_ = z; }
   void aux_rates(double t, double* zdot) const;
   /// Optional joint-space generalised forces (n_coords), added to eta; nullptr for none.
-  void set_joint_torques(const double* tau) { tau_ = tau; }
+  void set_joint_torques(const double* tau) {
+    tau_ = tau;
+    tau_jets_.resize(tau ? m_.coords.size() : 0);
+  }
+  /// With joint torques set: the jets (rate, Jacobian, bias; no value) of every joint
+  /// coordinate at the state of the last forces() call.
+  const std::vector<ScalarJet>& torque_jets() const { return tau_jets_; }
 
   /// Kinematics of (u, v); v may be nullptr (at rest).
   void load(const double* u, const double* v);
@@ -46,6 +52,12 @@ class Engine {
   /// (swept() is then true), unless a block is singular.
   void dynamics(double t, const double* u, const double* v, double* vdot,
                 bool reuse_factor = false);
+  /// dynamics() at the state already in the kinematic cache (load(), or kin_in() filled by the
+  /// caller).
+  void dynamics_loaded(double t, double* vdot, bool reuse_factor = false);
+  /// The kinematic cache, for callers that build the body states themselves (joint-space
+  /// forward and inverse dynamics: poses and velocities straight from the joint coordinates).
+  std::vector<BodyKin>& kin_in() { return kin_; }
   /// u' = S(u) v: xdot and 1/2 e (x) [0, omega].
   void udot(const double* u, const double* v, double* ud) const;
   /// Project u onto f(u, t) = 0 (minimum-norm Newton in metric W, quaternions renormalised) and
@@ -107,6 +119,7 @@ class Engine {
   VecX vd_;
   VecX track_ref_;  // unwrapped reference of tracked angle coordinates (by coordinate index)
   const double* tau_ = nullptr;
+  std::vector<ScalarJet> tau_jets_;
   const double* aux_ = nullptr;
   int nrows_ = 0;
   double tol_f_ = 1e-13;

@@ -20,16 +20,20 @@ struct BodyKin {
   Mat3 R = Mat3::Identity();
   Vec3 xd = Vec3::Zero();  ///< velocity of the centre of mass, world
   Vec3 w = Vec3::Zero();   ///< angular velocity, body frame
+  Vec3 W = Vec3::Zero();   ///< angular velocity, world frame (R w)
 };
 
 /// A vector's jet. Its 3 x 12 Jacobian is stored by structure: per slot s, the linear-velocity
-/// columns are lin[s] * I (points: +-1, directions: 0) and the angular-velocity columns ang[s]
-/// (present when has_ang[s]). Dot products and components then touch only what is nonzero.
+/// columns are lin[s] * I (points: +-1, directions: 0) and the angular-velocity columns
+/// -skew(arm[s]) R_s (present when has_ang[s]), where R_s is the slot body's rotation and arm[s]
+/// the world lever of the body-fixed vector (-R skew(a) = -skew(R a) R). Dot products and
+/// components then cost a cross product and one R^T product per slot.
 struct VecJet {
   Vec3 val, rate, bias;
   double lin[2] = {0.0, 0.0};
   bool has_ang[2] = {false, false};
-  Mat3 ang[2];
+  Vec3 arm[2];
+  const Mat3* R[2] = {nullptr, nullptr};
   /// The full 3 x 12 Jacobian.
   Mat3x12 full() const;
   /// n^T J (the Jacobian of n . vector for a fixed n).
@@ -56,6 +60,32 @@ ScalarJet dot(const VecJet& a, const VecJet& b);
 ScalarJet component(const VecJet& a, int k);
 /// atan2(s, c) of two scalar jets (value left 0 when !value: rate, Jacobian and bias only).
 ScalarJet atan2_jet(const ScalarJet& s, const ScalarJet& c, bool value = true);
+
+/// A world direction fixed in a body: its value, rate W x p and bias W x (W x p). The cheap
+/// form of a direction jet for rows that only dot two such directions.
+struct AxisJet {
+  Vec3 val, rate, bias;
+};
+inline AxisJet axis_jet(const BodyKin& k, const Vec3& a) {
+  AxisJet j;
+  j.val.noalias() = k.R * a;
+  j.rate = k.W.cross(j.val);
+  j.bias = k.W.cross(j.rate);
+  return j;
+}
+/// p . q for p fixed in body A (slot 0, rotation Ra) and q fixed in body B (slot 1): the same
+/// jet as dot(direction_jet(A), direction_jet(B)); d/dt (p . q) = omega_A . Ra^T (p x q) -
+/// omega_B . Rb^T (p x q).
+inline ScalarJet dot_axes(const AxisJet& p, const Mat3& Ra, const AxisJet& q, const Mat3& Rb) {
+  ScalarJet s;
+  s.val = p.val.dot(q.val);
+  s.rate = p.rate.dot(q.val) + p.val.dot(q.rate);
+  s.bias = p.bias.dot(q.val) + 2.0 * p.rate.dot(q.rate) + p.val.dot(q.bias);
+  const Vec3 c = p.val.cross(q.val);
+  s.J.segment<3>(3) = (Ra.transpose() * c).transpose();
+  s.J.segment<3>(9) = -(Rb.transpose() * c).transpose();
+  return s;
+}
 
 /// Joint frame axes of joint j in world, on the parent (side 0) or child (side 1) body.
 VecJet joint_axis_jet(const Model& m, const std::vector<BodyKin>& kin, int joint, int side,

@@ -38,10 +38,15 @@ class TreeSweep {
   std::vector<char> tri_;
   std::vector<double> a_;
   std::vector<Mat3> b_;
-  std::vector<Eigen::PartialPivLU<Mat3>> lu3_;
+  std::vector<Mat3> ci_;  // C^-1 (closed-form 3 x 3 inverse)
   VecX r_;
   bool ok_ = false;
-  void gather(const ConstraintEval& ce, const Step& s, int slot, Mat6& Z, Vec6* rhs) const;
+  void gather_child(const ConstraintEval& ce, const Step& s, Mat6& Z, Vec6& rhs) const;
+  /// y -= Z_parent x (the parent's columns of the step's rows, read in place)
+  void sub_parent_times(const ConstraintEval& ce, const Step& s, const Vec6& x, Vec6& y) const;
+  /// y -= Z_parent^T d
+  void sub_parent_transpose_times(const ConstraintEval& ce, const Step& s, const Vec6& d,
+                                  Eigen::Ref<Vec6> y) const;
 };
 
 }  // namespace armdyn
