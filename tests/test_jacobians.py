@@ -25,6 +25,8 @@ JOINT_ROWS = {
     "spherical": 3,
     "fixed": 6,
     "universal": 4,
+    "inline": 2,
+    "distance": 1,
 }
 H = 1e-3
 
@@ -44,6 +46,11 @@ def add_joint(b, kind, name, parent, child, point, rng):
     elif kind == "universal":
         axis2 = np.cross(axis, random_unit(rng))
         b.add_universal(name, parent, child, point, axis, axis2 / np.linalg.norm(axis2))
+    elif kind == "inline":
+        b.add_inline(name, parent, child, point, axis)
+    elif kind == "distance":
+        # a rod from the point to a second point one unit away
+        b.add_distance(name, parent, point, child, point + axis)
     else:  # pragma: no cover
         raise ValueError(kind)
 

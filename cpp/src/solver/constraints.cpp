@@ -20,14 +20,11 @@ inline void put_row(ConstraintEval& ce, ConstraintBlock& b, int r, const ScalarJ
 // the three rows x_b + R_b s_b - x_a - R_a s_a = 0 (coincident joint points) in block rows 0..2:
 // Jacobian [-I, skew(r_a) R_a | I, -skew(r_b) R_b] with the world levers r = R s
 inline void put_point_rows(ConstraintEval& ce, ConstraintBlock& b, const BodyKin& ka,
-                           const BodyKin& kb, const Vec3& sa, const Vec3& sb, bool with_xi) {
-  const Vec3 ra = ka.R * sa, rb = kb.R * sb;
-  const Vec3 wra = ka.W.cross(ra), wrb = kb.W.cross(rb);
-  const Vec3 d = kb.x + rb - ka.x - ra;
+                           const BodyKin& kb, const SepJet& d, bool with_xi) {
   Mat3 Ma, Mb;
   for (int c = 0; c < 3; ++c) {
-    Ma.col(c) = ra.cross(ka.R.col(c));
-    Mb.col(c) = kb.R.col(c).cross(rb);
+    Ma.col(c) = d.ra.cross(ka.R.col(c));
+    Mb.col(c) = kb.R.col(c).cross(d.rb);
   }
   for (int k = 0; k < 3; ++k) {
     auto row = b.J.row(k);
@@ -36,10 +33,10 @@ inline void put_point_rows(ConstraintEval& ce, ConstraintBlock& b, const BodyKin
     row.segment<3>(3) = Ma.row(k);
     row[6 + k] = 1.0;
     row.segment<3>(9) = Mb.row(k);
-    ce.f[b.row0 + k] = d[k];
+    ce.f[b.row0 + k] = d.val[k];
     ce.rhs[b.row0 + k] = 0.0;
   }
-  if (with_xi) ce.xi.segment<3>(b.row0) = kb.W.cross(wrb) - ka.W.cross(wra);
+  if (with_xi) ce.xi.segment<3>(b.row0) = d.bias;
 }
 
 inline double wrap_angle(double a) { return std::remainder(a, 2.0 * M_PI); }
@@ -96,19 +93,16 @@ void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t,
     ConstraintBlock& b = ce.blocks[bi++];
     const BodyKin& ka = kin_of(kin, j.parent);
     const BodyKin& kb = kin_of(kin, j.child);
-    // generic jets, for the rows that mix the separation with an axis
-    auto ax = [&](int side, int k) {
-      return side == 0 ? direction_jet(ka, j.frame_parent.col(k), 0)
-                       : direction_jet(kb, j.frame_child.col(k), 1);
-    };
-    auto sep = [&] {
-      return difference(point_jet(kb, j.point_child, 1), point_jet(ka, j.point_parent, 0));
-    };
-    // rows dotting an axis of the parent's joint frame with one of the child's
+    // separation of the joint points, and the joint frames' axes in world
+    auto sep = [&] { return sep_jet(ka, j.point_parent, kb, j.point_child); };
     auto pa = [&](int k) { return axis_jet(ka, j.frame_parent.col(k)); };
     auto pb = [&](int k) { return axis_jet(kb, j.frame_child.col(k)); };
+    // a parent axis dotted with a child axis, or with the separation
     auto axes_row = [&](int r, const AxisJet& p, const AxisJet& q) {
       put_row(ce, b, r, dot_axes(p, ka.R, q, kb.R), with_xi);
+    };
+    auto sep_row = [&](int r, const AxisJet& p, const SepJet& d) {
+      put_row(ce, b, r, dot_axis_sep(p, ka.R, d, kb.R), with_xi);
     };
     int r = 0;
     switch (j.type) {
@@ -117,7 +111,7 @@ void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t,
       case JointType::Universal:
       case JointType::Fixed:
         // coincident joint points: 3 rows
-        put_point_rows(ce, b, ka, kb, j.point_parent, j.point_child, with_xi);
+        put_point_rows(ce, b, ka, kb, sep(), with_xi);
         r = 3;
         break;
       default:
@@ -132,9 +126,9 @@ void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t,
         axes_row(r++, za, pb(1));
         if (j.type == JointType::Cylindrical) {
           // the child's joint point on the parent's axis line
-          const VecJet d = sep();
-          put_row(ce, b, r++, dot(ax(0, 0), d), with_xi);
-          put_row(ce, b, r++, dot(ax(0, 1), d), with_xi);
+          const SepJet d = sep();
+          sep_row(r++, pa(0), d);
+          sep_row(r++, pa(1), d);
         }
         break;
       }
@@ -144,21 +138,22 @@ void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t,
       case JointType::Fixed:
       case JointType::Prismatic: {
         // relative rotation locked: z_a.x_b = z_a.y_b = x_a.y_b = 0
-        const AxisJet za = pa(2), yb = pb(1);
+        const AxisJet za = pa(2), xa = pa(0), yb = pb(1);
         axes_row(r++, za, pb(0));
         axes_row(r++, za, yb);
-        axes_row(r++, pa(0), yb);
+        axes_row(r++, xa, yb);
         if (j.type == JointType::Prismatic) {
           // separation along the parent's z axis only
-          const VecJet d = sep();
-          put_row(ce, b, r++, dot(ax(0, 0), d), with_xi);
-          put_row(ce, b, r++, dot(ax(0, 1), d), with_xi);
+          const SepJet d = sep();
+          sep_row(r++, xa, d);
+          sep_row(r++, pa(1), d);
         }
         break;
       }
       case JointType::Distance: {
         // (|d|^2 - L^2) / (2 L): zero on the sphere, gradient the unit direction there
-        const VecJet d = sep();
+        const VecJet d =
+            difference(point_jet(kb, j.point_child, 1), point_jet(ka, j.point_parent, 0));
         ScalarJet s = dot(d, d);
         const double k = 0.5 / j.length;
         s.val = k * (s.val - j.length * j.length);
@@ -170,9 +165,9 @@ void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t,
       }
       case JointType::Inline: {
         // the child's point on the parent's axis line: no separation across the axis
-        const VecJet d = sep();
-        put_row(ce, b, r++, dot(ax(0, 0), d), with_xi);
-        put_row(ce, b, r++, dot(ax(0, 1), d), with_xi);
+        const SepJet d = sep();
+        sep_row(r++, pa(0), d);
+        sep_row(r++, pa(1), d);
         break;
       }
       default:

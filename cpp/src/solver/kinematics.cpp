@@ -167,6 +167,31 @@ ScalarJet atan2_jet(const ScalarJet& s, const ScalarJet& c, bool value) {
   return t;
 }
 
+SepJet sep_jet(const BodyKin& ka, const Vec3& sa, const BodyKin& kb, const Vec3& sb) {
+  SepJet d;
+  d.ra.noalias() = ka.R * sa;
+  d.rb.noalias() = kb.R * sb;
+  const Vec3 wra = ka.W.cross(d.ra), wrb = kb.W.cross(d.rb);
+  d.val = kb.x + d.rb - ka.x - d.ra;
+  d.rate = kb.xd + wrb - ka.xd - wra;
+  d.bias = kb.W.cross(wrb) - ka.W.cross(wra);
+  return d;
+}
+
+ScalarJet dot_axis_sep(const AxisJet& p, const Mat3& Ra, const SepJet& d, const Mat3& Rb) {
+  // slot 0: -p^T | Ra^T (p x d) + p^T skew(r_a) R_a = Ra^T (p x (d + r_a))
+  // slot 1: +p^T | p^T (-skew(r_b) R_b) = Rb^T (r_b x p)
+  ScalarJet s;
+  s.val = p.val.dot(d.val);
+  s.rate = p.rate.dot(d.val) + p.val.dot(d.rate);
+  s.bias = p.bias.dot(d.val) + 2.0 * p.rate.dot(d.rate) + p.val.dot(d.bias);
+  s.J.segment<3>(0) = -p.val.transpose();
+  s.J.segment<3>(3) = (Ra.transpose() * p.val.cross(d.val + d.ra)).transpose();
+  s.J.segment<3>(6) = p.val.transpose();
+  s.J.segment<3>(9) = (Rb.transpose() * d.rb.cross(p.val)).transpose();
+  return s;
+}
+
 VecJet joint_axis_jet(const Model& m, const std::vector<BodyKin>& kin, int joint, int side,
                       int axis) {
   const Joint& jt = m.joints[joint];
@@ -208,7 +233,11 @@ ScalarJet coord_jet(const Model& m, const std::vector<BodyKin>& kin, int coord, 
     return t;
   }
   // displacement along the parent's joint axis
-  return dot(joint_axis_jet(m, kin, c.joint, 0, 2), joint_separation_jet(m, kin, c.joint));
+  const Joint& jt = m.joints[c.joint];
+  const BodyKin& ka = kin_of(kin, jt.parent);
+  const BodyKin& kb = kin_of(kin, jt.child);
+  return dot_axis_sep(axis_jet(ka, jt.frame_parent.col(2)), ka.R,
+                      sep_jet(ka, jt.point_parent, kb, jt.point_child), kb.R);
 }
 
 }  // namespace armdyn

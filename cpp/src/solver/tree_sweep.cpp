@@ -6,6 +6,17 @@
 
 namespace armdyn {
 
+namespace {
+// closed-form inverse of a 3 x 3 block; false when it is singular to working precision (its
+// determinant below 1e-10 of the product of its row norms)
+inline bool inverse3(const Mat3& M, Mat3& Mi) {
+  const double det = M.determinant();
+  if (!(std::abs(det) > 1e-10 * M.row(0).norm() * M.row(1).norm() * M.row(2).norm())) return false;
+  Mi = M.inverse();
+  return true;
+}
+}  // namespace
+
 void TreeSweep::plan(const Model& m, const ConstraintEval& ce) {
   ok_ = false;
   steps_.clear();
@@ -39,7 +50,7 @@ void TreeSweep::plan(const Model& m, const ConstraintEval& ce) {
   }
   lu_.resize(steps_.size());
   tri_.assign(steps_.size(), 0);
-  a_.assign(steps_.size(), 1.0);
+  ai_.assign(steps_.size(), Mat3::Identity());
   b_.assign(steps_.size(), Mat3::Zero());
   ci_.assign(steps_.size(), Mat3::Identity());
   r_ = VecX::Zero(m.nv);
@@ -83,22 +94,21 @@ bool TreeSweep::solve(const Model& m, const ConstraintEval& ce, const VecX& eta,
     const Step& s = steps_[k];
     gather_child(ce, s, Zc, rhs);
     if (s.parent != kGround) sub_parent_times(ce, s, vd.segment<6>(6 * s.parent), rhs);
-    const double a = Zc(0, 0);
-    const bool tri = (a == 1.0 || a == -1.0) && Zc.block<3, 3>(3, 0).isZero(0.0) &&
-                     Zc.block<3, 3>(0, 0) == a * Mat3::Identity();
-    tri_[k] = tri;
+    int tri = 0;
+    if (Zc.block<3, 3>(3, 0).isZero(0.0))
+      tri = 1;
+    else if (Zc.block<3, 3>(0, 0).isZero(0.0))
+      tri = 2;
+    tri_[k] = static_cast<char>(tri);
     if (tri) {
-      // [a I, B; 0, C] x = rhs: x_w = C^-1 rhs_w, x_v = (rhs_v - B x_w) / a
-      const Mat3 C = Zc.block<3, 3>(3, 3);
-      const double det = C.determinant();
-      if (!(std::abs(det) > 1e-10 * C.row(0).norm() * C.row(1).norm() * C.row(2).norm()))
+      // rows (top, bot) = [A B; 0 C]: x_w = C^-1 rhs_bot, x_v = A^-1 (rhs_top - B x_w)
+      const int top = tri == 1 ? 0 : 3, bot = 3 - top;
+      if (!inverse3(Zc.block<3, 3>(top, 0), ai_[k]) || !inverse3(Zc.block<3, 3>(bot, 3), ci_[k]))
         return false;
-      a_[k] = a;
-      b_[k] = Zc.block<3, 3>(0, 3);
-      ci_[k] = C.inverse();
-      const Vec3 xw = ci_[k] * rhs.tail<3>();
+      b_[k] = Zc.block<3, 3>(top, 3);
+      const Vec3 xw = ci_[k] * rhs.segment<3>(bot);
       vd.segment<3>(6 * s.child + 3) = xw;
-      vd.segment<3>(6 * s.child) = (rhs.head<3>() - b_[k] * xw) / a;
+      vd.segment<3>(6 * s.child).noalias() = ai_[k] * (rhs.segment<3>(top) - b_[k] * xw);
       continue;
     }
     lu_[k].compute(Zc);
@@ -118,10 +128,12 @@ bool TreeSweep::solve(const Model& m, const ConstraintEval& ce, const VecX& eta,
     // shares already taken out)
     Vec6 d;
     if (tri_[k]) {
-      // [a I, 0; B^T, C^T] d = r: d_v = r_v / a, d_w = C^-T (r_w - B^T d_v)
-      d.head<3>() = r_.segment<3>(6 * s.child) / a_[k];
-      d.tail<3>().noalias() =
-          ci_[k].transpose() * (r_.segment<3>(6 * s.child + 3) - b_[k].transpose() * d.head<3>());
+      // [A^T 0; B^T C^T] (d_top, d_bot) = r: d_top = A^-T r_v, d_bot = C^-T (r_w - B^T d_top)
+      const int top = tri_[k] == 1 ? 0 : 3, bot = 3 - top;
+      const Vec3 dt = ai_[k].transpose() * r_.segment<3>(6 * s.child);
+      d.segment<3>(top) = dt;
+      d.segment<3>(bot).noalias() =
+          ci_[k].transpose() * (r_.segment<3>(6 * s.child + 3) - b_[k].transpose() * dt);
     } else {
       d = lu_[k].transpose().solve(r_.segment<6>(6 * s.child));
     }

@@ -87,6 +87,16 @@ inline ScalarJet dot_axes(const AxisJet& p, const Mat3& Ra, const AxisJet& q, co
   return s;
 }
 
+/// The separation d = (x_b + R_b s_b) - (x_a + R_a s_a) of two body points, with its world
+/// levers r_a = R_a s_a and r_b = R_b s_b (Jacobian [-I, skew(r_a) R_a | I, -skew(r_b) R_b]).
+struct SepJet {
+  Vec3 val, rate, bias, ra, rb;
+};
+SepJet sep_jet(const BodyKin& ka, const Vec3& sa, const BodyKin& kb, const Vec3& sb);
+/// p . d for a direction p fixed in body A (slot 0) and the separation d of A's and B's points:
+/// the same jet as dot(direction_jet(A), difference(point_jet(B), point_jet(A))).
+ScalarJet dot_axis_sep(const AxisJet& p, const Mat3& Ra, const SepJet& d, const Mat3& Rb);
+
 /// Joint frame axes of joint j in world, on the parent (side 0) or child (side 1) body.
 VecJet joint_axis_jet(const Model& m, const std::vector<BodyKin>& kin, int joint, int side,
                       int axis);

@@ -33,12 +33,11 @@ class TreeSweep {
   };
   std::vector<Step> steps_;
   std::vector<Eigen::PartialPivLU<Mat6>> lu_;
-  // block-triangular steps (revolute joint plus drive, fixed joint): the child's block is
-  // [a I, B; 0, C] (position rows first), solved through C alone
+  // block-triangular steps: the child's block is [A B; 0 C] (revolute joint plus drive, fixed
+  // joint: A = +-I) or [0 C; A B] (prismatic joint plus drive), solved through the 3 x 3 inverses
+  // of A and C. tri_: 0 full 6 x 6 LU, 1 upper form, 2 rows swapped.
   std::vector<char> tri_;
-  std::vector<double> a_;
-  std::vector<Mat3> b_;
-  std::vector<Mat3> ci_;  // C^-1 (closed-form 3 x 3 inverse)
+  std::vector<Mat3> ai_, b_, ci_;
   VecX r_;
   bool ok_ = false;
   void gather_child(const ConstraintEval& ce, const Step& s, Mat6& Z, Vec6& rhs) const;
