@@ -252,7 +252,8 @@ bool BlockSparseSchur::factor(const ConstraintEval& ce, const std::vector<Mat6>*
     const auto J = b.J.middleCols<6>(6 * sc.slot);
     if (winv) {
       const Mat6& w = (*winv)[b.body[sc.slot]];
-      jw.leftCols<3>().noalias() = J.leftCols<3>() * w.topLeftCorner<3, 3>();
+      // the translational block of W^-1 is (1/m) I
+      jw.leftCols<3>() = J.leftCols<3>() * w(0, 0);
       jw.rightCols<3>().noalias() = J.rightCols<3>() * w.bottomRightCorner<3, 3>();
     } else {
       jw = J;
@@ -331,10 +332,11 @@ bool BlockSparseSchur::factor_column(int k) {
   for (int j = 0; j < s; ++j) {
     double d = L[j + j * s];
     for (int p = 0; p < j; ++p) d -= L[j + p * s] * L[j + p * s];
-    if (!(d > 1e-12 * diag0_[c.row0 + j])) return false;
-    min_rel_ = std::min(min_rel_, d / diag0_[c.row0 + j]);
+    const double d0 = diag0_[c.row0 + j];
+    if (!(d > 1e-12 * d0)) return false;
+    if (d < min_rel_ * d0) min_rel_ = d / d0;  // (divides only at a new minimum)
     // nearly dependent: the pivot at the shift's level (relative to the diagonal)
-    if (shift_ > 0.0 && d < 10.0 * shift_ * diag0_[c.row0 + j]) weak_.push_back(c.row0 + j);
+    if (shift_ > 0.0 && d < 10.0 * shift_ * d0) weak_.push_back(c.row0 + j);
     const double l = std::sqrt(d);
     L[j + j * s] = l;
     inv[j] = 1.0 / l;

@@ -182,7 +182,7 @@ void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t,
     for (int k = 0; k < 2; ++k) {
       const int c = k == 0 ? g.coord_a : g.coord_b;
       const double r = k == 0 ? g.r_a : g.r_b;
-      const ScalarJet q = coord_jet(m, kin, c);
+      const ScalarJet& q = ce.coord_cache ? ce.coord_cache->get(m, kin, c) : coord_jet(m, kin, c);
       const double ref = ce.track_ref ? (*ce.track_ref)[c] : 0.0;
       f += r * (ref + std::remainder(q.val - ref, 2.0 * M_PI));
       xi += r * q.bias;

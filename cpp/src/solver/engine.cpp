@@ -31,12 +31,17 @@ Engine::Engine(const Model& m)
       nrows_(m.nc) {
   kin_.resize(m.nb);
   ce_.init(m);
+  jets_.init(m);
+  ce_.coord_cache = &jets_;
   sweep_.plan(m, ce_);
   ce_.track_ref = &track_ref_;
   tol_f_ = 1e-13 * std::max(1.0, m.length_scale);
 }
 
-void Engine::load(const double* u, const double* v) { body_kinematics(m_, u, v, kin_); }
+void Engine::load(const double* u, const double* v) {
+  body_kinematics(m_, u, v, kin_);
+  jets_.reset();
+}
 
 void Engine::scatter(const Row12& g, int pa, int pb) {
   if (pa != kGround) eta_.segment<6>(6 * pa) += g.segment<6>(0).transpose();
@@ -80,7 +85,7 @@ void Engine::forces(double t) {
   }
   // joint-coordinate forces: springs, dampers, friction, inputs
   for (const CoordForce& cf : m_.coord_forces) {
-    const ScalarJet q = coord_jet(m_, kin_, cf.coord);
+    const ScalarJet& q = jets_.get(m_, kin_, cf.coord);
     const Coord& c = m_.coords[cf.coord];
     double tau;
     try {
@@ -97,7 +102,8 @@ void Engine::forces(double t) {
   // gear pairs with backlash: contact force along the line of action
   for (size_t gi = 0; gi < m_.gears.size(); ++gi) {
     const GearPair& g = m_.gears[gi];
-    const ScalarJet qa = coord_jet(m_, kin_, g.coord_a), qb = coord_jet(m_, kin_, g.coord_b);
+    const ScalarJet& qa = jets_.get(m_, kin_, g.coord_a);
+    const ScalarJet& qb = jets_.get(m_, kin_, g.coord_b);
     const double s = g.r_a * tracked(g.coord_a, qa.val) + g.r_b * tracked(g.coord_b, qb.val);
     const double sd = g.r_a * qa.rate + g.r_b * qb.rate;
     double pen;
@@ -267,7 +273,7 @@ std::string Engine::diagnose_singularity(double t, const double* u, const double
 void Engine::aux_rates(double t, double* zdot) const {
   for (const CoordForce& cf : m_.coord_forces) {
     if (cf.aux < 0) continue;
-    const ScalarJet q = coord_jet(m_, kin_, cf.coord);
+    const ScalarJet& q = jets_.get(m_, kin_, cf.coord);
     const double z = aux_ ? aux_[cf.aux] : 0.0;
     coord_force_value(cf, m_.coords[cf.coord].angular, q.val, q.rate, t, z, &zdot[cf.aux]);
   }

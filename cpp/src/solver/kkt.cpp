@@ -289,21 +289,23 @@ void KktSolver::apply_winv(const VecX& y, VecX& x) const {
     x = y;
     return;
   }
-  for (int b = 0; b < m_.nb; ++b) x.segment<6>(6 * b).noalias() = minv_[b] * y.segment<6>(6 * b);
+  for (int b = 0; b < m_.nb; ++b) apply_minv(b, y.segment<6>(6 * b), x.segment<6>(6 * b));
 }
 
 void KktSolver::accelerations(const ConstraintEval& ce, const VecX& eta, VecX& vdot, VecX& delta) {
   // a = Gamma^-1 eta; delta = A^-1 (zeta a + xi); vdot = a - Gamma^-1 zeta^T delta
-  for (int b = 0; b < m_.nb; ++b)
-    vdot.segment<6>(6 * b).noalias() = minv_[b] * eta.segment<6>(6 * b);
+  for (int b = 0; b < m_.nb; ++b) apply_minv(b, eta.segment<6>(6 * b), vdot.segment<6>(6 * b));
   delta.setZero();
   if (nrows_ == 0) return;
   zeta_times(ce, nrows_, vdot, b_);
   b_.head(nrows_) += ce.xi.head(nrows_);
   solve_schur(b_, delta);
   zeta_transpose_times(ce, nrows_, delta, tmp_nv_);
-  for (int b = 0; b < m_.nb; ++b)
-    vdot.segment<6>(6 * b).noalias() -= minv_[b] * tmp_nv_.segment<6>(6 * b);
+  for (int b = 0; b < m_.nb; ++b) {
+    vdot.segment<3>(6 * b) -= minv_[b](0, 0) * tmp_nv_.segment<3>(6 * b);
+    vdot.segment<3>(6 * b + 3).noalias() -=
+        minv_[b].bottomRightCorner<3, 3>() * tmp_nv_.segment<3>(6 * b + 3);
+  }
 }
 
 }  // namespace armdyn

@@ -32,6 +32,8 @@ struct ConstraintEval {
   /// false: drive rows get no residual (f = 0, no angle evaluated), for callers that only want
   /// zeta, rhs and xi at states built on the manifold (joint-space inverse dynamics).
   bool drive_values = true;
+  /// Optional cache of coordinate jets at the evaluated state (the ideal gear rows read it).
+  CoordJetCache* coord_cache = nullptr;
   /// Optional unwrapped references of angle coordinates (by coordinate index), so that ideal
   /// gear rows see multi-turn angles; nullptr: wrapped angles.
   const VecX* track_ref = nullptr;

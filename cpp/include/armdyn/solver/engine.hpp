@@ -24,6 +24,8 @@ struct ProjectionStats {
 class Engine {
  public:
   explicit Engine(const Model& m);
+  Engine(const Engine&) = delete;  // ce_ points into this engine's jet cache
+  Engine& operator=(const Engine&) = delete;
 
   /// Rows taking part: all (joints + drives) by default, or joints only (joint-space calls).
   void set_include_drives(bool on) { nrows_ = on ? m_.nc : m_.nc_joint; }
@@ -57,7 +59,10 @@ class Engine {
   void dynamics_loaded(double t, double* vdot, bool reuse_factor = false);
   /// The kinematic cache, for callers that build the body states themselves (joint-space
   /// forward and inverse dynamics: poses and velocities straight from the joint coordinates).
-  std::vector<BodyKin>& kin_in() { return kin_; }
+  std::vector<BodyKin>& kin_in() {
+    jets_.reset();
+    return kin_;
+  }
   /// u' = S(u) v: xdot and 1/2 e (x) [0, omega].
   void udot(const double* u, const double* v, double* ud) const;
   /// Project u onto f(u, t) = 0 (minimum-norm Newton in metric W, quaternions renormalised) and
@@ -120,6 +125,7 @@ class Engine {
   VecX track_ref_;  // unwrapped reference of tracked angle coordinates (by coordinate index)
   const double* tau_ = nullptr;
   std::vector<ScalarJet> tau_jets_;
+  mutable CoordJetCache jets_;  // coordinate jets at the loaded state
   const double* aux_ = nullptr;
   int nrows_ = 0;
   double tol_f_ = 1e-13;

@@ -108,6 +108,31 @@ VecJet joint_separation_jet(const Model& m, const std::vector<BodyKin>& kin, int
 /// value = false skips the angle itself (rate, Jacobian and bias only).
 ScalarJet coord_jet(const Model& m, const std::vector<BodyKin>& kin, int coord, bool value = true);
 
+/// Joint-coordinate jets (with values) computed at most once per kinematic state: a coordinate
+/// read by several elements (an ideal gear row, a motor, a backlash pair) is evaluated once.
+/// reset() whenever the state changes.
+class CoordJetCache {
+ public:
+  void init(const Model& m) {
+    jet_.assign(m.coords.size(), ScalarJet());
+    stamp_.assign(m.coords.size(), 0);
+    now_ = 1;
+  }
+  void reset() { ++now_; }
+  const ScalarJet& get(const Model& m, const std::vector<BodyKin>& kin, int c) {
+    if (stamp_[c] != now_) {
+      jet_[c] = coord_jet(m, kin, c);
+      stamp_[c] = now_;
+    }
+    return jet_[c];
+  }
+
+ private:
+  std::vector<ScalarJet> jet_;
+  std::vector<unsigned long> stamp_;
+  unsigned long now_ = 1;
+};
+
 /// Acceleration of joint coordinate c from the Cartesian accelerations: J vdot + bias.
 inline double coord_acceleration(const Model& m, const ScalarJet& s, int c,
                                  const Eigen::Ref<const VecX>& vdot) {

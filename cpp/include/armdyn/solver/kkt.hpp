@@ -76,7 +76,13 @@ class KktSolver {
 
  private:
   const Model& m_;
-  std::vector<Mat6> minv_;  // per-body Gamma^-1 blocks
+  std::vector<Mat6> minv_;  // per-body Gamma^-1 blocks: diag((1/m) I, I^-1)
+  template <class In, class Out>
+  void apply_minv(int b, const In& y, Out&& x) const {
+    x.template head<3>() = minv_[b](0, 0) * y.template head<3>();
+    x.template tail<3>().noalias() =
+        minv_[b].template bottomRightCorner<3, 3>() * y.template tail<3>();
+  }
   std::unique_ptr<BlockSparseSchur> sp_all_, sp_joint_;
   const BlockSparseSchur* sp_ = nullptr;  // the factor in use when sparse_
   bool sparse_ = false;
