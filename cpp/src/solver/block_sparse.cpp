@@ -185,9 +185,9 @@ inline void with_rows(int n, F&& f) {
   }
 }
 
-// T(sg x sh) += JW(sg x 6, row-major) Jh(sh x 6, rows `stride` apart)^T, column-major T;
-// diag: lower triangle only. SG > 0 fixes sg at compile time.
-template <int SG, bool DIAG>
+// T(sg x sh) += JW(sg x NC columns of a row-major sg x 6) Jh(sh x NC, rows `stride` apart)^T,
+// column-major T; diag: lower triangle only. SG > 0 fixes sg at compile time.
+template <int SG, bool DIAG, int NC>
 inline void assemble(double* __restrict__ t, const double* __restrict__ jw,
                      const double* __restrict__ jh0, long stride, int sg_rt, int sh) {
   const int sg = SG > 0 ? SG : sg_rt;
@@ -195,8 +195,9 @@ inline void assemble(double* __restrict__ t, const double* __restrict__ jw,
     const double* __restrict__ jh = jh0 + c * stride;
     for (int r = DIAG ? c : 0; r < sg; ++r) {
       const double* jr = jw + 6 * r;
-      t[r + c * sg] += jr[0] * jh[0] + jr[1] * jh[1] + jr[2] * jh[2] + jr[3] * jh[3] +
-                       jr[4] * jh[4] + jr[5] * jh[5];
+      double x = jr[0] * jh[0];
+      for (int k = 1; k < NC; ++k) x += jr[k] * jh[k];
+      t[r + c * sg] += x;
     }
   }
 }
@@ -244,7 +245,8 @@ bool BlockSparseSchur::factor(const ConstraintEval& ce, const std::vector<Mat6>*
   weak_.clear();
   std::fill(val_.begin(), val_.end(), 0.0);
   double* v = val_.data();
-  // J_g,s W_b^-1 once per (block, slot), with W^-1 = diag(W_xx, W_ww) per body
+  // J_g,s W_b^-1 once per (block, slot), with W^-1 = diag(W_xx, W_ww) per body (W_xx = w I);
+  // the translational part only where the block has no point-row structure
   for (const Scaled& sc : scaled_) {
     const ConstraintBlock& b = ce.blocks[sc.g];
     Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor, 6, 6>> jw(
@@ -252,34 +254,47 @@ bool BlockSparseSchur::factor(const ConstraintEval& ce, const std::vector<Mat6>*
     const auto J = b.J.middleCols<6>(6 * sc.slot);
     if (winv) {
       const Mat6& w = (*winv)[b.body[sc.slot]];
-      // the translational block of W^-1 is (1/m) I
-      jw.leftCols<3>() = J.leftCols<3>() * w(0, 0);
+      if (!b.point_rows) jw.leftCols<3>() = J.leftCols<3>() * w(0, 0);
       jw.rightCols<3>().noalias() = J.rightCols<3>() * w.bottomRightCorner<3, 3>();
     } else {
       jw = J;
     }
   }
   // assembly: A(g, h) += (J_g,b W_b^-1) J_h,b^T over the bodies b the two blocks share (lower
-  // triangle only on the diagonal blocks)
+  // triangle only on the diagonal blocks): the rotational columns by products, the translational
+  // ones through the point-row structure (+-I on rows 0..2) where the blocks have it
   for (const Assembly& a : asm_) {
     const ConstraintBlock& bg = ce.blocks[a.g];
     const ConstraintBlock& bh = ce.blocks[a.h];
     const double* jw = jw_.data() + a.jw;
-    const int sg = bg.nrows;
+    const int sg = bg.nrows, sh = bh.nrows;
     const double* jh = bh.J.data() + 6 * a.sh;
     const long stride = bh.J.cols();
     double* t = v + a.target;
-    if (a.g == a.h) {
-      assemble<0, true>(t, jw, jh, stride, sg, bh.nrows);
-      continue;
-    }
-    switch (sg) {  // joint blocks of 5 rows (revolute, prismatic) against any
-      case 5:
-        assemble<5, false>(t, jw, jh, stride, 5, bh.nrows);
-        break;
-      default:
-        assemble<0, false>(t, jw, jh, stride, sg, bh.nrows);
-        break;
+    const bool diag = a.g == a.h;
+    if (diag)
+      assemble<0, true, 3>(t, jw + 3, jh + 3, stride, sg, sh);
+    else if (sg == 5)  // joint blocks of 5 rows (revolute, prismatic) against any
+      assemble<5, false, 3>(t, jw + 3, jh + 3, stride, 5, sh);
+    else
+      assemble<0, false, 3>(t, jw + 3, jh + 3, stride, sg, sh);
+    const double eg = bg.point_rows ? (a.sg == 0 ? -1.0 : 1.0) : 0.0;
+    const double eh = bh.point_rows ? (a.sh == 0 ? -1.0 : 1.0) : 0.0;
+    const double wl = winv ? (*winv)[a.body](0, 0) : 1.0;
+    if (eg != 0.0 && eh != 0.0) {
+      for (int i = 0; i < 3; ++i) t[i + i * sg] += eg * eh * wl;
+    } else if (eg != 0.0) {
+      // (J_g W^-1)_lin = eg w [I; 0]: T(i, c) += eg w J_h(c, i) for i < 3
+      for (int c = 0; c < sh; ++c)
+        for (int i = 0; i < 3; ++i) t[i + c * sg] += eg * wl * jh[c * stride + i];
+    } else if (eh != 0.0) {
+      // (J_h)_lin = eh [I; 0]: T(r, i) += eh (J_g W^-1)(r, i) for i < 3
+      for (int i = 0; i < 3; ++i)
+        for (int r = 0; r < sg; ++r) t[r + i * sg] += eh * jw[6 * r + i];
+    } else if (diag) {
+      assemble<0, true, 3>(t, jw, jh, stride, sg, sh);
+    } else {
+      assemble<0, false, 3>(t, jw, jh, stride, sg, sh);
     }
   }
   const int np = static_cast<int>(col_.size());

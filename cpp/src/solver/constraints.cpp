@@ -64,7 +64,10 @@ void ConstraintEval::init(const Model& m) {
   auto add_block = [&](int row0, int nrows, int pa, int pb) { add_block_n(row0, nrows, {pa, pb}); };
   for (const Joint& j : m.joints) {
     const int r = joint_rows(j.type);
-    if (r > 0) add_block(j.row0, r, j.parent, j.child);
+    if (r == 0) continue;
+    add_block(j.row0, r, j.parent, j.child);
+    blocks.back().point_rows = j.type == JointType::Spherical || j.type == JointType::Revolute ||
+                               j.type == JointType::Universal || j.type == JointType::Fixed;
   }
   for (const GearConstraint& g : m.gear_constraints) add_block_n(g.row, 1, gear_bodies(m, g));
   for (const Drive& d : m.drives) {

@@ -21,6 +21,10 @@ struct ConstraintBlock {
   int row0 = 0, nrows = 0;
   int nbody = 2;
   int body[kMaxBlockBodies] = {kGround, kGround, kGround, kGround};
+  /// Rows 0..2 are coincident-point rows (spherical, revolute, universal and fixed joints):
+  /// their translational columns are -I (slot 0) and +I (slot 1), and the block's other rows
+  /// have none. The KKT assembly uses this structure.
+  bool point_rows = false;
   BlockMat J;
 };
 
