@@ -270,17 +270,12 @@ void JointSpaceInverseDynamics::compute(Eigen::Ref<const VecX> q, Eigen::Ref<con
                                         Eigen::Ref<const VecX> qdd, Eigen::Ref<VecX> tau,
                                         double t) {
   const long nco = static_cast<long>(driven_.coords.size());
-  if (qdd.size() != nco)
-    throw ModelError(msg("inverse_dynamics: qdd has length ", qdd.size(), ", expected ", nco));
-  if (!qdd.allFinite()) throw ModelError("inverse_dynamics: qdd contains NaN or inf");
+  check_joint_vector(q, nco, "inverse_dynamics", "q");
+  check_joint_vector(qd, nco, "inverse_dynamics", "qd");
+  check_joint_vector(qdd, nco, "inverse_dynamics", "qdd");
   if (!std::isfinite(t)) throw ModelError("inverse_dynamics: t is not finite");
   if (tau.size() != nco)
     throw ModelError(msg("inverse_dynamics: tau has length ", tau.size(), ", expected ", nco));
-  if (q.size() != nco || qd.size() != nco)
-    throw ModelError(msg("inverse_dynamics: q and qd need length ", nco, ", got ", q.size(),
-                         " and ", qd.size()));
-  if (!q.allFinite() || !qd.allFinite())
-    throw ModelError("inverse_dynamics: q or qd contains NaN or inf");
   joint_space_kinematics(*src_, q, qd, e_->kin_in());
   for (long c = 0; c < nco; ++c) {
     ref_[3 * c] = q[c];

@@ -17,13 +17,11 @@ void require_joint_space(const Model& m, const char* what) {
                          m.joint_space_reason));
 }
 
-namespace {
-void check_vec(Eigen::Ref<const VecX> x, long n, const char* fn, const char* name) {
+void check_joint_vector(Eigen::Ref<const VecX> x, long n, const char* fn, const char* name) {
   if (x.size() != n)
     throw ModelError(msg(fn, ": ", name, " has length ", x.size(), ", expected ", n));
   if (!x.allFinite()) throw ModelError(msg(fn, ": ", name, " contains NaN or inf"));
 }
-}  // namespace
 
 void state_from_joints(const Model& m, const VecX& q, const VecX& qd, VecX& u, VecX& v) {
   TreeFkWork work;
@@ -81,8 +79,8 @@ void state_from_joints(const Model& m, Eigen::Ref<const VecX> q, Eigen::Ref<cons
                        VecX& v, TreeFkWork& work) {
   require_joint_space(m, "state_from_joints");
   const long nc = static_cast<long>(m.coords.size());
-  check_vec(q, nc, "state_from_joints", "q");
-  check_vec(qd, nc, "state_from_joints", "qd");
+  check_joint_vector(q, nc, "state_from_joints", "q");
+  check_joint_vector(qd, nc, "state_from_joints", "qd");
   u.resize(m.nq);
   v.resize(m.nv);
   joint_space_kinematics(m, q, qd, work.kin);
@@ -96,8 +94,8 @@ void state_from_joints(const Model& m, Eigen::Ref<const VecX> q, Eigen::Ref<cons
 }
 
 void joint_coordinates(const Model& m, const VecX& u, const VecX& v, VecX& q, VecX& qd) {
-  check_vec(u, m.nq, "joint_coordinates", "u");
-  check_vec(v, m.nv, "joint_coordinates", "v");
+  check_joint_vector(u, m.nq, "joint_coordinates", "u");
+  check_joint_vector(v, m.nv, "joint_coordinates", "v");
   std::vector<BodyKin> kin;
   body_kinematics(m, u.data(), v.data(), kin);
   const int nc = static_cast<int>(m.coords.size());
@@ -128,11 +126,11 @@ void JointSpaceForwardDynamics::compute(Eigen::Ref<const VecX> q, Eigen::Ref<con
                                         double t) {
   const Model& m = *m_;
   const long nc = static_cast<long>(m.coords.size());
-  check_vec(tau, nc, "forward_dynamics", "tau");
+  check_joint_vector(tau, nc, "forward_dynamics", "tau");
   if (out.size() != nc)
     throw ModelError(msg("forward_dynamics: out has length ", out.size(), ", expected ", nc));
-  check_vec(q, nc, "forward_dynamics", "q");
-  check_vec(qd, nc, "forward_dynamics", "qd");
+  check_joint_vector(q, nc, "forward_dynamics", "q");
+  check_joint_vector(qd, nc, "forward_dynamics", "qd");
   joint_space_kinematics(m, q, qd, e_->kin_in());
   tau_ = tau;
   e_->dynamics_loaded(t, vd_.data());
@@ -143,7 +141,7 @@ void JointSpaceForwardDynamics::compute(Eigen::Ref<const VecX> q, Eigen::Ref<con
 VecX forward_dynamics(const Model& m, const VecX& q, const VecX& qd, const VecX& tau) {
   require_joint_space(m, "forward_dynamics");
   const long nc = static_cast<long>(m.coords.size());
-  check_vec(tau, nc, "forward_dynamics", "tau");
+  check_joint_vector(tau, nc, "forward_dynamics", "tau");
   VecX u, v;
   state_from_joints(m, q, qd, u, v);
   Engine e(m);

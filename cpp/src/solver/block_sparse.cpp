@@ -165,24 +165,17 @@ BlockSparseSchur::BlockSparseSchur(const Model& m, const KktPlan& plan) : m_(m) 
 }
 
 namespace {
-// f(std::integral_constant<int, N>{}) with N the row count of the common joint and gear blocks
-// (1, 5, 6), for kernels unrolled at compile time; N = 0 (the size at run time) otherwise
+// f(std::integral_constant<int, N>{}) with N = n when n is one of Ns (kernels unrolled at
+// compile time), N = 0 (the size at run time) otherwise
+template <int... Ns, class F>
+inline void with_size(int n, F&& f) {
+  const bool hit = ((n == Ns ? (f(std::integral_constant<int, Ns>{}), true) : false) || ...);
+  if (!hit) f(std::integral_constant<int, 0>{});
+}
+// the row counts of the common joint and gear blocks
 template <class F>
 inline void with_rows(int n, F&& f) {
-  switch (n) {
-    case 1:
-      f(std::integral_constant<int, 1>{});
-      break;
-    case 5:
-      f(std::integral_constant<int, 5>{});
-      break;
-    case 6:
-      f(std::integral_constant<int, 6>{});
-      break;
-    default:
-      f(std::integral_constant<int, 0>{});
-      break;
-  }
+  with_size<1, 5, 6>(n, f);
 }
 
 // T(sg x sh) += JW(sg x NC columns of a row-major sg x 6) Jh(sh x NC, rows `stride` apart)^T,
@@ -307,30 +300,9 @@ bool BlockSparseSchur::factor(const ConstraintEval& ce, const std::vector<Mat6>*
     }
   }
   for (int k = 0; k < np; ++k) {
-    bool ok;
-    switch (col_[k].size) {  // the block sizes of joints (1..6 rows) get unrolled kernels
-      case 1:
-        ok = factor_column<1>(k);
-        break;
-      case 2:
-        ok = factor_column<2>(k);
-        break;
-      case 3:
-        ok = factor_column<3>(k);
-        break;
-      case 4:
-        ok = factor_column<4>(k);
-        break;
-      case 5:
-        ok = factor_column<5>(k);
-        break;
-      case 6:
-        ok = factor_column<6>(k);
-        break;
-      default:
-        ok = factor_column<0>(k);
-        break;
-    }
+    bool ok = false;  // the block sizes of joints (1..6 rows) get unrolled kernels
+    with_size<1, 2, 3, 4, 5, 6>(col_[k].size,
+                                [&](auto N) { ok = this->factor_column<decltype(N)::value>(k); });
     if (!ok) return false;
   }
   return true;

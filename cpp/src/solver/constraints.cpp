@@ -104,8 +104,13 @@ void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t,
     auto axes_row = [&](int r, const AxisJet& p, const AxisJet& q) {
       put_row(ce, b, r, dot_axes(p, ka.R, q, kb.R), with_xi);
     };
-    auto sep_row = [&](int r, const AxisJet& p, const SepJet& d) {
-      put_row(ce, b, r, dot_axis_sep(p, ka.R, d, kb.R), with_xi);
+    // the child's joint point on the parent's joint axis line: no separation along the
+    // parent's x and y axes (2 rows from row r)
+    auto on_axis_rows = [&](int r) {
+      const SepJet d = sep();
+      put_row(ce, b, r, dot_axis_sep(pa(0), ka.R, d, kb.R), with_xi);
+      put_row(ce, b, r + 1, dot_axis_sep(pa(1), ka.R, d, kb.R), with_xi);
+      return r + 2;
     };
     int r = 0;
     switch (j.type) {
@@ -127,12 +132,7 @@ void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t,
         const AxisJet za = pa(2);
         axes_row(r++, za, pb(0));
         axes_row(r++, za, pb(1));
-        if (j.type == JointType::Cylindrical) {
-          // the child's joint point on the parent's axis line
-          const SepJet d = sep();
-          sep_row(r++, pa(0), d);
-          sep_row(r++, pa(1), d);
-        }
+        if (j.type == JointType::Cylindrical) r = on_axis_rows(r);
         break;
       }
       case JointType::Universal:
@@ -141,16 +141,11 @@ void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t,
       case JointType::Fixed:
       case JointType::Prismatic: {
         // relative rotation locked: z_a.x_b = z_a.y_b = x_a.y_b = 0
-        const AxisJet za = pa(2), xa = pa(0), yb = pb(1);
+        const AxisJet za = pa(2), yb = pb(1);
         axes_row(r++, za, pb(0));
         axes_row(r++, za, yb);
-        axes_row(r++, xa, yb);
-        if (j.type == JointType::Prismatic) {
-          // separation along the parent's z axis only
-          const SepJet d = sep();
-          sep_row(r++, xa, d);
-          sep_row(r++, pa(1), d);
-        }
+        axes_row(r++, pa(0), yb);
+        if (j.type == JointType::Prismatic) r = on_axis_rows(r);  // sliding along z_a only
         break;
       }
       case JointType::Distance: {
@@ -166,13 +161,9 @@ void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t,
         put_row(ce, b, r++, s, with_xi);
         break;
       }
-      case JointType::Inline: {
-        // the child's point on the parent's axis line: no separation across the axis
-        const SepJet d = sep();
-        sep_row(r++, pa(0), d);
-        sep_row(r++, pa(1), d);
+      case JointType::Inline:
+        r = on_axis_rows(r);
         break;
-      }
       default:
         break;
     }

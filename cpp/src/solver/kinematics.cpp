@@ -39,20 +39,6 @@ inline Eigen::Matrix<double, 1, 3> ang_left(const Mat3& R, const Vec3& arm, cons
 }
 }  // namespace
 
-Mat3x12 VecJet::full() const {
-  Mat3x12 J = Mat3x12::Zero();
-  for (int s = 0; s < 2; ++s) {
-    J.block<3, 3>(0, 6 * s).diagonal().setConstant(lin[s]);
-    if (has_ang[s]) {
-      const Vec3& a = arm[s];
-      Mat3 sk;
-      sk << 0, -a[2], a[1], a[2], 0, -a[0], -a[1], a[0], 0;
-      J.block<3, 3>(0, 6 * s + 3).noalias() = -sk * *R[s];
-    }
-  }
-  return J;
-}
-
 Row12 VecJet::left(const Vec3& n) const {
   Row12 r;
   for (int s = 0; s < 2; ++s) {
@@ -128,45 +114,6 @@ ScalarJet dot(const VecJet& a, const VecJet& b) {
   return s;
 }
 
-ScalarJet component(const VecJet& a, int k) {
-  ScalarJet s;
-  s.val = a.val[k];
-  s.rate = a.rate[k];
-  s.bias = a.bias[k];
-  for (int sl = 0; sl < 2; ++sl) {
-    s.J.segment<3>(6 * sl).setZero();
-    s.J[6 * sl + k] = a.lin[sl];
-    if (a.has_ang[sl]) {
-      // arm x e_k
-      const Vec3& r = a.arm[sl];
-      Vec3 c;
-      if (k == 0)
-        c = Vec3(0.0, r[2], -r[1]);
-      else if (k == 1)
-        c = Vec3(-r[2], 0.0, r[0]);
-      else
-        c = Vec3(r[1], -r[0], 0.0);
-      s.J.segment<3>(6 * sl + 3) = (a.R[sl]->transpose() * c).transpose();
-    } else {
-      s.J.segment<3>(6 * sl + 3).setZero();
-    }
-  }
-  return s;
-}
-
-ScalarJet atan2_jet(const ScalarJet& s, const ScalarJet& c, bool value) {
-  // theta = atan2(s, c): theta' = (c s' - s c') / r^2, and the bias follows from differentiating
-  // once more: (c s_bias - s c_bias) / r^2 - 2 theta' (c c' + s s') / r^2
-  ScalarJet t;
-  const double r2 = s.val * s.val + c.val * c.val;
-  t.val = value ? std::atan2(s.val, c.val) : 0.0;
-  t.rate = (c.val * s.rate - s.val * c.rate) / r2;
-  t.J = (c.val * s.J - s.val * c.J) / r2;
-  t.bias = (c.val * s.bias - s.val * c.bias) / r2 -
-           2.0 * t.rate * (c.val * c.rate + s.val * s.rate) / r2;
-  return t;
-}
-
 SepJet sep_jet(const BodyKin& ka, const Vec3& sa, const BodyKin& kb, const Vec3& sb) {
   SepJet d;
   d.ra.noalias() = ka.R * sa;
@@ -192,19 +139,6 @@ ScalarJet dot_axis_sep(const AxisJet& p, const Mat3& Ra, const SepJet& d, const 
   return s;
 }
 
-VecJet joint_axis_jet(const Model& m, const std::vector<BodyKin>& kin, int joint, int side,
-                      int axis) {
-  const Joint& jt = m.joints[joint];
-  if (side == 0) return direction_jet(kin_of(kin, jt.parent), jt.frame_parent.col(axis), 0);
-  return direction_jet(kin_of(kin, jt.child), jt.frame_child.col(axis), 1);
-}
-
-VecJet joint_separation_jet(const Model& m, const std::vector<BodyKin>& kin, int joint) {
-  const Joint& jt = m.joints[joint];
-  return difference(point_jet(kin_of(kin, jt.child), jt.point_child, 1),
-                    point_jet(kin_of(kin, jt.parent), jt.point_parent, 0));
-}
-
 ScalarJet coord_jet(const Model& m, const std::vector<BodyKin>& kin, int coord, bool value) {
   const Coord& c = m.coords[coord];
   if (c.angular) {
@@ -215,8 +149,9 @@ ScalarJet coord_jet(const Model& m, const std::vector<BodyKin>& kin, int coord, 
     const AxisJet xa = axis_jet(ka, jt.frame_parent.col(0));
     const AxisJet ya = axis_jet(ka, jt.frame_parent.col(1));
     const AxisJet xb = axis_jet(kb, jt.frame_child.col(0));
-    // theta = atan2(s, c) with s = ya . xb, c = xa . xb (atan2_jet of the two dot_axes jets,
-    // with both Jacobians folded into one R^T product per side)
+    // theta = atan2(s, c) with s = ya . xb, c = xa . xb: theta' = (c s' - s c') / r^2 and
+    // bias (c s_bias - s c_bias) / r^2 - 2 theta' (c c' + s s') / r^2; the two dot products'
+    // Jacobians (dot_axes) folded into one R^T product per side
     const double sv = ya.val.dot(xb.val), cv = xa.val.dot(xb.val);
     const double sr = ya.rate.dot(xb.val) + ya.val.dot(xb.rate);
     const double cr = xa.rate.dot(xb.val) + xa.val.dot(xb.rate);

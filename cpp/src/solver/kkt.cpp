@@ -12,8 +12,8 @@ namespace armdyn {
 KktSolver::KktSolver(const Model& m)
     : m_(m),
       tmp_nv_(VecX::Zero(m.nv)),
-      tmp_nc_(VecX::Zero(m.nc)),
       b_(VecX::Zero(m.nc)),
+      tmp_nc_(VecX::Zero(m.nc)),
       w_(VecX::Zero(m.nc)),
       tmp2_(VecX::Zero(m.nc)),
       ref_r_(VecX::Zero(m.nc)),

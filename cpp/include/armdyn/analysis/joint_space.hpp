@@ -14,8 +14,8 @@ namespace armdyn {
 
 class Engine;
 
-/// Per-body scratch of state_from_joints (world rotation, position, velocity, angular velocity),
-/// kept by callers that evaluate repeatedly so that no call allocates.
+/// Per-body scratch of state_from_joints (the bodies' kinematics), kept by callers that evaluate
+/// repeatedly so that no call allocates.
 struct TreeFkWork {
   std::vector<BodyKin> kin;
 };
@@ -57,5 +57,7 @@ class JointSpaceForwardDynamics {
 
 /// Check that the model supports joint-space calls; throws ModelError naming the reason.
 void require_joint_space(const Model& m, const char* what);
+/// Check a joint-space vector's length (n) and values; throws ModelError "fn: name ...".
+void check_joint_vector(Eigen::Ref<const VecX> x, long n, const char* fn, const char* name);
 
 }  // namespace armdyn

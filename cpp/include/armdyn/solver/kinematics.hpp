@@ -27,15 +27,14 @@ struct BodyKin {
 /// columns are lin[s] * I (points: +-1, directions: 0) and the angular-velocity columns
 /// -skew(arm[s]) R_s (present when has_ang[s]), where R_s is the slot body's rotation and arm[s]
 /// the world lever of the body-fixed vector (-R skew(a) = -skew(R a) R). Dot products and
-/// components then cost a cross product and one R^T product per slot.
+/// left(n) then cost a cross product and one R^T product per slot. The general form, for
+/// spring-dampers and distance joints; joint rows use the fused AxisJet and SepJet below.
 struct VecJet {
   Vec3 val, rate, bias;
   double lin[2] = {0.0, 0.0};
   bool has_ang[2] = {false, false};
   Vec3 arm[2];
   const Mat3* R[2] = {nullptr, nullptr};
-  /// The full 3 x 12 Jacobian.
-  Mat3x12 full() const;
   /// n^T J (the Jacobian of n . vector for a fixed n).
   Row12 left(const Vec3& n) const;
 };
@@ -57,9 +56,6 @@ VecJet direction_jet(const BodyKin& k, const Vec3& a, int slot);
 VecJet point_jet(const BodyKin& k, const Vec3& s, int slot);
 VecJet difference(const VecJet& p, const VecJet& q);  ///< p - q
 ScalarJet dot(const VecJet& a, const VecJet& b);
-ScalarJet component(const VecJet& a, int k);
-/// atan2(s, c) of two scalar jets (value left 0 when !value: rate, Jacobian and bias only).
-ScalarJet atan2_jet(const ScalarJet& s, const ScalarJet& c, bool value = true);
 
 /// A world direction fixed in a body: its value, rate W x p and bias W x (W x p). The cheap
 /// form of a direction jet for rows that only dot two such directions.
@@ -96,12 +92,6 @@ SepJet sep_jet(const BodyKin& ka, const Vec3& sa, const BodyKin& kb, const Vec3&
 /// p . d for a direction p fixed in body A (slot 0) and the separation d of A's and B's points:
 /// the same jet as dot(direction_jet(A), difference(point_jet(B), point_jet(A))).
 ScalarJet dot_axis_sep(const AxisJet& p, const Mat3& Ra, const SepJet& d, const Mat3& Rb);
-
-/// Joint frame axes of joint j in world, on the parent (side 0) or child (side 1) body.
-VecJet joint_axis_jet(const Model& m, const std::vector<BodyKin>& kin, int joint, int side,
-                      int axis);
-/// Vector from the parent's joint point to the child's joint point, world.
-VecJet joint_separation_jet(const Model& m, const std::vector<BodyKin>& kin, int joint);
 
 /// Jet of joint coordinate c (angle in (-pi, pi] or displacement) in the Jacobian slots of its
 /// joint's (parent, child).
