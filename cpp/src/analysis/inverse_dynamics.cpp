@@ -196,7 +196,7 @@ InverseDynamicsResult inverse_dynamics_driven(const Model& m, const std::vector<
     for (int c = 0; c < nco; ++c) {
       const ScalarJet s = coord_jet(m, e.kin(), c);
       double qv = s.val;
-      if (m.coords[c].angular && k > 0) qv = qprev[c] + std::remainder(s.val - qprev[c], 2 * M_PI);
+      if (m.coords[c].angular && k > 0) qv = qprev[c] + wrap_angle(s.val - qprev[c]);
       qprev[c] = qv;
       out.q.push_back(qv);
       out.qd.push_back(s.rate);

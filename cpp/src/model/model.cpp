@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "armdyn/errors.hpp"
+#include "armdyn/math/angles.hpp"
 
 namespace armdyn {
 
@@ -167,9 +168,7 @@ double gear_force(const GearPair& g, double s, double sd, double& penetration) {
 
 double coord_force_value(const CoordForce& cf, bool angular, double q, double qdot, double t,
                          double z, double* zdot) {
-  auto diff = [&](double a, double b) {
-    return angular ? std::remainder(a - b, 2.0 * M_PI) : a - b;
-  };
+  auto diff = [&](double a, double b) { return angular ? wrap_angle(a - b) : a - b; };
   double tau = -cf.stiffness * diff(q, cf.rest) - cf.damping * qdot;
   if (cf.coulomb > 0) tau -= cf.coulomb * std::tanh(qdot / cf.v_smooth);
   if (cf.has_input) tau += cf.input.eval(t).y;

@@ -179,11 +179,12 @@ inline void with_rows(int n, F&& f) {
 }
 
 // T(sg x sh) += JW(sg x NC columns of a row-major sg x 6) Jh(sh x NC, rows `stride` apart)^T,
-// column-major T; diag: lower triangle only. SG > 0 fixes sg at compile time.
-template <int SG, bool DIAG, int NC>
+// column-major T; DIAG: lower triangle only. SG, SH > 0 fix the sizes at compile time.
+template <int SG, int SH, bool DIAG, int NC>
 inline void assemble(double* __restrict__ t, const double* __restrict__ jw,
-                     const double* __restrict__ jh0, long stride, int sg_rt, int sh) {
+                     const double* __restrict__ jh0, long stride, int sg_rt, int sh_rt) {
   const int sg = SG > 0 ? SG : sg_rt;
+  const int sh = SH > 0 ? SH : sh_rt;
   for (int c = 0; c < sh; ++c) {
     const double* __restrict__ jh = jh0 + c * stride;
     for (int r = DIAG ? c : 0; r < sg; ++r) {
@@ -195,38 +196,65 @@ inline void assemble(double* __restrict__ t, const double* __restrict__ jw,
   }
 }
 
-// T(na x nb) -= La(na x s) Lb(nb x s)^T, column-major; diag: lower triangle only (na == nb).
-// NA > 0 fixes na at compile time.
-template <int NA>
+// One body's term of the block (g, h): T(sg x sh) += (J_g W^-1)(sg x 6) J_h(sh x 6)^T. The
+// rotational columns by products; the translational ones through the point-row structure
+// (rows 0..2 of the block are eg I, resp. eh I, for eg, eh = +-1; 0: no such structure).
+template <int SG, int SH, bool DIAG>
+inline void assemble_pair(double* __restrict__ t, const double* __restrict__ jw,
+                          const double* __restrict__ jh, long stride, int sg_rt, int sh_rt,
+                          double eg, double eh, double wl) {
+  const int sg = SG > 0 ? SG : sg_rt;
+  const int sh = SH > 0 ? SH : sh_rt;
+  if (eg == 0.0 && eh == 0.0) {
+    assemble<SG, SH, DIAG, 6>(t, jw, jh, stride, sg, sh);
+    return;
+  }
+  assemble<SG, SH, DIAG, 3>(t, jw + 3, jh + 3, stride, sg, sh);
+  if (eg != 0.0 && eh != 0.0) {
+    for (int i = 0; i < 3; ++i) t[i + i * sg] += eg * eh * wl;
+  } else if (eg != 0.0) {
+    // (J_g W^-1)_lin = eg w [I; 0]: T(i, c) += eg w J_h(c, i) for i < 3
+    for (int c = 0; c < sh; ++c)
+      for (int i = 0; i < 3; ++i) t[i + c * sg] += eg * wl * jh[c * stride + i];
+  } else {
+    // (J_h)_lin = eh [I; 0]: T(r, i) += eh (J_g W^-1)(r, i) for i < 3
+    for (int i = 0; i < 3; ++i)
+      for (int r = 0; r < sg; ++r) t[r + i * sg] += eh * jw[6 * r + i];
+  }
+}
+
+// T(na x nb) -= La(na x s) Lb(nb x s)^T, column-major; DIAG: lower triangle only (na == nb).
+// NA, NB, S > 0 fix the sizes at compile time (fully unrolled for the common joint blocks).
+template <int NA, int NB, int S, bool DIAG>
 inline void schur_update(double* __restrict__ T, const double* __restrict__ La,
-                         const double* __restrict__ Lb, int na_rt, int nb, int s, bool diag) {
+                         const double* __restrict__ Lb, int na_rt, int nb_rt, int s_rt) {
   const int na = NA > 0 ? NA : na_rt;
+  const int nb = NB > 0 ? NB : nb_rt;
+  const int s = S > 0 ? S : s_rt;
+  // each entry of T is read and written once (a sum over p in registers): no store-to-load
+  // stalls between the rank-1 passes
   for (int cc = 0; cc < nb; ++cc) {
     double* __restrict__ t = T + cc * na;
-    for (int p = 0; p < s; ++p) {
-      const double lb = Lb[cc + p * nb];
-      const double* __restrict__ la = La + p * na;
-      if (diag) {
-        for (int r = cc; r < na; ++r) t[r] -= la[r] * lb;
-      } else {
-        for (int r = 0; r < na; ++r) t[r] -= la[r] * lb;
-      }
+    for (int r = DIAG ? cc : 0; r < na; ++r) {
+      double x = La[r] * Lb[cc];
+      for (int p = 1; p < s; ++p) x += La[r + p * na] * Lb[cc + p * nb];
+      t[r] -= x;
     }
   }
 }
 // X(si x s) <- X L^-T with L (s x s) lower triangular, inv its reciprocal diagonal.
-template <int SI>
+template <int SI, int S>
 inline void trsm_right(double* __restrict__ X, const double* __restrict__ L,
-                       const double* __restrict__ inv, int si_rt, int s) {
+                       const double* __restrict__ inv, int si_rt, int s_rt) {
   const int si = SI > 0 ? SI : si_rt;
+  const int s = S > 0 ? S : s_rt;
   for (int j = 0; j < s; ++j) {
     double* __restrict__ xj = X + j * si;
-    for (int p = 0; p < j; ++p) {
-      const double l = L[j + p * s];
-      const double* __restrict__ xp = X + p * si;
-      for (int r = 0; r < si; ++r) xj[r] -= l * xp[r];
+    for (int r = 0; r < si; ++r) {
+      double x = xj[r];
+      for (int p = 0; p < j; ++p) x -= L[j + p * s] * X[r + p * si];
+      xj[r] = x * inv[j];
     }
-    for (int r = 0; r < si; ++r) xj[r] *= inv[j];
   }
 }
 }  // namespace
@@ -264,30 +292,18 @@ bool BlockSparseSchur::factor(const ConstraintEval& ce, const std::vector<Mat6>*
     const double* jh = bh.J.data() + 6 * a.sh;
     const long stride = bh.J.cols();
     double* t = v + a.target;
-    const bool diag = a.g == a.h;
-    if (diag)
-      assemble<0, true, 3>(t, jw + 3, jh + 3, stride, sg, sh);
-    else if (sg == 5)  // joint blocks of 5 rows (revolute, prismatic) against any
-      assemble<5, false, 3>(t, jw + 3, jh + 3, stride, 5, sh);
-    else
-      assemble<0, false, 3>(t, jw + 3, jh + 3, stride, sg, sh);
     const double eg = bg.point_rows ? (a.sg == 0 ? -1.0 : 1.0) : 0.0;
     const double eh = bh.point_rows ? (a.sh == 0 ? -1.0 : 1.0) : 0.0;
     const double wl = winv ? (*winv)[a.body](0, 0) : 1.0;
-    if (eg != 0.0 && eh != 0.0) {
-      for (int i = 0; i < 3; ++i) t[i + i * sg] += eg * eh * wl;
-    } else if (eg != 0.0) {
-      // (J_g W^-1)_lin = eg w [I; 0]: T(i, c) += eg w J_h(c, i) for i < 3
-      for (int c = 0; c < sh; ++c)
-        for (int i = 0; i < 3; ++i) t[i + c * sg] += eg * wl * jh[c * stride + i];
-    } else if (eh != 0.0) {
-      // (J_h)_lin = eh [I; 0]: T(r, i) += eh (J_g W^-1)(r, i) for i < 3
-      for (int i = 0; i < 3; ++i)
-        for (int r = 0; r < sg; ++r) t[r + i * sg] += eh * jw[6 * r + i];
-    } else if (diag) {
-      assemble<0, true, 3>(t, jw, jh, stride, sg, sh);
+    if (a.g == a.h) {
+      with_rows(sg,
+                [&](auto N) { assemble_pair<N, N, true>(t, jw, jh, stride, sg, sh, eg, eh, wl); });
     } else {
-      assemble<0, false, 3>(t, jw, jh, stride, sg, sh);
+      with_rows(sg, [&](auto NG) {
+        with_rows(sh, [&](auto NH) {
+          assemble_pair<NG, NH, false>(t, jw, jh, stride, sg, sh, eg, eh, wl);
+        });
+      });
     }
   }
   const int np = static_cast<int>(col_.size());
@@ -315,30 +331,40 @@ bool BlockSparseSchur::factor_column(int k) {
   double* __restrict__ v = val_.data();
   double* __restrict__ L = v + c.diag;
   double* __restrict__ inv = inv_diag_.data() + c.row0;
-  // dense Cholesky of the diagonal block (lower triangle), pivots against the row's diagonal
+  // dense Cholesky of the diagonal block, pivots against the row's diagonal. Computed as
+  // L D L^T first (the unscaled columns U = L D in the lower triangle, L = U D^-1 in the upper
+  // one, D in inv), so that only one division per pivot lies on the chain from one pivot to the
+  // next; the square roots and the scaling to the Cholesky factor follow off that chain.
   for (int j = 0; j < s; ++j) {
     double d = L[j + j * s];
-    for (int p = 0; p < j; ++p) d -= L[j + p * s] * L[j + p * s];
+    for (int p = 0; p < j; ++p) d -= L[j + p * s] * L[p + j * s];
     const double d0 = diag0_[c.row0 + j];
     if (!(d > 1e-12 * d0)) return false;
     if (d < min_rel_ * d0) min_rel_ = d / d0;  // (divides only at a new minimum)
     // nearly dependent: the pivot at the shift's level (relative to the diagonal)
     if (shift_ > 0.0 && d < 10.0 * shift_ * d0) weak_.push_back(c.row0 + j);
-    const double l = std::sqrt(d);
-    L[j + j * s] = l;
-    inv[j] = 1.0 / l;
+    inv[j] = d;
+    const double id = 1.0 / d;
     for (int i = j + 1; i < s; ++i) {
       double x = L[i + j * s];
-      for (int p = 0; p < j; ++p) x -= L[i + p * s] * L[j + p * s];
-      L[i + j * s] = x * inv[j];
+      for (int p = 0; p < j; ++p) x -= L[i + p * s] * L[p + j * s];
+      L[i + j * s] = x;
+      L[j + i * s] = x * id;
     }
+  }
+  // Cholesky: L_ij = U_ij / sqrt(d_j), L_jj = sqrt(d_j)
+  for (int j = 0; j < s; ++j) {
+    const double l = std::sqrt(inv[j]);
+    L[j + j * s] = l;
+    inv[j] = 1.0 / l;
+    for (int i = j + 1; i < s; ++i) L[i + j * s] *= inv[j];
   }
   // blocks below: X <- X L_kk^-T, column by column
   for (int e = 0; e < c.nsub; ++e) {
     const Sub& sb = sub_[c.sub_begin + e];
     const int si = col_[sb.pos].size;
     double* X = v + sb.off;
-    with_rows(si, [&](auto N) { trsm_right<N>(X, L, inv, si, s); });
+    with_rows(si, [&](auto N) { trsm_right<N, S>(X, L, inv, si, s); });
   }
   // Schur updates of the later blocks: T(a, b) -= L(a, k) L(b, k)^T (lower triangle of the
   // diagonal blocks), with the row count of the common joint blocks fixed at compile time
@@ -350,29 +376,36 @@ bool BlockSparseSchur::factor_column(int k) {
     const double* La = v + sa.off;
     const double* Lb = v + sb.off;
     double* T = v + u.target;
-    const bool diag = u.a == u.b;
-    with_rows(na, [&](auto N) { schur_update<N>(T, La, Lb, na, nb, s, diag); });
+    if (u.a == u.b) {
+      with_rows(na, [&](auto N) { schur_update<N, N, S, true>(T, La, Lb, na, na, s); });
+    } else {
+      with_rows(na, [&](auto NA) {
+        with_rows(nb, [&](auto NB) { schur_update<NA, NB, S, false>(T, La, Lb, na, nb, s); });
+      });
+    }
   }
   return true;
 }
 
 namespace {
 // y(ni) -= X(ni x s) x(s), X column-major
-template <int NI>
+template <int NI, int S>
 inline void sub_gemv(double* __restrict__ y, const double* __restrict__ X,
-                     const double* __restrict__ xk, int ni_rt, int s) {
+                     const double* __restrict__ xk, int ni_rt, int s_rt) {
   const int ni = NI > 0 ? NI : ni_rt;
-  for (int j = 0; j < s; ++j) {
-    const double xj = xk[j];
-    const double* __restrict__ col = X + j * ni;
-    for (int r = 0; r < ni; ++r) y[r] -= col[r] * xj;
+  const int s = S > 0 ? S : s_rt;
+  for (int r = 0; r < ni; ++r) {
+    double t = X[r] * xk[0];
+    for (int j = 1; j < s; ++j) t += X[r + j * ni] * xk[j];
+    y[r] -= t;
   }
 }
 // xk(s) -= X(ni x s)^T y(ni)
-template <int NI>
+template <int NI, int S>
 inline void sub_gemv_t(double* __restrict__ xk, const double* __restrict__ X,
-                       const double* __restrict__ y, int ni_rt, int s) {
+                       const double* __restrict__ y, int ni_rt, int s_rt) {
   const int ni = NI > 0 ? NI : ni_rt;
+  const int s = S > 0 ? S : s_rt;
   for (int j = 0; j < s; ++j) {
     const double* __restrict__ col = X + j * ni;
     double t = 0.0;
@@ -382,46 +415,55 @@ inline void sub_gemv_t(double* __restrict__ xk, const double* __restrict__ X,
 }
 }  // namespace
 
+template <int S>
+void BlockSparseSchur::forward_column(int k, double* xd) const {
+  const Column& c = col_[k];
+  const int s = S > 0 ? S : c.size;
+  const double* __restrict__ L = val_.data() + c.diag;
+  double* __restrict__ xk = xd + c.row0;
+  const double* __restrict__ inv = inv_diag_.data() + c.row0;
+  for (int j = 0; j < s; ++j) {
+    double t = xk[j];
+    for (int p = 0; p < j; ++p) t -= L[j + p * s] * xk[p];
+    xk[j] = t * inv[j];
+  }
+  for (int e = 0; e < c.nsub; ++e) {
+    const Sub& sb = sub_[c.sub_begin + e];
+    const int ni = col_[sb.pos].size;
+    double* xi = xd + col_[sb.pos].row0;
+    const double* X = val_.data() + sb.off;
+    with_rows(ni, [&](auto N) { sub_gemv<N, S>(xi, X, xk, ni, s); });
+  }
+}
+
+template <int S>
+void BlockSparseSchur::backward_column(int k, double* xd) const {
+  const Column& c = col_[k];
+  const int s = S > 0 ? S : c.size;
+  const double* __restrict__ L = val_.data() + c.diag;
+  double* __restrict__ xk = xd + c.row0;
+  for (int e = 0; e < c.nsub; ++e) {
+    const Sub& sb = sub_[c.sub_begin + e];
+    const int ni = col_[sb.pos].size;
+    const double* xi = xd + col_[sb.pos].row0;
+    const double* X = val_.data() + sb.off;
+    with_rows(ni, [&](auto N) { sub_gemv_t<N, S>(xk, X, xi, ni, s); });
+  }
+  const double* __restrict__ inv = inv_diag_.data() + c.row0;
+  for (int j = s - 1; j >= 0; --j) {
+    double t = xk[j];
+    for (int p = j + 1; p < s; ++p) t -= L[p + j * s] * xk[p];
+    xk[j] = t * inv[j];
+  }
+}
+
 void BlockSparseSchur::solve_in_place(VecX& x) const {
-  const double* v = val_.data();
   double* xd = x.data();
   const int np = static_cast<int>(col_.size());
-  for (int k = 0; k < np; ++k) {
-    const Column& c = col_[k];
-    const int s = c.size;
-    const double* L = v + c.diag;
-    double* xk = xd + c.row0;
-    const double* inv = inv_diag_.data() + c.row0;
-    for (int j = 0; j < s; ++j) {
-      double t = xk[j];
-      for (int p = 0; p < j; ++p) t -= L[j + p * s] * xk[p];
-      xk[j] = t * inv[j];
-    }
-    for (int e = 0; e < c.nsub; ++e) {
-      const Sub& sb = sub_[c.sub_begin + e];
-      const Column& ci = col_[sb.pos];
-      double* xi = xd + ci.row0;
-      with_rows(ci.size, [&](auto N) { sub_gemv<N>(xi, v + sb.off, xk, ci.size, s); });
-    }
-  }
-  for (int k = np - 1; k >= 0; --k) {
-    const Column& c = col_[k];
-    const int s = c.size;
-    const double* L = v + c.diag;
-    double* xk = xd + c.row0;
-    for (int e = 0; e < c.nsub; ++e) {
-      const Sub& sb = sub_[c.sub_begin + e];
-      const Column& ci = col_[sb.pos];
-      const double* xi = xd + ci.row0;
-      with_rows(ci.size, [&](auto N) { sub_gemv_t<N>(xk, v + sb.off, xi, ci.size, s); });
-    }
-    const double* inv = inv_diag_.data() + c.row0;
-    for (int j = s - 1; j >= 0; --j) {
-      double t = xk[j];
-      for (int p = j + 1; p < s; ++p) t -= L[p + j * s] * xk[p];
-      xk[j] = t * inv[j];
-    }
-  }
+  for (int k = 0; k < np; ++k)
+    with_rows(col_[k].size, [&](auto N) { this->forward_column<decltype(N)::value>(k, xd); });
+  for (int k = np - 1; k >= 0; --k)
+    with_rows(col_[k].size, [&](auto N) { this->backward_column<decltype(N)::value>(k, xd); });
 }
 
 }  // namespace armdyn

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "armdyn/math/angles.hpp"
+
 namespace armdyn {
 
 namespace {
@@ -38,8 +40,6 @@ inline void put_point_rows(ConstraintEval& ce, ConstraintBlock& b, const BodyKin
   }
   if (with_xi) ce.xi.segment<3>(b.row0) = d.bias;
 }
-
-inline double wrap_angle(double a) { return std::remainder(a, 2.0 * M_PI); }
 
 }  // namespace
 
@@ -178,7 +178,7 @@ void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t,
       const double r = k == 0 ? g.r_a : g.r_b;
       const ScalarJet& q = ce.coord_cache ? ce.coord_cache->get(m, kin, c) : coord_jet(m, kin, c);
       const double ref = ce.track_ref ? (*ce.track_ref)[c] : 0.0;
-      f += r * (ref + std::remainder(q.val - ref, 2.0 * M_PI));
+      f += r * (ref + wrap_angle(q.val - ref));
       xi += r * q.bias;
       const Joint& j = m.joints[m.coords[c].joint];
       const int ends[2] = {j.parent, j.child};

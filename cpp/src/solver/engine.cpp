@@ -10,7 +10,6 @@
 namespace armdyn {
 
 namespace {
-inline double wrap_angle(double a) { return std::remainder(a, 2.0 * M_PI); }
 std::string short_number(double x) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%g", x);

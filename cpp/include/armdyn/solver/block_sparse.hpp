@@ -91,6 +91,11 @@ class BlockSparseSchur {
   /// Factor block column k (S: its size at compile time, 0: at run time).
   template <int S>
   bool factor_column(int k);
+  /// The forward (L) and backward (L^T) substitutions of block column k on x.
+  template <int S>
+  void forward_column(int k, double* x) const;
+  template <int S>
+  void backward_column(int k, double* x) const;
   int nrows_ = 0;
 };
 

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "armdyn/math/angles.hpp"
 #include "armdyn/solver/kkt.hpp"
 #include "armdyn/solver/tree_sweep.hpp"
 
@@ -82,7 +83,7 @@ class Engine {
   /// Unwrapped value of a tracked angle coordinate (gears) from its raw (wrapped) value,
   /// continuous with the value at the last projection.
   double tracked(int coord, double raw) const {
-    return track_ref_[coord] + std::remainder(raw - track_ref_[coord], 2.0 * M_PI);
+    return track_ref_[coord] + wrap_angle(raw - track_ref_[coord]);
   }
   /// Gear mesh displacement s, rate and penetration |s| - backlash/2 at the loaded state.
   void gear_mesh(int g, double& s, double& sd, double& penetration) const;
