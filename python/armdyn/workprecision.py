@@ -12,7 +12,9 @@ same problem in the same process:
 - MuJoCo (RK4 and implicit Euler at fixed steps, ``mj_step`` looping in C between outputs)
   where the problem is a tree (A01; the UR5 through MuJoCo's own URDF import);
 - Exudyn (generalized-alpha, fixed steps) on a redundant-coordinate model of the UR5
-  (:mod:`armdyn.peer_exudyn`; Exudyn's explicit solvers do not take its joint constraints).
+  (:mod:`armdyn.peer_exudyn`; Exudyn's explicit solvers do not take its joint constraints);
+- MuJoCo (RK4, stiff ``connect`` loop closures) and Exudyn (redundant coordinates) models of the
+  closed-loop squeezer and A02 (:mod:`armdyn.peer_closed_loops`).
 
 Errors are measured as in the IFToMM benchmark: the largest absolute deviation over the output
 grid of the problem's reference quantity (positions of a point [m], or angles [rad]).
@@ -236,6 +238,12 @@ def _ur5_more_peers(problem, ref, quick, repeats):
     return peer_exudyn.workprecision_curves(problem, ref, quick, repeats)
 
 
+def _closed_loop_peers(problem, ref, quick, repeats):
+    from armdyn import peer_closed_loops
+
+    return peer_closed_loops.workprecision_curves(problem, ref, quick, repeats)
+
+
 _A01_XML = """<mujoco><option gravity="0 -9.81 0" timestep="0.001"/>
 <worldbody><body name="p"><joint name="pivot" type="hinge" axis="0 0 1"/>
 <inertial pos="1 0 0" mass="1" diaginertia="1e-12 1e-12 1e-12"/></body></worldbody></mujoco>"""
@@ -285,6 +293,7 @@ PROBLEMS: dict[str, Problem] = {
         scipy_rhs=lambda: references.a02_rhs(40),
         scipy_label="the reference's one-DOF branch ODE",
         scipy_observe=lambda y: np.column_stack([np.cos(y[0]), np.sin(y[0])]),
+        more_peers=_closed_loop_peers,
     ),
     "five_dof": Problem(
         name="five_dof",
@@ -354,6 +363,7 @@ PROBLEMS: dict[str, Problem] = {
         scipy_rhs=references.squeezer_rhs,
         reference_check=_squeezer_check,
         scipy_observe=lambda y: y[:7].T,
+        more_peers=_closed_loop_peers,
     ),
 }
 

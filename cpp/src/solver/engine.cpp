@@ -281,7 +281,7 @@ void Engine::aux_rates(double t, double* zdot) const {
 void Engine::commit_tracking() {
   // every angle coordinate is followed over turns (gears need it; outputs use it)
   for (int c = 0; c < static_cast<int>(m_.coords.size()); ++c)
-    if (m_.coords[c].angular) track_ref_[c] = tracked(c, coord_jet(m_, kin_, c).val);
+    if (m_.coords[c].angular) track_ref_[c] = tracked(c, coord_value(m_, kin_, c));
 }
 
 void Engine::gear_mesh(int gi, double& s, double& sd, double& penetration) const {
@@ -326,8 +326,8 @@ void Engine::energy(const double* u, const double* v, double& ke, double& pe) {
   }
   for (const CoordForce& cf : m_.coord_forces) {
     if (cf.stiffness == 0.0) continue;
-    const ScalarJet q = coord_jet(m_, kin_, cf.coord);
-    const double dq = m_.coords[cf.coord].angular ? wrap_angle(q.val - cf.rest) : q.val - cf.rest;
+    const double q = coord_value(m_, kin_, cf.coord);
+    const double dq = m_.coords[cf.coord].angular ? wrap_angle(q - cf.rest) : q - cf.rest;
     pe += 0.5 * cf.stiffness * dq * dq;
   }
 }

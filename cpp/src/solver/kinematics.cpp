@@ -139,6 +139,20 @@ ScalarJet dot_axis_sep(const AxisJet& p, const Mat3& Ra, const SepJet& d, const 
   return s;
 }
 
+double coord_value(const Model& m, const std::vector<BodyKin>& kin, int coord) {
+  const Coord& c = m.coords[coord];
+  const Joint& jt = m.joints[c.joint];
+  const BodyKin& ka = kin_of(kin, jt.parent);
+  const BodyKin& kb = kin_of(kin, jt.child);
+  if (c.angular) {
+    const Vec3 xb = kb.R * jt.frame_child.col(0);
+    return std::atan2((ka.R * jt.frame_parent.col(1)).dot(xb),
+                      (ka.R * jt.frame_parent.col(0)).dot(xb));
+  }
+  const Vec3 d = kb.x + kb.R * jt.point_child - ka.x - ka.R * jt.point_parent;
+  return (ka.R * jt.frame_parent.col(2)).dot(d);
+}
+
 ScalarJet coord_jet(const Model& m, const std::vector<BodyKin>& kin, int coord, bool value) {
   const Coord& c = m.coords[coord];
   if (c.angular) {

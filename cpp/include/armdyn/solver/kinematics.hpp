@@ -97,6 +97,8 @@ ScalarJet dot_axis_sep(const AxisJet& p, const Mat3& Ra, const SepJet& d, const 
 /// joint's (parent, child).
 /// value = false skips the angle itself (rate, Jacobian and bias only).
 ScalarJet coord_jet(const Model& m, const std::vector<BodyKin>& kin, int coord, bool value = true);
+/// The value of coord_jet alone (positions only: no rates, Jacobian or bias).
+double coord_value(const Model& m, const std::vector<BodyKin>& kin, int coord);
 
 /// Joint-coordinate jets (with values) computed at most once per kinematic state: a coordinate
 /// read by several elements (an ideal gear row, a motor, a backlash pair) is evaluated once.
