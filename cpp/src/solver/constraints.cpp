@@ -217,14 +217,49 @@ void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t,
   }
 }
 
+namespace {
+// the rows of slot s of a block (R rows at compile time, 0: at run time), row-major, rows
+// 6 kMaxBlockBodies apart
+template <int R>
+using SlotMap = Eigen::Map<
+    const Eigen::Matrix<double, R == 0 ? Eigen::Dynamic : R, 6, Eigen::RowMajor, R == 0 ? 6 : R, 6>,
+    0, Eigen::OuterStride<6 * kMaxBlockBodies>>;
+
+template <int R>
+inline void block_times(const ConstraintBlock& b, const double* x, double* y) {
+  const int n = R > 0 ? R : b.nrows;
+  Eigen::Map<Eigen::Matrix<double, R == 0 ? Eigen::Dynamic : R, 1, 0, R == 0 ? 6 : R, 1>> yb(y, n);
+  yb.setZero();
+  for (int s = 0; s < b.nbody; ++s)
+    if (b.body[s] != kGround)
+      yb.noalias() +=
+          SlotMap<R>(b.J.data() + 6 * s, n, 6) * Eigen::Map<const Vec6>(x + 6 * b.body[s]);
+}
+
+template <int R>
+inline void block_transpose_times(const ConstraintBlock& b, const double* y, double* x) {
+  const int n = R > 0 ? R : b.nrows;
+  Eigen::Map<const Eigen::Matrix<double, R == 0 ? Eigen::Dynamic : R, 1, 0, R == 0 ? 6 : R, 1>> yb(
+      y, n);
+  for (int s = 0; s < b.nbody; ++s)
+    if (b.body[s] != kGround)
+      Eigen::Map<Vec6>(x + 6 * b.body[s]).noalias() +=
+          SlotMap<R>(b.J.data() + 6 * s, n, 6).transpose() * yb;
+}
+}  // namespace
+
 void zeta_times(const ConstraintEval& ce, int nrows, Eigen::Ref<const VecX> x, VecX& y) {
+  // fixed-size kernels for the row counts of the common blocks (revolute and prismatic joints,
+  // gears and drives)
   for (const ConstraintBlock& b : ce.blocks) {
     if (b.row0 >= nrows) continue;
-    auto yb = y.segment(b.row0, b.nrows);
-    yb.setZero();
-    for (int s = 0; s < b.nbody; ++s)
-      if (b.body[s] != kGround)
-        yb.noalias() += b.J.middleCols<6>(6 * s) * x.segment<6>(6 * b.body[s]);
+    double* yb = y.data() + b.row0;
+    if (b.nrows == 5)
+      block_times<5>(b, x.data(), yb);
+    else if (b.nrows == 1)
+      block_times<1>(b, x.data(), yb);
+    else
+      block_times<0>(b, x.data(), yb);
   }
 }
 
@@ -232,10 +267,13 @@ void zeta_transpose_times(const ConstraintEval& ce, int nrows, Eigen::Ref<const 
   x.setZero();
   for (const ConstraintBlock& b : ce.blocks) {
     if (b.row0 >= nrows) continue;
-    for (int s = 0; s < b.nbody; ++s)
-      if (b.body[s] != kGround)
-        x.segment<6>(6 * b.body[s]).noalias() +=
-            b.J.middleCols<6>(6 * s).transpose() * y.segment(b.row0, b.nrows);
+    const double* yb = y.data() + b.row0;
+    if (b.nrows == 5)
+      block_transpose_times<5>(b, yb, x.data());
+    else if (b.nrows == 1)
+      block_transpose_times<1>(b, yb, x.data());
+    else
+      block_transpose_times<0>(b, yb, x.data());
   }
 }
 
