@@ -7,7 +7,7 @@
   Panda, a 5 s run, the 44-body geared arm, chains of 2–1000 bodies) and writes JSON + a plot.
 * ``armdyn workprecision [PROBLEM ...] [--quick] [--out DIR]`` sweeps tolerances on the standard
   problems (IFToMM A01, A02, Andrews' squeezer) and records error against CPU time for armdyn's
-  integrators and the peers (SciPy, MuJoCo), as JSON + a log-log plot per problem.
+  integrators and the peers (SciPy, MuJoCo, Exudyn), as JSON + a log-log plot per problem.
 * ``armdyn verify`` prints the solver's accuracy figures: pendulum period, energy and momentum
   conservation, constraint drift, and the cross-check against recursive Newton–Euler.
 """
