@@ -70,12 +70,13 @@ Exudyn (:func:`exudyn_squeezer`, :func:`exudyn_a02`)
     sample checked to lie on it. A02: GeneralizedAlpha passes the singular positions without
     ``linearSolver.ignoreSingularJacobian`` (the steps never land exactly on them and the factor
     never fails), so it stays off and a singular factor would show as a failure;
-    TrapezoidalIndex2 fails in Newton (no convergence after 25 iterations, step reduction
-    unavailable at fixed steps) near a singular position, e.g. at t = 2.7 s (h = 0.01 s),
-    1.25 s (h = 0.0125 s) or 1.245 s (h = 0.005 s), with or without that flag, full or modified
-    Newton, at Newton tolerances 1e-6 to 1e-10; GeneralizedAlpha fails the same way at the
-    largest step, h = 0.05 s (t = 5.55 s). Those runs are recorded as failed points with the
-    reason. The measured curves: ``armdyn workprecision a02`` (docs/results/workprecision).
+    TrapezoidalIndex2 fails in Newton (step reduction is unavailable at fixed steps) at the
+    first singular position, t ≈ 1.25 s, at every step of the sweep; GeneralizedAlpha fails the
+    same way at two of its steps (a02.json lists where and why). Hand trials while building this
+    module (with ``ignoreSingularJacobian``, full Newton, Newton tolerances 1e-6 to 1e-10; not
+    kept in the repository) did not get TrapezoidalIndex2 through. Failed runs are recorded as
+    failed points with the reason. The measured curves: ``armdyn workprecision a02``
+    (docs/results/workprecision).
 
     Checks: Exudyn's own initial-acceleration solve (``computeInitialAccelerations`` in
     ``InitializeSolver``) gives the reference's squeezer accelerations to 1e-14 relative and
@@ -99,6 +100,7 @@ import time
 
 import numpy as np
 
+from armdyn.peer_exudyn import _exudyn, implicit_settings, solve_checked
 from armdyn.scenes import standard
 
 SQUEEZER_JOINTS = ("beta", "Theta", "gamma", "Phi", "delta", "Omega", "epsilon")
@@ -352,13 +354,6 @@ def mujoco_a02(n: int = A02_N, phi0: float = np.pi / 2, speed: float = 1.0) -> M
 # -- Exudyn -----------------------------------------------------------------------------------
 
 
-def _exudyn():
-    import exudyn as exu
-    from exudyn import itemInterface as eii
-
-    return exu, eii
-
-
 class _Planar:
     """An Exudyn system of planar rigid bodies (node at the centre of mass) and revolute joints
     given by their world points in the starting configuration."""
@@ -463,19 +458,11 @@ class ExudynPeer:
         return planar, sensors, observed, angle0
 
     def _settings(self, t_end, n_steps, n_out, spectral_radius, newton_rtol):
-        from armdyn.peer_exudyn import _base_settings
-
         exu = _exudyn()[0]
-        ss = _base_settings(t_end, n_steps)
+        ss = implicit_settings(t_end, n_steps, t_end / n_out, spectral_radius, newton_rtol)
         if self.sparse:
             ss.linearSolver.solverType = exu.LinearSolverType.EigenSparse
         ss.linearSolver.ignoreSingularJacobian = self.ignore_singular
-        ss.solution.sensors.active = True
-        ss.solution.sensors.writePeriod = t_end / n_out
-        ss.timeIntegration.newton.relativeTolerance = newton_rtol
-        ss.timeIntegration.newton.absoluteTolerance = 1e-2 * newton_rtol
-        ss.timeIntegration.generalizedAlpha.spectralRadius = spectral_radius
-        ss.timeIntegration.generalizedAlpha.computeInitialAccelerations = True
         return ss
 
     def initial_accelerations(self) -> np.ndarray:
@@ -510,47 +497,19 @@ class ExudynPeer:
             raise ValueError(f"peer_closed_loops: Exudyn method {method!r} not in {EXUDYN_METHODS}")
         if n_steps % n_out:
             raise ValueError("peer_closed_loops: n_steps must be a multiple of n_out")
-        exu = _exudyn()[0]
         planar, sensors, _observed, angle0 = self.system()
         ss = self._settings(t_end, n_steps, n_out, spectral_radius, newton_rtol)
-        solver_type = getattr(exu.DynamicSolverType, method)
         t_out = np.linspace(0.0, t_end, n_out + 1)
         h = t_end / n_steps
         mbs = planar.mbs
 
         def solve():
-            printing = exu.config.printToConsole
-            exu.config.printToConsole = False  # Exudyn's failure banners; the reason is kept
-            try:
-                ok = exu.SolveDynamic(mbs, ss, solverType=solver_type, storeSolver=True)
-            except (exu.SolverError, RuntimeError):
-                ok = False
-            finally:
-                exu.config.printToConsole = printing
-            solver = mbs.sys["dynamicSolver"]
-            t_reached = mbs.systemData.GetTime()
-            if not ok or abs(t_reached - t_end) > 1e-9 * t_end:
-                conv = solver.conv
-                why = solver.GetErrorString() or "no reason given"
-                if conv.linearSolverFailed or conv.massMatrixNotInvertible:
-                    why = f"singular system matrix ({why})"
-                elif not conv.newtonConverged:
-                    # at fixed steps Exudyn reports the failed Newton as a failed step reduction
-                    why = f"Newton did not converge, residual {conv.lastResidual:.3g}"
-                raise RuntimeError(
-                    f"Exudyn {method} stopped at t = {t_reached:.4g} s (step "
-                    f"{int(solver.it.currentStepIndex)}, h = {h:.3g} s): {why}"
-                )
+            stats = solve_checked(mbs, ss, method, t_end)
             data = [np.asarray(mbs.GetSensorStoredData(s)) for s in sensors]
             t = data[0][:, 0]
             if len(t) != n_out + 1 or np.abs(t - t_out).max() > 1e-6 * h:
                 raise RuntimeError("peer_closed_loops: Exudyn's sensor samples miss output times")
             angles = angle0 + np.column_stack([d[:, 3] for d in data])
-            stats = {
-                "steps": int(solver.it.currentStepIndex) - 1,
-                "newton_iterations": int(solver.it.newtonStepsCount),
-                "jacobians": int(solver.it.newtonJacobiCount),
-            }
             return self._observe(angles), stats
 
         return solve

@@ -107,27 +107,64 @@ def _base_settings(t_end: float, n_steps: int):
     return ss
 
 
-def _timed_solve(mbs, ss, method: str, t_end: float) -> tuple[float, dict]:
-    """exu.SolveDynamic timed with process_time; returns (CPU s, step statistics)."""
+def implicit_settings(
+    t_end: float, n_steps: int, sample_dt: float, spectral_radius: float, newton_rtol: float
+):
+    """Settings of a fixed-step implicit run: sensors every ``sample_dt``, Newton relative
+    tolerance ``newton_rtol`` (absolute 1e-2 of it), generalized-alpha ``spectral_radius``,
+    consistent initial accelerations."""
+    ss = _base_settings(t_end, n_steps)
+    ss.solution.sensors.active = True
+    ss.solution.sensors.writePeriod = sample_dt
+    ss.timeIntegration.newton.relativeTolerance = newton_rtol
+    ss.timeIntegration.newton.absoluteTolerance = 1e-2 * newton_rtol
+    ss.timeIntegration.generalizedAlpha.spectralRadius = spectral_radius
+    ss.timeIntegration.generalizedAlpha.computeInitialAccelerations = True
+    return ss
+
+
+def solve_checked(mbs, ss, method: str, t_end: float) -> dict:
+    """exu.SolveDynamic to ``t_end``; returns the step statistics, or raises ``RuntimeError``
+    with where and why Exudyn stopped (Exudyn's own console banners suppressed)."""
     exu = _exudyn()[0]
-    solver = getattr(exu.DynamicSolverType, "RK44" if method == "RK4" else method)
-    t0 = time.process_time()
+    solver_type = getattr(exu.DynamicSolverType, "RK44" if method == "RK4" else method)
+    printing = exu.config.printToConsole
+    exu.config.printToConsole = False
     try:
-        ok = exu.SolveDynamic(mbs, ss, solverType=solver, storeSolver=True)
-    except (exu.SolverError, RuntimeError) as exc:
-        raise RuntimeError(f"peer_exudyn: Exudyn {method} failed: {exc}") from exc
-    cpu = time.process_time() - t0
+        ok = exu.SolveDynamic(mbs, ss, solverType=solver_type, storeSolver=True)
+    except (exu.SolverError, RuntimeError):
+        ok = False
+    finally:
+        exu.config.printToConsole = printing
+    solver = mbs.sys["dynamicSolver"]
     t_reached = mbs.systemData.GetTime()
     if not ok or abs(t_reached - t_end) > 1e-9 * max(1.0, t_end):
-        raise RuntimeError(f"peer_exudyn: Exudyn {method} stopped at t = {t_reached}")
-    it = mbs.sys["dynamicSolver"].it
-    stats = {
+        conv = solver.conv
+        why = solver.GetErrorString() or "no reason given"
+        if conv.linearSolverFailed or conv.massMatrixNotInvertible:
+            why = f"singular system matrix ({why})"
+        elif not conv.newtonConverged:
+            # at fixed steps Exudyn reports the failed Newton as a failed step reduction
+            why = f"Newton did not converge, residual {conv.lastResidual:.3g}"
+        h = t_end / ss.timeIntegration.numberOfSteps
+        raise RuntimeError(
+            f"Exudyn {method} stopped at t = {t_reached:.4g} s (step "
+            f"{int(solver.it.currentStepIndex)}, h = {h:.3g} s): {why}"
+        )
+    it = solver.it
+    return {
         "steps": int(it.currentStepIndex) - 1,
         "rejected": int(it.rejectedAutomaticStepSizeSteps),
         "newton_iterations": int(it.newtonStepsCount),
         "jacobians": int(it.newtonJacobiCount),
     }
-    return cpu, stats
+
+
+def _timed_solve(mbs, ss, method: str, t_end: float) -> tuple[float, dict]:
+    """:func:`solve_checked` timed with process_time; returns (CPU s, step statistics)."""
+    t0 = time.process_time()
+    stats = solve_checked(mbs, ss, method, t_end)
+    return time.process_time() - t0, stats
 
 
 class ExudynArm:
@@ -262,13 +299,8 @@ class ExudynArm:
         if method not in IMPLICIT:
             raise ValueError(f"peer_exudyn: unknown method {method!r}; supported: {IMPLICIT}")
         _sc, mbs, nodes, _joints, sensors = self.build()
-        ss = _base_settings(t_end, n_steps)
-        ss.solution.sensors.active = True
-        ss.solution.sensors.writePeriod = t_end / n_steps if sample_dt is None else sample_dt
-        ss.timeIntegration.newton.relativeTolerance = newton_rtol
-        ss.timeIntegration.newton.absoluteTolerance = 1e-2 * newton_rtol
-        ss.timeIntegration.generalizedAlpha.spectralRadius = spectral_radius
-        ss.timeIntegration.generalizedAlpha.computeInitialAccelerations = True
+        dt = t_end / n_steps if sample_dt is None else sample_dt
+        ss = implicit_settings(t_end, n_steps, dt, spectral_radius, newton_rtol)
         cpu, self.last_stats = _timed_solve(mbs, ss, method, t_end)
         return mbs, nodes, sensors, cpu
 

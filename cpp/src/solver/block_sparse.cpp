@@ -388,18 +388,6 @@ bool BlockSparseSchur::factor_column(int k) {
 }
 
 namespace {
-// y(ni) -= X(ni x s) x(s), X column-major
-template <int NI, int S>
-inline void sub_gemv(double* __restrict__ y, const double* __restrict__ X,
-                     const double* __restrict__ xk, int ni_rt, int s_rt) {
-  const int ni = NI > 0 ? NI : ni_rt;
-  const int s = S > 0 ? S : s_rt;
-  for (int r = 0; r < ni; ++r) {
-    double t = X[r] * xk[0];
-    for (int j = 1; j < s; ++j) t += X[r + j * ni] * xk[j];
-    y[r] -= t;
-  }
-}
 // xk(s) -= X(ni x s)^T y(ni)
 template <int NI, int S>
 inline void sub_gemv_t(double* __restrict__ xk, const double* __restrict__ X,
@@ -432,7 +420,8 @@ void BlockSparseSchur::forward_column(int k, double* xd) const {
     const int ni = col_[sb.pos].size;
     double* xi = xd + col_[sb.pos].row0;
     const double* X = val_.data() + sb.off;
-    with_rows(ni, [&](auto N) { sub_gemv<N, S>(xi, X, xk, ni, s); });
+    // xi -= X xk: the block update with a single column
+    with_rows(ni, [&](auto N) { schur_update<N, 1, S, false>(xi, X, xk, ni, 1, s); });
   }
 }
 

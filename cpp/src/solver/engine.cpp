@@ -286,7 +286,8 @@ void Engine::commit_tracking() {
 
 void Engine::gear_mesh(int gi, double& s, double& sd, double& penetration) const {
   const GearPair& g = m_.gears[gi];
-  const ScalarJet qa = coord_jet(m_, kin_, g.coord_a), qb = coord_jet(m_, kin_, g.coord_b);
+  const ScalarJet& qa = jets_.get(m_, kin_, g.coord_a);
+  const ScalarJet& qb = jets_.get(m_, kin_, g.coord_b);
   s = g.r_a * tracked(g.coord_a, qa.val) + g.r_b * tracked(g.coord_b, qb.val);
   sd = g.r_a * qa.rate + g.r_b * qb.rate;
   penetration = std::abs(s) - 0.5 * g.backlash;
