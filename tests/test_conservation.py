@@ -25,9 +25,10 @@ from scipy.integrate import solve_ivp
 RTOL = ATOL = 1e-10
 
 
-def test_double_pendulum_energy():
+@pytest.mark.parametrize("integrator", ["dopri5", "dop853"])
+def test_double_pendulum_energy(integrator):
     dp = double_pendulum(phi1=np.pi / 3, phi2=np.pi / 2)
-    res = ad.simulate(dp.model, 10.0, integrator="dopri5", rtol=RTOL, atol=ATOL, output_dt=0.01)
+    res = ad.simulate(dp.model, 10.0, integrator=integrator, rtol=RTOL, atol=ATOL, output_dt=0.01)
     assert res.t[-1] == pytest.approx(10.0, abs=1e-9)
     ke, pe = np.asarray(res.kinetic_energy), np.asarray(res.potential_energy)
     energy = ke + pe

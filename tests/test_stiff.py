@@ -57,6 +57,13 @@ def test_auto_picks_by_stiffness_and_says_why():
     soft = ad.simulate(spring_mass_pendulum(stiffness=1e2), 1.0, integrator="auto", output_dt=0.5)
     assert soft.stats["integrator"] == "dopri5"
     assert "not stiff" in soft.stats["integrator_reason"]
+    # not stiff, tight tolerance: the 8th-order pair
+    tight = ad.simulate(
+        spring_mass_pendulum(stiffness=1e2), 1.0, integrator="auto", rtol=1e-9, output_dt=0.5
+    )
+    assert tight.stats["integrator"] == "dop853"
+    assert "not stiff" in tight.stats["integrator_reason"]
+    assert "<= 1e-7 favours the 8th-order pair" in tight.stats["integrator_reason"]
     stiff = ad.simulate(spring_mass_pendulum(stiffness=1e10), 1.0, integrator="auto", output_dt=0.5)
     assert stiff.stats["integrator"] == "trbdf2"
     reason = stiff.stats["integrator_reason"]

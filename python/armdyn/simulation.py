@@ -79,21 +79,23 @@ def simulate(
         model: a finalized :class:`armdyn.Model`.
         t_end: end time [s] (> 0).
         integrator: ``"dopri5"`` (Dormand–Prince 5(4), error control, dense output),
-            ``"rk4"`` (classical fixed step ``dt``), ``"trbdf2"`` (L-stable implicit TR-BDF2
-            with error control, for stiff scenes), ``"kinematic"`` (a fully driven model:
-            each output state is solved from the constraints, nothing is integrated), or
-            ``"auto"``: kinematic when the drives leave no degree of freedom (and outputs are
-            on an ``output_dt`` grid), else TR-BDF2 when the stiffness estimate of the force
-            elements says an explicit method would need more than 5000 steps for stability
-            alone, else DOPRI5. Default (``None``): kinematic for a fully driven model with
-            ``output_dt``, else DOPRI5. A fully driven model has nothing to integrate: its
-            DOPRI5 run only supplies starting guesses to the same position, velocity and
-            acceleration problems, so both give the same outputs. ``stats["integrator"]`` and
-            ``stats["integrator_reason"]`` say which was used and why.
-        rtol, atol: DOPRI5 tolerances on every component of (u, v).
-        dt: RK4 step (required for rk4); DOPRI5/TR-BDF2 initial step (optional).
+            ``"dop853"`` (Dormand–Prince 8(5,3), error control, 7th-order dense output: for
+            tight tolerances), ``"rk4"`` (classical fixed step ``dt``), ``"trbdf2"``
+            (L-stable implicit TR-BDF2 with error control, for stiff scenes), ``"kinematic"``
+            (a fully driven model: each output state is solved from the constraints, nothing is
+            integrated), or ``"auto"``: kinematic when the drives leave no degree of freedom
+            (and outputs are on an ``output_dt`` grid), else TR-BDF2 when the stiffness
+            estimate of the force elements says an explicit method would need more than 5000
+            steps for stability alone, else DOP853 for ``rtol <= 1e-7`` and DOPRI5 above.
+            Default (``None``): kinematic for a fully driven model with ``output_dt``, else
+            DOPRI5. A fully driven model has nothing to integrate: its DOPRI5 run only supplies
+            starting guesses to the same position, velocity and acceleration problems, so both
+            give the same outputs. ``stats["integrator"]`` and ``stats["integrator_reason"]``
+            say which was used and why.
+        rtol, atol: error-control tolerances on every component of (u, v).
+        dt: RK4 step (required for rk4); DOPRI5/DOP853/TR-BDF2 initial step (optional).
         output_dt: spacing of output times (default: every accepted step). Output states are
-            interpolated (DOPRI5 dense output) and projected onto the constraints.
+            interpolated (the integrator's dense output) and projected onto the constraints.
         q0, qd0: initial joint coordinates and rates (n_coords,) for joint-space tree models;
             default: the model's assembled state at rest.
         u0, v0: initial Cartesian state (nq,), (nv,) instead of q0/qd0 (projected onto the
@@ -101,7 +103,7 @@ def simulate(
         projection: metric of the minimum-norm projection: ``"mass"`` (kinetic-energy metric,
             reuses the KKT factorisation) or ``"unweighted"`` (the paper's form).
         max_steps: limit on steps.
-        max_step: largest step of DOPRI5/TR-BDF2 (default: no limit).
+        max_step: largest step of DOPRI5/DOP853/TR-BDF2 (default: no limit).
         merge_welded: integrate bodies joined by fixed joints as one composite body (fewer
             bodies and rows: the same motion at lower cost); the outputs still cover every body
             and joint, the fixed joints' reactions from their bodies' Newton–Euler balances.

@@ -263,9 +263,10 @@ PROBLEMS: dict[str, Problem] = {
         required=(1e-1, 1e-3),
         sweeps={
             "dopri5": [1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11],
+            "dop853": [1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13],
             "rk4": [1e-2, 5e-3, 2.5e-3, 1.25e-3, 6.25e-4],
         },
-        quick_sweeps={"dopri5": [1e-6, 1e-8], "rk4": [2.5e-3]},
+        quick_sweeps={"dopri5": [1e-6, 1e-8], "dop853": [1e-10], "rk4": [2.5e-3]},
         scipy_rhs=references.a01_rhs,
         scipy_observe=lambda y: np.column_stack([np.sin(y[0]), -np.cos(y[0])]),
         mujoco_xml=_A01_XML,
@@ -288,8 +289,11 @@ PROBLEMS: dict[str, Problem] = {
         # near the singular position the KKT solver switches to its regularised block-sparse
         # factor (kkt.hpp): seconds per 20 s run. SciPy integrates the reference's own
         # one-DOF branch equation, which presumes the motion the others must keep to.
-        sweeps={"dopri5": [1e-6, 1e-7, 1e-8, 1e-9, 1e-10]},
-        quick_sweeps={"dopri5": [1e-6, 1e-8]},
+        sweeps={
+            "dopri5": [1e-6, 1e-7, 1e-8, 1e-9, 1e-10],
+            "dop853": [1e-4, 1e-5, 1e-6, 1e-7, 1e-8],
+        },
+        quick_sweeps={"dopri5": [1e-6, 1e-8], "dop853": [1e-6]},
         scipy_rhs=lambda: references.a02_rhs(40),
         scipy_label="the reference's one-DOF branch ODE",
         scipy_observe=lambda y: np.column_stack([np.cos(y[0]), np.sin(y[0])]),
@@ -311,9 +315,10 @@ PROBLEMS: dict[str, Problem] = {
         sweeps={
             "kinematic": [0.0],
             "dopri5": [1e-4, 1e-6, 1e-8, 1e-10],
+            "dop853": [1e-4, 1e-6, 1e-8, 1e-10],
             "rk4": [0.1, 0.05, 0.025, 0.0125],
         },
-        quick_sweeps={"kinematic": [0.0], "dopri5": [1e-6], "rk4": [0.05]},
+        quick_sweeps={"kinematic": [0.0], "dopri5": [1e-6], "dop853": [1e-6], "rk4": [0.05]},
     ),
     "ur5": Problem(
         name="ur5",
@@ -330,9 +335,10 @@ PROBLEMS: dict[str, Problem] = {
         angular=True,
         sweeps={
             "dopri5": [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10],
+            "dop853": [1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11],
             "rk4": [4e-3, 2e-3, 1e-3, 5e-4, 2.5e-4],
         },
-        quick_sweeps={"dopri5": [1e-6, 1e-8], "rk4": [1e-3]},
+        quick_sweeps={"dopri5": [1e-6, 1e-8], "dop853": [1e-8], "rk4": [1e-3]},
         scipy_rhs=lambda: _Ur5.get().rhs(),
         scipy_observe=lambda y: y[:6].T,
         scipy_label="on Pinocchio's ABA",
@@ -356,10 +362,11 @@ PROBLEMS: dict[str, Problem] = {
         angular=True,
         sweeps={
             "dopri5": [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11],
+            "dop853": [1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12],
             "rk4": [1e-4, 5e-5, 2.5e-5, 1.25e-5, 6.25e-6],
             "trbdf2": [1e-4, 1e-5, 1e-6, 1e-7],
         },
-        quick_sweeps={"dopri5": [1e-6, 1e-8], "rk4": [2.5e-5]},
+        quick_sweeps={"dopri5": [1e-6, 1e-8], "dop853": [1e-8], "rk4": [2.5e-5]},
         scipy_rhs=references.squeezer_rhs,
         reference_check=_squeezer_check,
         scipy_observe=lambda y: y[:7].T,

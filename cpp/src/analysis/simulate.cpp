@@ -333,7 +333,7 @@ double stiffness_estimate(const Model& m, std::string& culprit) {
   return lam;
 }
 
-std::string choose_integrator(const Model& m, double t_end, std::string& reason) {
+std::string choose_integrator(const Model& m, double t_end, double rtol, std::string& reason) {
   std::string culprit;
   const double lam = stiffness_estimate(m, culprit);
   const double steps = lam * t_end / 3.3;
@@ -343,8 +343,15 @@ std::string choose_integrator(const Model& m, double t_end, std::string& reason)
                  " steps for stability alone");
     return "trbdf2";
   }
-  reason = msg("dopri5: fastest rate ", lam, " 1/s (", culprit, "), about ",
-               static_cast<long>(steps), " explicit steps for stability: not stiff");
+  const std::string rate =
+      msg("fastest rate ", lam, " 1/s (", culprit, "), about ", static_cast<long>(steps),
+          " explicit steps for stability: not stiff");
+  // tight tolerances: the 8th-order pair needs far fewer steps (docs/results/workprecision)
+  if (rtol <= 1e-7) {
+    reason = msg("dop853: ", rate, "; rtol ", rtol, " <= 1e-7 favours the 8th-order pair");
+    return "dop853";
+  }
+  reason = msg("dopri5: ", rate);
   return "dopri5";
 }
 
@@ -352,10 +359,12 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
                    const VecX& v0) {
   if (!(t_end > 0) || !std::isfinite(t_end))
     throw ModelError(msg("simulate: t_end must be positive and finite, got ", t_end));
-  if (opt.integrator != "dopri5" && opt.integrator != "rk4" && opt.integrator != "trbdf2" &&
-      opt.integrator != "auto" && opt.integrator != "kinematic" && opt.integrator != "default")
-    throw ModelError(msg("simulate: unknown integrator '", opt.integrator,
-                         "' (expected 'dopri5', 'rk4', 'trbdf2', 'kinematic' or 'auto')"));
+  if (opt.integrator != "dopri5" && opt.integrator != "dop853" && opt.integrator != "rk4" &&
+      opt.integrator != "trbdf2" && opt.integrator != "auto" && opt.integrator != "kinematic" &&
+      opt.integrator != "default")
+    throw ModelError(
+        msg("simulate: unknown integrator '", opt.integrator,
+            "' (expected 'dopri5', 'dop853', 'rk4', 'trbdf2', 'kinematic' or 'auto')"));
   const StepOptions& s = opt.step;
   if (!(s.rtol > 0) || !std::isfinite(s.rtol))
     throw ModelError(msg("simulate: rtol must be positive, got ", s.rtol));
@@ -399,7 +408,7 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
         "kinematic: the drives leave no degree of freedom, so each output state follows from "
         "the constraints (position, velocity and acceleration problems); nothing to integrate";
   } else if (opt.integrator == "auto") {
-    out.integrator = choose_integrator(ms, t_end, out.integrator_reason);
+    out.integrator = choose_integrator(ms, t_end, s.rtol, out.integrator_reason);
   } else if (opt.integrator == "default") {
     out.integrator = "dopri5";
   }
@@ -446,6 +455,8 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
       }
     } else if (out.integrator == "dopri5")
       integrate_dopri5(sys, y, 0.0, t_end, s, out.stats);
+    else if (out.integrator == "dop853")
+      integrate_dop853(sys, y, 0.0, t_end, s, out.stats);
     else if (out.integrator == "trbdf2")
       integrate_trbdf2(sys, y, 0.0, t_end, s, out.stats);
     else

@@ -14,7 +14,7 @@
 namespace armdyn {
 
 struct SimOptions {
-  std::string integrator = "dopri5";  ///< "dopri5" | "rk4" | "trbdf2" | "auto"
+  std::string integrator = "dopri5";  ///< "dopri5" | "dop853" | "rk4" | "trbdf2" | "auto"
   StepOptions step;
   Metric projection = Metric::Mass;
   /// integrate bodies joined by fixed joints as one composite body (Model::welded)
@@ -46,9 +46,10 @@ struct SimResult {
 /// elements (springs: sqrt(k / m_eff), dampers: c / m_eff, with m_eff the effective mass of the
 /// element's direction under the constraints at the assembled state, from one KKT solve each),
 /// and a sentence naming the element. The explicit DOPRI5 needs about |lambda| t_end / 3.3 steps
-/// for stability alone; "auto" picks TR-BDF2 when that exceeds 5000 steps.
+/// for stability alone; "auto" picks TR-BDF2 when that exceeds 5000 steps, else DOP853 for
+/// rtol <= 1e-7 and DOPRI5 above.
 double stiffness_estimate(const Model& m, std::string& culprit);
-std::string choose_integrator(const Model& m, double t_end, std::string& reason);
+std::string choose_integrator(const Model& m, double t_end, double rtol, std::string& reason);
 
 /// Run from (u0, v0) (projected first) over [0, t_end]. Errors during the run stop it: the
 /// result up to the last good output is returned with `error` set.

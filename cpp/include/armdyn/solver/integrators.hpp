@@ -3,6 +3,12 @@
 //  - DOPRI5: Dormand-Prince 5(4), FSAL, PI step control and 4th-order dense output (Hairer,
 //    Norsett & Wanner, Solving ODEs I, II.5 and II.6; the ode45 scheme). The error is estimated on
 //    the unprojected pair; the accepted value is projected and the first stage re-evaluated there.
+//  - DOP853: Dormand-Prince 8(5,3), 12 stages plus the step's end (FSAL), the error of the
+//    5th-order estimate damped by the 3rd-order one, and 7th-order dense output from three
+//    more stages, computed only on steps that hold an output time or an event (Hairer, Norsett
+//    & Wanner, Solving ODEs I, II.10; Hairer's dop853). For tight tolerances, where DOPRI5
+//    needs many times its steps. The error is estimated on the unprojected pair; the accepted
+//    end point is projected and the step's last stage evaluated there.
 //  - RK4: classical fixed step, projected after each step.
 //  - TR-BDF2: the L-stable, stiffly accurate ESDIRK form of the trapezoidal rule followed by
 //    BDF2 (Bank et al. 1985; Hosea & Shampine 1996, the ode23tb scheme), for stiff scenes. Order
@@ -50,8 +56,8 @@ struct StepStats {
 
 struct StepOptions {
   double rtol = 1e-6, atol = 1e-8;
-  double dt = 0.0;         ///< RK4 step; DOPRI5 initial step (0: automatic)
-  double max_step = 0.0;   ///< DOPRI5 (0: no limit)
+  double dt = 0.0;         ///< RK4 step; DOPRI5/DOP853 initial step (0: automatic)
+  double max_step = 0.0;   ///< DOPRI5, DOP853, TR-BDF2 (0: no limit)
   double output_dt = 0.0;  ///< 0: output every accepted step
   long max_steps = 10000000;
 };
@@ -63,6 +69,8 @@ std::vector<double> output_times(double t0, double t1, double dt);
 /// Integrate from t0 to t1; y holds the projected initial state on entry, the final on exit.
 /// @throws SolverError on step-size underflow, too many steps or non-finite values.
 void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepOptions& opt,
+                      StepStats& stats);
+void integrate_dop853(OdeSystem& sys, VecX& y, double t0, double t1, const StepOptions& opt,
                       StepStats& stats);
 void integrate_trbdf2(OdeSystem& sys, VecX& y, double t0, double t1, const StepOptions& opt,
                       StepStats& stats);
