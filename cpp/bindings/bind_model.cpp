@@ -156,6 +156,26 @@ void bind_model(py::module_& m) {
                             py::arg("effort") = j.effort, py::arg("velocity") = j.velocity_limit);
           },
           py::arg("joint"))
+      .def(
+          "joint_frame",
+          [](const Model& md, const std::string& name) {
+            const Joint& j = md.joints[md.find_joint(name)];
+            auto body = [&](int b) {
+              return b == kGround ? std::string("ground") : md.bodies[b].name;
+            };
+            return py::dict(py::arg("type") = joint_type_name(j.type),
+                            py::arg("parent") = body(j.parent), py::arg("child") = body(j.child),
+                            py::arg("point_parent") = to_numpy(VecX(j.point_parent)),
+                            py::arg("point_child") = to_numpy(VecX(j.point_child)),
+                            py::arg("frame_parent") = to_numpy(MatX(j.frame_parent)),
+                            py::arg("frame_child") = to_numpy(MatX(j.frame_child)),
+                            py::arg("coord") = j.coord0);
+          },
+          py::arg("joint"),
+          "The joint's bodies and frames: 'point_parent'/'point_child' (the joint point in each "
+          "body's frame, relative to its centre of mass; the world for 'ground'), "
+          "'frame_parent'/'frame_child' (the joint frame's axes as columns in each body's "
+          "frame; z is the joint axis) and 'coord' (its first joint coordinate, -1 if none).")
       .def("summary", &Model::summary, "Readable description: sizes, topology, solver path.")
       .def_property_readonly(
           "kkt_path", [](const Model& m) { return m.kkt_all.path; },

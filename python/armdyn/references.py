@@ -218,3 +218,98 @@ def squeezer_angles(t, rtol=1e-13):
     t = np.asarray(t, dtype=float)
     sol = solve_ivp(f, (0.0, t[-1]), y0, method="DOP853", rtol=rtol, atol=rtol, t_eval=t)
     return sol.y[:7].T
+
+
+# --- the geared arm (six-DOF paper), without backlash ------------------------------------------
+
+
+def _quintic(t, y1, t0, t1):
+    """Rest-to-rest quintic from 0 at t0 to y1 at t1: value and rate."""
+    tau = np.clip((t - t0) / (t1 - t0), 0.0, 1.0)
+    s = tau**3 * (10.0 - 15.0 * tau + 6.0 * tau**2)
+    sd = 30.0 * tau**2 * (1.0 - tau) ** 2 / (t1 - t0)
+    return y1 * s, y1 * sd
+
+
+class GearedArmReference:
+    """The backlash-free geared arm (``geared_arm_6dof(backlash=0)``, 44 bodies) in its six arm
+    joint angles p, by a second library: Pinocchio's CRBA and RNEA on the open tree of the same
+    bodies (:func:`armdyn.peer_pinocchio.pinocchio_tree` of ``ideal_gears=False``: rotors and
+    shafts free), reduced by the gear ratios. Each train's rolling conditions
+    r1 q_motor + R1 q_shaft = 0 and r2 q_shaft + R2 q_joint = 0 give q = T p with a constant T,
+    so T^T M(Tp) T p'' = T^T (Q - b(Tp, Tp')): M from CRBA, b (gravity, Coriolis, centrifugal)
+    from RNEA at zero acceleration, Q the PD motor torques
+    clamp(kp (N ref(t) - q_m) + kd (N ref'(t) - q_m'), ±limit) on the rotors, with the quintic
+    references written out here. Nothing of armdyn's Newton–Euler/KKT path is used."""
+
+    def __init__(self, **scene):
+        import inspect
+
+        import pinocchio as pin
+
+        from armdyn.peer_pinocchio import pinocchio_tree
+        from armdyn.scenes.geared_arm import JOINTS, RATIOS, geared_arm_6dof
+
+        defaults = {k: v.default for k, v in inspect.signature(geared_arm_6dof).parameters.items()}
+        self.scene = dict(defaults, **scene, backlash=0.0, n_motors=1, control="motor")
+        tree = geared_arm_6dof(**dict(self.scene, ideal_gears=False))
+        self.pin = pin
+        self.pm, self.idx = pinocchio_tree(tree)
+        self.pd = self.pm.createData()
+        names = list(tree.coord_names)
+        n = len(names)
+        self.T = np.zeros((n, 6))
+        self.motor = np.zeros(6, dtype=int)
+        self.ratio = np.zeros(6)
+        for j, (name, _p, _a, _pt, R2, r2, R1, r1, _e) in enumerate(JOINTS):
+            self.T[names.index(name), j] = 1.0
+            self.T[names.index(f"{name}_shaft"), j] = -R2 / r2
+            self.T[names.index(f"{name}_motor"), j] = (R1 / r1) * (R2 / r2)
+            self.motor[j] = names.index(f"{name}_motor")
+            self.ratio[j] = RATIOS[name]
+            assert np.isclose(self.ratio[j], (R1 / r1) * (R2 / r2))
+        self.arm = np.array([names.index(j[0]) for j in JOINTS])
+
+    def motor_torques(self, t, q, qd):
+        """PD motor torques on the rotor coordinates (tree coordinate order)."""
+        s = self.scene
+        ref, rate = _quintic(t, self.ratio * np.asarray(s["targets"]), s["t_start"], s["t_end"])
+        e = ref - q[self.motor]
+        u = s["kp"] * np.arctan2(np.sin(e), np.cos(e)) + s["kd"] * (rate - qd[self.motor])
+        Q = np.zeros(q.size)
+        Q[self.motor] = np.clip(u, -s["torque_limit"], s["torque_limit"])
+        return Q
+
+    def tree_terms(self, q, qd):
+        """M(q) and b(q, qd) of the open tree in armdyn's coordinate order."""
+        pin, i = self.pin, self.idx
+        qp = np.zeros(self.pm.nq)
+        vp = np.zeros(self.pm.nv)
+        qp[i], vp[i] = q, qd
+        M = pin.crba(self.pm, self.pd, qp)
+        M = np.triu(M) + np.triu(M, 1).T
+        b = pin.rnea(self.pm, self.pd, qp, vp, np.zeros(self.pm.nv))
+        return M[np.ix_(i, i)], b[i]
+
+    def rhs(self):
+        T = self.T
+
+        def f(t, y):
+            p, pd = y[:6], y[6:]
+            q, qd = T @ p, T @ pd
+            M, b = self.tree_terms(q, qd)
+            pdd = np.linalg.solve(T.T @ M @ T, T.T @ (self.motor_torques(t, q, qd) - b))
+            return np.concatenate([pd, pdd])
+
+        return f, np.zeros(12)
+
+    def angles(self, t, rtol=1e-12):
+        """(n_t, 6) arm joint angles on the times ``t`` (DOP853 at ``rtol``, dense output)."""
+        from scipy.integrate import solve_ivp
+
+        f, y0 = self.rhs()
+        t = np.asarray(t, dtype=float)
+        sol = solve_ivp(f, (0.0, t[-1]), y0, method="DOP853", rtol=rtol, atol=rtol, t_eval=t)
+        if not sol.success:
+            raise RuntimeError(f"geared-arm reference: {sol.message}")
+        return sol.y[:6].T

@@ -99,6 +99,7 @@ def geared_arm_6dof(
     kd=0.5,
     torque_limit=10.0,
     preload=0.0,
+    ideal_gears=True,
 ):
     """Build the geared arm (see the module docstring for every dimension).
 
@@ -117,6 +118,10 @@ def geared_arm_6dof(
             (with an odd count the last train gets none), so the biases cancel on the gear
             but hold the teeth of the two groups against opposite flanks. Ramped in by a
             quintic over [0, t_start/2] so the teeth close before the motion starts.
+        ideal_gears: False leaves out the ideal gear constraints (stage 1, and stage 2 without
+            backlash): rotors and shafts then turn freely, an open tree in the joint
+            coordinates. Not a mechanism of its own: :mod:`armdyn.references` eliminates the
+            gear ratios from its Euler–Lagrange equations to obtain an independent reference.
     """
     if not 1 <= int(n_motors) <= 6:
         raise _core.ModelError(f"geared_arm_6dof: n_motors must be 1..6, got {n_motors}")
@@ -173,12 +178,14 @@ def geared_arm_6dof(
             b.add_fixed(f"{tag}_p2_key", f"{tag}_wheel_1", f"{tag}_pinion_2", point=c2)
             b.add_revolute(f"{tag}_motor", parent, f"{tag}_rotor", point=c1, axis=axis)
             b.add_fixed(f"{tag}_p1_key", f"{tag}_rotor", f"{tag}_pinion_1", point=c1)
-            b.add_gear(f"{tag}_stage_1", f"{tag}_motor", f"{tag}_shaft", r1, R1)
+            if ideal_gears:
+                b.add_gear(f"{tag}_stage_1", f"{tag}_motor", f"{tag}_shaft", r1, R1)
             # without backlash, one ideal stage-2 mesh per joint: further trains on the same
             # gear would be redundant constraints, so they mesh through a stiff contact with
             # zero clearance
             if backlash == 0 and k == 0:
-                b.add_gear(f"{tag}_stage_2", f"{tag}_shaft", name, r2, R2)
+                if ideal_gears:
+                    b.add_gear(f"{tag}_stage_2", f"{tag}_shaft", name, r2, R2)
             else:
                 b.add_gear_pair(
                     f"{tag}_stage_2",

@@ -1,0 +1,78 @@
+"""A Pinocchio model of an armdyn tree, for references and peer curves by a second library.
+
+:func:`pinocchio_tree` rebuilds a finalized armdyn model whose joints form a tree of revolute,
+prismatic and fixed joints (``model.joint_space``) as a ``pinocchio.Model`` from the model's
+own data only: masses, inertias, and each joint's frames (:meth:`armdyn.Model.joint_frame`).
+Every armdyn joint with a coordinate becomes a Pinocchio joint about (along) the z axis of its
+joint frame, placed where that frame sits in the parent body at the build pose; bodies joined by
+fixed joints are appended to their parent's Pinocchio joint. Pinocchio's CRBA and RNEA on it are
+then the Euler–Lagrange terms of the same mechanism computed by a different library.
+
+Force elements (motors, springs) and gear couplings are *not* carried over: the caller adds
+them in the joint coordinates (see ``armdyn.references.GearedArmReference``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from armdyn import _core
+
+
+def _se3(pin, rotation, translation):
+    return pin.SE3(np.asarray(rotation, dtype=float), np.asarray(translation, dtype=float))
+
+
+def pinocchio_tree(model: _core.Model):
+    """``(pin_model, idx_q)``: the Pinocchio model, and for each armdyn joint coordinate (model
+    order) its index in Pinocchio's configuration vector (``q_pin[idx_q] = q``). Gravity is the
+    model's. Raises ModelError for models outside revolute/prismatic/fixed trees."""
+    import pinocchio as pin
+
+    if not model.joint_space:
+        raise _core.ModelError(
+            "pinocchio_tree: the model is not a tree of joints with coordinates (see summary())"
+        )
+    names = list(model.body_names)
+    masses, inertias = np.asarray(model.masses), np.asarray(model.inertias)
+    pm = pin.Model()
+    pm.gravity = pin.Motion(np.asarray(model.gravity, dtype=float), np.zeros(3))
+    # where each body sits: (Pinocchio joint id, placement of the body's CoM frame in it)
+    placed = {"ground": (0, pin.SE3.Identity())}
+    coord_joint = {}  # armdyn coordinate -> Pinocchio joint id
+    frames = [model.joint_frame(j) for j in model.joint_names]
+    # depth first from the ground: Pinocchio's algorithms (CRBA) need each joint's subtree to
+    # occupy consecutive velocity indices
+    children: dict[str, list[int]] = {}
+    for k, jf in enumerate(frames):
+        children.setdefault(jf["parent"], []).append(k)
+    order, stack = [], list(reversed(children.get("ground", [])))
+    while stack:
+        k = stack.pop()
+        order.append(k)
+        stack.extend(reversed(children.get(frames[k]["child"], [])))
+    if len(order) != len(frames):
+        raise _core.ModelError("pinocchio_tree: some joints do not connect to the ground")
+    for k in order:
+        jf = frames[k]
+        parent_id, x_jp_p = placed[jf["parent"]]
+        x_p_j = _se3(pin, jf["frame_parent"], jf["point_parent"])
+        x_c_j = _se3(pin, jf["frame_child"], jf["point_child"])
+        x_j_c = x_c_j.inverse()
+        jname = model.joint_names[k]
+        if jf["type"] == "fixed":
+            jid, x_body = parent_id, x_jp_p * x_p_j * x_j_c
+        elif jf["type"] in ("revolute", "prismatic"):
+            joint = pin.JointModelRZ() if jf["type"] == "revolute" else pin.JointModelPZ()
+            jid = pm.addJoint(parent_id, joint, x_jp_p * x_p_j, jname)
+            coord_joint[jf["coord"]] = jid
+            x_body = x_j_c
+        else:
+            raise _core.ModelError(f"pinocchio_tree: joint '{jname}' is {jf['type']}")
+        b = names.index(jf["child"])
+        r = x_body.rotation
+        inertia = pin.Inertia(masses[b], x_body.translation, r @ inertias[b] @ r.T)
+        pm.appendBodyToJoint(jid, inertia, pin.SE3.Identity())
+        placed[jf["child"]] = (jid, x_body)
+    idx_q = np.array([pm.joints[coord_joint[c]].idx_q for c in range(model.n_coords)], dtype=int)
+    return pm, idx_q
