@@ -197,22 +197,36 @@ void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
       throw SolverError(msg("dopri5: step size underflow (h=", h, ") at t=", t,
                             "; the problem may be stiff or singular there"));
     h = representable_step(t, h);
-    // stages
-    yt = y + h * a21 * k1;
-    sys.rhs(t + c2 * h, yt, k2);
-    yt = y + h * (a31 * k1 + a32 * k2);
-    sys.rhs(t + c3 * h, yt, k3);
-    yt = y + h * (a41 * k1 + a42 * k2 + a43 * k3);
-    sys.rhs(t + c4 * h, yt, k4);
-    yt = y + h * (a51 * k1 + a52 * k2 + a53 * k3 + a54 * k4);
-    sys.rhs(t + c5 * h, yt, k5);
-    yt = y + h * (a61 * k1 + a62 * k2 + a63 * k3 + a64 * k4 + a65 * k5);
-    sys.rhs(t + h, yt, k6);
+    // stages; a stage that cannot be evaluated (a point off the constraint manifold where the
+    // accelerations are not finite, e.g. at a large step near a singular position) rejects the
+    // step like a failed error test, and the error itself is raised once the step cannot shrink
+    bool stages_ok = true;
+    try {
+      yt = y + h * a21 * k1;
+      sys.rhs(t + c2 * h, yt, k2);
+      yt = y + h * (a31 * k1 + a32 * k2);
+      sys.rhs(t + c3 * h, yt, k3);
+      yt = y + h * (a41 * k1 + a42 * k2 + a43 * k3);
+      sys.rhs(t + c4 * h, yt, k4);
+      yt = y + h * (a51 * k1 + a52 * k2 + a53 * k3 + a54 * k4);
+      sys.rhs(t + c5 * h, yt, k5);
+      yt = y + h * (a61 * k1 + a62 * k2 + a63 * k3 + a64 * k4 + a65 * k5);
+      sys.rhs(t + h, yt, k6);
+    } catch (const SolverError&) {
+      if (!(h * fac_min >= hmin)) throw;
+      stages_ok = false;
+    }
+    if (!stages_ok) {
+      h *= fac_min;
+      ++st.rejected;
+      last_rejected = true;
+      continue;
+    }
     y1 = y + h * (a71 * k1 + a73 * k3 + a74 * k4 + a75 * k5 + a76 * k6);
     // the last stage at the projected y1: FSAL with the projection folded in, so that an
     // accepted step needs no re-evaluation at its projected end point (the projection moves y1
     // by the order of the local error, which changes the estimate below by O(h) of that). A
-    // projection that fails rejects the step.
+    // projection or evaluation that fails rejects the step.
     const bool fsal_projected = sys.project_last_stage();
     yp = y1;
     bool projected = true;
@@ -222,7 +236,7 @@ void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
       else
         sys.rhs(t + h, y1, k7);
     } catch (const SolverError&) {
-      if (!fsal_projected) throw;
+      if (!fsal_projected && !(h * fac_min >= hmin)) throw;
       projected = false;
     }
     st.rhs_evals += 6;
@@ -455,11 +469,24 @@ void integrate_dop853(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
       throw SolverError(msg("dop853: step size underflow (h=", h, ") at t=", t,
                             "; the problem may be stiff or singular there"));
     h = representable_step(t, h);
-    for (int s = 1; s < 12; ++s) {
-      stage_point(yt, y, h, C::a[s], s, k);
-      sys.rhs(t + C::c[s] * h, yt, k[s]);
+    // a stage that cannot be evaluated rejects the step (as in integrate_dopri5)
+    bool stages_ok = true;
+    try {
+      for (int s = 1; s < 12; ++s) {
+        stage_point(yt, y, h, C::a[s], s, k);
+        sys.rhs(t + C::c[s] * h, yt, k[s]);
+      }
+    } catch (const SolverError&) {
+      if (!(h * fac_min >= hmin)) throw;
+      stages_ok = false;
     }
     st.rhs_evals += 11;
+    if (!stages_ok) {
+      h *= fac_min;
+      ++st.rejected;
+      last_rejected = true;
+      continue;
+    }
     stage_point(y1, y, h, C::a[12], 12, k);
     // error: the 5th-order estimate, damped by the 3rd-order one where the latter is much
     // larger (Hairer's err^2 / sqrt(err^2 + 0.01 err3^2)), in the scaled max-norm of err_norm
@@ -512,11 +539,23 @@ void integrate_dop853(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
     }
     const bool outputs = !every_step && ko < touts.size() && touts[ko] <= tn;
     if (outputs || any_event) {
-      for (int s = 13; s < 16; ++s) {
-        stage_point(yt, y, h, C::a[s], s, k);
-        sys.rhs(t + C::c[s] * h, yt, k[s]);
+      bool dense_ok = true;
+      try {
+        for (int s = 13; s < 16; ++s) {
+          stage_point(yt, y, h, C::a[s], s, k);
+          sys.rhs(t + C::c[s] * h, yt, k[s]);
+        }
+      } catch (const SolverError&) {
+        if (!(h * fac_min >= hmin)) throw;
+        dense_ok = false;
       }
       st.rhs_evals += 3;
+      if (!dense_ok) {  // nothing of the step is kept: y, t and k[0] are unchanged
+        h *= fac_min;
+        ++st.rejected;
+        last_rejected = true;
+        continue;
+      }
       r[0] = y1 - y;
       r[1] = h * k[0] - r[0];
       r[2] = 2.0 * r[0] - h * (k[12] + k[0]);
