@@ -248,7 +248,7 @@ class GearedArmReference:
         import pinocchio as pin
 
         from armdyn.peer_pinocchio import pinocchio_tree
-        from armdyn.scenes.geared_arm import JOINTS, RATIOS, geared_arm_6dof
+        from armdyn.scenes.geared_arm import JOINTS, geared_arm_6dof
 
         defaults = {k: v.default for k, v in inspect.signature(geared_arm_6dof).parameters.items()}
         self.scene = dict(defaults, **scene, backlash=0.0, n_motors=1, control="motor")
@@ -259,16 +259,12 @@ class GearedArmReference:
         names = list(tree.coord_names)
         n = len(names)
         self.T = np.zeros((n, 6))
-        self.motor = np.zeros(6, dtype=int)
-        self.ratio = np.zeros(6)
+        self.motor = np.array([names.index(f"{j[0]}_motor") for j in JOINTS])
         for j, (name, _p, _a, _pt, R2, r2, R1, r1, _e) in enumerate(JOINTS):
             self.T[names.index(name), j] = 1.0
             self.T[names.index(f"{name}_shaft"), j] = -R2 / r2
-            self.T[names.index(f"{name}_motor"), j] = (R1 / r1) * (R2 / r2)
-            self.motor[j] = names.index(f"{name}_motor")
-            self.ratio[j] = RATIOS[name]
-            assert np.isclose(self.ratio[j], (R1 / r1) * (R2 / r2))
-        self.arm = np.array([names.index(j[0]) for j in JOINTS])
+            self.T[self.motor[j], j] = (R1 / r1) * (R2 / r2)  # the train's ratio N
+        self.ratio = self.T[self.motor, np.arange(6)]
 
     def motor_torques(self, t, q, qd):
         """PD motor torques on the rotor coordinates (tree coordinate order)."""

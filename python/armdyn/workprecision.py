@@ -146,9 +146,8 @@ def _squeezer_check(ref):
 UR5_Q0 = (0.3, -1.0, 1.2, -0.5, 0.8, 0.1)  # Pinocchio joint order, released at rest
 
 
-class _Ur5:
-    """The UR5 of example-robot-data in armdyn, Pinocchio and MuJoCo, built once, with the maps
-    between their joint orders."""
+class _BuiltOnce:
+    """A problem's models and references, built on first use and then shared."""
 
     _cache = None
 
@@ -157,6 +156,11 @@ class _Ur5:
         if cls._cache is None:
             cls._cache = cls()
         return cls._cache
+
+
+class _Ur5(_BuiltOnce):
+    """The UR5 of example-robot-data in armdyn, Pinocchio and MuJoCo, with the maps between their
+    joint orders."""
 
     def __init__(self):
         from armdyn import bench
@@ -246,17 +250,10 @@ def _closed_loop_peers(problem, ref, quick, repeats):
     return peer_closed_loops.workprecision_curves(problem, ref, quick, repeats)
 
 
-class _Geared:
-    """The backlash-free geared arm and its Pinocchio reference, built once."""
+class _Geared(_BuiltOnce):
+    """The backlash-free geared arm and its Pinocchio reference."""
 
-    _cache = None
     ARM = ("waist", "shoulder", "elbow", "wrist_roll", "wrist_pitch", "hand_roll")
-
-    @classmethod
-    def get(cls):
-        if cls._cache is None:
-            cls._cache = cls()
-        return cls._cache
 
     def __init__(self):
         self.ref = references.GearedArmReference()

@@ -126,6 +126,64 @@ inline void hermite(double th, double h, const VecX& y0, const VecX& f0, const V
   out = h00 * y0 + (h10 * h) * f0 + h01 * y1 + (h11 * h) * f1;
 }
 
+// Hairer's hinit: the first step from the size of y, f(t, y) and a difference quotient of f,
+// for a method whose local error is O(h^order). Uses yt and f1 as scratch.
+double initial_step(OdeSystem& sys, double t, const VecX& y, const VecX& f0, VecX& yt, VecX& f1,
+                    const StepOptions& opt, double hmax, int order, StepStats& st) {
+  if (opt.dt > 0) return opt.dt;
+  const double d0 = err_norm(y, y, y, opt.rtol, opt.atol);
+  const double dd1 = err_norm(f0, y, y, opt.rtol, opt.atol);
+  double h0 = (d0 < 1e-5 || dd1 < 1e-5) ? 1e-6 : 0.01 * d0 / dd1;
+  h0 = std::min(h0, hmax);
+  yt = y + h0 * f0;
+  sys.rhs(t + h0, yt, f1);
+  ++st.rhs_evals;
+  yt = f1 - f0;
+  const double dd2 = err_norm(yt, y, y, opt.rtol, opt.atol) / h0;
+  const double dm = std::max(dd1, dd2);
+  const double h1 = dm <= 1e-15 ? std::max(1e-6, h0 * 1e-3) : std::pow(0.01 / dm, 1.0 / order);
+  return std::min({100 * h0, h1, hmax});
+}
+
+// The checks before each step of an error-controlled method: the step budget, landing on t1,
+// step-size underflow; then h is made a representable step from t.
+void guard_step(const char* name, const StepOptions& opt, const StepStats& st, double t, double t1,
+                double hmin, double& h) {
+  if (st.steps + st.rejected >= opt.max_steps)
+    throw SolverError(
+        msg(name, ": more than ", opt.max_steps, " steps before t=", t1, " (reached t=", t, ")"));
+  if (t + 1.01 * h >= t1) h = t1 - t;
+  if (h < hmin)
+    throw SolverError(msg(name, ": step size underflow (h=", h, ") at t=", t,
+                          "; the problem may be stiff or singular there"));
+  h = representable_step(t, h);
+}
+
+// Runs the evaluations f of a step. A SolverError from them (a stage off the constraint
+// manifold where the accelerations are not finite, e.g. at a large step near a singular
+// position; a projection that does not converge) returns false, so that the step is rejected
+// and retried smaller; once h * fac would fall below hmin, the error itself propagates.
+template <class F>
+bool evaluates(F&& f, double h, double fac, double hmin) {
+  try {
+    f();
+    return true;
+  } catch (const SolverError&) {
+    if (!(h * fac >= hmin)) throw;
+    return false;
+  }
+}
+
+// Output times in (t, tn] from the dense output of the step [t, t + h]
+template <class Dense>
+void serve_outputs(OdeSystem& sys, const std::vector<double>& touts, size_t& ko, double t, double h,
+                   double tn, const Dense& dense, VecX& yo) {
+  for (; ko < touts.size() && touts[ko] <= tn; ++ko) {
+    dense((touts[ko] - t) / h, yo);
+    sys.output(touts[ko], yo);
+  }
+}
+
 }  // namespace
 
 void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepOptions& opt,
@@ -164,21 +222,7 @@ void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
   ++st.rhs_evals;
   sys.output(t, y);
 
-  // initial step (Hairer's hinit)
-  double h = opt.dt;
-  if (!(h > 0)) {
-    const double d0 = err_norm(y, y, y, opt.rtol, opt.atol);
-    const double dd1 = err_norm(k1, y, y, opt.rtol, opt.atol);
-    double h0 = (d0 < 1e-5 || dd1 < 1e-5) ? 1e-6 : 0.01 * d0 / dd1;
-    h0 = std::min(h0, hmax);
-    yt = y + h0 * k1;
-    sys.rhs(t + h0, yt, k2);
-    ++st.rhs_evals;
-    const double dd2 = err_norm(k2 - k1, y, y, opt.rtol, opt.atol) / h0;
-    const double dm = std::max(dd1, dd2);
-    const double h1 = dm <= 1e-15 ? std::max(1e-6, h0 * 1e-3) : std::pow(0.01 / dm, 0.2);
-    h = std::min({100 * h0, h1, hmax});
-  }
+  double h = initial_step(sys, t, y, k1, yt, k2, opt, hmax, 5, st);
   double facold = 1e-4;
   bool last_rejected = false;
   const double hmin = 1e-14 * std::max(1.0, std::abs(t1));
@@ -188,38 +232,31 @@ void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
   VecX gend(ne), gbuf(ne), ybuf(n);
   init_event_signs(sys, t, y, sgn, gbuf);
 
+  auto shrink = [&] {  // reject the step after a failed evaluation
+    h *= fac_min;
+    ++st.rejected;
+    last_rejected = true;
+  };
+
   while (t < t1) {
-    if (st.steps + st.rejected >= opt.max_steps)
-      throw SolverError(
-          msg("dopri5: more than ", opt.max_steps, " steps before t=", t1, " (reached t=", t, ")"));
-    if (t + 1.01 * h >= t1) h = t1 - t;
-    if (h < hmin)
-      throw SolverError(msg("dopri5: step size underflow (h=", h, ") at t=", t,
-                            "; the problem may be stiff or singular there"));
-    h = representable_step(t, h);
-    // stages; a stage that cannot be evaluated (a point off the constraint manifold where the
-    // accelerations are not finite, e.g. at a large step near a singular position) rejects the
-    // step like a failed error test, and the error itself is raised once the step cannot shrink
-    bool stages_ok = true;
-    try {
-      yt = y + h * a21 * k1;
-      sys.rhs(t + c2 * h, yt, k2);
-      yt = y + h * (a31 * k1 + a32 * k2);
-      sys.rhs(t + c3 * h, yt, k3);
-      yt = y + h * (a41 * k1 + a42 * k2 + a43 * k3);
-      sys.rhs(t + c4 * h, yt, k4);
-      yt = y + h * (a51 * k1 + a52 * k2 + a53 * k3 + a54 * k4);
-      sys.rhs(t + c5 * h, yt, k5);
-      yt = y + h * (a61 * k1 + a62 * k2 + a63 * k3 + a64 * k4 + a65 * k5);
-      sys.rhs(t + h, yt, k6);
-    } catch (const SolverError&) {
-      if (!(h * fac_min >= hmin)) throw;
-      stages_ok = false;
-    }
+    guard_step("dopri5", opt, st, t, t1, hmin, h);
+    // stages; one that cannot be evaluated rejects the step (evaluates)
+    const bool stages_ok = evaluates(
+        [&] {
+          yt = y + h * a21 * k1;
+          sys.rhs(t + c2 * h, yt, k2);
+          yt = y + h * (a31 * k1 + a32 * k2);
+          sys.rhs(t + c3 * h, yt, k3);
+          yt = y + h * (a41 * k1 + a42 * k2 + a43 * k3);
+          sys.rhs(t + c4 * h, yt, k4);
+          yt = y + h * (a51 * k1 + a52 * k2 + a53 * k3 + a54 * k4);
+          sys.rhs(t + c5 * h, yt, k5);
+          yt = y + h * (a61 * k1 + a62 * k2 + a63 * k3 + a64 * k4 + a65 * k5);
+          sys.rhs(t + h, yt, k6);
+        },
+        h, fac_min, hmin);
     if (!stages_ok) {
-      h *= fac_min;
-      ++st.rejected;
-      last_rejected = true;
+      shrink();
       continue;
     }
     y1 = y + h * (a71 * k1 + a73 * k3 + a74 * k4 + a75 * k5 + a76 * k6);
@@ -229,23 +266,17 @@ void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
     // projection or evaluation that fails rejects the step.
     const bool fsal_projected = sys.project_last_stage();
     yp = y1;
-    bool projected = true;
-    try {
-      if (fsal_projected)
-        sys.project_and_rhs(t + h, yp, k7);
-      else
-        sys.rhs(t + h, y1, k7);
-    } catch (const SolverError&) {
-      if (!fsal_projected && !(h * fac_min >= hmin)) throw;
-      projected = false;
-    }
+    const bool last_ok = evaluates(
+        [&] {
+          if (fsal_projected)
+            sys.project_and_rhs(t + h, yp, k7);
+          else
+            sys.rhs(t + h, y1, k7);
+        },
+        h, fac_min, hmin);
     st.rhs_evals += 6;
-    if (!projected) {
-      if (!(h * fac_min >= hmin))
-        throw SolverError(msg("dopri5: the projection fails for every step from t=", t));
-      h *= fac_min;
-      ++st.rejected;
-      last_rejected = true;
+    if (!last_ok) {
+      shrink();
       continue;
     }
     err = h * (e1 * k1 + e3 * k3 + e4 * k4 + e5 * k5 + e6 * k6 + e7 * k7);
@@ -280,12 +311,7 @@ void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
         const double th = locate_events(sys, t, h, dense, sgn, gend, gbuf, ybuf, crossed);
         take_events(sys, t, h, th, dense, crossed, sgn, st, tn, y1);
       }
-      if (!every_step && ko < touts.size() && touts[ko] <= tn) {
-        for (; ko < touts.size() && touts[ko] <= tn; ++ko) {
-          dense((touts[ko] - t) / h, yo);
-          sys.output(touts[ko], yo);
-        }
-      }
+      serve_outputs(sys, touts, ko, t, h, tn, dense, yo);
       // an event cut moved y1: project and evaluate there; otherwise k7 is already f(tn, y1)
       const bool cut = tn != t_end_step;
       y = y1;
@@ -437,22 +463,7 @@ void integrate_dop853(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
   ++st.rhs_evals;
   sys.output(t, y);
 
-  // initial step (Hairer's hinit for order 8)
-  double h = opt.dt;
-  if (!(h > 0)) {
-    const double d0 = err_norm(y, y, y, opt.rtol, opt.atol);
-    const double dd1 = err_norm(k[0], y, y, opt.rtol, opt.atol);
-    double h0 = (d0 < 1e-5 || dd1 < 1e-5) ? 1e-6 : 0.01 * d0 / dd1;
-    h0 = std::min(h0, hmax);
-    yt = y + h0 * k[0];
-    sys.rhs(t + h0, yt, k[1]);
-    ++st.rhs_evals;
-    yo = k[1] - k[0];
-    const double dd2 = err_norm(yo, y, y, opt.rtol, opt.atol) / h0;
-    const double dm = std::max(dd1, dd2);
-    const double h1 = dm <= 1e-15 ? std::max(1e-6, h0 * 1e-3) : std::pow(0.01 / dm, expo);
-    h = std::min({100 * h0, h1, hmax});
-  }
+  double h = initial_step(sys, t, y, k[0], yt, k[1], opt, hmax, 8, st);
   bool last_rejected = false;
   const double hmin = 1e-14 * std::max(1.0, std::abs(t1));
   const int ne = sys.n_events();
@@ -460,31 +471,24 @@ void integrate_dop853(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
   VecX gend(ne), gbuf(ne), ybuf(n);
   init_event_signs(sys, t, y, sgn, gbuf);
 
-  while (t < t1) {
-    if (st.steps + st.rejected >= opt.max_steps)
-      throw SolverError(
-          msg("dop853: more than ", opt.max_steps, " steps before t=", t1, " (reached t=", t, ")"));
-    if (t + 1.01 * h >= t1) h = t1 - t;
-    if (h < hmin)
-      throw SolverError(msg("dop853: step size underflow (h=", h, ") at t=", t,
-                            "; the problem may be stiff or singular there"));
-    h = representable_step(t, h);
-    // a stage that cannot be evaluated rejects the step (as in integrate_dopri5)
-    bool stages_ok = true;
-    try {
-      for (int s = 1; s < 12; ++s) {
-        stage_point(yt, y, h, C::a[s], s, k);
-        sys.rhs(t + C::c[s] * h, yt, k[s]);
-      }
-    } catch (const SolverError&) {
-      if (!(h * fac_min >= hmin)) throw;
-      stages_ok = false;
+  auto shrink = [&] {  // reject the step after a failed evaluation (evaluates)
+    h *= fac_min;
+    ++st.rejected;
+    last_rejected = true;
+  };
+  auto stages = [&](int from, int to) {
+    for (int s = from; s < to; ++s) {
+      stage_point(yt, y, h, C::a[s], s, k);
+      sys.rhs(t + C::c[s] * h, yt, k[s]);
     }
+  };
+
+  while (t < t1) {
+    guard_step("dop853", opt, st, t, t1, hmin, h);
+    const bool stages_ok = evaluates([&] { stages(1, 12); }, h, fac_min, hmin);
     st.rhs_evals += 11;
     if (!stages_ok) {
-      h *= fac_min;
-      ++st.rejected;
-      last_rejected = true;
+      shrink();
       continue;
     }
     stage_point(y1, y, h, C::a[12], 12, k);
@@ -514,14 +518,8 @@ void integrate_dop853(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
     // accepted: project the end point and evaluate there (stage 13, the next step's first); a
     // projection that fails rejects the step
     yp = y1;
-    try {
-      sys.project_and_rhs(t + h, yp, k[12]);
-    } catch (const SolverError&) {
-      if (!(h * fac_min >= hmin))
-        throw SolverError(msg("dop853: the projection fails for every step from t=", t));
-      h *= fac_min;
-      ++st.rejected;
-      last_rejected = true;
+    if (!evaluates([&] { sys.project_and_rhs(t + h, yp, k[12]); }, h, fac_min, hmin)) {
+      shrink();
       continue;
     }
     ++st.rhs_evals;
@@ -539,21 +537,10 @@ void integrate_dop853(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
     }
     const bool outputs = !every_step && ko < touts.size() && touts[ko] <= tn;
     if (outputs || any_event) {
-      bool dense_ok = true;
-      try {
-        for (int s = 13; s < 16; ++s) {
-          stage_point(yt, y, h, C::a[s], s, k);
-          sys.rhs(t + C::c[s] * h, yt, k[s]);
-        }
-      } catch (const SolverError&) {
-        if (!(h * fac_min >= hmin)) throw;
-        dense_ok = false;
-      }
+      const bool dense_ok = evaluates([&] { stages(13, 16); }, h, fac_min, hmin);
       st.rhs_evals += 3;
       if (!dense_ok) {  // nothing of the step is kept: y, t and k[0] are unchanged
-        h *= fac_min;
-        ++st.rejected;
-        last_rejected = true;
+        shrink();
         continue;
       }
       r[0] = y1 - y;
@@ -578,12 +565,7 @@ void integrate_dop853(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
       const double th = locate_events(sys, t, h, dense, sgn, gend, gbuf, ybuf, crossed);
       take_events(sys, t, h, th, dense, crossed, sgn, st, tn, y1);
     }
-    if (!every_step && ko < touts.size() && touts[ko] <= tn) {
-      for (; ko < touts.size() && touts[ko] <= tn; ++ko) {
-        dense((touts[ko] - t) / h, yo);
-        sys.output(touts[ko], yo);
-      }
-    }
+    serve_outputs(sys, touts, ko, t, h, tn, dense, yo);
     y = y1;
     if (tn != t_end_step) {  // an event cut the step: project and evaluate there
       sys.project_and_rhs(tn, y, k[0]);
