@@ -87,14 +87,30 @@ void bind_validate(py::module_& m) {
 
   py::class_<JointSpaceInverseDynamics>(
       m, "JointSpaceInverseDynamics",
-      "Joint torques/forces of a tree model for (q, qd, qdd), computed through the Cartesian "
-      "Newton-Euler KKT path with every joint coordinate driven. Keeps its workspace between "
-      "calls.")
-      .def(py::init([](ModelHolder md) {
+      "Joint torques/forces of a tree model for (q, qd, qdd) on the Cartesian bodies. "
+      "method='recursive' (default): O(n) Newton-Euler sweeps (body accelerations forward, "
+      "subtree wrenches backward, projected on the joint axes); method='kkt': every joint "
+      "coordinate driven to (q, qd, qdd) and the constrained system solved for its multipliers. "
+      "Keeps its workspace between calls.")
+      .def(py::init([](ModelHolder md, const std::string& method) {
+             JointSpaceInverseDynamics::Method mt;
+             if (method == "recursive")
+               mt = JointSpaceInverseDynamics::Method::Recursive;
+             else if (method == "kkt")
+               mt = JointSpaceInverseDynamics::Method::Kkt;
+             else
+               throw ModelError(msg("inverse_dynamics: unknown method '", method,
+                                    "' (expected 'recursive' or 'kkt')"));
              return std::make_unique<JointSpaceInverseDynamics>(
-                 std::const_pointer_cast<const Model>(md));
+                 std::const_pointer_cast<const Model>(md), mt);
            }),
-           py::arg("model"))
+           py::arg("model"), py::arg("method") = "recursive")
+      .def_property_readonly("method",
+                             [](const JointSpaceInverseDynamics& self) {
+                               return self.method() == JointSpaceInverseDynamics::Method::Recursive
+                                          ? "recursive"
+                                          : "kkt";
+                             })
       .def(
           "__call__",
           [](JointSpaceInverseDynamics& self, py::object q, py::object qd, py::object qdd,

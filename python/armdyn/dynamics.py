@@ -39,7 +39,7 @@ class InverseDynamicsResult:
     stats: dict = field(default_factory=dict)
 
 
-def inverse_dynamics(model: _core.Model, q=None, qd=None, qdd=None, *, t=None):
+def inverse_dynamics(model: _core.Model, q=None, qd=None, qdd=None, *, t=None, method="recursive"):
     """Actuator efforts for a prescribed motion.
 
     Two forms:
@@ -48,11 +48,13 @@ def inverse_dynamics(model: _core.Model, q=None, qd=None, qdd=None, *, t=None):
       freedom: at each time the position (Newton), velocity and acceleration problems of the
       driven constraints are solved, then the multipliers from ``Γ v' + ζᵀ δ = η``. Returns an
       :class:`InverseDynamicsResult` (drive efforts and joint reactions).
-    * ``inverse_dynamics(model, q, qd, qdd, t=0.0)`` — a tree model in joint space: every joint
-      coordinate is driven to (q, qd, qdd) and the same KKT solve gives the joint torques/forces
-      (model joint order; the model's own drives are ignored). 1-D inputs give a (n_coords,)
-      array, 2-D inputs (one sample per row) a (n, n_coords) array; ``t`` may then be one time
-      per row.
+    * ``inverse_dynamics(model, q, qd, qdd, t=0.0)`` — a tree model in joint space: the joint
+      torques/forces (model joint order; the model's own drives are ignored). 1-D inputs give a
+      (n_coords,) array, 2-D inputs (one sample per row) a (n, n_coords) array; ``t`` may then
+      be one time per row. ``method="recursive"`` (default): O(n) Newton–Euler sweeps over the
+      Cartesian bodies (accelerations forward, subtree wrenches backward, projected on the joint
+      axes); ``method="kkt"``: every joint coordinate driven to (q, qd, qdd) and the KKT
+      multipliers of those drives. Both give the same torques to round-off (tests).
 
     Sign: the torque/force the actuator applies to the child body about/along the joint axis
     (the RNEA/URDF effort convention); gravity and every force element of the model are
@@ -71,7 +73,7 @@ def inverse_dynamics(model: _core.Model, q=None, qd=None, qdd=None, *, t=None):
         return InverseDynamicsResult(**raw)
     if q is None or qd is None or qdd is None:
         raise _core.ModelError("inverse_dynamics: q, qd and qdd must all be given")
-    solver = _core.JointSpaceInverseDynamics(model)
+    solver = _core.JointSpaceInverseDynamics(model, method)
     q, qd, qdd = (np.asarray(a, dtype=float) for a in (q, qd, qdd))
     if q.ndim == 1:
         return solver(q, qd, qdd, 0.0 if t is None else float(t))

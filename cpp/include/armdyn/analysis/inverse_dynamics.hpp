@@ -76,10 +76,20 @@ struct InverseDynamicsResult {
 InverseDynamicsResult inverse_dynamics_driven(const Model& m, const std::vector<double>& times);
 
 /// Joint-space inverse dynamics of a tree model; the model's own drives are ignored.
+/// Two paths give the same torques:
+///  - Recursive (default): O(n) Newton-Euler sweeps over the Cartesian bodies. Forward, the
+///    bodies' accelerations from (q, qd, qdd); backward, the residual wrench Gamma v' - eta of
+///    each subtree, projected on its joint's axis (virtual work of the joint's motion).
+///  - Kkt: every joint coordinate driven to (q, qd, qdd) and the constrained system solved for
+///    its multipliers (the engine's tree sweep, or the KKT factorisation when singular).
+/// eta (gravity, gyroscopic terms, loads, springs, coordinate forces) comes from the engine in
+/// both, so force elements enter identically.
 class JointSpaceInverseDynamics {
  public:
+  enum class Method { Recursive, Kkt };
   /// @throws ModelError when the model is not a joint-space tree.
-  explicit JointSpaceInverseDynamics(std::shared_ptr<const Model> m);
+  explicit JointSpaceInverseDynamics(std::shared_ptr<const Model> m,
+                                     Method method = Method::Recursive);
   ~JointSpaceInverseDynamics();
   /// Joint torques/forces for (q, qd, qdd) at time t (t matters for profiled force elements).
   VecX compute(const VecX& q, const VecX& qd, const VecX& qdd, double t = 0.0);
@@ -87,12 +97,19 @@ class JointSpaceInverseDynamics {
   void compute(Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd, Eigen::Ref<const VecX> qdd,
                Eigen::Ref<VecX> tau, double t = 0.0);
   const Model& model() const { return *src_; }
+  Method method() const { return method_; }
 
  private:
+  void recursive(Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd, Eigen::Ref<const VecX> qdd,
+                 Eigen::Ref<VecX> tau, double t);
   std::shared_ptr<const Model> src_;
-  Model driven_;  // src_ with one drive per joint coordinate, in coordinate order
+  Method method_;
+  Model driven_;  // Kkt: src_ with one drive per joint coordinate, in coordinate order
   std::unique_ptr<Engine> e_;
   VecX vd_, ref_;
+  // Recursive: per body, world angular and centre-of-mass accelerations, then the subtree's
+  // residual force and moment about the centre of mass; per joint, its child-side point and axis
+  std::vector<Vec3> alpha_, acc_, force_, moment_, point_, axis_;
 };
 
 }  // namespace armdyn
