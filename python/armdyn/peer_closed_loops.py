@@ -82,6 +82,25 @@ Exudyn (:func:`exudyn_squeezer`, :func:`exudyn_a02`)
     ``InitializeSolver``) gives the reference's squeezer accelerations to 1e-14 relative and
     A02's crank acceleration -c cos(phi0) to round-off; the errors fall at second order.
 
+SciPy on Pinocchio (:class:`PinocchioA02`, A02 only)
+    What a SciPy user writes for a closed loop on Pinocchio: the open tree (cranks on the world,
+    couplers on the cranks' tips, joints added depth first), the loop closures as the in-plane
+    rows of a point constraint between frames on the coupler's and the crank's tips, and the
+    index-1 equations with Baumgarte terms (alpha = beta = 10 1/s), solved by ``np.linalg.solve``
+    on the dense KKT matrix at every evaluation and integrated by ``solve_ivp`` (DOP853). This is
+    the SciPy peer of A02: the SciPy curve of ``workprecision.PROBLEMS['a02']`` integrates the
+    reference's own one-DOF equation, which presumes the motion, and is marked as not a peer.
+    At the flat positions the KKT matrix is singular; DOP853's step then collapses
+    ("Required step size is less than spacing between numbers"), and each run is a failed point
+    with the time it reached. Pinocchio's own ``constraintDynamics`` (proximal, 3-D contacts, so
+    the out-of-plane rows are redundant) and a minimum-norm solve (``lstsq``) were tried by hand
+    while building this class: the first ran for minutes without reaching 20 s at rtol 1e-4, the
+    second diverged at the first flat position (not kept in the repository).
+
+    Check (tests/test_peer_closed_loops.py): in motion on the branch at phi = 0.7 rad, every
+    crank's acceleration equals the reference's -c cos(phi) and every coupler's relative one
+    its negative, to 1e-10 relative.
+
 What cannot be done: no exact (hard) constraints and no error-controlled step in MuJoCo; no error
 control and no explicit method on a constrained model in Exudyn; TrapezoidalIndex2 on A02.
 
@@ -682,7 +701,157 @@ def workprecision_curves(problem, ref, quick: bool, repeats: int) -> dict:
             curves[f"Exudyn {method} (redundant coordinates)"] = sweep_exudyn(
                 problem, peer, method, exu_steps, ref, repeats
             )
+    if problem.name == "a02":
+        with contextlib.suppress(ImportError):
+            import pinocchio  # noqa: F401
+
+            curves["SciPy DOP853 on Pinocchio (index 1, Baumgarte)"] = sweep_scipy_pinocchio(
+                problem,
+                PinocchioA02(),
+                A02_SCIPY_QUICK if quick else A02_SCIPY_RTOLS,
+                ref,
+                repeats,
+            )
     return curves
+
+
+# -- SciPy on Pinocchio ----------------------------------------------------------------------
+
+
+class PinocchioA02:
+    """A02 as a SciPy user would write it on Pinocchio: the open tree of revolute-z joints
+    (crank i at A_i = (i, 0) to the world, angle from +x; coupler i on crank i-1's tip B_{i-1},
+    angle relative to that crank), the n loop closures as the in-plane rows of the point
+    constraint coupler i tip = crank i tip, and the index-1 equations with Baumgarte
+    stabilisation (the usual remedy for drift when the state is (q, v)):
+
+        [M  J^T] [a     ]   [-h                               ]
+        [J  0  ] [lambda] = [-(dJ/dt) v - 2 alpha J v - beta^2 g]
+
+    M from ``pin.crba``, h from ``pin.nonLinearEffects``, J and (dJ/dt) v from Pinocchio's frame
+    Jacobians and classical frame accelerations (``LOCAL_WORLD_ALIGNED``). 1 kg, 1 m uniform bars
+    (in-plane inertia 1/12 about the centre), gravity -9.81 y. ``rhs()`` gives (f, y0) for
+    ``solve_ivp``; y = (q, v). At the flat positions J loses n ranks, the KKT matrix becomes
+    singular and the step size collapses: the measured curve records how far each run got."""
+
+    def __init__(self, n: int = A02_N, speed: float = 1.0, baumgarte: float = 10.0):
+        import pinocchio as pin
+
+        self.pin, self.n, self.alpha = pin, n, baumgarte
+        m = pin.Model()
+        m.gravity = pin.Motion(np.array([0.0, -standard.G, 0.0]), np.zeros(3))
+        bar = pin.Inertia(1.0, np.array([0.5, 0.0, 0.0]), np.diag([0.0, 1.0, 1.0]) / 12.0)
+        # depth first (crank i, then coupler i + 1 on its tip): Pinocchio's CRBA needs every
+        # subtree's velocity indices contiguous (with cranks first and couplers after, the
+        # crank-coupler blocks of M come out zero)
+        self.crank, self.coupler = [], []
+        tip = pin.SE3(np.eye(3), np.array([1.0, 0.0, 0.0]))
+        for i in range(n + 1):
+            place = pin.SE3(np.eye(3), np.array([i, 0.0, 0.0]))
+            j = m.addJoint(0, pin.JointModelRZ(), place, f"A{i}")
+            m.appendBodyToJoint(j, bar, pin.SE3.Identity())
+            self.crank.append(j)
+            if i < n:
+                j = m.addJoint(self.crank[i], pin.JointModelRZ(), tip, f"B{i}")
+                m.appendBodyToJoint(j, bar, pin.SE3.Identity())
+                self.coupler.append(j)
+        self.frames = []
+        for i in range(1, n + 1):
+            a = m.addFrame(
+                pin.Frame(f"coupler{i}_tip", self.coupler[i - 1], tip, pin.FrameType.OP_FRAME)
+            )
+            b = m.addFrame(pin.Frame(f"crank{i}_tip", self.crank[i], tip, pin.FrameType.OP_FRAME))
+            self.frames.append((a, b))
+        self.model, self.data = m, m.createData()
+        nv = m.nv
+        self.kkt = np.zeros((nv + 2 * n, nv + 2 * n))
+        # velocity index of every crank and coupler (revolute joints: one each, v index = id - 1)
+        self.crank_v = np.array([j - 1 for j in self.crank])
+        self.coupler_v = np.array([j - 1 for j in self.coupler])
+        self.y0 = np.concatenate(
+            [self.joint_vector(np.pi / 2, -np.pi / 2), self.joint_vector(-speed, speed)]
+        )
+
+    def joint_vector(self, crank: float, coupler: float) -> np.ndarray:
+        """A vector over Pinocchio's joints: one value on every crank, one on every coupler."""
+        x = np.empty(self.model.nv)
+        x[self.crank_v] = crank
+        x[self.coupler_v] = coupler
+        return x
+
+    def accelerations(self, q, v):
+        pin, m, d, n = self.pin, self.model, self.data, self.n
+        nv = m.nv
+        frame = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+        pin.crba(m, d, q)
+        M = np.triu(d.M) + np.triu(d.M, 1).T
+        h = pin.nonLinearEffects(m, d, q, v)
+        pin.computeJointJacobians(m, d, q)
+        pin.forwardKinematics(m, d, q, v, np.zeros(nv))
+        pin.updateFramePlacements(m, d)
+        K = self.kkt
+        K[:nv, :nv] = M
+        rhs = np.empty(nv + 2 * n)
+        rhs[:nv] = -h
+        for k, (a, b) in enumerate(self.frames):
+            r = slice(nv + 2 * k, nv + 2 * k + 2)
+            J = (pin.getFrameJacobian(m, d, a, frame) - pin.getFrameJacobian(m, d, b, frame))[:2]
+            K[r, :nv] = J
+            K[:nv, r] = J.T
+            dJv = (
+                pin.getFrameClassicalAcceleration(m, d, a, frame).linear
+                - pin.getFrameClassicalAcceleration(m, d, b, frame).linear
+            )[:2]
+            g = (d.oMf[a].translation - d.oMf[b].translation)[:2]
+            rhs[r] = -dJv - 2.0 * self.alpha * (J @ v) - self.alpha**2 * g
+        return np.linalg.solve(K, rhs)[:nv]
+
+    def rhs(self):
+        nv = self.model.nv
+
+        def f(_t, y):
+            return np.concatenate([y[nv:], self.accelerations(y[:nv], y[nv:])])
+
+        return f, self.y0.copy()
+
+
+A02_SCIPY_RTOLS = (1e-4, 1e-6, 1e-8)
+A02_SCIPY_QUICK = (1e-4,)
+
+
+def sweep_scipy_pinocchio(problem, peer: PinocchioA02, rtols, ref, repeats: int) -> list[dict]:
+    """SciPy DOP853 on the Pinocchio index-1 model (setting = rtol = atol). A run that stops
+    early (step size collapse at a singular position) is a failed point with the time reached."""
+    from scipy.integrate import solve_ivp
+
+    from armdyn import workprecision as wp
+
+    f, y0 = peer.rhs()
+    t_out = wp._output_times(problem)
+    points = []
+    for rtol in rtols:
+
+        def call(rtol=rtol):
+            return solve_ivp(
+                f, (0.0, problem.t_end), y0, method="DOP853", rtol=rtol, atol=rtol, t_eval=t_out
+            )
+
+        try:
+            sec, reps, sol = wp._cpu(call, repeats)
+        except np.linalg.LinAlgError as exc:  # an exactly singular KKT matrix
+            points.append({"setting": rtol, "error": float("nan"), "failed": str(exc)[:200]})
+            continue
+        point = {"setting": rtol, "cpu_s": sec, "repeats": reps, "rhs_evals": int(sol.nfev)}
+        if sol.success:
+            obs = np.column_stack([np.cos(sol.y[0]), np.sin(sol.y[0])])
+            point["error"] = wp._error(problem, obs, ref)
+        else:
+            point.update(
+                error=float("nan"),
+                failed=f"stopped at t = {sol.t[-1]:.4g} s: {sol.message}"[:200],
+            )
+        points.append(point)
+    return points
 
 
 # -- checks -----------------------------------------------------------------------------------
