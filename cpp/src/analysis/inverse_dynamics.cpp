@@ -314,25 +314,9 @@ void JointSpaceInverseDynamics::recursive(Eigen::Ref<const VecX> q, Eigen::Ref<c
     const Joint& j = m.joints[ji];
     const bool on_ground = j.parent == kGround;
     const BodyKin& c = kin[j.child];
-    double thd = 0, thdd = 0, dd = 0, ddd = 0;
-    switch (j.type) {
-      case JointType::Revolute:
-        thd = qd[j.coord0];
-        thdd = qdd[j.coord0];
-        break;
-      case JointType::Prismatic:
-        dd = qd[j.coord0];
-        ddd = qdd[j.coord0];
-        break;
-      case JointType::Cylindrical:
-        thd = qd[j.coord0];
-        thdd = qdd[j.coord0];
-        dd = qd[j.coord0 + 1];
-        ddd = qdd[j.coord0 + 1];
-        break;
-      default:
-        break;
-    }
+    double thd, thdd, dd, ddd;
+    joint_components(j, qd, thd, dd);
+    joint_components(j, qdd, thdd, ddd);
     const Vec3 z =
         on_ground ? Vec3(j.frame_parent.col(2)) : Vec3(kin[j.parent].R * j.frame_parent.col(2));
     const Vec3 pc = c.x + c.R * j.point_child;

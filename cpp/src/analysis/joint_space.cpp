@@ -38,25 +38,9 @@ void joint_space_kinematics(const Model& m, Eigen::Ref<const VecX> q, Eigen::Ref
     const BodyKin& p = j.parent != kGround ? kin[j.parent] : ground;
     const Mat3 A = p.R * j.frame_parent;
     const Vec3 z = A.col(2);
-    double th = 0, thd = 0, d = 0, dd = 0;
-    switch (j.type) {
-      case JointType::Revolute:
-        th = q[j.coord0];
-        thd = qd[j.coord0];
-        break;
-      case JointType::Prismatic:
-        d = q[j.coord0];
-        dd = qd[j.coord0];
-        break;
-      case JointType::Cylindrical:
-        th = q[j.coord0];
-        thd = qd[j.coord0];
-        d = q[j.coord0 + 1];
-        dd = qd[j.coord0 + 1];
-        break;
-      default:
-        break;
-    }
+    double th, thd, d, dd;
+    joint_components(j, q, th, d);
+    joint_components(j, qd, thd, dd);
     // child joint frame B = A Rz(th), placed at P + d z
     const double ct = std::cos(th), st = std::sin(th);
     Mat3 B;

@@ -20,6 +20,27 @@ struct TreeFkWork {
   std::vector<BodyKin> kin;
 };
 
+/// Joint j's turn and slide about/along its axis from a joint-space vector x (q, qd or qdd):
+/// revolute (x, 0), prismatic (0, x), cylindrical (angle, displacement), otherwise (0, 0).
+inline void joint_components(const Joint& j, const Eigen::Ref<const VecX>& x, double& turn,
+                             double& slide) {
+  turn = slide = 0.0;
+  switch (j.type) {
+    case JointType::Revolute:
+      turn = x[j.coord0];
+      break;
+    case JointType::Prismatic:
+      slide = x[j.coord0];
+      break;
+    case JointType::Cylindrical:
+      turn = x[j.coord0];
+      slide = x[j.coord0 + 1];
+      break;
+    default:
+      break;
+  }
+}
+
 /// Body poses and velocities (R, x, xd, w, W) of a joint-space tree from joint coordinates q and
 /// rates qd, straight into a kinematic cache (size nb). Sizes and values are not checked.
 void joint_space_kinematics(const Model& m, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
