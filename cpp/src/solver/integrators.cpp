@@ -184,6 +184,95 @@ void serve_outputs(OdeSystem& sys, const std::vector<double>& touts, size_t& ko,
   }
 }
 
+// The bookkeeping DOPRI5 and DOP853 share: the output times, the step bounds, the clock (t, h),
+// the rejection state and the event signs with their scratch. Each method keeps its stages, its
+// error estimate, its step-size controller and its dense output.
+struct AdaptiveRun {
+  const char* name;
+  const StepOptions& opt;
+  double t1, t, h = 0.0, hmax, hmin;
+  std::vector<double> touts;
+  bool every_step;
+  size_t ko = 1;
+  bool last_rejected = false;
+  int ne;
+  std::vector<int> sgn, crossed;
+  VecX gend, gbuf, ybuf, yo;
+
+  AdaptiveRun(const char* name_, OdeSystem& sys, const StepOptions& o, double t0, double t1_,
+              long n)
+      : name(name_),
+        opt(o),
+        t1(t1_),
+        t(t0),
+        hmax(o.max_step > 0 ? o.max_step : t1_ - t0),
+        hmin(1e-14 * std::max(1.0, std::abs(t1_))),
+        touts(output_times(t0, t1_, o.output_dt)),
+        every_step(touts.empty()),
+        ne(sys.n_events()),
+        sgn(ne, 1),
+        gend(ne),
+        gbuf(ne),
+        ybuf(n),
+        yo(n) {}
+
+  /// f0 = f(t0, y) at the projected y; the output at t0, the event signs and the first step
+  /// for a method of the given order (yt, f1: scratch).
+  void start(OdeSystem& sys, VecX& y, VecX& f0, VecX& yt, VecX& f1, int order, StepStats& st) {
+    sys.project_and_rhs(t, y, f0);
+    ++st.rhs_evals;
+    sys.output(t, y);
+    h = initial_step(sys, t, y, f0, yt, f1, opt, hmax, order, st);
+    init_event_signs(sys, t, y, sgn, gbuf);
+  }
+  void guard(const StepStats& st) { guard_step(name, opt, st, t, t1, hmin, h); }
+  /// Rejects the step: h scaled by factor.
+  void reject(double factor, StepStats& st) {
+    h *= factor;
+    ++st.rejected;
+    last_rejected = true;
+  }
+  /// The end of the step from t (t1 itself when within round-off of it).
+  double step_end() const {
+    return (t + h >= t1 - 1e-14 * std::max(1.0, std::abs(t1))) ? t1 : t + h;
+  }
+  /// An output time lies in (t, tn].
+  bool output_inside(double tn) const {
+    return !every_step && ko < touts.size() && touts[ko] <= tn;
+  }
+  /// Whether an event function changed sign between t and (tn, y1) (its values kept in gend).
+  bool sign_change(OdeSystem& sys, double tn, const VecX& y1) {
+    if (ne == 0) return false;
+    sys.events(tn, y1, gend.data());
+    for (int i = 0; i < ne; ++i)
+      if (gend[i] * sgn[i] < 0) return true;
+    return false;
+  }
+  /// An accepted step with its dense output: ends it at the earliest event crossing (when
+  /// events), serves the output times in (t, tn] and sets y = y1. Returns whether an event cut
+  /// the step (tn and y1 then moved, and f must be evaluated afresh at them).
+  template <class Dense>
+  bool accept(OdeSystem& sys, double& tn, const Dense& dense, bool events, VecX& y, VecX& y1,
+              StepStats& st) {
+    const double t_end_step = tn;
+    if (events) {
+      const double th = locate_events(sys, t, h, dense, sgn, gend, gbuf, ybuf, crossed);
+      take_events(sys, t, h, th, dense, crossed, sgn, st, tn, y1);
+    }
+    serve_outputs(sys, touts, ko, t, h, tn, dense, yo);
+    y = y1;
+    return tn != t_end_step;
+  }
+  /// The clock moves to tn (y and the first stage there in place); the next step is hnew.
+  void advance(OdeSystem& sys, double tn, const VecX& y, double hnew, StepStats& st) {
+    t = tn;
+    ++st.steps;
+    if (every_step) sys.output(t, y);
+    h = hnew;
+    last_rejected = false;
+  }
+};
+
 }  // namespace
 
 void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepOptions& opt,
@@ -210,36 +299,14 @@ void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
 
   const long n = y.size();
   VecX k1(n), k2(n), k3(n), k4(n), k5(n), k6(n), k7(n), yt(n), y1(n), err(n);
-  VecX r1(n), r2(n), r3(n), r4(n), r5(n), yo(n), yp(n);
-  const std::vector<double> touts = output_times(t0, t1, opt.output_dt);
-  const bool every_step = touts.empty();
-  size_t ko = 1;
-  const double span = t1 - t0;
-  const double hmax = opt.max_step > 0 ? opt.max_step : span;
-
-  double t = t0;
-  sys.project_and_rhs(t, y, k1);
-  ++st.rhs_evals;
-  sys.output(t, y);
-
-  double h = initial_step(sys, t, y, k1, yt, k2, opt, hmax, 5, st);
+  VecX r1(n), r2(n), r3(n), r4(n), r5(n), yp(n);
+  AdaptiveRun run("dopri5", sys, opt, t0, t1, n);
+  double &t = run.t, &h = run.h;
+  run.start(sys, y, k1, yt, k2, 5, st);
   double facold = 1e-4;
-  bool last_rejected = false;
-  const double hmin = 1e-14 * std::max(1.0, std::abs(t1));
-  // events: signs at the start of the step
-  const int ne = sys.n_events();
-  std::vector<int> sgn(ne, 1), crossed;
-  VecX gend(ne), gbuf(ne), ybuf(n);
-  init_event_signs(sys, t, y, sgn, gbuf);
-
-  auto shrink = [&] {  // reject the step after a failed evaluation
-    h *= fac_min;
-    ++st.rejected;
-    last_rejected = true;
-  };
 
   while (t < t1) {
-    guard_step("dopri5", opt, st, t, t1, hmin, h);
+    run.guard(st);
     // stages; one that cannot be evaluated rejects the step (evaluates)
     const bool stages_ok = evaluates(
         [&] {
@@ -254,9 +321,9 @@ void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
           yt = y + h * (a61 * k1 + a62 * k2 + a63 * k3 + a64 * k4 + a65 * k5);
           sys.rhs(t + h, yt, k6);
         },
-        h, fac_min, hmin);
+        h, fac_min, run.hmin);
     if (!stages_ok) {
-      shrink();
+      run.reject(fac_min, st);
       continue;
     }
     y1 = y + h * (a71 * k1 + a73 * k3 + a74 * k4 + a75 * k5 + a76 * k6);
@@ -273,10 +340,10 @@ void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
           else
             sys.rhs(t + h, y1, k7);
         },
-        h, fac_min, hmin);
+        h, fac_min, run.hmin);
     st.rhs_evals += 6;
     if (!last_ok) {
-      shrink();
+      run.reject(fac_min, st);
       continue;
     }
     err = h * (e1 * k1 + e3 * k3 + e4 * k4 + e5 * k5 + e6 * k6 + e7 * k7);
@@ -287,13 +354,13 @@ void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
       // accepted: dense output coefficients, outputs inside (t, t + h], projection
       double fac = fac11 / std::pow(facold, beta);
       fac = std::clamp(fac / safe, 1.0 / fac_max, 1.0 / fac_min);
-      double hnew = std::min(h / fac, hmax);
-      if (last_rejected) hnew = std::min(hnew, h);
+      double hnew = std::min(h / fac, run.hmax);
+      if (run.last_rejected) hnew = std::min(hnew, h);
       facold = std::max(en, 1e-4);
-      double tn = (t + h >= t1 - 1e-14 * std::max(1.0, std::abs(t1))) ? t1 : t + h;
-      const bool need_dense = ne > 0 || (!every_step && ko < touts.size() && touts[ko] <= tn);
+      double tn = run.step_end();
       if (fsal_projected) y1 = yp;  // the dense output ends where the next step starts
-      if (need_dense) {
+      const bool events = run.sign_change(sys, tn, y1);
+      if (events || run.output_inside(tn)) {
         r1 = y;
         r2 = y1 - y;
         r3 = h * k1 - r2;
@@ -304,32 +371,16 @@ void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
         const double th1 = 1.0 - th;
         out = r1 + th * (r2 + th1 * (r3 + th * (r4 + th1 * r5)));
       };
-      // events: cut the step at the earliest crossing and restart from there
-      const double t_end_step = tn;
-      if (ne > 0) {
-        sys.events(tn, y1, gend.data());
-        const double th = locate_events(sys, t, h, dense, sgn, gend, gbuf, ybuf, crossed);
-        take_events(sys, t, h, th, dense, crossed, sgn, st, tn, y1);
-      }
-      serve_outputs(sys, touts, ko, t, h, tn, dense, yo);
       // an event cut moved y1: project and evaluate there; otherwise k7 is already f(tn, y1)
-      const bool cut = tn != t_end_step;
-      y = y1;
-      if (cut || !fsal_projected) {
+      if (run.accept(sys, tn, dense, events, y, y1, st) || !fsal_projected) {
         sys.project_and_rhs(tn, y, k1);
         ++st.rhs_evals;
       } else {
         k1 = k7;
       }
-      t = tn;
-      ++st.steps;
-      if (every_step) sys.output(t, y);
-      h = hnew;
-      last_rejected = false;
+      run.advance(sys, tn, y, hnew, st);
     } else {
-      h = h / std::min(1.0 / fac_min, fac11 / safe);
-      ++st.rejected;
-      last_rejected = true;
+      run.reject(1.0 / std::min(1.0 / fac_min, fac11 / safe), st);
     }
   }
 }
@@ -451,31 +502,10 @@ void integrate_dop853(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
   for (VecX& ki : k) ki.resize(n);
   std::array<VecX, 7> r;  // dense output: y(t + th h) = y + th (r0 + (1-th)(r1 + th(r2 + ...)))
   for (VecX& ri : r) ri.resize(n);
-  VecX yt(n), y1(n), yo(n), yp(n);
-  const std::vector<double> touts = output_times(t0, t1, opt.output_dt);
-  const bool every_step = touts.empty();
-  size_t ko = 1;
-  const double span = t1 - t0;
-  const double hmax = opt.max_step > 0 ? opt.max_step : span;
-
-  double t = t0;
-  sys.project_and_rhs(t, y, k[0]);
-  ++st.rhs_evals;
-  sys.output(t, y);
-
-  double h = initial_step(sys, t, y, k[0], yt, k[1], opt, hmax, 8, st);
-  bool last_rejected = false;
-  const double hmin = 1e-14 * std::max(1.0, std::abs(t1));
-  const int ne = sys.n_events();
-  std::vector<int> sgn(ne, 1), crossed;
-  VecX gend(ne), gbuf(ne), ybuf(n);
-  init_event_signs(sys, t, y, sgn, gbuf);
-
-  auto shrink = [&] {  // reject the step after a failed evaluation (evaluates)
-    h *= fac_min;
-    ++st.rejected;
-    last_rejected = true;
-  };
+  VecX yt(n), y1(n), yp(n);
+  AdaptiveRun run("dop853", sys, opt, t0, t1, n);
+  double &t = run.t, &h = run.h;
+  run.start(sys, y, k[0], yt, k[1], 8, st);
   auto stages = [&](int from, int to) {
     for (int s = from; s < to; ++s) {
       stage_point(yt, y, h, C::a[s], s, k);
@@ -484,11 +514,11 @@ void integrate_dop853(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
   };
 
   while (t < t1) {
-    guard_step("dop853", opt, st, t, t1, hmin, h);
-    const bool stages_ok = evaluates([&] { stages(1, 12); }, h, fac_min, hmin);
+    run.guard(st);
+    const bool stages_ok = evaluates([&] { stages(1, 12); }, h, fac_min, run.hmin);
     st.rhs_evals += 11;
     if (!stages_ok) {
-      shrink();
+      run.reject(fac_min, st);
       continue;
     }
     stage_point(y1, y, h, C::a[12], 12, k);
@@ -510,37 +540,30 @@ void integrate_dop853(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
     if (!std::isfinite(en)) throw SolverError(msg("dop853: non-finite error estimate at t=", t));
     const double fac11 = std::pow(en, expo);
     if (en > 1.0) {
-      h = h / std::min(1.0 / fac_min, fac11 / safe);
-      ++st.rejected;
-      last_rejected = true;
+      run.reject(1.0 / std::min(1.0 / fac_min, fac11 / safe), st);
       continue;
     }
     // accepted: project the end point and evaluate there (stage 13, the next step's first); a
     // projection that fails rejects the step
     yp = y1;
-    if (!evaluates([&] { sys.project_and_rhs(t + h, yp, k[12]); }, h, fac_min, hmin)) {
-      shrink();
+    if (!evaluates([&] { sys.project_and_rhs(t + h, yp, k[12]); }, h, fac_min, run.hmin)) {
+      run.reject(fac_min, st);
       continue;
     }
     ++st.rhs_evals;
     y1 = yp;  // the dense output ends where the next step starts
     const double fac = std::clamp(fac11 / safe, 1.0 / fac_max, 1.0 / fac_min);
-    double hnew = std::min(h / fac, hmax);
-    if (last_rejected) hnew = std::min(hnew, h);
-    double tn = (t + h >= t1 - 1e-14 * std::max(1.0, std::abs(t1))) ? t1 : t + h;
+    double hnew = std::min(h / fac, run.hmax);
+    if (run.last_rejected) hnew = std::min(hnew, h);
+    double tn = run.step_end();
     // dense output only where it is used: an output time inside the step or a sign change of
     // an event function (three more right-hand sides)
-    bool any_event = false;
-    if (ne > 0) {
-      sys.events(tn, y1, gend.data());
-      for (int i = 0; i < ne; ++i) any_event = any_event || gend[i] * sgn[i] < 0;
-    }
-    const bool outputs = !every_step && ko < touts.size() && touts[ko] <= tn;
-    if (outputs || any_event) {
-      const bool dense_ok = evaluates([&] { stages(13, 16); }, h, fac_min, hmin);
+    const bool events = run.sign_change(sys, tn, y1);
+    if (events || run.output_inside(tn)) {
+      const bool dense_ok = evaluates([&] { stages(13, 16); }, h, fac_min, run.hmin);
       st.rhs_evals += 3;
       if (!dense_ok) {  // nothing of the step is kept: y, t and k[0] are unchanged
-        shrink();
+        run.reject(fac_min, st);
         continue;
       }
       r[0] = y1 - y;
@@ -560,24 +583,13 @@ void integrate_dop853(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
           th * (r[0] +
                 th1 * (r[1] + th * (r[2] + th1 * (r[3] + th * (r[4] + th1 * (r[5] + th * r[6]))))));
     };
-    const double t_end_step = tn;
-    if (any_event) {
-      const double th = locate_events(sys, t, h, dense, sgn, gend, gbuf, ybuf, crossed);
-      take_events(sys, t, h, th, dense, crossed, sgn, st, tn, y1);
-    }
-    serve_outputs(sys, touts, ko, t, h, tn, dense, yo);
-    y = y1;
-    if (tn != t_end_step) {  // an event cut the step: project and evaluate there
+    if (run.accept(sys, tn, dense, events, y, y1, st)) {  // an event cut the step
       sys.project_and_rhs(tn, y, k[0]);
       ++st.rhs_evals;
     } else {
       std::swap(k[0], k[12]);
     }
-    t = tn;
-    ++st.steps;
-    if (every_step) sys.output(t, y);
-    h = hnew;
-    last_rejected = false;
+    run.advance(sys, tn, y, hnew, st);
   }
 }
 
