@@ -254,5 +254,11 @@ def test_recursive_and_kkt_paths_agree(rng):
         t = rng.uniform(0.0, 3.0)
         a, b = rec(q, qd, qdd, t), kkt(q, qd, qdd, t)
         assert rel_err(a, b) <= tol(1e-12)
+    # the same through ad.inverse_dynamics, rows and method included
+    q, qd, qdd = rng.uniform(-2.0, 2.0, size=(3, 2, n))
+    rows = ad.inverse_dynamics(model, q, qd, qdd, t=0.7, method="kkt")
+    assert rel_err(ad.inverse_dynamics(model, q, qd, qdd, t=0.7), rows) <= tol(1e-12)
     with pytest.raises(_core.ModelError, match="unknown method 'aba'"):
-        _core.JointSpaceInverseDynamics(model, method="aba")
+        ad.inverse_dynamics(model, q[0], qd[0], qdd[0], method="aba")
+    with pytest.raises(_core.ModelError, match="method applies to the joint-space form"):
+        ad.inverse_dynamics(model, t=[0.0], method="kkt")

@@ -39,7 +39,7 @@ class InverseDynamicsResult:
     stats: dict = field(default_factory=dict)
 
 
-def inverse_dynamics(model: _core.Model, q=None, qd=None, qdd=None, *, t=None, method="recursive"):
+def inverse_dynamics(model: _core.Model, q=None, qd=None, qdd=None, *, t=None, method=None):
     """Actuator efforts for a prescribed motion.
 
     Two forms:
@@ -51,10 +51,11 @@ def inverse_dynamics(model: _core.Model, q=None, qd=None, qdd=None, *, t=None, m
     * ``inverse_dynamics(model, q, qd, qdd, t=0.0)`` — a tree model in joint space: the joint
       torques/forces (model joint order; the model's own drives are ignored). 1-D inputs give a
       (n_coords,) array, 2-D inputs (one sample per row) a (n, n_coords) array; ``t`` may then
-      be one time per row. ``method="recursive"`` (default): O(n) Newton–Euler sweeps over the
-      Cartesian bodies (accelerations forward, subtree wrenches backward, projected on the joint
-      axes); ``method="kkt"``: every joint coordinate driven to (q, qd, qdd) and the KKT
-      multipliers of those drives. Both give the same torques to round-off (tests).
+      be one time per row. ``method="recursive"`` (the default of this form): O(n) Newton–Euler
+      sweeps over the Cartesian bodies (accelerations forward, subtree wrenches backward,
+      projected on the joint axes); ``method="kkt"``: every joint coordinate driven to
+      (q, qd, qdd) and the KKT multipliers of those drives. Both give the same torques to
+      round-off (tests).
 
     Sign: the torque/force the actuator applies to the child body about/along the joint axis
     (the RNEA/URDF effort convention); gravity and every force element of the model are
@@ -68,12 +69,17 @@ def inverse_dynamics(model: _core.Model, q=None, qd=None, qdd=None, *, t=None, m
     if q is None and qd is None and qdd is None:
         if t is None:
             raise _core.ModelError("inverse_dynamics: give t (driven model) or q, qd, qdd")
+        if method is not None:
+            raise _core.ModelError(
+                "inverse_dynamics: method applies to the joint-space form (q, qd, qdd); the "
+                "driven form always solves the driven constraints for their multipliers"
+            )
         times = np.atleast_1d(np.asarray(t, dtype=float))
         raw = _core._inverse_dynamics_driven(model, times)
         return InverseDynamicsResult(**raw)
     if q is None or qd is None or qdd is None:
         raise _core.ModelError("inverse_dynamics: q, qd and qdd must all be given")
-    solver = _core.JointSpaceInverseDynamics(model, method)
+    solver = _core.JointSpaceInverseDynamics(model, method or "recursive")
     q, qd, qdd = (np.asarray(a, dtype=float) for a in (q, qd, qdd))
     if q.ndim == 1:
         return solver(q, qd, qdd, 0.0 if t is None else float(t))

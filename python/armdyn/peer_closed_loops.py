@@ -70,8 +70,9 @@ Exudyn (:func:`exudyn_squeezer`, :func:`exudyn_a02`)
     sample checked to lie on it. A02: GeneralizedAlpha passes the singular positions without
     ``linearSolver.ignoreSingularJacobian`` (the steps never land exactly on them and the factor
     never fails), so it stays off and a singular factor would show as a failure;
-    TrapezoidalIndex2 fails in Newton (step reduction is unavailable at fixed steps) at the
-    first singular position, t ≈ 1.25 s, at every step of the sweep; GeneralizedAlpha fails the
+    TrapezoidalIndex2 passes the first singular position (t ≈ 0.72 s) and fails in Newton (step
+    reduction is unavailable at fixed steps) at the second, t ≈ 1.244 s, at every step of the
+    sweep; GeneralizedAlpha fails the
     same way at two of its steps (a02.json lists where and why). Hand trials while building this
     module (with ``ignoreSingularJacobian``, full Newton, Newton tolerances 1e-6 to 1e-10; not
     kept in the repository) did not get TrapezoidalIndex2 through. Failed runs are recorded as
@@ -120,6 +121,7 @@ import time
 import numpy as np
 
 from armdyn.peer_exudyn import _exudyn, implicit_settings, solve_checked
+from armdyn.peer_pinocchio import mass_matrix
 from armdyn.scenes import standard
 
 SQUEEZER_JOINTS = ("beta", "Theta", "gamma", "Phi", "delta", "Omega", "epsilon")
@@ -140,6 +142,8 @@ A02_MJ_STEPS = (1e-2, 5e-3, 2.5e-3, 1.25e-3, 6.25e-4)
 A02_MJ_QUICK = (2.5e-3,)
 A02_EXU_STEPS = (400, 800, 1600, 3200, 6400, 12800)
 A02_EXU_QUICK = (1600,)
+A02_SCIPY_RTOLS = (1e-4, 1e-6, 1e-8)  # SciPy DOP853 on Pinocchio
+A02_SCIPY_QUICK = (1e-4,)
 
 
 def _f(x) -> str:
@@ -199,14 +203,15 @@ def squeezer_mjcf() -> str:
         body(6, "epsilon", "A", zero, q0[6], body(5, "Omega", "H", pts["A"], q0[5])),
     ]
     anchor = _xyz(pts["E"] - pts["F"])  # E in K2's frame
+    h = 1e-5  # the starting step; set_step(h) sets the same time constant and softness
     loops = "".join(
-        f'<connect name="E{k}" body1="K2" body2="K{k}" anchor="{anchor}" solref="2e-5 1" '
-        f'solimp="{imp}"/>'
+        f'<connect name="E{k}" body1="K2" body2="K{k}" anchor="{anchor}" '
+        f'solref="{_f(TIMECONST_STEPS * h)} 1" solimp="{imp}"/>'
         for k in (3, 4, 6)
     )
     return (
         '<mujoco model="andrews_squeezer"><compiler angle="radian"/>'
-        '<option gravity="0 0 0" integrator="RK4" timestep="1e-5"/>'
+        f'<option gravity="0 0 0" integrator="RK4" timestep="{_f(h)}"/>'
         f'<worldbody><site name="C" pos="{_xyz(pts["C"])}"/>{"".join(tree)}</worldbody>'
         f"<equality>{loops}</equality>"
         f'<tendon><spatial name="spring" stiffness="{_f(p["c0"])}" '
@@ -221,6 +226,7 @@ def a02_mjcf(n: int = A02_N, phi0: float = np.pi / 2, speed: float = 1.0) -> str
     upright) turning at -``speed`` rad/s, the couplers translating; qpos of hinge ``A{i}`` is
     crank i's angle from +x."""
     i12 = 1.0 / 12.0
+    h = 1e-3  # the starting step; set_step(h) sets the same time constant and softness
     imp = " ".join(_f(s) for s in SOLIMP)
     e = np.array([np.cos(phi0), np.sin(phi0)])
     quat = f"{_f(np.cos(phi0 / 2))} 0 0 {_f(np.sin(phi0 / 2))}"  # crank axis = inertial x
@@ -243,13 +249,13 @@ def a02_mjcf(n: int = A02_N, phi0: float = np.pi / 2, speed: float = 1.0) -> str
         if i > 0:
             loops.append(
                 f'<connect name="C{i}" body1="coupler{i}" body2="crank{i}" anchor="1 0 0" '
-                f'solref="0.002 1" solimp="{imp}"/>'
+                f'solref="{_f(TIMECONST_STEPS * h)} 1" solimp="{imp}"/>'
             )
     # qvel in tree order: A0, B0, A1, B1, ..., A{n}; couplers turn at +speed against their crank
     qvel = " ".join([f"{_f(-speed)} {_f(speed)}"] * n + [_f(-speed)])
     return (
         f'<mujoco model="iftomm_a02_{n}"><compiler angle="radian"/>'
-        f'<option gravity="0 {_f(-standard.G)} 0" integrator="RK4" timestep="1e-3"/>'
+        f'<option gravity="0 {_f(-standard.G)} 0" integrator="RK4" timestep="{_f(h)}"/>'
         f"<worldbody>{''.join(bodies)}</worldbody><equality>{''.join(loops)}</equality>"
         f'<keyframe><key name="start" qvel="{qvel}"/></keyframe></mujoco>'
     )
@@ -267,8 +273,7 @@ class MujocoPeer:
 
         self.mujoco = mujoco
         self.xml = xml
-        self.model = mujoco.MjModel.from_xml_string(xml)
-        self.model.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
+        self.model = mujoco.MjModel.from_xml_string(xml)  # RK4, softness as set_step
         self.qpos_index = np.array(
             [self.model.joint(name).qposadr[0] for name in observed_joints], dtype=int
         )
@@ -449,11 +454,10 @@ class ExudynPeer:
     quantities. ``sparse``: ``EigenSparse`` instead of ``EXUdense``.
     """
 
-    def __init__(self, build, observe, sparse=False, ignore_singular=False):
+    def __init__(self, build, observe, sparse=False):
         self._build = build
         self._observe = observe
         self.sparse = sparse
-        self.ignore_singular = ignore_singular
 
     def system(self):
         """A fresh assembled system with Coordinates sensors on the observed nodes. Returns
@@ -481,7 +485,8 @@ class ExudynPeer:
         ss = implicit_settings(t_end, n_steps, t_end / n_out, spectral_radius, newton_rtol)
         if self.sparse:
             ss.linearSolver.solverType = exu.LinearSolverType.EigenSparse
-        ss.linearSolver.ignoreSingularJacobian = self.ignore_singular
+        # off: a singular factor shows as a failed run, not as silently regularised steps
+        ss.linearSolver.ignoreSingularJacobian = False
         return ss
 
     def initial_accelerations(self) -> np.ndarray:
@@ -609,15 +614,12 @@ def exudyn_squeezer() -> ExudynPeer:
     return ExudynPeer(_squeezer_planar, lambda phi: q0 + squeezer_to_angles(phi))
 
 
-def exudyn_a02(
-    n: int = A02_N, phi0: float = np.pi / 2, speed: float = 1.0, ignore_singular: bool = False
-) -> ExudynPeer:
+def exudyn_a02(n: int = A02_N, phi0: float = np.pi / 2, speed: float = 1.0) -> ExudynPeer:
     """A02 in Exudyn (EigenSparse); observes B0 = (cos, sin) of crank 0's angle."""
     return ExudynPeer(
         lambda: _a02_planar(n, phi0, speed),
         lambda a: np.column_stack([np.cos(a[:, 0]), np.sin(a[:, 0])]),
         sparse=True,
-        ignore_singular=ignore_singular,
     )
 
 
@@ -705,12 +707,15 @@ def workprecision_curves(problem, ref, quick: bool, repeats: int) -> dict:
         with contextlib.suppress(ImportError):
             import pinocchio  # noqa: F401
 
-            curves["SciPy DOP853 on Pinocchio (index 1, Baumgarte)"] = sweep_scipy_pinocchio(
+            from armdyn.workprecision import sweep_scipy
+
+            curves["SciPy DOP853 on Pinocchio (index 1, Baumgarte)"] = sweep_scipy(
                 problem,
-                PinocchioA02(),
+                "DOP853",
                 A02_SCIPY_QUICK if quick else A02_SCIPY_RTOLS,
                 ref,
                 repeats,
+                rhs=PinocchioA02().rhs(),
             )
     return curves
 
@@ -783,8 +788,7 @@ class PinocchioA02:
         pin, m, d, n = self.pin, self.model, self.data, self.n
         nv = m.nv
         frame = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
-        pin.crba(m, d, q)
-        M = np.triu(d.M) + np.triu(d.M, 1).T
+        M = mass_matrix(pin, m, d, q)
         h = pin.nonLinearEffects(m, d, q, v)
         pin.computeJointJacobians(m, d, q)
         pin.forwardKinematics(m, d, q, v, np.zeros(nv))
@@ -813,45 +817,6 @@ class PinocchioA02:
             return np.concatenate([y[nv:], self.accelerations(y[:nv], y[nv:])])
 
         return f, self.y0.copy()
-
-
-A02_SCIPY_RTOLS = (1e-4, 1e-6, 1e-8)
-A02_SCIPY_QUICK = (1e-4,)
-
-
-def sweep_scipy_pinocchio(problem, peer: PinocchioA02, rtols, ref, repeats: int) -> list[dict]:
-    """SciPy DOP853 on the Pinocchio index-1 model (setting = rtol = atol). A run that stops
-    early (step size collapse at a singular position) is a failed point with the time reached."""
-    from scipy.integrate import solve_ivp
-
-    from armdyn import workprecision as wp
-
-    f, y0 = peer.rhs()
-    t_out = wp._output_times(problem)
-    points = []
-    for rtol in rtols:
-
-        def call(rtol=rtol):
-            return solve_ivp(
-                f, (0.0, problem.t_end), y0, method="DOP853", rtol=rtol, atol=rtol, t_eval=t_out
-            )
-
-        try:
-            sec, reps, sol = wp._cpu(call, repeats)
-        except np.linalg.LinAlgError as exc:  # an exactly singular KKT matrix
-            points.append({"setting": rtol, "error": float("nan"), "failed": str(exc)[:200]})
-            continue
-        point = {"setting": rtol, "cpu_s": sec, "repeats": reps, "rhs_evals": int(sol.nfev)}
-        if sol.success:
-            obs = np.column_stack([np.cos(sol.y[0]), np.sin(sol.y[0])])
-            point["error"] = wp._error(problem, obs, ref)
-        else:
-            point.update(
-                error=float("nan"),
-                failed=f"stopped at t = {sol.t[-1]:.4g} s: {sol.message}"[:200],
-            )
-        points.append(point)
-    return points
 
 
 # -- checks -----------------------------------------------------------------------------------

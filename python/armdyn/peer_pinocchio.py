@@ -19,6 +19,12 @@ import numpy as np
 from armdyn import _core
 
 
+def mass_matrix(pin, model, data, q) -> np.ndarray:
+    """The joint-space mass matrix from ``pin.crba``, which fills only its upper triangle."""
+    m = pin.crba(model, data, q)
+    return np.triu(m) + np.triu(m, 1).T
+
+
 def _se3(pin, rotation, translation):
     return pin.SE3(np.asarray(rotation, dtype=float), np.asarray(translation, dtype=float))
 

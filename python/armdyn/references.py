@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from armdyn.peer_pinocchio import mass_matrix, pinocchio_tree
 from armdyn.scenes.standard import SQUEEZER, G
 
 # --- A01 ------------------------------------------------------------------------------------
@@ -247,12 +248,11 @@ class GearedArmReference:
 
         import pinocchio as pin
 
-        from armdyn.peer_pinocchio import pinocchio_tree
         from armdyn.scenes.geared_arm import JOINTS, geared_arm_6dof
 
         defaults = {k: v.default for k, v in inspect.signature(geared_arm_6dof).parameters.items()}
         self.scene = dict(defaults, **scene, backlash=0.0, n_motors=1, control="motor")
-        tree = geared_arm_6dof(**dict(self.scene, ideal_gears=False))
+        self.tree = tree = geared_arm_6dof(**dict(self.scene, ideal_gears=False))
         self.pin = pin
         self.pm, self.idx = pinocchio_tree(tree)
         self.pd = self.pm.createData()
@@ -282,10 +282,27 @@ class GearedArmReference:
         qp = np.zeros(self.pm.nq)
         vp = np.zeros(self.pm.nv)
         qp[i], vp[i] = q, qd
-        M = pin.crba(self.pm, self.pd, qp)
-        M = np.triu(M) + np.triu(M, 1).T
+        M = mass_matrix(pin, self.pm, self.pd, qp)
         b = pin.rnea(self.pm, self.pd, qp, vp, np.zeros(self.pm.nv))
         return M[np.ix_(i, i)], b[i]
+
+    def lagrange_check(self, times, seed: int = 0) -> float:
+        """Worst relative difference, over random states (q, qd, qdd uniform in [-3, 3]) at the
+        given times, between these tree equations (M qdd + b - Q) and the torques of armdyn's
+        independent Lagrange validator on the same open tree."""
+        from armdyn.validation import LagrangeValidator
+
+        lv = LagrangeValidator(self.tree)
+        n = len(self.idx)
+        rng = np.random.default_rng(seed)
+        worst = 0.0
+        for t in times:
+            q, qd, qdd = (rng.uniform(-3.0, 3.0, n) for _ in range(3))
+            m, b = self.tree_terms(q, qd)
+            mine = m @ qdd + b - self.motor_torques(t, q, qd)
+            val = lv.torques(q, qd, qdd, t)
+            worst = max(worst, float(np.abs(mine - val).max() / np.abs(val).max()))
+        return worst
 
     def rhs(self):
         T = self.T

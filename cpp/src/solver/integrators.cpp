@@ -226,9 +226,9 @@ struct AdaptiveRun {
     init_event_signs(sys, t, y, sgn, gbuf);
   }
   void guard(const StepStats& st) { guard_step(name, opt, st, t, t1, hmin, h); }
-  /// Rejects the step: h scaled by factor.
-  void reject(double factor, StepStats& st) {
-    h *= factor;
+  /// Rejects the step; the next attempt takes h_retry.
+  void reject(double h_retry, StepStats& st) {
+    h = h_retry;
     ++st.rejected;
     last_rejected = true;
   }
@@ -323,7 +323,7 @@ void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
         },
         h, fac_min, run.hmin);
     if (!stages_ok) {
-      run.reject(fac_min, st);
+      run.reject(h * fac_min, st);
       continue;
     }
     y1 = y + h * (a71 * k1 + a73 * k3 + a74 * k4 + a75 * k5 + a76 * k6);
@@ -343,7 +343,7 @@ void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
         h, fac_min, run.hmin);
     st.rhs_evals += 6;
     if (!last_ok) {
-      run.reject(fac_min, st);
+      run.reject(h * fac_min, st);
       continue;
     }
     err = h * (e1 * k1 + e3 * k3 + e4 * k4 + e5 * k5 + e6 * k6 + e7 * k7);
@@ -380,7 +380,7 @@ void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
       }
       run.advance(sys, tn, y, hnew, st);
     } else {
-      run.reject(1.0 / std::min(1.0 / fac_min, fac11 / safe), st);
+      run.reject(h / std::min(1.0 / fac_min, fac11 / safe), st);
     }
   }
 }
@@ -518,7 +518,7 @@ void integrate_dop853(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
     const bool stages_ok = evaluates([&] { stages(1, 12); }, h, fac_min, run.hmin);
     st.rhs_evals += 11;
     if (!stages_ok) {
-      run.reject(fac_min, st);
+      run.reject(h * fac_min, st);
       continue;
     }
     stage_point(y1, y, h, C::a[12], 12, k);
@@ -540,14 +540,14 @@ void integrate_dop853(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
     if (!std::isfinite(en)) throw SolverError(msg("dop853: non-finite error estimate at t=", t));
     const double fac11 = std::pow(en, expo);
     if (en > 1.0) {
-      run.reject(1.0 / std::min(1.0 / fac_min, fac11 / safe), st);
+      run.reject(h / std::min(1.0 / fac_min, fac11 / safe), st);
       continue;
     }
     // accepted: project the end point and evaluate there (stage 13, the next step's first); a
     // projection that fails rejects the step
     yp = y1;
     if (!evaluates([&] { sys.project_and_rhs(t + h, yp, k[12]); }, h, fac_min, run.hmin)) {
-      run.reject(fac_min, st);
+      run.reject(h * fac_min, st);
       continue;
     }
     ++st.rhs_evals;
@@ -563,7 +563,7 @@ void integrate_dop853(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
       const bool dense_ok = evaluates([&] { stages(13, 16); }, h, fac_min, run.hmin);
       st.rhs_evals += 3;
       if (!dense_ok) {  // nothing of the step is kept: y, t and k[0] are unchanged
-        run.reject(fac_min, st);
+        run.reject(h * fac_min, st);
         continue;
       }
       r[0] = y1 - y;

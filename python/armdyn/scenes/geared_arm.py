@@ -118,16 +118,22 @@ def geared_arm_6dof(
             (with an odd count the last train gets none), so the biases cancel on the gear
             but hold the teeth of the two groups against opposite flanks. Ramped in by a
             quintic over [0, t_start/2] so the teeth close before the motion starts.
-        ideal_gears: False leaves out the ideal gear constraints (stage 1, and stage 2 without
-            backlash): rotors and shafts then turn freely, an open tree in the joint
-            coordinates. Not a mechanism of its own: :mod:`armdyn.references` eliminates the
-            gear ratios from its Euler–Lagrange equations to obtain an independent reference.
+        ideal_gears: False leaves out the ideal gear constraints (stage 1 and stage 2): rotors
+            and shafts then turn freely, an open tree in the joint coordinates. Only with
+            backlash=0 and n_motors=1 (otherwise a ModelError). Not a mechanism of its own:
+            :mod:`armdyn.references` eliminates the gear ratios from its Euler–Lagrange equations
+            to obtain an independent reference.
     """
     if not 1 <= int(n_motors) <= 6:
         raise _core.ModelError(f"geared_arm_6dof: n_motors must be 1..6, got {n_motors}")
     if shared_joint not in RATIOS:
         raise _core.ModelError(
             f"geared_arm_6dof: unknown shared_joint {shared_joint!r} (one of {sorted(RATIOS)})"
+        )
+    if not ideal_gears and (backlash > 0 or n_motors > 1):
+        raise _core.ModelError(
+            "geared_arm_6dof: ideal_gears=False (the open tree) needs backlash=0 and n_motors=1; "
+            "the stage-2 contacts of a backlash or multi-motor arm would couple it"
         )
     if control not in ("motor", "drive"):
         raise _core.ModelError(
@@ -183,10 +189,7 @@ def geared_arm_6dof(
             # without backlash, one ideal stage-2 mesh per joint: further trains on the same
             # gear would be redundant constraints, so they mesh through a stiff contact with
             # zero clearance
-            if backlash == 0 and k == 0:
-                if ideal_gears:
-                    b.add_gear(f"{tag}_stage_2", f"{tag}_shaft", name, r2, R2)
-            else:
+            if backlash > 0 or k > 0:
                 b.add_gear_pair(
                     f"{tag}_stage_2",
                     f"{tag}_shaft",
@@ -198,6 +201,8 @@ def geared_arm_6dof(
                     exponent=1.5,
                     hc_damping=hc_damping,
                 )
+            elif ideal_gears:
+                b.add_gear(f"{tag}_stage_2", f"{tag}_shaft", name, r2, R2)
             n_ratio = RATIOS[name]
             ref = _core.profiles.quintic(0.0, n_ratio * float(target), t_start, t_end)
             if control == "motor":
