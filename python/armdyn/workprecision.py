@@ -515,7 +515,8 @@ def sweep_scipy(
     """SciPy ``solve_ivp`` points (setting = rtol = atol) on ``rhs`` = (f, y0), by default the
     problem's ``scipy_rhs()``, observed by ``observe`` (default ``scipy_observe``). A run that
     stops early (a failed step, or an exactly singular matrix inside f) is a failed point that
-    says why and the latest time f was evaluated at."""
+    says why, the last output time reached and the latest time f was evaluated at (a rejected
+    step's stages can lie beyond where the run got stuck)."""
     from scipy.integrate import solve_ivp
 
     f, y0 = rhs if rhs is not None else problem.scipy_rhs()
@@ -554,7 +555,9 @@ def sweep_scipy(
             point["error"] = _error(problem, observe(sol.y), ref)
         else:
             point.update(
-                error=float("nan"), failed=f"stopped at t = {reached[0]:.4g} s: {sol.message}"[:200]
+                error=float("nan"),
+                failed=f"stopped after the output at t = {sol.t[-1]:.4g} s (latest evaluation "
+                f"at t = {reached[0]:.4g} s): {sol.message}"[:200],
             )
         points.append(point)
     return points
