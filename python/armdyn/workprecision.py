@@ -253,6 +253,12 @@ def _closed_loop_peers(problem, ref, quick, repeats):
     return peer_closed_loops.workprecision_curves(problem, ref, quick, repeats)
 
 
+def _geared_peers(problem, ref, quick, repeats):
+    from armdyn import peer_geared
+
+    return peer_geared.workprecision_curves(problem, ref, quick, repeats)
+
+
 class _Geared(_BuiltOnce):
     """The backlash-free geared arm and its Pinocchio reference."""
 
@@ -409,6 +415,7 @@ PROBLEMS: dict[str, Problem] = {
         scipy_observe=lambda y: y[:6].T,
         scipy_label="on Pinocchio's CRBA/RNEA, gear-reduced",
         scipy_rtols=(1e-4, 1e-6, 1e-8, 1e-10),
+        more_peers=_geared_peers,
         reference_check=lambda ref: _Geared.get().check(ref),
     ),
     "squeezer": Problem(
