@@ -6,7 +6,8 @@
 * ``armdyn bench [--out DIR]`` times armdyn against Pinocchio and SciPy in one process (UR5,
   Panda, a 5 s run, the 44-body geared arm, chains of 2–1000 bodies) and writes JSON + a plot.
 * ``armdyn workprecision [PROBLEM ...] [--quick] [--out DIR]`` sweeps tolerances on the standard
-  problems (IFToMM A01, A02, Andrews' squeezer) and records error against CPU time for armdyn's
+  problems (IFToMM A01, A02, Andrews' squeezer), the five-DOF paper arm, the UR5 and the geared
+  arm, and records error against CPU time for armdyn's
   integrators and the peers (SciPy, MuJoCo, Exudyn), as JSON + a log-log plot per problem.
 * ``armdyn verify`` prints the solver's accuracy figures: pendulum period, energy and momentum
   conservation, constraint drift, and the cross-check against recursive Newton–Euler.
@@ -38,7 +39,8 @@ def main(argv: list[str] | None = None) -> int:
         "problems",
         nargs="*",
         default=["all"],
-        help="squeezer, a01, five_dof, a02 (slow), or all (all but a02)",
+        help="squeezer, a01, a02, five_dof, ur5, geared_arm, or all (every one; a02 and "
+        "geared_arm take minutes)",
     )
     wp.add_argument("--out", default="docs/results/workprecision", help="folder for JSON + PNG")
     wp.add_argument("--quick", action="store_true", help="two points per curve")

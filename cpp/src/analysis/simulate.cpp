@@ -39,6 +39,15 @@ class WeldExpander {
     }
     for (size_t g = 0; g < m_.gear_constraints.size(); ++g)
       row_map_[m_.gear_constraints[g].row] = w_.gear_constraints[g].row;
+    // coordinates of the full model -> those of the welded one (fixed joints have none)
+    coord_map_.assign(m_.coords.size(), -1);
+    for (size_t j = 0; j < m_.joints.size(); ++j) {
+      const int jw = m_.weld_joint[j];
+      if (jw < 0) continue;
+      for (int k = 0; k < joint_coords(m_.joints[j].type); ++k)
+        coord_map_[m_.joints[j].coord0 + k] = w_.joints[jw].coord0 + k;
+    }
+    track_ = VecX::Zero(static_cast<long>(m_.coords.size()));
     for (size_t k = 0; k < m_.drives.size(); ++k) row_map_[m_.drives[k].row] = w_.drives[k].row;
     // the block of each merged joint
     block_of_.assign(m_.joints.size(), -1);
@@ -99,8 +108,12 @@ class WeldExpander {
   /// merged fixed joints' from each member's Newton-Euler balance, far members first
   /// (zeta_far^T delta_j = eta - Gamma vdot - the other rows' forces). Leaves the engine loaded
   /// for joint_reaction() and the residuals.
-  void reactions(double t, const VecX& delta_w, const double* aux) {
+  void reactions(double t, const VecX& delta_w, const double* aux, const VecX& tracking_w) {
     e_.set_aux(aux);
+    // the welded run's multi-turn angles: the gear rows (and their residuals) need them
+    for (size_t c = 0; c < coord_map_.size(); ++c)
+      if (coord_map_[c] >= 0) track_[static_cast<long>(c)] = tracking_w[coord_map_[c]];
+    e_.set_tracking(track_);
     e_.load(u_.data(), v_.data());
     ConstraintEval& ce = e_.constraints();
     eval_constraints(m_, e_.kin(), t, false, ce);
@@ -136,8 +149,9 @@ class WeldExpander {
   const Model& m_;
   const Model& w_;
   Engine e_;
-  VecX u_, v_, vd_, delta_, r_, tmp_;
+  VecX u_, v_, vd_, delta_, r_, tmp_, track_;
   std::vector<Vec4> qrel_;
+  std::vector<int> coord_map_;
   std::vector<int> row_map_, block_of_;
 };
 
@@ -207,7 +221,7 @@ class MbsSystem : public OdeSystem {
     Engine* re = &e_;  // the engine of the bodies and joints reported
     if (ex_) {
       ex_->expand(u, v, vd.data());
-      ex_->reactions(t, e_.delta(), aux);
+      ex_->reactions(t, e_.delta(), aux, e_.tracking());
       re = &ex_->engine();
       re->loaded_residuals(ex_->v().data(), rf, rv);
       u = ex_->u().data();
