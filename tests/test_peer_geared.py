@@ -55,18 +55,23 @@ def test_exudyn_geared_arm_is_the_same_mechanism(ref, state):
 
 def test_mujoco_geared_arm_converges(ref, angles):
     pytest.importorskip("mujoco")
-    errors = {}
+    moving = np.linspace(0.0, T_END, N_OUT + 1) > 0.5  # where the control is not zero
+    errors, moving_errors = {}, {}
     for control in pg.CONTROLS:
         peer = pg.MujocoGeared(ref, control)
-        for h in (5e-4 / 1.25, 2e-4):
+        for h in (4e-4, 2e-4):
             peer.set_step(h)
             qpos = peer.run(peer.mujoco.MjData(peer.model), T_END, N_OUT)
-            errors[control, h] = np.abs(peer.observe(qpos) - angles).max()
+            d = np.abs(peer.observe(qpos) - angles)
+            errors[control, h] = d.max()
+            moving_errors[control, h] = d[moving].max()
     for control in pg.CONTROLS:
         # second order (soft constraints, midpoint control): measured ratio about 4
         assert errors[control, 2e-4] < errors[control, 4e-4] / 3
-    # the held midpoint control costs no accuracy against the exact per-stage one
-    assert errors["midpoint", 2e-4] < 1.5 * errors["stage", 2e-4]
+    # during the motion the held midpoint control costs no accuracy against the exact per-stage
+    # one (measured 7.10e-8 and 7.14e-8 at h = 2e-4; held at the step start instead: 9.0e-6).
+    # The largest error, at t = 0.05 s before the motion, is the same for both.
+    assert moving_errors["midpoint", 2e-4] < 1.5 * moving_errors["stage", 2e-4]
 
 
 def test_exudyn_geared_arm_converges(ref, angles):

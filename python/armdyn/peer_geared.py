@@ -72,6 +72,7 @@ from armdyn.peer_closed_loops import (
     sweep_mujoco_rk4,
 )
 from armdyn.peer_exudyn import _exudyn, implicit_settings, solve_checked
+from armdyn.references import GearedArmReference, _quintic
 from armdyn.scenes.geared_arm import JOINTS
 
 ARM = tuple(j[0] for j in JOINTS)
@@ -114,11 +115,7 @@ class _Motors:
 
     def reference(self, t: float):
         """Rotor reference angles and rates at t (the quintic rest-to-rest profile)."""
-        d = self.t1 - self.t0
-        tau = min(max((t - self.t0) / d, 0.0), 1.0)
-        s = tau**3 * (10.0 - 15.0 * tau + 6.0 * tau * tau)
-        sd = 30.0 * tau * tau * (1.0 - tau) ** 2 / d
-        return self.goal * s, self.goal * sd
+        return _quintic(t, self.goal, self.t0, self.t1)
 
     def feedforward(self, t: float) -> np.ndarray:
         """The time-dependent part of the PD torque: kp ref(t) + kd ref'(t)."""
@@ -131,9 +128,7 @@ class _Motors:
         return np.clip(u, -self.limit, self.limit)
 
 
-def _reference():
-    from armdyn.references import GearedArmReference
-
+def _reference() -> GearedArmReference:
     return GearedArmReference()
 
 
@@ -292,10 +287,10 @@ class ExudynGeared:
             [self.names.index(n) for n in self.ref.tree.coord_names], dtype=int
         )
 
-    def system(self, t0: float = 0.0, q=None, qd=None):
-        """A fresh assembled system (tree, gears, motors), optionally starting at time ``t0``
-        from the tree state (q, qd) in armdyn's coordinate order. Returns (SystemContainer,
-        MainSystem, node)."""
+    def system(self, q=None, qd=None):
+        """A fresh assembled system (tree, gears, motors), optionally starting from the tree
+        state (q, qd) in armdyn's coordinate order (the start time is the solver settings').
+        Returns (SystemContainer, MainSystem, node)."""
         eii = _exudyn()[1]
         sc, mbs, node = self.tree.build()
         for a, b, k in gear_couplings():
@@ -326,14 +321,13 @@ class ExudynGeared:
             mbs.SetNodeParameter(node, "initialCoordinates", list(q0))
             mbs.SetNodeParameter(node, "initialCoordinates_t", list(v0))
         mbs.Assemble()
-        self._t0 = float(t0)
         return sc, mbs, node
 
     def initial_accelerations(self, t: float, q, qd) -> np.ndarray:
         """Exudyn's own initial-acceleration solve (``computeInitialAccelerations``) at time t
         from the tree state (q, qd); the accelerations in armdyn's coordinate order."""
         exu = _exudyn()[0]
-        _sc, mbs, node = self.system(t, q, qd)
+        _sc, mbs, node = self.system(q, qd)
         ss = implicit_settings(t + 1.0, 1, 1.0, SPECTRAL_RADIUS, NEWTON_RTOL)
         ss.timeIntegration.startTime = float(t)
         solver = exu.MainSolverImplicitSecondOrder()

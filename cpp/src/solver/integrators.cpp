@@ -834,9 +834,9 @@ void integrate_trbdf2(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
       if (every_step) sys.output(t, y);
       jac_current = false;
       // a fresh Jacobian costs n right-hand sides: re-evaluate it after slow convergence only
-      // once the extra iterations have cost half of that (the squeezer's 14 states: 7 extra
-      // iterations; the geared arm's 235 states: 118, where a Jacobian per step would cost
-      // about 40 times the step itself). A Newton failure still refreshes it at once.
+      // once the extra iterations have cost half of that (the squeezer's 91 states: 46 extra
+      // iterations; the geared arm's 234: 117, where a Jacobian per step would cost about 40
+      // times the step itself). A Newton failure still refreshes it at once.
       if ((slow || refreshed_in_step) && 2 * extra >= n) {
         refreshed_in_step = false;
         weights(y);
