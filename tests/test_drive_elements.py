@@ -114,7 +114,8 @@ def test_bad_friction_and_motor_input():
         b.add_motor("no_joint", 0.0, kp=1.0, kd=0.1)
 
 
-def test_pi_motor_removes_the_static_sag():
+@pytest.mark.parametrize("coordinates", ["cartesian", "joint"])
+def test_pi_motor_removes_the_static_sag(coordinates):
     """With an integral term the holding error vanishes (the sag of the PD motor is m g (l/2)
     cos q / kp); the integral state is part of the simulation, not of q."""
     m, length = 2.0, 0.5
@@ -125,7 +126,7 @@ def test_pi_motor_removes_the_static_sag():
     b.add_revolute("pitch", "ground", "bar", point=(0, 0, 0), axis=(0, -1, 0))
     b.add_motor("pitch", 0.0, kp=200.0, kd=20.0, ki=400.0)
     model = b.finalize()
-    res = ad.simulate(model, 20.0, rtol=1e-10, atol=1e-12, output_dt=1.0)
+    res = ad.simulate(model, 20.0, rtol=1e-10, atol=1e-12, output_dt=1.0, coordinates=coordinates)
     assert abs(res.q[1, 0]) > 1e-3  # it sags first
     assert abs(res.q[-1, 0]) <= 1e-7
     with pytest.raises(ad.ModelError, match="integral term"):

@@ -37,10 +37,20 @@ def gear_pair(hc_damping=0.5, backlash=GAP):
     return b.finalize()
 
 
+# the joint-space path (coordinates="joint") against the same closed forms
+@pytest.mark.parametrize("coordinates", ["cartesian", "joint"])
 @pytest.mark.parametrize("integrator", ["dopri5", "dop853", "trbdf2"])
-def test_contact_onset_is_located_at_the_closed_form_time(integrator):
+def test_contact_onset_is_located_at_the_closed_form_time(integrator, coordinates):
     model = gear_pair()
-    res = ad.simulate(model, 0.01, integrator=integrator, rtol=1e-9, atol=1e-12, output_dt=0.001)
+    res = ad.simulate(
+        model,
+        0.01,
+        integrator=integrator,
+        rtol=1e-9,
+        atol=1e-12,
+        output_dt=0.001,
+        coordinates=coordinates,
+    )
     ev = res.events
     assert ev["gear"][0] == "mesh" and ev["onset"][0]
     # located on the dense output; the remaining 1e-8 is the integration error of θ_a at rtol 1e-9
@@ -62,10 +72,19 @@ def test_rk4_locates_the_onset_between_its_fixed_steps():
     assert np.min(np.abs(res.t - t_c)) <= 1e-12
 
 
+@pytest.mark.parametrize("coordinates", ["cartesian", "joint"])
 @pytest.mark.parametrize("integrator", ["dopri5", "dop853"])
-def test_undamped_contact_conserves_energy_with_the_work_of_the_torque(integrator):
+def test_undamped_contact_conserves_energy_with_the_work_of_the_torque(integrator, coordinates):
     model = gear_pair(hc_damping=0.0)
-    res = ad.simulate(model, 0.02, integrator=integrator, rtol=1e-11, atol=1e-13, output_dt=0.0005)
+    res = ad.simulate(
+        model,
+        0.02,
+        integrator=integrator,
+        rtol=1e-11,
+        atol=1e-13,
+        output_dt=0.0005,
+        coordinates=coordinates,
+    )
     qa, qb = res.q[:, 0], res.q[:, 1]
     s = RA * qa + RB * qb
     pen = np.maximum(np.abs(s) - GAP / 2, 0.0)
@@ -123,18 +142,20 @@ def ideal_pair():
     return b.finalize()
 
 
-def test_ideal_gear_over_many_turns():
+@pytest.mark.parametrize("coordinates", ["cartesian", "joint"])
+def test_ideal_gear_over_many_turns(coordinates):
     model = ideal_pair()
     assert model.mobility == 1
     assert "gear mesh" in model.summary()
-    res = ad.simulate(model, 1.0, rtol=1e-10, atol=1e-12, output_dt=0.05)
+    res = ad.simulate(model, 1.0, rtol=1e-10, atol=1e-12, output_dt=0.05, coordinates=coordinates)
     alpha = T / (IA + (RA / RB) ** 2 * IB)
     assert res.q[-1, 0] == pytest.approx(0.5 * alpha, rel=1e-8)  # ≈ 1000 rad: 160 turns
     assert np.max(np.abs(RA * res.q[:, 0] + RB * res.q[:, 1])) <= 1e-11
     assert np.max(res.position_residual) <= 1e-12
 
 
-def test_ideal_gear_on_a_moving_carrier_conserves_energy():
+@pytest.mark.parametrize("coordinates", ["cartesian", "joint"])
+def test_ideal_gear_on_a_moving_carrier_conserves_energy(coordinates):
     """Both gears ride on a carrier arm pivoting on ground (the gear row touches three bodies):
     free motion conserves energy and keeps r_a q_a + r_b q_b = 0 in relative angles."""
     b = ad.ModelBuilder(gravity=(0.0, 0.0, -9.81))
@@ -149,7 +170,16 @@ def test_ideal_gear_on_a_moving_carrier_conserves_energy():
     assert model.mobility == 2
     u0, v0 = np.asarray(model.u0), np.zeros(model.nv)
     v0[6 + 4] = 30.0  # spin the pinion (body frame y); projection makes the state consistent
-    res = ad.simulate(model, 2.0, rtol=1e-10, atol=1e-12, output_dt=0.05, u0=u0, v0=v0)
+    res = ad.simulate(
+        model,
+        2.0,
+        rtol=1e-10,
+        atol=1e-12,
+        output_dt=0.05,
+        u0=u0,
+        v0=v0,
+        coordinates=coordinates,
+    )
     names = list(model.coord_names)
     qa, qb = res.q[:, names.index("ja")], res.q[:, names.index("jb")]
     assert np.max(np.abs(RA * qa + RB * qb)) <= 1e-11

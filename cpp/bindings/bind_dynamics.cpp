@@ -74,6 +74,7 @@ py::dict result_dict(const Model& md, const SimResult& r) {
   s["integrator_reason"] = r.integrator_reason;
   s["solver_bodies"] = r.solver_bodies;
   s["solver_rows"] = r.solver_rows;
+  s["formulation"] = r.formulation;
   d["stats"] = s;
   py::dict ev;
   ev["t"] = to_numpy(r.event_t.data(), {static_cast<py::ssize_t>(r.event_t.size())});
@@ -95,9 +96,10 @@ void bind_dynamics(py::module_& m) {
       "_simulate",
       [](const Model& md, double t_end, const std::string& integrator, double rtol, double atol,
          double dt, double output_dt, py::object u0, py::object v0, const std::string& projection,
-         long max_steps, double max_step, bool merge_welded) {
+         long max_steps, double max_step, bool merge_welded, const std::string& coordinates) {
         SimOptions o;
         o.merge_welded = merge_welded;
+        o.coordinates = coordinates;
         o.step.max_step = max_step;
         o.integrator = integrator;
         o.step.rtol = rtol;
@@ -117,7 +119,8 @@ void bind_dynamics(py::module_& m) {
       },
       py::arg("model"), py::arg("t_end"), py::arg("integrator"), py::arg("rtol"), py::arg("atol"),
       py::arg("dt"), py::arg("output_dt"), py::arg("u0"), py::arg("v0"), py::arg("projection"),
-      py::arg("max_steps"), py::arg("max_step") = 0.0, py::arg("merge_welded") = true);
+      py::arg("max_steps"), py::arg("max_step") = 0.0, py::arg("merge_welded") = true,
+      py::arg("coordinates") = "cartesian");
 
   m.def(
       "state_from_joints",

@@ -6,6 +6,7 @@
 
 #include "armdyn/analysis/inverse_dynamics.hpp"
 #include "armdyn/analysis/joint_space.hpp"
+#include "armdyn/analysis/tree_dynamics.hpp"
 #include "armdyn/validate/validators.hpp"
 #include "common.hpp"
 
@@ -29,6 +30,13 @@ using namespace py_helpers;
 namespace {
 
 using ModelHolder = std::shared_ptr<Model>;
+
+/// TreeDynamics with its model kept alive.
+struct TreeDynamicsPy {
+  explicit TreeDynamicsPy(ModelHolder md) : m(std::move(md)), td(*m) {}
+  ModelHolder m;
+  TreeDynamics td;
+};
 
 MatX to_mat(const py::handle& obj, const std::string& name, long cols) {
   auto a = as_array(obj, name);
@@ -126,13 +134,28 @@ void bind_validate(py::module_& m) {
 
   py::class_<JointSpaceForwardDynamics>(
       m, "JointSpaceForwardDynamics",
-      "Joint accelerations of a tree model for (q, qd, tau) through the Cartesian KKT path "
-      "(drives ignored). Keeps its workspace between calls.")
-      .def(py::init([](ModelHolder md) {
+      "Joint accelerations of a tree model for (q, qd, tau); drives ignored, coordinate forces "
+      "included. method='crba' (default): the joint-space mass matrix by the composite-rigid-"
+      "body algorithm and the bias by recursive Newton-Euler, then Cholesky; method='kkt': the "
+      "Cartesian constrained Newton-Euler system. Keeps its workspace between calls.")
+      .def(py::init([](ModelHolder md, const std::string& method) {
+             JointSpaceForwardDynamics::Method mt;
+             if (method == "crba")
+               mt = JointSpaceForwardDynamics::Method::Crba;
+             else if (method == "kkt")
+               mt = JointSpaceForwardDynamics::Method::Kkt;
+             else
+               throw ModelError(msg("forward_dynamics: unknown method '", method,
+                                    "' (expected 'crba' or 'kkt')"));
              return std::make_unique<JointSpaceForwardDynamics>(
-                 std::const_pointer_cast<const Model>(md));
+                 std::const_pointer_cast<const Model>(md), mt);
            }),
-           py::arg("model"))
+           py::arg("model"), py::arg("method") = "crba")
+      .def_property_readonly(
+          "method",
+          [](const JointSpaceForwardDynamics& self) {
+            return self.method() == JointSpaceForwardDynamics::Method::Crba ? "crba" : "kkt";
+          })
       .def(
           "__call__",
           [](JointSpaceForwardDynamics& self, py::object q, py::object qd, py::object tau,
@@ -146,6 +169,55 @@ void bind_validate(py::module_& m) {
           },
           py::arg("q"), py::arg("qd"), py::arg("tau"), py::arg("t") = 0.0);
 
+  py::class_<TreeDynamicsPy>(
+      m, "TreeDynamics",
+      "Joint-space forward dynamics of a tree without drives, ideal gears allowed (the path of "
+      "simulate(coordinates='joint')): the mass matrix by the composite-rigid-body algorithm, "
+      "bias and applied forces by recursive Newton-Euler, gears eliminated by their null space. "
+      "Keeps its workspace between calls.")
+      .def(py::init([](ModelHolder md) {
+             if (!md) throw ModelError("TreeDynamics: no model");
+             return std::make_unique<TreeDynamicsPy>(md);
+           }),
+           py::arg("model"))
+      .def(
+          "__call__",
+          [](TreeDynamicsPy& self, py::object q, py::object qd, py::object tau, double t) {
+            const long n = self.td.n();
+            const VecArg qa(q, "q", n), qda(qd, "qd", n), ta(tau, "tau", n);
+            check_joint_vector(*qa, n, "TreeDynamics", "q");
+            check_joint_vector(*qda, n, "TreeDynamics", "qd");
+            check_joint_vector(*ta, n, "TreeDynamics", "tau");
+            if (!std::isfinite(t)) throw ModelError("TreeDynamics: t is not finite");
+            if (self.m->n_aux)
+              throw ModelError(
+                  "TreeDynamics: the model's PI motors have integral states; "
+                  "simulate() integrates them");
+            py::array_t<double> out(n);
+            self.td.accelerations(t, (*qa).data(), (*qda).data(), nullptr, (*ta).data(),
+                                  out.mutable_data());
+            return out;
+          },
+          py::arg("q"), py::arg("qd"), py::arg("tau"), py::arg("t") = 0.0,
+          "Joint accelerations for joint forces tau at (q, qd, t); the model's coordinate "
+          "forces and gear contacts are included, the ideal gears' rows are held.")
+      .def(
+          "mass_matrix",
+          [](TreeDynamicsPy& self, py::object q) {
+            const long n = self.td.n();
+            const VecArg qa(q, "q", n);
+            check_joint_vector(*qa, n, "TreeDynamics.mass_matrix", "q");
+            const MatX& M = self.td.mass_matrix((*qa).data());
+            py::array_t<double> out({n, n});
+            Eigen::Map<Eigen::Matrix<double, -1, -1, Eigen::RowMajor>>(out.mutable_data(), n, n) =
+                M;
+            return out;
+          },
+          py::arg("q"), "The joint-space mass matrix M(q) (n_coords x n_coords).")
+      .def_property_readonly("dof", [](const TreeDynamicsPy& s) { return s.td.dof(); })
+      .def_property_readonly("description",
+                             [](const TreeDynamicsPy& s) { return s.td.description(); });
+
   // timing loops in C++ (benchmarks): seconds per call of `count` calls with fixed inputs
   m.def("_time_forward_loop", [](JointSpaceForwardDynamics& self, py::object q, py::object qd,
                                  py::object tau, long count) {
@@ -154,6 +226,15 @@ void bind_validate(py::module_& m) {
     VecX out(n);
     return time_loop(count, [&] { self.compute(qv, qdv, tv, out); });
   });
+  m.def("_time_tree_loop",
+        [](TreeDynamicsPy& self, py::object q, py::object qd, py::object tau, long count) {
+          const long n = self.td.n();
+          const VecX qv = to_vec(q, "q", n), qdv = to_vec(qd, "qd", n), tv = to_vec(tau, "tau", n);
+          VecX out(n);
+          return time_loop(count, [&] {
+            self.td.accelerations(0.0, qv.data(), qdv.data(), nullptr, tv.data(), out.data());
+          });
+        });
   m.def("_time_inverse_loop", [](JointSpaceInverseDynamics& self, py::object q, py::object qd,
                                  py::object qdd, long count) {
     const long n = static_cast<long>(self.model().coords.size());

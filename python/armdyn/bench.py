@@ -119,7 +119,8 @@ class PinPair:
         if self.pm.nq != self.pm.nv or self.pm.nq != len(names):
             raise ValueError("only revolute/prismatic arms are compared")
         self.perm = np.array([names.index(n) for n in pin_names])
-        self.fd = _core.JointSpaceForwardDynamics(self.am)
+        self.fd = _core.JointSpaceForwardDynamics(self.am)  # CRBA + Cholesky
+        self.fd_kkt = _core.JointSpaceForwardDynamics(self.am, "kkt")  # Cartesian KKT
         self.id = _core.JointSpaceInverseDynamics(self.am)
 
     def to_armdyn(self, x):
@@ -130,16 +131,23 @@ class PinPair:
     def cross_check(self, n: int = 50, seed: int = 0) -> dict:
         """Worst relative errors of armdyn against aba (q̈) and rnea (τ) over random states."""
         rng = np.random.default_rng(seed)
-        worst_fd = worst_id = 0.0
+        worst_fd = worst_kkt = worst_id = 0.0
         for _ in range(n):
             q, v, tau, acc = rng.uniform(-np.pi, np.pi, size=(4, self.pm.nq))
             a_pin = self.pin.aba(self.pm, self.pd, q, v, tau)
-            a_ad = self.fd(self.to_armdyn(q), self.to_armdyn(v), self.to_armdyn(tau))[self.perm]
+            args = (self.to_armdyn(q), self.to_armdyn(v), self.to_armdyn(tau))
+            a_ad = self.fd(*args)[self.perm]
             worst_fd = max(worst_fd, np.max(np.abs(a_ad - a_pin)) / np.max(np.abs(a_pin)))
+            a_kkt = self.fd_kkt(*args)[self.perm]
+            worst_kkt = max(worst_kkt, np.max(np.abs(a_kkt - a_pin)) / np.max(np.abs(a_pin)))
             t_pin = self.pin.rnea(self.pm, self.pd, q, v, acc)
             t_ad = self.id(self.to_armdyn(q), self.to_armdyn(v), self.to_armdyn(acc))[self.perm]
             worst_id = max(worst_id, np.max(np.abs(t_ad - t_pin)) / np.max(np.abs(t_pin)))
-        return {"fd_rel_error": float(worst_fd), "id_rel_error": float(worst_id)}
+        return {
+            "fd_rel_error": float(worst_fd),
+            "fd_kkt_rel_error": float(worst_kkt),
+            "id_rel_error": float(worst_id),
+        }
 
     def timings(self, number: int = 2000) -> dict:
         rng = np.random.default_rng(1)
@@ -151,9 +159,16 @@ class PinPair:
             "pin_rnea_python_us": 1e6 * _median_time(lambda: pin.rnea(pm, pd, q, v, tau), number),
             "armdyn_fd_python_us": 1e6 * _median_time(lambda: self.fd(qa, va, ta), number),
             "armdyn_id_python_us": 1e6 * _median_time(lambda: self.id(qa, va, ta), number),
+            "armdyn_fd_kkt_python_us": 1e6 * _median_time(lambda: self.fd_kkt(qa, va, ta), number),
             "armdyn_fd_cpp_us": 1e6
             * float(
                 np.median([_core._time_forward_loop(self.fd, qa, va, ta, number) for _ in range(5)])
+            ),
+            "armdyn_fd_kkt_cpp_us": 1e6
+            * float(
+                np.median(
+                    [_core._time_forward_loop(self.fd_kkt, qa, va, ta, number) for _ in range(5)]
+                )
             ),
             "armdyn_id_cpp_us": 1e6
             * float(
@@ -162,6 +177,7 @@ class PinPair:
         }
         r["ratio_fd_python"] = r["armdyn_fd_python_us"] / r["pin_aba_python_us"]
         r["ratio_id_python"] = r["armdyn_id_python_us"] / r["pin_rnea_python_us"]
+        r["ratio_fd_kkt_python"] = r["armdyn_fd_kkt_python_us"] / r["pin_aba_python_us"]
         return r
 
 
@@ -224,16 +240,30 @@ def bench_geared_arm() -> dict:
     """Time per DOPRI5 step of the 44-body geared arm with backlash (0.3 s into the motion).
 
     By default simulate integrates the welded model (bodies joined by fixed joints as one
-    composite: 18 bodies, 96 rows); the full 44-body model (252 rows) is timed beside it."""
+    composite: 18 bodies, 96 rows); the full 44-body model (252 rows) is timed beside it, and
+    the joint-space path (``coordinates="joint"``: 18 joint coordinates, CRBA), whose error
+    control acts on (q, qd) instead of (u, v), so its steps differ."""
     model = geared_arm_6dof(n_motors=1, backlash=1e-4)
 
-    def run(merge=True):
-        return simulate(model, 0.3, rtol=1e-6, atol=1e-8, output_dt=0.3, merge_welded=merge)
+    def run(merge=True, coordinates="cartesian"):
+        return simulate(
+            model,
+            0.3,
+            rtol=1e-6,
+            atol=1e-8,
+            output_dt=0.3,
+            merge_welded=merge,
+            coordinates=coordinates,
+        )
 
     out = {"bodies": int(model.nb), "kkt_path": model.kkt_path}
-    for key, merge in (("welded", True), ("full", False)):
-        res = run(merge)
-        cpu = _median_time(lambda merge=merge: run(merge), 1, 3)
+    for key, merge, coords in (
+        ("welded", True, "cartesian"),
+        ("full", False, "cartesian"),
+        ("joint", True, "joint"),
+    ):
+        res = run(merge, coords)
+        cpu = _median_time(lambda merge=merge, coords=coords: run(merge, coords), 1, 3)
         out[key] = {
             "solver_bodies": int(res.stats["solver_bodies"]),
             "solver_rows": int(res.stats["solver_rows"]),

@@ -4,8 +4,10 @@
 integrator the tolerance (DOPRI5, TR-BDF2) or step (RK4, MuJoCo) is swept; each point records the
 error against an independent reference (:mod:`armdyn.references`, derived by a different method
 in minimal coordinates), the CPU time of the whole solve (median of warm repeats, one warm-up
-run first) and the counters (steps, right-hand sides, KKT solves, factorisations). Peers run the
-same problem in the same process:
+run first) and the counters (steps, right-hand sides, KKT solves, factorisations). On trees
+(the UR5, the geared arm) armdyn's integrators also run on ``simulate(coordinates="joint")``,
+the joint-space path (curves "armdyn <integrator> (joint)"). Peers run the same problem in the
+same process:
 
 - SciPy ``solve_ivp`` (DOP853, RK45) on the minimal-coordinate equations of the reference
   (for the UR5: on Pinocchio's ABA);
@@ -64,6 +66,10 @@ class Problem:
     init: Callable | None = None  # model -> simulate kwargs
     sweeps: dict = field(default_factory=dict)
     quick_sweeps: dict = field(default_factory=dict)
+    # the same integrators on simulate(coordinates="joint") (trees without drives, gears
+    # allowed): curves "armdyn <integrator> (joint)"
+    joint_sweeps: dict = field(default_factory=dict)
+    quick_joint_sweeps: dict = field(default_factory=dict)
     required: tuple | None = None  # (low, high) precision of the benchmark
     scipy_rhs: Callable | None = None  # () -> (f, y0)
     scipy_observe: Callable | None = None  # y (k, n) -> (n, kq)
@@ -381,6 +387,11 @@ PROBLEMS: dict[str, Problem] = {
             "rk4": [4e-3, 2e-3, 1e-3, 5e-4, 2.5e-4],
         },
         quick_sweeps={"dopri5": [1e-6, 1e-8], "dop853": [1e-8], "rk4": [1e-3]},
+        joint_sweeps={
+            "dopri5": [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10],
+            "dop853": [1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11],
+        },
+        quick_joint_sweeps={"dop853": [1e-8]},
         scipy_rhs=lambda: _Ur5.get().rhs(),
         scipy_observe=lambda y: y[:6].T,
         scipy_label="on Pinocchio's ABA",
@@ -411,6 +422,13 @@ PROBLEMS: dict[str, Problem] = {
             "rk4": [4e-4, 2e-4, 1e-4],
         },
         quick_sweeps={"dopri5": [1e-4]},
+        joint_sweeps={
+            "dopri5": [1e-3, 1e-4, 1e-6, 1e-8],
+            "dop853": [1e-4, 1e-6, 1e-8, 1e-10],
+            "trbdf2": [1e-4, 1e-5, 1e-6, 1e-7, 1e-8],
+            "rk4": [4e-4, 2e-4, 1e-4],
+        },
+        quick_joint_sweeps={"trbdf2": [1e-5]},
         scipy_rhs=lambda: _Geared.get().ref.rhs(),
         scipy_observe=lambda y: y[:6].T,
         scipy_label="on Pinocchio's CRBA/RNEA, gear-reduced",
@@ -480,10 +498,17 @@ def _output_times(problem: Problem) -> np.ndarray:
     return np.linspace(0.0, problem.t_end, problem.n_out + 1)
 
 
-def sweep_armdyn(problem: Problem, integrator: str, settings, ref, repeats: int = 5) -> list[dict]:
+def sweep_armdyn(
+    problem: Problem,
+    integrator: str,
+    settings,
+    ref,
+    repeats: int = 5,
+    coordinates: str = "cartesian",
+) -> list[dict]:
     """armdyn's curve; ``ref`` is the reference on the output times."""
     model = problem.build()
-    kwargs = problem.init(model) if problem.init else {}
+    kwargs = dict(problem.init(model) if problem.init else {}, coordinates=coordinates)
     points = []
     for s in settings:
         opts = dict(kwargs, output_dt=problem.t_end / problem.n_out)
@@ -632,6 +657,11 @@ def run_problem(name: str, quick: bool = False, peers: bool = True, echo: bool =
         curves[f"armdyn {integ}"] = sweep_armdyn(p, integ, settings, ref, reps)
         if echo:
             _echo(f"armdyn {integ}", curves[f"armdyn {integ}"])
+    for integ, settings in (p.quick_joint_sweeps if quick else p.joint_sweeps).items():
+        key = f"armdyn {integ} (joint)"
+        curves[key] = sweep_armdyn(p, integ, settings, ref, reps, coordinates="joint")
+        if echo:
+            _echo(key, curves[key])
     not_peers = {}
     if peers and p.scipy_rhs is not None:
         for method in ("DOP853", "RK45"):

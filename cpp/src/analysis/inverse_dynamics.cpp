@@ -231,9 +231,7 @@ JointSpaceInverseDynamics::JointSpaceInverseDynamics(std::shared_ptr<const Model
   if (method_ == Method::Recursive) {
     // the engine only evaluates eta; nothing of the drives or the KKT system is used
     e_ = std::make_unique<Engine>(*src_);
-    const size_t nb = static_cast<size_t>(src_->nb), nj = src_->joints.size();
-    for (auto* v : {&alpha_, &acc_, &force_, &moment_}) v->assign(nb, Vec3::Zero());
-    for (auto* v : {&point_, &axis_}) v->assign(nj, Vec3::Zero());
+    rne_.resize(*src_);
     return;
   }
   driven_ = *src_;
@@ -302,73 +300,10 @@ void JointSpaceInverseDynamics::compute(Eigen::Ref<const VecX> q, Eigen::Ref<con
 void JointSpaceInverseDynamics::recursive(Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
                                           Eigen::Ref<const VecX> qdd, Eigen::Ref<VecX> tau,
                                           double t) {
-  const Model& m = *src_;
   std::vector<BodyKin>& kin = e_->kin_in();
-  joint_space_kinematics(m, q, qd, kin);
+  joint_space_kinematics(*src_, q, qd, kin);
   e_->forces(t);
-  const VecX& eta = e_->eta();
-  // forward sweep, parents first: the child's joint point Pc = P + d z moves with the parent
-  // plus the slide along z; the child turns about z at Pc (the derivative of the velocities
-  // of joint_space_kinematics)
-  for (int ji : m.tree_order) {
-    const Joint& j = m.joints[ji];
-    const bool on_ground = j.parent == kGround;
-    const BodyKin& c = kin[j.child];
-    double thd, thdd, dd, ddd;
-    joint_components(j, qd, thd, dd);
-    joint_components(j, qdd, thdd, ddd);
-    const Vec3 z =
-        on_ground ? Vec3(j.frame_parent.col(2)) : Vec3(kin[j.parent].R * j.frame_parent.col(2));
-    const Vec3 pc = c.x + c.R * j.point_child;
-    point_[ji] = pc;
-    axis_[ji] = z;
-    Vec3 acc = ddd * z;
-    Vec3& alpha = alpha_[j.child];
-    alpha = thdd * z;
-    if (!on_ground) {
-      const BodyKin& p = kin[j.parent];
-      const Vec3 r = pc - p.x;
-      acc += acc_[j.parent] + alpha_[j.parent].cross(r) + p.W.cross(p.W.cross(r)) +
-             2.0 * dd * p.W.cross(z);
-      alpha += alpha_[j.parent] + thd * p.W.cross(z);
-    }
-    const Vec3 e = c.x - pc;
-    acc_[j.child] = acc + alpha.cross(e) + c.W.cross(c.W.cross(e));
-  }
-  // each body's residual Gamma v' - eta: force (world) and moment about its centre of mass
-  // (world axes; eta's torque is in body axes)
-  for (int i = 0; i < m.nb; ++i) {
-    const Body& b = m.bodies[i];
-    const BodyKin& k = kin[i];
-    force_[i] = b.mass * acc_[i] - eta.segment<3>(6 * i);
-    moment_[i] = k.R * (b.inertia * (k.R.transpose() * alpha_[i]) - eta.segment<3>(6 * i + 3));
-  }
-  // backward sweep, children first: the subtree's wrench, and its virtual work along the joint
-  // coordinates (the moment about the joint point on z, the force along z)
-  for (auto it = m.tree_order.rbegin(); it != m.tree_order.rend(); ++it) {
-    const Joint& j = m.joints[*it];
-    const int c = j.child;
-    const Vec3& z = axis_[*it];
-    const Vec3 arm = kin[c].x - point_[*it];
-    switch (j.type) {
-      case JointType::Revolute:
-        tau[j.coord0] = z.dot(moment_[c] + arm.cross(force_[c]));
-        break;
-      case JointType::Prismatic:
-        tau[j.coord0] = z.dot(force_[c]);
-        break;
-      case JointType::Cylindrical:
-        tau[j.coord0] = z.dot(moment_[c] + arm.cross(force_[c]));
-        tau[j.coord0 + 1] = z.dot(force_[c]);
-        break;
-      default:
-        break;
-    }
-    if (j.parent != kGround) {
-      force_[j.parent] += force_[c];
-      moment_[j.parent] += moment_[c] + (kin[c].x - kin[j.parent].x).cross(force_[c]);
-    }
-  }
+  rne_residual(*src_, kin, qd, qdd, e_->eta(), rne_, tau);
 }
 
 }  // namespace armdyn

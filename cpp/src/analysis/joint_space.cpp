@@ -3,6 +3,7 @@
 
 #include <utility>
 
+#include "armdyn/analysis/tree_dynamics.hpp"
 #include "armdyn/errors.hpp"
 #include "armdyn/math/quaternion.hpp"
 #include "armdyn/solver/engine.hpp"
@@ -59,6 +60,78 @@ void joint_space_kinematics(const Model& m, Eigen::Ref<const VecX> q, Eigen::Ref
   }
 }
 
+void RneWork::resize(const Model& m) {
+  const size_t nb = static_cast<size_t>(m.nb), nj = m.joints.size();
+  for (auto* v : {&alpha, &acc, &force, &moment}) v->assign(nb, Vec3::Zero());
+  for (auto* v : {&point, &axis}) v->assign(nj, Vec3::Zero());
+}
+
+void rne_residual(const Model& m, const std::vector<BodyKin>& kin, Eigen::Ref<const VecX> qd,
+                  Eigen::Ref<const VecX> qdd, const VecX& eta, RneWork& w, Eigen::Ref<VecX> tau) {
+  // forward sweep, parents first: the child's joint point Pc = P + d z moves with the parent
+  // plus the slide along z; the child turns about z at Pc (the derivative of the velocities
+  // of joint_space_kinematics)
+  for (int ji : m.tree_order) {
+    const Joint& j = m.joints[ji];
+    const bool on_ground = j.parent == kGround;
+    const BodyKin& c = kin[j.child];
+    double thd, thdd, dd, ddd;
+    joint_components(j, qd, thd, dd);
+    joint_components(j, qdd, thdd, ddd);
+    const Vec3 z =
+        on_ground ? Vec3(j.frame_parent.col(2)) : Vec3(kin[j.parent].R * j.frame_parent.col(2));
+    const Vec3 pc = c.x + c.R * j.point_child;
+    w.point[ji] = pc;
+    w.axis[ji] = z;
+    Vec3 acc = ddd * z;
+    Vec3& alpha = w.alpha[j.child];
+    alpha = thdd * z;
+    if (!on_ground) {
+      const BodyKin& p = kin[j.parent];
+      const Vec3 r = pc - p.x;
+      acc += w.acc[j.parent] + w.alpha[j.parent].cross(r) + p.W.cross(p.W.cross(r)) +
+             2.0 * dd * p.W.cross(z);
+      alpha += w.alpha[j.parent] + thd * p.W.cross(z);
+    }
+    const Vec3 e = c.x - pc;
+    w.acc[j.child] = acc + alpha.cross(e) + c.W.cross(c.W.cross(e));
+  }
+  // each body's residual Gamma v' - eta: force (world) and moment about its centre of mass
+  // (world axes; eta's torque is in body axes)
+  for (int i = 0; i < m.nb; ++i) {
+    const Body& b = m.bodies[i];
+    const BodyKin& k = kin[i];
+    w.force[i] = b.mass * w.acc[i] - eta.segment<3>(6 * i);
+    w.moment[i] = k.R * (b.inertia * (k.R.transpose() * w.alpha[i]) - eta.segment<3>(6 * i + 3));
+  }
+  // backward sweep, children first: the subtree's wrench, and its virtual work along the joint
+  // coordinates (the moment about the joint point on z, the force along z)
+  for (auto it = m.tree_order.rbegin(); it != m.tree_order.rend(); ++it) {
+    const Joint& j = m.joints[*it];
+    const int c = j.child;
+    const Vec3& z = w.axis[*it];
+    const Vec3 arm = kin[c].x - w.point[*it];
+    switch (j.type) {
+      case JointType::Revolute:
+        tau[j.coord0] = z.dot(w.moment[c] + arm.cross(w.force[c]));
+        break;
+      case JointType::Prismatic:
+        tau[j.coord0] = z.dot(w.force[c]);
+        break;
+      case JointType::Cylindrical:
+        tau[j.coord0] = z.dot(w.moment[c] + arm.cross(w.force[c]));
+        tau[j.coord0 + 1] = z.dot(w.force[c]);
+        break;
+      default:
+        break;
+    }
+    if (j.parent != kGround) {
+      w.force[j.parent] += w.force[c];
+      w.moment[j.parent] += w.moment[c] + (kin[c].x - kin[j.parent].x).cross(w.force[c]);
+    }
+  }
+}
+
 void state_from_joints(const Model& m, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd, VecX& u,
                        VecX& v, TreeFkWork& work) {
   require_joint_space(m, "state_from_joints");
@@ -68,12 +141,16 @@ void state_from_joints(const Model& m, Eigen::Ref<const VecX> q, Eigen::Ref<cons
   u.resize(m.nq);
   v.resize(m.nv);
   joint_space_kinematics(m, q, qd, work.kin);
+  cartesian_state(m, work.kin, u.data(), v.data());
+}
+
+void cartesian_state(const Model& m, const std::vector<BodyKin>& kin, double* u, double* v) {
   for (int i = 0; i < m.nb; ++i) {
-    const BodyKin& k = work.kin[i];
-    u.segment<3>(7 * i) = k.x;
-    u.segment<4>(7 * i + 3) = rot_to_quat(k.R);
-    v.segment<3>(6 * i) = k.xd;
-    v.segment<3>(6 * i + 3) = k.w;
+    const BodyKin& k = kin[i];
+    Eigen::Map<Vec3>(u + 7 * i) = k.x;
+    Eigen::Map<Vec4>(u + 7 * i + 3) = rot_to_quat(k.R);
+    Eigen::Map<Vec3>(v + 6 * i) = k.xd;
+    Eigen::Map<Vec3>(v + 6 * i + 3) = k.w;
   }
 }
 
@@ -92,10 +169,15 @@ void joint_coordinates(const Model& m, const VecX& u, const VecX& v, VecX& q, Ve
   }
 }
 
-JointSpaceForwardDynamics::JointSpaceForwardDynamics(std::shared_ptr<const Model> m)
-    : m_(std::move(m)) {
+JointSpaceForwardDynamics::JointSpaceForwardDynamics(std::shared_ptr<const Model> m, Method method)
+    : m_(std::move(m)), method_(method) {
   if (!m_) throw ModelError("forward_dynamics: no model");
   require_joint_space(*m_, "forward_dynamics");
+  if (method_ == Method::Crba) {
+    td_ = std::make_unique<TreeDynamics>(*m_, true);
+    z_ = VecX::Zero(std::max(m_->n_aux, 1));
+    return;
+  }
   e_ = std::make_unique<Engine>(*m_);
   e_->set_include_drives(false);
   vd_ = VecX::Zero(m_->nv);
@@ -115,6 +197,11 @@ void JointSpaceForwardDynamics::compute(Eigen::Ref<const VecX> q, Eigen::Ref<con
     throw ModelError(msg("forward_dynamics: out has length ", out.size(), ", expected ", nc));
   check_joint_vector(q, nc, "forward_dynamics", "q");
   check_joint_vector(qd, nc, "forward_dynamics", "qd");
+  if (td_) {
+    // contiguous inputs (numpy arrays, VecX) pass straight through
+    td_->accelerations(t, q.data(), qd.data(), z_.data(), tau.data(), out.data());
+    return;
+  }
   joint_space_kinematics(m, q, qd, e_->kin_in());
   tau_ = tau;
   e_->dynamics_loaded(t, vd_.data());

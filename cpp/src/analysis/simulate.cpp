@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "armdyn/analysis/inverse_dynamics.hpp"
+#include "armdyn/analysis/tree_dynamics.hpp"
 #include "armdyn/errors.hpp"
 #include "armdyn/math/quaternion.hpp"
 #include "armdyn/solver/engine.hpp"
@@ -273,6 +274,64 @@ class MbsSystem : public OdeSystem {
   WeldExpander* ex_ = nullptr;
 };
 
+// The joint-space equations of motion of a tree (TreeDynamics) as an ODE on y = (q, qd, z).
+// Outputs go through the Cartesian system at the state built by forward kinematics, with the
+// engine's multi-turn angles set from q: every table (poses, reactions, gear forces, residuals)
+// is the one a Cartesian run reports.
+class JointSystem : public OdeSystem {
+ public:
+  JointSystem(const Model& m, MbsSystem& cart)
+      : m_(m),
+        td_(m),
+        cart_(cart),
+        n_(td_.n()),
+        yc_(VecX::Zero(m.nq + m.nv + m.n_aux)),
+        track_(VecX::Zero(td_.n())) {
+    fkw_.kin.resize(m.nb);
+  }
+
+  void rhs(double t, const VecX& y, VecX& dy) override {
+    const double* q = y.data();
+    const double* qd = q + n_;
+    const double* z = qd + n_;
+    dy.head(n_) = y.segment(n_, n_);
+    td_.accelerations(t, q, qd, z, nullptr, dy.data() + n_);
+    if (m_.n_aux) td_.aux_rates(t, q, qd, z, dy.data() + 2 * n_);
+  }
+
+  void project_and_rhs(double t, VecX& y, VecX& dy) override {
+    td_.project(y.data(), y.data() + n_);
+    rhs(t, y, dy);
+  }
+
+  void output(double t, const VecX& y) override {
+    const Eigen::Map<const VecX> q(y.data(), n_), qd(y.data() + n_, n_);
+    joint_space_kinematics(m_, q, qd, fkw_.kin);
+    cartesian_state(m_, fkw_.kin, yc_.data(), yc_.data() + m_.nq);
+    yc_.tail(m_.n_aux) = y.tail(m_.n_aux);
+    track_ = q;
+    cart_.engine().set_tracking(track_);
+    cart_.output(t, yc_);
+  }
+
+  int n_events() const override { return static_cast<int>(m_.gears.size()); }
+  void events(double /*t*/, const VecX& y, double* g) override {
+    double s, sd;
+    for (int i = 0; i < n_events(); ++i) td_.gear_mesh(i, y.data(), y.data() + n_, s, sd, g[i]);
+  }
+  void on_event(double t, int i, int direction) override { cart_.on_event(t, i, direction); }
+
+  const TreeDynamics& dynamics() const { return td_; }
+
+ private:
+  const Model& m_;
+  TreeDynamics td_;
+  MbsSystem& cart_;
+  int n_;
+  VecX yc_, track_;
+  TreeFkWork fkw_;
+};
+
 }  // namespace
 
 double stiffness_estimate(const Model& m, std::string& culprit) {
@@ -391,6 +450,9 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
   if (!(s.output_dt >= 0) || !std::isfinite(s.output_dt))
     throw ModelError(msg("simulate: output_dt must be positive, got ", s.output_dt));
   if (s.max_steps <= 0) throw ModelError("simulate: max_steps must be positive");
+  if (opt.coordinates != "cartesian" && opt.coordinates != "joint" && opt.coordinates != "auto")
+    throw ModelError(msg("simulate: unknown coordinates '", opt.coordinates,
+                         "' (expected 'cartesian', 'joint' or 'auto')"));
   if (u0.size() != m.nq || v0.size() != m.nv)
     throw ModelError(msg("simulate: initial state has sizes (", u0.size(), ", ", v0.size(),
                          "), expected (", m.nq, ", ", m.nv, ")"));
@@ -426,6 +488,14 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
   } else if (opt.integrator == "default") {
     out.integrator = "dopri5";
   }
+  // "auto": joint space wherever it applies (a tree without drives), the Cartesian path else
+  const bool joint =
+      opt.coordinates == "joint" || (opt.coordinates == "auto" && out.integrator != "kinematic" &&
+                                     TreeDynamics::unsupported(ms).empty());
+  if (joint && out.integrator == "kinematic")
+    throw ModelError(
+        "simulate: coordinates 'joint' integrates a tree without drives; a fully driven model "
+        "takes the kinematic path (coordinates 'cartesian')");
   if (s.output_dt > 0) {
     const size_t n = static_cast<size_t>(t_end / s.output_dt) + 2;
     out.t.reserve(n);
@@ -433,6 +503,23 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
     out.v.reserve(n * m.nv);
   }
   MbsSystem sys(ms, opt.projection, out);
+  std::unique_ptr<JointSystem> jsys;
+  if (joint) {
+    try {
+      jsys = std::make_unique<JointSystem>(ms, sys);
+    } catch (const ModelError& err) {
+      throw ModelError(msg("simulate: coordinates 'joint': ", err.what()));
+    }
+    out.formulation = jsys->dynamics().description();
+  } else {
+    out.formulation = msg("cartesian: ", ms.nb, " bodies, ", ms.nc, " constraint rows, KKT path '",
+                          ms.kkt_all.path, "'");
+    if (opt.coordinates == "auto")
+      out.formulation += msg(" (joint space does not apply: ",
+                             out.integrator == "kinematic" ? std::string("fully driven")
+                                                           : TreeDynamics::unsupported(ms),
+                             ")");
+  }
   std::unique_ptr<WeldExpander> expander;
   VecX y = VecX::Zero(ms.nq + ms.nv + ms.n_aux);
   if (welded) {
@@ -467,35 +554,55 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
         t_last = solver.t_good;
         throw;
       }
-    } else if (out.integrator == "dopri5")
-      integrate_dopri5(sys, y, 0.0, t_end, s, out.stats);
-    else if (out.integrator == "dop853")
-      integrate_dop853(sys, y, 0.0, t_end, s, out.stats);
-    else if (out.integrator == "trbdf2")
-      integrate_trbdf2(sys, y, 0.0, t_end, s, out.stats);
-    else
-      integrate_rk4(sys, y, 0.0, t_end, s, out.stats);
+    } else {
+      OdeSystem* ode = &sys;
+      VecX yj;
+      if (joint) {
+        // (q, qd) of the projected initial state, angles continued from the engine's tracking
+        Engine& e = sys.engine();
+        e.set_aux(y.data() + ms.nq + ms.nv);
+        e.project(0.0, y.data(), y.data() + ms.nq, opt.projection);
+        VecX q, qd;
+        joint_coordinates(ms, y.head(ms.nq), y.segment(ms.nq, ms.nv), q, qd);
+        for (int c = 0; c < static_cast<int>(ms.coords.size()); ++c)
+          if (ms.coords[c].angular) q[c] = e.tracked(c, q[c]);
+        const long nco = q.size();
+        yj = VecX::Zero(2 * nco + ms.n_aux);
+        yj << q, qd, y.tail(ms.n_aux);
+        ode = jsys.get();
+      }
+      VecX& yi = joint ? yj : y;
+      if (out.integrator == "dopri5")
+        integrate_dopri5(*ode, yi, 0.0, t_end, s, out.stats);
+      else if (out.integrator == "dop853")
+        integrate_dop853(*ode, yi, 0.0, t_end, s, out.stats);
+      else if (out.integrator == "trbdf2")
+        integrate_trbdf2(*ode, yi, 0.0, t_end, s, out.stats);
+      else
+        integrate_rk4(*ode, yi, 0.0, t_end, s, out.stats);
+    }
   } catch (const SolverError& err) {
     out.error = err.what();
     // say why when the constraints are (nearly) singular at the last accepted state
     if (out.integrator != "kinematic") t_last = out.t.empty() ? 0.0 : out.t.back();
-    try {
-      sys.engine().set_aux(y.data() + ms.nq + ms.nv);
-      // the kinematic path stops short of a limit point (no solution beyond it) by its
-      // continuation's smallest step, where the rank loss shows only at looser thresholds
-      std::string why;
-      for (const double threshold : {1e-7, 1e-5, 1e-3}) {
-        why = sys.engine().diagnose_singularity(t_last, y.data(), y.data() + ms.nq, threshold);
-        if (!why.empty() || out.integrator != "kinematic") break;
+    // (the joint-space path has no constraint Jacobian to diagnose but the gears' constant one)
+    if (!joint) try {
+        sys.engine().set_aux(y.data() + ms.nq + ms.nv);
+        // the kinematic path stops short of a limit point (no solution beyond it) by its
+        // continuation's smallest step, where the rank loss shows only at looser thresholds
+        std::string why;
+        for (const double threshold : {1e-7, 1e-5, 1e-3}) {
+          why = sys.engine().diagnose_singularity(t_last, y.data(), y.data() + ms.nq, threshold);
+          if (!why.empty() || out.integrator != "kinematic") break;
+        }
+        if (!why.empty() && out.error.back() == '.') {
+          why[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(why[0])));
+          out.error += " " + why;
+        } else if (!why.empty()) {
+          out.error += "; " + why;
+        }
+      } catch (const std::exception&) {
       }
-      if (!why.empty() && out.error.back() == '.') {
-        why[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(why[0])));
-        out.error += " " + why;
-      } else if (!why.empty()) {
-        out.error += "; " + why;
-      }
-    } catch (const std::exception&) {
-    }
   }
   out.cpu_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   out.solver_bodies = ms.nb;

@@ -492,6 +492,7 @@ std::shared_ptr<Model> finalize_draft(const Model& draft, const FinalizeOptions&
   // topology: a tree has exactly nb joints; order joints parent-before-child from ground
   m.is_tree = static_cast<int>(m.joints.size()) == m.nb;
   m.joint_space_ok = false;
+  m.joint_tree = false;
   if (m.is_tree) {
     std::vector<char> seen(m.nb + 1, 0);
     seen[m.nb] = 1;
@@ -527,6 +528,7 @@ std::shared_ptr<Model> finalize_draft(const Model& draft, const FinalizeOptions&
         ok = false;
       }
     }
+    m.joint_tree = ok;
     if (ok && !m.gear_constraints.empty()) {
       ok = false;
       m.joint_space_reason =

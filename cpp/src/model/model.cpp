@@ -139,6 +139,21 @@ std::string Model::summary() const {
        << welded->kkt_all.path << ", ~" << welded->kkt_all.flops
        << " flops per factorisation) and reports all " << nb << " bodies\n";
   }
+  {
+    // simulate(coordinates="joint"): the integrated model (welded, when fixed joints merge)
+    const Model& s = welded ? *welded : *this;
+    os << "  joint-space path (simulate coordinates='joint'): ";
+    if (!s.joint_tree)
+      os << "not available (" << s.joint_space_reason << ")\n";
+    else if (!s.drives.empty())
+      os << "not available (drive '" << s.drives[0].name << "' prescribes a coordinate)\n";
+    else
+      os << "available: " << s.coords.size() << " coordinates"
+         << (s.gear_constraints.empty() ? std::string()
+                                        : ", " + std::to_string(s.gear_constraints.size()) +
+                                              " ideal-gear rows eliminated by their null space")
+         << "; mass matrix by CRBA\n";
+  }
   os << "  gravity: [" << gravity.x() << ", " << gravity.y() << ", " << gravity.z() << "]\n";
   os << "  bodies:\n";
   for (const Body& b : bodies) os << "    " << b.name << "  mass " << b.mass << " kg\n";

@@ -84,6 +84,7 @@ void Engine::forces(double t) {
   }
   // joint-coordinate forces: springs, dampers, friction, inputs
   for (const CoordForce& cf : m_.coord_forces) {
+    if (!coord_forces_) break;
     const ScalarJet& q = jets_.get(m_, kin_, cf.coord);
     const Coord& c = m_.coords[cf.coord];
     double tau;
@@ -99,7 +100,7 @@ void Engine::forces(double t) {
     scatter(tau * q.J, j.parent, j.child);
   }
   // gear pairs with backlash: contact force along the line of action
-  for (size_t gi = 0; gi < m_.gears.size(); ++gi) {
+  for (size_t gi = 0; gi < m_.gears.size() && coord_forces_; ++gi) {
     const GearPair& g = m_.gears[gi];
     const ScalarJet& qa = jets_.get(m_, kin_, g.coord_a);
     const ScalarJet& qb = jets_.get(m_, kin_, g.coord_b);

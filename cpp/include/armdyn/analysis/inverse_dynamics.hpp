@@ -107,9 +107,7 @@ class JointSpaceInverseDynamics {
   Model driven_;  // Kkt: src_ with one drive per joint coordinate, in coordinate order
   std::unique_ptr<Engine> e_;
   VecX vd_, ref_;
-  // Recursive: per body, world angular and centre-of-mass accelerations, then the subtree's
-  // residual force and moment about the centre of mass; per joint, its child-side point and axis
-  std::vector<Vec3> alpha_, acc_, force_, moment_, point_, axis_;
+  RneWork rne_;  // Recursive: the sweep's scratch
 };
 
 }  // namespace armdyn

@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Joint-space entry points for tree models whose joints define coordinates (revolute, prismatic,
 // cylindrical, fixed): the Cartesian state from joint coordinates (forward kinematics along the
-// tree), joint coordinates from the Cartesian state, and forward dynamics computed through the
-// Cartesian KKT path (not a reduced-coordinate algorithm).
+// tree), joint coordinates from the Cartesian state, the recursive Newton-Euler residual, and
+// forward dynamics, by the joint-space CRBA path (TreeDynamics) or through the Cartesian KKT
+// system.
 #pragma once
 
 #include <memory>
@@ -13,6 +14,7 @@
 namespace armdyn {
 
 class Engine;
+class TreeDynamics;
 
 /// Per-body scratch of state_from_joints (the bodies' kinematics), kept by callers that evaluate
 /// repeatedly so that no call allocates.
@@ -46,33 +48,59 @@ inline void joint_components(const Joint& j, const Eigen::Ref<const VecX>& x, do
 void joint_space_kinematics(const Model& m, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
                             std::vector<BodyKin>& kin);
 
+/// Scratch of rne_residual: per body (alpha, acc, force, moment), per joint (point, axis).
+struct RneWork {
+  std::vector<Vec3> alpha, acc, force, moment, point, axis;
+  void resize(const Model& m);
+};
+
+/// The joint-space residual of the Newton-Euler equations of a tree,
+///   tau = M(q) qdd + b(q, qd) - J(q)^T eta,
+/// with kin filled by joint_space_kinematics at (q, qd) and eta the bodies' applied and
+/// gyroscopic forces there (Engine::forces). Forward, parents first, each body's angular and
+/// centre-of-mass accelerations; backward, children first, each subtree's residual wrench
+/// (Gamma v' - eta) and its virtual work along the joint's coordinates. O(n); w.point and w.axis
+/// are left holding each joint's child-side point and world axis.
+void rne_residual(const Model& m, const std::vector<BodyKin>& kin, Eigen::Ref<const VecX> qd,
+                  Eigen::Ref<const VecX> qdd, const VecX& eta, RneWork& w, Eigen::Ref<VecX> tau);
+
 /// Cartesian (u, v) from joint coordinates q and rates qd (n_coords each).
 /// @throws ModelError when the model is not a joint-space tree or sizes are wrong.
 void state_from_joints(const Model& m, const VecX& q, const VecX& qd, VecX& u, VecX& v);
 /// The same with caller-owned scratch (no allocation once u, v and work are sized).
 void state_from_joints(const Model& m, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd, VecX& u,
                        VecX& v, TreeFkWork& work);
+/// The Cartesian state (u: nq, v: nv) of a kinematic cache.
+void cartesian_state(const Model& m, const std::vector<BodyKin>& kin, double* u, double* v);
 /// Joint coordinates (angles in (-pi, pi]) and rates at (u, v).
 void joint_coordinates(const Model& m, const VecX& u, const VecX& v, VecX& q, VecX& qd);
 /// qdd for joint torques/forces tau; drives are ignored (joint rows only).
 VecX forward_dynamics(const Model& m, const VecX& q, const VecX& qd, const VecX& tau);
 
-/// forward_dynamics with a workspace kept between calls (the engine, its KKT plan and buffers):
-/// repeated calls allocate nothing beyond the returned vector.
+/// forward_dynamics with a workspace kept between calls; repeated calls allocate nothing.
+///  - Crba (default): the joint-space mass matrix by the composite-rigid-body algorithm, the
+///    bias by recursive Newton-Euler, a Cholesky solve (TreeDynamics);
+///  - Kkt: the Cartesian constrained Newton-Euler system with the joint torques as loads.
+/// Both include the model's coordinate forces and ignore its drives.
 class JointSpaceForwardDynamics {
  public:
+  enum class Method { Crba, Kkt };
   /// @throws ModelError when the model is not a joint-space tree.
-  explicit JointSpaceForwardDynamics(std::shared_ptr<const Model> m);
+  explicit JointSpaceForwardDynamics(std::shared_ptr<const Model> m, Method method = Method::Crba);
   ~JointSpaceForwardDynamics();
   /// qdd into out (n_coords) for torques/forces tau at time t.
   /// @throws ModelError on wrong sizes or non-finite inputs.
   void compute(Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd, Eigen::Ref<const VecX> tau,
                Eigen::Ref<VecX> out, double t = 0.0);
   const Model& model() const { return *m_; }
+  Method method() const { return method_; }
 
  private:
   std::shared_ptr<const Model> m_;
+  Method method_;
   std::unique_ptr<Engine> e_;
+  std::unique_ptr<TreeDynamics> td_;
+  VecX z_;  // integral states of PI motors: zero
   VecX vd_, tau_;
 };
 

@@ -19,6 +19,11 @@ struct SimOptions {
   Metric projection = Metric::Mass;
   /// integrate bodies joined by fixed joints as one composite body (Model::welded)
   bool merge_welded = true;
+  /// "cartesian": the bodies' Cartesian state (u, v) with the constrained Newton-Euler
+  /// equations and the topological projection (the paper's method). "joint": the joint
+  /// coordinates and rates (q, qd) of a tree, ideal gears allowed (TreeDynamics: CRBA and the
+  /// gears' null space); the outputs are the same Cartesian tables, built from (q, qd).
+  std::string coordinates = "cartesian";
 };
 
 /// Row-major output tables: one row per output time.
@@ -40,6 +45,7 @@ struct SimResult {
   std::string error;  ///< non-empty when the run stopped early (SolverError message)
   std::string integrator, integrator_reason;  ///< the method used, and why (for "auto")
   int solver_bodies = 0, solver_rows = 0;     ///< bodies and rows of the model integrated
+  std::string formulation;  ///< the coordinates integrated and the solver path, one line
 };
 
 /// Stiffness estimate for integrator="auto": the fastest rate |lambda| [1/s] of the force

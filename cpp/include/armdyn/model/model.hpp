@@ -190,6 +190,9 @@ class Model {
   bool joint_space_ok =
       false;  ///< tree of revolute/prismatic/cylindrical/fixed joints, parent->child
   std::string joint_space_reason;
+  /// a tree of joint-coordinate joints defined parent -> child, ideal gears allowed (the
+  /// joint-space path of simulate, armdyn/analysis/tree_dynamics.hpp)
+  bool joint_tree = false;
   std::vector<int> tree_order;  ///< joints in parent-before-child order (if is_tree)
   int rank_joint = 0, rank_all = 0;
   int mobility = 0;         ///< nv - rank of joint rows (degrees of freedom without drives)

@@ -43,6 +43,9 @@ class Engine {
   /// With joint torques set: the jets (rate, Jacobian, bias; no value) of every joint
   /// coordinate at the state of the last forces() call.
   const std::vector<ScalarJet>& torque_jets() const { return tau_jets_; }
+  /// false: forces() leaves out the joint-coordinate forces and gear pairs (a joint-space
+  /// caller adds them to its generalised forces directly, from unwrapped coordinates).
+  void set_coordinate_forces(bool on) { coord_forces_ = on; }
 
   /// Kinematics of (u, v); v may be nullptr (at rest).
   void load(const double* u, const double* v);
@@ -132,6 +135,7 @@ class Engine {
   double tol_f_ = 1e-13;
   TreeSweep sweep_;
   bool swept_ = false;
+  bool coord_forces_ = true;
 };
 
 }  // namespace armdyn

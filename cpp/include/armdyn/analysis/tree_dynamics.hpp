@@ -1,0 +1,81 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Joint-space forward dynamics of a tree with ideal gears, in minimal coordinates q (the
+// joint angles and displacements, multi-turn):
+//   M(q) qdd + b(q, qd) - J^T eta = Q(q, qd, t) + G^T lambda,   G qdd = 0,
+// with
+//  - M by the composite-rigid-body algorithm in world axes (Featherstone, Rigid Body Dynamics
+//    Algorithms, 2008, ch. 6): each subtree's spatial inertia about the world origin, and
+//    M_jk = S_j . (I_subtree(k) S_k) for j on the path from k to the root;
+//  - b - J^T eta the recursive Newton-Euler residual at qdd = 0 (rne_residual): velocity
+//    products, gravity, body loads and spring-dampers (eta of Engine::forces);
+//  - Q the joint-coordinate forces (springs, dampers, friction, inputs, PD/PI motors) and the
+//    gear pairs' contact forces, straight from the unwrapped coordinates;
+//  - G the ideal gears' rows (r_a, r_b in their coordinates' columns; constant), eliminated by
+//    an orthonormal basis T of their null space (a QR of G^T at construction):
+//    qdd = T (T^T M T)^-1 T^T (Q - b + J^T eta).
+// The rows are linear in q, so every Runge-Kutta method keeps G q = 0 and G qd = 0 exactly up to
+// round-off; project() removes that round-off. The Cartesian path (Engine) remains the reference:
+// tests compare the two.
+#pragma once
+
+#include <Eigen/Cholesky>
+#include <string>
+#include <vector>
+
+#include "armdyn/analysis/joint_space.hpp"
+#include "armdyn/solver/engine.hpp"
+
+namespace armdyn {
+
+class TreeDynamics {
+ public:
+  /// ignore_drives: the model's drives play no part (joint-space forward dynamics for given
+  /// joint forces); otherwise a model with drives is refused.
+  /// @throws ModelError (unsupported() as the reason) when the path does not apply.
+  explicit TreeDynamics(const Model& m, bool ignore_drives = false);
+  TreeDynamics(const TreeDynamics&) = delete;
+  TreeDynamics& operator=(const TreeDynamics&) = delete;
+
+  /// Why the model cannot use the joint-space path (loops, joints without coordinates, a
+  /// child-to-parent joint, drives), or empty when it can.
+  static std::string unsupported(const Model& m, bool ignore_drives = false);
+
+  int n() const { return n_; }      ///< joint coordinates
+  int dof() const { return dof_; }  ///< independent coordinates (n - rank of the gear rows)
+  std::string description() const;  ///< one line for the run's statistics
+  const Model& model() const { return m_; }
+
+  /// Accelerations qdd (n) at (q, qd) (n each), auxiliary states z (model.n_aux; may be nullptr
+  /// when there are none) and time t; tau: extra joint forces (n) or nullptr. Allocates nothing.
+  /// @throws SolverError naming the culprit when a force is not finite or M is not positive
+  ///   definite.
+  void accelerations(double t, const double* q, const double* qd, const double* z,
+                     const double* tau, double* qdd);
+  /// Rates of the auxiliary states (PI motors' integral terms) at (q, qd, z, t).
+  void aux_rates(double t, const double* q, const double* qd, const double* z, double* zdot) const;
+  /// Gear pair g's mesh displacement s, rate and penetration |s| - backlash/2.
+  void gear_mesh(int g, const double* q, const double* qd, double& s, double& sd,
+                 double& penetration) const;
+  /// Remove the round-off from G q = 0 and G qd = 0 (Euclidean projection onto the null space).
+  void project(double* q, double* qd);
+  /// The joint-space mass matrix at q (n x n), by the composite-rigid-body algorithm.
+  const MatX& mass_matrix(const double* q);
+  /// The mass matrix of the last accelerations() or mass_matrix() call.
+  const MatX& last_mass_matrix() const { return M_; }
+
+ private:
+  void crba();  // M_ at the kinematics in e_.kin_in()
+  const Model& m_;
+  Engine e_;  // eta only: gravity, gyroscopic terms, body loads, spring-dampers
+  int n_ = 0, dof_ = 0, rank_ = 0;
+  std::vector<std::vector<int>> anc_;  // per coordinate: its joint's and the ancestors' coords
+  std::vector<int> coord_body_;        // per coordinate: the child body of its joint
+  RneWork rne_;
+  std::vector<Mat6> ic_;  // per body: the subtree's spatial inertia about the world origin
+  std::vector<Vec6> s_;   // per coordinate: its motion (angular; velocity of the origin)
+  MatX M_, T_, range_, MT_, Mr_;
+  VecX zero_, rhs_, y_, w_;
+  Eigen::LLT<MatX> llt_;
+};
+
+}  // namespace armdyn
