@@ -735,12 +735,14 @@ def plot(result: dict, path: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(6.4, 4.6))
+    fig, ax = plt.subplots(figsize=(10.0, 4.8))
     for key, pts in result["curves"].items():
         e = [q["error"] for q in pts if np.isfinite(q.get("error", np.nan))]
         c = [q["cpu_s"] for q in pts if np.isfinite(q.get("error", np.nan))]
         if e:
-            style = "-o" if key.startswith("armdyn") else "--s"
+            style = "--s"
+            if key.startswith("armdyn"):
+                style = "-^" if key.endswith("(joint)") else "-o"
             ax.loglog(e, c, style, label=key, ms=4)
     if result.get("required_precision"):
         for r in result["required_precision"]:
@@ -749,7 +751,8 @@ def plot(result: dict, path: Path) -> None:
     ax.set_ylabel("CPU time [s] (median of warm runs)")
     ax.set_title(result["title"], fontsize=10)
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7)
+    # beside the axes: the curves stay visible however many there are
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
