@@ -175,7 +175,6 @@ JointSpaceForwardDynamics::JointSpaceForwardDynamics(std::shared_ptr<const Model
   require_joint_space(*m_, "forward_dynamics");
   if (method_ == Method::Crba) {
     td_ = std::make_unique<TreeDynamics>(*m_, true);
-    z_ = VecX::Zero(std::max(m_->n_aux, 1));
     return;
   }
   e_ = std::make_unique<Engine>(*m_);
@@ -199,7 +198,8 @@ void JointSpaceForwardDynamics::compute(Eigen::Ref<const VecX> q, Eigen::Ref<con
   check_joint_vector(qd, nc, "forward_dynamics", "qd");
   if (td_) {
     // contiguous inputs (numpy arrays, VecX) pass straight through
-    td_->accelerations(t, q.data(), qd.data(), z_.data(), tau.data(), out.data());
+    // PI motors' integral states are zero, as on the KKT path
+    td_->accelerations(t, q.data(), qd.data(), nullptr, tau.data(), out.data());
     return;
   }
   joint_space_kinematics(m, q, qd, e_->kin_in());

@@ -281,12 +281,7 @@ class MbsSystem : public OdeSystem {
 class JointSystem : public OdeSystem {
  public:
   JointSystem(const Model& m, MbsSystem& cart)
-      : m_(m),
-        td_(m),
-        cart_(cart),
-        n_(td_.n()),
-        yc_(VecX::Zero(m.nq + m.nv + m.n_aux)),
-        track_(VecX::Zero(td_.n())) {
+      : m_(m), td_(m), cart_(cart), n_(td_.n()), yc_(VecX::Zero(m.nq + m.nv + m.n_aux)) {
     fkw_.kin.resize(m.nb);
   }
 
@@ -309,8 +304,7 @@ class JointSystem : public OdeSystem {
     joint_space_kinematics(m_, q, qd, fkw_.kin);
     cartesian_state(m_, fkw_.kin, yc_.data(), yc_.data() + m_.nq);
     yc_.tail(m_.n_aux) = y.tail(m_.n_aux);
-    track_ = q;
-    cart_.engine().set_tracking(track_);
+    cart_.engine().set_tracking(q);
     cart_.output(t, yc_);
   }
 
@@ -328,7 +322,7 @@ class JointSystem : public OdeSystem {
   TreeDynamics td_;
   MbsSystem& cart_;
   int n_;
-  VecX yc_, track_;
+  VecX yc_;
   TreeFkWork fkw_;
 };
 
@@ -491,7 +485,7 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
   // "auto": joint space wherever it applies (a tree without drives), the Cartesian path else
   const bool joint =
       opt.coordinates == "joint" || (opt.coordinates == "auto" && out.integrator != "kinematic" &&
-                                     TreeDynamics::unsupported(ms).empty());
+                                     ms.joint_path_reason().empty());
   if (joint && out.integrator == "kinematic")
     throw ModelError(
         "simulate: coordinates 'joint' integrates a tree without drives; a fully driven model "
@@ -515,10 +509,10 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
     out.formulation = msg("cartesian: ", ms.nb, " bodies, ", ms.nc, " constraint rows, KKT path '",
                           ms.kkt_all.path, "'");
     if (opt.coordinates == "auto")
-      out.formulation += msg(" (joint space does not apply: ",
-                             out.integrator == "kinematic" ? std::string("fully driven")
-                                                           : TreeDynamics::unsupported(ms),
-                             ")");
+      out.formulation +=
+          msg(" (joint space does not apply: ",
+              out.integrator == "kinematic" ? std::string("fully driven") : ms.joint_path_reason(),
+              ")");
   }
   std::unique_ptr<WeldExpander> expander;
   VecX y = VecX::Zero(ms.nq + ms.nv + ms.n_aux);
@@ -558,14 +552,13 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
       OdeSystem* ode = &sys;
       VecX yj;
       if (joint) {
-        // (q, qd) of the projected initial state, angles continued from the engine's tracking
+        // (q, qd) of the projected initial state; angles start in (-pi, pi], as the Cartesian
+        // run's tracking does
         Engine& e = sys.engine();
         e.set_aux(y.data() + ms.nq + ms.nv);
         e.project(0.0, y.data(), y.data() + ms.nq, opt.projection);
         VecX q, qd;
         joint_coordinates(ms, y.head(ms.nq), y.segment(ms.nq, ms.nv), q, qd);
-        for (int c = 0; c < static_cast<int>(ms.coords.size()); ++c)
-          if (ms.coords[c].angular) q[c] = e.tracked(c, q[c]);
         const long nco = q.size();
         yj = VecX::Zero(2 * nco + ms.n_aux);
         yj << q, qd, y.tail(ms.n_aux);
@@ -586,7 +579,8 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
     // say why when the constraints are (nearly) singular at the last accepted state
     if (out.integrator != "kinematic") t_last = out.t.empty() ? 0.0 : out.t.back();
     // (the joint-space path has no constraint Jacobian to diagnose but the gears' constant one)
-    if (!joint) try {
+    if (!joint) {
+      try {
         sys.engine().set_aux(y.data() + ms.nq + ms.nv);
         // the kinematic path stops short of a limit point (no solution beyond it) by its
         // continuation's smallest step, where the rank loss shows only at looser thresholds
@@ -603,6 +597,7 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
         }
       } catch (const std::exception&) {
       }
+    }
   }
   out.cpu_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   out.solver_bodies = ms.nb;

@@ -9,18 +9,8 @@
 
 namespace armdyn {
 
-std::string TreeDynamics::unsupported(const Model& m, bool ignore_drives) {
-  if (!m.joint_tree)
-    return m.joint_space_reason.empty() ? std::string("the model is not a tree")
-                                        : m.joint_space_reason;
-  if (!m.drives.empty() && !ignore_drives)
-    return msg("drive '", m.drives[0].name,
-               "' prescribes a coordinate (the joint-space path has no driving rows)");
-  return {};
-}
-
 TreeDynamics::TreeDynamics(const Model& m, bool ignore_drives) : m_(m), e_(m) {
-  const std::string why = unsupported(m, ignore_drives);
+  const std::string why = m.joint_path_reason(ignore_drives);
   if (!why.empty()) throw ModelError(msg("joint-space dynamics: ", why));
   e_.set_coordinate_forces(false);
   n_ = static_cast<int>(m.coords.size());
@@ -28,10 +18,8 @@ TreeDynamics::TreeDynamics(const Model& m, bool ignore_drives) : m_(m), e_(m) {
   std::vector<int> joint_of_child(m.nb, -1);
   for (size_t j = 0; j < m.joints.size(); ++j) joint_of_child[m.joints[j].child] = int(j);
   anc_.assign(n_, {});
-  coord_body_.assign(n_, kGround);
   for (int c = 0; c < n_; ++c) {
     const int ji = m.coords[c].joint;
-    coord_body_[c] = m.joints[ji].child;
     for (int jj = ji; jj >= 0;) {
       const Joint& j = m.joints[jj];
       for (int k = 0; k < joint_coords(j.type); ++k) anc_[c].push_back(j.coord0 + k);
@@ -96,14 +84,13 @@ void TreeDynamics::crba() {
     const Joint& j = m.joints[*it];
     if (j.parent != kGround) ic_[j.parent] += ic_[j.child];
   }
-  // each coordinate's motion: a turn about the axis through the joint point, or a slide
+  // each coordinate's motion: a turn about the axis through the joint point, or a slide (the
+  // joint frames of the Newton-Euler sweep)
   for (int ji : m.tree_order) {
     const Joint& j = m.joints[ji];
     if (j.coord0 < 0) continue;
-    const Vec3 z = j.parent == kGround ? Vec3(j.frame_parent.col(2))
-                                       : Vec3(kin[j.parent].R * j.frame_parent.col(2));
-    const BodyKin& c = kin[j.child];
-    const Vec3 p = c.x + c.R * j.point_child;
+    const Vec3& z = rne_.axis[ji];
+    const Vec3& p = rne_.point[ji];
     for (int k = 0; k < joint_coords(j.type); ++k) {
       Vec6& s = s_[j.coord0 + k];
       const bool slide = j.type == JointType::Prismatic || k == 1;
@@ -115,14 +102,17 @@ void TreeDynamics::crba() {
     }
   }
   for (int k = 0; k < n_; ++k) {
-    const Vec6 f = ic_[coord_body_[k]] * s_[k];
+    const Vec6 f = ic_[m.joints[m.coords[k].joint].child] * s_[k];
     for (int j : anc_[k]) M_(j, k) = M_(k, j) = s_[j].dot(f);
   }
 }
 
 const MatX& TreeDynamics::mass_matrix(const double* q) {
   const Eigen::Map<const VecX> qv(q, n_);
-  joint_space_kinematics(m_, qv, zero_, e_.kin_in());
+  std::vector<BodyKin>& kin = e_.kin_in();
+  joint_space_kinematics(m_, qv, zero_, kin);
+  // the sweep places the joint frames; its torques (rhs_, scratch here) are not used
+  rne_residual(m_, kin, zero_, zero_, e_.eta(), rne_, rhs_);
   crba();
   return M_;
 }

@@ -142,11 +142,10 @@ std::string Model::summary() const {
   {
     // simulate(coordinates="joint"): the integrated model (welded, when fixed joints merge)
     const Model& s = welded ? *welded : *this;
+    const std::string why = s.joint_path_reason();
     os << "  joint-space path (simulate coordinates='joint'): ";
-    if (!s.joint_tree)
-      os << "not available (" << s.joint_space_reason << ")\n";
-    else if (!s.drives.empty())
-      os << "not available (drive '" << s.drives[0].name << "' prescribes a coordinate)\n";
+    if (!why.empty())
+      os << "not available (" << why << ")\n";
     else
       os << "available: " << s.coords.size() << " coordinates"
          << (s.gear_constraints.empty() ? std::string()
@@ -171,6 +170,15 @@ std::string Model::summary() const {
   const size_t nforce = body_loads.size() + springs.size() + coord_forces.size() + gears.size();
   if (nforce) os << "  force elements: " << nforce << " (besides gravity)\n";
   return os.str();
+}
+
+std::string Model::joint_path_reason(bool ignore_drives) const {
+  if (!joint_tree)
+    return joint_space_reason.empty() ? "the model is not a tree" : joint_space_reason;
+  if (!drives.empty() && !ignore_drives)
+    return "drive '" + drives[0].name +
+           "' prescribes a coordinate (the joint-space path has no driving rows)";
+  return {};
 }
 
 double gear_force(const GearPair& g, double s, double sd, double& penetration) {

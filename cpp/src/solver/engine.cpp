@@ -47,6 +47,41 @@ void Engine::scatter(const Row12& g, int pa, int pb) {
   if (pb != kGround) eta_.segment<6>(6 * pb) += g.segment<6>(6).transpose();
 }
 
+void Engine::coordinate_forces(double t) {
+  // joint-coordinate forces: springs, dampers, friction, inputs
+  for (const CoordForce& cf : m_.coord_forces) {
+    const ScalarJet& q = jets_.get(m_, kin_, cf.coord);
+    const Coord& c = m_.coords[cf.coord];
+    double tau;
+    try {
+      const double z = (cf.aux >= 0 && aux_) ? aux_[cf.aux] : 0.0;
+      tau = coord_force_value(cf, c.angular, q.val, q.rate, t, z);
+    } catch (const SolverError& err) {
+      throw SolverError(msg("force on joint coordinate '", c.name, "': ", err.what()));
+    }
+    if (!std::isfinite(tau))
+      throw SolverError(msg("non-finite force on joint coordinate '", c.name, "' at t=", t));
+    const Joint& j = m_.joints[c.joint];
+    scatter(tau * q.J, j.parent, j.child);
+  }
+  // gear pairs with backlash: contact force along the line of action
+  for (size_t gi = 0; gi < m_.gears.size(); ++gi) {
+    const GearPair& g = m_.gears[gi];
+    const ScalarJet& qa = jets_.get(m_, kin_, g.coord_a);
+    const ScalarJet& qb = jets_.get(m_, kin_, g.coord_b);
+    const double s = g.r_a * tracked(g.coord_a, qa.val) + g.r_b * tracked(g.coord_b, qb.val);
+    const double sd = g.r_a * qa.rate + g.r_b * qb.rate;
+    double pen;
+    const double f = gear_force(g, s, sd, pen);
+    if (f == 0.0) continue;
+    const double fs = s >= 0 ? f : -f;
+    const Joint& ja = m_.joints[m_.coords[g.coord_a].joint];
+    const Joint& jb = m_.joints[m_.coords[g.coord_b].joint];
+    scatter(-g.r_a * fs * qa.J, ja.parent, ja.child);
+    scatter(-g.r_b * fs * qb.J, jb.parent, jb.child);
+  }
+}
+
 void Engine::forces(double t) {
   // gravity and gyroscopic terms, per body
   for (int i = 0; i < m_.nb; ++i) {
@@ -82,39 +117,7 @@ void Engine::forces(double t) {
     const double tension = sd.stiffness * (L - sd.rest_length) + sd.damping * Ld;
     scatter(-tension * d.left(n), sd.body_a, sd.body_b);
   }
-  // joint-coordinate forces: springs, dampers, friction, inputs
-  for (const CoordForce& cf : m_.coord_forces) {
-    if (!coord_forces_) break;
-    const ScalarJet& q = jets_.get(m_, kin_, cf.coord);
-    const Coord& c = m_.coords[cf.coord];
-    double tau;
-    try {
-      const double z = (cf.aux >= 0 && aux_) ? aux_[cf.aux] : 0.0;
-      tau = coord_force_value(cf, c.angular, q.val, q.rate, t, z);
-    } catch (const SolverError& err) {
-      throw SolverError(msg("force on joint coordinate '", c.name, "': ", err.what()));
-    }
-    if (!std::isfinite(tau))
-      throw SolverError(msg("non-finite force on joint coordinate '", c.name, "' at t=", t));
-    const Joint& j = m_.joints[c.joint];
-    scatter(tau * q.J, j.parent, j.child);
-  }
-  // gear pairs with backlash: contact force along the line of action
-  for (size_t gi = 0; gi < m_.gears.size() && coord_forces_; ++gi) {
-    const GearPair& g = m_.gears[gi];
-    const ScalarJet& qa = jets_.get(m_, kin_, g.coord_a);
-    const ScalarJet& qb = jets_.get(m_, kin_, g.coord_b);
-    const double s = g.r_a * tracked(g.coord_a, qa.val) + g.r_b * tracked(g.coord_b, qb.val);
-    const double sd = g.r_a * qa.rate + g.r_b * qb.rate;
-    double pen;
-    const double f = gear_force(g, s, sd, pen);
-    if (f == 0.0) continue;
-    const double fs = s >= 0 ? f : -f;
-    const Joint& ja = m_.joints[m_.coords[g.coord_a].joint];
-    const Joint& jb = m_.joints[m_.coords[g.coord_b].joint];
-    scatter(-g.r_a * fs * qa.J, ja.parent, ja.child);
-    scatter(-g.r_b * fs * qb.J, jb.parent, jb.child);
-  }
+  if (coord_forces_) coordinate_forces(t);
   // joint-space torques of a joint-space call
   if (tau_) {
     for (int c = 0; c < static_cast<int>(m_.coords.size()); ++c) {

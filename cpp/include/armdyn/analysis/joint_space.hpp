@@ -100,7 +100,6 @@ class JointSpaceForwardDynamics {
   Method method_;
   std::unique_ptr<Engine> e_;
   std::unique_ptr<TreeDynamics> td_;
-  VecX z_;  // integral states of PI motors: zero
   VecX vd_, tau_;
 };
 

@@ -31,14 +31,10 @@ class TreeDynamics {
  public:
   /// ignore_drives: the model's drives play no part (joint-space forward dynamics for given
   /// joint forces); otherwise a model with drives is refused.
-  /// @throws ModelError (unsupported() as the reason) when the path does not apply.
+  /// @throws ModelError (Model::joint_path_reason) when the path does not apply.
   explicit TreeDynamics(const Model& m, bool ignore_drives = false);
   TreeDynamics(const TreeDynamics&) = delete;
   TreeDynamics& operator=(const TreeDynamics&) = delete;
-
-  /// Why the model cannot use the joint-space path (loops, joints without coordinates, a
-  /// child-to-parent joint, drives), or empty when it can.
-  static std::string unsupported(const Model& m, bool ignore_drives = false);
 
   int n() const { return n_; }      ///< joint coordinates
   int dof() const { return dof_; }  ///< independent coordinates (n - rank of the gear rows)
@@ -64,12 +60,11 @@ class TreeDynamics {
   const MatX& last_mass_matrix() const { return M_; }
 
  private:
-  void crba();  // M_ at the kinematics in e_.kin_in()
+  void crba();  // M_ at the kinematics in e_.kin_in() and the joint frames in rne_
   const Model& m_;
   Engine e_;  // eta only: gravity, gyroscopic terms, body loads, spring-dampers
   int n_ = 0, dof_ = 0, rank_ = 0;
   std::vector<std::vector<int>> anc_;  // per coordinate: its joint's and the ancestors' coords
-  std::vector<int> coord_body_;        // per coordinate: the child body of its joint
   RneWork rne_;
   std::vector<Mat6> ic_;  // per body: the subtree's spatial inertia about the world origin
   std::vector<Vec6> s_;   // per coordinate: its motion (angular; velocity of the origin)

@@ -193,6 +193,9 @@ class Model {
   /// a tree of joint-coordinate joints defined parent -> child, ideal gears allowed (the
   /// joint-space path of simulate, armdyn/analysis/tree_dynamics.hpp)
   bool joint_tree = false;
+  /// Why the joint-space path (TreeDynamics) does not apply to this model -- not a joint tree,
+  /// or (unless ignore_drives) a drive prescribes a coordinate -- or empty when it does.
+  std::string joint_path_reason(bool ignore_drives = false) const;
   std::vector<int> tree_order;  ///< joints in parent-before-child order (if is_tree)
   int rank_joint = 0, rank_all = 0;
   int mobility = 0;         ///< nv - rank of joint rows (degrees of freedom without drives)

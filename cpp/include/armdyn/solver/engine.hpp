@@ -97,7 +97,7 @@ class Engine {
   /// Set the tracked angles' references from the loaded state (after each projection).
   void commit_tracking();
   const VecX& tracking() const { return track_ref_; }
-  void set_tracking(const VecX& ref) { track_ref_ = ref; }
+  void set_tracking(const Eigen::Ref<const VecX>& ref) { track_ref_ = ref; }
 
   const VecX& delta() const { return delta_; }
   /// Set the multipliers (all rows) that joint_reaction() reports.
@@ -120,6 +120,7 @@ class Engine {
 
  private:
   void scatter(const Row12& g, int pa, int pb);
+  void coordinate_forces(double t);  // joint-coordinate forces and gear pairs into eta_
   const Model& m_;
   std::vector<BodyKin> kin_;
   ConstraintEval ce_;
