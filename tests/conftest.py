@@ -2,33 +2,39 @@
 
 Every model here is built through the public builder API (docs/api.md). Geometry is always
 generated in WORLD coordinates at the assembly pose, which is also what the independent numpy
-reference (armdyn.reference) consumes, so the two never share code paths.
+oracle (tests/oracles/numpy_rne.py) consumes, so the two never share code paths.
 
 Helpers are plain functions (import them with ``from conftest import ...``; pytest puts this
-directory on sys.path) and a few are also exposed as fixtures.
+directory on sys.path, so the oracles import as ``oracles.numpy_rne``) and a few are also exposed
+as fixtures. The repository root is put on sys.path too, for the tests of ``benchmarks/`` (the
+benchmark harness and peer models, not installed with armdyn).
 """
 
 from __future__ import annotations
 
 import os
 import re
+import sys
+from pathlib import Path
 from types import SimpleNamespace
 
 import armdyn as ad
 import numpy as np
 import pytest
-from armdyn.reference import (
+from armdyn.scenes.extreme import random_inertia, random_quat, random_unit
+from oracles.numpy_rne import (
     SerialChain,
     quat_exp,
     quat_mul,
     quat_to_rot,
-    random_inertia,
-    random_quat,
     random_serial_arm,
-    random_unit,
     rot_axis_angle,
     rot_to_quat,
 )
+
+ROOT = Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
 
 G = 9.81
 GRAVITY = (0.0, 0.0, -G)
@@ -162,7 +168,7 @@ def double_pendulum(
     """Planar double pendulum of two solid rods (radius rho) in the x-z plane, revolute joints
     about world +y, pivot at the origin. Absolute assembly angles phi1, phi2 from hanging
     (right-handed about +y). Each rod lies along its body z axis (body orientation = Ry(phi)).
-    Returns the model and the numpy reference chain (armdyn.reference) of the same
+    Returns the model and the numpy reference chain (oracles.numpy_rne) of the same
     geometry."""
     yhat = np.array([0.0, 1.0, 0.0])
     r1 = rot_axis_angle(yhat, phi1)
@@ -213,7 +219,7 @@ def double_pendulum(
 
 
 def spatial_arm(rng, n: int = 6, prismatic: bool = False, gravity=GRAVITY):
-    """Random spatial serial arm (see armdyn.reference.random_serial_arm)."""
+    """Random spatial serial arm (see oracles.numpy_rne.random_serial_arm)."""
     return random_serial_arm(rng, n, prismatic=prismatic, gravity=gravity)
 
 

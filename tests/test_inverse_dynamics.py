@@ -1,8 +1,8 @@
 """Inverse dynamics through driving constraints.
 
 * joint-space form ``inverse_dynamics(model, q, qd, qdd)`` against the independent numpy
-  recursive Newton–Euler of ``armdyn.reference`` on random spatial arms (full inertias, random
-  axes, prismatic joints): ≤ 1e-10 relative;
+  recursive Newton–Euler of ``tests/oracles/numpy_rne.py`` on random spatial arms (full
+  inertias, random axes, prismatic joints): ≤ 1e-10 relative;
 * driven form ``inverse_dynamics(model, t=...)`` against the drive efforts of a forward
   simulation and against the independent Lagrange validator;
 * replay: the computed torques fed back as joint torque inputs to the undriven model reproduce

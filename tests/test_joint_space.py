@@ -1,7 +1,7 @@
 """Joint-space interface against the independent numpy recursive Newton-Euler reference.
 
 - ad.forward_dynamics of random 6-DOF spatial arms (full inertia tensors; all-revolute and a
-  variant with prismatic joints) = M^-1 (tau - bias) from armdyn.reference;
+  variant with prismatic joints) = M^-1 (tau - bias) from tests/oracles/numpy_rne.py;
 - ad.state_from_joints = the reference forward kinematics (CoM, orientation, CoM velocity,
   body-frame angular velocity), and ad.joint_coordinates inverts it;
 - a URDF arm (tests/data/urdf/arm6.urdf) loaded with ad.load_urdf equals the same arm built by
@@ -16,7 +16,6 @@ from pathlib import Path
 import armdyn as ad
 import numpy as np
 import pytest
-from armdyn.reference import SerialChain, rot_axis_angle, rpy_to_rot
 from conftest import (
     GRAVITY,
     coord_index,
@@ -28,6 +27,7 @@ from conftest import (
     to_armdyn,
     tol,
 )
+from oracles.numpy_rne import SerialChain, rot_axis_angle, rpy_to_rot
 
 URDF_PATH = Path(__file__).parent / "data" / "urdf" / "arm6.urdf"
 REL = 1e-10

@@ -35,7 +35,7 @@ def test_verify_figures():
         assert value <= 1e-9
     for _, rf, rv in verify.drift(steps=2000).values():
         assert rf <= 1e-12 and rv <= 1e-12
-    assert verify.rnea_crosscheck(n_arms=2) <= 1e-10
+    assert verify.lagrange_crosscheck(n_arms=2) <= 1e-10
 
 
 def test_cli_verify_entry_point(capsys):

@@ -1,7 +1,7 @@
 """The Lagrange and geometric validators and the five-DOF paper's metrics.
 
-References used here: the numpy recursive Newton–Euler of ``armdyn.reference`` (random arms),
-SymPy (the paper's printed equations and the complete Euler–Lagrange equations of the planar
+References used here: the numpy recursive Newton–Euler of ``tests/oracles/numpy_rne.py`` (random
+arms), SymPy (the paper's printed equations and the complete Euler–Lagrange equations of the planar
 point-mass arm), closed forms (the paper's equations (22)–(25)), and the paper's own arithmetic.
 """
 

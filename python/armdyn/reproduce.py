@@ -26,7 +26,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from armdyn.reference import quat_to_rot
+from armdyn._rotation import quat_to_rot
 from armdyn.scenes import paper
 from armdyn.simulation import simulate
 from armdyn.validation import (

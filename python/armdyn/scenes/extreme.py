@@ -1,13 +1,16 @@
 """Scenes of the extreme-case studies (docs/extreme_cases.md) and of the solver-path checks: an
-overconstrained Bricard linkage, a fast heavy top, random spatial chains (open or closed), a
-chain with a large mass ratio and its independent reference, and a pendulum whose force turns
-NaN. SI units, z up."""
+overconstrained Bricard linkage, a fast heavy top, random spatial chains (open or closed), random
+spatial serial arms with their geometry (for independent models of the same arm), a chain with a
+large mass ratio, and a pendulum whose force turns NaN. SI units, z up."""
 
 from __future__ import annotations
+
+from types import SimpleNamespace
 
 import numpy as np
 
 from armdyn import _core
+from armdyn._rotation import quat_to_rot
 
 
 def bricard(side=0.3, mass=1.0):
@@ -71,15 +74,102 @@ def random_chain(n, close_loop=False, seed=1, masses=None):
     return b.finalize()
 
 
-def mass_ratio_chain(ratio=1e6, n=5, seed=3):
-    """A random spatial chain of n revolute links (:func:`armdyn.reference.random_serial_arm`:
-    random axes, steps, full inertias and body orientations) whose masses alternate √ratio and
-    1/√ratio kg. Returns the arm's namespace: ``model``, ``chain`` (the same arm as the
-    independent numpy RNEA/CRBA model) and ``perm`` (q_armdyn[perm[i]] = q_reference[i])."""
-    from armdyn.reference import random_serial_arm
+def random_unit(rng, n: int = 3) -> np.ndarray:
+    """A random unit vector of length ``n``."""
+    v = rng.normal(size=n)
+    return v / np.linalg.norm(v)
 
+
+def random_quat(rng) -> np.ndarray:
+    """Random unit Euler parameters, scalar-first, e0 >= 0."""
+    e = random_unit(rng, 4)
+    return e if e[0] >= 0 else -e
+
+
+def random_inertia(rng, mass: float, lo: float = 0.002, hi: float = 0.03) -> np.ndarray:
+    """A random FULL inertia tensor (body axes, about the CoM): R diag(principal) R^T with the
+    principal moments built from second moments s_k > 0 (I1 = s2 + s3, ...), so it is symmetric,
+    positive-definite and satisfies the triangle inequality strictly."""
+    s = mass * rng.uniform(lo, hi, size=3)
+    principal = np.array([s[1] + s[2], s[0] + s[2], s[0] + s[1]])
+    e = rng.normal(size=4)
+    r = quat_to_rot(e / np.linalg.norm(e))
+    inertia = r @ np.diag(principal) @ r.T
+    return 0.5 * (inertia + inertia.T)
+
+
+def random_spatial_arm(
+    rng, n: int = 6, prismatic: bool = False, gravity=(0.0, 0.0, -9.81), masses=None
+) -> SimpleNamespace:
+    """Random spatial serial arm ground - link1 - ... - linkn, built with the builder.
+
+    Random link masses, random FULL inertias (R diag R^T, SPD, triangle inequality), random CoM
+    offsets, random body orientations, random joint points and random joint axes. With
+    ``prismatic=True`` every joint with index % 3 == 1 is prismatic (e.g. R P R R P R for
+    n = 6). ``masses`` (n values) replaces the random link masses.
+
+    Returns a namespace with ``model``, ``builder`` and the arm's geometry in world coordinates
+    at q = 0, from which an independent model of the same arm can be built: ``types`` ('R' /
+    'P'), ``points``, ``axes`` (joint points and axes), ``coms``, ``masses``, ``inertias_body``
+    (body axes), ``quats`` (body → world), ``joint_names``, ``body_names``, ``n``, and ``perm``
+    such that q_armdyn[perm[i]] = q_arm[i] (q_arm in link order).
+    """
+    types = ["P" if (prismatic and i % 3 == 1) else "R" for i in range(n)]
+    points = np.zeros((n, 3))
+    steps = np.zeros((n, 3))
+    p = np.array([0.0, 0.0, 0.1])
+    for i in range(n):
+        points[i] = p
+        d = random_unit(rng) * rng.uniform(0.15, 0.4)
+        steps[i] = d
+        p = p + d
+    axes = np.array([random_unit(rng) for _ in range(n)])
+    coms = points + 0.5 * steps + 0.05 * rng.normal(size=(n, 3))
+    drawn = rng.uniform(0.5, 3.0, size=n)  # drawn either way: the same geometry for a seed
+    masses = drawn if masses is None else np.asarray(masses, dtype=float)
+    inertias_body = np.array([random_inertia(rng, m) for m in masses])
+    quats = np.array([random_quat(rng) for _ in range(n)])
+    body_names = [f"link{i + 1}" for i in range(n)]
+    joint_names = [f"j{i + 1}" for i in range(n)]
+    b = _core.ModelBuilder(gravity=gravity)
+    for i in range(n):
+        b.add_body(
+            body_names[i],
+            float(masses[i]),
+            inertias_body[i],
+            position=coms[i],
+            orientation=quats[i],
+        )
+    for i in range(n):
+        parent = "ground" if i == 0 else body_names[i - 1]
+        add = b.add_revolute if types[i] == "R" else b.add_prismatic
+        add(joint_names[i], parent, body_names[i], points[i], axes[i])
+    model = b.finalize()
+    perm = np.array([list(model.coord_names).index(jn) for jn in joint_names])
+    return SimpleNamespace(
+        model=model,
+        builder=b,
+        types=types,
+        points=points,
+        axes=axes,
+        coms=coms,
+        masses=masses,
+        inertias_body=inertias_body,
+        quats=quats,
+        joint_names=joint_names,
+        body_names=body_names,
+        perm=perm,
+        n=n,
+        gravity=gravity,
+    )
+
+
+def mass_ratio_chain(ratio=1e6, n=5, seed=3) -> SimpleNamespace:
+    """A random spatial chain of n revolute links (:func:`random_spatial_arm`: random axes,
+    steps, full inertias and body orientations) whose masses alternate √ratio and 1/√ratio kg.
+    Returns the arm's namespace (``model``, its geometry and ``perm``)."""
     masses = [np.sqrt(ratio) if i % 2 == 0 else 1 / np.sqrt(ratio) for i in range(n)]
-    return random_serial_arm(np.random.default_rng(seed), n, masses=masses)
+    return random_spatial_arm(np.random.default_rng(seed), n, masses=masses)
 
 
 def nan_force_pendulum(t_nan=0.31):

@@ -1,10 +1,10 @@
-"""Independent numpy reference dynamics for serial (tree) chains of revolute/prismatic joints.
+"""Test oracle: independent numpy dynamics for serial (tree) chains of revolute/prismatic joints.
 
-The dynamics here never call armdyn (only `random_serial_arm` uses the builder, to make the
-same arm for both sides). The chain is described exactly like the armdyn builder describes it:
-everything in WORLD coordinates at the assembly pose q = 0 (joint points, joint axes, centres of
-mass, inertias), plus the parent index of every joint (-1 = ground). Joint i moves body i
-relative to body parents[i]; parents[i] < i.
+The dynamics here never call armdyn (only `random_serial_arm` takes its random geometry from
+`armdyn.scenes.extreme.random_spatial_arm`, which builds the same arm with the builder). The chain
+is described exactly like the armdyn builder describes it: everything in WORLD coordinates at the
+assembly pose q = 0 (joint points, joint axes, centres of mass, inertias), plus the parent index of
+every joint (-1 = ground). Joint i moves body i relative to body parents[i]; parents[i] < i.
 
 Joint coordinate convention (the one armdyn documents): q_i = 0 at the assembly pose; a revolute
 coordinate is the right-handed rotation of the child about the joint axis relative to the parent,
@@ -20,8 +20,6 @@ models and for comparing orientations, and are self-contained.
 """
 
 from __future__ import annotations
-
-from types import SimpleNamespace
 
 import numpy as np
 
@@ -139,11 +137,6 @@ def quat_exp(theta):
     if a < 1e-300:
         return np.array([1.0, 0.0, 0.0, 0.0])
     return np.concatenate([[np.cos(0.5 * a)], np.sin(0.5 * a) / a * theta])
-
-
-def random_rotation(rng):
-    e = rng.normal(size=4)
-    return quat_to_rot(e / np.linalg.norm(e))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -324,113 +317,43 @@ class SerialChain:
 
 
 # ----------------------------------------------------------------------------------------------
-# random test arms, built both with the armdyn builder and as a reference chain
+# the numpy model of armdyn's random spatial arms
 # ----------------------------------------------------------------------------------------------
 
 
-def random_unit(rng, n: int = 3):
-    v = rng.normal(size=n)
-    return v / np.linalg.norm(v)
-
-
-def random_quat(rng):
-    """Random unit Euler parameters, scalar-first, e0 >= 0."""
-    e = random_unit(rng, 4)
-    return e if e[0] >= 0 else -e
-
-
-def random_inertia(rng, mass: float, lo: float = 0.002, hi: float = 0.03):
-    """A random FULL inertia tensor (body axes, about the CoM): R diag(principal) R^T with the
-    principal moments built from second moments s_k > 0 (I1 = s2 + s3, ...), so it is symmetric,
-    positive-definite and satisfies the triangle inequality strictly."""
-    s = mass * rng.uniform(lo, hi, size=3)
-    principal = np.array([s[1] + s[2], s[0] + s[2], s[0] + s[1]])
-    r = random_rotation(rng)
-    inertia = r @ np.diag(principal) @ r.T
-    return 0.5 * (inertia + inertia.T)
+def serial_chain(arm) -> SerialChain:
+    """The SerialChain of an arm of :func:`armdyn.scenes.extreme.random_spatial_arm` (or
+    ``mass_ratio_chain``), from its geometry only (joint types, points and axes, centres of
+    mass, masses, body-axis inertias and orientations at q = 0); rotations and world inertias
+    are computed here."""
+    axes = np.asarray(arm.axes, dtype=float)
+    assert np.linalg.matrix_rank(axes, tol=1e-3) >= min(2, arm.n)  # not all parallel
+    rotations = np.array([quat_to_rot(e) for e in arm.quats])
+    inertias_world = np.einsum("nij,njk,nlk->nil", rotations, arm.inertias_body, rotations)
+    return SerialChain(
+        arm.types,
+        list(range(-1, arm.n - 1)),
+        arm.points,
+        axes,
+        arm.coms,
+        arm.masses,
+        inertias_world,
+        rotations=rotations,
+        gravity=arm.gravity,
+    )
 
 
 def random_serial_arm(
     rng, n: int = 6, prismatic: bool = False, gravity=(0.0, 0.0, -9.81), masses=None
 ):
-    """Random spatial serial arm ground - link1 - ... - linkn built with the builder.
+    """:func:`armdyn.scenes.extreme.random_spatial_arm` (random geometry, built with the builder)
+    with the numpy model of the same arm: the namespace gains ``chain`` (:func:`serial_chain`),
+    ``rotations`` (body -> world at q = 0) and ``inertias_world``; ``perm`` maps the chain's
+    joint order to armdyn's, q_armdyn[perm[i]] = q_reference[i]."""
+    from armdyn.scenes.extreme import random_spatial_arm
 
-    Random link masses, random FULL inertias (R diag R^T, SPD, triangle inequality), random CoM
-    offsets, random body orientations, random joint points and random joint axes. With
-    prismatic=True every joint with index % 3 == 1 is prismatic (e.g. R P R R P R for n = 6).
-    ``masses`` (n values) replaces the random link masses.
-
-    Returns a namespace with the model and everything the numpy reference needs (world frame at
-    q = 0): types, points, axes, coms, masses, inertias_body (body axes), inertias_world,
-    quats / rotations (body -> world at q = 0), joint_names, body_names, and `chain`, the
-    SerialChain of that geometry, and `perm` such that
-    q_armdyn[perm[i]] = q_reference[i].
-    """
-    types = ["P" if (prismatic and i % 3 == 1) else "R" for i in range(n)]
-    points = np.zeros((n, 3))
-    steps = np.zeros((n, 3))
-    p = np.array([0.0, 0.0, 0.1])
-    for i in range(n):
-        points[i] = p
-        d = random_unit(rng) * rng.uniform(0.15, 0.4)
-        steps[i] = d
-        p = p + d
-    axes = np.array([random_unit(rng) for _ in range(n)])
-    # guarantee the axes are not all parallel (random ones never are, but be explicit)
-    assert np.linalg.matrix_rank(axes, tol=1e-3) >= 2
-    coms = points + 0.5 * steps + 0.05 * rng.normal(size=(n, 3))
-    drawn = rng.uniform(0.5, 3.0, size=n)  # drawn either way: the same geometry for a seed
-    masses = drawn if masses is None else np.asarray(masses, dtype=float)
-    inertias_body = np.array([random_inertia(rng, m) for m in masses])
-    quats = np.array([random_quat(rng) for _ in range(n)])
-    rotations = np.array([quat_to_rot(e) for e in quats])
-    inertias_world = np.einsum("nij,njk,nlk->nil", rotations, inertias_body, rotations)
-
-    body_names = [f"link{i + 1}" for i in range(n)]
-    joint_names = [f"j{i + 1}" for i in range(n)]
-    from armdyn import _core  # only to build the same arm on the armdyn side
-
-    b = _core.ModelBuilder(gravity=gravity)
-    for i in range(n):
-        b.add_body(
-            body_names[i],
-            float(masses[i]),
-            inertias_body[i],
-            position=coms[i],
-            orientation=quats[i],
-        )
-    for i in range(n):
-        parent = "ground" if i == 0 else body_names[i - 1]
-        add = b.add_revolute if types[i] == "R" else b.add_prismatic
-        add(joint_names[i], parent, body_names[i], points[i], axes[i])
-    model = b.finalize()
-    chain = SerialChain(
-        types,
-        list(range(-1, n - 1)),
-        points,
-        axes,
-        coms,
-        masses,
-        inertias_world,
-        rotations=rotations,
-        gravity=gravity,
-    )
-    perm = np.array([list(model.coord_names).index(jn) for jn in joint_names])
-    return SimpleNamespace(
-        model=model,
-        builder=b,
-        chain=chain,
-        types=types,
-        points=points,
-        axes=axes,
-        coms=coms,
-        masses=masses,
-        inertias_body=inertias_body,
-        inertias_world=inertias_world,
-        quats=quats,
-        rotations=rotations,
-        joint_names=joint_names,
-        body_names=body_names,
-        perm=perm,
-        n=n,
-    )
+    arm = random_spatial_arm(rng, n, prismatic=prismatic, gravity=gravity, masses=masses)
+    arm.chain = serial_chain(arm)
+    arm.rotations = arm.chain.rotations
+    arm.inertias_world = arm.chain.inertias
+    return arm
