@@ -145,17 +145,6 @@ void bind_dynamics(py::module_& m) {
       "Joint coordinates (angles in (-pi, pi]) and rates at the Cartesian state (u, v).");
 
   m.def(
-      "forward_dynamics",
-      [](const Model& md, py::object q, py::object qd, py::object tau) {
-        const long n = static_cast<long>(md.coords.size());
-        return to_numpy(
-            forward_dynamics(md, to_vec(q, "q", n), to_vec(qd, "qd", n), to_vec(tau, "tau", n)));
-      },
-      py::arg("model"), py::arg("q"), py::arg("qd"), py::arg("tau"),
-      "Joint accelerations of a tree model for joint torques/forces tau, computed through the "
-      "Cartesian KKT system (drives are ignored).");
-
-  m.def(
       "evaluate_constraints",
       [](const Model& md, py::object u, py::object v, double t) {
         const VecX uu = to_vec(u, "u", md.nq), vv = to_vec(v, "v", md.nv);
@@ -176,10 +165,10 @@ void bind_dynamics(py::module_& m) {
       "f (nc,), zeta (nc, nv), xi (nc,) and rhs (nc,) with zeta v = rhs and zeta v' = -xi.");
 
   m.def(
-      "accelerations",
+      "body_accelerations",
       [](const Model& md, py::object u, py::object v, double t) {
         const VecX uu = to_vec(u, "u", md.nq), vv = to_vec(v, "v", md.nv);
-        check_state(md, uu, vv, "accelerations");
+        check_state(md, uu, vv, "body_accelerations");
         Engine e(md);
         VecX vd(md.nv);
         e.dynamics(t, uu.data(), vv.data(), vd.data());
@@ -189,7 +178,7 @@ void bind_dynamics(py::module_& m) {
       "Solve the KKT system at (u, v, t): returns (v' (nv,), multipliers delta (nc,)).");
 
   m.def(
-      "mass_matrix",
+      "body_mass_matrix",
       [](const Model& md) {
         MatX g = MatX::Zero(md.nv, md.nv);
         for (int i = 0; i < md.nb; ++i) {
@@ -201,10 +190,10 @@ void bind_dynamics(py::module_& m) {
       py::arg("model"), "Gamma = blockdiag(m_i I3, J_i) (nv, nv), constant.");
 
   m.def(
-      "generalized_forces",
+      "body_forces",
       [](const Model& md, py::object u, py::object v, double t) {
         const VecX uu = to_vec(u, "u", md.nq), vv = to_vec(v, "v", md.nv);
-        check_state(md, uu, vv, "generalized_forces");
+        check_state(md, uu, vv, "body_forces");
         Engine e(md);
         e.load(uu.data(), vv.data());
         e.forces(t);

@@ -2,10 +2,7 @@
 // Bindings of inverse dynamics and the Lagrange and geometric validators.
 #include <pybind11/stl.h>
 
-#include <chrono>
-
 #include "armdyn/analysis/inverse_dynamics.hpp"
-#include "armdyn/analysis/joint_space.hpp"
 #include "armdyn/analysis/tree_dynamics.hpp"
 #include "armdyn/validate/validators.hpp"
 #include "common.hpp"
@@ -14,17 +11,6 @@ namespace armdyn {
 
 namespace py = pybind11;
 
-namespace {
-/// Seconds per call of fn over `count` calls, without the GIL.
-template <class Fn>
-double time_loop(long count, Fn&& fn) {
-  py::gil_scoped_release nogil;
-  const auto t0 = std::chrono::steady_clock::now();
-  for (long i = 0; i < count; ++i) fn();
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() /
-         static_cast<double>(count);
-}
-}  // namespace
 using namespace py_helpers;
 
 namespace {
@@ -93,84 +79,8 @@ void bind_validate(py::module_& m) {
       },
       py::arg("model"), py::arg("t"));
 
-  py::class_<JointSpaceInverseDynamics>(
-      m, "JointSpaceInverseDynamics",
-      "Joint torques/forces of a tree model for (q, qd, qdd) on the Cartesian bodies. "
-      "method='recursive' (default): O(n) Newton-Euler sweeps (body accelerations forward, "
-      "subtree wrenches backward, projected on the joint axes); method='kkt': every joint "
-      "coordinate driven to (q, qd, qdd) and the constrained system solved for its multipliers. "
-      "Keeps its workspace between calls.")
-      .def(py::init([](ModelHolder md, const std::string& method) {
-             JointSpaceInverseDynamics::Method mt;
-             if (method == "recursive")
-               mt = JointSpaceInverseDynamics::Method::Recursive;
-             else if (method == "kkt")
-               mt = JointSpaceInverseDynamics::Method::Kkt;
-             else
-               throw ModelError(msg("inverse_dynamics: unknown method '", method,
-                                    "' (expected 'recursive' or 'kkt')"));
-             return std::make_unique<JointSpaceInverseDynamics>(
-                 std::const_pointer_cast<const Model>(md), mt);
-           }),
-           py::arg("model"), py::arg("method") = "recursive")
-      .def_property_readonly("method",
-                             [](const JointSpaceInverseDynamics& self) {
-                               return self.method() == JointSpaceInverseDynamics::Method::Recursive
-                                          ? "recursive"
-                                          : "kkt";
-                             })
-      .def(
-          "__call__",
-          [](JointSpaceInverseDynamics& self, py::object q, py::object qd, py::object qdd,
-             double t) {
-            const long n = static_cast<long>(self.model().coords.size());
-            const VecArg qa(q, "q", n), qda(qd, "qd", n), qdda(qdd, "qdd", n);
-            py::array_t<double> out(n);
-            Eigen::Map<VecX> o(out.mutable_data(), n);
-            self.compute(*qa, *qda, *qdda, o, t);
-            return out;
-          },
-          py::arg("q"), py::arg("qd"), py::arg("qdd"), py::arg("t") = 0.0);
-
-  py::class_<JointSpaceForwardDynamics>(
-      m, "JointSpaceForwardDynamics",
-      "Joint accelerations of a tree model for (q, qd, tau); drives ignored, coordinate forces "
-      "included. method='crba' (default): the joint-space mass matrix by the composite-rigid-"
-      "body algorithm and the bias by recursive Newton-Euler, then Cholesky; method='kkt': the "
-      "Cartesian constrained Newton-Euler system. Keeps its workspace between calls.")
-      .def(py::init([](ModelHolder md, const std::string& method) {
-             JointSpaceForwardDynamics::Method mt;
-             if (method == "crba")
-               mt = JointSpaceForwardDynamics::Method::Crba;
-             else if (method == "kkt")
-               mt = JointSpaceForwardDynamics::Method::Kkt;
-             else
-               throw ModelError(msg("forward_dynamics: unknown method '", method,
-                                    "' (expected 'crba' or 'kkt')"));
-             return std::make_unique<JointSpaceForwardDynamics>(
-                 std::const_pointer_cast<const Model>(md), mt);
-           }),
-           py::arg("model"), py::arg("method") = "crba")
-      .def_property_readonly(
-          "method",
-          [](const JointSpaceForwardDynamics& self) {
-            return self.method() == JointSpaceForwardDynamics::Method::Crba ? "crba" : "kkt";
-          })
-      .def(
-          "__call__",
-          [](JointSpaceForwardDynamics& self, py::object q, py::object qd, py::object tau,
-             double t) {
-            const long n = static_cast<long>(self.model().coords.size());
-            const VecArg qa(q, "q", n), qda(qd, "qd", n), ta(tau, "tau", n);
-            py::array_t<double> out(n);
-            Eigen::Map<VecX> o(out.mutable_data(), n);
-            self.compute(*qa, *qda, *ta, o, t);
-            return out;
-          },
-          py::arg("q"), py::arg("qd"), py::arg("tau"), py::arg("t") = 0.0);
-
   py::class_<TreeDynamicsPy>(
-      m, "TreeDynamics",
+      m, "_TreeDynamics",
       "Joint-space forward dynamics of a tree without drives, ideal gears allowed (the path of "
       "simulate(coordinates='joint')): the mass matrix by the composite-rigid-body algorithm, "
       "bias and applied forces by recursive Newton-Euler, gears eliminated by their null space. "
@@ -217,31 +127,6 @@ void bind_validate(py::module_& m) {
       .def_property_readonly("dof", [](const TreeDynamicsPy& s) { return s.td.dof(); })
       .def_property_readonly("description",
                              [](const TreeDynamicsPy& s) { return s.td.description(); });
-
-  // timing loops in C++ (benchmarks): seconds per call of `count` calls with fixed inputs
-  m.def("_time_forward_loop", [](JointSpaceForwardDynamics& self, py::object q, py::object qd,
-                                 py::object tau, long count) {
-    const long n = static_cast<long>(self.model().coords.size());
-    const VecX qv = to_vec(q, "q", n), qdv = to_vec(qd, "qd", n), tv = to_vec(tau, "tau", n);
-    VecX out(n);
-    return time_loop(count, [&] { self.compute(qv, qdv, tv, out); });
-  });
-  m.def("_time_tree_loop",
-        [](TreeDynamicsPy& self, py::object q, py::object qd, py::object tau, long count) {
-          const long n = self.td.n();
-          const VecX qv = to_vec(q, "q", n), qdv = to_vec(qd, "qd", n), tv = to_vec(tau, "tau", n);
-          VecX out(n);
-          return time_loop(count, [&] {
-            self.td.accelerations(0.0, qv.data(), qdv.data(), nullptr, tv.data(), out.data());
-          });
-        });
-  m.def("_time_inverse_loop", [](JointSpaceInverseDynamics& self, py::object q, py::object qd,
-                                 py::object qdd, long count) {
-    const long n = static_cast<long>(self.model().coords.size());
-    const VecX qv = to_vec(q, "q", n), qdv = to_vec(qd, "qd", n), av = to_vec(qdd, "qdd", n);
-    VecX out(n);
-    return time_loop(count, [&] { self.compute(qv, qdv, av, out); });
-  });
 
   py::class_<LagrangeValidator>(
       m, "LagrangeValidator",

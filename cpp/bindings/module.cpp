@@ -9,6 +9,7 @@ namespace armdyn {
 void bind_model(py::module_& m);
 void bind_dynamics(py::module_& m);
 void bind_validate(py::module_& m);
+void bind_algorithm(py::module_& m);
 }  // namespace armdyn
 
 PYBIND11_MODULE(_core, m) {
@@ -19,4 +20,5 @@ PYBIND11_MODULE(_core, m) {
   armdyn::bind_model(m);
   armdyn::bind_dynamics(m);
   armdyn::bind_validate(m);
+  armdyn::bind_algorithm(m);
 }

@@ -9,30 +9,34 @@ projection keeps the constraints satisfied to round-off.
 
 from armdyn import scenes, validation
 from armdyn._core import (
+    Data,
     Model,
     ModelBuilder,
     ModelError,
     Profile,
     SolverError,
     UrdfError,
-    accelerations,
+    body_accelerations,
+    body_forces,
+    body_mass_matrix,
     energy,
     evaluate_constraints,
     forward_dynamics,
-    generalized_forces,
+    inverse_dynamics,
     joint_coordinates,
     mass_matrix,
     profiles,
     state_from_joints,
     urdf_builder,
 )
-from armdyn.dynamics import InverseDynamicsResult, inverse_dynamics
+from armdyn.dynamics import InverseDynamicsResult, driven_inverse_dynamics
 from armdyn.simulation import SimulationResult, load_urdf, simulate
 from armdyn.validation import LagrangeValidator
 
 __version__ = "0.1.0"
 
 __all__ = [
+    "Data",
     "InverseDynamicsResult",
     "LagrangeValidator",
     "Model",
@@ -42,11 +46,13 @@ __all__ = [
     "SimulationResult",
     "SolverError",
     "UrdfError",
-    "accelerations",
+    "body_accelerations",
+    "body_forces",
+    "body_mass_matrix",
+    "driven_inverse_dynamics",
     "energy",
     "evaluate_constraints",
     "forward_dynamics",
-    "generalized_forces",
     "inverse_dynamics",
     "joint_coordinates",
     "load_urdf",

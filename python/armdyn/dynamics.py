@@ -1,4 +1,5 @@
-"""Inverse dynamics through driving constraints, on the Cartesian Newton–Euler/KKT path."""
+"""Inverse dynamics of a driven model: the drives' efforts and the joint reactions along a
+prescribed motion, from the driven constraints' multipliers (the Cartesian Newton–Euler/KKT path)."""
 
 from __future__ import annotations
 
@@ -11,7 +12,7 @@ from armdyn import _core
 
 @dataclass
 class InverseDynamicsResult:
-    """Outputs of :func:`inverse_dynamics` on a driven model, one row per time.
+    """Outputs of :func:`driven_inverse_dynamics`, one row per time.
 
     Attributes:
         t: (n,) times [s].
@@ -39,54 +40,21 @@ class InverseDynamicsResult:
     stats: dict = field(default_factory=dict)
 
 
-def inverse_dynamics(model: _core.Model, q=None, qd=None, qdd=None, *, t=None, method=None):
-    """Actuator efforts for a prescribed motion.
+def driven_inverse_dynamics(model: _core.Model, t) -> InverseDynamicsResult:
+    """Actuator efforts and joint reactions of a *driven* model along its prescribed motion.
 
-    Two forms:
+    The model's drives must leave no degree of freedom. At each time of ``t`` (increasing, s)
+    the position (Newton), velocity and acceleration problems of the driven constraints are
+    solved, then the multipliers from ``Γ v' + ζᵀ δ = η``: the drives' multipliers are the
+    actuator efforts (τ = −δ_drive, the torque/force the actuator applies to the child body
+    about/along the joint axis), the others the joint reactions.
 
-    * ``inverse_dynamics(model, t=times)`` — a *driven* model whose drives leave no degree of
-      freedom: at each time the position (Newton), velocity and acceleration problems of the
-      driven constraints are solved, then the multipliers from ``Γ v' + ζᵀ δ = η``. Returns an
-      :class:`InverseDynamicsResult` (drive efforts and joint reactions).
-    * ``inverse_dynamics(model, q, qd, qdd, t=0.0)`` — a tree model in joint space: the joint
-      torques/forces (model joint order; the model's own drives are ignored). 1-D inputs give a
-      (n_coords,) array, 2-D inputs (one sample per row) a (n, n_coords) array; ``t`` may then
-      be one time per row. ``method="recursive"`` (the default of this form): O(n) Newton–Euler
-      sweeps over the Cartesian bodies (accelerations forward, subtree wrenches backward,
-      projected on the joint axes); ``method="kkt"``: every joint coordinate driven to
-      (q, qd, qdd) and the KKT multipliers of those drives. Both give the same torques to
-      round-off (tests).
-
-    Sign: the torque/force the actuator applies to the child body about/along the joint axis
-    (the RNEA/URDF effort convention); gravity and every force element of the model are
-    included.
+    For the joint torques of a tree at given ``(q, q̇, q̈)`` use :func:`armdyn.inverse_dynamics`.
 
     Raises:
-        ModelError: under-driven model (the undriven coordinates are named), wrong shapes, NaN.
+        ModelError: under-driven model (the undriven coordinates are named), invalid times.
         SolverError: the driven constraints are kinematically singular at some time (the
             dependent drive/joint rows are named), or the position problem does not converge.
     """
-    if q is None and qd is None and qdd is None:
-        if t is None:
-            raise _core.ModelError("inverse_dynamics: give t (driven model) or q, qd, qdd")
-        if method is not None:
-            raise _core.ModelError(
-                "inverse_dynamics: method applies to the joint-space form (q, qd, qdd); the "
-                "driven form always solves the driven constraints for their multipliers"
-            )
-        times = np.atleast_1d(np.asarray(t, dtype=float))
-        raw = _core._inverse_dynamics_driven(model, times)
-        return InverseDynamicsResult(**raw)
-    if q is None or qd is None or qdd is None:
-        raise _core.ModelError("inverse_dynamics: q, qd and qdd must all be given")
-    solver = _core.JointSpaceInverseDynamics(model, method or "recursive")
-    q, qd, qdd = (np.asarray(a, dtype=float) for a in (q, qd, qdd))
-    if q.ndim == 1:
-        return solver(q, qd, qdd, 0.0 if t is None else float(t))
-    if q.ndim != 2 or qd.shape != q.shape or qdd.shape != q.shape:
-        raise _core.ModelError(
-            f"inverse_dynamics: q, qd, qdd must have one shape (n, {model.n_coords}); got "
-            f"{q.shape}, {qd.shape}, {qdd.shape}"
-        )
-    times = np.zeros(len(q)) if t is None else np.broadcast_to(np.asarray(t, float), (len(q),))
-    return np.array([solver(q[i], qd[i], qdd[i], float(times[i])) for i in range(len(q))])
+    times = np.atleast_1d(np.asarray(t, dtype=float))
+    return InverseDynamicsResult(**_core._inverse_dynamics_driven(model, times))

@@ -3,10 +3,8 @@
 
 #include <utility>
 
-#include "armdyn/analysis/tree_dynamics.hpp"
 #include "armdyn/errors.hpp"
 #include "armdyn/math/quaternion.hpp"
-#include "armdyn/solver/engine.hpp"
 
 namespace armdyn {
 
@@ -29,9 +27,11 @@ void state_from_joints(const Model& m, const VecX& q, const VecX& qd, VecX& u, V
   state_from_joints(m, q, qd, u, v, work);
 }
 
-void joint_space_kinematics(const Model& m, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
-                            std::vector<BodyKin>& kin) {
-  // world pose and velocity of each body, parent before child
+namespace {
+// world pose (and, with Velocities, velocity) of each body, parent before child
+template <bool Velocities>
+void tree_kinematics(const Model& m, Eigen::Ref<const VecX> q, const double* qd,
+                     std::vector<BodyKin>& kin) {
   kin.resize(m.nb);
   const BodyKin ground{};
   for (int ji : m.tree_order) {
@@ -39,9 +39,8 @@ void joint_space_kinematics(const Model& m, Eigen::Ref<const VecX> q, Eigen::Ref
     const BodyKin& p = j.parent != kGround ? kin[j.parent] : ground;
     const Mat3 A = p.R * j.frame_parent;
     const Vec3 z = A.col(2);
-    double th, thd, d, dd;
+    double th, d;
     joint_components(j, q, th, d);
-    joint_components(j, qd, thd, dd);
     // child joint frame B = A Rz(th), placed at P + d z
     const double ct = std::cos(th), st = std::sin(th);
     Mat3 B;
@@ -53,11 +52,27 @@ void joint_space_kinematics(const Model& m, Eigen::Ref<const VecX> q, Eigen::Ref
     BodyKin& c = kin[j.child];
     c.R.noalias() = B * j.frame_child.transpose();
     c.x = Pc - c.R * j.point_child;
-    c.W = p.W + thd * z;
-    const Vec3 Pcd = p.xd + p.W.cross(Pc - p.x) + dd * z;
-    c.xd = Pcd + c.W.cross(c.x - Pc);
-    c.w.noalias() = c.R.transpose() * c.W;
+    if constexpr (Velocities) {
+      double thd, dd;
+      joint_components(j, Eigen::Map<const VecX>(qd, q.size()), thd, dd);
+      c.W = p.W + thd * z;
+      const Vec3 Pcd = p.xd + p.W.cross(Pc - p.x) + dd * z;
+      c.xd = Pcd + c.W.cross(c.x - Pc);
+      c.w.noalias() = c.R.transpose() * c.W;
+    } else {
+      c.W = c.xd = c.w = Vec3::Zero();
+    }
   }
+}
+}  // namespace
+
+void joint_space_kinematics(const Model& m, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
+                            std::vector<BodyKin>& kin) {
+  tree_kinematics<true>(m, q, qd.data(), kin);
+}
+
+void joint_space_poses(const Model& m, Eigen::Ref<const VecX> q, std::vector<BodyKin>& kin) {
+  tree_kinematics<false>(m, q, nullptr, kin);
 }
 
 void RneWork::resize(const Model& m) {
@@ -167,65 +182,6 @@ void joint_coordinates(const Model& m, const VecX& u, const VecX& v, VecX& q, Ve
     q[c] = s.val;
     qd[c] = s.rate;
   }
-}
-
-JointSpaceForwardDynamics::JointSpaceForwardDynamics(std::shared_ptr<const Model> m, Method method)
-    : m_(std::move(m)), method_(method) {
-  if (!m_) throw ModelError("forward_dynamics: no model");
-  require_joint_space(*m_, "forward_dynamics");
-  if (method_ == Method::Crba) {
-    td_ = std::make_unique<TreeDynamics>(*m_, true);
-    return;
-  }
-  e_ = std::make_unique<Engine>(*m_);
-  e_->set_include_drives(false);
-  vd_ = VecX::Zero(m_->nv);
-  tau_ = VecX::Zero(static_cast<long>(m_->coords.size()));
-  e_->set_joint_torques(tau_.data());
-}
-
-JointSpaceForwardDynamics::~JointSpaceForwardDynamics() = default;
-
-void JointSpaceForwardDynamics::compute(Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
-                                        Eigen::Ref<const VecX> tau, Eigen::Ref<VecX> out,
-                                        double t) {
-  const Model& m = *m_;
-  const long nc = static_cast<long>(m.coords.size());
-  check_joint_vector(tau, nc, "forward_dynamics", "tau");
-  if (out.size() != nc)
-    throw ModelError(msg("forward_dynamics: out has length ", out.size(), ", expected ", nc));
-  check_joint_vector(q, nc, "forward_dynamics", "q");
-  check_joint_vector(qd, nc, "forward_dynamics", "qd");
-  if (td_) {
-    // contiguous inputs (numpy arrays, VecX) pass straight through
-    // PI motors' integral states are zero, as on the KKT path
-    td_->accelerations(t, q.data(), qd.data(), nullptr, tau.data(), out.data());
-    return;
-  }
-  joint_space_kinematics(m, q, qd, e_->kin_in());
-  tau_ = tau;
-  e_->dynamics_loaded(t, vd_.data());
-  // the coordinate jets of the torques, at this state
-  for (int c = 0; c < nc; ++c) out[c] = coord_acceleration(m, e_->torque_jets()[c], c, vd_);
-}
-
-VecX forward_dynamics(const Model& m, const VecX& q, const VecX& qd, const VecX& tau) {
-  require_joint_space(m, "forward_dynamics");
-  const long nc = static_cast<long>(m.coords.size());
-  check_joint_vector(tau, nc, "forward_dynamics", "tau");
-  VecX u, v;
-  state_from_joints(m, q, qd, u, v);
-  Engine e(m);
-  e.set_include_drives(false);
-  e.set_joint_torques(tau.data());
-  VecX vdot(m.nv);
-  e.dynamics(0.0, u.data(), v.data(), vdot.data());
-  // qdd = J vdot + bias for every coordinate
-  VecX qdd(nc);
-  for (int c = 0; c < nc; ++c) {
-    qdd[c] = coord_acceleration(m, coord_jet(m, e.kin(), c), c, vdot);
-  }
-  return qdd;
 }
 
 }  // namespace armdyn

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "armdyn/algorithm/forces.hpp"
 #include "armdyn/errors.hpp"
 #include "armdyn/math/quaternion.hpp"
 
@@ -83,40 +84,7 @@ void Engine::coordinate_forces(double t) {
 }
 
 void Engine::forces(double t) {
-  // gravity and gyroscopic terms, per body
-  for (int i = 0; i < m_.nb; ++i) {
-    const Body& b = m_.bodies[i];
-    const BodyKin& k = kin_[i];
-    eta_.segment<3>(6 * i) = b.mass * m_.gravity;
-    eta_.segment<3>(6 * i + 3) = -k.w.cross(b.inertia * k.w);
-  }
-  // applied loads: force at a body point and torque, world axes
-  for (const BodyLoad& l : m_.body_loads) {
-    double s = 1.0;
-    if (l.has_profile) {
-      try {
-        s = l.profile.eval(t).y;
-      } catch (const SolverError& err) {
-        throw SolverError(msg("load on body '", m_.bodies[l.body].name, "': ", err.what()));
-      }
-    }
-    const BodyKin& k = kin_[l.body];
-    const Vec3 fb = k.R.transpose() * (s * l.force);
-    eta_.segment<3>(6 * l.body) += s * l.force;
-    eta_.segment<3>(6 * l.body + 3) += k.R.transpose() * (s * l.torque) + l.point.cross(fb);
-  }
-  // point-to-point spring-dampers: generalised force -tension * dL/dv
-  for (const SpringDamper& sd : m_.springs) {
-    const VecJet d = difference(point_jet(kin_of(kin_, sd.body_b), sd.point_b, 1),
-                                point_jet(kin_of(kin_, sd.body_a), sd.point_a, 0));
-    const double L = d.val.norm();
-    if (!(L > 1e-12))
-      throw SolverError(msg("spring-damper '", sd.name, "': length became zero at t=", t));
-    const Vec3 n = d.val / L;
-    const double Ld = n.dot(d.rate);
-    const double tension = sd.stiffness * (L - sd.rest_length) + sd.damping * Ld;
-    scatter(-tension * d.left(n), sd.body_a, sd.body_b);
-  }
+  body_forces(m_, kin_, t, eta_);
   if (coord_forces_) coordinate_forces(t);
   // joint-space torques of a joint-space call
   if (tau_) {

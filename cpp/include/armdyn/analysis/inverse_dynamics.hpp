@@ -1,18 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Inverse dynamics through driving constraints (methods.md §7.2), on the same Cartesian
-// Newton-Euler/KKT path as forward dynamics:
-//  - driven models (drives leave no freedom): at each time, the position problem (Newton on
-//    f(u, t) = 0), the velocity problem (zeta v = rhs) and the acceleration problem
-//    (zeta vdot = -xi) are solved, and the multipliers follow from Gamma vdot + zeta^T delta = eta.
-//    Drive multipliers give the actuator efforts tau = -delta_drive; the others the joint
-//    reactions.
-//  - joint space (tree models): every joint coordinate is driven to the given (q, qd, qdd) and
-//    the same KKT solve gives the joint torques/forces in the model's joint order.
-// Sign: tau is the torque/force the actuator applies to the child body about/along the joint
-// axis (the RNEA / URDF effort convention).
+// Inverse dynamics of a driven model (drives leave no freedom) through its driving constraints
+// (methods.md §7.2), on the Cartesian Newton-Euler/KKT path: at each time the position problem
+// (Newton on f(u, t) = 0), the velocity problem (zeta v = rhs) and the acceleration problem
+// (zeta vdot = -xi) are solved, and the multipliers follow from Gamma vdot + zeta^T delta = eta.
+// Drive multipliers give the actuator efforts tau = -delta_drive (the torque/force the actuator
+// applies to the child body about/along the joint axis, the RNEA / URDF effort convention); the
+// others the joint reactions. Joint-space inverse dynamics of a tree: armdyn/algorithm/rnea.hpp.
 #pragma once
 
-#include <memory>
 #include <string>
 #include <vector>
 
@@ -74,40 +69,5 @@ struct InverseDynamicsResult {
 ///   coordinates) or the times are invalid; SolverError when the driven constraints become
 ///   singular (naming the dependent drive/joint rows) or the position problem fails.
 InverseDynamicsResult inverse_dynamics_driven(const Model& m, const std::vector<double>& times);
-
-/// Joint-space inverse dynamics of a tree model; the model's own drives are ignored.
-/// Two paths give the same torques:
-///  - Recursive (default): O(n) Newton-Euler sweeps over the Cartesian bodies. Forward, the
-///    bodies' accelerations from (q, qd, qdd); backward, the residual wrench Gamma v' - eta of
-///    each subtree, projected on its joint's axis (virtual work of the joint's motion).
-///  - Kkt: every joint coordinate driven to (q, qd, qdd) and the constrained system solved for
-///    its multipliers (the engine's tree sweep, or the KKT factorisation when singular).
-/// eta (gravity, gyroscopic terms, loads, springs, coordinate forces) comes from the engine in
-/// both, so force elements enter identically.
-class JointSpaceInverseDynamics {
- public:
-  enum class Method { Recursive, Kkt };
-  /// @throws ModelError when the model is not a joint-space tree.
-  explicit JointSpaceInverseDynamics(std::shared_ptr<const Model> m,
-                                     Method method = Method::Recursive);
-  ~JointSpaceInverseDynamics();
-  /// Joint torques/forces for (q, qd, qdd) at time t (t matters for profiled force elements).
-  VecX compute(const VecX& q, const VecX& qd, const VecX& qdd, double t = 0.0);
-  /// The same into tau (n_coords), allocating nothing.
-  void compute(Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd, Eigen::Ref<const VecX> qdd,
-               Eigen::Ref<VecX> tau, double t = 0.0);
-  const Model& model() const { return *src_; }
-  Method method() const { return method_; }
-
- private:
-  void recursive(Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd, Eigen::Ref<const VecX> qdd,
-                 Eigen::Ref<VecX> tau, double t);
-  std::shared_ptr<const Model> src_;
-  Method method_;
-  Model driven_;  // Kkt: src_ with one drive per joint coordinate, in coordinate order
-  std::unique_ptr<Engine> e_;
-  VecX vd_, ref_;
-  RneWork rne_;  // Recursive: the sweep's scratch
-};
 
 }  // namespace armdyn

@@ -1,20 +1,14 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Joint-space entry points for tree models whose joints define coordinates (revolute, prismatic,
 // cylindrical, fixed): the Cartesian state from joint coordinates (forward kinematics along the
-// tree), joint coordinates from the Cartesian state, the recursive Newton-Euler residual, and
-// forward dynamics, by the joint-space CRBA path (TreeDynamics) or through the Cartesian KKT
-// system.
+// tree), joint coordinates from the Cartesian state, and the recursive Newton-Euler residual
+// (the sweep of armdyn/algorithm/rnea.hpp and of forward dynamics).
 #pragma once
-
-#include <memory>
 
 #include "armdyn/model/model.hpp"
 #include "armdyn/solver/kinematics.hpp"
 
 namespace armdyn {
-
-class Engine;
-class TreeDynamics;
 
 /// Per-body scratch of state_from_joints (the bodies' kinematics), kept by callers that evaluate
 /// repeatedly so that no call allocates.
@@ -48,6 +42,9 @@ inline void joint_components(const Joint& j, const Eigen::Ref<const VecX>& x, do
 void joint_space_kinematics(const Model& m, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
                             std::vector<BodyKin>& kin);
 
+/// The same without velocities: poses only (R, x), velocities zero.
+void joint_space_poses(const Model& m, Eigen::Ref<const VecX> q, std::vector<BodyKin>& kin);
+
 /// Scratch of rne_residual: per body (alpha, acc, force, moment), per joint (point, axis).
 struct RneWork {
   std::vector<Vec3> alpha, acc, force, moment, point, axis;
@@ -74,35 +71,6 @@ void state_from_joints(const Model& m, Eigen::Ref<const VecX> q, Eigen::Ref<cons
 void cartesian_state(const Model& m, const std::vector<BodyKin>& kin, double* u, double* v);
 /// Joint coordinates (angles in (-pi, pi]) and rates at (u, v).
 void joint_coordinates(const Model& m, const VecX& u, const VecX& v, VecX& q, VecX& qd);
-/// qdd for joint torques/forces tau; drives are ignored (joint rows only).
-VecX forward_dynamics(const Model& m, const VecX& q, const VecX& qd, const VecX& tau);
-
-/// forward_dynamics with a workspace kept between calls; repeated calls allocate nothing.
-///  - Crba (default): the joint-space mass matrix by the composite-rigid-body algorithm, the
-///    bias by recursive Newton-Euler, a Cholesky solve (TreeDynamics);
-///  - Kkt: the Cartesian constrained Newton-Euler system with the joint torques as loads.
-/// Both include the model's coordinate forces and ignore its drives.
-class JointSpaceForwardDynamics {
- public:
-  enum class Method { Crba, Kkt };
-  /// @throws ModelError when the model is not a joint-space tree.
-  explicit JointSpaceForwardDynamics(std::shared_ptr<const Model> m, Method method = Method::Crba);
-  ~JointSpaceForwardDynamics();
-  /// qdd into out (n_coords) for torques/forces tau at time t.
-  /// @throws ModelError on wrong sizes or non-finite inputs.
-  void compute(Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd, Eigen::Ref<const VecX> tau,
-               Eigen::Ref<VecX> out, double t = 0.0);
-  const Model& model() const { return *m_; }
-  Method method() const { return method_; }
-
- private:
-  std::shared_ptr<const Model> m_;
-  Method method_;
-  std::unique_ptr<Engine> e_;
-  std::unique_ptr<TreeDynamics> td_;
-  VecX vd_, tau_;
-};
-
 /// Check that the model supports joint-space calls; throws ModelError naming the reason.
 void require_joint_space(const Model& m, const char* what);
 /// Check a joint-space vector's length (n) and values; throws ModelError "fn: name ...".

@@ -22,8 +22,7 @@
 #include <string>
 #include <vector>
 
-#include "armdyn/analysis/joint_space.hpp"
-#include "armdyn/solver/engine.hpp"
+#include "armdyn/data.hpp"
 
 namespace armdyn {
 
@@ -57,20 +56,15 @@ class TreeDynamics {
   /// The joint-space mass matrix at q (n x n), by the composite-rigid-body algorithm.
   const MatX& mass_matrix(const double* q);
   /// The mass matrix of the last accelerations() or mass_matrix() call.
-  const MatX& last_mass_matrix() const { return M_; }
+  const MatX& last_mass_matrix() const { return d_.M; }
 
  private:
-  void crba();  // M_ at the kinematics in e_.kin_in() and the joint frames in rne_
   const Model& m_;
-  Engine e_;  // eta only: gravity, gyroscopic terms, body loads, spring-dampers
+  Data d_;  // kinematics, forces, Newton-Euler and CRBA buffers
   int n_ = 0, dof_ = 0, rank_ = 0;
-  std::vector<std::vector<int>> anc_;  // per coordinate: its joint's and the ancestors' coords
-  RneWork rne_;
-  std::vector<Mat6> ic_;  // per body: the subtree's spatial inertia about the world origin
-  std::vector<Vec6> s_;   // per coordinate: its motion (angular; velocity of the origin)
-  MatX M_, T_, range_, MT_, Mr_;
-  VecX zero_, rhs_, y_, w_;
-  Eigen::LLT<MatX> llt_;
+  MatX T_, range_, MT_, Mr_;  // the gears' null space and range; M T; T^T M T
+  VecX y_, w_;
+  Eigen::LLT<MatX> llt_;  // of T^T M T (with gears)
 };
 
 }  // namespace armdyn

@@ -1,0 +1,214 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Bindings of the joint-space algorithms (armdyn/algorithm/): armdyn.Data, forward_dynamics,
+// inverse_dynamics and mass_matrix. One state (1-D arrays) or one state per row (2-D arrays,
+// evaluated in one C++ loop without the GIL). Without data=, each thread keeps one Data per
+// model, so repeated calls allocate nothing but their output array.
+#include <memory>
+#include <vector>
+
+#include "armdyn/algorithm/crba.hpp"
+#include "armdyn/algorithm/dynamics.hpp"
+#include "common.hpp"
+
+namespace armdyn {
+
+namespace py = pybind11;
+using namespace py_helpers;
+
+namespace {
+
+using ModelHolder = std::shared_ptr<Model>;
+
+/// armdyn.Data: a workspace with its model kept alive.
+struct DataPy {
+  explicit DataPy(ModelHolder md) : model(std::move(md)), data(*model) {}
+  ModelHolder model;
+  Data data;
+};
+
+/// This thread's workspace for md: the last few models used, the most recent first.
+Data& cached_data(const ModelHolder& md) {
+  struct Entry {
+    const Model* key;
+    std::weak_ptr<Model> alive;  // a freed model's address may be reused by another
+    std::unique_ptr<Data> data;
+  };
+  thread_local std::vector<Entry> cache;
+  for (size_t i = 0; i < cache.size(); ++i) {
+    if (cache[i].key != md.get() || cache[i].alive.expired()) continue;
+    if (i > 0) std::swap(cache[0], cache[i]);
+    return *cache[0].data;
+  }
+  constexpr size_t kMaxModels = 8;
+  for (size_t i = cache.size(); i-- > 0;)
+    if (cache[i].alive.expired()) cache.erase(cache.begin() + static_cast<long>(i));
+  if (cache.size() >= kMaxModels) cache.pop_back();
+  cache.insert(cache.begin(), Entry{md.get(), md, std::make_unique<Data>(*md)});
+  return *cache[0].data;
+}
+
+Data& data_for(const ModelHolder& md, const py::object& data, const char* fn) {
+  if (!md) throw ModelError(msg(fn, ": no model"));
+  if (data.is_none()) return cached_data(md);
+  auto* d = data.cast<DataPy*>();
+  check_data(*md, d->data, fn);
+  return d->data;
+}
+
+bool is_batch(const py::handle& q) {
+  return py::isinstance<py::array>(q) && py::reinterpret_borrow<py::array>(q).ndim() == 2;
+}
+
+double scalar_time(const py::handle& t, const char* fn) {
+  if (PyFloat_Check(t.ptr())) return PyFloat_AS_DOUBLE(t.ptr());
+  try {
+    return t.cast<double>();
+  } catch (const py::cast_error&) {
+    throw ModelError(msg(fn, ": t must be a number (or one per row of a 2-D q)"));
+  }
+}
+
+/// A (rows, n) float64 C-contiguous array of a 2-D argument (converted when needed).
+py::array_t<double> rows_of(const py::handle& obj, const char* fn, const char* name, long rows,
+                            long n) {
+  auto a = as_array(obj, msg(fn, ": ", name));
+  if (a.ndim() != 2 || a.shape(0) != rows || a.shape(1) != n)
+    throw ModelError(
+        msg(fn, ": ", name, " must have shape (", rows, ", ", n, "), got ", shape_str(a)));
+  return a;
+}
+
+/// f(i, q_i, a_i, b_i, t_i, out_i) for every row i of the 2-D arguments q, a, b (shape (N, n)),
+/// t a number or one per row; out has shape (N, *out_shape). Runs without the GIL; an error
+/// names its row.
+template <class Fn>
+py::array_t<double> batch(const char* fn, long n, const py::handle& q, const py::handle& a,
+                          const char* an, const py::handle& b, const char* bn, const py::handle& t,
+                          std::vector<py::ssize_t> out_shape, Fn&& f) {
+  const long rows = static_cast<long>(py::reinterpret_borrow<py::array>(q).shape(0));
+  const auto Q = rows_of(q, fn, "q", rows, n), A = rows_of(a, fn, an, rows, n),
+             B = rows_of(b, fn, bn, rows, n);
+  VecX ts;
+  double t0 = 0.0;
+  const bool per_row_t = py::isinstance<py::array>(t) || py::isinstance<py::sequence>(t);
+  if (per_row_t)
+    ts = to_vec(t, msg(fn, ": t"), rows);
+  else
+    t0 = scalar_time(t, fn);
+  long out_size = 1;
+  for (auto s : out_shape) out_size *= static_cast<long>(s);
+  out_shape.insert(out_shape.begin(), rows);
+  py::array_t<double> out(out_shape);
+  const double *qp = Q.data(), *ap = A.data(), *bp = B.data();
+  double* op = out.mutable_data();
+  py::gil_scoped_release nogil;
+  for (long i = 0; i < rows; ++i) {
+    using Row = Eigen::Map<const VecX>;
+    try {
+      f(Row(qp + i * n, n), Row(ap + i * n, n), Row(bp + i * n, n), per_row_t ? ts[i] : t0,
+        op + i * out_size);
+    } catch (const SolverError& e) {
+      throw SolverError(msg("row ", i, ": ", e.what()));
+    } catch (const ModelError& e) {
+      throw ModelError(msg("row ", i, ": ", e.what()));
+    }
+  }
+  return out;
+}
+
+py::array_t<double> vector_out(const VecX& v) {
+  py::array_t<double> a(v.size());
+  std::copy(v.data(), v.data() + v.size(), a.mutable_data());
+  return a;
+}
+
+}  // namespace
+
+void bind_algorithm(py::module_& m) {
+  py::class_<DataPy>(m, "Data",
+                     "Workspace of one model's evaluations: every buffer forward_dynamics, "
+                     "inverse_dynamics and mass_matrix write. One per thread; pass it as data= "
+                     "to choose it explicitly (otherwise each thread keeps one per model).")
+      .def(py::init([](ModelHolder md) {
+             if (!md) throw ModelError("Data: no model");
+             return std::make_unique<DataPy>(std::move(md));
+           }),
+           py::arg("model"))
+      .def_property_readonly("model", [](const DataPy& d) { return d.model; });
+
+  m.def(
+      "forward_dynamics",
+      [](const ModelHolder& md, const py::object& q, const py::object& qd, const py::object& tau,
+         const py::object& t, const std::string& method, const py::object& data) {
+        constexpr const char* fn = "forward_dynamics";
+        Data& d = data_for(md, data, fn);
+        const DynamicsMethod mth = dynamics_method(method, fn);
+        const Model& mm = *md;
+        if (is_batch(q))
+          return batch(fn, d.n, q, qd, "qd", tau, "tau", t, {d.n},
+                       [&](auto qi, auto qdi, auto ti, double tt, double* out) {
+                         const VecX& r = forward_dynamics(mm, d, qi, qdi, ti, tt, mth);
+                         std::copy(r.data(), r.data() + d.n, out);
+                       });
+        const VecArg qa(q, "q", d.n), qda(qd, "qd", d.n), ta(tau, "tau", d.n);
+        return vector_out(forward_dynamics(mm, d, *qa, *qda, *ta, scalar_time(t, fn), mth));
+      },
+      py::arg("model"), py::arg("q"), py::arg("qd"), py::arg("tau"), py::arg("t") = 0.0,
+      py::arg("method") = "auto", py::arg("data") = py::none(),
+      "Joint accelerations qdd of a tree for joint torques/forces tau at (q, qd) and time t "
+      "[s] (n_coords each; 2-D: one state per row). method: 'joint' (CRBA mass matrix, "
+      "recursive Newton-Euler bias, Cholesky), 'cartesian' (the constrained Newton-Euler KKT "
+      "system of the bodies), 'auto' (joint). The model's force elements act; drives are "
+      "ignored.");
+
+  m.def(
+      "inverse_dynamics",
+      [](const ModelHolder& md, const py::object& q, const py::object& qd, const py::object& qdd,
+         const py::object& t, const std::string& method, const py::object& data) {
+        constexpr const char* fn = "inverse_dynamics";
+        Data& d = data_for(md, data, fn);
+        const DynamicsMethod mth = dynamics_method(method, fn);
+        const Model& mm = *md;
+        if (is_batch(q))
+          return batch(fn, d.n, q, qd, "qd", qdd, "qdd", t, {d.n},
+                       [&](auto qi, auto qdi, auto ai, double tt, double* out) {
+                         const VecX& r = inverse_dynamics(mm, d, qi, qdi, ai, tt, mth);
+                         std::copy(r.data(), r.data() + d.n, out);
+                       });
+        const VecArg qa(q, "q", d.n), qda(qd, "qd", d.n), aa(qdd, "qdd", d.n);
+        return vector_out(inverse_dynamics(mm, d, *qa, *qda, *aa, scalar_time(t, fn), mth));
+      },
+      py::arg("model"), py::arg("q"), py::arg("qd"), py::arg("qdd"), py::arg("t") = 0.0,
+      py::arg("method") = "auto", py::arg("data") = py::none(),
+      "Joint torques/forces tau realising qdd at (q, qd) and time t [s] (n_coords each; 2-D: "
+      "one state per row): what each joint's actuator applies to its child about/along the "
+      "joint axis, gravity and the model's force elements included, drives ignored. method: "
+      "'joint' (recursive Newton-Euler), 'cartesian' (every coordinate driven, the drives' KKT "
+      "multipliers), 'auto' (joint).");
+
+  m.def(
+      "mass_matrix",
+      [](const ModelHolder& md, const py::object& q, const py::object& data) {
+        constexpr const char* fn = "mass_matrix";
+        Data& d = data_for(md, data, fn);
+        const Model& mm = *md;
+        const long n = d.n;
+        // M is symmetric: its column-major storage is also its row-major one
+        if (is_batch(q))
+          return batch(fn, n, q, q, "q", q, "q", py::float_(0.0), {n, n},
+                       [&](auto qi, auto, auto, double, double* out) {
+                         const MatX& M = crba(mm, d, qi);
+                         std::copy(M.data(), M.data() + n * n, out);
+                       });
+        const VecArg qa(q, "q", n);
+        const MatX& M = crba(mm, d, *qa);
+        py::array_t<double> a({n, n});
+        std::copy(M.data(), M.data() + n * n, a.mutable_data());
+        return a;
+      },
+      py::arg("model"), py::arg("q"), py::arg("data") = py::none(),
+      "The joint-space mass matrix M(q) (n_coords, n_coords) of a tree, by the "
+      "composite-rigid-body algorithm; 2-D q (one state per row) gives (rows, n, n).");
+}
+
+}  // namespace armdyn

@@ -1,0 +1,23 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The joint-space mass matrix of a tree by the composite-rigid-body algorithm in world axes
+// (Featherstone, Rigid Body Dynamics Algorithms, 2008, ch. 6): each subtree's spatial inertia
+// about the world origin, and M_jk = S_j . (I_subtree(k) S_k) for j on the path from k to ground.
+#pragma once
+
+#include "armdyn/data.hpp"
+
+namespace armdyn {
+
+/// M(q) (n_coords x n_coords) into data.M. Allocates nothing.
+/// @throws ModelError when the model is not a joint-space tree, on a wrong size or non-finite q.
+const MatX& crba(const Model& m, Data& d, Eigen::Ref<const VecX> q);
+
+/// crba() without the checks, for callers that checked the model and q themselves (the
+/// joint-space simulation of a tree with ideal gears, which crba() refuses).
+const MatX& mass_matrix_at(const Model& m, Data& d, Eigen::Ref<const VecX> q);
+
+/// data.M from the kinematics in data.kin and the joint frames (data.rne.point, data.rne.axis)
+/// that rne_residual placed there; no checks. The step shared by crba() and forward dynamics.
+void crba_loaded(const Model& m, Data& d);
+
+}  // namespace armdyn

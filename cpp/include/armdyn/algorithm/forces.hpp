@@ -1,0 +1,33 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The force laws, in one place: the bodies' applied and gyroscopic forces (gravity, -w x J w,
+// body loads, point-to-point spring-dampers) as the Cartesian generalised force eta, and the
+// joint-coordinate forces (springs, dampers, friction, inputs, PD/PI motors: coord_force_value)
+// with the gear pairs' contact forces (gear_force) as joint-space generalised forces.
+#pragma once
+
+#include <vector>
+
+#include "armdyn/model/model.hpp"
+#include "armdyn/solver/kinematics.hpp"
+
+namespace armdyn {
+
+/// eta (nv) at the kinematics kin and time t: per body (force in world axes, torque in body
+/// axes). Overwrites eta.
+/// @throws SolverError naming the element (a profile that fails, a spring of zero length) or the
+///   body (a non-finite force).
+void body_forces(const Model& m, const std::vector<BodyKin>& kin, double t, Eigen::Ref<VecX> eta);
+
+/// The joint-coordinate forces and gear-pair contact forces (n_coords) at joint coordinates q
+/// (multi-turn), rates qd, auxiliary states z (model.n_aux, nullptr: all zero) and time t.
+/// Overwrites out.
+/// @throws SolverError naming the coordinate when a force is not finite.
+void coordinate_forces(const Model& m, const double* q, const double* qd, const double* z, double t,
+                       Eigen::Ref<VecX> out);
+
+/// Gear pair g's mesh displacement s = r_a q_a + r_b q_b, its rate, and the penetration
+/// |s| - backlash/2, at joint coordinates q (multi-turn) and rates qd.
+void gear_mesh(const Model& m, int g, const double* q, const double* qd, double& s, double& sd,
+               double& penetration);
+
+}  // namespace armdyn

@@ -1,0 +1,85 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "armdyn/algorithm/crba.hpp"
+
+namespace armdyn {
+
+void crba_loaded(const Model& m, Data& d) {
+  // each body's spatial inertia about the world origin: I_O = R J R^T + m (|c|^2 1 - c c^T)
+  for (int i = 0; i < m.nb; ++i) {
+    const Body& b = m.bodies[i];
+    const BodyKin& k = d.kin[i];
+    Data::Composite& I = d.ic[i];
+    I.m = b.mass;
+    I.h = b.mass * k.x;
+    const Mat3 RJ = k.R * b.inertia;
+    I.I.noalias() = RJ * k.R.transpose();
+    I.I.noalias() -= I.h * k.x.transpose();
+    I.I.diagonal().array() += I.h.dot(k.x);
+  }
+  // composites, children first
+  for (auto it = m.tree_order.rbegin(); it != m.tree_order.rend(); ++it) {
+    const Joint& j = m.joints[*it];
+    if (j.parent == kGround) continue;
+    Data::Composite& p = d.ic[j.parent];
+    const Data::Composite& c = d.ic[j.child];
+    p.m += c.m;
+    p.h += c.h;
+    p.I += c.I;
+  }
+  // each coordinate's motion: a turn about the axis through the joint point, or a slide (the
+  // joint frames of the Newton-Euler sweep)
+  for (int ji : m.tree_order) {
+    const Joint& j = m.joints[ji];
+    if (j.coord0 < 0) continue;
+    const Vec3& z = d.rne.axis[ji];
+    const Vec3& p = d.rne.point[ji];
+    for (int k = 0; k < joint_coords(j.type); ++k) {
+      Vec6& s = d.s[j.coord0 + k];
+      if (j.type == JointType::Prismatic || k == 1) {
+        s << Vec3::Zero(), z;
+      } else {
+        s << z, p.cross(z);
+      }
+    }
+  }
+  // M_jk for j among the coordinates of k's joint and of the joints towards ground
+  for (int k = 0; k < d.n; ++k) {
+    const int jk = m.coords[k].joint;
+    // the subtree's momentum for the motion s = (w, v_O)
+    const Data::Composite& I = d.ic[m.joints[jk].child];
+    const Vec3 w = d.s[k].head<3>(), v = d.s[k].tail<3>();
+    Vec6 f;
+    f.head<3>().noalias() = I.I * w;
+    f.head<3>() += I.h.cross(v);
+    f.tail<3>() = I.m * v - I.h.cross(w);
+    for (int ji = jk; ji >= 0;) {
+      const Joint& j = m.joints[ji];
+      for (int c = j.coord0; c < j.coord0 + joint_coords(j.type); ++c)
+        d.M(c, k) = d.M(k, c) = d.s[c].dot(f);
+      ji = j.parent == kGround ? -1 : d.joint_of_body[j.parent];
+    }
+  }
+}
+
+const MatX& crba(const Model& m, Data& d, Eigen::Ref<const VecX> q) {
+  require_joint_space(m, "mass_matrix");
+  check_data(m, d, "mass_matrix");
+  check_joint_vector(q, d.n, "mass_matrix", "q");
+  return mass_matrix_at(m, d, q);
+}
+
+const MatX& mass_matrix_at(const Model& m, Data& d, Eigen::Ref<const VecX> q) {
+  joint_space_poses(m, q, d.kin);
+  // the joint frames (as the Newton-Euler sweep places them): child-side point, world axis
+  for (int ji : m.tree_order) {
+    const Joint& j = m.joints[ji];
+    const BodyKin& c = d.kin[j.child];
+    d.rne.point[ji] = c.x + c.R * j.point_child;
+    d.rne.axis[ji] = j.parent == kGround ? Vec3(j.frame_parent.col(2))
+                                         : Vec3(d.kin[j.parent].R * j.frame_parent.col(2));
+  }
+  crba_loaded(m, d);
+  return d.M;
+}
+
+}  // namespace armdyn

@@ -1,0 +1,137 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "armdyn/algorithm/dynamics.hpp"
+
+#include <cmath>
+
+#include "armdyn/algorithm/crba.hpp"
+#include "armdyn/algorithm/forces.hpp"
+#include "armdyn/algorithm/rnea.hpp"
+#include "armdyn/errors.hpp"
+#include "armdyn/solver/engine.hpp"
+
+namespace armdyn {
+
+namespace {
+
+void check_inputs(const Model& m, const Data& d, Eigen::Ref<const VecX> q,
+                  Eigen::Ref<const VecX> qd, Eigen::Ref<const VecX> x, double t, const char* fn,
+                  const char* xname) {
+  require_joint_space(m, fn);
+  check_data(m, d, fn);
+  check_joint_vector(q, d.n, fn, "q");
+  check_joint_vector(qd, d.n, fn, "qd");
+  check_joint_vector(x, d.n, fn, xname);
+  if (!std::isfinite(t)) throw ModelError(msg(fn, ": t is not finite"));
+}
+
+// forward dynamics through the Cartesian KKT system, the joint torques as loads
+void forward_cartesian(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
+                       Eigen::Ref<const VecX> tau, double t) {
+  if (!d.engine) {
+    d.engine = std::make_unique<Engine>(m);
+    d.engine->set_include_drives(false);
+    d.vd = VecX::Zero(m.nv);
+    d.tau_in = VecX::Zero(d.n);
+    d.engine->set_joint_torques(d.tau_in.data());
+  }
+  Engine& e = *d.engine;
+  joint_space_kinematics(m, q, qd, e.kin_in());
+  d.tau_in = tau;
+  e.dynamics_loaded(t, d.vd.data());
+  // the coordinate jets of the torques, at this state
+  for (int c = 0; c < d.n; ++c) d.qdd[c] = coord_acceleration(m, e.torque_jets()[c], c, d.vd);
+}
+
+// inverse dynamics through the KKT system with every joint coordinate driven to (q, qd, qdd)
+void inverse_cartesian(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
+                       Eigen::Ref<const VecX> qdd, double t) {
+  const int n = d.n;
+  if (!d.driven_engine) {
+    auto driven = std::make_unique<Model>(m);
+    driven->drives.clear();
+    driven->drive_index.clear();
+    for (int c = 0; c < n; ++c) {
+      Drive dr;
+      dr.name = driven->coords[c].name;
+      dr.joint = driven->coords[c].joint;
+      dr.coord = driven->coords[c].sub;
+      dr.profile = Profile::constant(0.0);
+      dr.row = driven->nc_joint + c;
+      driven->drive_index[dr.name] = c;
+      driven->drives.push_back(dr);
+    }
+    driven->nc = driven->nc_joint + n;
+    driven->rank_all = driven->rank_joint + n;
+    driven->mobility_driven = driven->mobility - n;
+    driven->redundant = false;
+    driven->redundant_rows.clear();
+    // the drives changed the row blocks: plan the KKT factorisation afresh
+    driven->kkt_all = plan_kkt(*driven, driven->nc);
+    driven->kkt_joint = plan_kkt(*driven, driven->nc_joint);
+    d.driven = std::move(driven);
+    d.driven_engine = std::make_unique<Engine>(*d.driven);
+    d.vd = VecX::Zero(m.nv);
+    d.drive_ref = VecX::Zero(3 * n);
+    d.driven_engine->constraints().drive_ref = d.drive_ref.data();
+    // the state is built on the manifold from (q, qd): only zeta, rhs and xi are wanted
+    d.driven_engine->constraints().drive_values = false;
+  }
+  Engine& e = *d.driven_engine;
+  joint_space_kinematics(m, q, qd, e.kin_in());
+  for (int c = 0; c < n; ++c) {
+    d.drive_ref[3 * c] = q[c];
+    d.drive_ref[3 * c + 1] = qd[c];
+    d.drive_ref[3 * c + 2] = qdd[c];
+  }
+  // square zeta: the engine takes its O(n) tree sweep (KKT factorisation only when singular)
+  e.dynamics_loaded(t, d.vd.data());
+  for (int c = 0; c < n; ++c) d.tau[c] = -e.delta()[d.driven->nc_joint + c];
+}
+
+}  // namespace
+
+DynamicsMethod dynamics_method(const std::string& name, const char* fn) {
+  if (name == "auto") return DynamicsMethod::Auto;
+  if (name == "joint") return DynamicsMethod::Joint;
+  if (name == "cartesian") return DynamicsMethod::Cartesian;
+  throw ModelError(msg(fn, ": method must be 'auto', 'joint' or 'cartesian', got '", name, "'"));
+}
+
+const VecX& forward_dynamics(const Model& m, Data& d, Eigen::Ref<const VecX> q,
+                             Eigen::Ref<const VecX> qd, Eigen::Ref<const VecX> tau, double t,
+                             DynamicsMethod method) {
+  check_inputs(m, d, q, qd, tau, t, "forward_dynamics", "tau");
+  if (method == DynamicsMethod::Cartesian) {
+    forward_cartesian(m, d, q, qd, tau, t);
+    return d.qdd;
+  }
+  // M qdd = tau + Q - (b - J^T eta): the Newton-Euler residual at qdd = 0 gives the bias
+  joint_space_kinematics(m, q, qd, d.kin);
+  body_forces(m, d.kin, t, d.eta);
+  rne_residual(m, d.kin, qd, d.zero, d.eta, d.rne, d.rhs);
+  d.rhs = tau - d.rhs;
+  if (!m.coord_forces.empty() || !m.gears.empty()) {
+    coordinate_forces(m, q.data(), qd.data(), nullptr, t, d.coord_tau);
+    d.rhs += d.coord_tau;
+  }
+  crba_loaded(m, d);
+  d.llt.compute(d.M);
+  if (d.llt.info() != Eigen::Success)
+    throw SolverError(
+        "forward_dynamics: the joint-space mass matrix is not positive definite (a massless "
+        "subtree?)");
+  d.qdd = d.rhs;
+  d.llt.solveInPlace(d.qdd);
+  return d.qdd;
+}
+
+const VecX& inverse_dynamics(const Model& m, Data& d, Eigen::Ref<const VecX> q,
+                             Eigen::Ref<const VecX> qd, Eigen::Ref<const VecX> qdd, double t,
+                             DynamicsMethod method) {
+  if (method != DynamicsMethod::Cartesian) return rnea(m, d, q, qd, qdd, t);
+  check_inputs(m, d, q, qd, qdd, t, "inverse_dynamics", "qdd");
+  inverse_cartesian(m, d, q, qd, qdd, t);
+  return d.tau;
+}
+
+}  // namespace armdyn
