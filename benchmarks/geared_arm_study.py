@@ -1,26 +1,24 @@
 """The first paper's study on armdyn.scenes.geared_arm_6dof (armdyn.geared_study): 5 s runs
 with 1–4 motors on the waist's driven gear, 0.1 mm backlash, without and with anti-backlash
 preload, plus the backlash-free arm. Writes docs/figures/geared_arm_torque.png (in the style of
-the paper's Fig. 3 a–d) and docs/results/geared_arm_study.json, and prints the table of
+the paper's Fig. 3 a–d) and benchmarks/results/geared_arm_study.json, and prints the table of
 docs/geared_arm.md. `armdyn reproduce` runs the same study into its report folder.
 
-    python benchmarks/geared_arm_study.py
+    python -m benchmarks.geared_arm_study        (from the repository root)
 """
 
 from __future__ import annotations
 
-from pathlib import Path
-
 from armdyn import geared_study
 
-ROOT = Path(__file__).resolve().parents[1]
+from benchmarks.common import RESULTS, ROOT
 
 
 def main():
     rows = geared_study.run_study(
         ROOT / "docs" / "figures" / "geared_arm_torque.png",
-        ROOT / "docs" / "results" / "geared_arm_study.json",
-        command="python benchmarks/geared_arm_study.py",
+        RESULTS / "geared_arm_study.json",
+        command="python -m benchmarks.geared_arm_study",
     )
     print(geared_study.table(rows))
 

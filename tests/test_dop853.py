@@ -2,13 +2,13 @@
 method.
 
 * Order: the IFToMM A01 pendulum (a Cartesian body on a revolute joint, projected after every
-  step) against its closed form in Jacobi elliptic functions (``armdyn.references``). With the
+  step) against its closed form in Jacobi elliptic functions (``benchmarks.references``). With the
   error control switched off (``rtol = atol = 1`` and ``max_step = h``: every step is accepted
   at exactly h) the error at the step ends must fall as h^8, and at output times inside the
   steps (the dense output, whose local error is O(h^8)) at least as h^7. A wrong coefficient in
   the tables drops the order.
 * Error control: Andrews' squeezer against the seven-angle index-1 reference (a different
-  formulation, ``armdyn.references.squeezer_angles``): the error follows rtol, and the 8th-order
+  formulation, ``benchmarks.references.squeezer_angles``): the error follows rtol, and the 8th-order
   pair needs far fewer steps than DOPRI5 at a tight tolerance.
 * Events and energy: see ``test_gears.py`` and ``test_conservation.py`` (parametrized over the
   integrators).
@@ -19,9 +19,11 @@ import itertools
 import armdyn as ad
 import numpy as np
 import pytest
-from armdyn import references
 from armdyn.scenes import standard
-from armdyn.workprecision import PROBLEMS, _error, _output_times
+
+from benchmarks import references
+from benchmarks.common import error, output_times
+from benchmarks.workprecision import PROBLEMS
 
 
 def _a01_errors(n: int, t_end: float = 2.0):
@@ -48,11 +50,11 @@ def test_dop853_is_eighth_order_against_the_closed_form():
 @pytest.mark.parametrize("rtol", [1e-6, 1e-8, 1e-10])
 def test_dop853_error_follows_rtol_on_the_squeezer(rtol):
     p = PROBLEMS["squeezer"]
-    t = _output_times(p)
+    t = output_times(p)
     ref = p.reference(t)
     model = p.build()
     res = ad.simulate(model, p.t_end, integrator="dop853", rtol=rtol, atol=rtol, output_dt=t[1])
-    err = _error(p, p.observe(model, res), ref)  # angle differences wrapped to (-pi, pi]
+    err = error(p, p.observe(model, res), ref)  # angle differences wrapped to (-pi, pi]
     assert err <= 2.0 * rtol  # measured 0.92, 0.82, 0.35 times rtol
     assert res.position_residual.max() <= 1e-12
     if rtol == 1e-10:
@@ -67,9 +69,9 @@ def test_a_stage_that_cannot_be_evaluated_rejects_the_step():
     the one-DOF branch to within the tolerance's order (measured 6.2e-4 m)."""
     p = PROBLEMS["a02"]
     model = p.build()
-    t = _output_times(p)
+    t = output_times(p)
     res = ad.simulate(
         model, p.t_end, integrator="dop853", rtol=1e-4, atol=1e-4, output_dt=t[1], **p.init(model)
     )
     assert res.t[-1] == pytest.approx(p.t_end)
-    assert _error(p, p.observe(model, res), p.reference(t)) <= 2e-3
+    assert error(p, p.observe(model, res), p.reference(t)) <= 2e-3

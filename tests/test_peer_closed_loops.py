@@ -1,4 +1,4 @@
-"""The MuJoCo and Exudyn peers of the closed-loop standard problems (armdyn.peer_closed_loops)
+"""The MuJoCo and Exudyn peers of the closed-loop standard problems (benchmarks.peers.closed_loops)
 are the same mechanisms as the references: accelerations at the start, and errors that fall
 under step refinement."""
 
@@ -6,9 +6,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from armdyn import peer_closed_loops as pcl
-from armdyn import references
-from armdyn.workprecision import PROBLEMS
+
+from benchmarks import references
+from benchmarks.peers import closed_loops as pcl
+from benchmarks.workprecision import PROBLEMS
 
 SQUEEZER_T, SQUEEZER_OUT = 0.03, 300
 A02_T, A02_OUT = 2.0, 40  # 2 s: crank 0 passes the flat (singular) position at t = 0.7 s

@@ -1,4 +1,4 @@
-"""The MuJoCo and Exudyn peers of the geared arm (armdyn.peer_geared) are the same mechanism as
+"""The MuJoCo and Exudyn peers of the geared arm (benchmarks.peers.geared) are the same mechanism as
 the reference (Pinocchio on the open tree, reduced by the gear ratios): accelerations at a moving
 state during the motion, and errors that fall under step refinement."""
 
@@ -6,8 +6,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from armdyn import peer_geared as pg
-from armdyn.workprecision import PROBLEMS
+
+from benchmarks.peers import geared as pg
+from benchmarks.workprecision import PROBLEMS
 
 T_END, N_OUT = 1.0, 20  # the motion starts at t = 0.5 s
 

@@ -1,6 +1,6 @@
-"""`armdyn.peer_pinocchio.pinocchio_tree` (an armdyn tree rebuilt in Pinocchio from the model's
+"""`benchmarks.peers.pinocchio.pinocchio_tree` (an armdyn tree rebuilt in Pinocchio from the model's
 masses, inertias and joint frames) and the geared-arm reference built on it
-(`armdyn.references.GearedArmReference`, the `geared_arm` work-precision problem).
+(`benchmarks.references.GearedArmReference`, the `geared_arm` work-precision problem).
 
 * The converter against Pinocchio's own URDF parser: the UR5 and the Panda loaded by armdyn
   (urdfdom) and converted must give Pinocchio's mass matrix and RNEA torques of the URDF loaded
@@ -16,19 +16,21 @@ masses, inertias and joint frames) and the geared-arm reference built on it
 import armdyn as ad
 import numpy as np
 import pytest
-from armdyn import bench
+
+from benchmarks import common
 
 pin = pytest.importorskip("pinocchio")
 
-from armdyn.peer_pinocchio import mass_matrix, pinocchio_tree  # noqa: E402
-from armdyn.references import GearedArmReference  # noqa: E402
 from armdyn.scenes.geared_arm import geared_arm_6dof  # noqa: E402
-from armdyn.workprecision import _Geared  # noqa: E402
+
+from benchmarks.peers.pinocchio import PinPair, mass_matrix, pinocchio_tree  # noqa: E402
+from benchmarks.references import GearedArmReference  # noqa: E402
+from benchmarks.workprecision import _Geared  # noqa: E402
 
 
 @pytest.mark.parametrize("robot", ["ur5", "panda"])
 def test_tree_conversion_equals_pinocchios_urdf_parser(robot):
-    pair = bench.PinPair(bench.robot_urdf(robot))
+    pair = PinPair(common.robot_urdf(robot))
     conv, idx = pinocchio_tree(pair.am)
     cd = conv.createData()
     rng = np.random.default_rng(11)

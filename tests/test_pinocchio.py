@@ -1,34 +1,40 @@
 """Cross-check against Pinocchio on real URDF arms (issue 5): the same URDF loaded by armdyn
-(urdfdom, Cartesian Newton–Euler KKT path) and by Pinocchio (its own URDF parser, articulated-
-body and recursive Newton–Euler algorithms). Forward dynamics must equal ``pin.aba`` and
-inverse dynamics ``pin.rnea`` to 1e-9 relative over random states; this is the check
-``armdyn bench`` also runs next to its timings."""
+(urdfdom) and by Pinocchio (its own URDF parser, articulated-body, recursive Newton–Euler and
+composite-rigid-body algorithms), through :class:`benchmarks.peers.pinocchio.PinPair`. The public
+``forward_dynamics`` (default and Cartesian KKT path) must equal ``pin.aba``,
+``inverse_dynamics`` ``pin.rnea`` and ``mass_matrix`` ``pin.crba`` to 1e-9 relative over random
+states; this is the check ``python -m benchmarks.bench`` also runs next to its timings. The UR5
+work-precision problem and its peers are checked here too."""
 
 import numpy as np
 import pytest
-from armdyn import bench
+
+from benchmarks import common
+from benchmarks.peers.pinocchio import PinPair
 
 pytest.importorskip("pinocchio")
 
 
 @pytest.mark.parametrize("robot", ["ur5", "panda"])
 def test_forward_and_inverse_dynamics_equal_pinocchio(robot):
-    path = bench.robot_urdf(robot)
+    path = common.robot_urdf(robot)
     assert path is not None, "example-robot-data is part of the test extra"
-    pair = bench.PinPair(path)
+    pair = PinPair(path)
     assert pair.am.nb == pair.pm.nq  # one body per joint: both parsers read the same tree
     errors = pair.cross_check(n=50, seed=7)
     assert errors["fd_rel_error"] <= 1e-9
+    assert errors["fd_kkt_rel_error"] <= 1e-9
     assert errors["id_rel_error"] <= 1e-9
+    assert errors["mass_matrix_rel_error"] <= 1e-9
 
 
 def test_ur5_run_agrees_with_pinocchio_and_mujoco_solves_the_same_arm():
-    # 5 s of the UR5 falling from a bent pose (armdyn workprecision ur5, quick sweeps): armdyn's
+    # 5 s of the UR5 falling from a bent pose (workprecision ur5, quick sweeps): armdyn's
     # DOPRI5 at rtol 1e-8 stays within 1e-5 rad (measured 4.9e-6) of a DOP853 (rtol 1e-13)
     # integration of Pinocchio's ABA over all 100 outputs, and MuJoCo's import of the same URDF
     # has Pinocchio's accelerations (so its curve in the benchmark is the same problem)
     pytest.importorskip("mujoco")
-    from armdyn import workprecision as wp
+    from benchmarks import workprecision as wp
 
     r = wp.run_problem("ur5", quick=True, echo=False)
     dopri = {p["setting"]: p["error"] for p in r["curves"]["armdyn dopri5"]}
@@ -42,16 +48,18 @@ def test_ur5_run_agrees_with_pinocchio_and_mujoco_solves_the_same_arm():
 
 
 def test_exudyn_peer_converges_to_the_pinocchio_reference():
-    # the Exudyn peer of armdyn bench (redundant coordinates: Euler-parameter bodies, revolute
+    # the Exudyn peer of the UR5 problem (redundant coordinates: Euler-parameter bodies, revolute
     # joints as constraints) solves the same UR5 problem: TrapezoidalIndex2 at fixed steps
     # converges at second order to the DOP853 (rtol 1e-13) integration of Pinocchio's ABA
     # (measured 6.1e-4 rad at 5000 steps, 1.5e-4 at 10000)
     pytest.importorskip("exudyn")
     import pinocchio as pin
-    from armdyn import peer_exudyn, workprecision
 
-    pm = pin.buildModelFromUrdf(str(bench.robot_urdf("ur5")))
-    arm = peer_exudyn.build_ur5_like(pm, np.asarray(workprecision.UR5_Q0))
+    from benchmarks import workprecision
+    from benchmarks.peers import exudyn
+
+    pm = pin.buildModelFromUrdf(str(common.robot_urdf("ur5")))
+    arm = exudyn.build_ur5_like(pm, np.asarray(common.UR5_Q0))
     ref = workprecision._Ur5.get().reference(np.linspace(0.0, 5.0, 2))[-1]
     errors = []
     for n in (5000, 10000):

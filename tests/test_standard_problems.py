@@ -1,14 +1,16 @@
 """The standard problems (IFToMM A01/A02, Andrews' squeezer) against independent references and
-published values; the inline and distance joints they are built with; `armdyn workprecision`."""
+published values; the inline and distance joints they are built with; the work-precision sweep
+(`python -m benchmarks.workprecision`)."""
 
 import json
 
 import armdyn as ad
 import numpy as np
 import pytest
-from armdyn import references
 from armdyn.scenes import standard
-from armdyn.workprecision import PROBLEMS, run_problem
+
+from benchmarks import references
+from benchmarks.workprecision import PROBLEMS, run_problem
 
 # Hairer & Wanner (1996) §VII.7 / Test Set "andrews": consistent initial accelerations of β and Θ
 # and the first two multipliers (all others are zero at rest)
@@ -75,7 +77,7 @@ def test_squeezer_model_matches_hairer_wanner():
     model = standard.andrews_squeezer()
     assert model.nb == 7 and model.nc == 41 and model.mobility == 1
     assert len(model.redundant_rows) == 0
-    vdot, _ = ad.accelerations(model, model.u0, model.v0)
+    vdot, _ = ad.body_accelerations(model, model.u0, model.v0)
     k1, k2 = 6 * 0 + 5, 6 * 1 + 5  # omega_z of K1, K2 (body z = world z)
     np.testing.assert_allclose([vdot[k1], vdot[k2] - vdot[k1]], HW_QDD0, rtol=1e-12)
     res = ad.simulate(model, 0.03, rtol=1e-10, atol=1e-10, output_dt=1e-4)
@@ -105,9 +107,9 @@ def test_workprecision_sweep_writes_curves(tmp_path):
     errors = [p["error"] for p in pts]
     assert errors[1] < errors[0] / 20  # rtol 1e-6 -> 1e-8: the error follows the tolerance
     assert all(p["steps"] > 0 and p["cpu_s"] > 0 for p in pts)
-    from armdyn.__main__ import main
+    from benchmarks.workprecision import main
 
-    assert main(["workprecision", "squeezer", "--quick", "--no-peers", "--out", str(tmp_path)]) == 0
+    assert main(["squeezer", "--quick", "--no-peers", "--out", str(tmp_path)]) == 0
     saved = json.loads((tmp_path / "squeezer.json").read_text())
     assert saved["machine"]["cores"] >= 1 and "armdyn dopri5" in saved["curves"]
     assert (tmp_path / "squeezer.png").stat().st_size > 0
@@ -123,7 +125,7 @@ def test_five_dof_driven_run_matches_the_complete_lagrange_torques_at_any_tolera
 
 def test_mujoco_peer_solves_the_same_a01():
     mujoco = pytest.importorskip("mujoco")
-    from armdyn.workprecision import _A01_XML
+    from benchmarks.workprecision import _A01_XML
 
     m = mujoco.MjModel.from_xml_string(_A01_XML)
     m.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4

@@ -8,14 +8,17 @@ and test_drive_elements.py (parametrised over ``coordinates``)."""
 import armdyn as ad
 import numpy as np
 import pytest
-from armdyn import _core, bench
+from armdyn import _core
 from armdyn.scenes.geared_arm import geared_arm_6dof
+
+from benchmarks import common
+from benchmarks.peers.pinocchio import PinPair
 
 
 @pytest.mark.parametrize("robot", ["ur5", "panda"])
 def test_mass_matrix_and_accelerations_equal_pinocchio(robot):
     pin = pytest.importorskip("pinocchio")
-    pair = bench.PinPair(bench.robot_urdf(robot))
+    pair = PinPair(common.robot_urdf(robot))
     td = _core.TreeDynamics(pair.am)
     kkt = _core.JointSpaceForwardDynamics(pair.am, "kkt")
     assert td.dof == pair.pm.nq
@@ -102,10 +105,10 @@ def test_spatial_arm_runs_equal_on_both_paths():
 
 def test_geared_arm_joint_path_equals_the_reference_and_the_cartesian_run():
     """The 44-body geared arm (18 coordinates, 12 ideal gears: 6 independent) on its PD motors.
-    At moving states its accelerations equal those of the Pinocchio reference of armdyn
-    workprecision geared_arm (CRBA/RNEA of the open tree, reduced by the gear ratios; no armdyn
-    code), and a 2.5 s run agrees with the Cartesian path."""
-    from armdyn.references import GearedArmReference
+    At moving states its accelerations equal those of the Pinocchio reference of the
+    geared_arm work-precision problem (CRBA/RNEA of the open tree, reduced by the gear ratios; no
+    armdyn code), and a 2.5 s run agrees with the Cartesian path."""
+    from benchmarks.references import GearedArmReference
 
     model = geared_arm_6dof(backlash=0.0)
     ref = GearedArmReference()

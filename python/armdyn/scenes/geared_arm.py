@@ -121,7 +121,7 @@ def geared_arm_6dof(
         ideal_gears: False leaves out the ideal gear constraints (stage 1 and stage 2): rotors
             and shafts then turn freely, an open tree in the joint coordinates. Only with
             backlash=0 and n_motors=1 (otherwise a ModelError). Not a mechanism of its own:
-            :mod:`armdyn.references` eliminates the gear ratios from its Euler–Lagrange equations
+            ``benchmarks.references`` eliminates the gear ratios from its Euler–Lagrange equations
             to obtain an independent reference.
     """
     if not 1 <= int(n_motors) <= 6:

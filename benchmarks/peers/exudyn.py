@@ -1,4 +1,4 @@
-"""Exudyn peer model of a serial (or tree) revolute arm loaded from a URDF, e.g. the UR5.
+"""Exudyn peer models of a serial (or tree) revolute arm loaded from a URDF, e.g. the UR5.
 
 :class:`ExudynArm` (:func:`build_ur5_like`) is the model for the benchmark, built from the
 Pinocchio model of the URDF (``pin.buildModelFromUrdf``) in Exudyn's *redundant* (absolute)
@@ -18,12 +18,11 @@ output ``Rotation`` (z component, the same angle but wrapped to (-pi, pi]), whic
 during the run (every step by default) and which is unwrapped.
 
 Solvers: with joint constraints and Euler parameters only Exudyn's implicit solvers work,
-'GeneralizedAlpha' (index 3; spectral radius 0.9 by default, since 1.0, the undamped trapezoidal
-rule, fails in Newton at t = 2.17 s on the UR5) and 'TrapezoidalIndex2' (index 2). Both are second
-order with fixed steps; Exudyn has no error control for implicit solvers. Its explicit solvers
-(RK44, DOPRI5, ODE23, RK67, ...) refuse the model: "explicit integrator detected node ... which
-contains algebraic variables" (Euler parameters), and with rotation-vector nodes "... object ...
-which contains constraints that cannot be solved" -- they only eliminate simple
+'GeneralizedAlpha' (index 3; spectral radius 0.9 by default) and 'TrapezoidalIndex2' (index 2). Both
+are second order with fixed steps; Exudyn has no error control for implicit solvers. Its explicit
+solvers (RK44, DOPRI5, ODE23, RK67, ...) refuse the model: "explicit integrator detected node ...
+which contains algebraic variables" (Euler parameters), and with rotation-vector nodes "... object
+... which contains constraints that cannot be solved" -- they only eliminate simple
 CoordinateConstraints. So ``ExudynArm.run(..., 'RK4')`` and ``ExudynArm.run_tolerance`` raise
 ``NotImplementedError``.
 
@@ -32,8 +31,8 @@ same arm as an ``ObjectKinematicTree``: *minimal* coordinates (the joint angles,
 so not the redundant-coordinate peer, but the only way Exudyn runs RK4 or DOPRI5 (with
 ``automaticStepSize`` and tolerances) on it.
 
-``python -m armdyn.peer_exudyn`` runs the convergence check against SciPy DOP853 (rtol 1e-13) on
-Pinocchio's ABA.
+``python -m benchmarks.peers.exudyn`` runs the convergence check against SciPy DOP853 (rtol
+1e-13) on Pinocchio's ABA.
 """
 
 from __future__ import annotations
@@ -41,6 +40,8 @@ from __future__ import annotations
 import time
 
 import numpy as np
+
+from benchmarks import common
 
 GRAVITY = (0.0, 0.0, -9.81)
 IMPLICIT = ("GeneralizedAlpha", "TrapezoidalIndex2")
@@ -494,23 +495,21 @@ def build_ur5_like_tree(pm, q0) -> ExudynTreeArm:
     return ExudynTreeArm(pm, q0)
 
 
-# -- armdyn workprecision hook ----------------------------------------------------------------
+# -- work-precision hook ----------------------------------------------------------------------
 
 WP_STEPS = (1000, 2000, 5000, 10000, 20000, 50000)
 WP_STEPS_QUICK = (5000,)
 
 
 def workprecision_curves(problem, ref, quick: bool, repeats: int) -> dict:
-    """Curves for ``armdyn workprecision ur5``: the redundant-coordinate Exudyn model with
-    TrapezoidalIndex2 and GeneralizedAlpha (spectral radius 0.9) at fixed steps (setting = step
+    """Curves for ``python -m benchmarks.workprecision ur5``: the redundant-coordinate Exudyn model
+    with TrapezoidalIndex2 and GeneralizedAlpha (spectral radius 0.9) at fixed steps (setting = step
     size). Error: max wrapped |q - q_ref| over the problem's output grid; CPU: median over
     ``repeats`` of the ``exu.SolveDynamic`` time (one run when it takes more than 2 s)."""
     import pinocchio as pin
 
-    from armdyn import bench, workprecision
-
-    pm = pin.buildModelFromUrdf(str(bench.robot_urdf("ur5")))
-    arm = build_ur5_like(pm, np.asarray(workprecision.UR5_Q0))
+    pm = pin.buildModelFromUrdf(str(common.robot_urdf("ur5")))
+    arm = build_ur5_like(pm, np.asarray(common.UR5_Q0))
     curves = {}
     for method in ("TrapezoidalIndex2", "GeneralizedAlpha"):
         points = []
@@ -524,7 +523,7 @@ def workprecision_curves(problem, ref, quick: bool, repeats: int) -> dict:
                 point.update(
                     cpu_s=float(np.median(cpus)),
                     repeats=len(cpus),
-                    error=workprecision._error(problem, q, ref),
+                    error=common.error(problem, q, ref),
                     newton_iterations=arm.last_stats["newton_iterations"],
                 )
             except RuntimeError as exc:
@@ -557,11 +556,9 @@ def main() -> None:
     import exudyn as exu
     import pinocchio as pin
 
-    from armdyn import bench
-
-    path = bench.robot_urdf("ur5")
+    path = common.robot_urdf("ur5")
     pm = pin.buildModelFromUrdf(str(path))
-    q0 = np.array([0.3, -1.0, 1.2, -0.5, 0.8, 0.1])
+    q0 = np.array(common.UR5_Q0)
     t_end = 5.0
     ref = _reference(pm, q0, t_end)
     print(f"Exudyn {exu.__version__}, {path.name}, q0 = {q0.tolist()}, t_end = {t_end} s")

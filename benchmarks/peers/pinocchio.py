@@ -1,4 +1,10 @@
-"""A Pinocchio model of an armdyn tree, for references and peer curves by a second library.
+"""Pinocchio as a peer: the same URDF in armdyn and Pinocchio, and an armdyn tree rebuilt in
+Pinocchio.
+
+:class:`PinPair` loads one URDF in both libraries (armdyn through urdfdom, Pinocchio through its
+own parser) with the map between their joint orders, and cross-checks armdyn's public
+``forward_dynamics``, ``inverse_dynamics`` and ``mass_matrix`` against ``pin.aba``, ``pin.rnea``
+and ``pin.crba``.
 
 :func:`pinocchio_tree` rebuilds a finalized armdyn model whose joints form a tree of revolute,
 prismatic and fixed joints (``model.joint_space``) as a ``pinocchio.Model`` from the model's
@@ -9,13 +15,15 @@ fixed joints are appended to their parent's Pinocchio joint. Pinocchio's CRBA an
 then the Euler–Lagrange terms of the same mechanism computed by a different library.
 
 Force elements (motors, springs) and gear couplings are *not* carried over: the caller adds
-them in the joint coordinates (see ``armdyn.references.GearedArmReference``).
+them in the joint coordinates (see ``benchmarks.references.GearedArmReference``).
 """
 
 from __future__ import annotations
 
-import numpy as np
+from pathlib import Path
 
+import armdyn as ad
+import numpy as np
 from armdyn import _core
 
 
@@ -82,3 +90,54 @@ def pinocchio_tree(model: _core.Model):
         placed[jf["child"]] = (jid, x_body)
     idx_q = np.array([pm.joints[coord_joint[c]].idx_q for c in range(model.n_coords)], dtype=int)
     return pm, idx_q
+
+
+class PinPair:
+    """The same URDF in armdyn (``am``) and Pinocchio (``pm``, ``pd``), with the coordinate map
+    between them: ``q_armdyn[perm] = q_pinocchio`` (:meth:`to_armdyn`)."""
+
+    def __init__(self, path: Path):
+        import pinocchio as pin
+
+        self.pin = pin
+        self.pm = pin.buildModelFromUrdf(str(path))
+        self.pd = self.pm.createData()
+        self.am = ad.load_urdf(str(path))
+        names = list(self.am.coord_names)
+        pin_names = [self.pm.names[i] for i in range(1, self.pm.njoints)]
+        if self.pm.nq != self.pm.nv or self.pm.nq != len(names):
+            raise ValueError("only revolute/prismatic arms are compared")
+        self.perm = np.array([names.index(n) for n in pin_names])
+
+    def to_armdyn(self, x):
+        """A vector (or rows of vectors) in Pinocchio's joint order, in armdyn's."""
+        x = np.asarray(x, dtype=float)
+        out = np.empty_like(x)
+        out[..., self.perm] = x
+        return out
+
+    def cross_check(self, n: int = 50, seed: int = 0) -> dict:
+        """Worst relative errors over ``n`` random states of armdyn's public functions against
+        Pinocchio: ``forward_dynamics`` (default method, and ``method="cartesian"``, the KKT
+        path) against ``pin.aba``, ``inverse_dynamics`` against ``pin.rnea`` and ``mass_matrix``
+        against ``pin.crba``; each relative to the largest entry of Pinocchio's answer."""
+        pin, pm, pd, p = self.pin, self.pm, self.pd, self.perm
+        rng = np.random.default_rng(seed)
+        worst = dict.fromkeys(("fd", "fd_kkt", "id", "mass_matrix"), 0.0)
+
+        def update(key, a, b):
+            worst[key] = max(worst[key], float(np.max(np.abs(a - b)) / np.max(np.abs(b))))
+
+        for _ in range(n):
+            q, v, tau, acc = rng.uniform(-np.pi, np.pi, size=(4, pm.nq))
+            qa, va, ta, aa = (self.to_armdyn(x) for x in (q, v, tau, acc))
+            a_pin = pin.aba(pm, pd, q, v, tau)
+            update("fd", ad.forward_dynamics(self.am, qa, va, ta)[p], a_pin)
+            update("fd_kkt", ad.forward_dynamics(self.am, qa, va, ta, method="cartesian")[p], a_pin)
+            update("id", ad.inverse_dynamics(self.am, qa, va, aa)[p], pin.rnea(pm, pd, q, v, acc))
+            update(
+                "mass_matrix",
+                ad.mass_matrix(self.am, qa)[np.ix_(p, p)],
+                mass_matrix(pin, pm, pd, q),
+            )
+        return {f"{k}_rel_error": v for k, v in worst.items()}

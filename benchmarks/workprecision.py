@@ -1,8 +1,9 @@
 """Error against run time (work–precision) on standard problems, with peers on the same axes.
 
-``armdyn workprecision <problem> [--quick] [--out DIR]`` or :func:`run`. For each problem and
-integrator the tolerance (DOPRI5, TR-BDF2) or step (RK4, MuJoCo) is swept; each point records the
-error against an independent reference (:mod:`armdyn.references`, derived by a different method
+``python -m benchmarks.workprecision [PROBLEM ...] [--quick] [--no-peers] [--out DIR]`` (from the
+repository root) or :func:`run`. For each problem and integrator the tolerance (DOPRI5, TR-BDF2)
+or step (RK4, MuJoCo) is swept; each point records the error against an independent reference
+(:mod:`benchmarks.references`, derived by a different method
 in minimal coordinates), the CPU time of the whole solve (median of warm repeats, one warm-up
 run first) and the counters (steps, right-hand sides, KKT solves, factorisations). On trees
 (the UR5, the geared arm) armdyn's integrators also run on ``simulate(coordinates="joint")``,
@@ -14,41 +15,43 @@ same process:
 - MuJoCo (RK4 and implicit Euler at fixed steps, ``mj_step`` looping in C between outputs)
   where the problem is a tree (A01; the UR5 through MuJoCo's own URDF import);
 - Exudyn (generalized-alpha, fixed steps) on a redundant-coordinate model of the UR5
-  (:mod:`armdyn.peer_exudyn`; Exudyn's explicit solvers do not take its joint constraints);
+  (:mod:`benchmarks.peers.exudyn`; Exudyn's explicit solvers do not take its joint constraints);
 - MuJoCo (RK4, stiff ``connect`` loop closures) and Exudyn (redundant coordinates) models of the
-  closed-loop squeezer and A02 (:mod:`armdyn.peer_closed_loops`).
+  closed-loop squeezer and A02 (:mod:`benchmarks.peers.closed_loops`), and of the geared arm
+  (:mod:`benchmarks.peers.geared`).
 
 Errors are measured as in the IFToMM benchmark: the largest absolute deviation over the output
 grid of the problem's reference quantity (positions of a point [m], or angles [rad]).
 Protocol: ``../shared/design/methods.md`` §8 (Hairer–Wanner work–precision diagrams).
+Results: ``benchmarks/results/workprecision/`` (JSON and a plot per problem, and a README.md
+summary of every problem's JSON in the folder).
 """
 
 from __future__ import annotations
 
+import argparse
 import json
-import platform
-import time
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-
-from armdyn import _core, references
+from armdyn import _core, simulate
 from armdyn.reproduce import efforts_in_coord_order
 from armdyn.scenes import paper, standard
 from armdyn.scenes.geared_arm import geared_arm_6dof
-from armdyn.simulation import simulate
+
+from benchmarks import common, references
+from benchmarks.common import error, output_times, sweep_scipy
+from benchmarks.peers.mujoco import mujoco_from_urdf
+from benchmarks.peers.pinocchio import PinPair
 
 
 def _quat_angle_z(u: np.ndarray, body: int) -> np.ndarray:
     """Rotation angle about world z of a body that only turns about z (from its quaternion)."""
     e = u[:, 7 * body + 3 : 7 * body + 7]
     return 2.0 * np.arctan2(e[:, 3], e[:, 0])
-
-
-def _wrap(a):
-    return np.remainder(np.asarray(a) + np.pi, 2 * np.pi) - np.pi
 
 
 @dataclass
@@ -148,11 +151,8 @@ def _a01_check(ref):
 
 
 def _squeezer_check(ref):
-    d = _wrap(ref[-1] - references.ANDREWS_TEST_SET_T003)
+    d = common.wrap(ref[-1] - references.ANDREWS_TEST_SET_T003)
     return {"reference_vs_test_set_at_0.03_rad": float(np.abs(d).max())}
-
-
-UR5_Q0 = (0.3, -1.0, 1.2, -0.5, 0.8, 0.1)  # Pinocchio joint order, released at rest
 
 
 class _BuiltOnce:
@@ -172,14 +172,12 @@ class _Ur5(_BuiltOnce):
     joint orders."""
 
     def __init__(self):
-        from armdyn import bench
-
-        path = bench.robot_urdf("ur5")
+        path = common.robot_urdf("ur5")
         if path is None:
             raise _core.ModelError("workprecision ur5: example-robot-data is not installed")
-        self.pair = bench.PinPair(path)
+        self.pair = PinPair(path)
         self.path = path
-        self.q0 = np.array(UR5_Q0)
+        self.q0 = np.array(common.UR5_Q0)
         self._mj_perm = None
 
     def rhs(self):
@@ -207,9 +205,7 @@ class _Ur5(_BuiltOnce):
         return res.q[:, self.pair.perm]
 
     def mujoco(self):
-        from armdyn import bench
-
-        mj, perm = bench.mujoco_from_urdf(self.path, self.pair)
+        mj, perm = mujoco_from_urdf(self.path, self.pair)
         qpos0 = np.zeros(mj.nq)
         qpos0[perm] = self.q0
         self._mj_perm = perm
@@ -247,22 +243,22 @@ class _Ur5(_BuiltOnce):
 
 def _ur5_more_peers(problem, ref, quick, repeats):
     try:
-        from armdyn import peer_exudyn
+        from benchmarks.peers import exudyn
     except ImportError:
         return {}
-    return peer_exudyn.workprecision_curves(problem, ref, quick, repeats)
+    return exudyn.workprecision_curves(problem, ref, quick, repeats)
 
 
 def _closed_loop_peers(problem, ref, quick, repeats):
-    from armdyn import peer_closed_loops
+    from benchmarks.peers import closed_loops
 
-    return peer_closed_loops.workprecision_curves(problem, ref, quick, repeats)
+    return closed_loops.workprecision_curves(problem, ref, quick, repeats)
 
 
 def _geared_peers(problem, ref, quick, repeats):
-    from armdyn import peer_geared
+    from benchmarks.peers import geared
 
-    return peer_geared.workprecision_curves(problem, ref, quick, repeats)
+    return geared.workprecision_curves(problem, ref, quick, repeats)
 
 
 class _Geared(_BuiltOnce):
@@ -281,7 +277,7 @@ class _Geared(_BuiltOnce):
     def check(self, ref):
         """The reference against itself at rtol 1e-11, and its tree equations (Pinocchio, the
         motor law) against armdyn's Lagrange validator on the open tree at random states."""
-        t = _output_times(PROBLEMS["geared_arm"])
+        t = output_times(PROBLEMS["geared_arm"])
         loose = self.ref.angles(t, rtol=1e-11)
         worst = self.ref.lagrange_check((0.3, 1.7, 3.0), seed=5)
         return {
@@ -464,38 +460,8 @@ PROBLEMS: dict[str, Problem] = {
 }
 
 
-def _error(problem: Problem, obs: np.ndarray, ref: np.ndarray) -> float:
-    if obs.shape != ref.shape or not np.all(np.isfinite(obs)):
-        return float("nan")
-    d = obs - ref
-    if problem.angular:
-        d = _wrap(d)
-    return float(np.abs(d).max())
-
-
-def _cpu(fn, repeats: int):
-    """Median CPU time of ``repeats`` warm calls (after one warm-up) and the last result. A
-    first call longer than 2 s is itself the measurement: warm-up effects are below the noise
-    there, and repeating it would only cost time."""
-    t0 = time.process_time()
-    out = fn()
-    first = time.process_time() - t0
-    if first > 2.0:
-        return first, 1, out
-    times = []
-    for _ in range(repeats):
-        t0 = time.process_time()
-        out = fn()
-        times.append(time.process_time() - t0)
-    return float(np.median(times)), len(times), out
-
-
 def _repeats_for(quick: bool) -> int:
     return 3 if quick else 5
-
-
-def _output_times(problem: Problem) -> np.ndarray:
-    return np.linspace(0.0, problem.t_end, problem.n_out + 1)
 
 
 def sweep_armdyn(
@@ -522,12 +488,12 @@ def sweep_armdyn(
 
         point = {"setting": s}
         try:
-            sec, reps, res = _cpu(call, repeats)
+            sec, reps, res = common.cpu_time(call, repeats)
             obs = problem.observe(model, res)
             point.update(
                 cpu_s=sec,
                 repeats=reps,
-                error=_error(problem, obs, ref),
+                error=error(problem, obs, ref),
                 **{
                     k: res.stats[k]
                     for k in ("steps", "rejected", "rhs_evals", "kkt_solves", "factorizations")
@@ -537,60 +503,6 @@ def sweep_armdyn(
             )
         except _core.SolverError as exc:
             point.update(failed=str(exc).split(";")[0][:200], error=float("nan"))
-        points.append(point)
-    return points
-
-
-def sweep_scipy(
-    problem: Problem, method: str, rtols, ref, repeats: int = 5, rhs=None, observe=None
-) -> list[dict]:
-    """SciPy ``solve_ivp`` points (setting = rtol = atol) on ``rhs`` = (f, y0), by default the
-    problem's ``scipy_rhs()``, observed by ``observe`` (default ``scipy_observe``). A run that
-    stops early (a failed step, or an exactly singular matrix inside f) is a failed point that
-    says why, the last output time reached and the latest time f was evaluated at (a rejected
-    step's stages can lie beyond where the run got stuck)."""
-    from scipy.integrate import solve_ivp
-
-    f, y0 = rhs if rhs is not None else problem.scipy_rhs()
-    observe = observe or problem.scipy_observe
-    t_out = _output_times(problem)
-    reached = [0.0]
-
-    def f_tracked(t, y):
-        reached[0] = max(reached[0], t)
-        return f(t, y)
-
-    points = []
-    for rtol in rtols:
-
-        def call(rtol=rtol):
-            reached[0] = 0.0
-            return solve_ivp(
-                f_tracked,
-                (0.0, problem.t_end),
-                y0,
-                method=method,
-                rtol=rtol,
-                atol=rtol,
-                t_eval=t_out,
-            )
-
-        point = {"setting": rtol}
-        try:
-            sec, reps, sol = _cpu(call, repeats)
-        except np.linalg.LinAlgError as exc:
-            point.update(error=float("nan"), failed=f"at t = {reached[0]:.4g} s: {exc}"[:200])
-            points.append(point)
-            continue
-        point.update(cpu_s=sec, repeats=reps, rhs_evals=int(sol.nfev))
-        if sol.success:
-            point["error"] = _error(problem, observe(sol.y), ref)
-        else:
-            point.update(
-                error=float("nan"),
-                failed=f"stopped after the output at t = {sol.t[-1]:.4g} s (latest evaluation "
-                f"at t = {reached[0]:.4g} s): {sol.message}"[:200],
-            )
         points.append(point)
     return points
 
@@ -625,14 +537,14 @@ def sweep_mujoco(problem: Problem, integrator: str, steps, ref, repeats: int = 5
                 qpos[k + 1] = data.qpos
             return qpos
 
-        sec, reps, qpos = _cpu(call, repeats)
+        sec, reps, qpos = common.cpu_time(call, repeats)
         obs = problem.mujoco_observe(qpos)
         points.append(
             {
                 "setting": h,
                 "cpu_s": sec,
                 "repeats": reps,
-                "error": _error(problem, obs, ref),
+                "error": error(problem, obs, ref),
                 "steps": per * problem.n_out,
             }
         )
@@ -651,7 +563,7 @@ def run_problem(name: str, quick: bool = False, peers: bool = True, echo: bool =
     p = PROBLEMS[name]
     reps = _repeats_for(quick)
     sweeps = p.quick_sweeps if quick else p.sweeps
-    ref = p.reference(_output_times(p))
+    ref = p.reference(output_times(p))
     curves = {}
     for integ, settings in sweeps.items():
         curves[f"armdyn {integ}"] = sweep_armdyn(p, integ, settings, ref, reps)
@@ -758,25 +670,6 @@ def plot(result: dict, path: Path) -> None:
     plt.close(fig)
 
 
-def machine() -> dict:
-    import os
-
-    cpu = platform.processor()
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return {
-        "cpu": cpu,
-        "cores": os.cpu_count(),
-        "python": platform.python_version(),
-        "system": platform.platform(),
-    }
-
-
 def cpu_to(pts, target):
     """CPU time of the cheapest point of a curve with error <= target (None if none)."""
     ok = [q["cpu_s"] for q in pts if q.get("error", np.nan) <= target]
@@ -815,12 +708,13 @@ def summary_markdown(results: dict) -> str:
     return "\n".join(lines)
 
 
-# "all": every problem (A02 joined once its singular positions stopped falling back to the
-# dense pivoted KKT path, which took minutes per run)
-ALL = ("squeezer", "a01", "a02", "five_dof", "ur5", "geared_arm")
+ALL = ("squeezer", "a01", "a02", "five_dof", "ur5", "geared_arm")  # "all"
+OUT = common.RESULTS / "workprecision"
 
 
-def run(problems=None, out="docs/results/workprecision", quick=False, peers=True, echo=True):
+def run(problems=None, out=OUT, quick=False, peers=True, echo=True):
+    """Run the problems (``None`` or ``["all"]``: every one), write ``<problem>.json`` and
+    ``<problem>.png`` into ``out`` and a README.md summary of every problem's JSON there."""
     names = list(ALL) if not problems or problems == ["all"] else list(problems)
     outdir = Path(out)
     outdir.mkdir(parents=True, exist_ok=True)
@@ -829,9 +723,9 @@ def run(problems=None, out="docs/results/workprecision", quick=False, peers=True
         if echo:
             print(f"{name}: {PROBLEMS[name].title if name in PROBLEMS else name}")
         r = run_problem(name, quick=quick, peers=peers, echo=echo)
-        r["machine"] = machine()
-        r["command"] = "armdyn workprecision " + name + (" --quick" if quick else "")
-        (outdir / f"{name}.json").write_text(json.dumps(r, indent=1, default=float))
+        r["machine"] = common.machine()
+        r["command"] = "python -m benchmarks.workprecision " + name + (" --quick" if quick else "")
+        common.write_json(outdir / f"{name}.json", r)
         try:
             plot(r, outdir / f"{name}.png")
         except ImportError:
@@ -843,3 +737,26 @@ def run(problems=None, out="docs/results/workprecision", quick=False, peers=True
         saved[path.stem] = json.loads(path.read_text())
     (outdir / "README.md").write_text(summary_markdown(saved))
     return results
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(
+        prog="python -m benchmarks.workprecision",
+        description="Error against CPU time on the standard problems, with peers.",
+    )
+    parser.add_argument(
+        "problems",
+        nargs="*",
+        default=["all"],
+        help=f"{', '.join(ALL)}, or all (every one; a02 and geared_arm take minutes)",
+    )
+    parser.add_argument("--out", default=str(OUT), help="folder for JSON + PNG + README.md")
+    parser.add_argument("--quick", action="store_true", help="two points per curve")
+    parser.add_argument("--no-peers", action="store_true", help="armdyn's curves only")
+    args = parser.parse_args(argv)
+    run(args.problems, out=args.out, quick=args.quick, peers=not args.no_peers)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

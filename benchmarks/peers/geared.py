@@ -1,9 +1,11 @@
 """MuJoCo and Exudyn peer models of the backlash-free geared arm (``geared_arm_6dof(backlash=0)``,
-44 bodies, six PD motors behind two-stage gear trains), for ``armdyn workprecision geared_arm``.
+44 bodies, six PD motors behind two-stage gear trains), for
+``python -m benchmarks.workprecision geared_arm``.
 
 Both peers are minimal-coordinate models of the same open tree as the reference
-(:class:`armdyn.references.GearedArmReference`): the 18 revolute joints (six arm joints, six
-intermediate shafts, six rotors) of the Pinocchio model :func:`armdyn.peer_pinocchio.pinocchio_tree`
+(:class:`benchmarks.references.GearedArmReference`): the 18 revolute joints (six arm joints, six
+intermediate shafts, six rotors) of the Pinocchio model
+:func:`benchmarks.peers.pinocchio.pinocchio_tree`
 builds from the scene's bodies, each Pinocchio joint carrying the composite inertia of the bodies
 welded to it. The twelve gear meshes are constraints between joint coordinates, from the scene's
 pitch radii (:data:`armdyn.scenes.geared_arm.JOINTS`): q_motor = -(R1/r1) q_shaft and
@@ -15,30 +17,31 @@ MuJoCo (:class:`MujocoGeared`)
     ``hinge`` about z and an ``<inertial>`` (mass, centre of mass, ``fullinertia``) from
     ``pm.inertias``; no geoms, contacts off. Each gear mesh is an ``<equality><joint>`` with
     ``polycoef`` = (0, ratio, 0, 0, 0), softened like the closed-loop peers
-    (:mod:`armdyn.peer_closed_loops`: ``solimp`` 0.9999 everywhere, ``solref`` = (2 h, 1)). Each
-    motor is a ``<general>`` actuator on its rotor with gain 1 and affine bias
+    (:mod:`benchmarks.peers.closed_loops`: ``solimp`` 0.9999 everywhere, ``solref`` = (2 h,
+    1)). Each motor is a ``<general>`` actuator on its rotor with gain 1 and affine bias
     (0, -kp, -kd), ``forcerange`` +-limit: force = ctrl - kp q - kd q' clamped, so the PD law is
     evaluated by MuJoCo at every RK4 stage with the stage's state; only the time-dependent part
     ctrl = kp N ref(t) + kd N ref'(t) comes from outside. ``control="midpoint"`` (the peer's
     curve) sets ctrl before each step to its value at the step's midpoint t + h/2 and holds it
     over the step (a midpoint rule: O(h^2), the order of the soft constraints' error);
     ``control="stage"`` sets it at every stage's own time from a ``mjcb_control`` callback (exact,
-    but a Python call per stage). ``python -m armdyn.peer_geared`` runs both at the same steps.
+    but a Python call per stage). ``python -m benchmarks.peers.geared`` runs both at the same
+    steps.
     Solver: RK4 at fixed steps. The explicit step is bounded by the motors' damping on the
     light rotors (about 5400 1/s, as for armdyn's explicit methods): RK4 is stable up to
     h ~ 2.8 / 5400 ~ 5e-4 s.
 
 Exudyn (:class:`ExudynGeared`)
-    One ``ObjectKinematicTree`` (minimal coordinates, :class:`armdyn.peer_exudyn.ExudynTreeArm`)
-    with the 18 joints, each gear mesh an ``ObjectConnectorCoordinate`` (``factor1`` = ratio)
-    between two ``MarkerNodeCoordinate`` of the tree's node, and the motor law the tree's
-    ``forceUserFunction`` (a Python function of t, q, q' called at every evaluation). A
-    redundant-coordinate model (rigid bodies with Euler parameters, as the UR5 and closed-loop
-    peers) is not available here: Exudyn has no gear element between rigid bodies, and a gear
-    couples *relative* joint angles, which are not coordinates of such a model. Exudyn's
-    explicit solvers refuse the coordinate constraints ("explicit integrator detected
-    CoordinateConstraint object ... that does not have one ground node"), so the curves are its
-    implicit 'GeneralizedAlpha' (spectral radius 0.9) and 'TrapezoidalIndex2' at fixed steps,
+    One ``ObjectKinematicTree`` (minimal coordinates,
+    :class:`benchmarks.peers.exudyn.ExudynTreeArm`) with the 18 joints, each gear mesh an
+    ``ObjectConnectorCoordinate`` (``factor1`` = ratio) between two ``MarkerNodeCoordinate`` of the
+    tree's node, and the motor law the tree's ``forceUserFunction`` (a Python function of t, q, q'
+    called at every evaluation). A redundant-coordinate model (rigid bodies with Euler parameters,
+    as the UR5 and closed-loop peers) is not available here: Exudyn has no gear element between
+    rigid bodies, and a gear couples *relative* joint angles, which are not coordinates of such a
+    model. Exudyn's explicit solvers refuse the coordinate constraints ("explicit integrator
+    detected CoordinateConstraint object ... that does not have one ground node"), so the curves are
+    its implicit 'GeneralizedAlpha' (spectral radius 0.9) and 'TrapezoidalIndex2' at fixed steps,
     Newton relative tolerance 1e-10, as for the other Exudyn peers.
 
 The torque limit (10 N m) is never reached on this run (the largest PD torque is below 4 N m), so
@@ -51,9 +54,9 @@ exact at any velocity) and Exudyn's own initial-acceleration solve, at a moving 
 motion, equal the reference's gear-reduced Pinocchio accelerations; and the errors of both fall
 with the step.
 
-CPU time: the median of warm repeats (``workprecision._cpu``) of the stepping alone, the Python
-loop that sets ctrl (MuJoCo) and the force user function (Exudyn) included, since they are part
-of running these models. Building and compiling the models is not timed.
+CPU time: the median of warm repeats (:func:`benchmarks.common.cpu_time`) of the stepping alone, the
+Python loop that sets ctrl (MuJoCo) and the force user function (Exudyn) included, since they are
+part of running these models. Building and compiling the models is not timed.
 """
 
 from __future__ import annotations
@@ -61,8 +64,10 @@ from __future__ import annotations
 import contextlib
 
 import numpy as np
+from armdyn.scenes.geared_arm import JOINTS
 
-from armdyn.peer_closed_loops import (
+from benchmarks import common
+from benchmarks.peers.closed_loops import (
     NEWTON_RTOL,
     SOLIMP,
     SPECTRAL_RADIUS,
@@ -71,9 +76,8 @@ from armdyn.peer_closed_loops import (
     sweep_exudyn,
     sweep_mujoco_rk4,
 )
-from armdyn.peer_exudyn import _exudyn, implicit_settings, solve_checked
-from armdyn.references import GearedArmReference, _quintic
-from armdyn.scenes.geared_arm import JOINTS
+from benchmarks.peers.exudyn import _exudyn, implicit_settings, solve_checked
+from benchmarks.references import GearedArmReference, _quintic
 
 ARM = tuple(j[0] for j in JOINTS)
 CONTROLS = ("midpoint", "stage")
@@ -271,7 +275,7 @@ class ExudynGeared:
     gears and the motor law as its force user function (module docstring)."""
 
     def __init__(self, ref=None):
-        from armdyn.peer_exudyn import ExudynTreeArm
+        from benchmarks.peers.exudyn import ExudynTreeArm
 
         self.ref = _reference() if ref is None else ref
         self.motors = _Motors(self.ref)
@@ -369,12 +373,12 @@ class ExudynGeared:
         return solve
 
 
-# -- armdyn workprecision hook ----------------------------------------------------------------
+# -- work-precision hook ----------------------------------------------------------------------
 
 
 def workprecision_curves(problem, ref, quick: bool, repeats: int) -> dict:
-    """Curves for ``armdyn workprecision geared_arm``: MuJoCo RK4 (midpoint control) and Exudyn
-    GeneralizedAlpha / TrapezoidalIndex2, each only if its package imports."""
+    """Curves for ``python -m benchmarks.workprecision geared_arm``: MuJoCo RK4 (midpoint
+    control) and Exudyn GeneralizedAlpha / TrapezoidalIndex2, each only if its package imports."""
     curves = {}
     reference = None
     with contextlib.suppress(ImportError):
@@ -413,8 +417,6 @@ def main() -> None:
     """Checks against the reference and a short convergence table (both MuJoCo controls)."""
     import time
 
-    from armdyn import workprecision as wp
-
     ref = _reference()
     p, pd, t = moving_state(ref)
     q, qd = ref.T @ p, ref.T @ pd
@@ -431,8 +433,8 @@ def main() -> None:
         ("Exudyn initial accelerations", exu_acc),
     ):
         print(f"{what + ' vs reference:':52s}{np.abs(acc - expect).max() / scale:.2e}")
-    problem = wp.PROBLEMS["geared_arm"]
-    t_out = np.linspace(0.0, problem.t_end, problem.n_out + 1)
+    t_end, n_out = 5.0, 100  # the geared_arm problem's run and output grid
+    t_out = np.linspace(0.0, t_end, n_out + 1)
     angles = ref.angles(t_out)
     for control in CONTROLS:
         peer = MujocoGeared(ref, control)
@@ -440,9 +442,9 @@ def main() -> None:
             peer.set_step(h)
             data = peer.mujoco.MjData(peer.model)
             t0 = time.process_time()
-            qpos = peer.run(data, problem.t_end, problem.n_out)
+            qpos = peer.run(data, t_end, n_out)
             cpu = time.process_time() - t0
-            err = wp._error(problem, peer.observe(qpos), angles)
+            err = common.max_error(peer.observe(qpos), angles, angular=True)
             print(f"MuJoCo rk4 control={control:8s} h = {h:.1e}: error {err:.2e}, CPU {cpu:.2f} s")
 
 

@@ -1,5 +1,6 @@
-"""MuJoCo and Exudyn peer models of the closed-loop standard problems: Andrews' squeezer and the
-IFToMM A02 N-four-bar, for ``armdyn workprecision squeezer`` and ``armdyn workprecision a02``.
+"""MuJoCo, Exudyn and SciPy-on-Pinocchio peer models of the closed-loop standard problems:
+Andrews' squeezer and the IFToMM A02 N-four-bar (``python -m benchmarks.workprecision squeezer``
+and ``... a02``).
 
 Both mechanisms are planar; every peer model is built from the same data as armdyn's
 (:data:`armdyn.scenes.standard.SQUEEZER`, :func:`~armdyn.scenes.standard.squeezer_points`, the A02
@@ -28,28 +29,12 @@ MuJoCo (:func:`mujoco_squeezer`, :func:`mujoco_a02`)
     with the regulariser R = (1 - d) / d * diag(J M^-1 J^T), and the impedance d is clamped to
     mjMAXIMP = 0.9999, so they can be made stiff but never exact. Settings: ``solimp`` =
     (0.9999, 0.9999, 0.001, 0.5, 2) (d = 0.9999 everywhere, the most MuJoCo allows) and
-    ``solref`` = (2 h, 1): time constant twice the step, critically damped, set again for every
-    step size. 2 h is the smallest time constant MuJoCo's ``refsafe`` flag allows, and it is
-    also the best of the choices tried by hand while building this module (time constant h with
-    ``refsafe`` off, fixed time constants from 2e-6 s to 4e-5 s: each gave a larger error at the
-    same step or went unstable; those trial runs are not kept in the repository). A fixed time
-    constant leaves a violation floor whatever the step (k = 1 / timeconst^2 sets the loop
-    violation, and MuJoCo leaves (dJ/dt) v out of the constraint acceleration). So the
-    constraint error shrinks like h^2 with the step and RK4's curves fall at second order once
-    that dominates. The "direct" form solref = (-k, -b) with
-    k = 1 / (2h)^2, b = 2 / (2h) is the same law. Newton solver, default tolerance (equality
-    constraints only: it takes one iteration; a tolerance of 1e-12 does not change the error). A
-    run whose accelerations blow up (MuJoCo then resets the state and warns ``mjWARN_BADQACC``)
-    is a failed point. The curves come through the Problem's ``more_peers`` hook, not
-    ``workprecision.sweep_mujoco``, because the time constant changes with every step and the
-    steps must suit each problem's time scale.
-
-    Checks (tests/test_peer_closed_loops.py): at t = 0 the hard-constraint accelerations from
-    MuJoCo's own terms (``mj_fullM``, ``qfrc_smooth``, ``efc_J``; KKT solve) equal the reference
-    ODE's to 1.8e-12 relative, i.e. geometry, masses, inertias, spring and torque are the same
-    mechanism; MuJoCo's own (soft) ``qacc`` differs by 1.3e-3 of the largest acceleration, which
-    is the impedance bound, not a modelling difference (so the suggested 1e-6 agreement of
-    qacc cannot be met by any MuJoCo setting); and the error falls under step refinement.
+    ``solref`` = (2 h, 1): time constant twice the step (the smallest MuJoCo's ``refsafe`` flag
+    allows), critically damped, set again for every step size, so the constraint error shrinks
+    like h^2 with the step. Newton solver, default tolerance. A run whose accelerations blow up
+    (MuJoCo then resets the state and warns ``mjWARN_BADQACC``) is a failed point. The curves
+    come through the problem's ``more_peers`` hook, not ``workprecision.sweep_mujoco``, because
+    the time constant changes with every step and the steps must suit each problem's time scale.
 
 Exudyn (:func:`exudyn_squeezer`, :func:`exudyn_a02`)
     Redundant (absolute) coordinates: one ``NodeRigidBody2D`` (x, y, theta of the centre of
@@ -64,24 +49,12 @@ Exudyn (:func:`exudyn_squeezer`, :func:`exudyn_a02`)
     Solvers: 'GeneralizedAlpha' (index 3, spectral radius 0.9 as for the UR5 peer) and
     'TrapezoidalIndex2' (index 2), both second order at fixed steps (Exudyn has no error control
     for implicit solvers, and its explicit ones refuse constraints: see
-    :mod:`armdyn.peer_exudyn`). Newton relative tolerance 1e-10 (absolute 1e-12), Exudyn's
+    :mod:`benchmarks.peers.exudyn`). Newton relative tolerance 1e-10 (absolute 1e-12), Exudyn's
     default modified Newton; ``EXUdense`` for the 41 unknowns of the squeezer, ``EigenSparse``
     for the 485 of A02. The angles come from node sensors sampled on the output grid, each
-    sample checked to lie on it. A02: GeneralizedAlpha passes the singular positions without
-    ``linearSolver.ignoreSingularJacobian`` (the steps never land exactly on them and the factor
-    never fails), so it stays off and a singular factor would show as a failure;
-    TrapezoidalIndex2 passes the first singular position (t ≈ 0.72 s) and fails in Newton (step
-    reduction is unavailable at fixed steps) at the second, t ≈ 1.244 s, at every step of the
-    sweep; GeneralizedAlpha fails the
-    same way at two of its steps (a02.json lists where and why). Hand trials while building this
-    module (with ``ignoreSingularJacobian``, full Newton, Newton tolerances 1e-6 to 1e-10; not
-    kept in the repository) did not get TrapezoidalIndex2 through. Failed runs are recorded as
-    failed points with the reason. The measured curves: ``armdyn workprecision a02``
-    (docs/results/workprecision).
-
-    Checks: Exudyn's own initial-acceleration solve (``computeInitialAccelerations`` in
-    ``InitializeSolver``) gives the reference's squeezer accelerations to 1e-14 relative and
-    A02's crank acceleration -c cos(phi0) to round-off; the errors fall at second order.
+    sample checked to lie on it. ``linearSolver.ignoreSingularJacobian`` stays off, so a
+    singular factor at A02's flat positions shows as a failure. Failed runs are recorded as
+    failed points with the reason.
 
 SciPy on Pinocchio (:class:`PinocchioA02`, A02 only)
     What a SciPy user writes for a closed loop on Pinocchio: the open tree (cranks on the world,
@@ -91,26 +64,22 @@ SciPy on Pinocchio (:class:`PinocchioA02`, A02 only)
     on the dense KKT matrix at every evaluation and integrated by ``solve_ivp`` (DOP853). This is
     the SciPy peer of A02: the SciPy curve of ``workprecision.PROBLEMS['a02']`` integrates the
     reference's own one-DOF equation, which presumes the motion, and is marked as not a peer.
-    At the flat positions the KKT matrix is singular; DOP853's step then collapses
-    ("Required step size is less than spacing between numbers"), and each run is a failed point
-    with the time it reached. Pinocchio's own ``constraintDynamics`` (proximal, 3-D contacts, so
-    the out-of-plane rows are redundant) and a minimum-norm solve (``lstsq``) were tried by hand
-    while building this class: the first ran for minutes without reaching 20 s at rtol 1e-4, the
-    second diverged at the first flat position (not kept in the repository).
+    At the flat positions the KKT matrix is singular; a run that stops there is a failed point
+    with the time it reached.
 
-    Check (tests/test_peer_closed_loops.py): in motion on the branch at phi = 0.7 rad, every
-    crank's acceleration equals the reference's -c cos(phi) and every coupler's relative one
-    its negative, to 1e-10 relative.
+Checks (tests/test_peer_closed_loops.py): the hard-constraint accelerations from MuJoCo's own
+terms (``mj_fullM``, ``qfrc_smooth``, ``efc_J``; KKT solve), Exudyn's own initial-acceleration
+solve and PinocchioA02's accelerations equal the references'; the errors fall under step
+refinement.
 
-What cannot be done: no exact (hard) constraints and no error-controlled step in MuJoCo; no error
-control and no explicit method on a constrained model in Exudyn; TrapezoidalIndex2 on A02.
+CPU time: the median of warm repeats (:func:`benchmarks.common.cpu_time`) of the stepping alone:
+MuJoCo ``mj_resetData`` + ``mj_step`` between outputs, Exudyn ``SolveDynamic`` on an assembled
+system (which restarts from the initial state each time) + reading its sensors. Building and
+compiling the models is not timed.
 
-CPU time: the median of warm repeats (``workprecision._cpu``) of the stepping alone: MuJoCo
-``mj_resetData`` + ``mj_step`` between outputs, Exudyn ``SolveDynamic`` on an assembled system
-(which restarts from the initial state each time) + reading its sensors. Building and compiling
-the models is not timed.
-
-``python -m armdyn.peer_closed_loops`` prints the checks and a short convergence table.
+``python -m benchmarks.peers.closed_loops`` prints the checks and a short convergence table.
+Measured figures and the settings tried while building these models:
+``benchmarks/results/peer_notes.md``.
 """
 
 from __future__ import annotations
@@ -119,10 +88,11 @@ import contextlib
 import time
 
 import numpy as np
-
-from armdyn.peer_exudyn import _exudyn, implicit_settings, solve_checked
-from armdyn.peer_pinocchio import mass_matrix
 from armdyn.scenes import standard
+
+from benchmarks import common
+from benchmarks.peers.exudyn import _exudyn, implicit_settings, solve_checked
+from benchmarks.peers.pinocchio import mass_matrix
 
 SQUEEZER_JOINTS = ("beta", "Theta", "gamma", "Phi", "delta", "Omega", "epsilon")
 A02_N = 40  # the workprecision problem's N
@@ -623,26 +593,24 @@ def exudyn_a02(n: int = A02_N, phi0: float = np.pi / 2, speed: float = 1.0) -> E
     )
 
 
-# -- armdyn workprecision hook ----------------------------------------------------------------
+# -- work-precision hook ----------------------------------------------------------------------
 
 
 def sweep_mujoco_rk4(problem, peer: MujocoPeer, steps, ref, repeats: int) -> list[dict]:
     """MuJoCo RK4 points (setting = step size h; constraint time constant 2 h)."""
-    from armdyn import workprecision as wp
-
     points = []
     for h in steps:
         point = {"setting": float(h), "steps": round(problem.t_end / h)}
         try:
             peer.set_step(h)
             data = peer.mujoco.MjData(peer.model)
-            sec, reps, qpos = wp._cpu(
+            sec, reps, qpos = common.cpu_time(
                 lambda d=data: peer.run(d, problem.t_end, problem.n_out), repeats
             )
             point.update(
                 cpu_s=sec,
                 repeats=reps,
-                error=wp._error(problem, peer.observe(qpos), ref),
+                error=common.error(problem, peer.observe(qpos), ref),
                 constraint_timeconst=TIMECONST_STEPS * float(h),
                 max_position_residual=peer.loop_residual(qpos),
             )
@@ -654,18 +622,16 @@ def sweep_mujoco_rk4(problem, peer: MujocoPeer, steps, ref, repeats: int) -> lis
 
 def sweep_exudyn(problem, peer: ExudynPeer, method: str, n_steps, ref, repeats: int) -> list[dict]:
     """Exudyn points (setting = step size t_end / n)."""
-    from armdyn import workprecision as wp
-
     points = []
     for n in n_steps:
         point = {"setting": problem.t_end / n, "steps": int(n)}
         try:
             solve = peer.runner(problem.t_end, problem.n_out, n, method)
-            sec, reps, (obs, stats) = wp._cpu(solve, repeats)
+            sec, reps, (obs, stats) = common.cpu_time(solve, repeats)
             point.update(
                 cpu_s=sec,
                 repeats=reps,
-                error=wp._error(problem, obs, ref),
+                error=common.error(problem, obs, ref),
                 newton_iterations=stats["newton_iterations"],
                 jacobians=stats["jacobians"],
             )
@@ -676,7 +642,7 @@ def sweep_exudyn(problem, peer: ExudynPeer, method: str, n_steps, ref, repeats: 
 
 
 def workprecision_curves(problem, ref, quick: bool, repeats: int) -> dict:
-    """Curves for ``armdyn workprecision squeezer`` and ``a02``: MuJoCo RK4 and Exudyn
+    """Curves for ``python -m benchmarks.workprecision squeezer`` and ``a02``: MuJoCo RK4 and Exudyn
     GeneralizedAlpha / TrapezoidalIndex2, each only if its package imports."""
     if problem.name == "squeezer":
         make_mj, make_exu = mujoco_squeezer, exudyn_squeezer
@@ -707,9 +673,7 @@ def workprecision_curves(problem, ref, quick: bool, repeats: int) -> dict:
         with contextlib.suppress(ImportError):
             import pinocchio  # noqa: F401
 
-            from armdyn.workprecision import sweep_scipy
-
-            curves["SciPy DOP853 on Pinocchio (index 1, Baumgarte)"] = sweep_scipy(
+            curves["SciPy DOP853 on Pinocchio (index 1, Baumgarte)"] = common.sweep_scipy(
                 problem,
                 "DOP853",
                 A02_SCIPY_QUICK if quick else A02_SCIPY_RTOLS,
@@ -824,7 +788,7 @@ class PinocchioA02:
 
 def main() -> None:
     """The peer models against the references: initial accelerations and short sweeps."""
-    from armdyn import references
+    from benchmarks import references
 
     f, y0 = references.squeezer_rhs()
     a_ref = f(0.0, y0)[7:]

@@ -10,15 +10,15 @@ Each is derived by hand in minimal coordinates, not from the Cartesian model:
   at every right-hand side), integrated with SciPy's DOP853 at rtol 1e-13. The Test Set's
   published end values at t = 0.03 s check it (``ANDREWS_TEST_SET_T003``).
 
-The same right-hand sides serve as the SciPy peer in :mod:`armdyn.workprecision`.
+The same right-hand sides serve as the SciPy peer in :mod:`benchmarks.workprecision`.
 """
 
 from __future__ import annotations
 
 import numpy as np
-
-from armdyn.peer_pinocchio import mass_matrix, pinocchio_tree
 from armdyn.scenes.standard import SQUEEZER, G
+
+from benchmarks.peers.pinocchio import mass_matrix, pinocchio_tree
 
 # --- A01 ------------------------------------------------------------------------------------
 
@@ -235,7 +235,7 @@ def _quintic(t: float, y1, t0: float, t1: float):
 class GearedArmReference:
     """The backlash-free geared arm (``geared_arm_6dof(backlash=0)``, 44 bodies) in its six arm
     joint angles p, by a second library: Pinocchio's CRBA and RNEA on the open tree of the same
-    bodies (:func:`armdyn.peer_pinocchio.pinocchio_tree` of ``ideal_gears=False``: rotors and
+    bodies (:func:`benchmarks.peers.pinocchio.pinocchio_tree` of ``ideal_gears=False``: rotors and
     shafts free), reduced by the gear ratios. Each train's rolling conditions
     r1 q_motor + R1 q_shaft = 0 and r2 q_shaft + R2 q_joint = 0 give q = T p with a constant T,
     so T^T M(Tp) T p'' = T^T (Q - b(Tp, Tp')): M from CRBA, b (gravity, Coriolis, centrifugal)
@@ -247,7 +247,6 @@ class GearedArmReference:
         import inspect
 
         import pinocchio as pin
-
         from armdyn.scenes.geared_arm import JOINTS, geared_arm_6dof
 
         defaults = {k: v.default for k, v in inspect.signature(geared_arm_6dof).parameters.items()}
