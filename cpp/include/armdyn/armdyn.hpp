@@ -1,0 +1,36 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// armdyn: the supported C++ API in one include. Link armdyn::core (find_package(armdyn)).
+//
+//   armdyn::ModelBuilder b;                      // bodies, joints, drives, force elements
+//   armdyn::ModelPtr model = b.finalize();       // the immutable Model, assembled
+//   armdyn::JointSpaceForwardDynamics fd(model); // qdd = FD(q, qd, tau)
+//   armdyn::JointSpaceInverseDynamics id(model); // tau = ID(q, qd, qdd)
+//   armdyn::SimResult r = armdyn::simulate(*model, t_end, options, model->u0, model->v0);
+#pragma once
+
+// errors and math
+#include "armdyn/errors.hpp"
+#include "armdyn/math/angles.hpp"
+#include "armdyn/math/quaternion.hpp"
+#include "armdyn/math/types.hpp"
+
+// model description
+#include "armdyn/model/builder.hpp"
+#include "armdyn/model/model.hpp"
+#include "armdyn/model/profile.hpp"
+
+// URDF import
+#include "armdyn/io/urdf.hpp"
+
+// the Cartesian pipeline: kinematics, constraints, KKT, engine, integrators
+#include "armdyn/solver/engine.hpp"
+#include "armdyn/solver/integrators.hpp"
+
+// joint-space algorithms and whole runs
+#include "armdyn/analysis/inverse_dynamics.hpp"
+#include "armdyn/analysis/joint_space.hpp"
+#include "armdyn/analysis/simulate.hpp"
+#include "armdyn/analysis/tree_dynamics.hpp"
+
+// validators independent of the Cartesian path
+#include "armdyn/validate/validators.hpp"

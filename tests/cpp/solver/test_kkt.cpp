@@ -1,0 +1,103 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The KKT solver (armdyn/solver/kkt.hpp) against a dense LU of the augmented system, on a
+// spatial tree, a closed loop, and a model with redundant rows (the pivoted path).
+#include <cmath>
+
+#include "armdyn/analysis/joint_space.hpp"
+#include "armdyn/solver/engine.hpp"
+#include "armdyn/solver/kkt.hpp"
+#include "check.hpp"
+#include "models.hpp"
+
+using namespace armdyn;
+
+namespace {
+
+/// A moving state of m: the assembled pose with velocities projected onto zeta v = 0.
+void moving_state(const Model& m, Engine& e, VecX& u, VecX& v) {
+  u = m.u0;
+  v.resize(m.nv);
+  for (int i = 0; i < m.nv; ++i) v[i] = 0.8 * std::cos(0.9 * i + 0.4);
+  e.project(0.0, u.data(), v.data(), Metric::Mass);
+}
+
+void compare_with_dense(const ModelPtr& m) {
+  Engine e(*m);
+  VecX u, v;
+  moving_state(*m, e, u, v);
+  // Engine::dynamics fills the constraints, eta and the KKT factor at (u, v)
+  VecX vdot(m->nv);
+  e.dynamics(0.0, u.data(), v.data(), vdot.data());
+  VecX vref, dref;
+  armdyn_test::dense_kkt(*m, e.constraints(), e.eta(), m->nc, vref, dref);
+  CHECK_MAT_NEAR(vdot, vref, 1e-10);
+  // zeta^T delta is unique even when delta is not (redundant rows)
+  const MatX z = dense_zeta(*m, e.constraints());
+  CHECK_MAT_NEAR(z.transpose() * e.delta(), z.transpose() * dref, 1e-9);
+  // the solver on its own, from the same evaluation
+  KktSolver k(*m);
+  k.factor(e.constraints(), m->nc, Metric::Mass);
+  VecX vd2(m->nv), d2(m->nc);
+  k.accelerations(e.constraints(), e.eta(), vd2, d2);
+  CHECK_MAT_NEAR(vd2, vref, 1e-10);
+  // the accelerations satisfy the constraint level: zeta vdot = -xi
+  CHECK_MAT_NEAR(z * vdot, -e.constraints().xi, 1e-9);
+}
+
+}  // namespace
+
+TEST_CASE(tree_matches_dense_lu) {
+  compare_with_dense(armdyn_test::spatial_arm_builder().finalize());
+}
+
+TEST_CASE(closed_loop_matches_dense_lu) {
+  ModelBuilder b;
+  const Mat3 in = Vec3(0.01, 0.02, 0.015).asDiagonal();
+  b.add_body("crank", 1.0, in, Vec3(0, 0, 0.25), armdyn_test::kIdentityQuat);
+  b.add_body("coupler", 2.0, in, Vec3(0.5, 0, 0.5), armdyn_test::kIdentityQuat);
+  b.add_body("rocker", 1.5, in, Vec3(1.0, 0, 0.3), armdyn_test::kIdentityQuat);
+  b.add_revolute("A", "ground", "crank", Vec3(0, 0, 0), Vec3::UnitY());
+  b.add_revolute("B", "crank", "coupler", Vec3(0, 0, 0.5), Vec3::UnitY());
+  b.add_revolute("D", "ground", "rocker", Vec3(1, 0, 0.1), Vec3::UnitY());
+  b.add_inline("C", "rocker", "coupler", Vec3(1, 0, 0.5), Vec3::UnitY());
+  compare_with_dense(b.finalize());
+}
+
+TEST_CASE(redundant_rows_take_the_pivoted_path) {
+  // the same loop closed by a revolute: 3 of its rows repeat what the planar loop implies
+  ModelBuilder b;
+  const Mat3 in = Vec3(0.01, 0.02, 0.015).asDiagonal();
+  b.add_body("crank", 1.0, in, Vec3(0, 0, 0.25), armdyn_test::kIdentityQuat);
+  b.add_body("coupler", 2.0, in, Vec3(0.5, 0, 0.5), armdyn_test::kIdentityQuat);
+  b.add_body("rocker", 1.5, in, Vec3(1.0, 0, 0.3), armdyn_test::kIdentityQuat);
+  b.add_revolute("A", "ground", "crank", Vec3(0, 0, 0), Vec3::UnitY());
+  b.add_revolute("B", "crank", "coupler", Vec3(0, 0, 0.5), Vec3::UnitY());
+  b.add_revolute("D", "ground", "rocker", Vec3(1, 0, 0.1), Vec3::UnitY());
+  b.add_revolute("C", "rocker", "coupler", Vec3(1, 0, 0.5), Vec3::UnitY());
+  const ModelPtr m = b.finalize();
+  CHECK(m->redundant);
+  CHECK(m->mobility == 1);
+  compare_with_dense(m);
+}
+
+TEST_CASE(schur_solve_with_identity_metric) {
+  // A = zeta zeta^T (the unweighted projection's metric)
+  const ModelPtr m = armdyn_test::spatial_arm_builder().finalize();
+  Engine e(*m);
+  e.load(m->u0.data(), nullptr);
+  VecX vdot(m->nv);
+  e.dynamics(0.0, m->u0.data(), m->v0.data(), vdot.data());
+  KktSolver k(*m);
+  k.factor(e.constraints(), m->nc, Metric::Identity);
+  CHECK(k.metric() == Metric::Identity);
+  const MatX z = dense_zeta(*m, e.constraints());
+  const VecX b = VecX::LinSpaced(m->nc, 1.0, -0.5);
+  VecX x(m->nc);
+  k.solve_schur(b, x);
+  CHECK_MAT_NEAR((z * z.transpose()) * x, b, 1e-10);
+  VecX y = VecX::LinSpaced(m->nv, -1.0, 1.0), wy(m->nv);
+  k.apply_winv(y, wy);
+  CHECK_MAT_NEAR(wy, y, 0.0);
+}
+
+ARMDYN_TEST_MAIN()
