@@ -1,21 +1,30 @@
-"""Dense Schur Cholesky against the block elimination at small sizes: forward dynamics per call
+"""Dense Schur Cholesky against the block elimination at small sizes: forward dynamics per state
 on random spatial chains of n revolute links (5 rows each), `model.with_kkt_path("dense")`
-against the path finalize() picks, in the C++ timing loop. This measurement is why no model
-is put on the dense path for being small (block_sparse.hpp).
+against the path finalize() picks, through the public
+``armdyn.forward_dynamics(..., method="cartesian")`` on a batch of states (one C++ loop). This
+measurement is why no model is put on the dense path for being small (block_sparse.hpp).
 
     python benchmarks/kkt_paths.py
 """
 
 from __future__ import annotations
 
+import time
+
+import armdyn as ad
 import numpy as np
-from armdyn import _core, scenes
+from armdyn import scenes
 
 
 def per_call(model, n, count=20000):
-    fd = _core.JointSpaceForwardDynamics(model)
-    q = np.linspace(0.1, 0.5, n)
-    return float(np.median([_core._time_forward_loop(fd, q, q, q, count) for _ in range(5)]))
+    """Median seconds per state of forward dynamics on the KKT path, over 5 batches."""
+    q = np.tile(np.linspace(0.1, 0.5, n), (count, 1))
+    times = []
+    for _ in range(5):
+        t0 = time.perf_counter()
+        ad.forward_dynamics(model, q, q, q, method="cartesian")
+        times.append((time.perf_counter() - t0) / count)
+    return float(np.median(times))
 
 
 def main():

@@ -52,7 +52,7 @@ def _urdf(joint: str, links: str = URDF_LINKS) -> str:
 
 def _slider_crank_dead_centre():
     model = ad.scenes.slider_driven_to_dead_centre()
-    return ad.inverse_dynamics(model, t=np.linspace(0.0, 1.0, 11))
+    return ad.driven_inverse_dynamics(model, np.linspace(0.0, 1.0, 11))
 
 
 def _nan_force_run():
@@ -431,7 +431,7 @@ CASES = [
         "acc-u-length",
         "arrays",
         "accelerations with u of length 5",
-        lambda: ad.accelerations(_pendulum(), np.zeros(5), np.zeros(6)),
+        lambda: ad.body_accelerations(_pendulum(), np.zeros(5), np.zeros(6)),
         ME,
         r"\bu\b",
     ),
@@ -521,7 +521,7 @@ CASES = [
         "id-under-driven",
         "inverse dynamics",
         "driven inverse dynamics of an undriven model",
-        lambda: ad.inverse_dynamics(_pendulum(), t=[0.0, 1.0]),
+        lambda: ad.driven_inverse_dynamics(_pendulum(), [0.0, 1.0]),
         ME,
         "hinge",
     ),
@@ -529,7 +529,7 @@ CASES = [
         "id-times",
         "inverse dynamics",
         "times not increasing",
-        lambda: ad.inverse_dynamics(_driven(), t=[0.0, 0.5, 0.5]),
+        lambda: ad.driven_inverse_dynamics(_driven(), [0.0, 0.5, 0.5]),
         ME,
         "increase",
     ),

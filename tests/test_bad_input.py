@@ -264,9 +264,9 @@ def test_state_from_joints_wrong_length(pendulum):
 
 def test_accelerations_wrong_state_length(pendulum):
     with pytest.raises(ad.ModelError, match=r"\bu\b"):
-        ad.accelerations(pendulum, np.zeros(5), np.zeros(6))
+        ad.body_accelerations(pendulum, np.zeros(5), np.zeros(6))
     with pytest.raises(ad.ModelError, match=r"\bv\b"):
-        ad.accelerations(pendulum, np.asarray(pendulum.u0), np.zeros(5))
+        ad.body_accelerations(pendulum, np.asarray(pendulum.u0), np.zeros(5))
 
 
 # ----------------------------------------------------------------------------------------------

@@ -32,9 +32,9 @@ def test_bricard_mobility_motion_and_symmetry():
     assert np.max(np.abs(q[:, [3, 5]] - q[:, [1]])) <= 1e-8
     # reactions are the minimum-norm ones: delta = pinv(zeta^T) (eta - Gamma vdot)
     u, v = res.u[10], res.v[10]
-    vdot, delta = ad.accelerations(model, u, v)
+    vdot, delta = ad.body_accelerations(model, u, v)
     zeta = np.asarray(ad.evaluate_constraints(model, u, v)["zeta"])
-    rhs = np.asarray(ad.generalized_forces(model, u, v)) - ad.mass_matrix(model) @ vdot
+    rhs = np.asarray(ad.body_forces(model, u, v)) - ad.body_mass_matrix(model) @ vdot
     assert rel_err(delta, np.linalg.pinv(zeta.T, rcond=1e-10) @ rhs) <= 1e-8
 
 

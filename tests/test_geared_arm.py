@@ -22,16 +22,16 @@ def test_drive_torque_through_ideal_gears_equals_inverse_dynamics_over_the_ratio
     times = np.linspace(0.0, 5.0, 11)
     geared = geared_arm_6dof(control="drive", gear_mass_scale=1e-6)
     arm = geared_arm_6dof(trains=False, gear_mass_scale=1e-6)
-    idg = ad.inverse_dynamics(geared, t=times)
-    ida = ad.inverse_dynamics(arm, t=times)
+    idg = ad.driven_inverse_dynamics(geared, times)
+    ida = ad.driven_inverse_dynamics(arm, times)
     for k, name in enumerate(arm.drive_names):
         rotor = list(geared.drive_names).index(f"{name}_motor")
         expected = ida.drive_forces[:, k] / RATIOS[name]
         scale = max(np.max(np.abs(expected)), 1e-3)
         assert np.max(np.abs(idg.drive_forces[:, rotor] - expected)) <= 1e-5 * scale, name
     # with real masses the trains' own inertia adds to it: visible during the motion
-    full = ad.inverse_dynamics(geared_arm_6dof(control="drive"), t=times)
-    arm_full = ad.inverse_dynamics(geared_arm_6dof(trains=False), t=times)
+    full = ad.driven_inverse_dynamics(geared_arm_6dof(control="drive"), times)
+    arm_full = ad.driven_inverse_dynamics(geared_arm_6dof(trains=False), times)
     rotor = list(geared.drive_names).index("shoulder_motor")
     k = list(arm.drive_names).index("shoulder")
     gap = full.drive_forces[:, rotor] - arm_full.drive_forces[:, k] / RATIOS["shoulder"]

@@ -215,7 +215,7 @@ def test_motor_torque_through_an_ideal_gear_equals_inverse_dynamics_through_the_
     geared, direct = build(False), build(True)
     times = np.linspace(0.0, 1.0, 21)
     sim = ad.simulate(geared, 1.0, rtol=1e-10, atol=1e-12, output_dt=0.05)
-    idr = ad.inverse_dynamics(direct, t=times)
+    idr = ad.driven_inverse_dynamics(direct, times)
     alpha_a = np.array([profile_a.eval(t)[2] for t in times])
     names = list(direct.drive_names)
     tau_b = idr.drive_forces[:, names.index("jb")]
@@ -223,5 +223,5 @@ def test_motor_torque_through_an_ideal_gear_equals_inverse_dynamics_through_the_
     assert np.max(np.abs(tau_b)) > 0.1  # the load matters
     assert np.max(np.abs(sim.drive_forces[:, 0] - expected)) <= 1e-9 * np.max(np.abs(expected))
     # and the geared model's own inverse dynamics agrees
-    idg = ad.inverse_dynamics(geared, t=times)
+    idg = ad.driven_inverse_dynamics(geared, times)
     assert np.max(np.abs(idg.drive_forces[:, 0] - expected)) <= 1e-9 * np.max(np.abs(expected))

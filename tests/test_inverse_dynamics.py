@@ -1,9 +1,9 @@
 """Inverse dynamics through driving constraints.
 
-* joint-space form ``inverse_dynamics(model, q, qd, qdd)`` against the independent numpy
+* joint-space ``inverse_dynamics(model, q, qd, qdd)`` against the independent numpy
   recursive Newton–Euler of ``tests/oracles/numpy_rne.py`` on random spatial arms (full
   inertias, random axes, prismatic joints): ≤ 1e-10 relative;
-* driven form ``inverse_dynamics(model, t=...)`` against the drive efforts of a forward
+* ``driven_inverse_dynamics(model, t)`` against the drive efforts of a forward
   simulation and against the independent Lagrange validator;
 * replay: the computed torques fed back as joint torque inputs to the undriven model reproduce
   the prescribed trajectory (time-domain) and the prescribed accelerations (pointwise);
@@ -73,7 +73,7 @@ def test_driven_inverse_dynamics_matches_simulation_and_lagrange(rng):
     # integrated (not the kinematic path, which is inverse dynamics' own solver)
     sim = ad.simulate(model, 1.0, integrator="dopri5", rtol=1e-10, atol=1e-12, output_dt=0.02)
     assert sim.stats["steps"] > 0
-    idr = ad.inverse_dynamics(model, t=sim.t)
+    idr = ad.driven_inverse_dynamics(model, sim.t)
     scale = np.max(np.abs(sim.drive_forces))
     assert np.max(np.abs(idr.drive_forces - sim.drive_forces)) <= tol(1e-10) * scale
     assert np.max(np.abs(idr.q - sim.q)) <= tol(1e-10)
@@ -91,7 +91,10 @@ def test_forward_replay_tracks_the_drives():
     arm, reproduce the prescribed cubic trajectories when integrated forward."""
     driven = paper.three_dof_arm()
     free = paper.three_dof_arm(drives=False)
-    solver = _core.JointSpaceInverseDynamics(free)
+
+    def solver(q, qd, qdd, t):
+        return ad.inverse_dynamics(free, q, qd, qdd, t)
+
     targets, T = paper.ARM3.targets, paper.ARM3.duration
     profiles = [_core.profiles.cubic(0.0, float(x), 0.0, T) for x in targets]
 
@@ -134,7 +137,7 @@ def test_sign_convention_static_link():
     b.add_revolute("pitch", "ground", "bar", point=(0, 0, 0), axis=(0, -1, 0))
     b.add_drive("pitch", 0.0)
     model = b.finalize()
-    idr = ad.inverse_dynamics(model, t=[0.0, 1.0])
+    idr = ad.driven_inverse_dynamics(model, [0.0, 1.0])
     assert idr.drive_forces[:, 0] == pytest.approx(m * G * length / 2, rel=1e-12)
     tau = ad.inverse_dynamics(model, [0.0], [0.0], [0.0])
     assert tau[0] == pytest.approx(m * G * length / 2, rel=1e-12)
@@ -148,7 +151,7 @@ def test_sign_convention_static_link():
 def test_under_driven_model_names_coordinates():
     model = paper.five_dof_arm(drives=False)
     with pytest.raises(ad.ModelError, match=r"5 degree.*'twist'.*'extend'"):
-        ad.inverse_dynamics(model, t=[0.0, 1.0])
+        ad.driven_inverse_dynamics(model, [0.0, 1.0])
 
 
 def test_singular_driven_slider_crank_names_the_drive():
@@ -157,10 +160,10 @@ def test_singular_driven_slider_crank_names_the_drive():
     model = ad.scenes.slider_driven_to_dead_centre()
     assert model.mobility_driven == 0
     # away from the dead centre it is fine
-    ok = ad.inverse_dynamics(model, t=np.linspace(0.0, 0.5, 6))
+    ok = ad.driven_inverse_dynamics(model, np.linspace(0.0, 0.5, 6))
     assert np.all(np.isfinite(ok.drive_forces))
     with pytest.raises(ad.SolverError, match=r"singular.*drive 'guide'"):
-        ad.inverse_dynamics(model, t=np.linspace(0.0, 1.0, 11))
+        ad.driven_inverse_dynamics(model, np.linspace(0.0, 1.0, 11))
 
 
 def test_inverse_dynamics_bad_input():
@@ -170,8 +173,8 @@ def test_inverse_dynamics_bad_input():
     with pytest.raises(ad.ModelError, match=r"q.*length|shape"):
         ad.inverse_dynamics(arm_model, [0, 0], [0, 0, 0], [0, 0, 0])
     with pytest.raises(ad.ModelError, match="increase"):
-        ad.inverse_dynamics(arm_model, t=[0.0, 0.5, 0.5])
-    with pytest.raises(ad.ModelError, match="q, qd and qdd"):
+        ad.driven_inverse_dynamics(arm_model, [0.0, 0.5, 0.5])
+    with pytest.raises(TypeError, match="qd"):
         ad.inverse_dynamics(arm_model, [0, 0, 0])
     loop = ad.scenes.four_bar()
     with pytest.raises(ad.ModelError, match="inverse_dynamics"):
@@ -182,8 +185,8 @@ def test_driven_loop_on_a_coarse_grid_by_continuation():
     """A driven closed loop (slider-crank, crank at 2π rad/s) solved at times far apart: the
     position problem is continued through intermediate times and gives the fine-grid answer."""
     model = ad.scenes.slider_crank()
-    fine = ad.inverse_dynamics(model, t=np.linspace(0.0, 0.37, 75))
-    coarse = ad.inverse_dynamics(model, t=[0.0, 0.37])
+    fine = ad.driven_inverse_dynamics(model, np.linspace(0.0, 0.37, 75))
+    coarse = ad.driven_inverse_dynamics(model, [0.0, 0.37])
     assert np.max(np.abs(coarse.q[-1] - fine.q[-1])) <= 1e-11  # (quaternions may differ in sign)
     assert np.max(np.abs(coarse.drive_forces[-1] - fine.drive_forces[-1])) <= 1e-9 * max(
         1.0, np.max(np.abs(fine.drive_forces))
@@ -240,25 +243,31 @@ def _branched_tree_with_force_elements(rng):
 
 
 def test_recursive_and_kkt_paths_agree(rng):
-    """The O(n) Newton–Euler sweeps (default) and the driven-KKT multipliers are two
-    derivations of the same torques; every joint type and force element enters both through
-    the engine's eta, the accelerations and projections are derived separately."""
+    """The O(n) Newton–Euler sweeps (method "joint", the default) and the driven-KKT
+    multipliers (method "cartesian") are two derivations of the same torques: the joint path
+    takes the coordinate forces straight from q, the Cartesian one through the engine's eta;
+    the accelerations and projections are derived separately."""
     model = _branched_tree_with_force_elements(rng)
-    rec = _core.JointSpaceInverseDynamics(model)
-    kkt = _core.JointSpaceInverseDynamics(model, method="kkt")
-    assert (rec.method, kkt.method) == ("recursive", "kkt")
     n = model.n_coords
     assert n == 8
     for _ in range(20):
         q, qd, qdd = rng.uniform(-2.0, 2.0, size=(3, n))
         t = rng.uniform(0.0, 3.0)
-        a, b = rec(q, qd, qdd, t), kkt(q, qd, qdd, t)
+        a = ad.inverse_dynamics(model, q, qd, qdd, t, method="joint")
+        b = ad.inverse_dynamics(model, q, qd, qdd, t, method="cartesian")
         assert rel_err(a, b) <= tol(1e-12)
-    # the same through ad.inverse_dynamics, rows and method included
+        assert np.array_equal(ad.inverse_dynamics(model, q, qd, qdd, t), a)  # auto: joint
+    # one state per row, one time per row, and an explicit workspace
     q, qd, qdd = rng.uniform(-2.0, 2.0, size=(3, 2, n))
-    rows = ad.inverse_dynamics(model, q, qd, qdd, t=0.7, method="kkt")
-    assert rel_err(ad.inverse_dynamics(model, q, qd, qdd, t=0.7), rows) <= tol(1e-12)
-    with pytest.raises(_core.ModelError, match="unknown method 'aba'"):
+    times = np.array([0.7, 1.9])
+    rows = ad.inverse_dynamics(model, q, qd, qdd, t=times, method="cartesian")
+    data = ad.Data(model)
+    joint_rows = ad.inverse_dynamics(model, q, qd, qdd, t=times, data=data)
+    assert rel_err(joint_rows, rows) <= tol(1e-12)
+    for i in range(2):
+        single = ad.inverse_dynamics(model, q[i], qd[i], qdd[i], times[i])
+        assert np.array_equal(joint_rows[i], single)
+    with pytest.raises(_core.ModelError, match="method must be 'auto', 'joint' or 'cartesian'"):
         ad.inverse_dynamics(model, q[0], qd[0], qdd[0], method="aba")
-    with pytest.raises(_core.ModelError, match="method applies to the joint-space form"):
-        ad.inverse_dynamics(model, t=[0.0], method="kkt")
+    with pytest.raises(_core.ModelError, match="data was made for another model"):
+        ad.inverse_dynamics(paper.three_dof_arm(), [0.0] * 3, [0.0] * 3, [0.0] * 3, data=data)

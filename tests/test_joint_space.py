@@ -104,8 +104,10 @@ def test_principal_inertia_vector(rng):
         b.add_body("b", 1.5, inertia, position=(0.3, 0.0, -0.2), orientation=random_quat_fixed())
         b.add_revolute("hinge", "ground", "b", (0.0, 0.0, 0.0), (0.3, 1.0, 0.1))
         models.append(b.finalize())
-    np.testing.assert_array_equal(ad.mass_matrix(models[0]), ad.mass_matrix(models[1]))
-    np.testing.assert_allclose(np.diag(ad.mass_matrix(models[0]))[3:], [0.1, 0.2, 0.25], atol=0)
+    np.testing.assert_array_equal(ad.body_mass_matrix(models[0]), ad.body_mass_matrix(models[1]))
+    np.testing.assert_allclose(
+        np.diag(ad.body_mass_matrix(models[0]))[3:], [0.1, 0.2, 0.25], atol=0
+    )
 
 
 def random_quat_fixed():
@@ -298,7 +300,7 @@ def test_urdf_arm_matches_hand_built(rng):
 
 def _body_mass(model, k):
     """Mass of body k from the mass matrix (Gamma = blockdiag(m I, J))."""
-    return float(np.asarray(ad.mass_matrix(model))[6 * k, 6 * k])
+    return float(np.asarray(ad.body_mass_matrix(model))[6 * k, 6 * k])
 
 
 def test_urdf_parser_of_this_test(tmp_path):

@@ -41,7 +41,7 @@ def test_five_dof_run_is_kinematic_and_equals_the_integrated_run():
     assert ad.simulate(model, 1.0, integrator="auto", output_dt=0.1).stats["integrator"] == (
         "kinematic"
     )
-    idr = ad.inverse_dynamics(model, t=kin.t)
+    idr = ad.driven_inverse_dynamics(model, kin.t)
     assert rel_err(idr.drive_forces, kin.drive_forces) <= 1e-14
 
 

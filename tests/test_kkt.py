@@ -35,8 +35,8 @@ REL = 1e-10
 
 
 def reference_solution(model, u, v, t=0.0):
-    gamma = np.asarray(ad.mass_matrix(model), dtype=float)
-    eta = np.asarray(ad.generalized_forces(model, u, v, t), dtype=float)
+    gamma = np.asarray(ad.body_mass_matrix(model), dtype=float)
+    eta = np.asarray(ad.body_forces(model, u, v, t), dtype=float)
     c = ad.evaluate_constraints(model, u, v, t)
     zeta = np.asarray(c["zeta"], dtype=float)
     xi = np.asarray(c["xi"], dtype=float)
@@ -59,7 +59,7 @@ def reference_solution(model, u, v, t=0.0):
 
 
 def check_against_reference(model, u, v, t=0.0, redundant=False):
-    vdot, delta = ad.accelerations(model, u, v, t)
+    vdot, delta = ad.body_accelerations(model, u, v, t)
     vdot, delta = np.asarray(vdot, dtype=float), np.asarray(delta, dtype=float)
     vdot_ref, delta_ref, zeta = reference_solution(model, u, v, t)
     assert vdot.shape == (model.nv,) and delta.shape == (model.nc,)
@@ -78,7 +78,7 @@ def check_against_reference(model, u, v, t=0.0, redundant=False):
 def test_arm_gamma_eta_closed_form(rng, prismatic):
     arm = spatial_arm(rng, prismatic=prismatic)
     model = arm.model
-    gamma = np.asarray(ad.mass_matrix(model))
+    gamma = np.asarray(ad.body_mass_matrix(model))
     ref = np.zeros((model.nv, model.nv))
     for k in range(arm.n):
         ref[6 * k : 6 * k + 3, 6 * k : 6 * k + 3] = arm.masses[k] * np.eye(3)
@@ -86,7 +86,7 @@ def test_arm_gamma_eta_closed_form(rng, prismatic):
     np.testing.assert_allclose(gamma, ref, rtol=0, atol=1e-14)
     u = np.array(model.u0, dtype=float)
     v = rng.normal(size=model.nv)
-    eta = np.asarray(ad.generalized_forces(model, u, v))
+    eta = np.asarray(ad.body_forces(model, u, v))
     eta_ref = np.zeros(model.nv)
     for k in range(arm.n):
         w = v[6 * k + 3 : 6 * k + 6]
@@ -124,7 +124,7 @@ def test_arm_accelerations_match_rnea(rng, prismatic):
         q_ref = rng.uniform(-1.5, 1.5, arm.n)
         qd_ref = rng.normal(size=arm.n)
         u, v = ad.state_from_joints(model, to_armdyn(arm.perm, q_ref), to_armdyn(arm.perm, qd_ref))
-        vdot, _ = ad.accelerations(model, u, v)
+        vdot, _ = ad.body_accelerations(model, u, v)
         qdd_ref = arm.chain.forward(q_ref, qd_ref, np.zeros(arm.n))
         kin = arm.chain.kinematics(q_ref, qd_ref, qdd_ref)
         ref = np.zeros(model.nv)

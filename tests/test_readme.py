@@ -47,14 +47,24 @@ def test_cli_verify_entry_point(capsys):
     assert ad.__version__
 
 
-def test_inverse_dynamics_snippet_runs():
-    """The README's inverse-dynamics example (second python block) runs and its own asserts
-    (joint-space form = driven form = Lagrange validator) hold."""
+def test_dynamics_snippets_run():
+    """The README's dynamics examples (second and third python blocks, one namespace) run and
+    their own asserts hold: inverse dynamics inverts forward dynamics, the Cartesian path equals
+    the joint path, and the joint-space torques equal the driven form's drive efforts and the
+    Lagrange validator's."""
     blocks = re.findall(r"```python\n(.*?)```", README.read_text(), re.S)
-    assert len(blocks) >= 2
+    assert len(blocks) >= 3
     ns: dict = {}
-    exec(compile(blocks[1], "README inverse dynamics", "exec"), ns)
+    exec(compile(blocks[1], "README dynamics functions", "exec"), ns)
+    exec(compile(blocks[2], "README driven inverse dynamics", "exec"), ns)
+    assert ns["QDD"].shape == (1000, 5)
     assert ns["idr"].drive_forces.shape == (3, 5)
+    # the mass matrix is the Lagrange validator's, and the batch equals row-by-row calls
+    lag = ad.LagrangeValidator(ns["free"])
+    np.testing.assert_allclose(ns["M"], lag.mass_matrix(ns["q"]), rtol=1e-12, atol=1e-14)
+    Q = ns["Q"]
+    rows = np.array([ad.forward_dynamics(ns["free"], Q[i], Q[i], Q[i]) for i in (0, 999)])
+    np.testing.assert_array_equal(ns["QDD"][[0, 999]], rows)
 
 
 def test_readme_quotes_the_reproduce_tables():

@@ -1,6 +1,6 @@
-"""The joint-space path (``TreeDynamics``, ``simulate(coordinates="joint")``,
-``JointSpaceForwardDynamics(method="crba")``) against independent references: Pinocchio's CRBA
-and ABA on real URDF arms, the Pinocchio reference of the geared arm, and armdyn's Cartesian
+"""The joint-space path (``forward_dynamics``/``mass_matrix`` with method "joint", and
+``_TreeDynamics``, the ODE of ``simulate(coordinates="joint")``) against independent
+references: Pinocchio's CRBA and ABA on real URDF arms, the Pinocchio reference of the geared arm, and armdyn's Cartesian
 constrained Newton–Euler path (the paper's method), which shares no code with it beyond the
 force laws. Closed-form checks of the joint path on gears and PI motors are in test_gears.py
 and test_drive_elements.py (parametrised over ``coordinates``)."""
@@ -19,8 +19,7 @@ from benchmarks.peers.pinocchio import PinPair
 def test_mass_matrix_and_accelerations_equal_pinocchio(robot):
     pin = pytest.importorskip("pinocchio")
     pair = PinPair(common.robot_urdf(robot))
-    td = _core.TreeDynamics(pair.am)
-    kkt = _core.JointSpaceForwardDynamics(pair.am, "kkt")
+    td = _core._TreeDynamics(pair.am)
     assert td.dof == pair.pm.nq
     rng = np.random.default_rng(11)
     worst_m = worst_a = worst_kkt = 0.0
@@ -28,19 +27,22 @@ def test_mass_matrix_and_accelerations_equal_pinocchio(robot):
         q, v, tau = rng.uniform(-np.pi, np.pi, size=(3, pair.pm.nq))
         m_pin = pin.crba(pair.pm, pair.pd, q)
         m_pin = np.triu(m_pin) + np.triu(m_pin, 1).T  # Pinocchio fills the upper triangle
-        m_ad = td.mass_matrix(pair.to_armdyn(q))[np.ix_(pair.perm, pair.perm)]
-        worst_m = max(worst_m, np.abs(m_ad - m_pin).max() / np.abs(m_pin).max())
         qa, va, ta = (pair.to_armdyn(x) for x in (q, v, tau))
-        a_ad = td(qa, va, ta)
+        m_ad = ad.mass_matrix(pair.am, qa)[np.ix_(pair.perm, pair.perm)]
+        worst_m = max(worst_m, np.abs(m_ad - m_pin).max() / np.abs(m_pin).max())
+        assert np.array_equal(td.mass_matrix(qa), ad.mass_matrix(pair.am, qa))
+        a_ad = ad.forward_dynamics(pair.am, qa, va, ta, method="joint")
         a_pin = pin.aba(pair.pm, pair.pd, q, v, tau)
         worst_a = max(worst_a, np.abs(a_ad[pair.perm] - a_pin).max() / np.abs(a_pin).max())
-        worst_kkt = max(worst_kkt, np.abs(a_ad - kkt(qa, va, ta)).max() / np.abs(a_ad).max())
+        a_kkt = ad.forward_dynamics(pair.am, qa, va, ta, method="cartesian")
+        worst_kkt = max(worst_kkt, np.abs(a_ad - a_kkt).max() / np.abs(a_ad).max())
+        # the simulation's ODE and "auto" are this path
+        assert np.array_equal(td(qa, va, ta), a_ad)
+        assert np.array_equal(ad.forward_dynamics(pair.am, qa, va, ta), a_ad)
     # measured: M 1.0e-15, accelerations 1.7e-14 (Panda)
     assert worst_m <= 1e-12
     assert worst_a <= 1e-10
     assert worst_kkt <= 1e-10
-    # the default forward dynamics is this path
-    assert _core.JointSpaceForwardDynamics(pair.am).method == "crba"
 
 
 def spatial_arm():
@@ -75,15 +77,16 @@ def spatial_arm():
 
 def test_force_elements_equal_the_cartesian_path():
     model = spatial_arm()
-    td = _core.TreeDynamics(model)
-    kkt = _core.JointSpaceForwardDynamics(model, "kkt")
+    td = _core._TreeDynamics(model)
     rng = np.random.default_rng(5)
     n = model.n_coords
     worst = 0.0
     for t in np.linspace(0.0, 2.0, 9):
         q, qd, tau = rng.uniform(-1.0, 1.0, size=(3, n))
         a = td(q, qd, tau, t)
-        worst = max(worst, np.abs(a - kkt(q, qd, tau, t)).max() / np.abs(a).max())
+        assert np.array_equal(ad.forward_dynamics(model, q, qd, tau, t, method="joint"), a)
+        kkt = ad.forward_dynamics(model, q, qd, tau, t, method="cartesian")
+        worst = max(worst, np.abs(a - kkt).max() / np.abs(a).max())
     assert worst <= 1e-10
 
 
@@ -114,7 +117,7 @@ def test_geared_arm_joint_path_equals_the_reference_and_the_cartesian_run():
     ref = GearedArmReference()
     f, _ = ref.rhs()
     perm = [list(ref.tree.coord_names).index(c) for c in model.coord_names]
-    td = _core.TreeDynamics(model)
+    td = _core._TreeDynamics(model)
     assert td.dof == 6
     n = model.n_coords
     rng = np.random.default_rng(2)
@@ -158,15 +161,15 @@ def test_joint_path_bad_input():
     res = ad.simulate(ad.scenes.four_bar(), 0.05, coordinates="auto")
     assert "joint space does not apply: the model has closed loops" in res.stats["formulation"]
     model = spatial_arm()
-    td = _core.TreeDynamics(model)
+    td = _core._TreeDynamics(model)
     z = np.zeros(model.n_coords)
     with pytest.raises(ad.ModelError, match="TreeDynamics: q contains NaN"):
         td(np.full(model.n_coords, np.nan), z, z)
     with pytest.raises(ad.ModelError, match=r"tau: expected shape \(5,\), got \(2,\)"):
         td(z, z, np.zeros(2))
     with pytest.raises(ad.ModelError, match="closed loops"):
-        _core.TreeDynamics(ad.scenes.four_bar())
-    with pytest.raises(ad.ModelError, match="unknown method 'aba'"):
-        _core.JointSpaceForwardDynamics(model, "aba")
+        _core._TreeDynamics(ad.scenes.four_bar())
+    with pytest.raises(ad.ModelError, match="method must be 'auto', 'joint' or 'cartesian'"):
+        ad.forward_dynamics(model, z, z, z, method="aba")
     # the model and a run after the errors are intact
     assert ad.simulate(model, 0.1, coordinates="auto").stats["formulation"].startswith("joint")

@@ -1,5 +1,6 @@
 """Inverse dynamics of a driven model: the drives' efforts and the joint reactions along a
-prescribed motion, from the driven constraints' multipliers (the Cartesian Newton–Euler/KKT path)."""
+prescribed motion, from the driven constraints' multipliers (the Cartesian Newton–Euler/KKT
+path)."""
 
 from __future__ import annotations
 

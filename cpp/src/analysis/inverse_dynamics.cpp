@@ -160,13 +160,13 @@ void DrivenSolver::solve(double t, VecX& u, VecX& v, VecX& vd, double& rf, doubl
 InverseDynamicsResult inverse_dynamics_driven(const Model& m, const std::vector<double>& times) {
   Engine e(m);
   const double t0 = (!times.empty() && times.front() < 0.0) ? times.front() : 0.0;
-  DrivenSolver solver(m, e, "inverse_dynamics", t0);  // u0 is assembled at t = 0
-  if (times.empty()) throw ModelError("inverse_dynamics: no times given");
+  DrivenSolver solver(m, e, "driven_inverse_dynamics", t0);  // u0 is assembled at t = 0
+  if (times.empty()) throw ModelError("driven_inverse_dynamics: no times given");
   for (size_t k = 0; k < times.size(); ++k) {
     if (!std::isfinite(times[k]))
-      throw ModelError(msg("inverse_dynamics: time ", k, " is not finite"));
+      throw ModelError(msg("driven_inverse_dynamics: time ", k, " is not finite"));
     if (k > 0 && !(times[k] > times[k - 1]))
-      throw ModelError(msg("inverse_dynamics: times must increase strictly (index ", k, ")"));
+      throw ModelError(msg("driven_inverse_dynamics: times must increase strictly (index ", k, ")"));
   }
   const auto start = std::chrono::steady_clock::now();
   InverseDynamicsResult out;
