@@ -1,9 +1,9 @@
 """The joint-space path (``forward_dynamics``/``mass_matrix`` with method "joint", and
 ``_TreeDynamics``, the ODE of ``simulate(coordinates="joint")``) against independent
-references: Pinocchio's CRBA and ABA on real URDF arms, the Pinocchio reference of the geared arm, and armdyn's Cartesian
-constrained Newton–Euler path (the paper's method), which shares no code with it beyond the
-force laws. Closed-form checks of the joint path on gears and PI motors are in test_gears.py
-and test_drive_elements.py (parametrised over ``coordinates``)."""
+references: Pinocchio's CRBA and ABA on real URDF arms, the Pinocchio reference of the geared
+arm, and armdyn's Cartesian constrained Newton–Euler path (the paper's method), which shares no
+code with it beyond the force laws. Closed-form checks of the joint path on gears and PI motors
+are in test_gears.py and test_drive_elements.py (parametrised over ``coordinates``)."""
 
 import armdyn as ad
 import numpy as np
