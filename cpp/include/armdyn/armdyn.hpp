@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // armdyn: the supported C++ API in one include. Link armdyn::core (find_package(armdyn)).
 //
-//   armdyn::ModelBuilder b;                      // bodies, joints, drives, force elements
-//   armdyn::ModelPtr model = b.finalize();       // the immutable Model, assembled
-//   armdyn::JointSpaceForwardDynamics fd(model); // qdd = FD(q, qd, tau)
-//   armdyn::JointSpaceInverseDynamics id(model); // tau = ID(q, qd, qdd)
+//   armdyn::ModelBuilder b;                   // bodies, joints, drives, force elements
+//   armdyn::ModelPtr model = b.finalize();    // the immutable Model, assembled
+//   armdyn::Data data(*model);                // every per-evaluation buffer
+//   armdyn::forward_dynamics(*model, data, q, qd, tau);   // qdd
+//   armdyn::inverse_dynamics(*model, data, q, qd, qdd);   // tau
+//   armdyn::crba(*model, data, q);                        // M(q)
 //   armdyn::SimResult r = armdyn::simulate(*model, t_end, options, model->u0, model->v0);
 #pragma once
 
@@ -14,10 +16,17 @@
 #include "armdyn/math/quaternion.hpp"
 #include "armdyn/math/types.hpp"
 
-// model description
+// model description and its per-evaluation workspace
+#include "armdyn/data.hpp"
 #include "armdyn/model/builder.hpp"
 #include "armdyn/model/model.hpp"
 #include "armdyn/model/profile.hpp"
+
+// joint-space algorithms: forces, recursive Newton-Euler, CRBA, forward/inverse dynamics
+#include "armdyn/algorithm/crba.hpp"
+#include "armdyn/algorithm/dynamics.hpp"
+#include "armdyn/algorithm/forces.hpp"
+#include "armdyn/algorithm/rnea.hpp"
 
 // URDF import
 #include "armdyn/io/urdf.hpp"
@@ -26,7 +35,7 @@
 #include "armdyn/solver/engine.hpp"
 #include "armdyn/solver/integrators.hpp"
 
-// joint-space algorithms and whole runs
+// driven inverse dynamics, joint-space state, tree dynamics with gears, whole runs
 #include "armdyn/analysis/inverse_dynamics.hpp"
 #include "armdyn/analysis/joint_space.hpp"
 #include "armdyn/analysis/simulate.hpp"

@@ -1,0 +1,73 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The force laws (armdyn/algorithm/forces.hpp): gravity and the gyroscopic torque, a point
+// spring-damper's tension along its line, joint springs and gear contact.
+#include <cmath>
+
+#include "armdyn/algorithm/forces.hpp"
+#include "armdyn/math/quaternion.hpp"
+#include "check.hpp"
+#include "models.hpp"
+
+using namespace armdyn;
+
+TEST_CASE(gravity_and_gyroscopic_torque) {
+  ModelBuilder b(Vec3(0.2, -0.1, -9.81));
+  const Mat3 J = Vec3(0.1, 0.2, 0.25).asDiagonal();
+  b.add_body("b", 2.0, J, Vec3(0, 0, 1), quat_exp(Vec3(0.3, 0.1, 0.2)));
+  b.add_free("free", "b");
+  const ModelPtr m = b.finalize();
+  VecX v(6);
+  v << 0.1, 0.2, 0.3, 1.0, -2.0, 0.5;
+  std::vector<BodyKin> kin(1);
+  body_kinematics(*m, m->u0.data(), v.data(), kin);
+  VecX eta(6);
+  body_forces(*m, kin, 0.0, eta);
+  CHECK_MAT_NEAR(eta.head<3>(), 2.0 * Vec3(0.2, -0.1, -9.81), 1e-14);
+  const Vec3 w = v.tail<3>();
+  CHECK_MAT_NEAR(eta.tail<3>(), Vec3(-w.cross(J * w)), 1e-14);
+}
+
+TEST_CASE(point_spring_damper_tension) {
+  // a spring from a ground point to a body, stretched by 0.1 beyond its rest length and
+  // lengthening at 0.5 m/s: tension k dL + c dL/dt pulls the body towards the anchor
+  ModelBuilder b(Vec3::Zero());
+  b.add_body("b", 1.0, Vec3(0.1, 0.1, 0.1).asDiagonal(), Vec3(1.0, 0, 0),
+             armdyn_test::kIdentityQuat);
+  b.add_free("free", "b");
+  b.add_spring_damper("s", "ground", Vec3(0, 0, 0), "b", Vec3(1.0, 0, 0), 200.0, 3.0, 0.9);
+  const ModelPtr m = b.finalize();
+  VecX v = VecX::Zero(6);
+  v[0] = 0.5;
+  std::vector<BodyKin> kin(1);
+  body_kinematics(*m, m->u0.data(), v.data(), kin);
+  VecX eta(6);
+  body_forces(*m, kin, 0.0, eta);
+  CHECK_MAT_NEAR(eta.head<3>(), Vec3(-(200.0 * 0.1 + 3.0 * 0.5), 0, 0), 1e-12);
+  CHECK_MAT_NEAR(eta.tail<3>(), Vec3::Zero(), 1e-12);  // acts at the centre of mass
+}
+
+TEST_CASE(joint_spring_and_gear_contact) {
+  ModelBuilder b(Vec3::Zero());
+  const Mat3 in = Vec3(0.01, 0.01, 0.02).asDiagonal();
+  b.add_body("a", 1.0, in, Vec3(0, 0, 0), armdyn_test::kIdentityQuat);
+  b.add_body("c", 1.0, in, Vec3(0.3, 0, 0), armdyn_test::kIdentityQuat);
+  b.add_revolute("ja", "ground", "a", Vec3(0, 0, 0), Vec3::UnitZ());
+  b.add_revolute("jc", "ground", "c", Vec3(0.3, 0, 0), Vec3::UnitZ());
+  b.add_joint_spring_damper("ja", 50.0, 2.0, 0.1);
+  b.add_gear_pair("g", "ja", "jc", 0.1, 0.2, 0.002, 1e5, 1.0, 0.0);
+  const ModelPtr m = b.finalize();
+  // s = 0.1 qa + 0.2 qc = 0.1 * 0.3 + 0.2 * 0.0 = 0.03: penetration 0.029, F = 1e5 * 0.029
+  const double q[2] = {0.3, 0.0}, qd[2] = {0.4, 0.0};
+  double s, sd, pen;
+  gear_mesh(*m, 0, q, qd, s, sd, pen);
+  CHECK_NEAR(s, 0.03, 1e-15);
+  CHECK_NEAR(sd, 0.04, 1e-15);
+  CHECK_NEAR(pen, 0.029, 1e-15);
+  VecX tau(2);
+  coordinate_forces(*m, q, qd, nullptr, 0.0, tau);
+  const double f = 1e5 * 0.029;
+  CHECK_NEAR(tau[0], -50.0 * (0.3 - 0.1) - 2.0 * 0.4 - 0.1 * f, 1e-10);
+  CHECK_NEAR(tau[1], -0.2 * f, 1e-10);
+}
+
+ARMDYN_TEST_MAIN()

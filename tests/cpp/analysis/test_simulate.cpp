@@ -1,0 +1,93 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Whole runs (armdyn/analysis/simulate.hpp): a pendulum's energy is conserved and its angle
+// follows an independent RK4 integration of I_O phi'' = -m g L sin(phi); a prismatic body
+// falls as g t^2 / 2; the Cartesian and joint-space formulations agree.
+#include <cmath>
+
+#include "armdyn/analysis/simulate.hpp"
+#include "check.hpp"
+#include "models.hpp"
+
+using namespace armdyn;
+
+namespace {
+
+/// phi(t) of the pendulum from (phi0, 0) by classical RK4 with a fine step (the reference).
+double pendulum_reference(const armdyn_test::Pendulum& p, double t_end) {
+  const int n = 20000;
+  const double h = t_end / n;
+  double x = p.phi0, w = 0.0;
+  for (int k = 0; k < n; ++k) {
+    const double k1x = w, k1w = p.phidd(x);
+    const double k2x = w + 0.5 * h * k1w, k2w = p.phidd(x + 0.5 * h * k1x);
+    const double k3x = w + 0.5 * h * k2w, k3w = p.phidd(x + 0.5 * h * k2x);
+    const double k4x = w + h * k3w, k4w = p.phidd(x + h * k3x);
+    x += h / 6 * (k1x + 2 * k2x + 2 * k3x + k4x);
+    w += h / 6 * (k1w + 2 * k2w + 2 * k3w + k4w);
+  }
+  return x;
+}
+
+}  // namespace
+
+TEST_CASE(pendulum_angle_and_energy) {
+  armdyn_test::Pendulum p;
+  p.phi0 = 1.2;
+  const ModelPtr m = p.model();
+  const double t_end = 2.0;
+  for (const char* coords : {"cartesian", "joint"}) {
+    SimOptions opt;
+    opt.integrator = "dop853";
+    opt.step.rtol = 1e-11;
+    opt.step.atol = 1e-12;
+    opt.step.output_dt = 0.1;
+    opt.coordinates = coords;
+    const SimResult r = simulate(*m, t_end, opt, m->u0, m->v0);
+    CHECK(r.error.empty());
+    CHECK(r.n == 21);
+    CHECK_NEAR(r.t.back(), t_end, 1e-12);
+    CHECK_NEAR(p.phi0 + r.q.back(), pendulum_reference(p, t_end), 1e-8);
+    const double e0 = r.kinetic_energy[0] + r.potential_energy[0];
+    CHECK_NEAR(e0, -p.m * p.g * p.L * std::cos(p.phi0), 1e-12);  // V = m g z, at rest
+    for (long k = 0; k < r.n; ++k) {
+      CHECK_NEAR(r.kinetic_energy[k] + r.potential_energy[k], e0, 1e-8);
+      // T = 1/2 I_O phi'^2
+      CHECK_NEAR(r.kinetic_energy[k], 0.5 * p.io() * r.qd[k] * r.qd[k], 1e-12);
+      CHECK(r.position_residual[k] < 1e-10);
+    }
+  }
+}
+
+TEST_CASE(prismatic_body_falls_at_g) {
+  ModelBuilder b(Vec3(0, 0, -9.81));
+  b.add_body("block", 2.0, Vec3(0.1, 0.1, 0.1).asDiagonal(), Vec3(0, 0, 5),
+             armdyn_test::kIdentityQuat);
+  b.add_prismatic("rail", "ground", "block", Vec3(0, 0, 5), Vec3::UnitZ());
+  const ModelPtr m = b.finalize();
+  SimOptions opt;
+  opt.integrator = "rk4";
+  opt.step.dt = 0.01;
+  opt.step.output_dt = 0.25;
+  const SimResult r = simulate(*m, 1.0, opt, m->u0, m->v0);
+  CHECK(r.n == 5);
+  for (long k = 0; k < r.n; ++k) {
+    const double t = r.t[k];
+    CHECK_NEAR(r.q[k], -0.5 * 9.81 * t * t, 1e-12);
+    CHECK_NEAR(r.qd[k], -9.81 * t, 1e-12);
+    CHECK_NEAR(r.u[7 * k + 2], 5.0 - 0.5 * 9.81 * t * t, 1e-12);
+    // the rail carries no load along itself; across it nothing (gravity is along the rail)
+    CHECK_NEAR(r.qdd[k], -9.81, 1e-12);
+  }
+  CHECK(r.integrator == "rk4");
+}
+
+TEST_CASE(bad_options_are_refused) {
+  const ModelPtr m = armdyn_test::Pendulum().model();
+  SimOptions opt;
+  opt.integrator = "euler";
+  CHECK_THROWS(simulate(*m, 1.0, opt, m->u0, m->v0), ModelError);
+  SimOptions ok;
+  CHECK_THROWS(simulate(*m, 1.0, ok, VecX::Zero(3), m->v0), ModelError);
+}
+
+ARMDYN_TEST_MAIN()
