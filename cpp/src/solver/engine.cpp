@@ -28,6 +28,9 @@ Engine::Engine(const Model& m)
       mu_(VecX::Zero(m.nc)),
       vd_(VecX::Zero(m.nv)),
       track_ref_(VecX::Zero(static_cast<long>(m.coords.size()))),
+      cq_(VecX::Zero(static_cast<long>(m.coords.size()))),
+      cqd_(VecX::Zero(static_cast<long>(m.coords.size()))),
+      ctau_(VecX::Zero(static_cast<long>(m.coords.size()))),
       nrows_(m.nc) {
   kin_.resize(m.nb);
   ce_.init(m);
@@ -49,37 +52,27 @@ void Engine::scatter(const Row12& g, int pa, int pb) {
 }
 
 void Engine::coordinate_forces(double t) {
-  // joint-coordinate forces: springs, dampers, friction, inputs
+  if (m_.coord_forces.empty() && m_.gears.empty()) return;
+  // the coordinates the laws read, from their jets (gear angles unwrapped over turns)
   for (const CoordForce& cf : m_.coord_forces) {
     const ScalarJet& q = jets_.get(m_, kin_, cf.coord);
-    const Coord& c = m_.coords[cf.coord];
-    double tau;
-    try {
-      const double z = (cf.aux >= 0 && aux_) ? aux_[cf.aux] : 0.0;
-      tau = coord_force_value(cf, c.angular, q.val, q.rate, t, z);
-    } catch (const SolverError& err) {
-      throw SolverError(msg("force on joint coordinate '", c.name, "': ", err.what()));
-    }
-    if (!std::isfinite(tau))
-      throw SolverError(msg("non-finite force on joint coordinate '", c.name, "' at t=", t));
-    const Joint& j = m_.joints[c.joint];
-    scatter(tau * q.J, j.parent, j.child);
+    cq_[cf.coord] = q.val;
+    cqd_[cf.coord] = q.rate;
   }
-  // gear pairs with backlash: contact force along the line of action
-  for (size_t gi = 0; gi < m_.gears.size(); ++gi) {
-    const GearPair& g = m_.gears[gi];
-    const ScalarJet& qa = jets_.get(m_, kin_, g.coord_a);
-    const ScalarJet& qb = jets_.get(m_, kin_, g.coord_b);
-    const double s = g.r_a * tracked(g.coord_a, qa.val) + g.r_b * tracked(g.coord_b, qb.val);
-    const double sd = g.r_a * qa.rate + g.r_b * qb.rate;
-    double pen;
-    const double f = gear_force(g, s, sd, pen);
-    if (f == 0.0) continue;
-    const double fs = s >= 0 ? f : -f;
-    const Joint& ja = m_.joints[m_.coords[g.coord_a].joint];
-    const Joint& jb = m_.joints[m_.coords[g.coord_b].joint];
-    scatter(-g.r_a * fs * qa.J, ja.parent, ja.child);
-    scatter(-g.r_b * fs * qb.J, jb.parent, jb.child);
+  for (const GearPair& g : m_.gears) {
+    for (const int c : {g.coord_a, g.coord_b}) {
+      const ScalarJet& q = jets_.get(m_, kin_, c);
+      cq_[c] = tracked(c, q.val);
+      cqd_[c] = q.rate;
+    }
+  }
+  // the joint-space generalised forces (the laws of armdyn/algorithm/forces.hpp), mapped onto
+  // the bodies through each coordinate's Jacobian
+  armdyn::coordinate_forces(m_, cq_.data(), cqd_.data(), aux_, t, ctau_);
+  for (int c = 0; c < static_cast<int>(m_.coords.size()); ++c) {
+    if (ctau_[c] == 0.0) continue;
+    const Joint& j = m_.joints[m_.coords[c].joint];
+    scatter(ctau_[c] * jets_.get(m_, kin_, c).J, j.parent, j.child);
   }
 }
 

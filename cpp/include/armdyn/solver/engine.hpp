@@ -127,7 +127,8 @@ class Engine {
   KktSolver kkt_;
   VecX eta_, delta_, tmp_nv_, tmp_nc_, mu_;
   VecX vd_;
-  VecX track_ref_;  // unwrapped reference of tracked angle coordinates (by coordinate index)
+  VecX track_ref_;        // unwrapped reference of tracked angle coordinates (by coordinate index)
+  VecX cq_, cqd_, ctau_;  // coordinate values, rates and generalised forces of the force laws
   const double* tau_ = nullptr;
   std::vector<ScalarJet> tau_jets_;
   mutable CoordJetCache jets_;  // coordinate jets at the loaded state
