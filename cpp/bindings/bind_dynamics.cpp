@@ -99,9 +99,9 @@ void bind_dynamics(py::module_& m) {
          long max_steps, double max_step, bool merge_welded, const std::string& coordinates) {
         SimOptions o;
         o.merge_welded = merge_welded;
-        o.coordinates = coordinates;
+        o.coordinates = coordinates_from_name(coordinates);
         o.step.max_step = max_step;
-        o.integrator = integrator;
+        o.integrator = integrator_from_name(integrator);
         o.step.rtol = rtol;
         o.step.atol = atol;
         o.step.dt = dt;

@@ -46,7 +46,7 @@ int main() {
 
   // released from the assembly pose at rest: one second of motion
   armdyn::SimOptions options;
-  options.integrator = "dop853";
+  options.integrator = armdyn::Integrator::Dop853;
   options.step.rtol = 1e-10;
   options.step.atol = 1e-12;
   options.step.output_dt = 0.25;

@@ -35,9 +35,9 @@ TEST_CASE(pendulum_angle_and_energy) {
   p.phi0 = 1.2;
   const ModelPtr m = p.model();
   const double t_end = 2.0;
-  for (const char* coords : {"cartesian", "joint"}) {
+  for (const Coordinates coords : {Coordinates::Cartesian, Coordinates::Joint}) {
     SimOptions opt;
-    opt.integrator = "dop853";
+    opt.integrator = Integrator::Dop853;
     opt.step.rtol = 1e-11;
     opt.step.atol = 1e-12;
     opt.step.output_dt = 0.1;
@@ -65,7 +65,7 @@ TEST_CASE(prismatic_body_falls_at_g) {
   b.add_prismatic("rail", "ground", "block", Vec3(0, 0, 5), Vec3::UnitZ());
   const ModelPtr m = b.finalize();
   SimOptions opt;
-  opt.integrator = "rk4";
+  opt.integrator = Integrator::Rk4;
   opt.step.dt = 0.01;
   opt.step.output_dt = 0.25;
   const SimResult r = simulate(*m, 1.0, opt, m->u0, m->v0);
@@ -84,7 +84,10 @@ TEST_CASE(prismatic_body_falls_at_g) {
 TEST_CASE(bad_options_are_refused) {
   const ModelPtr m = armdyn_test::Pendulum().model();
   SimOptions opt;
-  opt.integrator = "euler";
+  CHECK_THROWS(integrator_from_name("euler"), ModelError);
+  CHECK_THROWS(coordinates_from_name("polar"), ModelError);
+  CHECK(integrator_from_name(integrator_name(Integrator::Trbdf2)) == Integrator::Trbdf2);
+  opt.integrator = Integrator::Rk4;  // without a step dt
   CHECK_THROWS(simulate(*m, 1.0, opt, m->u0, m->v0), ModelError);
   SimOptions ok;
   CHECK_THROWS(simulate(*m, 1.0, ok, VecX::Zero(3), m->v0), ModelError);

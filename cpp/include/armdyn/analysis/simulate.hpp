@@ -13,17 +13,31 @@
 
 namespace armdyn {
 
+/// The time integration of a run. Default: Kinematic for a fully driven model with output
+/// times, else Dopri5. Auto: Kinematic likewise, else choose_integrator().
+enum class Integrator { Default, Auto, Dopri5, Dop853, Rk4, Trbdf2, Kinematic };
+/// The state integrated (see SimOptions::coordinates).
+enum class Coordinates { Cartesian, Joint, Auto };
+
+/// "dopri5", "dop853", "rk4", "trbdf2", "kinematic", "auto", "default".
+const char* integrator_name(Integrator i);
+/// The inverse of integrator_name; throws ModelError naming the accepted names.
+Integrator integrator_from_name(const std::string& name);
+/// "cartesian", "joint" or "auto"; throws ModelError otherwise.
+Coordinates coordinates_from_name(const std::string& name);
+
 struct SimOptions {
-  std::string integrator = "dopri5";  ///< "dopri5" | "dop853" | "rk4" | "trbdf2" | "auto"
+  Integrator integrator = Integrator::Default;
   StepOptions step;
   Metric projection = Metric::Mass;
   /// integrate bodies joined by fixed joints as one composite body (Model::welded)
   bool merge_welded = true;
-  /// "cartesian": the bodies' Cartesian state (u, v) with the constrained Newton-Euler
-  /// equations and the topological projection (the paper's method). "joint": the joint
+  /// Cartesian: the bodies' Cartesian state (u, v) with the constrained Newton-Euler
+  /// equations and the topological projection (the paper's method). Joint: the joint
   /// coordinates and rates (q, qd) of a tree, ideal gears allowed (TreeDynamics: CRBA and the
-  /// gears' null space); the outputs are the same Cartesian tables, built from (q, qd).
-  std::string coordinates = "cartesian";
+  /// gears' null space); the outputs are the same Cartesian tables, built from (q, qd). Auto:
+  /// Joint wherever it applies (a tree without drives), else Cartesian.
+  Coordinates coordinates = Coordinates::Cartesian;
 };
 
 /// Row-major output tables: one row per output time.
@@ -55,7 +69,7 @@ struct SimResult {
 /// for stability alone; "auto" picks TR-BDF2 when that exceeds 5000 steps, else DOP853 for
 /// rtol <= 1e-7 and DOPRI5 above.
 double stiffness_estimate(const Model& m, std::string& culprit);
-std::string choose_integrator(const Model& m, double t_end, double rtol, std::string& reason);
+Integrator choose_integrator(const Model& m, double t_end, double rtol, std::string& reason);
 
 /// Run from (u0, v0) (projected first) over [0, t_end]. Errors during the run stop it: the
 /// result up to the last good output is returned with `error` set.

@@ -1,0 +1,330 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Internal to simulate(): the ODE systems of the two formulations and the recording of outputs.
+//  - MbsSystem: the Cartesian state y = (u, v, z) with the constrained Newton-Euler equations
+//    (Engine) and the topological projection; it records every output table.
+//  - JointSystem: the joint coordinates y = (q, qd, z) of a tree (TreeDynamics); its outputs go
+//    through MbsSystem at the state built by forward kinematics.
+//  - WeldExpander: reports a run of the welded model (Model::welded) in the bodies and joints of
+//    the full model.
+#pragma once
+
+#include <vector>
+
+#include "armdyn/analysis/simulate.hpp"
+#include "armdyn/analysis/tree_dynamics.hpp"
+#include "armdyn/math/quaternion.hpp"
+#include "armdyn/solver/engine.hpp"
+
+namespace armdyn::detail {
+
+// Reports a run of the welded model (Model::welded) in the bodies and joints of the full model.
+class WeldExpander {
+ public:
+  explicit WeldExpander(const Model& full)
+      : m_(full),
+        w_(*full.welded),
+        e_(full),
+        u_(VecX::Zero(full.nq)),
+        v_(VecX::Zero(full.nv)),
+        vd_(VecX::Zero(full.nv)),
+        delta_(VecX::Zero(full.nc)),
+        r_(VecX::Zero(full.nv)),
+        tmp_(VecX::Zero(full.nv)) {
+    for (const Model::Weld& w : m_.weld) qrel_.push_back(rot_to_quat(w.rotation));
+    // rows of the full model -> rows of the welded one (-1: a merged fixed joint)
+    row_map_.assign(m_.nc, -1);
+    for (size_t j = 0; j < m_.joints.size(); ++j) {
+      const int jw = m_.weld_joint[j];
+      if (jw < 0) continue;
+      for (int k = 0; k < joint_rows(m_.joints[j].type); ++k)
+        row_map_[m_.joints[j].row0 + k] = w_.joints[jw].row0 + k;
+    }
+    for (size_t g = 0; g < m_.gear_constraints.size(); ++g)
+      row_map_[m_.gear_constraints[g].row] = w_.gear_constraints[g].row;
+    // coordinates of the full model -> those of the welded one (fixed joints have none)
+    coord_map_.assign(m_.coords.size(), -1);
+    for (size_t j = 0; j < m_.joints.size(); ++j) {
+      const int jw = m_.weld_joint[j];
+      if (jw < 0) continue;
+      for (int k = 0; k < joint_coords(m_.joints[j].type); ++k)
+        coord_map_[m_.joints[j].coord0 + k] = w_.joints[jw].coord0 + k;
+    }
+    track_ = VecX::Zero(static_cast<long>(m_.coords.size()));
+    for (size_t k = 0; k < m_.drives.size(); ++k) row_map_[m_.drives[k].row] = w_.drives[k].row;
+    // the block of each merged joint
+    block_of_.assign(m_.joints.size(), -1);
+    const ConstraintEval& ce = e_.constraints();
+    for (size_t j = 0; j < m_.joints.size(); ++j)
+      for (size_t b = 0; b < ce.blocks.size(); ++b)
+        if (joint_rows(m_.joints[j].type) > 0 && ce.blocks[b].row0 == m_.joints[j].row0)
+          block_of_[j] = static_cast<int>(b);
+  }
+
+  /// The composites' state (uw, vw) from a full state: each from its root body.
+  void contract(const VecX& u, const VecX& v, VecX& uw, VecX& vw) const {
+    for (int c = 0; c < w_.nb; ++c) {
+      const int r = m_.weld_root[c];
+      const Model::Weld& w = m_.weld[r];
+      const Vec4 qr = u.segment<4>(7 * r + 3).normalized();
+      const Vec4& e = qrel_[r];
+      const Vec4 qc = quat_mul(qr, Vec4(e[0], -e[1], -e[2], -e[3]));
+      const Mat3 Rc = quat_to_rot(qc);
+      const Vec3 wc = w.rotation * v.segment<3>(6 * r + 3);
+      uw.segment<3>(7 * c) = u.segment<3>(7 * r) - Rc * w.offset;
+      uw.segment<4>(7 * c + 3) = qc;
+      vw.segment<3>(6 * c) = v.segment<3>(6 * r) - Rc * wc.cross(w.offset);
+      vw.segment<3>(6 * c + 3) = wc;
+    }
+  }
+
+  /// The full state (and accelerations, when vdw is given) from the composites'.
+  void expand(const double* uw, const double* vw, const double* vdw) {
+    for (int b = 0; b < m_.nb; ++b) {
+      const Model::Weld& w = m_.weld[b];
+      if (w.composite == kGround) {
+        u_.segment<3>(7 * b) = w.offset;
+        u_.segment<4>(7 * b + 3) = qrel_[b];
+        v_.segment<6>(6 * b).setZero();
+        vd_.segment<6>(6 * b).setZero();
+        continue;
+      }
+      const int c = w.composite;
+      const Vec4 qc(uw[7 * c + 3], uw[7 * c + 4], uw[7 * c + 5], uw[7 * c + 6]);
+      const Mat3 Rc = quat_to_rot(qc);
+      const Vec3 wc(vw[6 * c + 3], vw[6 * c + 4], vw[6 * c + 5]);
+      const Vec3 wxo = wc.cross(w.offset);
+      u_.segment<3>(7 * b) = Vec3(uw[7 * c], uw[7 * c + 1], uw[7 * c + 2]) + Rc * w.offset;
+      u_.segment<4>(7 * b + 3) = quat_mul(qc, qrel_[b]);
+      v_.segment<3>(6 * b) = Vec3(vw[6 * c], vw[6 * c + 1], vw[6 * c + 2]) + Rc * wxo;
+      v_.segment<3>(6 * b + 3) = w.rotation.transpose() * wc;
+      if (vdw) {
+        const Vec3 al(vdw[6 * c + 3], vdw[6 * c + 4], vdw[6 * c + 5]);
+        vd_.segment<3>(6 * b) = Vec3(vdw[6 * c], vdw[6 * c + 1], vdw[6 * c + 2]) +
+                                Rc * (al.cross(w.offset) + wc.cross(wxo));
+        vd_.segment<3>(6 * b + 3) = w.rotation.transpose() * al;
+      }
+    }
+  }
+
+  /// Multipliers of the full model at the expanded state: the welded run's for its rows, the
+  /// merged fixed joints' from each member's Newton-Euler balance, far members first
+  /// (zeta_far^T delta_j = eta - Gamma vdot - the other rows' forces). Leaves the engine loaded
+  /// for joint_reaction() and the residuals.
+  void reactions(double t, const VecX& delta_w, const double* aux, const VecX& tracking_w) {
+    e_.set_aux(aux);
+    // the welded run's multi-turn angles: the gear rows (and their residuals) need them
+    for (size_t c = 0; c < coord_map_.size(); ++c)
+      if (coord_map_[c] >= 0) track_[static_cast<long>(c)] = tracking_w[coord_map_[c]];
+    e_.set_tracking(track_);
+    e_.load(u_.data(), v_.data());
+    ConstraintEval& ce = e_.constraints();
+    eval_constraints(m_, e_.kin(), t, false, ce);
+    e_.forces(t);
+    for (int r = 0; r < m_.nc; ++r) delta_[r] = row_map_[r] >= 0 ? delta_w[row_map_[r]] : 0.0;
+    const VecX& eta = e_.eta();
+    for (int b = 0; b < m_.nb; ++b) {
+      const Body& bd = m_.bodies[b];
+      r_.segment<3>(6 * b) = eta.segment<3>(6 * b) - bd.mass * vd_.segment<3>(6 * b);
+      r_.segment<3>(6 * b + 3) = eta.segment<3>(6 * b + 3) - bd.inertia * vd_.segment<3>(6 * b + 3);
+    }
+    zeta_transpose_times(ce, m_.nc, delta_, tmp_);
+    r_ -= tmp_;
+    for (const auto& [j, far] : m_.weld_sweep) {
+      const Joint& jt = m_.joints[j];
+      const ConstraintBlock& blk = ce.blocks[block_of_[j]];
+      const int sf = jt.child == far ? 1 : 0;
+      const Mat6 Zf = blk.J.block<6, 6>(0, 6 * sf);
+      const Vec6 d = Zf.transpose().partialPivLu().solve(Vec6(r_.segment<6>(6 * far)));
+      delta_.segment<6>(jt.row0) = d;
+      const int near = sf == 1 ? jt.parent : jt.child;
+      if (near != kGround)
+        r_.segment<6>(6 * near).noalias() -= blk.J.block<6, 6>(0, 6 * (1 - sf)).transpose() * d;
+    }
+    e_.set_multipliers(delta_);
+  }
+
+  Engine& engine() { return e_; }
+  const VecX& u() const { return u_; }
+  const VecX& v() const { return v_; }
+
+ private:
+  const Model& m_;
+  const Model& w_;
+  Engine e_;
+  VecX u_, v_, vd_, delta_, r_, tmp_, track_;
+  std::vector<Vec4> qrel_;
+  std::vector<int> coord_map_;
+  std::vector<int> row_map_, block_of_;
+};
+
+// the constrained equations of motion as an ODE on y = (u, v), with projection and recording
+class MbsSystem : public OdeSystem {
+ public:
+  MbsSystem(const Model& m, Metric metric, SimResult& out)
+      : m_(m), e_(m), metric_(metric), out_(out), yo_(m.nq + m.nv), vd_(m.nv) {}
+
+  // y = (u, v, z): z the auxiliary states (PI integral terms), not projected
+  void rhs(double t, const VecX& y, VecX& dy) override {
+    e_.set_aux(y.data() + m_.nq + m_.nv);
+    e_.dynamics(t, y.data(), y.data() + m_.nq, dy.data() + m_.nq);
+    e_.udot(y.data(), y.data() + m_.nq, dy.data());
+    if (m_.n_aux) e_.aux_rates(t, dy.data() + m_.nq + m_.nv);
+  }
+
+  void project_and_rhs(double t, VecX& y, VecX& dy) override {
+    e_.set_aux(y.data() + m_.nq + m_.nv);
+    e_.project(t, y.data(), y.data() + m_.nq, metric_);
+    e_.dynamics(t, y.data(), y.data() + m_.nq, dy.data() + m_.nq, true);
+    e_.udot(y.data(), y.data() + m_.nq, dy.data());
+    if (m_.n_aux) e_.aux_rates(t, dy.data() + m_.nq + m_.nv);
+  }
+
+  void output(double t, const VecX& y) override {
+    yo_ = y;
+    double* u = yo_.data();
+    double* v = yo_.data() + m_.nq;
+    e_.set_aux(yo_.data() + m_.nq + m_.nv);
+    e_.project(t, u, v, metric_);
+    e_.dynamics(t, u, v, vd_.data(), true);
+    double rf, rv;
+    e_.loaded_residuals(v, rf, rv);
+    record(t, u, v, vd_, rf, rv, yo_.data() + m_.nq + m_.nv);
+  }
+
+  bool project_last_stage() const override { return !e_.kkt().near_singular(); }
+
+  /// Report in the bodies and joints of the full model (a welded run).
+  void set_expander(WeldExpander* ex) { ex_ = ex; }
+
+  /// Record the outputs at (u, v, t); the engine holds the dynamics evaluated there.
+  void record(double t, const double* u, const double* v, const VecX& vd, double rf, double rv,
+              const double* aux = nullptr) {
+    // joint coordinates (angles unwrapped along the run) and rates
+    const long row = out_.n;
+    for (size_t c = 0; c < m_.coords.size(); ++c) {
+      const ScalarJet q = coord_jet(m_, e_.kin(), static_cast<int>(c));
+      // angles unwrapped over turns by the engine, which follows them at every projection
+      const double qv = m_.coords[c].angular ? e_.tracked(static_cast<int>(c), q.val) : q.val;
+      out_.q.push_back(qv);
+      out_.qd.push_back(q.rate);
+      out_.qdd.push_back(coord_acceleration(m_, q, static_cast<int>(c), vd));
+    }
+    // gear mesh forces: contact law of the gear pairs, multipliers of the ideal gears
+    for (int gi = 0; gi < static_cast<int>(m_.gears.size()); ++gi) {
+      double sm, sd, pen;
+      e_.gear_mesh(gi, sm, sd, pen);
+      const double f = gear_force(m_.gears[gi], sm, sd, pen);
+      out_.gear_forces.push_back(sm >= 0 ? f : -f);
+    }
+    for (const GearConstraint& g : m_.gear_constraints)
+      out_.gear_forces.push_back(e_.delta()[g.row]);
+    // actuator efforts: tau = -delta of the drive rows
+    for (const Drive& d : m_.drives) out_.drive_forces.push_back(-e_.delta()[d.row]);
+    Engine* re = &e_;  // the engine of the bodies and joints reported
+    if (ex_) {
+      ex_->expand(u, v, vd.data());
+      ex_->reactions(t, e_.delta(), aux, e_.tracking());
+      re = &ex_->engine();
+      re->loaded_residuals(ex_->v().data(), rf, rv);
+      u = ex_->u().data();
+      v = ex_->v().data();
+    }
+    double ke, pe;  // of every body (those welded to ground too)
+    re->energy(u, v, ke, pe);
+    const Model& rm = re->model();
+    for (size_t j = 0; j < rm.joints.size(); ++j) {
+      Vec3 f, tq;
+      re->joint_reaction(static_cast<int>(j), f, tq);
+      for (int k = 0; k < 3; ++k) {
+        out_.reaction_forces.push_back(f[k]);
+        out_.reaction_torques.push_back(tq[k]);
+      }
+    }
+    out_.t.push_back(t);
+    out_.u.insert(out_.u.end(), u, u + rm.nq);
+    out_.v.insert(out_.v.end(), v, v + rm.nv);
+    out_.position_residual.push_back(rf);
+    out_.velocity_residual.push_back(rv);
+    out_.kinetic_energy.push_back(ke);
+    out_.potential_energy.push_back(pe);
+    out_.n = row + 1;
+  }
+
+  int n_events() const override { return static_cast<int>(m_.gears.size()); }
+  void events(double /*t*/, const VecX& y, double* g) override {
+    e_.load(y.data(), y.data() + m_.nq);
+    for (int i = 0; i < n_events(); ++i) {
+      double s, sd;
+      e_.gear_mesh(i, s, sd, g[i]);
+    }
+  }
+  void on_event(double t, int i, int direction) override {
+    out_.event_t.push_back(t);
+    out_.event_index.push_back(i);
+    out_.event_direction.push_back(direction);
+  }
+
+  Engine& engine() { return e_; }
+
+ private:
+  const Model& m_;
+  Engine e_;
+  Metric metric_;
+  SimResult& out_;
+  VecX yo_, vd_;
+  WeldExpander* ex_ = nullptr;
+};
+
+// The joint-space equations of motion of a tree (TreeDynamics) as an ODE on y = (q, qd, z).
+// Outputs go through the Cartesian system at the state built by forward kinematics, with the
+// engine's multi-turn angles set from q: every table (poses, reactions, gear forces, residuals)
+// is the one a Cartesian run reports.
+class JointSystem : public OdeSystem {
+ public:
+  JointSystem(const Model& m, MbsSystem& cart)
+      : m_(m), td_(m), cart_(cart), n_(td_.n()), yc_(VecX::Zero(m.nq + m.nv + m.n_aux)) {
+    fkw_.kin.resize(m.nb);
+  }
+
+  void rhs(double t, const VecX& y, VecX& dy) override {
+    const double* q = y.data();
+    const double* qd = q + n_;
+    const double* z = qd + n_;
+    dy.head(n_) = y.segment(n_, n_);
+    td_.accelerations(t, q, qd, z, nullptr, dy.data() + n_);
+    if (m_.n_aux) td_.aux_rates(t, q, qd, z, dy.data() + 2 * n_);
+  }
+
+  void project_and_rhs(double t, VecX& y, VecX& dy) override {
+    td_.project(y.data(), y.data() + n_);
+    rhs(t, y, dy);
+  }
+
+  void output(double t, const VecX& y) override {
+    const Eigen::Map<const VecX> q(y.data(), n_), qd(y.data() + n_, n_);
+    joint_space_kinematics(m_, q, qd, fkw_.kin);
+    cartesian_state(m_, fkw_.kin, yc_.data(), yc_.data() + m_.nq);
+    yc_.tail(m_.n_aux) = y.tail(m_.n_aux);
+    cart_.engine().set_tracking(q);
+    cart_.output(t, yc_);
+  }
+
+  int n_events() const override { return static_cast<int>(m_.gears.size()); }
+  void events(double /*t*/, const VecX& y, double* g) override {
+    double s, sd;
+    for (int i = 0; i < n_events(); ++i) td_.gear_mesh(i, y.data(), y.data() + n_, s, sd, g[i]);
+  }
+  void on_event(double t, int i, int direction) override { cart_.on_event(t, i, direction); }
+
+  const TreeDynamics& dynamics() const { return td_; }
+
+ private:
+  const Model& m_;
+  TreeDynamics td_;
+  MbsSystem& cart_;
+  int n_;
+  VecX yc_;
+  TreeFkWork fkw_;
+};
+
+}  // namespace armdyn::detail
