@@ -3,8 +3,10 @@
 // follows an independent RK4 integration of I_O phi'' = -m g L sin(phi); a prismatic body
 // falls as g t^2 / 2; the Cartesian and joint-space formulations agree.
 #include <cmath>
+#include <string>
 
 #include "armdyn/analysis/simulate.hpp"
+#include "armdyn/errors.hpp"
 #include "check.hpp"
 #include "models.hpp"
 
@@ -81,16 +83,19 @@ TEST_CASE(prismatic_body_falls_at_g) {
   CHECK(r.integrator == "rk4");
 }
 
-TEST_CASE(bad_options_are_refused) {
-  const ModelPtr m = armdyn_test::Pendulum().model();
-  SimOptions opt;
+TEST_CASE(option_names_and_bad_options) {
+  CHECK(integrator_from_name("dop853") == Integrator::Dop853);
+  CHECK(std::string(integrator_name(Integrator::Trbdf2)) == "trbdf2");
+  CHECK(coordinates_from_name("joint") == Coordinates::Joint);
   CHECK_THROWS(integrator_from_name("euler"), ModelError);
   CHECK_THROWS(coordinates_from_name("polar"), ModelError);
-  CHECK(integrator_from_name(integrator_name(Integrator::Trbdf2)) == Integrator::Trbdf2);
-  opt.integrator = Integrator::Rk4;  // without a step dt
-  CHECK_THROWS(simulate(*m, 1.0, opt, m->u0, m->v0), ModelError);
+  const ModelPtr m = armdyn_test::Pendulum().model();
+  SimOptions rk4;
+  rk4.integrator = Integrator::Rk4;  // without a step
+  CHECK_THROWS(simulate(*m, 1.0, rk4, m->u0, m->v0), ModelError);
   SimOptions ok;
   CHECK_THROWS(simulate(*m, 1.0, ok, VecX::Zero(3), m->v0), ModelError);
+  CHECK_THROWS(simulate(*m, -1.0, ok, m->u0, m->v0), ModelError);
 }
 
 ARMDYN_TEST_MAIN()
