@@ -67,7 +67,7 @@ SciPy on Pinocchio (:class:`PinocchioA02`, A02 only)
     At the flat positions the KKT matrix is singular; a run that stops there is a failed point
     with the time it reached.
 
-Checks (tests/test_peer_closed_loops.py): the hard-constraint accelerations from MuJoCo's own
+Checks (tests/peers/test_peer_closed_loops.py): the hard-constraint accelerations from MuJoCo's own
 terms (``mj_fullM``, ``qfrc_smooth``, ``efc_J``; KKT solve), Exudyn's own initial-acceleration
 solve and PinocchioA02's accelerations equal the references'; the errors fall under step
 refinement.

@@ -48,7 +48,7 @@ The torque limit (10 N m) is never reached on this run (the largest PD torque is
 clamping it is part of each model but inactive. The angle error is not wrapped in the peers'
 PD laws (the reference wraps it): it stays far below pi.
 
-Checks (tests/test_peer_geared.py): MuJoCo's hard-constraint accelerations (``mj_fullM``,
+Checks (tests/peers/test_peer_geared.py): MuJoCo's hard-constraint accelerations (``mj_fullM``,
 ``qfrc_smooth``, ``efc_J``; the joint equalities have a constant Jacobian, so the KKT solve is
 exact at any velocity) and Exudyn's own initial-acceleration solve, at a moving state during the
 motion, equal the reference's gear-reduced Pinocchio accelerations; and the errors of both fall

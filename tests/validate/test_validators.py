@@ -260,7 +260,7 @@ def test_lagrange_validator_on_a_urdf_arm(rng):
     joint-space inverse dynamics (KKT path) and forward dynamics agree."""
     from pathlib import Path
 
-    model = ad.load_urdf(Path(__file__).parent / "data" / "urdf" / "arm6.urdf")
+    model = ad.load_urdf(Path(__file__).resolve().parents[1] / "data" / "urdf" / "arm6.urdf")
     lag = ad.LagrangeValidator(model)
     for _ in range(5):
         q, qd, qdd = rng.normal(size=(3, model.n_coords))

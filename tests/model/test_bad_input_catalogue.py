@@ -24,7 +24,7 @@ def test_bad_input(case):
 def test_docs_table_is_current():
     """docs/bad_inputs.md lists every case with its exception (the message column is the
     rendering at the time it was generated; regenerate with the command in its header)."""
-    doc = (Path(__file__).resolve().parents[1] / "docs" / "bad_inputs.md").read_text("utf-8")
+    doc = (Path(__file__).resolve().parents[2] / "docs" / "bad_inputs.md").read_text("utf-8")
     rows = [line for line in doc.splitlines() if line.startswith("| ") and "`" in line]
     assert len(rows) == len(CASES)
     for (cid, area, what, _fn, exc, _p), row in zip(CASES, rows, strict=True):

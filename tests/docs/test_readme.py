@@ -8,7 +8,7 @@ import armdyn as ad
 import numpy as np
 from armdyn import verify
 
-README = Path(__file__).resolve().parent.parent / "README.md"
+README = Path(__file__).resolve().parents[2] / "README.md"
 
 
 def test_quick_start_runs_and_holds_the_static_torque():

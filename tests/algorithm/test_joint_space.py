@@ -29,7 +29,7 @@ from conftest import (
 )
 from oracles.numpy_rne import SerialChain, rot_axis_angle, rpy_to_rot
 
-URDF_PATH = Path(__file__).parent / "data" / "urdf" / "arm6.urdf"
+URDF_PATH = Path(__file__).resolve().parents[1] / "data" / "urdf" / "arm6.urdf"
 REL = 1e-10
 
 

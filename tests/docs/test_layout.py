@@ -6,7 +6,7 @@ alike). Read from the sources with ``ast``; nothing is imported."""
 import ast
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def _modules() -> dict[str, Path]:

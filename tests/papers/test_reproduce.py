@@ -7,7 +7,7 @@ from pathlib import Path
 
 from armdyn.reproduce import run
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_reproduce_report(tmp_path):

@@ -8,7 +8,7 @@ from pathlib import Path
 import armdyn as ad
 from armdyn import validation
 
-API = (Path(__file__).resolve().parents[1] / "docs" / "api.md").read_text("utf-8")
+API = (Path(__file__).resolve().parents[2] / "docs" / "api.md").read_text("utf-8")
 
 
 def test_documented_package_names_exist():

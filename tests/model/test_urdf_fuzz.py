@@ -12,7 +12,7 @@ import numpy as np
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-DATA = Path(__file__).resolve().parent / "data" / "urdf"
+DATA = Path(__file__).resolve().parents[1] / "data" / "urdf"
 SOURCES = [(DATA / name).read_text(encoding="utf-8") for name in ("arm6.urdf", "slider.urdf")]
 NUMBER = re.compile(r"-?\d+(\.\d+)?(e-?\d+)?")
 BAD_NUMBERS = ["nan", "inf", "-inf", "-1", "0", "1e308", "-1e308", "abc", "", "1 2", "0x10"]
