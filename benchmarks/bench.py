@@ -6,8 +6,8 @@
   public ``forward_dynamics(model, q, qd, tau)``, ``inverse_dynamics(model, q, qd, qdd)`` and
   ``mass_matrix(model, q)`` against Pinocchio's ``aba``, ``rnea`` and ``crba``, one state per
   call for both (targets: ratio ≤ 1). The answers are cross-checked in the same run (relative
-  error; also a test, ``tests/algorithm/test_pinocchio.py``). ``forward_dynamics(..., method="cartesian")``
-  (the KKT path) is timed beside them.
+  error; also a test, ``tests/algorithm/test_pinocchio.py``).
+  ``forward_dynamics(..., method="cartesian")`` (the KKT path) is timed beside them.
 * A batch: ``forward_dynamics(model, Q, QD, TAU)`` on 1000 states (2-D arrays, one state per row)
   in one call against a Python loop of ``pin.aba`` over the same states (target: ratio ≤ 0.5);
   likewise ``inverse_dynamics`` against a loop of ``pin.rnea``.

@@ -3,8 +3,8 @@
     python -m benchmarks.extreme_cases   (from the repository root; writes docs/figures/*.png and
                                           benchmarks/results/extreme_cases.json)
 
-Each case is also a test (tests/simulate/test_stiff.py, tests/simulate/test_extreme.py); this script measures the
-cost side (steps, CPU time) and draws the figures.
+Each case is also a test (tests/simulate/test_stiff.py, tests/simulate/test_extreme.py); this
+script measures the cost side (steps, CPU time) and draws the figures.
 """
 
 from __future__ import annotations
