@@ -612,6 +612,10 @@ void integrate_rk4(OdeSystem& sys, VecX& y, double t0, double t1, const StepOpti
   VecX gend(ne), gbuf(ne), ybuf(n);
   init_event_signs(sys, t, y, sgn, gbuf);
   const double eps = 1e-12 * std::max(1.0, std::abs(t1));
+  // a step shortened to a located crossing may end just short of it (the location came from
+  // the longer step's interpolant): the next step then takes the event at once instead of
+  // shortening again, which would creep towards the crossing without reaching it
+  bool creeping = false;
   while (t < t1 - eps) {
     if (st.steps >= opt.max_steps)
       throw SolverError(msg("rk4: more than ", opt.max_steps, " steps before t=", t1));
@@ -639,16 +643,20 @@ void integrate_rk4(OdeSystem& sys, VecX& y, double t0, double t1, const StepOpti
       sys.events(tn, y1, gend.data());
       bool any = false;
       for (int i = 0; i < ne; ++i) any = any || gend[i] * sgn[i] < 0;
-      if (!any) break;
+      if (!any) {
+        creeping = round > 0;
+        break;
+      }
       sys.rhs(tn, y1, f1);
       ++st.rhs_evals;
       auto dense = [&](double th, VecX& out) { hermite(th, h, y, k1, y1, f1, out); };
       const double th = locate_events(sys, t, h, dense, sgn, gend, gbuf, ybuf, crossed);
-      if (round < 2 && th > 0 && th < 1.0 - 1e-9) {
+      if (!creeping && round < 2 && th > 0 && th < 1.0 - 1e-9) {
         h = representable_step(t, h * th);
         continue;
       }
       take_events(sys, t, h, th, dense, crossed, sgn, st, tn, y1);
+      creeping = false;
       break;
     }
     y = y1;

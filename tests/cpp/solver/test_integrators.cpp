@@ -102,16 +102,26 @@ TEST_CASE(rk4_is_fourth_order) {
 }
 
 TEST_CASE(rk4_locates_events) {
-  Oscillator sys;
-  VecX y = start();
-  StepOptions opt;
-  opt.dt = 0.01;
-  opt.max_steps = 100000;
-  StepStats st;
-  integrate_rk4(sys, y, 0.0, 2.0, opt, st);
-  CHECK(sys.event_t.size() == 1);
-  if (!sys.event_t.empty()) CHECK_NEAR(sys.event_t[0], 0.5 * M_PI, 1e-8);
-  CHECK_NEAR(y[0], std::cos(2.0), 1e-8);
+  // every step size, including those whose shortened step ends just short of the crossing
+  // (dt = 0.05 once crept towards it without reaching it until max_steps)
+  for (const double dt : {0.01, 0.02, 0.05, 0.1, 0.13}) {
+    Oscillator sys;
+    VecX y = start();
+    StepOptions opt;
+    opt.dt = dt;
+    opt.max_steps = 100000;
+    StepStats st;
+    integrate_rk4(sys, y, 0.0, 2.0, opt, st);
+    CHECK(sys.event_t.size() == 1);
+    CHECK(st.steps < 2.0 / dt + 10);
+    // RK4's global error ~ dt^4 / 100 on this problem
+    const double tol = std::max(1e-8, std::pow(dt, 4));
+    if (!sys.event_t.empty()) {
+      CHECK_NEAR(sys.event_t[0], 0.5 * M_PI, tol);
+      CHECK(sys.event_dir[0] == -1);
+    }
+    CHECK_NEAR(y[0], std::cos(2.0), tol);
+  }
 }
 
 TEST_CASE(trbdf2_is_stable_on_a_stiff_problem) {
