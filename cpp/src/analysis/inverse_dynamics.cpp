@@ -166,7 +166,8 @@ InverseDynamicsResult inverse_dynamics_driven(const Model& m, const std::vector<
     if (!std::isfinite(times[k]))
       throw ModelError(msg("driven_inverse_dynamics: time ", k, " is not finite"));
     if (k > 0 && !(times[k] > times[k - 1]))
-      throw ModelError(msg("driven_inverse_dynamics: times must increase strictly (index ", k, ")"));
+      throw ModelError(
+          msg("driven_inverse_dynamics: times must increase strictly (index ", k, ")"));
   }
   const auto start = std::chrono::steady_clock::now();
   InverseDynamicsResult out;
