@@ -613,9 +613,11 @@ void integrate_rk4(OdeSystem& sys, VecX& y, double t0, double t1, const StepOpti
   init_event_signs(sys, t, y, sgn, gbuf);
   const double eps = 1e-12 * std::max(1.0, std::abs(t1));
   // a step shortened to a located crossing may end just short of it (the location came from
-  // the longer step's interpolant): the next step then takes the event at once instead of
-  // shortening again, which would creep towards the crossing without reaching it
-  bool creeping = false;
+  // the longer step's interpolant); the next step locates it again from closer by. After a few
+  // such steps in a row the event is taken at once, instead of creeping towards the crossing
+  // without reaching it
+  int creeps = 0;
+  constexpr int kMaxCreeps = 3;
   while (t < t1 - eps) {
     if (st.steps >= opt.max_steps)
       throw SolverError(msg("rk4: more than ", opt.max_steps, " steps before t=", t1));
@@ -644,19 +646,19 @@ void integrate_rk4(OdeSystem& sys, VecX& y, double t0, double t1, const StepOpti
       bool any = false;
       for (int i = 0; i < ne; ++i) any = any || gend[i] * sgn[i] < 0;
       if (!any) {
-        creeping = round > 0;
+        creeps = round > 0 ? creeps + 1 : 0;
         break;
       }
       sys.rhs(tn, y1, f1);
       ++st.rhs_evals;
       auto dense = [&](double th, VecX& out) { hermite(th, h, y, k1, y1, f1, out); };
       const double th = locate_events(sys, t, h, dense, sgn, gend, gbuf, ybuf, crossed);
-      if (!creeping && round < 2 && th > 0 && th < 1.0 - 1e-9) {
+      if (creeps < kMaxCreeps && round < 2 && th > 0 && th < 1.0 - 1e-9) {
         h = representable_step(t, h * th);
         continue;
       }
       take_events(sys, t, h, th, dense, crossed, sgn, st, tn, y1);
-      creeping = false;
+      creeps = 0;
       break;
     }
     y = y1;
