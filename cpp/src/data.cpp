@@ -21,7 +21,7 @@ Data::Data(const Model& m) : model(&m), n(static_cast<int>(m.coords.size())) {
   rhs = VecX::Zero(n);
   qdd = VecX::Zero(n);
   zero = VecX::Zero(n);
-  llt = Eigen::LLT<MatX>(n);
+  L = MatX::Zero(n, n);
 }
 
 Data::~Data() = default;

@@ -4,7 +4,6 @@
 // nothing per call. One Data per thread: a Model is shared read-only, a Data is not.
 #pragma once
 
-#include <Eigen/Cholesky>
 #include <memory>
 #include <vector>
 
@@ -50,7 +49,7 @@ class Data {
   MatX M;                     ///< (n, n) joint-space mass matrix
   // --- forward dynamics ---
   VecX rhs, qdd, zero;
-  Eigen::LLT<MatX> llt;
+  MatX L;  ///< (n, n) Cholesky factor of M in its lower triangle (math/cholesky.hpp)
   // --- the Cartesian (KKT) path: made on first use ---
   std::unique_ptr<Engine> engine;  ///< forward dynamics through the Cartesian KKT system
   VecX vd, tau_in;                 ///< (nv) accelerations; (n) torques seen by the engine

@@ -7,6 +7,7 @@
 #include "armdyn/algorithm/forces.hpp"
 #include "armdyn/algorithm/rnea.hpp"
 #include "armdyn/errors.hpp"
+#include "armdyn/math/cholesky.hpp"
 #include "armdyn/solver/engine.hpp"
 
 namespace armdyn {
@@ -115,13 +116,12 @@ const VecX& forward_dynamics(const Model& m, Data& d, Eigen::Ref<const VecX> q,
     d.rhs += d.coord_tau;
   }
   crba_loaded(m, d);
-  d.llt.compute(d.M);
-  if (d.llt.info() != Eigen::Success)
+  if (!cholesky_factor(d.M, d.L))
     throw SolverError(
         "forward_dynamics: the joint-space mass matrix is not positive definite (a massless "
         "subtree?)");
   d.qdd = d.rhs;
-  d.llt.solveInPlace(d.qdd);
+  cholesky_solve(d.L, d.qdd);
   return d.qdd;
 }
 

@@ -7,6 +7,7 @@
 #include "armdyn/algorithm/crba.hpp"
 #include "armdyn/algorithm/forces.hpp"
 #include "armdyn/errors.hpp"
+#include "armdyn/math/cholesky.hpp"
 #include "armdyn/math/quaternion.hpp"
 
 namespace armdyn {
@@ -42,7 +43,7 @@ TreeDynamics::TreeDynamics(const Model& m, bool ignore_drives) : m_(m), d_(m) {
   Mr_ = MatX::Zero(dof_, dof_);
   y_ = VecX::Zero(dof_);
   w_ = VecX::Zero(rank_);
-  llt_ = Eigen::LLT<MatX>(dof_);
+  Lr_ = MatX::Zero(dof_, dof_);
 }
 
 std::string TreeDynamics::description() const {
@@ -81,17 +82,15 @@ void TreeDynamics::accelerations(double t, const double* q, const double* qd, co
   const MatX& M = d_.M;
   Eigen::Map<VecX> out(qdd, n_);
   if (rank_ == 0) {
-    d_.llt.compute(M);
-    if (d_.llt.info() != Eigen::Success) not_positive_definite(t);
+    if (!cholesky_factor(M, d_.L)) not_positive_definite(t);
     out = rhs;
-    d_.llt.solveInPlace(out);
+    cholesky_solve(d_.L, out);
   } else {
     MT_.noalias() = M * T_;
     Mr_.noalias() = T_.transpose() * MT_;
-    llt_.compute(Mr_);
-    if (llt_.info() != Eigen::Success) not_positive_definite(t);
+    if (!cholesky_factor(Mr_, Lr_)) not_positive_definite(t);
     y_.noalias() = T_.transpose() * rhs;
-    llt_.solveInPlace(y_);
+    cholesky_solve(Lr_, y_);
     out.noalias() = T_ * y_;
   }
 }

@@ -34,42 +34,6 @@ const char* joint_type_name(JointType t) {
   return "?";
 }
 
-int joint_rows(JointType t) {
-  switch (t) {
-    case JointType::Revolute:
-      return 5;
-    case JointType::Prismatic:
-      return 5;
-    case JointType::Spherical:
-      return 3;
-    case JointType::Fixed:
-      return 6;
-    case JointType::Cylindrical:
-      return 4;
-    case JointType::Universal:
-      return 4;
-    case JointType::Free:
-      return 0;
-    case JointType::Inline:
-      return 2;
-    case JointType::Distance:
-      return 1;
-  }
-  return 0;
-}
-
-int joint_coords(JointType t) {
-  switch (t) {
-    case JointType::Revolute:
-    case JointType::Prismatic:
-      return 1;
-    case JointType::Cylindrical:
-      return 2;
-    default:
-      return 0;
-  }
-}
-
 int Model::find_body(const std::string& name) const {
   if (name == "ground") return kGround;
   auto it = body_index.find(name);

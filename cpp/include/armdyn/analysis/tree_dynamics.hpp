@@ -18,7 +18,6 @@
 // tests compare the two.
 #pragma once
 
-#include <Eigen/Cholesky>
 #include <string>
 #include <vector>
 
@@ -64,7 +63,7 @@ class TreeDynamics {
   int n_ = 0, dof_ = 0, rank_ = 0;
   MatX T_, range_, MT_, Mr_;  // the gears' null space and range; M T; T^T M T
   VecX y_, w_;
-  Eigen::LLT<MatX> llt_;  // of T^T M T (with gears)
+  MatX Lr_;  // Cholesky factor of T^T M T (with gears)
 };
 
 }  // namespace armdyn

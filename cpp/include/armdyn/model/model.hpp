@@ -45,9 +45,39 @@ enum class JointType {
 const char* joint_type_name(JointType t);
 
 /// Number of constraint rows of a joint type.
-int joint_rows(JointType t);
+constexpr int joint_rows(JointType t) {
+  switch (t) {
+    case JointType::Revolute:
+    case JointType::Prismatic:
+      return 5;
+    case JointType::Spherical:
+      return 3;
+    case JointType::Fixed:
+      return 6;
+    case JointType::Cylindrical:
+    case JointType::Universal:
+      return 4;
+    case JointType::Free:
+      return 0;
+    case JointType::Inline:
+      return 2;
+    case JointType::Distance:
+      return 1;
+  }
+  return 0;
+}
 /// Number of joint coordinates (angle and/or displacement) a joint type defines.
-int joint_coords(JointType t);
+constexpr int joint_coords(JointType t) {
+  switch (t) {
+    case JointType::Revolute:
+    case JointType::Prismatic:
+      return 1;
+    case JointType::Cylindrical:
+      return 2;
+    default:
+      return 0;
+  }
+}
 
 struct Joint {
   std::string name;
