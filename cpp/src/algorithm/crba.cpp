@@ -69,15 +69,7 @@ const MatX& crba(const Model& m, Data& d, Eigen::Ref<const VecX> q) {
 }
 
 const MatX& mass_matrix_at(const Model& m, Data& d, Eigen::Ref<const VecX> q) {
-  joint_space_poses(m, q, d.kin);
-  // the joint frames (as the Newton-Euler sweep places them): child-side point, world axis
-  for (int ji : m.tree_order) {
-    const Joint& j = m.joints[ji];
-    const BodyKin& c = d.kin[j.child];
-    d.rne.point[ji] = c.x + c.R * j.point_child;
-    d.rne.axis[ji] = j.parent == kGround ? Vec3(j.frame_parent.col(2))
-                                         : Vec3(d.kin[j.parent].R * j.frame_parent.col(2));
-  }
+  joint_space_poses(m, q, d.kin, d.rne);
   crba_loaded(m, d);
   return d.M;
 }

@@ -107,7 +107,7 @@ const VecX& forward_dynamics(const Model& m, Data& d, Eigen::Ref<const VecX> q,
     return d.qdd;
   }
   // M qdd = tau + Q - (b - J^T eta): the Newton-Euler residual at qdd = 0 gives the bias
-  joint_space_kinematics(m, q, qd, d.kin);
+  joint_space_kinematics(m, q, qd, d.kin, d.rne);
   body_forces(m, d.kin, t, d.eta);
   rne_residual(m, d.kin, qd, d.zero, d.eta, d.rne, d.rhs);
   d.rhs = tau - d.rhs;

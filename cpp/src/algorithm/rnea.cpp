@@ -16,7 +16,7 @@ const VecX& rnea(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen::Ref<c
   check_joint_vector(qd, d.n, "inverse_dynamics", "qd");
   check_joint_vector(qdd, d.n, "inverse_dynamics", "qdd");
   if (!std::isfinite(t)) throw ModelError("inverse_dynamics: t is not finite");
-  joint_space_kinematics(m, q, qd, d.kin);
+  joint_space_kinematics(m, q, qd, d.kin, d.rne);
   body_forces(m, d.kin, t, d.eta);
   rne_residual(m, d.kin, qd, qdd, d.eta, d.rne, d.tau);
   if (!m.coord_forces.empty() || !m.gears.empty()) {

@@ -31,7 +31,7 @@ namespace {
 // world pose (and, with Velocities, velocity) of each body, parent before child
 template <bool Velocities>
 void tree_kinematics(const Model& m, Eigen::Ref<const VecX> q, const double* qd,
-                     std::vector<BodyKin>& kin) {
+                     std::vector<BodyKin>& kin, RneWork* frames) {
   kin.resize(m.nb);
   const BodyKin ground{};
   for (int ji : m.tree_order) {
@@ -49,6 +49,10 @@ void tree_kinematics(const Model& m, Eigen::Ref<const VecX> q, const double* qd,
     B.col(2) = z;
     const Vec3 P = p.x + p.R * j.point_parent;
     const Vec3 Pc = P + d * z;
+    if (frames) {
+      frames->point[ji] = Pc;
+      frames->axis[ji] = z;
+    }
     BodyKin& c = kin[j.child];
     c.R.noalias() = B * j.frame_child.transpose();
     c.x = Pc - c.R * j.point_child;
@@ -68,11 +72,21 @@ void tree_kinematics(const Model& m, Eigen::Ref<const VecX> q, const double* qd,
 
 void joint_space_kinematics(const Model& m, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
                             std::vector<BodyKin>& kin) {
-  tree_kinematics<true>(m, q, qd.data(), kin);
+  tree_kinematics<true>(m, q, qd.data(), kin, nullptr);
+}
+
+void joint_space_kinematics(const Model& m, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
+                            std::vector<BodyKin>& kin, RneWork& frames) {
+  tree_kinematics<true>(m, q, qd.data(), kin, &frames);
 }
 
 void joint_space_poses(const Model& m, Eigen::Ref<const VecX> q, std::vector<BodyKin>& kin) {
-  tree_kinematics<false>(m, q, nullptr, kin);
+  tree_kinematics<false>(m, q, nullptr, kin, nullptr);
+}
+
+void joint_space_poses(const Model& m, Eigen::Ref<const VecX> q, std::vector<BodyKin>& kin,
+                       RneWork& frames) {
+  tree_kinematics<false>(m, q, nullptr, kin, &frames);
 }
 
 void RneWork::resize(const Model& m) {
@@ -93,11 +107,8 @@ void rne_residual(const Model& m, const std::vector<BodyKin>& kin, Eigen::Ref<co
     double thd, thdd, dd, ddd;
     joint_components(j, qd, thd, dd);
     joint_components(j, qdd, thdd, ddd);
-    const Vec3 z =
-        on_ground ? Vec3(j.frame_parent.col(2)) : Vec3(kin[j.parent].R * j.frame_parent.col(2));
-    const Vec3 pc = c.x + c.R * j.point_child;
-    w.point[ji] = pc;
-    w.axis[ji] = z;
+    const Vec3& z = w.axis[ji];
+    const Vec3& pc = w.point[ji];
     Vec3 acc = ddd * z;
     Vec3& alpha = w.alpha[j.child];
     alpha = thdd * z;

@@ -61,7 +61,7 @@ void TreeDynamics::accelerations(double t, const double* q, const double* qd, co
                                  const double* tau, double* qdd) {
   const Model& m = m_;
   const Eigen::Map<const VecX> qv(q, n_), qdv(qd, n_);
-  joint_space_kinematics(m, qv, qdv, d_.kin);
+  joint_space_kinematics(m, qv, qdv, d_.kin, d_.rne);
   body_forces(m, d_.kin, t, d_.eta);
   // rhs = tau + Q - (b - J^T eta): the residual of the Newton-Euler equations at qdd = 0
   VecX& rhs = d_.rhs;

@@ -17,7 +17,8 @@ const MatX& crba(const Model& m, Data& d, Eigen::Ref<const VecX> q);
 const MatX& mass_matrix_at(const Model& m, Data& d, Eigen::Ref<const VecX> q);
 
 /// data.M from the kinematics in data.kin and the joint frames (data.rne.point, data.rne.axis)
-/// that rne_residual placed there; no checks. The step shared by crba() and forward dynamics.
+/// that joint_space_kinematics(..., frames) placed there; no checks. The step shared by crba() and
+/// forward dynamics.
 void crba_loaded(const Model& m, Data& d);
 
 }  // namespace armdyn

@@ -37,6 +37,12 @@ inline void joint_components(const Joint& j, const Eigen::Ref<const VecX>& x, do
   }
 }
 
+/// Scratch of rne_residual: per body (alpha, acc, force, moment), per joint (point, axis).
+struct RneWork {
+  std::vector<Vec3> alpha, acc, force, moment, point, axis;
+  void resize(const Model& m);
+};
+
 /// Body poses and velocities (R, x, xd, w, W) of a joint-space tree from joint coordinates q and
 /// rates qd, straight into a kinematic cache (size nb). Sizes and values are not checked.
 void joint_space_kinematics(const Model& m, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
@@ -44,20 +50,20 @@ void joint_space_kinematics(const Model& m, Eigen::Ref<const VecX> q, Eigen::Ref
 
 /// The same without velocities: poses only (R, x), velocities zero.
 void joint_space_poses(const Model& m, Eigen::Ref<const VecX> q, std::vector<BodyKin>& kin);
-
-/// Scratch of rne_residual: per body (alpha, acc, force, moment), per joint (point, axis).
-struct RneWork {
-  std::vector<Vec3> alpha, acc, force, moment, point, axis;
-  void resize(const Model& m);
-};
+/// Both of the above, and also each joint's child-side point and world axis into frames.point
+/// and frames.axis, which rne_residual and crba_loaded read.
+void joint_space_kinematics(const Model& m, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
+                            std::vector<BodyKin>& kin, RneWork& frames);
+void joint_space_poses(const Model& m, Eigen::Ref<const VecX> q, std::vector<BodyKin>& kin,
+                       RneWork& frames);
 
 /// The joint-space residual of the Newton-Euler equations of a tree,
 ///   tau = M(q) qdd + b(q, qd) - J(q)^T eta,
-/// with kin filled by joint_space_kinematics at (q, qd) and eta the bodies' applied and
-/// gyroscopic forces there (Engine::forces). Forward, parents first, each body's angular and
-/// centre-of-mass accelerations; backward, children first, each subtree's residual wrench
-/// (Gamma v' - eta) and its virtual work along the joint's coordinates. O(n); w.point and w.axis
-/// are left holding each joint's child-side point and world axis.
+/// with kin and w's joint frames (w.point, w.axis) filled by joint_space_kinematics(..., w) at
+/// (q, qd), and eta the bodies' applied and gyroscopic forces there (body_forces). Forward,
+/// parents first, each body's angular and centre-of-mass accelerations; backward, children
+/// first, each subtree's residual wrench (Gamma v' - eta) and its virtual work along the joint's
+/// coordinates. O(n).
 void rne_residual(const Model& m, const std::vector<BodyKin>& kin, Eigen::Ref<const VecX> qd,
                   Eigen::Ref<const VecX> qdd, const VecX& eta, RneWork& w, Eigen::Ref<VecX> tau);
 
