@@ -59,25 +59,27 @@ def per_call_timings(pair: PinPair, number: int = 2000) -> dict:
     q, v, tau = rng.uniform(-1, 1, size=(3, pm.nq))
     qa, va, ta = (pair.to_armdyn(x) for x in (q, v, tau))
 
-    def us(fn):
-        return 1e6 * median_time(fn, number)
-
-    r = {
-        "pin_aba_us": us(lambda: pin.aba(pm, pd, q, v, tau)),
-        "pin_rnea_us": us(lambda: pin.rnea(pm, pd, q, v, tau)),
-        "pin_crba_us": us(lambda: pin.crba(pm, pd, q)),
-        "armdyn_forward_dynamics_us": us(lambda: ad.forward_dynamics(am, qa, va, ta)),
-        "armdyn_inverse_dynamics_us": us(lambda: ad.inverse_dynamics(am, qa, va, ta)),
-        "armdyn_mass_matrix_us": us(lambda: ad.mass_matrix(am, qa)),
-        "armdyn_forward_dynamics_cartesian_us": us(
-            lambda: ad.forward_dynamics(am, qa, va, ta, method="cartesian")
-        ),
-    }
-    r["ratio_forward_dynamics"] = r["armdyn_forward_dynamics_us"] / r["pin_aba_us"]
-    r["ratio_inverse_dynamics"] = r["armdyn_inverse_dynamics_us"] / r["pin_rnea_us"]
-    r["ratio_mass_matrix"] = r["armdyn_mass_matrix_us"] / r["pin_crba_us"]
-    r["ratio_forward_dynamics_cartesian"] = (
-        r["armdyn_forward_dynamics_cartesian_us"] / r["pin_aba_us"]
+    t = common.interleaved_times(
+        {
+            "pin_aba": lambda: pin.aba(pm, pd, q, v, tau),
+            "armdyn_forward_dynamics": lambda: ad.forward_dynamics(am, qa, va, ta),
+            "pin_rnea": lambda: pin.rnea(pm, pd, q, v, tau),
+            "armdyn_inverse_dynamics": lambda: ad.inverse_dynamics(am, qa, va, ta),
+            "pin_crba": lambda: pin.crba(pm, pd, q),
+            "armdyn_mass_matrix": lambda: ad.mass_matrix(am, qa),
+            "armdyn_forward_dynamics_cartesian": lambda: ad.forward_dynamics(
+                am, qa, va, ta, method="cartesian"
+            ),
+        },
+        number,
+    )
+    r = {f"{name}_us": 1e6 * t[name] for name in t if name != "rounds"}
+    # ratios round by round (interleaved: the same load on both), then their median
+    r["ratio_forward_dynamics"] = common.paired_ratio(t, "armdyn_forward_dynamics", "pin_aba")
+    r["ratio_inverse_dynamics"] = common.paired_ratio(t, "armdyn_inverse_dynamics", "pin_rnea")
+    r["ratio_mass_matrix"] = common.paired_ratio(t, "armdyn_mass_matrix", "pin_crba")
+    r["ratio_forward_dynamics_cartesian"] = common.paired_ratio(
+        t, "armdyn_forward_dynamics_cartesian", "pin_aba"
     )
     return r
 
@@ -97,23 +99,26 @@ def batch_timings(pair: PinPair, n: int = BATCH, number: int = 5) -> dict:
     def rnea_loop():
         return [pin.rnea(pm, pd, Q[i], V[i], U[i]) for i in range(n)]
 
-    def ms(fn):
-        return 1e3 * median_time(fn, number)
-
     a_ad = ad.forward_dynamics(am, Qa, Va, Ua)[:, pair.perm]
     t_ad = ad.inverse_dynamics(am, Qa, Va, Ua)[:, pair.perm]
     a_pin, t_pin = np.array(aba_loop()), np.array(rnea_loop())
+    t = common.interleaved_times(
+        {
+            "pin_aba_loop": aba_loop,
+            "armdyn_forward_dynamics": lambda: ad.forward_dynamics(am, Qa, Va, Ua),
+            "pin_rnea_loop": rnea_loop,
+            "armdyn_inverse_dynamics": lambda: ad.inverse_dynamics(am, Qa, Va, Ua),
+        },
+        number,
+    )
     r = {
         "states": n,
         "fd_rel_error": float(np.max(np.abs(a_ad - a_pin)) / np.max(np.abs(a_pin))),
         "id_rel_error": float(np.max(np.abs(t_ad - t_pin)) / np.max(np.abs(t_pin))),
-        "pin_aba_loop_ms": ms(aba_loop),
-        "pin_rnea_loop_ms": ms(rnea_loop),
-        "armdyn_forward_dynamics_ms": ms(lambda: ad.forward_dynamics(am, Qa, Va, Ua)),
-        "armdyn_inverse_dynamics_ms": ms(lambda: ad.inverse_dynamics(am, Qa, Va, Ua)),
     }
-    r["ratio_forward_dynamics"] = r["armdyn_forward_dynamics_ms"] / r["pin_aba_loop_ms"]
-    r["ratio_inverse_dynamics"] = r["armdyn_inverse_dynamics_ms"] / r["pin_rnea_loop_ms"]
+    r.update({f"{name}_ms": 1e3 * t[name] for name in t if name != "rounds"})
+    r["ratio_forward_dynamics"] = common.paired_ratio(t, "armdyn_forward_dynamics", "pin_aba_loop")
+    r["ratio_inverse_dynamics"] = common.paired_ratio(t, "armdyn_inverse_dynamics", "pin_rnea_loop")
     r["armdyn_forward_dynamics_us_per_state"] = 1e3 * r["armdyn_forward_dynamics_ms"] / n
     return r
 

@@ -65,6 +65,31 @@ def median_time(fn, number: int, repeat: int = 7) -> float:
     return float(np.median(times))
 
 
+def interleaved_times(fns: dict, number: int, repeat: int = 15) -> dict:
+    """Seconds per call of each function of ``fns`` (name -> callable), measured in interleaved
+    rounds: every round times ``number`` calls of each function in turn, so that a change in the
+    machine's load falls on all of them alike. Returns, per name, the median over the rounds;
+    and ``rounds`` (per name, the list of per-round times) for ratios taken round by round."""
+    for fn in fns.values():
+        fn()
+    rounds = {name: [] for name in fns}
+    for _ in range(repeat):
+        for name, fn in fns.items():
+            t0 = time.perf_counter()
+            for _ in range(number):
+                fn()
+            rounds[name].append((time.perf_counter() - t0) / number)
+    out = {name: float(np.median(t)) for name, t in rounds.items()}
+    out["rounds"] = rounds
+    return out
+
+
+def paired_ratio(times: dict, a: str, b: str) -> float:
+    """Median over the rounds of interleaved_times of time(a) / time(b)."""
+    ra, rb = np.asarray(times["rounds"][a]), np.asarray(times["rounds"][b])
+    return float(np.median(ra / rb))
+
+
 def wrap(a):
     """Angles wrapped to [-pi, pi)."""
     return np.remainder(np.asarray(a) + np.pi, 2 * np.pi) - np.pi
