@@ -1,12 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "armdyn/data.hpp"
 
+#include <algorithm>
+
 #include "armdyn/errors.hpp"
-#include "armdyn/solver/engine.hpp"
 
 namespace armdyn {
 
-Data::Data(const Model& m) : model(&m), n(static_cast<int>(m.coords.size())) {
+Data::Data(const Model& m) : model(&m), n(static_cast<int>(m.coords.size())), kkt(m) {
   kin.resize(m.nb);
   eta = VecX::Zero(m.nv);
   coord_tau = VecX::Zero(n);
@@ -22,6 +23,26 @@ Data::Data(const Model& m) : model(&m), n(static_cast<int>(m.coords.size())) {
   qdd = VecX::Zero(n);
   zero = VecX::Zero(n);
   llt = Eigen::LLT<MatX>(n);
+  // the Cartesian pipeline
+  nrows = m.nc;
+  ce.init(m);
+  jets.init(m);
+  track_ref = VecX::Zero(n);
+  ce.coord_cache = &jets;
+  ce.track_ref = &track_ref;
+  tau_jets.resize(n);
+  cq = VecX::Zero(n);
+  cqd = VecX::Zero(n);
+  ctau = VecX::Zero(n);
+  sweep.plan(m, ce);
+  delta = VecX::Zero(m.nc);
+  vd_work = VecX::Zero(m.nv);
+  tmp_nv = VecX::Zero(m.nv);
+  tmp_nc = VecX::Zero(m.nc);
+  mu = VecX::Zero(m.nc);
+  tol_f = 1e-13 * std::max(1.0, m.length_scale);
+  vd = VecX::Zero(m.nv);
+  tau_in = VecX::Zero(n);
 }
 
 Data::~Data() = default;
