@@ -54,7 +54,7 @@ struct RneWork {
 /// The joint-space residual of the Newton-Euler equations of a tree,
 ///   tau = M(q) qdd + b(q, qd) - J(q)^T eta,
 /// with kin filled by joint_space_kinematics at (q, qd) and eta the bodies' applied and
-/// gyroscopic forces there (Engine::forces). Forward, parents first, each body's angular and
+/// gyroscopic forces there (body_forces). Forward, parents first, each body's angular and
 /// centre-of-mass accelerations; backward, children first, each subtree's residual wrench
 /// (Gamma v' - eta) and its virtual work along the joint's coordinates. O(n); w.point and w.axis
 /// are left holding each joint's child-side point and world axis.
