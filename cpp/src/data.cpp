@@ -8,8 +8,29 @@
 namespace armdyn {
 
 Data::Data(const Model& m) : model(&m), n(static_cast<int>(m.coords.size())), kkt(m) {
-  kin.resize(m.nb);
+  // the Cartesian pipeline's buffers first, next to the KKT solver's (allocated just above)
   eta = VecX::Zero(m.nv);
+  delta = VecX::Zero(m.nc);
+  tmp_nv = VecX::Zero(m.nv);
+  tmp_nc = VecX::Zero(m.nc);
+  mu = VecX::Zero(m.nc);
+  vd_work = VecX::Zero(m.nv);
+  track_ref = VecX::Zero(n);
+  cq = VecX::Zero(n);
+  cqd = VecX::Zero(n);
+  ctau = VecX::Zero(n);
+  nrows = m.nc;
+  tol_f = 1e-13 * std::max(1.0, m.length_scale);
+  kin.resize(m.nb);
+  ce.init(m);
+  jets.init(m);
+  ce.coord_cache = &jets;
+  ce.track_ref = &track_ref;
+  sweep.plan(m, ce);
+  vd = VecX::Zero(m.nv);
+  tau_in = VecX::Zero(n);
+  tau_jets.resize(n);
+  // the joint-space algorithms'
   coord_tau = VecX::Zero(n);
   rne.resize(m);
   tau = VecX::Zero(n);
@@ -23,26 +44,6 @@ Data::Data(const Model& m) : model(&m), n(static_cast<int>(m.coords.size())), kk
   qdd = VecX::Zero(n);
   zero = VecX::Zero(n);
   llt = Eigen::LLT<MatX>(n);
-  // the Cartesian pipeline
-  nrows = m.nc;
-  ce.init(m);
-  jets.init(m);
-  track_ref = VecX::Zero(n);
-  ce.coord_cache = &jets;
-  ce.track_ref = &track_ref;
-  tau_jets.resize(n);
-  cq = VecX::Zero(n);
-  cqd = VecX::Zero(n);
-  ctau = VecX::Zero(n);
-  sweep.plan(m, ce);
-  delta = VecX::Zero(m.nc);
-  vd_work = VecX::Zero(m.nv);
-  tmp_nv = VecX::Zero(m.nv);
-  tmp_nc = VecX::Zero(m.nc);
-  mu = VecX::Zero(m.nc);
-  tol_f = 1e-13 * std::max(1.0, m.length_scale);
-  vd = VecX::Zero(m.nv);
-  tau_in = VecX::Zero(n);
 }
 
 Data::~Data() = default;
