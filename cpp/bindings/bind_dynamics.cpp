@@ -1,9 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <pybind11/stl.h>
 
+#include "armdyn/algorithm/energy.hpp"
+#include "armdyn/algorithm/forces.hpp"
+#include "armdyn/algorithm/kinematics.hpp"
+#include "armdyn/algorithm/kkt.hpp"
 #include "armdyn/analysis/joint_space.hpp"
 #include "armdyn/analysis/simulate.hpp"
-#include "armdyn/solver/engine.hpp"
+#include "armdyn/data.hpp"
 #include "common.hpp"
 
 namespace armdyn {
@@ -169,10 +173,10 @@ void bind_dynamics(py::module_& m) {
       [](const Model& md, py::object u, py::object v, double t) {
         const VecX uu = to_vec(u, "u", md.nq), vv = to_vec(v, "v", md.nv);
         check_state(md, uu, vv, "body_accelerations");
-        Engine e(md);
+        Data d(md);
         VecX vd(md.nv);
-        e.dynamics(t, uu.data(), vv.data(), vd.data());
-        return py::make_tuple(to_numpy(vd), to_numpy(e.delta()));
+        body_accelerations(md, d, t, uu.data(), vv.data(), vd.data());
+        return py::make_tuple(to_numpy(vd), to_numpy(d.delta));
       },
       py::arg("model"), py::arg("u"), py::arg("v"), py::arg("t") = 0.0,
       "Solve the KKT system at (u, v, t): returns (v' (nv,), multipliers delta (nc,)).");
@@ -194,10 +198,10 @@ void bind_dynamics(py::module_& m) {
       [](const Model& md, py::object u, py::object v, double t) {
         const VecX uu = to_vec(u, "u", md.nq), vv = to_vec(v, "v", md.nv);
         check_state(md, uu, vv, "body_forces");
-        Engine e(md);
-        e.load(uu.data(), vv.data());
-        e.forces(t);
-        return to_numpy(e.eta());
+        Data d(md);
+        load_kinematics(md, d, uu.data(), vv.data());
+        cartesian_forces(md, d, t);
+        return to_numpy(d.eta);
       },
       py::arg("model"), py::arg("u"), py::arg("v"), py::arg("t") = 0.0,
       "eta (nv,): gravity, gyroscopic -w x Jw, loads, springs, joint forces.");
@@ -206,9 +210,9 @@ void bind_dynamics(py::module_& m) {
       "energy",
       [](const Model& md, py::object u, py::object v) {
         const VecX uu = to_vec(u, "u", md.nq), vv = to_vec(v, "v", md.nv);
-        Engine e(md);
+        Data d(md);
         double ke, pe;
-        e.energy(uu.data(), vv.data(), ke, pe);
+        energy(md, d, uu.data(), vv.data(), ke, pe);
         return py::make_tuple(ke, pe);
       },
       py::arg("model"), py::arg("u"), py::arg("v"), "(kinetic, potential) energy [J].");

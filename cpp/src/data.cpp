@@ -1,14 +1,36 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "armdyn/data.hpp"
 
+#include <algorithm>
+
 #include "armdyn/errors.hpp"
-#include "armdyn/solver/engine.hpp"
 
 namespace armdyn {
 
-Data::Data(const Model& m) : model(&m), n(static_cast<int>(m.coords.size())) {
-  kin.resize(m.nb);
+Data::Data(const Model& m) : model(&m), n(static_cast<int>(m.coords.size())), kkt(m) {
+  // the Cartesian pipeline's buffers first, next to the KKT solver's (allocated just above)
   eta = VecX::Zero(m.nv);
+  delta = VecX::Zero(m.nc);
+  tmp_nv = VecX::Zero(m.nv);
+  tmp_nc = VecX::Zero(m.nc);
+  mu = VecX::Zero(m.nc);
+  vd_work = VecX::Zero(m.nv);
+  track_ref = VecX::Zero(n);
+  cq = VecX::Zero(n);
+  cqd = VecX::Zero(n);
+  ctau = VecX::Zero(n);
+  nrows = m.nc;
+  tol_f = 1e-13 * std::max(1.0, m.length_scale);
+  kin.resize(m.nb);
+  ce.init(m);
+  jets.init(m);
+  ce.coord_cache = &jets;
+  ce.track_ref = &track_ref;
+  sweep.plan(m, ce);
+  vd = VecX::Zero(m.nv);
+  tau_in = VecX::Zero(n);
+  tau_jets.resize(n);
+  // the joint-space algorithms'
   coord_tau = VecX::Zero(n);
   rne.resize(m);
   tau = VecX::Zero(n);

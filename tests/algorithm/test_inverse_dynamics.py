@@ -245,7 +245,7 @@ def _branched_tree_with_force_elements(rng):
 def test_recursive_and_kkt_paths_agree(rng):
     """The O(n) Newton–Euler sweeps (method "joint", the default) and the driven-KKT
     multipliers (method "cartesian") are two derivations of the same torques: the joint path
-    takes the coordinate forces straight from q, the Cartesian one through the engine's eta;
+    takes the coordinate forces straight from q, the Cartesian one through the bodies' eta;
     the accelerations and projections are derived separately."""
     model = _branched_tree_with_force_elements(rng)
     n = model.n_coords

@@ -28,11 +28,20 @@
 #include "armdyn/algorithm/forces.hpp"
 #include "armdyn/algorithm/rnea.hpp"
 
+// the Cartesian pipeline on the bodies' state (u, v): kinematics, constraints, forces
+// (cartesian_forces), KKT (body_accelerations), projection, reactions, energy
+#include "armdyn/algorithm/constraints.hpp"
+#include "armdyn/algorithm/energy.hpp"
+#include "armdyn/algorithm/kinematics.hpp"
+#include "armdyn/algorithm/kkt.hpp"
+#include "armdyn/algorithm/projection.hpp"
+#include "armdyn/algorithm/reactions.hpp"
+
 // URDF import
 #include "armdyn/io/urdf.hpp"
 
-// the Cartesian pipeline: kinematics, constraints, KKT, engine, integrators
-#include "armdyn/solver/engine.hpp"
+// the integrators (the kernels under the pipeline -- jets, constraint rows, KKT factor, tree
+// sweep -- are in armdyn/solver/)
 #include "armdyn/solver/integrators.hpp"
 
 // driven inverse dynamics, joint-space state, tree dynamics with gears, whole runs

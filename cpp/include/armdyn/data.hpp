@@ -5,15 +5,30 @@
 #pragma once
 
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "armdyn/analysis/joint_space.hpp"
 #include "armdyn/model/model.hpp"
+#include "armdyn/solver/constraints.hpp"
 #include "armdyn/solver/kinematics.hpp"
+#include "armdyn/solver/kkt.hpp"
+#include "armdyn/solver/tree_sweep.hpp"
 
 namespace armdyn {
 
-class Engine;
+/// Counters of the Cartesian pipeline over a Data's life (a simulation reports them).
+struct PipelineStats {
+  long position_projections = 0;  ///< position corrections that needed a factorisation
+  long newton_iterations = 0;
+  long velocity_projections = 0;
+  long kkt_solves = 0;
+  long factorizations = 0;
+  /// body_accelerations evaluations where the constraint Jacobian had lower rank than at
+  /// assembly (a singular configuration); the first one is described in singular_note.
+  long singular_evaluations = 0;
+  std::string singular_note;
+};
 
 class Data {
  public:
@@ -27,9 +42,10 @@ class Data {
   const Model* model;  ///< the model the buffers are sized for (identity only, not owned)
   int n = 0;           ///< joint coordinates
 
-  // --- kinematics (forward_kinematics) ---
+  // --- kinematics: joint_space_kinematics, load_kinematics (shared by the joint-space and the
+  // Cartesian algorithms; each loads it before use) ---
   std::vector<BodyKin> kin;  ///< per body: pose and velocity
-  // --- forces (body_forces, coordinate_forces) ---
+  // --- forces (body_forces, coordinate_forces, cartesian_forces) ---
   VecX eta;        ///< (nv) applied and gyroscopic forces on the bodies
   VecX coord_tau;  ///< (n) joint-coordinate forces and gear contact forces
   // --- recursive Newton-Euler (rnea) ---
@@ -50,12 +66,37 @@ class Data {
   // --- forward dynamics ---
   VecX rhs, qdd, zero;
   MatX L;  ///< (n, n) Cholesky factor of M in its lower triangle (math/cholesky.hpp)
-  // --- the Cartesian (KKT) path: made on first use ---
-  std::unique_ptr<Engine> engine;  ///< forward dynamics through the Cartesian KKT system
-  VecX vd, tau_in;                 ///< (nv) accelerations; (n) torques seen by the engine
-  std::unique_ptr<Model> driven;   ///< inverse dynamics: the model with every coordinate driven
-  std::unique_ptr<Engine> driven_engine;
-  VecX drive_ref;  ///< (3 n) drive values (q, qd, qdd) of driven_engine
+
+  // --- the Cartesian pipeline on the bodies' state (u, v): algorithm/kinematics (load),
+  // constraints, forces (cartesian_forces), kkt (body_accelerations), projection, reactions,
+  // energy ---
+  // settings of the calls that follow, set by the caller:
+  int nrows = 0;  ///< rows taking part: model.nc (joints and drives, the default) or nc_joint
+  const double* aux = nullptr;  ///< auxiliary states z (model.n_aux); nullptr: all zero
+  /// Joint-space generalised forces (n) added to eta by cartesian_forces; nullptr: none.
+  const double* joint_torques = nullptr;
+  /// false: cartesian_forces leaves out the joint-coordinate forces and gear pairs (a
+  /// joint-space caller adds them to its generalised forces directly).
+  bool with_coordinate_forces = true;
+  // buffers:
+  ConstraintEval ce;   ///< f, zeta, rhs, xi at the loaded state
+  CoordJetCache jets;  ///< coordinate jets at the loaded state (ce.coord_cache)
+  VecX track_ref;      ///< (n) unwrapped reference of the angle coordinates (ce.track_ref)
+  std::vector<ScalarJet> tau_jets;   ///< (n) with joint_torques: each coordinate's jet (no value)
+  VecX cq, cqd, ctau;                ///< (n) coordinate values, rates and forces of the force laws
+  KktSolver kkt;                     ///< the factor of the KKT system's Schur complement
+  TreeSweep sweep;                   ///< the O(n) solve of a fully driven tree
+  bool swept = false;                ///< the last body_accelerations took the sweep (kkt not used)
+  VecX delta;                        ///< (nc) multipliers of the last body_accelerations
+  VecX vd_work, tmp_nv, tmp_nc, mu;  ///< (nv, nv, nc, nc) scratch
+  double tol_f = 1e-13;              ///< position residual accepted by project without a correction
+  PipelineStats stats;
+
+  // --- the public Cartesian forward and inverse dynamics (algorithm/dynamics) ---
+  VecX vd, tau_in;                    ///< (nv) accelerations; (n) the joint torques of the call
+  std::unique_ptr<Model> driven;      ///< inverse dynamics: the model with every coordinate driven
+  std::unique_ptr<Data> driven_data;  ///< made on first use, for *driven
+  VecX drive_ref;                     ///< (3 n) drive values (q, qd, qdd) of driven_data
 };
 
 /// Throws ModelError when data was not made for m.

@@ -5,10 +5,11 @@
 
 #include "armdyn/algorithm/crba.hpp"
 #include "armdyn/algorithm/forces.hpp"
+#include "armdyn/algorithm/kinematics.hpp"
+#include "armdyn/algorithm/kkt.hpp"
 #include "armdyn/algorithm/rnea.hpp"
 #include "armdyn/errors.hpp"
 #include "armdyn/math/cholesky.hpp"
-#include "armdyn/solver/engine.hpp"
 
 namespace armdyn {
 
@@ -25,29 +26,28 @@ void check_inputs(const Model& m, const Data& d, Eigen::Ref<const VecX> q,
   if (!std::isfinite(t)) throw ModelError(msg(fn, ": t is not finite"));
 }
 
-// forward dynamics through the Cartesian KKT system, the joint torques as loads
+// forward dynamics through the Cartesian KKT system, the joint torques as loads: the joint rows
+// only, the coordinate forces mapped onto the bodies
 void forward_cartesian(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
                        Eigen::Ref<const VecX> tau, double t) {
-  if (!d.engine) {
-    d.engine = std::make_unique<Engine>(m);
-    d.engine->set_include_drives(false);
-    d.vd = VecX::Zero(m.nv);
-    d.tau_in = VecX::Zero(d.n);
-    d.engine->set_joint_torques(d.tau_in.data());
-  }
-  Engine& e = *d.engine;
-  joint_space_kinematics(m, q, qd, e.kin_in());
+  d.nrows = m.nc_joint;
+  d.aux = nullptr;
+  d.with_coordinate_forces = true;
+  d.joint_torques = d.tau_in.data();
+  load_joint_kinematics(m, d, q, qd);
   d.tau_in = tau;
-  e.dynamics_loaded(t, d.vd.data());
+  body_accelerations_loaded(m, d, t, d.vd.data());
+  d.joint_torques = nullptr;
+  d.nrows = m.nc;
   // the coordinate jets of the torques, at this state
-  for (int c = 0; c < d.n; ++c) d.qdd[c] = coord_acceleration(m, e.torque_jets()[c], c, d.vd);
+  for (int c = 0; c < d.n; ++c) d.qdd[c] = coord_acceleration(m, d.tau_jets[c], c, d.vd);
 }
 
 // inverse dynamics through the KKT system with every joint coordinate driven to (q, qd, qdd)
 void inverse_cartesian(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
                        Eigen::Ref<const VecX> qdd, double t) {
   const int n = d.n;
-  if (!d.driven_engine) {
+  if (!d.driven_data) {
     auto driven = std::make_unique<Model>(m);
     driven->drives.clear();
     driven->drive_index.clear();
@@ -70,23 +70,22 @@ void inverse_cartesian(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen:
     driven->kkt_all = plan_kkt(*driven, driven->nc);
     driven->kkt_joint = plan_kkt(*driven, driven->nc_joint);
     d.driven = std::move(driven);
-    d.driven_engine = std::make_unique<Engine>(*d.driven);
-    d.vd = VecX::Zero(m.nv);
+    d.driven_data = std::make_unique<Data>(*d.driven);
     d.drive_ref = VecX::Zero(3 * n);
-    d.driven_engine->constraints().drive_ref = d.drive_ref.data();
+    d.driven_data->ce.drive_ref = d.drive_ref.data();
     // the state is built on the manifold from (q, qd): only zeta, rhs and xi are wanted
-    d.driven_engine->constraints().drive_values = false;
+    d.driven_data->ce.drive_values = false;
   }
-  Engine& e = *d.driven_engine;
-  joint_space_kinematics(m, q, qd, e.kin_in());
+  Data& dd = *d.driven_data;
+  load_joint_kinematics(m, dd, q, qd);
   for (int c = 0; c < n; ++c) {
     d.drive_ref[3 * c] = q[c];
     d.drive_ref[3 * c + 1] = qd[c];
     d.drive_ref[3 * c + 2] = qdd[c];
   }
-  // square zeta: the engine takes its O(n) tree sweep (KKT factorisation only when singular)
-  e.dynamics_loaded(t, d.vd.data());
-  for (int c = 0; c < n; ++c) d.tau[c] = -e.delta()[d.driven->nc_joint + c];
+  // square zeta: the O(n) tree sweep (KKT factorisation only when singular)
+  body_accelerations_loaded(*d.driven, dd, t, d.vd.data());
+  for (int c = 0; c < n; ++c) d.tau[c] = -dd.delta[d.driven->nc_joint + c];
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "armdyn/algorithm/kinematics.hpp"
 #include "armdyn/errors.hpp"
 
 namespace armdyn {
@@ -91,6 +92,73 @@ void coordinate_forces(const Model& m, const double* q, const double* qd, const 
     out[g.coord_a] -= g.r_a * fs;
     out[g.coord_b] -= g.r_b * fs;
   }
+}
+
+namespace {
+// the joint-coordinate forces and gear pairs of the Cartesian pipeline into d.eta
+void coordinate_forces_on_bodies(const Model& m, Data& d, double t) {
+  if (m.coord_forces.empty() && m.gears.empty()) return;
+  // the coordinates the laws read, from their jets (gear angles unwrapped over turns)
+  for (const CoordForce& cf : m.coord_forces) {
+    const ScalarJet& q = d.jets.get(m, d.kin, cf.coord);
+    d.cq[cf.coord] = q.val;
+    d.cqd[cf.coord] = q.rate;
+  }
+  for (const GearPair& g : m.gears) {
+    for (const int c : {g.coord_a, g.coord_b}) {
+      const ScalarJet& q = d.jets.get(m, d.kin, c);
+      d.cq[c] = tracked(d, c, q.val);
+      d.cqd[c] = q.rate;
+    }
+  }
+  // the joint-space generalised forces, mapped onto the bodies through each coordinate's
+  // Jacobian
+  coordinate_forces(m, d.cq.data(), d.cqd.data(), d.aux, t, d.ctau);
+  for (int c = 0; c < static_cast<int>(m.coords.size()); ++c) {
+    if (d.ctau[c] == 0.0) continue;
+    const Joint& j = m.joints[m.coords[c].joint];
+    add_pair(d.eta, d.ctau[c] * d.jets.get(m, d.kin, c).J, j.parent, j.child);
+  }
+}
+}  // namespace
+
+void cartesian_forces(const Model& m, Data& d, double t) {
+  body_forces(m, d.kin, t, d.eta);
+  if (d.with_coordinate_forces) coordinate_forces_on_bodies(m, d, t);
+  // joint-space torques of a joint-space call
+  if (d.joint_torques) {
+    const double* tau = d.joint_torques;
+    for (int c = 0; c < static_cast<int>(m.coords.size()); ++c) {
+      const ScalarJet& q = d.tau_jets[c] = coord_jet(m, d.kin, c, false);
+      if (tau[c] == 0.0) continue;
+      const Joint& j = m.joints[m.coords[c].joint];
+      add_pair(d.eta, tau[c] * q.J, j.parent, j.child);
+    }
+  }
+  if (!d.eta.allFinite()) {
+    for (int i = 0; i < m.nb; ++i)
+      if (!d.eta.segment<6>(6 * i).allFinite())
+        throw SolverError(
+            msg("non-finite applied force on body '", m.bodies[i].name, "' at t=", t));
+  }
+}
+
+void aux_rates(const Model& m, Data& d, double t, double* zdot) {
+  for (const CoordForce& cf : m.coord_forces) {
+    if (cf.aux < 0) continue;
+    const ScalarJet& q = d.jets.get(m, d.kin, cf.coord);
+    const double z = d.aux ? d.aux[cf.aux] : 0.0;
+    coord_force_value(cf, m.coords[cf.coord].angular, q.val, q.rate, t, z, &zdot[cf.aux]);
+  }
+}
+
+void gear_mesh(const Model& m, Data& d, int gi, double& s, double& sd, double& penetration) {
+  const GearPair& g = m.gears[gi];
+  const ScalarJet& qa = d.jets.get(m, d.kin, g.coord_a);
+  const ScalarJet& qb = d.jets.get(m, d.kin, g.coord_b);
+  s = g.r_a * tracked(d, g.coord_a, qa.val) + g.r_b * tracked(d, g.coord_b, qb.val);
+  sd = g.r_a * qa.rate + g.r_b * qb.rate;
+  penetration = std::abs(s) - 0.5 * g.backlash;
 }
 
 }  // namespace armdyn

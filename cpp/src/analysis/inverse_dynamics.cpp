@@ -5,10 +5,13 @@
 #include <chrono>
 #include <cmath>
 
+#include "armdyn/algorithm/kinematics.hpp"
+#include "armdyn/algorithm/kkt.hpp"
+#include "armdyn/algorithm/projection.hpp"
+#include "armdyn/algorithm/reactions.hpp"
 #include "armdyn/analysis/joint_space.hpp"
 #include "armdyn/errors.hpp"
 #include "armdyn/solver/block_sparse.hpp"
-#include "armdyn/solver/engine.hpp"
 #include "armdyn/solver/kinematics.hpp"
 
 namespace armdyn {
@@ -26,8 +29,8 @@ std::string undriven_coordinates(const Model& m) {
 
 }  // namespace
 
-DrivenSolver::DrivenSolver(const Model& m, Engine& e, const char* who, double t0)
-    : t_good(t0), m_(m), e_(e), who_(who), t_prev_(t0), fk_(m.joint_space_ok) {
+DrivenSolver::DrivenSolver(const Model& m, Data& d, const char* who, double t0)
+    : t_good(t0), m_(m), d_(d), who_(who), t_prev_(t0), fk_(m.joint_space_ok) {
   if (m.mobility_driven > 0)
     throw ModelError(
         msg(who, ": the drives leave ", m.mobility_driven,
@@ -40,7 +43,7 @@ DrivenSolver::DrivenSolver(const Model& m, Engine& e, const char* who, double t0
   u_save_ = VecX::Zero(m.nq);
   v_save_ = VecX::Zero(m.nv);
   u_pred_ = VecX::Zero(m.nq);
-  track_save_ = e.tracking();
+  track_save_ = d.track_ref;
 }
 
 void DrivenSolver::predict(double t_from, double t, VecX& u, VecX& v, const VecX& vd) {
@@ -56,7 +59,7 @@ void DrivenSolver::predict(double t_from, double t, VecX& u, VecX& v, const VecX
     state_from_joints(m_, qc_, qdc_, u, v, fkw_);
   } else if (t != t_from) {
     const double h = t - t_from;
-    e_.udot(u.data(), v.data(), ud_.data());
+    udot(m_, u.data(), v.data(), ud_.data());
     u += h * ud_;
     v += h * vd;
   }
@@ -64,12 +67,12 @@ void DrivenSolver::predict(double t_from, double t, VecX& u, VecX& v, const VecX
 
 std::string DrivenSolver::dependent_rows() const {
   std::string rows;
-  for (int r : e_.kkt().dependent_rows()) rows += (rows.empty() ? "" : "; ") + m_.row_name(r);
+  for (int r : d_.kkt.dependent_rows()) rows += (rows.empty() ? "" : "; ") + m_.row_name(r);
   return rows;
 }
 
 std::string DrivenSolver::singular_rows() const {
-  KktSolver& kkt = e_.kkt();
+  const KktSolver& kkt = d_.kkt;
   if (!(kkt.used_pseudo_inverse() && kkt.rank() < m_.rank_all)) return "";
   return msg(" The driven constraints are kinematically singular there: rank ", kkt.rank(),
              " instead of ", m_.rank_all, "; dependent rows: ", dependent_rows(), ".");
@@ -93,13 +96,13 @@ void DrivenSolver::solve(double t, VecX& u, VecX& v, VecX& vd, double& rf, doubl
     u_save_ = u;
     v_save_ = v;
     predict(t_prev_, t, u, v, vd);
-    e_.dynamics(t, u.data(), v.data(), vd.data());
-    e_.loaded_residuals(v.data(), rf, rv);
+    body_accelerations(m_, d_, t, u.data(), v.data(), vd.data());
+    loaded_residuals(m_, d_, v.data(), rf, rv);
     const double tol_f = 1e-13 * std::max(1.0, m_.length_scale);
     const double tol_v = 1e-13 * std::max(1.0, v.cwiseAbs().maxCoeff());
-    solved = rf <= tol_f && rv <= tol_v && flipped_joint(m_, e_.kin()) < 0;
+    solved = rf <= tol_f && rv <= tol_v && flipped_joint(m_, d_.kin) < 0;
     if (solved) {
-      e_.commit_tracking();
+      commit_tracking(m_, d_);
     } else {
       u = u_save_;
       v = v_save_;
@@ -114,13 +117,13 @@ void DrivenSolver::solve(double t, VecX& u, VecX& v, VecX& vd, double& rf, doubl
       const double t_next = std::min(t_cur + h, t);
       u_save_ = u;
       v_save_ = v;
-      track_save_ = e_.tracking();
+      track_save_ = d_.track_ref;
       std::string failure;
       try {
         predict(t_cur, t_next, u, v, vd);
         u_pred_ = u;
-        e_.project(t_next, u.data(), v.data(), Metric::Mass);
-        if (const int bad = flipped_joint(m_, e_.kin()); bad >= 0)
+        project(m_, d_, t_next, u.data(), v.data(), Metric::Mass);
+        if (const int bad = flipped_joint(m_, d_.kin); bad >= 0)
           failure = msg("the position problem converged to a flipped configuration of joint '",
                         m_.joints[bad].name, "'");
         // Newton must stay on the branch it was predicted on: a correction much larger than
@@ -134,33 +137,33 @@ void DrivenSolver::solve(double t, VecX& u, VecX& v, VecX& vd, double& rf, doubl
       if (failure.empty()) {
         t_cur = t_next;
         t_good = t_cur;
-        if (t_cur < t) e_.dynamics(t_cur, u.data(), v.data(), vd.data(), true);
+        if (t_cur < t) body_accelerations(m_, d_, t_cur, u.data(), v.data(), vd.data(), true);
         continue;
       }
       u = u_save_;
       v = v_save_;
-      e_.set_tracking(track_save_);
+      d_.track_ref = track_save_;
       h *= 0.5;
       if (fk_ || !(h >= h_min))
         throw SolverError(msg(who_, " at t=", t_next, ": ", failure, ".", singular_rows()));
     } while (t_cur < t);
     // acceleration problem and multipliers, with the factor left by the projection
-    e_.dynamics(t, u.data(), v.data(), vd.data(), true);
-    e_.loaded_residuals(v.data(), rf, rv);
+    body_accelerations(m_, d_, t, u.data(), v.data(), vd.data(), true);
+    loaded_residuals(m_, d_, v.data(), rf, rv);
   }
   t_prev_ = t;
   t_good = t;
-  KktSolver& kkt = e_.kkt();
-  if (throw_on_singular && !e_.swept() && kkt.used_pseudo_inverse() && kkt.rank() < m_.rank_all)
+  const KktSolver& kkt = d_.kkt;
+  if (throw_on_singular && !d_.swept && kkt.used_pseudo_inverse() && kkt.rank() < m_.rank_all)
     throw SolverError(msg(who_, ": kinematically singular at t=", t,
                           ": the driven constraints have rank ", kkt.rank(), " instead of ",
                           m_.rank_all, "; dependent rows: ", dependent_rows()));
 }
 
 InverseDynamicsResult inverse_dynamics_driven(const Model& m, const std::vector<double>& times) {
-  Engine e(m);
+  Data d(m);
   const double t0 = (!times.empty() && times.front() < 0.0) ? times.front() : 0.0;
-  DrivenSolver solver(m, e, "driven_inverse_dynamics", t0);  // u0 is assembled at t = 0
+  DrivenSolver solver(m, d, "driven_inverse_dynamics", t0);  // u0 is assembled at t = 0
   if (times.empty()) throw ModelError("driven_inverse_dynamics: no times given");
   for (size_t k = 0; k < times.size(); ++k) {
     if (!std::isfinite(times[k]))
@@ -195,7 +198,7 @@ InverseDynamicsResult inverse_dynamics_driven(const Model& m, const std::vector<
       throw SolverError(msg(err.what(), " Times solved before this one: ", k));
     }
     for (int c = 0; c < nco; ++c) {
-      const ScalarJet s = coord_jet(m, e.kin(), c);
+      const ScalarJet s = coord_jet(m, d.kin, c);
       double qv = s.val;
       if (m.coords[c].angular && k > 0) qv = qprev[c] + wrap_angle(s.val - qprev[c]);
       qprev[c] = qv;
@@ -203,10 +206,10 @@ InverseDynamicsResult inverse_dynamics_driven(const Model& m, const std::vector<
       out.qd.push_back(s.rate);
       out.qdd.push_back(coord_acceleration(m, s, c, vd));
     }
-    for (const Drive& d : m.drives) out.efforts.push_back(-e.delta()[d.row]);
+    for (const Drive& dr : m.drives) out.efforts.push_back(-d.delta[dr.row]);
     for (size_t j = 0; j < m.joints.size(); ++j) {
       Vec3 f, tq;
-      e.joint_reaction(static_cast<int>(j), f, tq);
+      joint_reaction(m, d, static_cast<int>(j), f, tq);
       for (int i = 0; i < 3; ++i) {
         out.reaction_forces.push_back(f[i]);
         out.reaction_torques.push_back(tq[i]);
@@ -219,8 +222,8 @@ InverseDynamicsResult inverse_dynamics_driven(const Model& m, const std::vector<
     out.velocity_residual.push_back(rv);
     ++out.n;
   }
-  out.newton_iterations = e.pstats.newton_iterations;
-  out.factorizations = e.factorizations;
+  out.newton_iterations = d.stats.newton_iterations;
+  out.factorizations = d.stats.factorizations;
   out.cpu_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }

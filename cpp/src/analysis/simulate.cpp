@@ -7,10 +7,13 @@
 #include <memory>
 #include <utility>
 
+#include "armdyn/algorithm/constraints.hpp"
+#include "armdyn/algorithm/kinematics.hpp"
+#include "armdyn/algorithm/projection.hpp"
 #include "armdyn/analysis/inverse_dynamics.hpp"
+#include "armdyn/data.hpp"
 #include "armdyn/detail/ode_systems.hpp"
 #include "armdyn/errors.hpp"
-#include "armdyn/solver/engine.hpp"
 
 namespace armdyn {
 
@@ -21,12 +24,13 @@ double stiffness_estimate(const Model& m, std::string& culprit) {
   double lam = 0.0;
   culprit = "no springs or dampers";
   if (m.springs.empty() && m.coord_forces.empty() && m.gears.empty()) return 0.0;
-  Engine e(m);
-  e.load(m.u0.data(), m.v0.data());
-  ConstraintEval& ce = e.constraints();
-  eval_constraints(m, e.kin(), 0.0, true, ce);
+  Data dat(m);
+  load_kinematics(m, dat, m.u0.data(), m.v0.data());
+  evaluate_constraints(m, dat, 0.0, true);
+  ConstraintEval& ce = dat.ce;
   ce.xi.setZero();
-  KktSolver& kkt = e.kkt();
+  KktSolver& kkt = dat.kkt;
+  const std::vector<BodyKin>& kin = dat.kin;
   kkt.factor(ce, m.nc, Metric::Mass);
   VecX eta = VecX::Zero(m.nv), vd = VecX::Zero(m.nv), delta = VecX::Zero(m.nc);
   auto inv_mass = [&](const Row12& g, int pa, int pb) {
@@ -43,8 +47,8 @@ double stiffness_estimate(const Model& m, std::string& culprit) {
     }
   };
   for (const SpringDamper& sd : m.springs) {
-    const VecJet d = difference(point_jet(kin_of(e.kin(), sd.body_b), sd.point_b, 1),
-                                point_jet(kin_of(e.kin(), sd.body_a), sd.point_a, 0));
+    const VecJet d = difference(point_jet(kin_of(kin, sd.body_b), sd.point_b, 1),
+                                point_jet(kin_of(kin, sd.body_a), sd.point_a, 0));
     const double L = d.val.norm();
     if (!(L > 0)) continue;
     const double im = inv_mass(d.left(d.val / L), sd.body_a, sd.body_b);
@@ -52,7 +56,7 @@ double stiffness_estimate(const Model& m, std::string& culprit) {
     consider(sd.damping * im, msg("spring-damper '", sd.name, "' (damping)"));
   }
   for (const CoordForce& cf : m.coord_forces) {
-    const ScalarJet q = coord_jet(m, e.kin(), cf.coord);
+    const ScalarJet q = coord_jet(m, kin, cf.coord);
     const Joint& j = m.joints[m.coords[cf.coord].joint];
     const double im = inv_mass(q.J, j.parent, j.child);
     const std::string& name = m.coords[cf.coord].name;
@@ -66,7 +70,7 @@ double stiffness_estimate(const Model& m, std::string& culprit) {
   }
   for (const GearPair& g : m.gears) {
     // mesh direction: r_a J_qa + r_b J_qb over the (up to four) bodies of the two joints
-    const ScalarJet qa = coord_jet(m, e.kin(), g.coord_a), qb = coord_jet(m, e.kin(), g.coord_b);
+    const ScalarJet qa = coord_jet(m, kin, g.coord_a), qb = coord_jet(m, kin, g.coord_b);
     const Joint& ja = m.joints[m.coords[g.coord_a].joint];
     const Joint& jb = m.joints[m.coords[g.coord_b].joint];
     eta.setZero();
@@ -222,7 +226,7 @@ void integrate(Integrator method, OdeSystem& ode, VecX& y, double t_end, const S
 /// the last state solved and t_last its time.
 void run_kinematic(const Model& ms, detail::MbsSystem& sys, VecX& y, double t_end, double output_dt,
                    SimResult& out, double& t_last) {
-  DrivenSolver solver(ms, sys.engine(), "simulate", 0.0);
+  DrivenSolver solver(ms, sys.data(), "simulate", 0.0);
   solver.throw_on_singular = false;  // counted and noted, as by the integrators
   VecX u = y.head(ms.nq), v = y.segment(ms.nq, ms.nv), vd = VecX::Zero(ms.nv);
   try {
@@ -243,9 +247,9 @@ void run_kinematic(const Model& ms, detail::MbsSystem& sys, VecX& y, double t_en
 /// (q, qd, z) of the projected Cartesian state y = (u, v, z); angles start in (-pi, pi], as the
 /// Cartesian run's tracking does.
 VecX joint_state(const Model& ms, detail::MbsSystem& sys, VecX& y, Metric projection) {
-  Engine& e = sys.engine();
-  e.set_aux(y.data() + ms.nq + ms.nv);
-  e.project(0.0, y.data(), y.data() + ms.nq, projection);
+  Data& d = sys.data();
+  d.aux = y.data() + ms.nq + ms.nv;
+  project(ms, d, 0.0, y.data(), y.data() + ms.nq, projection);
   VecX q, qd;
   joint_coordinates(ms, y.head(ms.nq), y.segment(ms.nq, ms.nv), q, qd);
   VecX yj(2 * q.size() + ms.n_aux);
@@ -258,13 +262,13 @@ VecX joint_state(const Model& ms, detail::MbsSystem& sys, VecX& y, Metric projec
 void explain_failure(const Model& ms, detail::MbsSystem& sys, const VecX& y, double t_last,
                      bool kinematic, std::string& error) {
   try {
-    Engine& e = sys.engine();
-    e.set_aux(y.data() + ms.nq + ms.nv);
+    Data& d = sys.data();
+    d.aux = y.data() + ms.nq + ms.nv;
     // the kinematic path stops short of a limit point (no solution beyond it) by its
     // continuation's smallest step, where the rank loss shows only at looser thresholds
     std::string why;
     for (const double threshold : {1e-7, 1e-5, 1e-3}) {
-      why = e.diagnose_singularity(t_last, y.data(), y.data() + ms.nq, threshold);
+      why = diagnose_singularity(ms, d, t_last, y.data(), y.data() + ms.nq, threshold);
       if (!why.empty() || !kinematic) break;
     }
     if (why.empty()) return;
@@ -280,15 +284,15 @@ void explain_failure(const Model& ms, detail::MbsSystem& sys, const VecX& y, dou
 
 /// The run's counters, and every table trimmed to the complete rows (a failed output may have
 /// pushed part of one).
-void finish(const Model& m, const Model& ms, const Engine& e, SimResult& out) {
+void finish(const Model& m, const Model& ms, const PipelineStats& st, SimResult& out) {
   out.solver_bodies = ms.nb;
   out.solver_rows = ms.nc;
-  out.kkt_solves = e.kkt_solves;
-  out.factorizations = e.factorizations;
-  out.position_projections = e.pstats.position_projections;
-  out.newton_iterations = e.pstats.newton_iterations;
-  out.singular_evaluations = e.singular_evaluations;
-  out.singular_note = e.singular_note;
+  out.kkt_solves = st.kkt_solves;
+  out.factorizations = st.factorizations;
+  out.position_projections = st.position_projections;
+  out.newton_iterations = st.newton_iterations;
+  out.singular_evaluations = st.singular_evaluations;
+  out.singular_note = st.singular_note;
   const size_t n = static_cast<size_t>(out.n), nco = m.coords.size(), nj = m.joints.size();
   out.t.resize(n);
   out.u.resize(n * m.nq);
@@ -393,7 +397,7 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
     if (!plan.joint) explain_failure(ms, sys, y, t_last, kinematic, out.error);
   }
   out.cpu_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  finish(m, ms, sys.engine(), out);
+  finish(m, ms, sys.data().stats, out);
   return out;
 }
 

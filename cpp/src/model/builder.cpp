@@ -8,11 +8,13 @@
 #include <deque>
 #include <numeric>
 
+#include "armdyn/algorithm/kinematics.hpp"
+#include "armdyn/algorithm/projection.hpp"
 #include "armdyn/analysis/joint_space.hpp"
+#include "armdyn/data.hpp"
 #include "armdyn/errors.hpp"
 #include "armdyn/math/quaternion.hpp"
 #include "armdyn/solver/block_sparse.hpp"
-#include "armdyn/solver/engine.hpp"
 
 namespace armdyn {
 
@@ -572,15 +574,15 @@ std::shared_ptr<Model> finalize_draft(const Model& draft, const FinalizeOptions&
   }
   const Metric metric = options.mass_weighted_assembly ? Metric::Mass : Metric::Identity;
   {
-    Engine e(m);
+    Data d(m);
     try {
-      e.project(0.0, m.u0.data(), m.v0.data(), metric);
+      project(m, d, 0.0, m.u0.data(), m.v0.data(), metric);
     } catch (const SolverError& err) {
       throw ModelError(
           msg("finalize: assembly failed (the joints cannot all be satisfied): ", err.what()));
     }
-    e.load(m.u0.data(), nullptr);
-    const int bad = flipped_joint(m, e.kin());
+    load_kinematics(m, d, m.u0.data(), nullptr);
+    const int bad = flipped_joint(m, d.kin);
     if (bad >= 0)
       throw ModelError(msg("finalize: assembly converged to a flipped configuration of joint '",
                            m.joints[bad].name,
@@ -638,8 +640,8 @@ std::shared_ptr<Model> finalize_draft(const Model& draft, const FinalizeOptions&
       p->path = "dense";
       p->description = "dense Schur complement, pivoted Cholesky (minimum-norm multipliers)";
     }
-    Engine e(m);
-    e.project(0.0, m.u0.data(), m.v0.data(), metric);
+    Data d(m);
+    project(m, d, 0.0, m.u0.data(), m.v0.data(), metric);
   }
   return mp;
 }

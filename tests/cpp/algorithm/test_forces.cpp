@@ -1,9 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The force laws (armdyn/algorithm/forces.hpp): gravity and the gyroscopic torque, a point
-// spring-damper's tension along its line, joint springs and gear contact.
+// spring-damper's tension along its line, joint springs and gear contact; and the Cartesian
+// forces stage: a joint spring, a PI motor and a joint torque on a pendulum as a torque about
+// the hinge axis, the motor's integral rate, and a gear mesh read over turns.
 #include <cmath>
 
 #include "armdyn/algorithm/forces.hpp"
+#include "armdyn/algorithm/kinematics.hpp"
 #include "armdyn/math/quaternion.hpp"
 #include "check.hpp"
 #include "models.hpp"
@@ -68,6 +71,72 @@ TEST_CASE(joint_spring_and_gear_contact) {
   const double f = 1e5 * 0.029;
   CHECK_NEAR(tau[0], -50.0 * (0.3 - 0.1) - 2.0 * 0.4 - 0.1 * f, 1e-10);
   CHECK_NEAR(tau[1], -0.2 * f, 1e-10);
+}
+
+TEST_CASE(cartesian_forces_map_joint_forces_onto_the_bodies) {
+  // a pendulum with a joint spring-damper and a PI motor on its hinge, and a joint torque: on
+  // the bob they are a torque tau R^T y about the hinge axis (body axes), nothing else
+  const armdyn_test::Pendulum p;
+  ModelBuilder b = p.builder();
+  b.add_joint_spring_damper("hinge", 30.0, 1.5, 0.2);
+  b.add_motor("hinge", Profile::constant(0.4), 5.0, 0.1, 100.0, nullptr, 0, 2.0);
+  const ModelPtr m = b.finalize();
+  CHECK(m->n_aux == 1);
+  Data d(*m);
+  const double q = 0.9, qd = -0.6, z = 0.25, tau_in = 1.75;
+  VecX u, v;
+  state_from_joints(*m, VecX::Constant(1, q), VecX::Constant(1, qd), u, v);
+  load_kinematics(*m, d, u.data(), v.data());
+  VecX eta0(6);
+  body_forces(*m, d.kin, 0.0, eta0);
+  d.aux = &z;
+  cartesian_forces(*m, d, 0.0);
+  const double tau = -30.0 * (q - 0.2) - 1.5 * qd + 5.0 * (0.4 - q) + 0.1 * (0.0 - qd) + 2.0 * z;
+  const Vec3 axis_body = d.kin[0].R.transpose() * Vec3::UnitY();
+  CHECK_MAT_NEAR(d.eta.head<3>(), eta0.head<3>(), 1e-12);
+  CHECK_MAT_NEAR(d.eta.tail<3>(), Vec3(eta0.tail<3>() + tau * axis_body), 1e-12);
+  // the motor's integral state grows at the tracking error
+  double zdot = -1.0;
+  aux_rates(*m, d, 0.0, &zdot);
+  CHECK_NEAR(zdot, 0.4 - q, 1e-14);
+  // a joint torque adds the same way; without the coordinate forces only it remains
+  d.joint_torques = &tau_in;
+  d.with_coordinate_forces = false;
+  cartesian_forces(*m, d, 0.0);
+  CHECK_MAT_NEAR(d.eta.head<3>(), eta0.head<3>(), 1e-12);
+  CHECK_MAT_NEAR(d.eta.tail<3>(), Vec3(eta0.tail<3>() + tau_in * axis_body), 1e-12);
+}
+
+TEST_CASE(cartesian_gear_mesh_over_turns) {
+  ModelBuilder b(Vec3::Zero());
+  const Mat3 in = Vec3(0.01, 0.01, 0.02).asDiagonal();
+  b.add_body("a", 1.0, in, Vec3(0, 0, 0), armdyn_test::kIdentityQuat);
+  b.add_body("c", 1.0, in, Vec3(0.3, 0, 0), armdyn_test::kIdentityQuat);
+  b.add_revolute("ja", "ground", "a", Vec3(0, 0, 0), Vec3::UnitZ());
+  b.add_revolute("jc", "ground", "c", Vec3(0.3, 0, 0), Vec3::UnitZ());
+  b.add_gear_pair("g", "ja", "jc", 0.1, 0.2, 0.002, 1e5, 1.0, 0.0);
+  const ModelPtr m = b.finalize();
+  Data d(*m);
+  // gear a one turn and 0.3 rad on, turning at 0.4 rad/s; c at -0.1 rad, turning at -0.5 rad/s
+  VecX u = m->u0, v = VecX::Zero(m->nv);
+  u.segment<4>(3) = quat_exp(Vec3(0, 0, 0.3));
+  u.segment<4>(7 + 3) = quat_exp(Vec3(0, 0, -0.1));
+  v[5] = 0.4;
+  v[11] = -0.5;
+  load_kinematics(*m, d, u.data(), v.data());
+  d.track_ref[0] = 2 * M_PI;  // the angle's last projected value: one turn
+  double s, sd, pen;
+  gear_mesh(*m, d, 0, s, sd, pen);
+  const double qa = 2 * M_PI + 0.3, qc = -0.1;
+  CHECK_NEAR(s, 0.1 * qa + 0.2 * qc, 1e-14);
+  CHECK_NEAR(sd, 0.1 * 0.4 + 0.2 * -0.5, 1e-14);
+  CHECK_NEAR(pen, std::abs(0.1 * qa + 0.2 * qc) - 0.001, 1e-14);
+  // the joint-space law at the same (multi-turn) coordinates agrees
+  const double q[2] = {qa, qc}, qd[2] = {0.4, -0.5};
+  double s2, sd2, pen2;
+  gear_mesh(*m, 0, q, qd, s2, sd2, pen2);
+  CHECK_NEAR(s, s2, 1e-14);
+  CHECK_NEAR(sd, sd2, 1e-14);
 }
 
 ARMDYN_TEST_MAIN()

@@ -3,8 +3,10 @@
 // spatial tree, a closed loop, and a model with redundant rows (the pivoted path).
 #include <cmath>
 
+#include "armdyn/algorithm/kkt.hpp"
+#include "armdyn/algorithm/projection.hpp"
 #include "armdyn/analysis/joint_space.hpp"
-#include "armdyn/solver/engine.hpp"
+#include "armdyn/data.hpp"
 #include "armdyn/solver/kkt.hpp"
 #include "check.hpp"
 #include "models.hpp"
@@ -14,34 +16,34 @@ using namespace armdyn;
 namespace {
 
 /// A moving state of m: the assembled pose with velocities projected onto zeta v = 0.
-void moving_state(const Model& m, Engine& e, VecX& u, VecX& v) {
+void moving_state(const Model& m, Data& d, VecX& u, VecX& v) {
   u = m.u0;
   v.resize(m.nv);
   for (int i = 0; i < m.nv; ++i) v[i] = 0.8 * std::cos(0.9 * i + 0.4);
-  e.project(0.0, u.data(), v.data(), Metric::Mass);
+  project(m, d, 0.0, u.data(), v.data(), Metric::Mass);
 }
 
 void compare_with_dense(const ModelPtr& m) {
-  Engine e(*m);
+  Data d(*m);
   VecX u, v;
-  moving_state(*m, e, u, v);
-  // Engine::dynamics fills the constraints, eta and the KKT factor at (u, v)
+  moving_state(*m, d, u, v);
+  // body_accelerations fills the constraints, eta and the KKT factor at (u, v)
   VecX vdot(m->nv);
-  e.dynamics(0.0, u.data(), v.data(), vdot.data());
+  body_accelerations(*m, d, 0.0, u.data(), v.data(), vdot.data());
   VecX vref, dref;
-  armdyn_test::dense_kkt(*m, e.constraints(), e.eta(), m->nc, vref, dref);
+  armdyn_test::dense_kkt(*m, d.ce, d.eta, m->nc, vref, dref);
   CHECK_MAT_NEAR(vdot, vref, 1e-10);
   // zeta^T delta is unique even when delta is not (redundant rows)
-  const MatX z = dense_zeta(*m, e.constraints());
-  CHECK_MAT_NEAR(z.transpose() * e.delta(), z.transpose() * dref, 1e-9);
+  const MatX z = dense_zeta(*m, d.ce);
+  CHECK_MAT_NEAR(z.transpose() * d.delta, z.transpose() * dref, 1e-9);
   // the solver on its own, from the same evaluation
   KktSolver k(*m);
-  k.factor(e.constraints(), m->nc, Metric::Mass);
+  k.factor(d.ce, m->nc, Metric::Mass);
   VecX vd2(m->nv), d2(m->nc);
-  k.accelerations(e.constraints(), e.eta(), vd2, d2);
+  k.accelerations(d.ce, d.eta, vd2, d2);
   CHECK_MAT_NEAR(vd2, vref, 1e-10);
   // the accelerations satisfy the constraint level: zeta vdot = -xi
-  CHECK_MAT_NEAR(z * vdot, -e.constraints().xi, 1e-9);
+  CHECK_MAT_NEAR(z * vdot, -d.ce.xi, 1e-9);
 }
 
 }  // namespace
@@ -83,14 +85,13 @@ TEST_CASE(redundant_rows_take_the_pivoted_path) {
 TEST_CASE(schur_solve_with_identity_metric) {
   // A = zeta zeta^T (the unweighted projection's metric)
   const ModelPtr m = armdyn_test::spatial_arm_builder().finalize();
-  Engine e(*m);
-  e.load(m->u0.data(), nullptr);
+  Data d(*m);
   VecX vdot(m->nv);
-  e.dynamics(0.0, m->u0.data(), m->v0.data(), vdot.data());
+  body_accelerations(*m, d, 0.0, m->u0.data(), m->v0.data(), vdot.data());
   KktSolver k(*m);
-  k.factor(e.constraints(), m->nc, Metric::Identity);
+  k.factor(d.ce, m->nc, Metric::Identity);
   CHECK(k.metric() == Metric::Identity);
-  const MatX z = dense_zeta(*m, e.constraints());
+  const MatX z = dense_zeta(*m, d.ce);
   const VecX b = VecX::LinSpaced(m->nc, 1.0, -0.5);
   VecX x(m->nc);
   k.solve_schur(b, x);

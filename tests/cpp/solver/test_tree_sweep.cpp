@@ -4,8 +4,9 @@
 // solution.
 #include <cmath>
 
+#include "armdyn/algorithm/kkt.hpp"
 #include "armdyn/analysis/joint_space.hpp"
-#include "armdyn/solver/engine.hpp"
+#include "armdyn/data.hpp"
 #include "armdyn/solver/tree_sweep.hpp"
 #include "check.hpp"
 #include "models.hpp"
@@ -33,24 +34,24 @@ TEST_CASE(fully_driven_tree_follows_its_drives) {
   VecX u, v;
   state_from_joints(*free_model, q, qd, u, v);
 
-  Engine e(*m);
+  Data d(*m);
   VecX vdot(m->nv);
-  e.dynamics(t, u.data(), v.data(), vdot.data());
-  CHECK(e.swept());
+  body_accelerations(*m, d, t, u.data(), v.data(), vdot.data());
+  CHECK(d.swept);
   // the accelerations of the prescribed motion
   CHECK_MAT_NEAR(vdot, armdyn_test::cartesian_acceleration_fd(*free_model, q, qd, qdd), 1e-7);
   // vdot and the multipliers against the dense KKT solve
   VecX vref, dref;
-  armdyn_test::dense_kkt(*m, e.constraints(), e.eta(), m->nc, vref, dref);
+  armdyn_test::dense_kkt(*m, d.ce, d.eta, m->nc, vref, dref);
   CHECK_MAT_NEAR(vdot, vref, 1e-10);
-  CHECK_MAT_NEAR(e.delta(), dref, 1e-9 * (1.0 + dref.lpNorm<Eigen::Infinity>()));
+  CHECK_MAT_NEAR(d.delta, dref, 1e-9 * (1.0 + dref.lpNorm<Eigen::Infinity>()));
 
   // the sweep on its own
   TreeSweep s;
-  s.plan(*m, e.constraints());
+  s.plan(*m, d.ce);
   CHECK(s.ok());
   VecX vd2(m->nv), d2(m->nc);
-  CHECK(s.solve(*m, e.constraints(), e.eta(), vd2, d2));
+  CHECK(s.solve(*m, d.ce, d.eta, vd2, d2));
   CHECK_MAT_NEAR(vd2, vref, 1e-10);
   CHECK_MAT_NEAR(d2, dref, 1e-9 * (1.0 + dref.lpNorm<Eigen::Infinity>()));
 }

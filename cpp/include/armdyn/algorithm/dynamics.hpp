@@ -22,7 +22,8 @@ enum class DynamicsMethod { Auto, Joint, Cartesian };
 DynamicsMethod dynamics_method(const std::string& name, const char* fn);
 
 /// Joint accelerations (n_coords) into data.qdd for joint torques/forces tau at (q, qd), time t.
-/// Allocates nothing after the first Cartesian call (which makes data.engine).
+/// Allocates nothing. The Cartesian method runs the pipeline of data on the joint rows
+/// (data.nrows = nc_joint, the torques as data.joint_torques) and restores its defaults.
 /// @throws ModelError when the model is not a joint-space tree, on wrong sizes or non-finite
 ///   inputs; SolverError when a force is not finite or the mass matrix is not positive definite.
 const VecX& forward_dynamics(const Model& m, Data& d, Eigen::Ref<const VecX> q,
@@ -30,6 +31,8 @@ const VecX& forward_dynamics(const Model& m, Data& d, Eigen::Ref<const VecX> q,
                              DynamicsMethod method = DynamicsMethod::Auto);
 
 /// Joint torques/forces (n_coords) into data.tau realising qdd at (q, qd), time t.
+/// Allocates nothing after the first Cartesian call (which makes data.driven and
+/// data.driven_data).
 /// @throws as forward_dynamics.
 const VecX& inverse_dynamics(const Model& m, Data& d, Eigen::Ref<const VecX> q,
                              Eigen::Ref<const VecX> qd, Eigen::Ref<const VecX> qdd, double t = 0.0,

@@ -12,39 +12,40 @@
 #include <vector>
 
 #include "armdyn/analysis/joint_space.hpp"
+#include "armdyn/data.hpp"
 #include "armdyn/model/model.hpp"
 
 namespace armdyn {
 
-class Engine;
-
 /// The state of a driven model (drives leave no freedom) at increasing times: the position
 /// problem f(u, t) = 0, the velocity problem zeta v = rhs, then the acceleration problem and the
-/// multipliers (Engine::dynamics), so that no time integration is needed.
+/// multipliers (body_accelerations, armdyn/algorithm/kkt.hpp), so that no time integration is
+/// needed.
 ///  - a tree with every coordinate driven: the state is the forward kinematics of the drive
 ///    values (q, qd), checked by its residuals (Newton only when they exceed round-off);
 ///  - otherwise Newton from a prediction (the last state moved by its rates), with continuation
 ///    (halving the step towards t) when Newton fails or jumps to another assembly branch.
 class DrivenSolver {
  public:
-  /// who names the caller in messages. t0: the time of the state passed to the first solve().
+  /// d: a Data of m, whose pipeline (all rows) it runs. who names the caller in messages.
+  /// t0: the time of the state passed to the first solve().
   /// @throws ModelError naming the undriven coordinates when the drives leave freedom.
-  DrivenSolver(const Model& m, Engine& e, const char* who, double t0);
-  /// (u, v) at the last solved time (or t0) in, at t out; vd the accelerations; the engine is
+  DrivenSolver(const Model& m, Data& d, const char* who, double t0);
+  /// (u, v) at the last solved time (or t0) in, at t out; vd the accelerations; the Data is
   /// left loaded at (u, v, t) with its multipliers; rf, rv the position and velocity residuals.
   /// On failure (u, v) hold the last state solved on the way to t, at time t_good.
   /// @throws SolverError when the position problem fails or (throw_on_singular) the driven
   ///   constraints are kinematically singular at t (naming the dependent rows).
   void solve(double t, VecX& u, VecX& v, VecX& vd, double& rf, double& rv);
-  /// false: a kinematically singular time is not an error; the engine counts it
-  /// (Engine::singular_evaluations) and its minimum-norm multipliers are kept, as in a run.
+  /// false: a kinematically singular time is not an error; it is counted
+  /// (Data::stats.singular_evaluations) and its minimum-norm multipliers are kept, as in a run.
   bool throw_on_singular = true;
   /// The time of the state left in (u, v) after a failed solve(): the last one solved.
   double t_good;
 
  private:
   const Model& m_;
-  Engine& e_;
+  Data& d_;
   const char* who_;
   double t_prev_;
   bool fk_;

@@ -7,15 +7,15 @@
 //    Algorithms, 2008, ch. 6): each subtree's spatial inertia about the world origin, and
 //    M_jk = S_j . (I_subtree(k) S_k) for j on the path from k to the root;
 //  - b - J^T eta the recursive Newton-Euler residual at qdd = 0 (rne_residual): velocity
-//    products, gravity, body loads and spring-dampers (eta of Engine::forces);
+//    products, gravity, body loads and spring-dampers (eta of body_forces);
 //  - Q the joint-coordinate forces (springs, dampers, friction, inputs, PD/PI motors) and the
 //    gear pairs' contact forces, straight from the unwrapped coordinates;
 //  - G the ideal gears' rows (r_a, r_b in their coordinates' columns; constant), eliminated by
 //    an orthonormal basis T of their null space (a QR of G^T at construction):
 //    qdd = T (T^T M T)^-1 T^T (Q - b + J^T eta).
 // The rows are linear in q, so every Runge-Kutta method keeps G q = 0 and G qd = 0 exactly up to
-// round-off; project() removes that round-off. The Cartesian path (Engine) remains the reference:
-// tests compare the two.
+// round-off; project() removes that round-off. The Cartesian path (algorithm/kkt.hpp) remains the
+// reference: tests compare the two.
 #pragma once
 
 #include <string>

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Internal to simulate(): the ODE systems of the two formulations and the recording of outputs.
 //  - MbsSystem: the Cartesian state y = (u, v, z) with the constrained Newton-Euler equations
-//    (Engine) and the topological projection; it records every output table.
+//    (armdyn/algorithm/kkt.hpp) and the topological projection (armdyn/algorithm/projection.hpp),
+//    on a Data of its model; it records every output table.
 //  - JointSystem: the joint coordinates y = (q, qd, z) of a tree (TreeDynamics); its outputs go
 //    through MbsSystem at the state built by forward kinematics.
 //  - WeldExpander: reports a run of the welded model (Model::welded) in the bodies and joints of
@@ -10,10 +11,17 @@
 
 #include <vector>
 
+#include "armdyn/algorithm/constraints.hpp"
+#include "armdyn/algorithm/energy.hpp"
+#include "armdyn/algorithm/forces.hpp"
+#include "armdyn/algorithm/kinematics.hpp"
+#include "armdyn/algorithm/kkt.hpp"
+#include "armdyn/algorithm/projection.hpp"
+#include "armdyn/algorithm/reactions.hpp"
 #include "armdyn/analysis/simulate.hpp"
 #include "armdyn/analysis/tree_dynamics.hpp"
+#include "armdyn/data.hpp"
 #include "armdyn/math/quaternion.hpp"
-#include "armdyn/solver/engine.hpp"
 
 namespace armdyn::detail {
 
@@ -23,7 +31,7 @@ class WeldExpander {
   explicit WeldExpander(const Model& full)
       : m_(full),
         w_(*full.welded),
-        e_(full),
+        d_(full),
         u_(VecX::Zero(full.nq)),
         v_(VecX::Zero(full.nv)),
         vd_(VecX::Zero(full.nv)),
@@ -53,7 +61,7 @@ class WeldExpander {
     for (size_t k = 0; k < m_.drives.size(); ++k) row_map_[m_.drives[k].row] = w_.drives[k].row;
     // the block of each merged joint
     block_of_.assign(m_.joints.size(), -1);
-    const ConstraintEval& ce = e_.constraints();
+    const ConstraintEval& ce = d_.ce;
     for (size_t j = 0; j < m_.joints.size(); ++j)
       for (size_t b = 0; b < ce.blocks.size(); ++b)
         if (joint_rows(m_.joints[j].type) > 0 && ce.blocks[b].row0 == m_.joints[j].row0)
@@ -108,20 +116,20 @@ class WeldExpander {
 
   /// Multipliers of the full model at the expanded state: the welded run's for its rows, the
   /// merged fixed joints' from each member's Newton-Euler balance, far members first
-  /// (zeta_far^T delta_j = eta - Gamma vdot - the other rows' forces). Leaves the engine loaded
-  /// for joint_reaction() and the residuals.
+  /// (zeta_far^T delta_j = eta - Gamma vdot - the other rows' forces). Leaves data() loaded
+  /// (kinematics, constraints, multipliers) for joint_reaction() and the residuals.
   void reactions(double t, const VecX& delta_w, const double* aux, const VecX& tracking_w) {
-    e_.set_aux(aux);
+    d_.aux = aux;
     // the welded run's multi-turn angles: the gear rows (and their residuals) need them
     for (size_t c = 0; c < coord_map_.size(); ++c)
       if (coord_map_[c] >= 0) track_[static_cast<long>(c)] = tracking_w[coord_map_[c]];
-    e_.set_tracking(track_);
-    e_.load(u_.data(), v_.data());
-    ConstraintEval& ce = e_.constraints();
-    eval_constraints(m_, e_.kin(), t, false, ce);
-    e_.forces(t);
+    d_.track_ref = track_;
+    load_kinematics(m_, d_, u_.data(), v_.data());
+    const ConstraintEval& ce = d_.ce;
+    evaluate_constraints(m_, d_, t, false);
+    cartesian_forces(m_, d_, t);
     for (int r = 0; r < m_.nc; ++r) delta_[r] = row_map_[r] >= 0 ? delta_w[row_map_[r]] : 0.0;
-    const VecX& eta = e_.eta();
+    const VecX& eta = d_.eta;
     for (int b = 0; b < m_.nb; ++b) {
       const Body& bd = m_.bodies[b];
       r_.segment<3>(6 * b) = eta.segment<3>(6 * b) - bd.mass * vd_.segment<3>(6 * b);
@@ -140,17 +148,18 @@ class WeldExpander {
       if (near != kGround)
         r_.segment<6>(6 * near).noalias() -= blk.J.block<6, 6>(0, 6 * (1 - sf)).transpose() * d;
     }
-    e_.set_multipliers(delta_);
+    d_.delta = delta_;
   }
 
-  Engine& engine() { return e_; }
+  /// The full model's pipeline, loaded by reactions().
+  Data& data() { return d_; }
   const VecX& u() const { return u_; }
   const VecX& v() const { return v_; }
 
  private:
   const Model& m_;
   const Model& w_;
-  Engine e_;
+  Data d_;
   VecX u_, v_, vd_, delta_, r_, tmp_, track_;
   std::vector<Vec4> qrel_;
   std::vector<int> coord_map_;
@@ -161,50 +170,50 @@ class WeldExpander {
 class MbsSystem : public OdeSystem {
  public:
   MbsSystem(const Model& m, Metric metric, SimResult& out)
-      : m_(m), e_(m), metric_(metric), out_(out), yo_(m.nq + m.nv), vd_(m.nv) {}
+      : m_(m), d_(m), metric_(metric), out_(out), yo_(m.nq + m.nv), vd_(m.nv) {}
 
   // y = (u, v, z): z the auxiliary states (PI integral terms), not projected
   void rhs(double t, const VecX& y, VecX& dy) override {
-    e_.set_aux(y.data() + m_.nq + m_.nv);
-    e_.dynamics(t, y.data(), y.data() + m_.nq, dy.data() + m_.nq);
-    e_.udot(y.data(), y.data() + m_.nq, dy.data());
-    if (m_.n_aux) e_.aux_rates(t, dy.data() + m_.nq + m_.nv);
+    d_.aux = y.data() + m_.nq + m_.nv;
+    body_accelerations(m_, d_, t, y.data(), y.data() + m_.nq, dy.data() + m_.nq);
+    udot(m_, y.data(), y.data() + m_.nq, dy.data());
+    if (m_.n_aux) aux_rates(m_, d_, t, dy.data() + m_.nq + m_.nv);
   }
 
   void project_and_rhs(double t, VecX& y, VecX& dy) override {
-    e_.set_aux(y.data() + m_.nq + m_.nv);
-    e_.project(t, y.data(), y.data() + m_.nq, metric_);
-    e_.dynamics(t, y.data(), y.data() + m_.nq, dy.data() + m_.nq, true);
-    e_.udot(y.data(), y.data() + m_.nq, dy.data());
-    if (m_.n_aux) e_.aux_rates(t, dy.data() + m_.nq + m_.nv);
+    d_.aux = y.data() + m_.nq + m_.nv;
+    project(m_, d_, t, y.data(), y.data() + m_.nq, metric_);
+    body_accelerations(m_, d_, t, y.data(), y.data() + m_.nq, dy.data() + m_.nq, true);
+    udot(m_, y.data(), y.data() + m_.nq, dy.data());
+    if (m_.n_aux) aux_rates(m_, d_, t, dy.data() + m_.nq + m_.nv);
   }
 
   void output(double t, const VecX& y) override {
     yo_ = y;
     double* u = yo_.data();
     double* v = yo_.data() + m_.nq;
-    e_.set_aux(yo_.data() + m_.nq + m_.nv);
-    e_.project(t, u, v, metric_);
-    e_.dynamics(t, u, v, vd_.data(), true);
+    d_.aux = yo_.data() + m_.nq + m_.nv;
+    project(m_, d_, t, u, v, metric_);
+    body_accelerations(m_, d_, t, u, v, vd_.data(), true);
     double rf, rv;
-    e_.loaded_residuals(v, rf, rv);
+    loaded_residuals(m_, d_, v, rf, rv);
     record(t, u, v, vd_, rf, rv, yo_.data() + m_.nq + m_.nv);
   }
 
-  bool project_last_stage() const override { return !e_.kkt().near_singular(); }
+  bool project_last_stage() const override { return !d_.kkt.near_singular(); }
 
   /// Report in the bodies and joints of the full model (a welded run).
   void set_expander(WeldExpander* ex) { ex_ = ex; }
 
-  /// Record the outputs at (u, v, t); the engine holds the dynamics evaluated there.
+  /// Record the outputs at (u, v, t); data() holds the dynamics evaluated there.
   void record(double t, const double* u, const double* v, const VecX& vd, double rf, double rv,
               const double* aux = nullptr) {
     // joint coordinates (angles unwrapped along the run) and rates
     const long row = out_.n;
     for (size_t c = 0; c < m_.coords.size(); ++c) {
-      const ScalarJet q = coord_jet(m_, e_.kin(), static_cast<int>(c));
-      // angles unwrapped over turns by the engine, which follows them at every projection
-      const double qv = m_.coords[c].angular ? e_.tracked(static_cast<int>(c), q.val) : q.val;
+      const ScalarJet q = coord_jet(m_, d_.kin, static_cast<int>(c));
+      // angles unwrapped over turns, followed at every projection
+      const double qv = m_.coords[c].angular ? tracked(d_, static_cast<int>(c), q.val) : q.val;
       out_.q.push_back(qv);
       out_.qd.push_back(q.rate);
       out_.qdd.push_back(coord_acceleration(m_, q, static_cast<int>(c), vd));
@@ -212,29 +221,28 @@ class MbsSystem : public OdeSystem {
     // gear mesh forces: contact law of the gear pairs, multipliers of the ideal gears
     for (int gi = 0; gi < static_cast<int>(m_.gears.size()); ++gi) {
       double sm, sd, pen;
-      e_.gear_mesh(gi, sm, sd, pen);
+      gear_mesh(m_, d_, gi, sm, sd, pen);
       const double f = gear_force(m_.gears[gi], sm, sd, pen);
       out_.gear_forces.push_back(sm >= 0 ? f : -f);
     }
-    for (const GearConstraint& g : m_.gear_constraints)
-      out_.gear_forces.push_back(e_.delta()[g.row]);
+    for (const GearConstraint& g : m_.gear_constraints) out_.gear_forces.push_back(d_.delta[g.row]);
     // actuator efforts: tau = -delta of the drive rows
-    for (const Drive& d : m_.drives) out_.drive_forces.push_back(-e_.delta()[d.row]);
-    Engine* re = &e_;  // the engine of the bodies and joints reported
+    for (const Drive& d : m_.drives) out_.drive_forces.push_back(-d_.delta[d.row]);
+    Data* rd = &d_;  // the pipeline of the bodies and joints reported
     if (ex_) {
       ex_->expand(u, v, vd.data());
-      ex_->reactions(t, e_.delta(), aux, e_.tracking());
-      re = &ex_->engine();
-      re->loaded_residuals(ex_->v().data(), rf, rv);
+      ex_->reactions(t, d_.delta, aux, d_.track_ref);
+      rd = &ex_->data();
+      loaded_residuals(*rd->model, *rd, ex_->v().data(), rf, rv);
       u = ex_->u().data();
       v = ex_->v().data();
     }
+    const Model& rm = *rd->model;
     double ke, pe;  // of every body (those welded to ground too)
-    re->energy(u, v, ke, pe);
-    const Model& rm = re->model();
+    energy(rm, *rd, u, v, ke, pe);
     for (size_t j = 0; j < rm.joints.size(); ++j) {
       Vec3 f, tq;
-      re->joint_reaction(static_cast<int>(j), f, tq);
+      joint_reaction(rm, *rd, static_cast<int>(j), f, tq);
       for (int k = 0; k < 3; ++k) {
         out_.reaction_forces.push_back(f[k]);
         out_.reaction_torques.push_back(tq[k]);
@@ -252,10 +260,10 @@ class MbsSystem : public OdeSystem {
 
   int n_events() const override { return static_cast<int>(m_.gears.size()); }
   void events(double /*t*/, const VecX& y, double* g) override {
-    e_.load(y.data(), y.data() + m_.nq);
+    load_kinematics(m_, d_, y.data(), y.data() + m_.nq);
     for (int i = 0; i < n_events(); ++i) {
       double s, sd;
-      e_.gear_mesh(i, s, sd, g[i]);
+      gear_mesh(m_, d_, i, s, sd, g[i]);
     }
   }
   void on_event(double t, int i, int direction) override {
@@ -264,11 +272,12 @@ class MbsSystem : public OdeSystem {
     out_.event_direction.push_back(direction);
   }
 
-  Engine& engine() { return e_; }
+  /// The model's Cartesian pipeline (settings, tracking, counters).
+  Data& data() { return d_; }
 
  private:
   const Model& m_;
-  Engine e_;
+  Data d_;
   Metric metric_;
   SimResult& out_;
   VecX yo_, vd_;
@@ -277,7 +286,7 @@ class MbsSystem : public OdeSystem {
 
 // The joint-space equations of motion of a tree (TreeDynamics) as an ODE on y = (q, qd, z).
 // Outputs go through the Cartesian system at the state built by forward kinematics, with the
-// engine's multi-turn angles set from q: every table (poses, reactions, gear forces, residuals)
+// multi-turn angles set from q: every table (poses, reactions, gear forces, residuals)
 // is the one a Cartesian run reports.
 class JointSystem : public OdeSystem {
  public:
@@ -305,7 +314,7 @@ class JointSystem : public OdeSystem {
     joint_space_kinematics(m_, q, qd, fkw_.kin);
     cartesian_state(m_, fkw_.kin, yc_.data(), yc_.data() + m_.nq);
     yc_.tail(m_.n_aux) = y.tail(m_.n_aux);
-    cart_.engine().set_tracking(q);
+    cart_.data().track_ref = q;
     cart_.output(t, yc_);
   }
 

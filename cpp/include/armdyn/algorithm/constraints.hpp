@@ -1,0 +1,17 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Constraints stage of the Cartesian pipeline: the residuals f(u, t), the velocity-space
+// Jacobian zeta, rhs (zeta v = rhs) and xi (zeta v' = -xi) of every row, at the kinematics
+// loaded in data.kin, into data.ce (assembled by armdyn/solver/constraints.hpp, the ideal gear
+// rows reading the coordinate jets and the tracked angles of data).
+#pragma once
+
+#include "armdyn/data.hpp"
+
+namespace armdyn {
+
+/// data.ce at the loaded kinematics and time t; xi only when with_xi.
+inline void evaluate_constraints(const Model& m, Data& d, double t, bool with_xi) {
+  eval_constraints(m, d.kin, t, with_xi, d.ce);
+}
+
+}  // namespace armdyn

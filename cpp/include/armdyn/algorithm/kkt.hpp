@@ -1,0 +1,28 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// KKT stage of the Cartesian pipeline: forward dynamics of the bodies' state, the constrained
+// Newton-Euler equations
+//   Gamma v' + zeta^T delta = eta,   zeta v' = -xi
+// over the rows taking part (data.nrows), solved for the accelerations v' and the multipliers
+// data.delta by the Schur complement of the KKT system (armdyn/solver/kkt.hpp), or, for the
+// square zeta of a fully driven tree, by two O(n) sweeps (armdyn/solver/tree_sweep.hpp). A
+// configuration where the Jacobian has lost rank against assembly is counted and described in
+// data.stats.
+#pragma once
+
+#include "armdyn/data.hpp"
+
+namespace armdyn {
+
+/// v' (nv) into vdot and the multipliers into data.delta at (u, v, t): loads the kinematics,
+/// evaluates the constraints (with xi) and the forces (cartesian_forces), and solves.
+/// reuse_factor: the last projection factored A at this very u with the mass metric.
+/// @throws SolverError when a force or the accelerations are not finite.
+void body_accelerations(const Model& m, Data& d, double t, const double* u, const double* v,
+                        double* vdot, bool reuse_factor = false);
+
+/// body_accelerations at the kinematics already loaded in data.kin (load_kinematics or
+/// load_joint_kinematics).
+void body_accelerations_loaded(const Model& m, Data& d, double t, double* vdot,
+                               bool reuse_factor = false);
+
+}  // namespace armdyn

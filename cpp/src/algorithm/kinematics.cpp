@@ -1,0 +1,41 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "armdyn/algorithm/kinematics.hpp"
+
+#include "armdyn/math/quaternion.hpp"
+
+namespace armdyn {
+
+void load_kinematics(const Model& m, Data& d, const double* u, const double* v) {
+  body_kinematics(m, u, v, d.kin);
+  d.jets.reset();
+}
+
+void load_joint_kinematics(const Model& m, Data& d, Eigen::Ref<const VecX> q,
+                           Eigen::Ref<const VecX> qd) {
+  d.jets.reset();
+  joint_space_kinematics(m, q, qd, d.kin);
+}
+
+void udot(const Model& m, const double* u, const double* v, double* ud) {
+  for (int i = 0; i < m.nb; ++i) {
+    const double* ui = u + 7 * i;
+    const double* vi = v + 6 * i;
+    double* o = ud + 7 * i;
+    o[0] = vi[0];
+    o[1] = vi[1];
+    o[2] = vi[2];
+    const Vec4 ed = quat_rate(Vec4(ui[3], ui[4], ui[5], ui[6]), Vec3(vi[3], vi[4], vi[5]));
+    o[3] = ed[0];
+    o[4] = ed[1];
+    o[5] = ed[2];
+    o[6] = ed[3];
+  }
+}
+
+void commit_tracking(const Model& m, Data& d) {
+  // every angle coordinate is followed over turns (gears need it; outputs use it)
+  for (int c = 0; c < static_cast<int>(m.coords.size()); ++c)
+    if (m.coords[c].angular) d.track_ref[c] = tracked(d, c, coord_value(m, d.kin, c));
+}
+
+}  // namespace armdyn

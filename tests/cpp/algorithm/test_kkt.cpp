@@ -1,0 +1,101 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The KKT stage (armdyn/algorithm/kkt.hpp) on closed forms: a physical pendulum's angular
+// acceleration -m g L sin(phi) / I_O at any rate, with a joint torque added, its drive's effort
+// I_O phi'' + m g L sin(phi) on the square (swept) system, the joint rows alone ignoring the
+// drive, and a free body falling at g and spinning by Euler's equations.
+#include <cmath>
+
+#include "armdyn/algorithm/kkt.hpp"
+#include "armdyn/math/quaternion.hpp"
+#include "check.hpp"
+#include "models.hpp"
+
+using namespace armdyn;
+
+TEST_CASE(pendulum_acceleration_is_the_closed_form) {
+  armdyn_test::Pendulum p;
+  p.phi0 = 0.9;
+  const ModelPtr m = p.model();
+  Data d(*m);
+  long solves = 0;
+  for (double qd : {0.0, 1.7, -2.4}) {
+    VecX u, v;
+    state_from_joints(*m, VecX::Constant(1, 0.0), VecX::Constant(1, qd), u, v);
+    VecX vdot(m->nv);
+    body_accelerations(*m, d, 0.0, u.data(), v.data(), vdot.data());
+    CHECK(d.stats.kkt_solves == ++solves);
+    CHECK(!d.swept);
+    const double alpha = p.phidd(p.phi0);  // -g/L sin(phi) for a point mass; independent of qd
+    // the centre of mass, r = x - hinge, moves on a circle about y:
+    // a = alpha (y x r) + omega^2 (y x (y x r))
+    const Vec3 r = u.head<3>(), y = Vec3::UnitY();
+    const Vec3 a = alpha * y.cross(r) + qd * qd * y.cross(y.cross(r));
+    CHECK_MAT_NEAR(vdot.head<3>(), a, 1e-12);
+    // body-frame angular acceleration: alpha about y (the body frame turns about y too)
+    const Mat3 R = quat_to_rot(u.segment<4>(3));
+    CHECK_MAT_NEAR(R * vdot.tail<3>(), alpha * y, 1e-12);
+  }
+}
+
+TEST_CASE(joint_torque_adds_to_the_pendulum) {
+  armdyn_test::Pendulum p;
+  p.phi0 = -0.6;
+  const ModelPtr m = p.model();
+  Data d(*m);
+  const double tau = 2.5;
+  d.joint_torques = &tau;
+  VecX vdot(m->nv);
+  body_accelerations(*m, d, 0.0, m->u0.data(), m->v0.data(), vdot.data());
+  const double phidd = (tau - p.m * p.g * p.L * std::sin(p.phi0)) / p.io();
+  const Mat3 R = quat_to_rot(m->u0.segment<4>(3));
+  CHECK_MAT_NEAR(R * vdot.tail<3>(), Vec3(0.0, phidd, 0.0), 1e-12);
+  // the torque's coordinate jet: the angle's rate is y . w
+  CHECK_NEAR(coord_acceleration(*m, d.tau_jets[0], 0, vdot), phidd, 1e-12);
+}
+
+TEST_CASE(driven_pendulum_effort_and_joint_rows_only) {
+  // the hinge driven by q(t) = 0.3 sin(2 pi t): square zeta, swept; the drive's effort is the
+  // torque of the prescribed motion
+  const armdyn_test::Pendulum p;
+  ModelBuilder b = p.builder();
+  const Profile prof = Profile::sine(0.3, 1.0, 0.0, 0.0);
+  b.add_drive("hinge", prof);
+  const ModelPtr m = b.finalize();
+  Data d(*m);
+  const double t = 0.2;
+  const ProfileValue pv = prof.eval(t);
+  VecX u, v;
+  state_from_joints(*m, VecX::Constant(1, pv.y), VecX::Constant(1, pv.yd), u, v);
+  VecX vdot(m->nv);
+  body_accelerations(*m, d, t, u.data(), v.data(), vdot.data());
+  CHECK(d.swept);
+  const Mat3 R = quat_to_rot(u.segment<4>(3));
+  CHECK_MAT_NEAR(R * vdot.tail<3>(), Vec3(0.0, pv.ydd, 0.0), 1e-12);
+  const double effort = p.io() * pv.ydd + p.m * p.g * p.L * std::sin(pv.y);
+  CHECK_NEAR(-d.delta[m->drives[0].row], effort, 1e-12);
+  // the joint rows alone: the free pendulum, the drive ignored
+  d.nrows = m->nc_joint;
+  body_accelerations(*m, d, t, u.data(), v.data(), vdot.data());
+  CHECK(!d.swept);
+  CHECK_MAT_NEAR(R * vdot.tail<3>(), Vec3(0.0, p.phidd(pv.y), 0.0), 1e-12);
+}
+
+TEST_CASE(free_body_falls_at_g_and_spins_by_euler) {
+  // a free body: xdd = g, and Euler's equations J w' = -w x J w
+  ModelBuilder b(Vec3(0.5, 0.0, -9.81));
+  const Mat3 J = Vec3(0.1, 0.2, 0.25).asDiagonal();
+  b.add_body("b", 2.0, J, Vec3(0, 0, 1), quat_exp(Vec3(0.2, 0.1, -0.3)));
+  b.add_free("free", "b");
+  const ModelPtr m = b.finalize();
+  CHECK(m->nc == 0);
+  Data d(*m);
+  VecX v(6);
+  v << 1.0, 0.0, 2.0, 0.7, -1.3, 2.2;
+  VecX vdot(6);
+  body_accelerations(*m, d, 0.0, m->u0.data(), v.data(), vdot.data());
+  CHECK_MAT_NEAR(vdot.head<3>(), Vec3(0.5, 0.0, -9.81), 1e-14);
+  const Vec3 w = v.tail<3>();
+  CHECK_MAT_NEAR(vdot.tail<3>(), Vec3(J.inverse() * (-w.cross(J * w))), 1e-13);
+}
+
+ARMDYN_TEST_MAIN()
