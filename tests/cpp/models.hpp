@@ -72,6 +72,24 @@ struct TwoLink {
 
 /// A spatial three-link arm with a prismatic joint and general (rotated, off-diagonal)
 /// inertias: for cross-checks between independent algorithms.
+/// A planar four-bar about y: crank and rocker on ground, closed at C by an inline joint (no
+/// redundant rows) or, with revolute_closure, by a revolute (3 of its rows redundant).
+inline ModelBuilder four_bar_builder(bool revolute_closure = false) {
+  ModelBuilder b;
+  const Mat3 in = Vec3(0.01, 0.02, 0.015).asDiagonal();
+  b.add_body("crank", 1.0, in, Vec3(0, 0, 0.25), kIdentityQuat);
+  b.add_body("coupler", 2.0, in, Vec3(0.5, 0, 0.5), kIdentityQuat);
+  b.add_body("rocker", 1.5, in, Vec3(1.0, 0, 0.3), kIdentityQuat);
+  b.add_revolute("A", "ground", "crank", Vec3(0, 0, 0), Vec3::UnitY());
+  b.add_revolute("B", "crank", "coupler", Vec3(0, 0, 0.5), Vec3::UnitY());
+  b.add_revolute("D", "ground", "rocker", Vec3(1, 0, 0.1), Vec3::UnitY());
+  if (revolute_closure)
+    b.add_revolute("C", "rocker", "coupler", Vec3(1, 0, 0.5), Vec3::UnitY());
+  else
+    b.add_inline("C", "rocker", "coupler", Vec3(1, 0, 0.5), Vec3::UnitY());
+  return b;
+}
+
 inline ModelBuilder spatial_arm_builder() {
   ModelBuilder b(Vec3(0.3, -0.2, -9.81));
   Mat3 i1;

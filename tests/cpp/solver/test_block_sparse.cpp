@@ -36,18 +36,7 @@ ModelPtr branched_tree(bool closed) {
   return b.finalize();
 }
 
-ModelPtr four_bar() {
-  ModelBuilder b;
-  const Mat3 in = Vec3(0.01, 0.02, 0.015).asDiagonal();
-  b.add_body("crank", 1.0, in, Vec3(0, 0, 0.25), armdyn_test::kIdentityQuat);
-  b.add_body("coupler", 2.0, in, Vec3(0.5, 0, 0.5), armdyn_test::kIdentityQuat);
-  b.add_body("rocker", 1.5, in, Vec3(1.0, 0, 0.3), armdyn_test::kIdentityQuat);
-  b.add_revolute("A", "ground", "crank", Vec3(0, 0, 0), Vec3::UnitY());
-  b.add_revolute("B", "crank", "coupler", Vec3(0, 0, 0.5), Vec3::UnitY());
-  b.add_revolute("D", "ground", "rocker", Vec3(1, 0, 0.1), Vec3::UnitY());
-  b.add_inline("C", "rocker", "coupler", Vec3(1, 0, 0.5), Vec3::UnitY());
-  return b.finalize();
-}
+ModelPtr four_bar() { return armdyn_test::four_bar_builder().finalize(); }
 
 void check_against_dense(const ModelPtr& m, bool expect_fill) {
   const KktPlan plan = plan_kkt(*m, m->nc);

@@ -53,30 +53,12 @@ TEST_CASE(tree_matches_dense_lu) {
 }
 
 TEST_CASE(closed_loop_matches_dense_lu) {
-  ModelBuilder b;
-  const Mat3 in = Vec3(0.01, 0.02, 0.015).asDiagonal();
-  b.add_body("crank", 1.0, in, Vec3(0, 0, 0.25), armdyn_test::kIdentityQuat);
-  b.add_body("coupler", 2.0, in, Vec3(0.5, 0, 0.5), armdyn_test::kIdentityQuat);
-  b.add_body("rocker", 1.5, in, Vec3(1.0, 0, 0.3), armdyn_test::kIdentityQuat);
-  b.add_revolute("A", "ground", "crank", Vec3(0, 0, 0), Vec3::UnitY());
-  b.add_revolute("B", "crank", "coupler", Vec3(0, 0, 0.5), Vec3::UnitY());
-  b.add_revolute("D", "ground", "rocker", Vec3(1, 0, 0.1), Vec3::UnitY());
-  b.add_inline("C", "rocker", "coupler", Vec3(1, 0, 0.5), Vec3::UnitY());
-  compare_with_dense(b.finalize());
+  compare_with_dense(armdyn_test::four_bar_builder().finalize());
 }
 
 TEST_CASE(redundant_rows_take_the_pivoted_path) {
   // the same loop closed by a revolute: 3 of its rows repeat what the planar loop implies
-  ModelBuilder b;
-  const Mat3 in = Vec3(0.01, 0.02, 0.015).asDiagonal();
-  b.add_body("crank", 1.0, in, Vec3(0, 0, 0.25), armdyn_test::kIdentityQuat);
-  b.add_body("coupler", 2.0, in, Vec3(0.5, 0, 0.5), armdyn_test::kIdentityQuat);
-  b.add_body("rocker", 1.5, in, Vec3(1.0, 0, 0.3), armdyn_test::kIdentityQuat);
-  b.add_revolute("A", "ground", "crank", Vec3(0, 0, 0), Vec3::UnitY());
-  b.add_revolute("B", "crank", "coupler", Vec3(0, 0, 0.5), Vec3::UnitY());
-  b.add_revolute("D", "ground", "rocker", Vec3(1, 0, 0.1), Vec3::UnitY());
-  b.add_revolute("C", "rocker", "coupler", Vec3(1, 0, 0.5), Vec3::UnitY());
-  const ModelPtr m = b.finalize();
+  const ModelPtr m = armdyn_test::four_bar_builder(true).finalize();
   CHECK(m->redundant);
   CHECK(m->mobility == 1);
   compare_with_dense(m);
