@@ -50,6 +50,8 @@ Data& cached_data(const ModelHolder& md) {
 Data& data_for(const ModelHolder& md, const py::object& data, const char* fn) {
   if (!md) throw ModelError(msg(fn, ": no model"));
   if (data.is_none()) return cached_data(md);
+  if (!py::isinstance<DataPy>(data))
+    throw ModelError(msg(fn, ": data must be an armdyn.Data (or None)"));
   auto* d = data.cast<DataPy*>();
   check_data(*md, d->data, fn);
   return d->data;

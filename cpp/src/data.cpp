@@ -18,7 +18,6 @@ Data::Data(const Model& m) : model(&m), n(static_cast<int>(m.coords.size())), kk
   track_ref = VecX::Zero(n);
   cq = VecX::Zero(n);
   cqd = VecX::Zero(n);
-  ctau = VecX::Zero(n);
   nrows = m.nc;
   tol_f = 1e-13 * std::max(1.0, m.length_scale);
   kin.resize(m.nb);

@@ -269,5 +269,7 @@ def test_recursive_and_kkt_paths_agree(rng):
         assert np.array_equal(joint_rows[i], single)
     with pytest.raises(_core.ModelError, match="method must be 'auto', 'joint' or 'cartesian'"):
         ad.inverse_dynamics(model, q[0], qd[0], qdd[0], method="aba")
+    with pytest.raises(_core.ModelError, match=r"data must be an armdyn\.Data"):
+        ad.inverse_dynamics(model, q[0], qd[0], qdd[0], data=model)
     with pytest.raises(_core.ModelError, match="data was made for another model"):
         ad.inverse_dynamics(paper.three_dof_arm(), [0.0] * 3, [0.0] * 3, [0.0] * 3, data=data)

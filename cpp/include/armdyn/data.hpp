@@ -47,7 +47,7 @@ class Data {
   std::vector<BodyKin> kin;  ///< per body: pose and velocity
   // --- forces (body_forces, coordinate_forces, cartesian_forces) ---
   VecX eta;        ///< (nv) applied and gyroscopic forces on the bodies
-  VecX coord_tau;  ///< (n) joint-coordinate forces and gear contact forces
+  VecX coord_tau;  ///< (n) joint-coordinate forces and gear contact forces (coordinate_forces)
   // --- recursive Newton-Euler (rnea) ---
   RneWork rne;
   VecX tau;  ///< (n) the last rnea's joint torques/forces
@@ -83,7 +83,7 @@ class Data {
   CoordJetCache jets;  ///< coordinate jets at the loaded state (ce.coord_cache)
   VecX track_ref;      ///< (n) unwrapped reference of the angle coordinates (ce.track_ref)
   std::vector<ScalarJet> tau_jets;   ///< (n) with joint_torques: each coordinate's jet (no value)
-  VecX cq, cqd, ctau;                ///< (n) coordinate values, rates and forces of the force laws
+  VecX cq, cqd;                      ///< (n) the coordinates the force laws read, from the jets
   KktSolver kkt;                     ///< the factor of the KKT system's Schur complement
   TreeSweep sweep;                   ///< the O(n) solve of a fully driven tree
   bool swept = false;                ///< the last body_accelerations took the sweep (kkt not used)

@@ -30,6 +30,14 @@ void check_inputs(const Model& m, const Data& d, Eigen::Ref<const VecX> q,
 // only, the coordinate forces mapped onto the bodies
 void forward_cartesian(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
                        Eigen::Ref<const VecX> tau, double t) {
+  // the call's settings, restored to the defaults on every exit (errors included)
+  struct Settings {
+    Data& d;
+    ~Settings() {
+      d.joint_torques = nullptr;
+      d.nrows = d.model->nc;
+    }
+  } restore{d};
   d.nrows = m.nc_joint;
   d.aux = nullptr;
   d.with_coordinate_forces = true;
@@ -37,8 +45,6 @@ void forward_cartesian(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen:
   load_joint_kinematics(m, d, q, qd);
   d.tau_in = tau;
   body_accelerations_loaded(m, d, t, d.vd.data());
-  d.joint_torques = nullptr;
-  d.nrows = m.nc;
   // the coordinate jets of the torques, at this state
   for (int c = 0; c < d.n; ++c) d.qdd[c] = coord_acceleration(m, d.tau_jets[c], c, d.vd);
 }
@@ -90,6 +96,29 @@ void inverse_cartesian(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen:
 
 }  // namespace
 
+void joint_space_equations(const Model& m, Data& d, const double* q, const double* qd,
+                           const double* z, const double* tau, double t) {
+  const Eigen::Map<const VecX> qv(q, d.n), qdv(qd, d.n);
+  joint_space_kinematics(m, qv, qdv, d.kin, d.rne);
+  body_forces(m, d.kin, t, d.eta);
+  // rhs = tau + Q - (b - J^T eta): the residual of the Newton-Euler equations at qdd = 0
+  VecX& rhs = d.rhs;
+  rne_residual(m, d.kin, qdv, d.zero, d.eta, d.rne, rhs);
+  rhs = -rhs;
+  if (tau) rhs += Eigen::Map<const VecX>(tau, d.n);
+  if (!m.coord_forces.empty() || !m.gears.empty()) {
+    coordinate_forces(m, q, qd, z, t, d.coord_tau);
+    rhs += d.coord_tau;
+  }
+  if (!rhs.allFinite()) {
+    for (int c = 0; c < d.n; ++c)
+      if (!std::isfinite(rhs[c]))
+        throw SolverError(msg("non-finite generalised force on joint coordinate '",
+                              m.coords[c].name, "' at t=", t));
+  }
+  crba_loaded(m, d);
+}
+
 DynamicsMethod dynamics_method(const std::string& name, const char* fn) {
   if (name == "auto") return DynamicsMethod::Auto;
   if (name == "joint") return DynamicsMethod::Joint;
@@ -105,16 +134,7 @@ const VecX& forward_dynamics(const Model& m, Data& d, Eigen::Ref<const VecX> q,
     forward_cartesian(m, d, q, qd, tau, t);
     return d.qdd;
   }
-  // M qdd = tau + Q - (b - J^T eta): the Newton-Euler residual at qdd = 0 gives the bias
-  joint_space_kinematics(m, q, qd, d.kin, d.rne);
-  body_forces(m, d.kin, t, d.eta);
-  rne_residual(m, d.kin, qd, d.zero, d.eta, d.rne, d.rhs);
-  d.rhs = tau - d.rhs;
-  if (!m.coord_forces.empty() || !m.gears.empty()) {
-    coordinate_forces(m, q.data(), qd.data(), nullptr, t, d.coord_tau);
-    d.rhs += d.coord_tau;
-  }
-  crba_loaded(m, d);
+  joint_space_equations(m, d, q.data(), qd.data(), nullptr, tau.data(), t);
   if (!cholesky_factor(d.M, d.L))
     throw SolverError(
         "forward_dynamics: the joint-space mass matrix is not positive definite (a massless "

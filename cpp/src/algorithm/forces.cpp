@@ -13,6 +13,23 @@ void add_pair(Eigen::Ref<VecX> eta, const Row12& g, int pa, int pb) {
   if (pa != kGround) eta.segment<6>(6 * pa) += g.segment<6>(0).transpose();
   if (pb != kGround) eta.segment<6>(6 * pb) += g.segment<6>(6).transpose();
 }
+
+// a non-finite entry of eta is an error naming its body
+void check_finite(const Model& m, Eigen::Ref<const VecX> eta, double t) {
+  if (eta.allFinite()) return;
+  for (int i = 0; i < m.nb; ++i)
+    if (!eta.segment<6>(6 * i).allFinite())
+      throw SolverError(msg("non-finite applied force on body '", m.bodies[i].name, "' at t=", t));
+}
+
+// the coordinates of gear pair g into d.cq, d.cqd from their jets, the angles tracked over turns
+void load_gear_coordinates(const Model& m, Data& d, const GearPair& g) {
+  for (const int c : {g.coord_a, g.coord_b}) {
+    const ScalarJet& q = d.jets.get(m, d.kin, c);
+    d.cq[c] = tracked(d, c, q.val);
+    d.cqd[c] = q.rate;
+  }
+}
 }  // namespace
 
 void body_forces(const Model& m, const std::vector<BodyKin>& kin, double t, Eigen::Ref<VecX> eta) {
@@ -50,12 +67,7 @@ void body_forces(const Model& m, const std::vector<BodyKin>& kin, double t, Eige
     const double tension = sd.stiffness * (L - sd.rest_length) + sd.damping * Ld;
     add_pair(eta, -tension * d.left(n), sd.body_a, sd.body_b);
   }
-  if (!eta.allFinite()) {
-    for (int i = 0; i < m.nb; ++i)
-      if (!eta.segment<6>(6 * i).allFinite())
-        throw SolverError(
-            msg("non-finite applied force on body '", m.bodies[i].name, "' at t=", t));
-  }
+  check_finite(m, eta, t);
 }
 
 void gear_mesh(const Model& m, int gi, const double* q, const double* qd, double& s, double& sd,
@@ -104,20 +116,14 @@ void coordinate_forces_on_bodies(const Model& m, Data& d, double t) {
     d.cq[cf.coord] = q.val;
     d.cqd[cf.coord] = q.rate;
   }
-  for (const GearPair& g : m.gears) {
-    for (const int c : {g.coord_a, g.coord_b}) {
-      const ScalarJet& q = d.jets.get(m, d.kin, c);
-      d.cq[c] = tracked(d, c, q.val);
-      d.cqd[c] = q.rate;
-    }
-  }
+  for (const GearPair& g : m.gears) load_gear_coordinates(m, d, g);
   // the joint-space generalised forces, mapped onto the bodies through each coordinate's
   // Jacobian
-  coordinate_forces(m, d.cq.data(), d.cqd.data(), d.aux, t, d.ctau);
+  coordinate_forces(m, d.cq.data(), d.cqd.data(), d.aux, t, d.coord_tau);
   for (int c = 0; c < static_cast<int>(m.coords.size()); ++c) {
-    if (d.ctau[c] == 0.0) continue;
+    if (d.coord_tau[c] == 0.0) continue;
     const Joint& j = m.joints[m.coords[c].joint];
-    add_pair(d.eta, d.ctau[c] * d.jets.get(m, d.kin, c).J, j.parent, j.child);
+    add_pair(d.eta, d.coord_tau[c] * d.jets.get(m, d.kin, c).J, j.parent, j.child);
   }
 }
 }  // namespace
@@ -135,12 +141,7 @@ void cartesian_forces(const Model& m, Data& d, double t) {
       add_pair(d.eta, tau[c] * q.J, j.parent, j.child);
     }
   }
-  if (!d.eta.allFinite()) {
-    for (int i = 0; i < m.nb; ++i)
-      if (!d.eta.segment<6>(6 * i).allFinite())
-        throw SolverError(
-            msg("non-finite applied force on body '", m.bodies[i].name, "' at t=", t));
-  }
+  check_finite(m, d.eta, t);
 }
 
 void aux_rates(const Model& m, Data& d, double t, double* zdot) {
@@ -153,12 +154,8 @@ void aux_rates(const Model& m, Data& d, double t, double* zdot) {
 }
 
 void gear_mesh(const Model& m, Data& d, int gi, double& s, double& sd, double& penetration) {
-  const GearPair& g = m.gears[gi];
-  const ScalarJet& qa = d.jets.get(m, d.kin, g.coord_a);
-  const ScalarJet& qb = d.jets.get(m, d.kin, g.coord_b);
-  s = g.r_a * tracked(d, g.coord_a, qa.val) + g.r_b * tracked(d, g.coord_b, qb.val);
-  sd = g.r_a * qa.rate + g.r_b * qb.rate;
-  penetration = std::abs(s) - 0.5 * g.backlash;
+  load_gear_coordinates(m, d, m.gears[gi]);
+  gear_mesh(m, gi, d.cq.data(), d.cqd.data(), s, sd, penetration);
 }
 
 }  // namespace armdyn

@@ -8,6 +8,12 @@
 
 namespace armdyn {
 
+std::string dependent_row_names(const Model& m, const Data& d) {
+  std::string rows;
+  for (int r : d.kkt.dependent_rows()) rows += (rows.empty() ? "" : "; ") + m.row_name(r);
+  return rows;
+}
+
 void body_accelerations(const Model& m, Data& d, double t, const double* u, const double* v,
                         double* vdot, bool reuse_factor) {
   load_kinematics(m, d, u, v);
@@ -40,10 +46,9 @@ void body_accelerations_loaded(const Model& m, Data& d, double t, double* vdot, 
     const int expected = nrows == m.nc ? m.rank_all : m.rank_joint;
     if (kkt.rank() < expected) {
       if (st.singular_evaluations++ == 0) {
-        std::string rows;
-        for (int r : kkt.dependent_rows()) rows += (rows.empty() ? "" : "; ") + m.row_name(r);
-        st.singular_note = msg("singular configuration at t=", t, ": constraint rank ", kkt.rank(),
-                               " instead of ", expected, "; dependent rows: ", rows);
+        st.singular_note =
+            msg("singular configuration at t=", t, ": constraint rank ", kkt.rank(), " instead of ",
+                expected, "; dependent rows: ", dependent_row_names(m, d));
       }
     }
   }

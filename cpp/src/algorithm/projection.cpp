@@ -6,6 +6,7 @@
 
 #include "armdyn/algorithm/constraints.hpp"
 #include "armdyn/algorithm/kinematics.hpp"
+#include "armdyn/algorithm/kkt.hpp"
 #include "armdyn/errors.hpp"
 #include "armdyn/math/quaternion.hpp"
 
@@ -116,11 +117,9 @@ std::string diagnose_singularity(const Model& m, Data& d, double t, const double
   kkt.factor_pivoted_at(d.ce, d.nrows, Metric::Mass, threshold);
   const int expected = d.nrows == m.nc ? m.rank_all : m.rank_joint;
   if (kkt.rank() >= expected) return "";
-  std::string rows;
-  for (int r : kkt.dependent_rows()) rows += (rows.empty() ? "" : "; ") + m.row_name(r);
   return msg("the constraint Jacobian is nearly singular at t=", t, " (rank ", kkt.rank(), " of ",
              expected, " at a ", short_number(threshold),
-             " threshold); nearly dependent rows: ", rows);
+             " threshold); nearly dependent rows: ", dependent_row_names(m, d));
 }
 
 }  // namespace armdyn

@@ -65,17 +65,11 @@ void DrivenSolver::predict(double t_from, double t, VecX& u, VecX& v, const VecX
   }
 }
 
-std::string DrivenSolver::dependent_rows() const {
-  std::string rows;
-  for (int r : d_.kkt.dependent_rows()) rows += (rows.empty() ? "" : "; ") + m_.row_name(r);
-  return rows;
-}
-
 std::string DrivenSolver::singular_rows() const {
   const KktSolver& kkt = d_.kkt;
   if (!(kkt.used_pseudo_inverse() && kkt.rank() < m_.rank_all)) return "";
   return msg(" The driven constraints are kinematically singular there: rank ", kkt.rank(),
-             " instead of ", m_.rank_all, "; dependent rows: ", dependent_rows(), ".");
+             " instead of ", m_.rank_all, "; dependent rows: ", dependent_row_names(m_, d_), ".");
 }
 
 void DrivenSolver::solve(double t, VecX& u, VecX& v, VecX& vd, double& rf, double& rv) {
@@ -157,7 +151,7 @@ void DrivenSolver::solve(double t, VecX& u, VecX& v, VecX& vd, double& rf, doubl
   if (throw_on_singular && !d_.swept && kkt.used_pseudo_inverse() && kkt.rank() < m_.rank_all)
     throw SolverError(msg(who_, ": kinematically singular at t=", t,
                           ": the driven constraints have rank ", kkt.rank(), " instead of ",
-                          m_.rank_all, "; dependent rows: ", dependent_rows()));
+                          m_.rank_all, "; dependent rows: ", dependent_row_names(m_, d_)));
 }
 
 InverseDynamicsResult inverse_dynamics_driven(const Model& m, const std::vector<double>& times) {

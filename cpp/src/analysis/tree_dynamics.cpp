@@ -5,10 +5,10 @@
 #include <cmath>
 
 #include "armdyn/algorithm/crba.hpp"
+#include "armdyn/algorithm/dynamics.hpp"
 #include "armdyn/algorithm/forces.hpp"
 #include "armdyn/errors.hpp"
 #include "armdyn/math/cholesky.hpp"
-#include "armdyn/math/quaternion.hpp"
 
 namespace armdyn {
 
@@ -59,26 +59,8 @@ const MatX& TreeDynamics::mass_matrix(const double* q) {
 
 void TreeDynamics::accelerations(double t, const double* q, const double* qd, const double* z,
                                  const double* tau, double* qdd) {
-  const Model& m = m_;
-  const Eigen::Map<const VecX> qv(q, n_), qdv(qd, n_);
-  joint_space_kinematics(m, qv, qdv, d_.kin, d_.rne);
-  body_forces(m, d_.kin, t, d_.eta);
-  // rhs = tau + Q - (b - J^T eta): the residual of the Newton-Euler equations at qdd = 0
-  VecX& rhs = d_.rhs;
-  rne_residual(m, d_.kin, qdv, d_.zero, d_.eta, d_.rne, rhs);
-  rhs = -rhs;
-  if (tau) rhs += Eigen::Map<const VecX>(tau, n_);
-  if (!m.coord_forces.empty() || !m.gears.empty()) {
-    coordinate_forces(m, q, qd, z, t, d_.coord_tau);
-    rhs += d_.coord_tau;
-  }
-  if (!rhs.allFinite()) {
-    for (int c = 0; c < n_; ++c)
-      if (!std::isfinite(rhs[c]))
-        throw SolverError(msg("non-finite generalised force on joint coordinate '",
-                              m.coords[c].name, "' at t=", t));
-  }
-  crba_loaded(m, d_);
+  joint_space_equations(m_, d_, q, qd, z, tau, t);
+  const VecX& rhs = d_.rhs;
   const MatX& M = d_.M;
   Eigen::Map<VecX> out(qdd, n_);
   if (rank_ == 0) {

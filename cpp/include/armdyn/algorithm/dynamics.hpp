@@ -21,6 +21,15 @@ enum class DynamicsMethod { Auto, Joint, Cartesian };
 /// "auto" | "joint" | "cartesian"; throws ModelError naming fn for anything else.
 DynamicsMethod dynamics_method(const std::string& name, const char* fn);
 
+/// The joint-space equations of motion M(q) qdd = rhs of a tree at (q, qd), auxiliary states z
+/// (model.n_aux; nullptr: all zero) and time t, with extra joint forces tau (nullptr: none):
+/// data.M by CRBA and data.rhs = tau + Q - (b - J^T eta), the Newton-Euler residual at qdd = 0
+/// (armdyn/algorithm/forces.hpp for eta and Q). The inputs are not checked; allocates nothing.
+/// Shared by forward_dynamics and the joint-space simulation (TreeDynamics).
+/// @throws SolverError naming the coordinate or body when a force is not finite.
+void joint_space_equations(const Model& m, Data& d, const double* q, const double* qd,
+                           const double* z, const double* tau, double t);
+
 /// Joint accelerations (n_coords) into data.qdd for joint torques/forces tau at (q, qd), time t.
 /// Allocates nothing. The Cartesian method runs the pipeline of data on the joint rows
 /// (data.nrows = nc_joint, the torques as data.joint_torques) and restores its defaults.

@@ -9,6 +9,8 @@
 // data.stats.
 #pragma once
 
+#include <string>
+
 #include "armdyn/data.hpp"
 
 namespace armdyn {
@@ -24,5 +26,9 @@ void body_accelerations(const Model& m, Data& d, double t, const double* u, cons
 /// load_joint_kinematics).
 void body_accelerations_loaded(const Model& m, Data& d, double t, double* vdot,
                                bool reuse_factor = false);
+
+/// The names of the rows the last factorisation of data.kkt found dependent, "; "-separated
+/// (Model::row_name), for messages about singular configurations.
+std::string dependent_row_names(const Model& m, const Data& d);
 
 }  // namespace armdyn

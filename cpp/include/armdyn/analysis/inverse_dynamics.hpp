@@ -52,8 +52,7 @@ class DrivenSolver {
   VecX qc_, qdc_, ud_, u_save_, v_save_, u_pred_, track_save_;
   TreeFkWork fkw_;
   void predict(double t_from, double t, VecX& u, VecX& v, const VecX& vd);
-  std::string dependent_rows() const;  ///< names of the KKT factor's dependent rows
-  std::string singular_rows() const;   ///< a sentence when the factor lost rank, else empty
+  std::string singular_rows() const;  ///< a sentence when the factor lost rank, else empty
 };
 
 struct InverseDynamicsResult {
