@@ -22,6 +22,13 @@ Data::Data(const Model& m) : model(&m), n(static_cast<int>(m.coords.size())), kk
   tol_f = 1e-13 * std::max(1.0, m.length_scale);
   kin.resize(m.nb);
   ce.init(m);
+  joint_block.assign(m.joints.size(), -1);
+  for (size_t j = 0; j < m.joints.size(); ++j)
+    for (size_t b = 0; b < ce.blocks.size(); ++b)
+      if (joint_rows(m.joints[j].type) > 0 && ce.blocks[b].row0 == m.joints[j].row0) {
+        joint_block[j] = static_cast<int>(b);
+        break;
+      }
   jets.init(m);
   ce.coord_cache = &jets;
   ce.track_ref = &track_ref;

@@ -123,3 +123,24 @@ def test_fixed_joint_reaction_of_a_hanging_weight_is_its_weight():
     assert np.abs(res.reaction_torques[:, j, :]).max() <= 1e-9
     pivot = res.reaction_forces[:, list(model.joint_names).index("pivot"), :]
     assert np.linalg.norm(pivot, axis=1) == pytest.approx(3.5 * 9.81, rel=1e-12)
+
+
+@pytest.mark.parametrize("merge", [True, False])
+def test_joint_space_run_reports_the_cartesian_tables_without_a_kkt_solve(merge):
+    """A joint-space run records its outputs from the tree's recursive sweeps: accelerations
+    from the joint-space dynamics, every joint's multipliers (the fixed joints' too) from the
+    bodies' Newton-Euler balances. Its tables equal the Cartesian run's (the paper's KKT
+    multipliers) and it makes no KKT solve."""
+    model = _welded_pendulums()
+    kw = dict(rtol=1e-11, atol=1e-12, output_dt=0.02, merge_welded=merge)
+    cart = ad.simulate(model, 1.0, **kw)
+    joint = ad.simulate(model, 1.0, coordinates="joint", **kw)
+    assert joint.stats["formulation"].startswith("joint space")
+    assert joint.stats["kkt_solves"] == 0 and cart.stats["kkt_solves"] > 0
+    # the joint angles start at 0 (round-off: 1e-16 apart); measured: row 0 (the same state)
+    # 1.6e-15, the run (each its own integration error) 5.8e-12
+    assert np.abs(joint.q - cart.q).max() <= 1e-11
+    for name in ("qdd", "u", "v", "reaction_forces", "reaction_torques", "kinetic_energy"):
+        assert rel_err(getattr(joint, name)[0], getattr(cart, name)[0], floor=1e-9) <= 1e-13, name
+        assert rel_err(getattr(joint, name), getattr(cart, name), floor=1e-9) <= 1e-10, name
+    assert joint.position_residual.max() <= 1e-13 and joint.velocity_residual.max() <= 1e-13

@@ -79,9 +79,10 @@ class Data {
   /// joint-space caller adds them to its generalised forces directly).
   bool with_coordinate_forces = true;
   // buffers:
-  ConstraintEval ce;   ///< f, zeta, rhs, xi at the loaded state
-  CoordJetCache jets;  ///< coordinate jets at the loaded state (ce.coord_cache)
-  VecX track_ref;      ///< (n) unwrapped reference of the angle coordinates (ce.track_ref)
+  ConstraintEval ce;             ///< f, zeta, rhs, xi at the loaded state
+  std::vector<int> joint_block;  ///< per joint: its row block in ce.blocks (-1: no rows)
+  CoordJetCache jets;            ///< coordinate jets at the loaded state (ce.coord_cache)
+  VecX track_ref;  ///< (n) unwrapped reference of the angle coordinates (ce.track_ref)
   std::vector<ScalarJet> tau_jets;   ///< (n) with joint_torques: each coordinate's jet (no value)
   VecX cq, cqd;                      ///< (n) the coordinates the force laws read, from the jets
   KktSolver kkt;                     ///< the factor of the KKT system's Schur complement

@@ -95,8 +95,8 @@ void RneWork::resize(const Model& m) {
   for (auto* v : {&point, &axis}) v->assign(nj, Vec3::Zero());
 }
 
-void rne_residual(const Model& m, const std::vector<BodyKin>& kin, Eigen::Ref<const VecX> qd,
-                  Eigen::Ref<const VecX> qdd, const VecX& eta, RneWork& w, Eigen::Ref<VecX> tau) {
+void rne_forward(const Model& m, const std::vector<BodyKin>& kin, Eigen::Ref<const VecX> qd,
+                 Eigen::Ref<const VecX> qdd, RneWork& w) {
   // forward sweep, parents first: the child's joint point Pc = P + d z moves with the parent
   // plus the slide along z; the child turns about z at Pc (the derivative of the velocities
   // of joint_space_kinematics)
@@ -122,6 +122,19 @@ void rne_residual(const Model& m, const std::vector<BodyKin>& kin, Eigen::Ref<co
     const Vec3 e = c.x - pc;
     w.acc[j.child] = acc + alpha.cross(e) + c.W.cross(c.W.cross(e));
   }
+}
+
+void tree_body_accelerations(const Model& m, const std::vector<BodyKin>& kin, const RneWork& w,
+                             double* vd) {
+  for (int i = 0; i < m.nb; ++i) {
+    Eigen::Map<Vec3>(vd + 6 * i) = w.acc[i];
+    Eigen::Map<Vec3>(vd + 6 * i + 3) = kin[i].R.transpose() * w.alpha[i];
+  }
+}
+
+void rne_residual(const Model& m, const std::vector<BodyKin>& kin, Eigen::Ref<const VecX> qd,
+                  Eigen::Ref<const VecX> qdd, const VecX& eta, RneWork& w, Eigen::Ref<VecX> tau) {
+  rne_forward(m, kin, qd, qdd, w);
   // each body's residual Gamma v' - eta: force (world) and moment about its centre of mass
   // (world axes; eta's torque is in body axes)
   for (int i = 0; i < m.nb; ++i) {

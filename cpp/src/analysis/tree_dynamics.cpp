@@ -37,7 +37,12 @@ TreeDynamics::TreeDynamics(const Model& m, bool ignore_drives) : m_(m), d_(m) {
     const MatX Q = qr.householderQ() * MatX::Identity(n_, n_);
     range_ = Q.leftCols(rank_);
     T_ = Q.rightCols(n_ - rank_);
+    Eigen::CompleteOrthogonalDecomposition<MatX> cod(Gt);
+    cod.setThreshold(1e-12);
+    Gt_pinv_ = cod.pseudoInverse();
   }
+  res_ = VecX::Zero(n_);
+  gear_delta_ = VecX::Zero(ng);
   dof_ = n_ - rank_;
   MT_ = MatX::Zero(n_, dof_);
   Mr_ = MatX::Zero(dof_, dof_);
@@ -75,6 +80,14 @@ void TreeDynamics::accelerations(double t, const double* q, const double* qd, co
     cholesky_solve(Lr_, y_);
     out.noalias() = T_ * y_;
   }
+}
+
+const VecX& TreeDynamics::gear_multipliers(const double* qdd) {
+  if (gear_delta_.size() == 0) return gear_delta_;
+  res_ = d_.rhs;
+  res_.noalias() -= d_.M * Eigen::Map<const VecX>(qdd, n_);
+  gear_delta_.noalias() = Gt_pinv_ * res_;
+  return gear_delta_;
 }
 
 void TreeDynamics::aux_rates(double t, const double* q, const double* qd, const double* z,

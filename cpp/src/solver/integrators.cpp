@@ -127,9 +127,12 @@ inline void hermite(double th, double h, const VecX& y0, const VecX& f0, const V
 }
 
 // Hairer's hinit: the first step from the size of y, f(t, y) and a difference quotient of f,
-// for a method whose local error is O(h^order). Uses yt and f1 as scratch.
+// for a method whose local error is O(h^order). Uses yt and f1 as scratch. Not below 100 hmin:
+// hinit's bound 100 h0 (h0 moving y by 1 % of its size) collapses when y is round-off above
+// zero (joint angles of 1e-16 from an assembled state, atol 1e-12 gives h0 ~ 1e-20); the
+// controller grows a small first step by up to 10x per step, and rejects one too large.
 double initial_step(OdeSystem& sys, double t, const VecX& y, const VecX& f0, VecX& yt, VecX& f1,
-                    const StepOptions& opt, double hmax, int order, StepStats& st) {
+                    const StepOptions& opt, double hmax, double hmin, int order, StepStats& st) {
   if (opt.dt > 0) return opt.dt;
   const double d0 = err_norm(y, y, y, opt.rtol, opt.atol);
   const double dd1 = err_norm(f0, y, y, opt.rtol, opt.atol);
@@ -142,7 +145,7 @@ double initial_step(OdeSystem& sys, double t, const VecX& y, const VecX& f0, Vec
   const double dd2 = err_norm(yt, y, y, opt.rtol, opt.atol) / h0;
   const double dm = std::max(dd1, dd2);
   const double h1 = dm <= 1e-15 ? std::max(1e-6, h0 * 1e-3) : std::pow(0.01 / dm, 1.0 / order);
-  return std::min({100 * h0, h1, hmax});
+  return std::max(std::min({100 * h0, h1, hmax}), std::min(100 * hmin, hmax));
 }
 
 // The checks before each step of an error-controlled method: the step budget, landing on t1,
@@ -222,7 +225,7 @@ struct AdaptiveRun {
     sys.project_and_rhs(t, y, f0);
     ++st.rhs_evals;
     sys.output(t, y);
-    h = initial_step(sys, t, y, f0, yt, f1, opt, hmax, order, st);
+    h = initial_step(sys, t, y, f0, yt, f1, opt, hmax, hmin, order, st);
     init_event_signs(sys, t, y, sgn, gbuf);
   }
   void guard(const StepStats& st) { guard_step(name, opt, st, t, t1, hmin, h); }

@@ -139,4 +139,35 @@ TEST_CASE(trbdf2_is_stable_on_a_stiff_problem) {
   CHECK(st.jacobians >= 1);
 }
 
+/// y'' = a: y = a t^2 / 2 from y(0) = y0 (a polynomial every Runge-Kutta pair integrates exactly).
+struct Falling : OdeSystem {
+  double a = 30.0;
+  void rhs(double, const VecX& y, VecX& dy) override {
+    dy.resize(2);
+    dy << y[1], a;
+  }
+  void project_and_rhs(double t, VecX& y, VecX& dy) override { rhs(t, y, dy); }
+  void output(double, const VecX&) override {}
+};
+
+TEST_CASE(first_step_from_a_round_off_start_does_not_underflow) {
+  // a joint angle of 1e-16 (an assembled state's round-off) with atol 1e-12: Hairer's hinit alone
+  // proposes h ~ 1e-20, below the step floor; the first step is held at 100 hmin
+  for (const bool dop853 : {false, true}) {
+    Falling sys;
+    VecX y = (VecX(2) << 1e-16, 0.0).finished();
+    StepOptions opt;
+    opt.rtol = 1e-11;
+    opt.atol = 1e-12;
+    StepStats st;
+    if (dop853)
+      integrate_dop853(sys, y, 0.0, 1.0, opt, st);
+    else
+      integrate_dopri5(sys, y, 0.0, 1.0, opt, st);
+    CHECK_NEAR(y[0], 15.0, 1e-10);
+    CHECK_NEAR(y[1], 30.0, 1e-10);
+    CHECK(st.steps < 40);  // from 1e-12 growing up to 10x per step
+  }
+}
+
 ARMDYN_TEST_MAIN()

@@ -57,6 +57,15 @@ void joint_space_kinematics(const Model& m, Eigen::Ref<const VecX> q, Eigen::Ref
 void joint_space_poses(const Model& m, Eigen::Ref<const VecX> q, std::vector<BodyKin>& kin,
                        RneWork& frames);
 
+/// The forward sweep of rne_residual alone: each body's angular acceleration (w.alpha) and
+/// centre-of-mass acceleration (w.acc), world axes, at (q, qd, qdd), parents first. O(n).
+void rne_forward(const Model& m, const std::vector<BodyKin>& kin, Eigen::Ref<const VecX> qd,
+                 Eigen::Ref<const VecX> qdd, RneWork& w);
+/// The bodies' Cartesian accelerations vd (nv: centre of mass in world, angular in the body
+/// frame) from rne_forward's sweep.
+void tree_body_accelerations(const Model& m, const std::vector<BodyKin>& kin, const RneWork& w,
+                             double* vd);
+
 /// The joint-space residual of the Newton-Euler equations of a tree,
 ///   tau = M(q) qdd + b(q, qd) - J(q)^T eta,
 /// with kin and w's joint frames (w.point, w.axis) filled by joint_space_kinematics(..., w) at

@@ -56,6 +56,14 @@ class TreeDynamics {
   const MatX& mass_matrix(const double* q);
   /// The mass matrix of the last accelerations() or mass_matrix() call.
   const MatX& last_mass_matrix() const { return d_.M; }
+  /// The ideal gears' multipliers (one per gear, the Cartesian rows' convention
+  /// M qdd = rhs - G^T delta) of the last accelerations() call, whose result is qdd: the
+  /// least-squares solution of G^T delta = rhs - M qdd (the minimum-norm one for redundant
+  /// gears). Empty without ideal gears. Allocates nothing.
+  const VecX& gear_multipliers(const double* qdd);
+  /// The evaluation behind the last accelerations() call: the tree's kinematics (data().kin),
+  /// joint frames (data().rne) and applied forces (data().eta) at its (q, qd, t).
+  const Data& data() const { return d_; }
 
  private:
   const Model& m_;
@@ -63,7 +71,9 @@ class TreeDynamics {
   int n_ = 0, dof_ = 0, rank_ = 0;
   MatX T_, range_, MT_, Mr_;  // the gears' null space and range; M T; T^T M T
   VecX y_, w_;
-  MatX Lr_;  // Cholesky factor of T^T M T (with gears)
+  MatX Lr_;       // Cholesky factor of T^T M T (with gears)
+  MatX Gt_pinv_;  // the pseudo-inverse of G^T (ng x n)
+  VecX res_, gear_delta_;
 };
 
 }  // namespace armdyn

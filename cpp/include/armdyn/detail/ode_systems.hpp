@@ -3,8 +3,9 @@
 //  - MbsSystem: the Cartesian state y = (u, v, z) with the constrained Newton-Euler equations
 //    (armdyn/algorithm/kkt.hpp) and the topological projection (armdyn/algorithm/projection.hpp),
 //    on a Data of its model; it records every output table.
-//  - JointSystem: the joint coordinates y = (q, qd, z) of a tree (TreeDynamics); its outputs go
-//    through MbsSystem at the state built by forward kinematics.
+//  - JointSystem: the joint coordinates y = (q, qd, z) of a tree (TreeDynamics); its outputs
+//    are recorded by MbsSystem at the state, accelerations and multipliers of the tree's
+//    recursive sweeps (no KKT solve).
 //  - WeldExpander: reports a run of the welded model (Model::welded) in the bodies and joints of
 //    the full model.
 #pragma once
@@ -35,9 +36,7 @@ class WeldExpander {
         u_(VecX::Zero(full.nq)),
         v_(VecX::Zero(full.nv)),
         vd_(VecX::Zero(full.nv)),
-        delta_(VecX::Zero(full.nc)),
-        r_(VecX::Zero(full.nv)),
-        tmp_(VecX::Zero(full.nv)) {
+        delta_(VecX::Zero(full.nc)) {
     for (const Model::Weld& w : m_.weld) qrel_.push_back(rot_to_quat(w.rotation));
     // rows of the full model -> rows of the welded one (-1: a merged fixed joint)
     row_map_.assign(m_.nc, -1);
@@ -59,13 +58,6 @@ class WeldExpander {
     }
     track_ = VecX::Zero(static_cast<long>(m_.coords.size()));
     for (size_t k = 0; k < m_.drives.size(); ++k) row_map_[m_.drives[k].row] = w_.drives[k].row;
-    // the block of each merged joint
-    block_of_.assign(m_.joints.size(), -1);
-    const ConstraintEval& ce = d_.ce;
-    for (size_t j = 0; j < m_.joints.size(); ++j)
-      for (size_t b = 0; b < ce.blocks.size(); ++b)
-        if (joint_rows(m_.joints[j].type) > 0 && ce.blocks[b].row0 == m_.joints[j].row0)
-          block_of_[j] = static_cast<int>(b);
   }
 
   /// The composites' state (uw, vw) from a full state: each from its root body.
@@ -116,7 +108,7 @@ class WeldExpander {
 
   /// Multipliers of the full model at the expanded state: the welded run's for its rows, the
   /// merged fixed joints' from each member's Newton-Euler balance, far members first
-  /// (zeta_far^T delta_j = eta - Gamma vdot - the other rows' forces). Leaves data() loaded
+  /// (sweep_multipliers). Leaves data() loaded
   /// (kinematics, constraints, multipliers) for joint_reaction() and the residuals.
   void reactions(double t, const VecX& delta_w, const double* aux, const VecX& tracking_w) {
     d_.aux = aux;
@@ -125,30 +117,11 @@ class WeldExpander {
       if (coord_map_[c] >= 0) track_[static_cast<long>(c)] = tracking_w[coord_map_[c]];
     d_.track_ref = track_;
     load_kinematics(m_, d_, u_.data(), v_.data());
-    const ConstraintEval& ce = d_.ce;
     evaluate_constraints(m_, d_, t, false);
     cartesian_forces(m_, d_, t);
     for (int r = 0; r < m_.nc; ++r) delta_[r] = row_map_[r] >= 0 ? delta_w[row_map_[r]] : 0.0;
-    const VecX& eta = d_.eta;
-    for (int b = 0; b < m_.nb; ++b) {
-      const Body& bd = m_.bodies[b];
-      r_.segment<3>(6 * b) = eta.segment<3>(6 * b) - bd.mass * vd_.segment<3>(6 * b);
-      r_.segment<3>(6 * b + 3) = eta.segment<3>(6 * b + 3) - bd.inertia * vd_.segment<3>(6 * b + 3);
-    }
-    zeta_transpose_times(ce, m_.nc, delta_, tmp_);
-    r_ -= tmp_;
-    for (const auto& [j, far] : m_.weld_sweep) {
-      const Joint& jt = m_.joints[j];
-      const ConstraintBlock& blk = ce.blocks[block_of_[j]];
-      const int sf = jt.child == far ? 1 : 0;
-      const Mat6 Zf = blk.J.block<6, 6>(0, 6 * sf);
-      const Vec6 d = Zf.transpose().partialPivLu().solve(Vec6(r_.segment<6>(6 * far)));
-      delta_.segment<6>(jt.row0) = d;
-      const int near = sf == 1 ? jt.parent : jt.child;
-      if (near != kGround)
-        r_.segment<6>(6 * near).noalias() -= blk.J.block<6, 6>(0, 6 * (1 - sf)).transpose() * d;
-    }
     d_.delta = delta_;
+    sweep_multipliers(m_, d_, vd_, m_.weld_sweep);
   }
 
   /// The full model's pipeline, loaded by reactions().
@@ -160,10 +133,10 @@ class WeldExpander {
   const Model& m_;
   const Model& w_;
   Data d_;
-  VecX u_, v_, vd_, delta_, r_, tmp_, track_;
+  VecX u_, v_, vd_, delta_, track_;
   std::vector<Vec4> qrel_;
   std::vector<int> coord_map_;
-  std::vector<int> row_map_, block_of_;
+  std::vector<int> row_map_;
 };
 
 // the constrained equations of motion as an ODE on y = (u, v), with projection and recording
@@ -285,14 +258,25 @@ class MbsSystem : public OdeSystem {
 };
 
 // The joint-space equations of motion of a tree (TreeDynamics) as an ODE on y = (q, qd, z).
-// Outputs go through the Cartesian system at the state built by forward kinematics, with the
-// multi-turn angles set from q: every table (poses, reactions, gear forces, residuals)
-// is the one a Cartesian run reports.
+// At an output, the joint-space dynamics give qdd (and the ideal gears' multipliers); the
+// tree's forward sweep gives the bodies' Cartesian state and accelerations, and the bodies'
+// Newton-Euler balances, children first, give every joint's multipliers (sweep_multipliers):
+// no Cartesian KKT solve and no projection. The Cartesian system then records the same tables
+// a Cartesian run reports (poses, reactions, gear forces, residuals, energies).
 class JointSystem : public OdeSystem {
  public:
   JointSystem(const Model& m, MbsSystem& cart)
-      : m_(m), td_(m), cart_(cart), n_(td_.n()), yc_(VecX::Zero(m.nq + m.nv + m.n_aux)) {
-    fkw_.kin.resize(m.nb);
+      : m_(m),
+        td_(m),
+        cart_(cart),
+        n_(td_.n()),
+        u_(VecX::Zero(m.nq)),
+        v_(VecX::Zero(m.nv)),
+        vd_(VecX::Zero(m.nv)),
+        qdd_(VecX::Zero(td_.n())),
+        rne_(td_.data().rne) {
+    for (auto it = m.tree_order.rbegin(); it != m.tree_order.rend(); ++it)
+      if (joint_rows(m.joints[*it].type) > 0) sweep_.emplace_back(*it, m.joints[*it].child);
   }
 
   void rhs(double t, const VecX& y, VecX& dy) override {
@@ -310,12 +294,29 @@ class JointSystem : public OdeSystem {
   }
 
   void output(double t, const VecX& y) override {
+    const double* z = y.data() + 2 * n_;
     const Eigen::Map<const VecX> q(y.data(), n_), qd(y.data() + n_, n_);
-    joint_space_kinematics(m_, q, qd, fkw_.kin);
-    cartesian_state(m_, fkw_.kin, yc_.data(), yc_.data() + m_.nq);
-    yc_.tail(m_.n_aux) = y.tail(m_.n_aux);
-    cart_.data().track_ref = q;
-    cart_.output(t, yc_);
+    td_.accelerations(t, q.data(), qd.data(), z, nullptr, qdd_.data());
+    const Data& jd = td_.data();  // the tree's kinematics and joint frames at (q, qd)
+    rne_.point = jd.rne.point;
+    rne_.axis = jd.rne.axis;
+    rne_forward(m_, jd.kin, qd, qdd_, rne_);
+    tree_body_accelerations(m_, jd.kin, rne_, vd_.data());
+    cartesian_state(m_, jd.kin, u_.data(), v_.data());
+    Data& d = cart_.data();
+    d.aux = z;
+    d.track_ref = q;
+    load_kinematics(m_, d, u_.data(), v_.data());
+    evaluate_constraints(m_, d, t, false);
+    cartesian_forces(m_, d, t);
+    const VecX& gear_delta = td_.gear_multipliers(qdd_.data());
+    d.delta.setZero();
+    for (size_t g = 0; g < m_.gear_constraints.size(); ++g)
+      d.delta[m_.gear_constraints[g].row] = gear_delta[static_cast<long>(g)];
+    sweep_multipliers(m_, d, vd_, sweep_);
+    double rf, rv;
+    loaded_residuals(m_, d, v_.data(), rf, rv);
+    cart_.record(t, u_.data(), v_.data(), vd_, rf, rv, z);
   }
 
   int n_events() const override { return static_cast<int>(m_.gears.size()); }
@@ -332,8 +333,9 @@ class JointSystem : public OdeSystem {
   TreeDynamics td_;
   MbsSystem& cart_;
   int n_;
-  VecX yc_;
-  TreeFkWork fkw_;
+  VecX u_, v_, vd_, qdd_;
+  RneWork rne_;                             // the forward sweep at the output's accelerations
+  std::vector<std::pair<int, int>> sweep_;  // (joint, child), children before parents
 };
 
 }  // namespace armdyn::detail
