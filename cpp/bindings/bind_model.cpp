@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <pybind11/stl.h>
 
+#include "armdyn/builder/builder.hpp"
+#include "armdyn/builder/summary.hpp"
 #include "armdyn/io/urdf.hpp"
-#include "armdyn/model/builder.hpp"
 #include "armdyn/solver/block_sparse.hpp"
 #include "common.hpp"
 
@@ -176,9 +177,11 @@ void bind_model(py::module_& m) {
           "body's frame, relative to its centre of mass; the world for 'ground'), "
           "'frame_parent'/'frame_child' (the joint frame's axes as columns in each body's "
           "frame; z is the joint axis) and 'coord' (its first joint coordinate, -1 if none).")
-      .def("summary", &Model::summary, "Readable description: sizes, topology, solver path.")
+      .def(
+          "summary", [](const Model& m) { return summary(m); },
+          "Readable description: sizes, topology, solver path.")
       .def_property_readonly(
-          "kkt_path", [](const Model& m) { return m.kkt_all.path; },
+          "kkt_path", [](const Model& m) { return kkt_path(m); },
           "KKT solver path chosen at finalize(): 'tree', 'tree+loops', 'sparse', or 'dense' "
           "(redundant rows).")
       .def(
@@ -186,23 +189,11 @@ void bind_model(py::module_& m) {
           [](const Model& m, const std::string& path) {
             if (path != "dense" && path != "auto")
               throw ModelError("with_kkt_path: path must be 'dense' or 'auto', got '" + path + "'");
+            // a copy derives its plans and welded form afresh (the welded model inherits the
+            // forced path: simulate() integrates it)
             auto c = std::make_shared<Model>(m);
-            c->kkt_all = plan_kkt(*c, c->nc);
-            c->kkt_joint = c->nc_joint != c->nc ? plan_kkt(*c, c->nc_joint) : KktPlan();
-            if (path == "dense" || c->redundant)
-              for (KktPlan* p : {&c->kkt_all, &c->kkt_joint}) {
-                p->path = "dense";
-                p->description = "dense Schur complement (forced)";
-              }
-            if (c->welded && path == "dense") {  // the model simulate() integrates, too
-              auto w = std::make_shared<Model>(*c->welded);
-              for (KktPlan* p : {&w->kkt_all, &w->kkt_joint}) {
-                p->path = "dense";
-                p->description = "dense Schur complement (forced)";
-              }
-              c->welded = w;
-            }
-            return c;
+            c->force_dense_kkt = path == "dense";
+            return std::const_pointer_cast<const Model>(c);
           },
           py::arg("path"),
           "A copy of the model on another KKT path: 'dense' (the reference: one dense Cholesky "
@@ -211,13 +202,14 @@ void bind_model(py::module_& m) {
           "kkt_plan",
           [](const Model& m) {
             py::dict d;
-            d["path"] = m.kkt_all.path;
-            d["description"] = m.kkt_all.description;
-            d["blocks"] = m.kkt_all.order.size();
-            d["factor_entries"] = m.kkt_all.factor_entries;
-            d["fill_blocks"] = m.kkt_all.fill_blocks;
-            d["loop_rows"] = m.kkt_all.loop_rows;
-            d["flops"] = m.kkt_all.flops;
+            const KktPlan& p = kkt_plans(m).all;
+            d["path"] = kkt_path(m);
+            d["description"] = kkt_path_description(m);
+            d["blocks"] = p.order.size();
+            d["factor_entries"] = p.factor_entries;
+            d["fill_blocks"] = p.fill_blocks;
+            d["loop_rows"] = p.loop_rows;
+            d["flops"] = p.flops;
             return d;
           },
           "The KKT plan's statistics (path, row blocks, factor entries, fill, flops).")

@@ -16,11 +16,16 @@
 #include "armdyn/math/quaternion.hpp"
 #include "armdyn/math/types.hpp"
 
-// model description and its per-evaluation workspace
+// the model description and its per-evaluation workspace
 #include "armdyn/data.hpp"
-#include "armdyn/model/builder.hpp"
 #include "armdyn/model/model.hpp"
 #include "armdyn/model/profile.hpp"
+
+// building a model: the builder (finalize: topology, assembly, rank analysis), its summary,
+// and the welded form simulate() integrates
+#include "armdyn/builder/builder.hpp"
+#include "armdyn/builder/summary.hpp"
+#include "armdyn/builder/weld.hpp"
 
 // joint-space algorithms: forces, recursive Newton-Euler, CRBA, forward/inverse dynamics
 #include "armdyn/algorithm/crba.hpp"

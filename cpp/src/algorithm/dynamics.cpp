@@ -72,9 +72,7 @@ void inverse_cartesian(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen:
     driven->mobility_driven = driven->mobility - n;
     driven->redundant = false;
     driven->redundant_rows.clear();
-    // the drives changed the row blocks: plan the KKT factorisation afresh
-    driven->kkt_all = plan_kkt(*driven, driven->nc);
-    driven->kkt_joint = plan_kkt(*driven, driven->nc_joint);
+    // (the copy plans its KKT factorisation afresh, for the new drive rows: kkt_plans)
     d.driven = std::move(driven);
     d.driven_data = std::make_unique<Data>(*d.driven);
     d.drive_ref = VecX::Zero(3 * n);

@@ -11,6 +11,7 @@
 #include "armdyn/algorithm/kinematics.hpp"
 #include "armdyn/algorithm/projection.hpp"
 #include "armdyn/analysis/inverse_dynamics.hpp"
+#include "armdyn/builder/weld.hpp"
 #include "armdyn/data.hpp"
 #include "armdyn/detail/ode_systems.hpp"
 #include "armdyn/errors.hpp"
@@ -150,6 +151,7 @@ void check_options(const Model& m, double t_end, const SimOptions& opt, const Ve
 /// integrator (never Default or Auto) and why, and the coordinates.
 struct RunPlan {
   const Model* ms = nullptr;
+  const Welding* welding = nullptr;
   bool welded = false;
   Integrator integrator = Integrator::Dopri5;
   std::string reason;
@@ -158,10 +160,11 @@ struct RunPlan {
 
 RunPlan plan_run(const Model& m, double t_end, const SimOptions& opt) {
   RunPlan p;
-  // bodies joined by fixed joints integrate as one composite body (Model::welded); the outputs
+  // bodies joined by fixed joints integrate as one composite body (builder/weld.hpp); the outputs
   // are reported for every body and joint of m
-  p.welded = m.welded != nullptr && opt.merge_welded;
-  p.ms = p.welded ? m.welded.get() : &m;
+  p.welding = opt.merge_welded ? welding(m) : nullptr;
+  p.welded = p.welding != nullptr;
+  p.ms = p.welded ? p.welding->model.get() : &m;
   // zero freedom left by the drives: every state follows from the constraints, no integration
   // (not with PI-motor states or gear contact, which have states or events of their own)
   const bool prescribed = m.mobility_driven == 0 && m.n_aux == 0 && m.gears.empty();
@@ -357,7 +360,7 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
     out.formulation = jsys->dynamics().description();
   } else {
     out.formulation = msg("cartesian: ", ms.nb, " bodies, ", ms.nc, " constraint rows, KKT path '",
-                          ms.kkt_all.path, "'");
+                          kkt_path(ms), "'");
     if (opt.coordinates == Coordinates::Auto)
       out.formulation += msg(" (joint space does not apply: ",
                              plan.integrator == Integrator::Kinematic ? std::string("fully driven")
@@ -368,7 +371,7 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
   std::unique_ptr<detail::WeldExpander> expander;
   VecX y = VecX::Zero(ms.nq + ms.nv + ms.n_aux);
   if (plan.welded) {
-    expander = std::make_unique<detail::WeldExpander>(m);
+    expander = std::make_unique<detail::WeldExpander>(m, *plan.welding);
     sys.set_expander(expander.get());
     VecX uw(ms.nq), vw(ms.nv);
     expander->contract(u0, v0, uw, vw);

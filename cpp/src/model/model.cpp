@@ -79,63 +79,6 @@ std::string Model::row_name(int row) const {
   return msg("row ", row);
 }
 
-std::string Model::summary() const {
-  std::ostringstream os;
-  os << "armdyn Model: " << nb << " bodies, " << joints.size() << " joints, " << drives.size()
-     << " drives\n";
-  os << "  sizes: nq=" << nq << " nv=" << nv << " nc=" << nc << " (joint rows " << nc_joint
-     << ", drive rows " << nc - nc_joint << "), joint coordinates " << coords.size() << "\n";
-  os << "  topology: " << (is_tree ? "tree" : "closed loops") << "; mobility " << mobility
-     << " DOF (nv - rank " << rank_joint << ")";
-  if (!drives.empty()) os << ", " << mobility_driven << " left free by the drives";
-  os << "\n";
-  if (redundant) {
-    os << "  redundant constraint rows (" << redundant_rows.size() << "):";
-    for (const auto& r : redundant_rows) os << "\n    " << r;
-    os << "\n  multipliers: minimum-norm (reactions of redundant joints are not unique)\n";
-  }
-  os << "  KKT path: " << kkt_all.path << " -- " << kkt_all.description << "\n";
-  if (welded) {
-    int merged = 0;
-    for (int jw : weld_joint) merged += jw < 0;
-    os << "  welded: " << merged << " fixed joints merged into composite bodies; simulate() "
-       << "integrates " << welded->nb << " bodies and " << welded->nc << " rows (KKT path "
-       << welded->kkt_all.path << ", ~" << welded->kkt_all.flops
-       << " flops per factorisation) and reports all " << nb << " bodies\n";
-  }
-  {
-    // simulate(coordinates="joint"): the integrated model (welded, when fixed joints merge)
-    const Model& s = welded ? *welded : *this;
-    const std::string why = s.joint_path_reason();
-    os << "  joint-space path (simulate coordinates='joint'): ";
-    if (!why.empty())
-      os << "not available (" << why << ")\n";
-    else
-      os << "available: " << s.coords.size() << " coordinates"
-         << (s.gear_constraints.empty() ? std::string()
-                                        : ", " + std::to_string(s.gear_constraints.size()) +
-                                              " ideal-gear rows eliminated by their null space")
-         << "; mass matrix by CRBA\n";
-  }
-  os << "  gravity: [" << gravity.x() << ", " << gravity.y() << ", " << gravity.z() << "]\n";
-  os << "  bodies:\n";
-  for (const Body& b : bodies) os << "    " << b.name << "  mass " << b.mass << " kg\n";
-  os << "  joints:\n";
-  for (const Joint& j : joints)
-    os << "    " << j.name << "  " << joint_type_name(j.type) << "  " << body_name(j.parent)
-       << " -> " << body_name(j.child) << "\n";
-  for (const GearConstraint& g : gear_constraints)
-    os << "  gear " << g.name << ": " << coords[g.coord_a].name << " (r " << g.r_a << ") - "
-       << coords[g.coord_b].name << " (r " << g.r_b << "), ideal\n";
-  for (const GearPair& g : gears)
-    os << "  gear pair " << g.name << ": " << coords[g.coord_a].name << " (r " << g.r_a << ") - "
-       << coords[g.coord_b].name << " (r " << g.r_b << "), backlash " << g.backlash << " m\n";
-  for (const Drive& d : drives) os << "  drive " << d.name << ": " << d.profile.describe() << "\n";
-  const size_t nforce = body_loads.size() + springs.size() + coord_forces.size() + gears.size();
-  if (nforce) os << "  force elements: " << nforce << " (besides gravity)\n";
-  return os.str();
-}
-
 std::string Model::joint_path_reason(bool ignore_drives) const {
   if (!joint_tree)
     return joint_space_reason.empty() ? "the model is not a tree" : joint_space_reason;

@@ -102,6 +102,28 @@ KktPlan plan_kkt(const Model& m, int nrows) {
   return p;
 }
 
+const KktPlans& kkt_plans(const Model& m) {
+  return m.derived.get<KktPlans>([&] {
+    KktPlans p;
+    p.all = plan_kkt(m, m.nc);
+    if (m.nc_joint != m.nc) p.joint = plan_kkt(m, m.nc_joint);
+    return p;
+  });
+}
+
+std::string kkt_path(const Model& m) {
+  if (m.nc == 0) return "";
+  if (m.redundant || m.force_dense_kkt) return "dense";
+  return kkt_plans(m).all.path;
+}
+
+std::string kkt_path_description(const Model& m) {
+  if (m.nc == 0) return "no constraint rows";
+  if (m.redundant) return "dense Schur complement, pivoted Cholesky (minimum-norm multipliers)";
+  if (m.force_dense_kkt) return "dense Schur complement (forced)";
+  return kkt_plans(m).all.description;
+}
+
 BlockSparseSchur::BlockSparseSchur(const Model& m, const KktPlan& plan) : m_(m) {
   ConstraintEval ce;
   ce.init(m);

@@ -26,11 +26,13 @@ KktSolver::KktSolver(const Model& m)
     minv_[i].topLeftCorner<3, 3>() = Mat3::Identity() / m.bodies[i].mass;
     minv_[i].bottomRightCorner<3, 3>() = m.bodies[i].inertia.inverse();
   }
-  const bool sparse_all = !m.redundant && !m.kkt_all.path.empty() && m.kkt_all.path != "dense";
-  if (sparse_all) sp_all_ = std::make_unique<BlockSparseSchur>(m, m.kkt_all);
-  if (!m.redundant && m.nc_joint != m.nc && !m.kkt_joint.path.empty() &&
-      m.kkt_joint.path != "dense")
-    sp_joint_ = std::make_unique<BlockSparseSchur>(m, m.kkt_joint);
+  // the block-sparse plans unless the model is redundant or forced onto the dense path
+  const bool sparse = !m.redundant && !m.force_dense_kkt && m.nc > 0;
+  const KktPlans* plans = sparse ? &kkt_plans(m) : nullptr;
+  const bool sparse_all = plans && plans->all.path != "dense";
+  if (sparse_all) sp_all_ = std::make_unique<BlockSparseSchur>(m, plans->all);
+  if (plans && m.nc_joint != m.nc && !plans->joint.path.empty() && plans->joint.path != "dense")
+    sp_joint_ = std::make_unique<BlockSparseSchur>(m, plans->joint);
   if (!sparse_all) ensure_dense();
 }
 

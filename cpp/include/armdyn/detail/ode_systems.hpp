@@ -6,7 +6,7 @@
 //  - JointSystem: the joint coordinates y = (q, qd, z) of a tree (TreeDynamics); its outputs
 //    are recorded by MbsSystem at the state, accelerations and multipliers of the tree's
 //    recursive sweeps (no KKT solve).
-//  - WeldExpander: reports a run of the welded model (Model::welded) in the bodies and joints of
+//  - WeldExpander: reports a run of the welded model (builder/weld.hpp) in the bodies and joints of
 //    the full model.
 #pragma once
 
@@ -21,27 +21,29 @@
 #include "armdyn/algorithm/reactions.hpp"
 #include "armdyn/analysis/simulate.hpp"
 #include "armdyn/analysis/tree_dynamics.hpp"
+#include "armdyn/builder/weld.hpp"
 #include "armdyn/data.hpp"
 #include "armdyn/math/quaternion.hpp"
 
 namespace armdyn::detail {
 
-// Reports a run of the welded model (Model::welded) in the bodies and joints of the full model.
+// Reports a run of the welded model (builder/weld.hpp) in the bodies and joints of the full model.
 class WeldExpander {
  public:
-  explicit WeldExpander(const Model& full)
+  WeldExpander(const Model& full, const Welding& welding)
       : m_(full),
-        w_(*full.welded),
+        wd_(welding),
+        w_(*welding.model),
         d_(full),
         u_(VecX::Zero(full.nq)),
         v_(VecX::Zero(full.nv)),
         vd_(VecX::Zero(full.nv)),
         delta_(VecX::Zero(full.nc)) {
-    for (const Model::Weld& w : m_.weld) qrel_.push_back(rot_to_quat(w.rotation));
+    for (const Weld& w : wd_.weld) qrel_.push_back(rot_to_quat(w.rotation));
     // rows of the full model -> rows of the welded one (-1: a merged fixed joint)
     row_map_.assign(m_.nc, -1);
     for (size_t j = 0; j < m_.joints.size(); ++j) {
-      const int jw = m_.weld_joint[j];
+      const int jw = wd_.weld_joint[j];
       if (jw < 0) continue;
       for (int k = 0; k < joint_rows(m_.joints[j].type); ++k)
         row_map_[m_.joints[j].row0 + k] = w_.joints[jw].row0 + k;
@@ -51,7 +53,7 @@ class WeldExpander {
     // coordinates of the full model -> those of the welded one (fixed joints have none)
     coord_map_.assign(m_.coords.size(), -1);
     for (size_t j = 0; j < m_.joints.size(); ++j) {
-      const int jw = m_.weld_joint[j];
+      const int jw = wd_.weld_joint[j];
       if (jw < 0) continue;
       for (int k = 0; k < joint_coords(m_.joints[j].type); ++k)
         coord_map_[m_.joints[j].coord0 + k] = w_.joints[jw].coord0 + k;
@@ -63,8 +65,8 @@ class WeldExpander {
   /// The composites' state (uw, vw) from a full state: each from its root body.
   void contract(const VecX& u, const VecX& v, VecX& uw, VecX& vw) const {
     for (int c = 0; c < w_.nb; ++c) {
-      const int r = m_.weld_root[c];
-      const Model::Weld& w = m_.weld[r];
+      const int r = wd_.roots[c];
+      const Weld& w = wd_.weld[r];
       const Vec4 qr = u.segment<4>(7 * r + 3).normalized();
       const Vec4& e = qrel_[r];
       const Vec4 qc = quat_mul(qr, Vec4(e[0], -e[1], -e[2], -e[3]));
@@ -80,7 +82,7 @@ class WeldExpander {
   /// The full state (and accelerations, when vdw is given) from the composites'.
   void expand(const double* uw, const double* vw, const double* vdw) {
     for (int b = 0; b < m_.nb; ++b) {
-      const Model::Weld& w = m_.weld[b];
+      const Weld& w = wd_.weld[b];
       if (w.composite == kGround) {
         u_.segment<3>(7 * b) = w.offset;
         u_.segment<4>(7 * b + 3) = qrel_[b];
@@ -121,7 +123,7 @@ class WeldExpander {
     cartesian_forces(m_, d_, t);
     for (int r = 0; r < m_.nc; ++r) delta_[r] = row_map_[r] >= 0 ? delta_w[row_map_[r]] : 0.0;
     d_.delta = delta_;
-    sweep_multipliers(m_, d_, vd_, m_.weld_sweep);
+    sweep_multipliers(m_, d_, vd_, wd_.sweep);
   }
 
   /// The full model's pipeline, loaded by reactions().
@@ -131,6 +133,7 @@ class WeldExpander {
 
  private:
   const Model& m_;
+  const Welding& wd_;
   const Model& w_;
   Data d_;
   VecX u_, v_, vd_, delta_, track_;

@@ -6,8 +6,8 @@
 
 #include <string>
 
+#include "armdyn/builder/builder.hpp"
 #include "armdyn/math/types.hpp"
-#include "armdyn/model/builder.hpp"
 
 namespace armdyn {
 

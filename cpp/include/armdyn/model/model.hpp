@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The immutable Model: bodies in Cartesian coordinates with Euler parameters, joints as
 // algebraic constraints, drives as rheonomic constraints, force elements, and the topology
-// analysis done once at finalize().
+// analysis done once at finalize() (armdyn/builder/builder.hpp).
 //
 // State layout (fixed): per body i, u_i = (x_i [m], e_i) with x_i the centre of mass in world
 // and e_i the scalar-first Euler parameters (body -> world); v_i = (xdot_i [m/s] in world,
@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "armdyn/math/types.hpp"
+#include "armdyn/model/derived.hpp"
 #include "armdyn/model/profile.hpp"
 
 namespace armdyn {
@@ -181,17 +182,11 @@ struct Coord {
   bool angular = true;
 };
 
-/// Symbolic plan of the block-sparse Schur factorisation (armdyn/solver/block_sparse.hpp).
-struct KktPlan {
-  std::string path;         ///< "tree", "tree+loops", "sparse", or "dense" (redundant rows)
-  std::string description;  ///< one line for Model::summary()
-  std::vector<int> order;   ///< elimination position -> block index
-  std::vector<int> pos;     ///< block index -> elimination position
-  /// per position: the later positions with a nonzero block in its column of L (sorted)
-  std::vector<std::vector<int>> cols;
-  int nrows = 0;  ///< the plan covers the blocks with rows < nrows
-  long factor_entries = 0, fill_blocks = 0, flops = 0;
-  int loop_rows = 0;  ///< rows of the blocks that receive fill
+/// Options of ModelBuilder::finalize(), kept with the model (the welded model simulate()
+/// derives from it is assembled with the same options).
+struct FinalizeOptions {
+  bool mass_weighted_assembly = true;
+  int max_assembly_iterations = 50;
 };
 
 class Model {
@@ -233,38 +228,24 @@ class Model {
   std::vector<std::string> redundant_rows;  ///< named redundant constraint rows
   bool redundant = false;
   double length_scale = 1.0;  ///< characteristic length for tolerances [m]
-  /// KKT solver plans chosen at finalize(): all rows, and the joint rows alone
-  KktPlan kkt_all, kkt_joint;
+  /// true: the KKT solves take the dense pivoted path whatever the plan (the reference path;
+  /// the Python Model.with_kkt_path("dense")). Redundant models take it anyway.
+  bool force_dense_kkt = false;
+  FinalizeOptions finalize_options;
 
   // --- assembled initial state ---
   VecX u0, v0;
 
   std::map<std::string, int> body_index, joint_index, drive_index;
 
-  // --- welded bodies (simulate's solver model) ---
-  /// Bodies joined by fixed joints form one rigid composite (welded to ground: part of ground).
-  /// `welded` is this model with each composite as one body and those fixed joints removed: the
-  /// same motion with fewer bodies and rows. simulate() integrates it and reports every body and
-  /// joint of this model (poses from the composites, fixed-joint reactions from the members'
-  /// Newton-Euler balances). nullptr when no fixed joint can be merged.
-  std::shared_ptr<const Model> welded;
-  struct Weld {
-    int composite = kGround;           ///< body of `welded` (kGround: welded to ground)
-    Vec3 offset = Vec3::Zero();        ///< the body's centre of mass in the composite's frame
-    Mat3 rotation = Mat3::Identity();  ///< the body's axes in the composite's frame
-  };
-  std::vector<Weld> weld;       ///< per body of this model
-  std::vector<int> weld_joint;  ///< per joint: its index in `welded`, -1 when merged away
-  /// the merged fixed joints, each body farther from its composite's root first:
-  /// (joint, the body on the far side)
-  std::vector<std::pair<int, int>> weld_sweep;
-  std::vector<int> weld_root;  ///< per composite: the body whose state defines it
-
   int find_body(const std::string& name) const;   ///< -1 for "ground"; throws ModelError
   int find_joint(const std::string& name) const;  ///< throws ModelError
   std::string row_name(int row) const;            ///< e.g. "joint 'elbow' row 4 (rotation)"
   std::string body_name(int b) const { return b == kGround ? "ground" : bodies[b].name; }
-  std::string summary() const;
+
+  /// What the solver and analysis layers derive from this model on first use (KKT plans, the
+  /// welded model): see armdyn/solver/block_sparse.hpp kkt_plans(), armdyn/builder/weld.hpp.
+  detail::DerivedCache derived;
 };
 
 using ModelPtr = std::shared_ptr<const Model>;

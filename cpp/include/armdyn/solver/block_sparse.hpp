@@ -3,9 +3,10 @@
 //
 // The unknowns are the constraint row blocks (a joint's rows, an ideal gear's row, a drive's row);
 // A has a nonzero block (g, h) exactly when blocks g and h touch a common body. The blocks are
-// ordered once, at finalize(), by minimum (row-weighted) degree with the drive blocks last, and
-// the symbolic factorisation (the block pattern of L, with its fill) is fixed then; the numeric
-// factorisation and the solves only walk precomputed lists and touch no allocator.
+// ordered once per model (kkt_plans(), on first use), by minimum (row-weighted) degree with the
+// drive blocks last, and the symbolic factorisation (the block pattern of L, with its fill) is
+// fixed then; the numeric factorisation and the solves only walk precomputed lists and touch no
+// allocator.
 //
 // This is the block form of Baraff's linear-time elimination ("Linear-time dynamics using
 // Lagrange multipliers", SIGGRAPH 1996) on the range-space (Schur) form: on a tree of joints the
@@ -24,6 +25,34 @@
 #include "armdyn/solver/constraints.hpp"
 
 namespace armdyn {
+
+/// Symbolic plan of the block-sparse Schur factorisation (armdyn/solver/block_sparse.hpp).
+struct KktPlan {
+  std::string path;         ///< "tree", "tree+loops", "sparse", or "dense" (redundant rows)
+  std::string description;  ///< one line for summary() (armdyn/builder/summary.hpp)
+  std::vector<int> order;   ///< elimination position -> block index
+  std::vector<int> pos;     ///< block index -> elimination position
+  /// per position: the later positions with a nonzero block in its column of L (sorted)
+  std::vector<std::vector<int>> cols;
+  int nrows = 0;  ///< the plan covers the blocks with rows < nrows
+  long factor_entries = 0, fill_blocks = 0, flops = 0;
+  int loop_rows = 0;  ///< rows of the blocks that receive fill
+};
+
+/// The plans of a model: all rows, and the joint rows alone (only when the model has drives).
+struct KktPlans {
+  KktPlan all, joint;
+};
+
+/// The model's plans, made on first use and kept with the model (Model::derived): the block
+/// structure only; a redundant model or one with force_dense_kkt takes the dense path whatever
+/// the plan (kkt_path()).
+const KktPlans& kkt_plans(const Model& m);
+/// The path the KKT solves of m take: "dense" for a redundant model or force_dense_kkt, else
+/// kkt_plans(m).all.path ("tree", "tree+loops" or "sparse"); "" without rows.
+std::string kkt_path(const Model& m);
+/// One line on that path for summaries.
+std::string kkt_path_description(const Model& m);
 
 /// Order the blocks with rows < nrows by minimum row-weighted degree and compute the fill.
 /// There is no size below which the plan turns dense: the block elimination ties with the dense

@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// ModelBuilder (armdyn/model/builder.hpp): sizes, topology, assembly and input validation.
+// ModelBuilder (armdyn/builder/builder.hpp): sizes, topology, assembly and input validation.
 #include <cmath>
 
+#include "armdyn/builder/builder.hpp"
 #include "armdyn/errors.hpp"
 #include "armdyn/math/quaternion.hpp"
-#include "armdyn/model/builder.hpp"
 #include "check.hpp"
 #include "models.hpp"
 

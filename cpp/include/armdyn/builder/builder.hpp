@@ -1,9 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // ModelBuilder: add bodies, joints, drives and force elements, then finalize() into an
-// immutable Model. Every add_* call validates its input first and leaves the builder unchanged
-// when it throws. Joint points and axes are given in WORLD coordinates at the assembly pose.
+// immutable Model: the topology analysis, the assembly of the initial state (the projection of
+// armdyn/algorithm/projection.hpp) and the rank analysis (mobility, redundant rows). The build
+// layer sits above the solver, as the URDF reader does; armdyn/model/ is the description alone.
+// Every add_* call validates its input first and leaves the builder unchanged when it throws. Joint
+// points and axes are given in WORLD coordinates at the assembly pose.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -11,11 +15,6 @@
 #include "armdyn/model/model.hpp"
 
 namespace armdyn {
-
-struct FinalizeOptions {
-  bool mass_weighted_assembly = true;
-  int max_assembly_iterations = 50;
-};
 
 class ModelBuilder {
  public:
@@ -111,5 +110,10 @@ class ModelBuilder {
   int resolve_body(const std::string& name, const std::string& context) const;
   Model m_;
 };
+
+namespace detail {
+/// finalize() of a draft model (what a builder holds): sizes, rows, topology, assembly, rank.
+std::shared_ptr<Model> finalize_draft(const Model& draft, const FinalizeOptions& options);
+}  // namespace detail
 
 }  // namespace armdyn

@@ -1,0 +1,209 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// ModelBuilder::finalize(): sizes and rows, connectivity and topology, the assembly of the
+// initial state and the rank analysis at it.
+#include <Eigen/QR>
+#include <algorithm>
+#include <deque>
+#include <numeric>
+
+#include "armdyn/algorithm/kinematics.hpp"
+#include "armdyn/algorithm/projection.hpp"
+#include "armdyn/analysis/joint_space.hpp"
+#include "armdyn/builder/builder.hpp"
+#include "armdyn/data.hpp"
+#include "armdyn/errors.hpp"
+#include "armdyn/solver/block_sparse.hpp"
+
+namespace armdyn {
+
+namespace detail {
+
+std::shared_ptr<Model> finalize_draft(const Model& draft, const FinalizeOptions& options) {
+  auto mp = std::make_shared<Model>(draft);
+  Model& m = *mp;
+  if (m.bodies.empty()) throw ModelError("finalize: the model has no bodies");
+  m.nb = static_cast<int>(m.bodies.size());
+  m.nq = 7 * m.nb;
+  m.nv = 6 * m.nb;
+  // ideal gear rows follow the joint rows; drives come last
+  for (GearConstraint& g : m.gear_constraints) g.row = m.nc_joint++;
+  for (size_t k = 0; k < m.drives.size(); ++k) m.drives[k].row = m.nc_joint + static_cast<int>(k);
+  m.nc = m.nc_joint + static_cast<int>(m.drives.size());
+
+  // connectivity: every body must reach ground through joints (node nb = ground)
+  std::vector<int> uf(m.nb + 1);
+  std::iota(uf.begin(), uf.end(), 0);
+  auto find = [&](int x) {
+    while (uf[x] != x) x = uf[x] = uf[uf[x]];
+    return x;
+  };
+  auto node = [&](int b) { return b == kGround ? m.nb : b; };
+  for (const Joint& j : m.joints) uf[find(node(j.parent))] = find(node(j.child));
+  std::vector<std::string> loose;
+  for (int i = 0; i < m.nb; ++i)
+    if (find(i) != find(m.nb)) loose.push_back(m.bodies[i].name);
+  if (!loose.empty()) {
+    std::string names;
+    for (size_t k = 0; k < loose.size() && k < 8; ++k) names += (k ? ", '" : "'") + loose[k] + "'";
+    if (loose.size() > 8) names += ", ...";
+    throw ModelError(msg("finalize: bodies not connected to ground: ", names,
+                         " (add a joint, or add_free for a free-floating body)"));
+  }
+
+  // topology: a tree has exactly nb joints; order joints parent-before-child from ground
+  m.is_tree = static_cast<int>(m.joints.size()) == m.nb;
+  m.joint_space_ok = false;
+  m.joint_tree = false;
+  if (m.is_tree) {
+    std::vector<char> seen(m.nb + 1, 0);
+    seen[m.nb] = 1;
+    std::deque<int> queue{m.nb};
+    std::vector<char> used(m.joints.size(), 0);
+    bool ok = true;
+    while (!queue.empty()) {
+      const int n = queue.front();
+      queue.pop_front();
+      for (size_t ji = 0; ji < m.joints.size(); ++ji) {
+        if (used[ji]) continue;
+        const Joint& j = m.joints[ji];
+        const int p = node(j.parent), c = node(j.child);
+        if (p != n && c != n) continue;
+        used[ji] = 1;
+        const int other = p == n ? c : p;
+        if (p != n && ok) {
+          ok = false;
+          m.joint_space_reason = msg("joint '", j.name, "' points from child to parent");
+        }
+        seen[other] = 1;
+        queue.push_back(other);
+        m.tree_order.push_back(static_cast<int>(ji));
+      }
+    }
+    for (const Joint& j : m.joints) {
+      if (j.type == JointType::Spherical || j.type == JointType::Universal ||
+          j.type == JointType::Free || j.type == JointType::Inline ||
+          j.type == JointType::Distance) {
+        if (ok)
+          m.joint_space_reason =
+              msg(joint_type_name(j.type), " joint '", j.name, "' has no joint coordinates");
+        ok = false;
+      }
+    }
+    m.joint_tree = ok;
+    if (ok && !m.gear_constraints.empty()) {
+      ok = false;
+      m.joint_space_reason =
+          msg("ideal gear '", m.gear_constraints[0].name, "' couples joint coordinates");
+    }
+    m.joint_space_ok = ok;
+  } else {
+    m.joint_space_reason = "the model has closed loops";
+  }
+
+  // characteristic length for tolerances
+  double ls = 0.0;
+  for (const Joint& j : m.joints) {
+    if (j.parent != kGround) ls = std::max(ls, j.point_parent.norm());
+    if (j.child != kGround) ls = std::max(ls, j.point_child.norm());
+  }
+  m.length_scale = std::max(ls, 1e-3);
+
+  m.finalize_options = options;
+
+  // assembly: project the given poses onto f(u, 0) = 0, then rest velocities onto zeta v = rhs
+  m.u0 = VecX(m.nq);
+  for (int i = 0; i < m.nb; ++i) {
+    m.u0.segment<3>(7 * i) = m.bodies[i].position;
+    m.u0.segment<4>(7 * i + 3) = m.bodies[i].orientation;
+  }
+  m.v0 = VecX::Zero(m.nv);
+  // a driven joint-space tree starts from the forward kinematics of the drives' initial values:
+  // Newton from the build pose could otherwise land on a flipped branch of the joint rows
+  if (m.joint_space_ok && !m.drives.empty()) {
+    VecX q, qd;
+    joint_coordinates(m, m.u0, m.v0, q, qd);
+    for (const Drive& d : m.drives) q[m.joints[d.joint].coord0 + d.coord] = d.profile.eval(0.0).y;
+    if (q.allFinite()) {
+      VecX u, v;
+      state_from_joints(m, q, VecX::Zero(q.size()), u, v);
+      m.u0 = u;
+    }
+  }
+  const Metric metric = options.mass_weighted_assembly ? Metric::Mass : Metric::Identity;
+  {
+    Data d(m);
+    try {
+      project(m, d, 0.0, m.u0.data(), m.v0.data(), metric);
+    } catch (const SolverError& err) {
+      throw ModelError(
+          msg("finalize: assembly failed (the joints cannot all be satisfied): ", err.what()));
+    }
+    load_kinematics(m, d, m.u0.data(), nullptr);
+    const int bad = flipped_joint(m, d.kin);
+    if (bad >= 0)
+      throw ModelError(msg("finalize: assembly converged to a flipped configuration of joint '",
+                           m.joints[bad].name,
+                           "' (its child frame is turned half a revolution against the parent's); "
+                           "give body poses closer to the joints' configuration"));
+  }
+
+  // rank analysis at the assembled configuration: mobility and redundant rows by name
+  {
+    std::vector<BodyKin> kin;
+    body_kinematics(m, m.u0.data(), nullptr, kin);
+    ConstraintEval ce;
+    ce.init(m);
+    eval_constraints(m, kin, 0.0, false, ce);
+    MatX z;
+    auto analyse = [&](int nrows, std::vector<std::string>* names) {
+      if (nrows == 0) return 0;
+      if (z.size() == 0) z = dense_zeta(m, ce);
+      Eigen::ColPivHouseholderQR<MatX> qr(z.topRows(nrows).transpose());
+      qr.setThreshold(1e-10);
+      const int r = static_cast<int>(qr.rank());
+      if (names)
+        for (int k = r; k < nrows; ++k)
+          names->push_back(m.row_name(qr.colsPermutation().indices()[k]));
+      return r;
+    };
+    // fast path: when the block-sparse Cholesky of zeta zeta^T succeeds on all rows, every row
+    // is independent (its pivots pass the same relative test the solver uses) and the dense
+    // QR below -- cubic in the rows -- is not needed
+    bool full_rank = false;
+    if (m.nc > 0 && !m.force_dense_kkt && kkt_plans(m).all.path != "dense") {
+      BlockSparseSchur sp(m, kkt_plans(m).all);
+      full_rank = sp.factor(ce, nullptr);
+    }
+    std::vector<std::string> all;
+    if (full_rank) {
+      m.rank_joint = m.nc_joint;
+      m.rank_all = m.nc;
+    } else {
+      m.rank_joint = analyse(m.nc_joint, &m.redundant_rows);
+      m.rank_all = analyse(m.nc, &all);
+    }
+    for (const auto& n : all)
+      if (std::find(m.redundant_rows.begin(), m.redundant_rows.end(), n) ==
+              m.redundant_rows.end() &&
+          n.rfind("drive", 0) == 0)
+        m.redundant_rows.push_back(n);
+    m.mobility = m.nv - m.rank_joint;
+    m.mobility_driven = m.nv - m.rank_all;
+    m.redundant = m.rank_joint < m.nc_joint || m.rank_all < m.nc;
+  }
+  if (m.redundant) {
+    // redundant rows: the dense pivoted factorisation (minimum-norm multipliers) throughout
+    // (KktSolver and kkt_path() read m.redundant)
+    Data d(m);
+    project(m, d, 0.0, m.u0.data(), m.v0.data(), metric);
+  }
+  return mp;
+}
+
+}  // namespace detail
+
+ModelPtr ModelBuilder::finalize(const FinalizeOptions& options) const {
+  return detail::finalize_draft(m_, options);
+}
+
+}  // namespace armdyn
