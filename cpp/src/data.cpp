@@ -54,6 +54,17 @@ Data::Data(const Model& m) : model(&m), n(static_cast<int>(m.coords.size())), kk
 
 Data::~Data() = default;
 
+void reset_pipeline(Data& d) {
+  d.nrows = d.model->nc;
+  d.aux = nullptr;
+  d.joint_torques = nullptr;
+  d.with_coordinate_forces = true;
+  d.track_ref.setZero();
+  d.swept = false;
+  d.stats = PipelineStats{};
+  d.kkt.reset();
+}
+
 void check_data(const Model& m, const Data& d, const char* fn) {
   if (d.model != &m) throw ModelError(msg(fn, ": data was made for another model"));
 }

@@ -11,6 +11,7 @@
 #include "armdyn/analysis/joint_space.hpp"
 #include "armdyn/model/model.hpp"
 #include "armdyn/solver/constraints.hpp"
+#include "armdyn/solver/integrators.hpp"
 #include "armdyn/solver/kinematics.hpp"
 #include "armdyn/solver/kkt.hpp"
 #include "armdyn/solver/tree_sweep.hpp"
@@ -66,6 +67,12 @@ class Data {
   // --- forward dynamics ---
   VecX rhs, qdd, zero;
   MatX L;  ///< (n, n) Cholesky factor of M in its lower triangle (math/cholesky.hpp)
+  /// TreeDynamics with ideal gears: M T, the reduced T^T M T and its factor, scratch (sized by
+  /// the first TreeDynamics on this Data)
+  struct TreeScratch {
+    MatX MT, Mr, Lr;
+    VecX y, w, res, gear_delta;
+  } tree;
 
   // --- the Cartesian pipeline on the bodies' state (u, v): algorithm/kinematics (load),
   // constraints, forces (cartesian_forces), kkt (body_accelerations), projection, reactions,
@@ -93,12 +100,32 @@ class Data {
   double tol_f = 1e-13;              ///< position residual accepted by project without a correction
   PipelineStats stats;
 
+  // --- whole runs (analysis/simulate) and driven solves (analysis/inverse_dynamics) ---
+  IntegratorWork integrator;  ///< the integrators' stages and scratch
+  /// a run's output: the state y, (u, v), the accelerations vd and joint accelerations qdd
+  struct RunScratch {
+    VecX y, u, v, vd, qdd;
+  } run;
+  /// DrivenSolver: the drive values, the predictor, the saved state and tracking
+  struct DrivenScratch {
+    VecX qc, qdc, ud, u_save, v_save, u_pred, track_save;
+    TreeFkWork fk;
+  } driven_solve;
+  /// a run of the welded model (builder/weld.hpp) evaluates on this Data of it (made on first
+  /// use); this Data then holds the full model's outputs
+  std::unique_ptr<Data> welded_data;
+
   // --- the public Cartesian forward and inverse dynamics (algorithm/dynamics) ---
   VecX vd, tau_in;                    ///< (nv) accelerations; (n) the joint torques of the call
   std::unique_ptr<Model> driven;      ///< inverse dynamics: the model with every coordinate driven
   std::unique_ptr<Data> driven_data;  ///< made on first use, for *driven
   VecX drive_ref;                     ///< (3 n) drive values (q, qd, qdd) of driven_data
 };
+
+/// Return the settings and learnt state of d's Cartesian pipeline to those of a new Data (the
+/// rows, auxiliary states, joint torques, tracked angles, counters and the KKT solver's sticky
+/// regularisation): a run on a reused Data then gives the same result, bit for bit.
+void reset_pipeline(Data& d);
 
 /// Throws ModelError when data was not made for m.
 void check_data(const Model& m, const Data& d, const char* fn);

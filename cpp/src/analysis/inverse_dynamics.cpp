@@ -30,19 +30,31 @@ std::string undriven_coordinates(const Model& m) {
 }  // namespace
 
 DrivenSolver::DrivenSolver(const Model& m, Data& d, const char* who, double t0)
-    : t_good(t0), m_(m), d_(d), who_(who), t_prev_(t0), fk_(m.joint_space_ok) {
+    : t_good(t0),
+      m_(m),
+      d_(d),
+      who_(who),
+      t_prev_(t0),
+      fk_(m.joint_space_ok),
+      qc_(d.driven_solve.qc),
+      qdc_(d.driven_solve.qdc),
+      ud_(d.driven_solve.ud),
+      u_save_(d.driven_solve.u_save),
+      v_save_(d.driven_solve.v_save),
+      u_pred_(d.driven_solve.u_pred),
+      track_save_(d.driven_solve.track_save),
+      fkw_(d.driven_solve.fk) {
+  check_data(m, d, who);
   if (m.mobility_driven > 0)
     throw ModelError(
         msg(who, ": the drives leave ", m.mobility_driven,
             " degree(s) of freedom unprescribed; undriven coordinates: ", undriven_coordinates(m),
             " (add drives, or use inverse_dynamics(model, q, qd, qdd) on a tree)"));
   const long nco = static_cast<long>(m.coords.size());
-  qc_ = VecX::Zero(nco);
-  qdc_ = VecX::Zero(nco);
-  ud_ = VecX::Zero(m.nq);
-  u_save_ = VecX::Zero(m.nq);
-  v_save_ = VecX::Zero(m.nv);
-  u_pred_ = VecX::Zero(m.nq);
+  for (auto [x, n] : {std::pair{&qc_, nco}, std::pair{&qdc_, nco}, std::pair{&ud_, long{m.nq}},
+                      std::pair{&u_save_, long{m.nq}}, std::pair{&v_save_, long{m.nv}},
+                      std::pair{&u_pred_, long{m.nq}}})
+    if (x->size() != n) *x = VecX::Zero(n);
   track_save_ = d.track_ref;
 }
 

@@ -210,16 +210,16 @@ RunPlan plan_run(const Model& m, double t_end, const SimOptions& opt) {
 }
 
 void integrate(Integrator method, OdeSystem& ode, VecX& y, double t_end, const StepOptions& s,
-               StepStats& stats) {
+               StepStats& stats, IntegratorWork& work) {
   switch (method) {
     case Integrator::Dopri5:
-      return integrate_dopri5(ode, y, 0.0, t_end, s, stats);
+      return integrate_dopri5(ode, y, 0.0, t_end, s, stats, &work);
     case Integrator::Dop853:
-      return integrate_dop853(ode, y, 0.0, t_end, s, stats);
+      return integrate_dop853(ode, y, 0.0, t_end, s, stats, &work);
     case Integrator::Trbdf2:
-      return integrate_trbdf2(ode, y, 0.0, t_end, s, stats);
+      return integrate_trbdf2(ode, y, 0.0, t_end, s, stats, &work);
     case Integrator::Rk4:
-      return integrate_rk4(ode, y, 0.0, t_end, s, stats);
+      return integrate_rk4(ode, y, 0.0, t_end, s, stats, &work);
     default:
       throw ModelError(msg("simulate: '", integrator_name(method), "' does not integrate"));
   }
@@ -335,9 +335,22 @@ Coordinates coordinates_from_name(const std::string& name) {
 
 SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const VecX& u0,
                    const VecX& v0) {
+  Data d(m);
+  return simulate(m, d, t_end, opt, u0, v0);
+}
+
+SimResult simulate(const Model& m, Data& d, double t_end, const SimOptions& opt, const VecX& u0,
+                   const VecX& v0) {
+  check_data(m, d, "simulate");
   check_options(m, t_end, opt, u0, v0);
   const RunPlan plan = plan_run(m, t_end, opt);
   const Model& ms = *plan.ms;  // the model integrated
+  // the Data the run evaluates on (of the welded model: d.welded_data), as a new one would be
+  if (plan.welded && (!d.welded_data || d.welded_data->model != &ms))
+    d.welded_data = std::make_unique<Data>(ms);
+  Data& ds = plan.welded ? *d.welded_data : d;
+  reset_pipeline(ds);
+  if (plan.welded) reset_pipeline(d);
   const StepOptions& s = opt.step;
   SimResult out;
   out.integrator = integrator_name(plan.integrator);
@@ -349,7 +362,7 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
     out.v.reserve(n * m.nv);
   }
   // the formulation's ODE system; outputs are recorded by the Cartesian one
-  detail::MbsSystem sys(ms, opt.projection, out);
+  detail::MbsSystem sys(ms, ds, opt.projection, out);
   std::unique_ptr<detail::JointSystem> jsys;
   if (plan.joint) {
     try {
@@ -371,7 +384,7 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
   std::unique_ptr<detail::WeldExpander> expander;
   VecX y = VecX::Zero(ms.nq + ms.nv + ms.n_aux);
   if (plan.welded) {
-    expander = std::make_unique<detail::WeldExpander>(m, *plan.welding);
+    expander = std::make_unique<detail::WeldExpander>(m, *plan.welding, d);
     sys.set_expander(expander.get());
     VecX uw(ms.nq), vw(ms.nv);
     expander->contract(u0, v0, uw, vw);
@@ -388,9 +401,9 @@ SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const Ve
       run_kinematic(ms, sys, y, t_end, s.output_dt, out, t_last);
     } else if (plan.joint) {
       VecX yj = joint_state(ms, sys, y, opt.projection);
-      integrate(plan.integrator, *jsys, yj, t_end, s, out.stats);
+      integrate(plan.integrator, *jsys, yj, t_end, s, out.stats, d.integrator);
     } else {
-      integrate(plan.integrator, sys, y, t_end, s, out.stats);
+      integrate(plan.integrator, sys, y, t_end, s, out.stats, d.integrator);
     }
   } catch (const SolverError& err) {
     out.error = err.what();

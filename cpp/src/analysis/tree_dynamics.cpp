@@ -19,36 +19,62 @@ namespace {
 }
 }  // namespace
 
-TreeDynamics::TreeDynamics(const Model& m, bool ignore_drives) : m_(m), d_(m) {
-  const std::string why = m.joint_path_reason(ignore_drives);
-  if (!why.empty()) throw ModelError(msg("joint-space dynamics: ", why));
-  n_ = d_.n;
-  // the ideal gears' rows and an orthonormal basis of their null space
-  const int ng = static_cast<int>(m.gear_constraints.size());
-  if (ng > 0) {
-    MatX Gt = MatX::Zero(n_, ng);
+const GearSpace& gear_space(const Model& m) {
+  return m.derived.get<GearSpace>([&] {
+    GearSpace gs;
+    const int n = static_cast<int>(m.coords.size());
+    const int ng = static_cast<int>(m.gear_constraints.size());
+    if (ng == 0) return gs;
+    MatX Gt = MatX::Zero(n, ng);
     for (int g = 0; g < ng; ++g) {
       Gt(m.gear_constraints[g].coord_a, g) += m.gear_constraints[g].r_a;
       Gt(m.gear_constraints[g].coord_b, g) += m.gear_constraints[g].r_b;
     }
     Eigen::ColPivHouseholderQR<MatX> qr(Gt);
     qr.setThreshold(1e-12);
-    rank_ = static_cast<int>(qr.rank());
-    const MatX Q = qr.householderQ() * MatX::Identity(n_, n_);
-    range_ = Q.leftCols(rank_);
-    T_ = Q.rightCols(n_ - rank_);
+    gs.rank = static_cast<int>(qr.rank());
+    const MatX Q = qr.householderQ() * MatX::Identity(n, n);
+    gs.range = Q.leftCols(gs.rank);
+    gs.T = Q.rightCols(n - gs.rank);
     Eigen::CompleteOrthogonalDecomposition<MatX> cod(Gt);
     cod.setThreshold(1e-12);
-    Gt_pinv_ = cod.pseudoInverse();
-  }
-  res_ = VecX::Zero(n_);
-  gear_delta_ = VecX::Zero(ng);
+    gs.Gt_pinv = cod.pseudoInverse();
+    return gs;
+  });
+}
+
+TreeDynamics::TreeDynamics(const Model& m, bool ignore_drives)
+    : own_(std::make_unique<Data>(m)), m_(m), d_(*own_), gs_(gear_space(m)) {
+  init(ignore_drives);
+}
+
+TreeDynamics::TreeDynamics(const Model& m, Data& d, bool ignore_drives)
+    : m_(m), d_(d), gs_(gear_space(m)) {
+  check_data(m, d, "joint-space dynamics");
+  init(ignore_drives);
+}
+
+void TreeDynamics::init(bool ignore_drives) {
+  const std::string why = m_.joint_path_reason(ignore_drives);
+  if (!why.empty()) throw ModelError(msg("joint-space dynamics: ", why));
+  n_ = d_.n;
+  rank_ = gs_.rank;
   dof_ = n_ - rank_;
-  MT_ = MatX::Zero(n_, dof_);
-  Mr_ = MatX::Zero(dof_, dof_);
-  y_ = VecX::Zero(dof_);
-  w_ = VecX::Zero(rank_);
-  Lr_ = MatX::Zero(dof_, dof_);
+  // the reduced system's scratch (with gears), in the Data
+  Data::TreeScratch& w = d_.tree;
+  auto size = [](MatX& x, long r, long c) {
+    if (x.rows() != r || x.cols() != c) x = MatX::Zero(r, c);
+  };
+  auto sizev = [](VecX& x, long r) {
+    if (x.size() != r) x = VecX::Zero(r);
+  };
+  size(w.MT, n_, dof_);
+  size(w.Mr, dof_, dof_);
+  size(w.Lr, dof_, dof_);
+  sizev(w.y, dof_);
+  sizev(w.w, rank_);
+  sizev(w.res, n_);
+  sizev(w.gear_delta, static_cast<long>(m_.gear_constraints.size()));
 }
 
 std::string TreeDynamics::description() const {
@@ -73,21 +99,23 @@ void TreeDynamics::accelerations(double t, const double* q, const double* qd, co
     out = rhs;
     cholesky_solve(d_.L, out);
   } else {
-    MT_.noalias() = M * T_;
-    Mr_.noalias() = T_.transpose() * MT_;
-    if (!cholesky_factor(Mr_, Lr_)) not_positive_definite(t);
-    y_.noalias() = T_.transpose() * rhs;
-    cholesky_solve(Lr_, y_);
-    out.noalias() = T_ * y_;
+    Data::TreeScratch& w = d_.tree;
+    w.MT.noalias() = M * gs_.T;
+    w.Mr.noalias() = gs_.T.transpose() * w.MT;
+    if (!cholesky_factor(w.Mr, w.Lr)) not_positive_definite(t);
+    w.y.noalias() = gs_.T.transpose() * rhs;
+    cholesky_solve(w.Lr, w.y);
+    out.noalias() = gs_.T * w.y;
   }
 }
 
 const VecX& TreeDynamics::gear_multipliers(const double* qdd) {
-  if (gear_delta_.size() == 0) return gear_delta_;
-  res_ = d_.rhs;
-  res_.noalias() -= d_.M * Eigen::Map<const VecX>(qdd, n_);
-  gear_delta_.noalias() = Gt_pinv_ * res_;
-  return gear_delta_;
+  Data::TreeScratch& w = d_.tree;
+  if (w.gear_delta.size() == 0) return w.gear_delta;
+  w.res = d_.rhs;
+  w.res.noalias() -= d_.M * Eigen::Map<const VecX>(qdd, n_);
+  w.gear_delta.noalias() = gs_.Gt_pinv * w.res;
+  return w.gear_delta;
 }
 
 void TreeDynamics::aux_rates(double t, const double* q, const double* qd, const double* z,
@@ -106,10 +134,11 @@ void TreeDynamics::gear_mesh(int gi, const double* q, const double* qd, double& 
 
 void TreeDynamics::project(double* q, double* qd) {
   if (rank_ == 0) return;
+  VecX& w = d_.tree.w;
   for (double* x : {q, qd}) {
     Eigen::Map<VecX> xv(x, n_);
-    w_.noalias() = range_.transpose() * xv;
-    xv.noalias() -= range_ * w_;
+    w.noalias() = gs_.range.transpose() * xv;
+    xv.noalias() -= gs_.range * w;
   }
 }
 

@@ -179,6 +179,21 @@ std::shared_ptr<const Welding> build_welding(const Model& m) {
   out->weld_joint = std::move(weld_joint);
   out->sweep = std::move(order);
   out->roots = std::move(roots);
+  for (const Weld& wb : out->weld) out->qrel.push_back(rot_to_quat(wb.rotation));
+  const Model& wm = *w;
+  out->row_map.assign(m.nc, -1);
+  out->coord_map.assign(m.coords.size(), -1);
+  for (int j = 0; j < nj; ++j) {
+    const int jw = out->weld_joint[j];
+    if (jw < 0) continue;
+    for (int k = 0; k < joint_rows(m.joints[j].type); ++k)
+      out->row_map[m.joints[j].row0 + k] = wm.joints[jw].row0 + k;
+    for (int k = 0; k < joint_coords(m.joints[j].type); ++k)
+      out->coord_map[m.joints[j].coord0 + k] = wm.joints[jw].coord0 + k;
+  }
+  for (size_t g = 0; g < m.gear_constraints.size(); ++g)
+    out->row_map[m.gear_constraints[g].row] = wm.gear_constraints[g].row;
+  for (size_t k = 0; k < m.drives.size(); ++k) out->row_map[m.drives[k].row] = wm.drives[k].row;
   return out;
 }
 

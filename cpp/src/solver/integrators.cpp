@@ -11,9 +11,9 @@
 
 namespace armdyn {
 
-std::vector<double> output_times(double t0, double t1, double dt) {
-  std::vector<double> ts;
-  if (!(dt > 0)) return ts;
+void output_times(double t0, double t1, double dt, std::vector<double>& ts) {
+  ts.clear();
+  if (!(dt > 0)) return;
   const double eps = 1e-9 * dt;
   for (long k = 0;; ++k) {
     const double t = t0 + static_cast<double>(k) * dt;
@@ -21,6 +21,11 @@ std::vector<double> output_times(double t0, double t1, double dt) {
     ts.push_back(t);
   }
   ts.push_back(t1);
+}
+
+std::vector<double> output_times(double t0, double t1, double dt) {
+  std::vector<double> ts;
+  output_times(t0, t1, dt, ts);
   return ts;
 }
 
@@ -194,30 +199,35 @@ struct AdaptiveRun {
   const char* name;
   const StepOptions& opt;
   double t1, t, h = 0.0, hmax, hmin;
-  std::vector<double> touts;
+  std::vector<double>& touts;
   bool every_step;
   size_t ko = 1;
   bool last_rejected = false;
   int ne;
-  std::vector<int> sgn, crossed;
-  VecX gend, gbuf, ybuf, yo;
+  std::vector<int>&sgn, &crossed;
+  VecX &gend, &gbuf, &ybuf, &yo;
 
+  // its buffers: the work's slots 36..39, output times and event signs
   AdaptiveRun(const char* name_, OdeSystem& sys, const StepOptions& o, double t0, double t1_,
-              long n)
+              long n, IntegratorWork& w)
       : name(name_),
         opt(o),
         t1(t1_),
         t(t0),
         hmax(o.max_step > 0 ? o.max_step : t1_ - t0),
         hmin(1e-14 * std::max(1.0, std::abs(t1_))),
-        touts(output_times(t0, t1_, o.output_dt)),
-        every_step(touts.empty()),
+        touts(w.times),
         ne(sys.n_events()),
-        sgn(ne, 1),
-        gend(ne),
-        gbuf(ne),
-        ybuf(n),
-        yo(n) {}
+        sgn(w.signs),
+        crossed(w.crossed),
+        gend(w.vec(36, ne)),
+        gbuf(w.vec(37, ne)),
+        ybuf(w.vec(38, n)),
+        yo(w.vec(39, n)) {
+    output_times(t0, t1_, o.output_dt, touts);
+    every_step = touts.empty();
+    sgn.assign(static_cast<size_t>(ne), 1);
+  }
 
   /// f0 = f(t0, y) at the projected y; the output at t0, the event signs and the first step
   /// for a method of the given order (yt, f1: scratch).
@@ -279,7 +289,9 @@ struct AdaptiveRun {
 }  // namespace
 
 void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepOptions& opt,
-                      StepStats& st) {
+                      StepStats& st, IntegratorWork* work) {
+  IntegratorWork local;
+  IntegratorWork& w = work ? *work : local;
   // Dormand-Prince coefficients
   constexpr double c2 = 1.0 / 5, c3 = 3.0 / 10, c4 = 4.0 / 5, c5 = 8.0 / 9;
   constexpr double a21 = 1.0 / 5;
@@ -301,9 +313,12 @@ void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
   const double expo1 = 0.2 - beta * 0.75;
 
   const long n = y.size();
-  VecX k1(n), k2(n), k3(n), k4(n), k5(n), k6(n), k7(n), yt(n), y1(n), err(n);
-  VecX r1(n), r2(n), r3(n), r4(n), r5(n), yp(n);
-  AdaptiveRun run("dopri5", sys, opt, t0, t1, n);
+  VecX &k1 = w.vec(0, n), &k2 = w.vec(1, n), &k3 = w.vec(2, n), &k4 = w.vec(3, n),
+       &k5 = w.vec(4, n), &k6 = w.vec(5, n), &k7 = w.vec(6, n), &yt = w.vec(7, n),
+       &y1 = w.vec(8, n), &err = w.vec(9, n);
+  VecX &r1 = w.vec(10, n), &r2 = w.vec(11, n), &r3 = w.vec(12, n), &r4 = w.vec(13, n),
+       &r5 = w.vec(14, n), &yp = w.vec(15, n);
+  AdaptiveRun run("dopri5", sys, opt, t0, t1, n, w);
   double &t = run.t, &h = run.h;
   run.start(sys, y, k1, yt, k2, 5, st);
   double facold = 1e-4;
@@ -496,17 +511,21 @@ inline void stage_point(VecX& out, const VecX& y, double h, const double* w, int
 }  // namespace
 
 void integrate_dop853(OdeSystem& sys, VecX& y, double t0, double t1, const StepOptions& opt,
-                      StepStats& st) {
+                      StepStats& st, IntegratorWork* work) {
+  IntegratorWork local;
+  IntegratorWork& w = work ? *work : local;
   namespace C = dop853;
   // step-size control: Hairer's dop853 defaults (no PI term)
   constexpr double safe = 0.9, fac_min = 0.333, fac_max = 6.0, expo = 1.0 / 8.0;
   const long n = y.size();
-  std::array<VecX, 16> k;
-  for (VecX& ki : k) ki.resize(n);
-  std::array<VecX, 7> r;  // dense output: y(t + th h) = y + th (r0 + (1-th)(r1 + th(r2 + ...)))
-  for (VecX& ri : r) ri.resize(n);
-  VecX yt(n), y1(n), yp(n);
-  AdaptiveRun run("dop853", sys, opt, t0, t1, n);
+  std::array<VecX, 16>& k = w.stages;
+  for (VecX& ki : k)
+    if (ki.size() != n) ki.resize(n);
+  std::array<VecX, 7>& r = w.dense;  // y(t + th h) = y + th (r0 + (1-th)(r1 + th(r2 + ...)))
+  for (VecX& ri : r)
+    if (ri.size() != n) ri.resize(n);
+  VecX &yt = w.vec(23, n), &y1 = w.vec(24, n), &yp = w.vec(25, n);
+  AdaptiveRun run("dop853", sys, opt, t0, t1, n, w);
   double &t = run.t, &h = run.h;
   run.start(sys, y, k[0], yt, k[1], 8, st);
   auto stages = [&](int from, int to) {
@@ -597,11 +616,15 @@ void integrate_dop853(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
 }
 
 void integrate_rk4(OdeSystem& sys, VecX& y, double t0, double t1, const StepOptions& opt,
-                   StepStats& st) {
+                   StepStats& st, IntegratorWork* work) {
   if (!(opt.dt > 0)) throw ModelError("rk4: dt must be positive");
+  IntegratorWork local;
+  IntegratorWork& w = work ? *work : local;
   const long n = y.size();
-  VecX k1(n), k2(n), k3(n), k4(n), yt(n), y1(n), f1(n);
-  const std::vector<double> touts = output_times(t0, t1, opt.output_dt);
+  VecX &k1 = w.vec(0, n), &k2 = w.vec(1, n), &k3 = w.vec(2, n), &k4 = w.vec(3, n),
+       &yt = w.vec(4, n), &y1 = w.vec(5, n), &f1 = w.vec(6, n);
+  std::vector<double>& touts = w.times;
+  output_times(t0, t1, opt.output_dt, touts);
   const bool every_step = touts.empty();
   size_t ko = 1;
   double t = t0;
@@ -611,8 +634,9 @@ void integrate_rk4(OdeSystem& sys, VecX& y, double t0, double t1, const StepOpti
   // events: located on the cubic Hermite interpolant of (y, k1) and (y1, f(t + h, y1)), which
   // costs extra right-hand sides only on steps where an event function changes sign
   const int ne = sys.n_events();
-  std::vector<int> sgn(ne, 1), crossed;
-  VecX gend(ne), gbuf(ne), ybuf(n);
+  std::vector<int>&sgn = w.signs, &crossed = w.crossed;
+  sgn.assign(static_cast<size_t>(ne), 1);
+  VecX &gend = w.vec(36, ne), &gbuf = w.vec(37, ne), &ybuf = w.vec(38, n);
   init_event_signs(sys, t, y, sgn, gbuf);
   const double eps = 1e-12 * std::max(1.0, std::abs(t1));
   // a step shortened to a located crossing may end just short of it (the location came from
@@ -683,7 +707,9 @@ void integrate_rk4(OdeSystem& sys, VecX& y, double t0, double t1, const StepOpti
 namespace armdyn {
 
 void integrate_trbdf2(OdeSystem& sys, VecX& y, double t0, double t1, const StepOptions& opt,
-                      StepStats& st) {
+                      StepStats& st, IntegratorWork* work) {
+  IntegratorWork local;
+  IntegratorWork& wk = work ? *work : local;
   // ESDIRK tableau: c = (0, 2d, 1); A = [0 0 0; d d 0; w w d]; b = last row (stiffly accurate);
   // embedded order 3: bh = ((1 - w)/3, (3w + 1)/3, d/3)
   const double d = 1.0 - std::sqrt(2.0) / 2.0, w = std::sqrt(2.0) / 4.0, c2 = 2.0 * d;
@@ -692,10 +718,14 @@ void integrate_trbdf2(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
   constexpr int max_newton = 8;
 
   const long n = y.size();
-  VecX K1(n), K2(n), K3(n), Y(n), y1(n), R(n), dK(n), err(n), f0(n), yp(n), fp(n), yo(n), sc(n);
-  MatX J(n, n), M(n, n);
-  Eigen::PartialPivLU<MatX> lu(n);
-  const std::vector<double> touts = output_times(t0, t1, opt.output_dt);
+  VecX &K1 = wk.vec(0, n), &K2 = wk.vec(1, n), &K3 = wk.vec(2, n), &Y = wk.vec(3, n),
+       &y1 = wk.vec(4, n), &R = wk.vec(5, n), &dK = wk.vec(6, n), &err = wk.vec(7, n),
+       &f0 = wk.vec(8, n), &yp = wk.vec(9, n), &fp = wk.vec(10, n), &yo = wk.vec(11, n),
+       &sc = wk.vec(12, n);
+  MatX &J = wk.mat(0, n), &M = wk.mat(1, n);
+  Eigen::PartialPivLU<MatX>& lu = wk.lu;
+  std::vector<double>& touts = wk.times;
+  output_times(t0, t1, opt.output_dt, touts);
   const bool every_step = touts.empty();
   size_t ko = 1;
   const double span = t1 - t0;
@@ -771,8 +801,9 @@ void integrate_trbdf2(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
   };
 
   const int ne = sys.n_events();
-  std::vector<int> sgn(ne, 1), crossed;
-  VecX gend(ne), gbuf(ne), ybuf(n), yh(n);
+  std::vector<int>&sgn = wk.signs, &crossed = wk.crossed;
+  sgn.assign(static_cast<size_t>(ne), 1);
+  VecX &gend = wk.vec(36, ne), &gbuf = wk.vec(37, ne), &ybuf = wk.vec(38, n), &yh = wk.vec(39, n);
   init_event_signs(sys, t, y, sgn, gbuf);
   weights(y);
   // initial step: a fraction of the span, limited by the first derivative

@@ -49,8 +49,9 @@ class DrivenSolver {
   const char* who_;
   double t_prev_;
   bool fk_;
-  VecX qc_, qdc_, ud_, u_save_, v_save_, u_pred_, track_save_;
-  TreeFkWork fkw_;
+  // scratch in the Data (Data::driven_solve)
+  VecX &qc_, &qdc_, &ud_, &u_save_, &v_save_, &u_pred_, &track_save_;
+  TreeFkWork& fkw_;
   void predict(double t_from, double t, VecX& u, VecX& v, const VecX& vd);
   std::string singular_rows() const;  ///< a sentence when the factor lost rank, else empty
 };

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "armdyn/data.hpp"
 #include "armdyn/model/model.hpp"
 #include "armdyn/solver/integrators.hpp"
 #include "armdyn/solver/kkt.hpp"
@@ -75,6 +76,14 @@ Integrator choose_integrator(const Model& m, double t_end, double rtol, std::str
 /// result up to the last good output is returned with `error` set.
 /// @throws ModelError for invalid options or initial-state sizes.
 SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const VecX& u0,
+                   const VecX& v0);
+/// The same on d, a Data of m, whose buffers the run uses and keeps for the next (the
+/// integrator's stages, the pipeline, a Data of the welded model): a run allocates only its
+/// output tables once d has seen a run of the same kind (integrator "auto" also makes one Data
+/// for its stiffness estimate). The result equals that of a new Data,
+/// bit for bit. One Data per thread.
+/// @throws ModelError also when d was made for another model.
+SimResult simulate(const Model& m, Data& d, double t_end, const SimOptions& opt, const VecX& u0,
                    const VecX& v0);
 
 }  // namespace armdyn

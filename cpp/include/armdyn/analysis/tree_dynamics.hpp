@@ -18,6 +18,7 @@
 // reference: tests compare the two.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -25,11 +26,24 @@
 
 namespace armdyn {
 
+/// The ideal gears' rows of a model, G (ng x n, constant), by an orthonormal basis T of their
+/// null space and one of their range, and the pseudo-inverse of G^T: derived once per model
+/// (Model::derived) by gear_space().
+struct GearSpace {
+  int rank = 0;
+  MatX T, range, Gt_pinv;
+};
+const GearSpace& gear_space(const Model& m);
+
 class TreeDynamics {
  public:
+  /// On a Data of m (its kinematics, forces, Newton-Euler, CRBA and tree buffers).
   /// ignore_drives: the model's drives play no part (joint-space forward dynamics for given
   /// joint forces); otherwise a model with drives is refused.
-  /// @throws ModelError (Model::joint_path_reason) when the path does not apply.
+  /// @throws ModelError (Model::joint_path_reason) when the path does not apply, or when d was
+  ///   made for another model.
+  TreeDynamics(const Model& m, Data& d, bool ignore_drives = false);
+  /// The same on a Data of its own.
   explicit TreeDynamics(const Model& m, bool ignore_drives = false);
   TreeDynamics(const TreeDynamics&) = delete;
   TreeDynamics& operator=(const TreeDynamics&) = delete;
@@ -66,14 +80,12 @@ class TreeDynamics {
   const Data& data() const { return d_; }
 
  private:
+  void init(bool ignore_drives);
+  std::unique_ptr<Data> own_;  // the standalone constructor's Data
   const Model& m_;
-  Data d_;  // kinematics, forces, Newton-Euler and CRBA buffers
+  Data& d_;
+  const GearSpace& gs_;
   int n_ = 0, dof_ = 0, rank_ = 0;
-  MatX T_, range_, MT_, Mr_;  // the gears' null space and range; M T; T^T M T
-  VecX y_, w_;
-  MatX Lr_;       // Cholesky factor of T^T M T (with gears)
-  MatX Gt_pinv_;  // the pseudo-inverse of G^T (ng x n)
-  VecX res_, gear_delta_;
 };
 
 }  // namespace armdyn

@@ -30,6 +30,11 @@ struct Welding {
   /// (joint, the body on the far side)
   std::vector<std::pair<int, int>> sweep;
   std::vector<int> roots;  ///< per composite: the body whose state defines it
+  std::vector<Vec4> qrel;  ///< per body: its Euler parameters in its composite's frame
+  /// per row of the full model: its row in `model` (-1: a merged fixed joint's)
+  std::vector<int> row_map;
+  /// per coordinate of the full model: its coordinate in `model` (fixed joints have none)
+  std::vector<int> coord_map;
 };
 
 /// m's welding, or nullptr when no fixed joint can be merged.

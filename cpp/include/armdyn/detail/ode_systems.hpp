@@ -30,45 +30,22 @@ namespace armdyn::detail {
 // Reports a run of the welded model (builder/weld.hpp) in the bodies and joints of the full model.
 class WeldExpander {
  public:
-  WeldExpander(const Model& full, const Welding& welding)
-      : m_(full),
-        wd_(welding),
-        w_(*welding.model),
-        d_(full),
-        u_(VecX::Zero(full.nq)),
-        v_(VecX::Zero(full.nv)),
-        vd_(VecX::Zero(full.nv)),
-        delta_(VecX::Zero(full.nc)) {
-    for (const Weld& w : wd_.weld) qrel_.push_back(rot_to_quat(w.rotation));
-    // rows of the full model -> rows of the welded one (-1: a merged fixed joint)
-    row_map_.assign(m_.nc, -1);
-    for (size_t j = 0; j < m_.joints.size(); ++j) {
-      const int jw = wd_.weld_joint[j];
-      if (jw < 0) continue;
-      for (int k = 0; k < joint_rows(m_.joints[j].type); ++k)
-        row_map_[m_.joints[j].row0 + k] = w_.joints[jw].row0 + k;
-    }
-    for (size_t g = 0; g < m_.gear_constraints.size(); ++g)
-      row_map_[m_.gear_constraints[g].row] = w_.gear_constraints[g].row;
-    // coordinates of the full model -> those of the welded one (fixed joints have none)
-    coord_map_.assign(m_.coords.size(), -1);
-    for (size_t j = 0; j < m_.joints.size(); ++j) {
-      const int jw = wd_.weld_joint[j];
-      if (jw < 0) continue;
-      for (int k = 0; k < joint_coords(m_.joints[j].type); ++k)
-        coord_map_[m_.joints[j].coord0 + k] = w_.joints[jw].coord0 + k;
-    }
-    track_ = VecX::Zero(static_cast<long>(m_.coords.size()));
-    for (size_t k = 0; k < m_.drives.size(); ++k) row_map_[m_.drives[k].row] = w_.drives[k].row;
+  /// On d, a Data of the full model: its run buffers hold the expanded state, its pipeline the
+  /// full model's evaluation.
+  WeldExpander(const Model& full, const Welding& welding, Data& d)
+      : m_(full), wd_(welding), d_(d), u_(d.run.u), v_(d.run.v), vd_(d.run.vd) {
+    u_ = VecX::Zero(full.nq);
+    v_ = VecX::Zero(full.nv);
+    vd_ = VecX::Zero(full.nv);
   }
 
   /// The composites' state (uw, vw) from a full state: each from its root body.
   void contract(const VecX& u, const VecX& v, VecX& uw, VecX& vw) const {
-    for (int c = 0; c < w_.nb; ++c) {
+    for (int c = 0; c < wd_.model->nb; ++c) {
       const int r = wd_.roots[c];
       const Weld& w = wd_.weld[r];
       const Vec4 qr = u.segment<4>(7 * r + 3).normalized();
-      const Vec4& e = qrel_[r];
+      const Vec4& e = wd_.qrel[r];
       const Vec4 qc = quat_mul(qr, Vec4(e[0], -e[1], -e[2], -e[3]));
       const Mat3 Rc = quat_to_rot(qc);
       const Vec3 wc = w.rotation * v.segment<3>(6 * r + 3);
@@ -85,7 +62,7 @@ class WeldExpander {
       const Weld& w = wd_.weld[b];
       if (w.composite == kGround) {
         u_.segment<3>(7 * b) = w.offset;
-        u_.segment<4>(7 * b + 3) = qrel_[b];
+        u_.segment<4>(7 * b + 3) = wd_.qrel[b];
         v_.segment<6>(6 * b).setZero();
         vd_.segment<6>(6 * b).setZero();
         continue;
@@ -96,7 +73,7 @@ class WeldExpander {
       const Vec3 wc(vw[6 * c + 3], vw[6 * c + 4], vw[6 * c + 5]);
       const Vec3 wxo = wc.cross(w.offset);
       u_.segment<3>(7 * b) = Vec3(uw[7 * c], uw[7 * c + 1], uw[7 * c + 2]) + Rc * w.offset;
-      u_.segment<4>(7 * b + 3) = quat_mul(qc, qrel_[b]);
+      u_.segment<4>(7 * b + 3) = quat_mul(qc, wd_.qrel[b]);
       v_.segment<3>(6 * b) = Vec3(vw[6 * c], vw[6 * c + 1], vw[6 * c + 2]) + Rc * wxo;
       v_.segment<3>(6 * b + 3) = w.rotation.transpose() * wc;
       if (vdw) {
@@ -110,19 +87,18 @@ class WeldExpander {
 
   /// Multipliers of the full model at the expanded state: the welded run's for its rows, the
   /// merged fixed joints' from each member's Newton-Euler balance, far members first
-  /// (sweep_multipliers). Leaves data() loaded
-  /// (kinematics, constraints, multipliers) for joint_reaction() and the residuals.
+  /// (sweep_multipliers). Leaves data() loaded (kinematics, constraints, multipliers) for
+  /// joint_reaction() and the residuals.
   void reactions(double t, const VecX& delta_w, const double* aux, const VecX& tracking_w) {
     d_.aux = aux;
     // the welded run's multi-turn angles: the gear rows (and their residuals) need them
-    for (size_t c = 0; c < coord_map_.size(); ++c)
-      if (coord_map_[c] >= 0) track_[static_cast<long>(c)] = tracking_w[coord_map_[c]];
-    d_.track_ref = track_;
+    for (size_t c = 0; c < wd_.coord_map.size(); ++c)
+      if (wd_.coord_map[c] >= 0) d_.track_ref[static_cast<long>(c)] = tracking_w[wd_.coord_map[c]];
     load_kinematics(m_, d_, u_.data(), v_.data());
     evaluate_constraints(m_, d_, t, false);
     cartesian_forces(m_, d_, t);
-    for (int r = 0; r < m_.nc; ++r) delta_[r] = row_map_[r] >= 0 ? delta_w[row_map_[r]] : 0.0;
-    d_.delta = delta_;
+    for (int r = 0; r < m_.nc; ++r)
+      d_.delta[r] = wd_.row_map[r] >= 0 ? delta_w[wd_.row_map[r]] : 0.0;
     sweep_multipliers(m_, d_, vd_, wd_.sweep);
   }
 
@@ -134,19 +110,19 @@ class WeldExpander {
  private:
   const Model& m_;
   const Welding& wd_;
-  const Model& w_;
-  Data d_;
-  VecX u_, v_, vd_, delta_, track_;
-  std::vector<Vec4> qrel_;
-  std::vector<int> coord_map_;
-  std::vector<int> row_map_;
+  Data& d_;
+  VecX &u_, &v_, &vd_;
 };
 
 // the constrained equations of motion as an ODE on y = (u, v), with projection and recording
 class MbsSystem : public OdeSystem {
  public:
-  MbsSystem(const Model& m, Metric metric, SimResult& out)
-      : m_(m), d_(m), metric_(metric), out_(out), yo_(m.nq + m.nv), vd_(m.nv) {}
+  /// On d, a Data of m (its pipeline; its run buffers hold the output state).
+  MbsSystem(const Model& m, Data& d, Metric metric, SimResult& out)
+      : m_(m), d_(d), metric_(metric), out_(out), yo_(d.run.y), vd_(d.run.vd) {
+    yo_ = VecX::Zero(m.nq + m.nv + m.n_aux);
+    vd_ = VecX::Zero(m.nv);
+  }
 
   // y = (u, v, z): z the auxiliary states (PI integral terms), not projected
   void rhs(double t, const VecX& y, VecX& dy) override {
@@ -253,10 +229,10 @@ class MbsSystem : public OdeSystem {
 
  private:
   const Model& m_;
-  Data d_;
+  Data& d_;
   Metric metric_;
   SimResult& out_;
-  VecX yo_, vd_;
+  VecX &yo_, &vd_;
   WeldExpander* ex_ = nullptr;
 };
 
@@ -268,16 +244,21 @@ class MbsSystem : public OdeSystem {
 // a Cartesian run reports (poses, reactions, gear forces, residuals, energies).
 class JointSystem : public OdeSystem {
  public:
+  /// On the Data of the Cartesian system (its joint-space buffers; its run buffers hold the
+  /// output state).
   JointSystem(const Model& m, MbsSystem& cart)
       : m_(m),
-        td_(m),
+        td_(m, cart.data()),
         cart_(cart),
         n_(td_.n()),
-        u_(VecX::Zero(m.nq)),
-        v_(VecX::Zero(m.nv)),
-        vd_(VecX::Zero(m.nv)),
-        qdd_(VecX::Zero(td_.n())),
-        rne_(td_.data().rne) {
+        u_(cart.data().run.u),
+        v_(cart.data().run.v),
+        vd_(cart.data().run.vd),
+        qdd_(cart.data().run.qdd) {
+    u_ = VecX::Zero(m.nq);
+    v_ = VecX::Zero(m.nv);
+    vd_ = VecX::Zero(m.nv);
+    qdd_ = VecX::Zero(n_);
     for (auto it = m.tree_order.rbegin(); it != m.tree_order.rend(); ++it)
       if (joint_rows(m.joints[*it].type) > 0) sweep_.emplace_back(*it, m.joints[*it].child);
   }
@@ -300,13 +281,12 @@ class JointSystem : public OdeSystem {
     const double* z = y.data() + 2 * n_;
     const Eigen::Map<const VecX> q(y.data(), n_), qd(y.data() + n_, n_);
     td_.accelerations(t, q.data(), qd.data(), z, nullptr, qdd_.data());
-    const Data& jd = td_.data();  // the tree's kinematics and joint frames at (q, qd)
-    rne_.point = jd.rne.point;
-    rne_.axis = jd.rne.axis;
-    rne_forward(m_, jd.kin, qd, qdd_, rne_);
-    tree_body_accelerations(m_, jd.kin, rne_, vd_.data());
-    cartesian_state(m_, jd.kin, u_.data(), v_.data());
+    // the same Data: the tree's kinematics and joint frames at (q, qd), read before the
+    // Cartesian pipeline loads the same state
     Data& d = cart_.data();
+    rne_forward(m_, d.kin, qd, qdd_, d.rne);
+    tree_body_accelerations(m_, d.kin, d.rne, vd_.data());
+    cartesian_state(m_, d.kin, u_.data(), v_.data());
     d.aux = z;
     d.track_ref = q;
     load_kinematics(m_, d, u_.data(), v_.data());

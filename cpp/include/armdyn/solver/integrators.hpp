@@ -20,6 +20,8 @@
 // (RK4); every output state is projected.
 #pragma once
 
+#include <Eigen/LU>
+#include <array>
 #include <vector>
 
 #include "armdyn/math/types.hpp"
@@ -65,16 +67,46 @@ struct StepOptions {
 /// Output times t0 + k dt strictly before t1 (within 1e-9 dt), then t1; empty when dt <= 0
 /// (an output at every accepted step).
 std::vector<double> output_times(double t0, double t1, double dt);
+/// The same into ts (no allocation when its capacity suffices).
+void output_times(double t0, double t1, double dt, std::vector<double>& ts);
+
+/// Every buffer of the integrators -- stages, dense-output coefficients, event values, the
+/// output times, TR-BDF2's Jacobian and LU -- sized by a run and reused by later runs of the
+/// same size, so that a run allocates nothing once its work has been used (a Data holds one:
+/// Data::integrator; without one, each call makes its own).
+struct IntegratorWork {
+  /// Vector slot i sized n (allocates only when its size changes).
+  VecX& vec(int i, long n) {
+    VecX& x = v_[static_cast<size_t>(i)];
+    if (x.size() != n) x.resize(n);
+    return x;
+  }
+  /// Matrix slot i sized n x n.
+  MatX& mat(int i, long n) {
+    MatX& x = m_[static_cast<size_t>(i)];
+    if (x.rows() != n || x.cols() != n) x.resize(n, n);
+    return x;
+  }
+  std::array<VecX, 16> stages;  ///< DOP853's stages
+  std::array<VecX, 7> dense;    ///< DOP853's dense-output coefficients
+  Eigen::PartialPivLU<MatX> lu;
+  std::vector<double> times;
+  std::vector<int> signs, crossed;
+
+ private:
+  std::array<VecX, 40> v_;
+  std::array<MatX, 2> m_;
+};
 
 /// Integrate from t0 to t1; y holds the projected initial state on entry, the final on exit.
 /// @throws SolverError on step-size underflow, too many steps or non-finite values.
 void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepOptions& opt,
-                      StepStats& stats);
+                      StepStats& stats, IntegratorWork* work = nullptr);
 void integrate_dop853(OdeSystem& sys, VecX& y, double t0, double t1, const StepOptions& opt,
-                      StepStats& stats);
+                      StepStats& stats, IntegratorWork* work = nullptr);
 void integrate_trbdf2(OdeSystem& sys, VecX& y, double t0, double t1, const StepOptions& opt,
-                      StepStats& stats);
+                      StepStats& stats, IntegratorWork* work = nullptr);
 void integrate_rk4(OdeSystem& sys, VecX& y, double t0, double t1, const StepOptions& opt,
-                   StepStats& stats);
+                   StepStats& stats, IntegratorWork* work = nullptr);
 
 }  // namespace armdyn

@@ -73,6 +73,13 @@ class KktSolver {
   }
   /// A singular configuration was met: the solver runs regularised from then on.
   bool near_singular() const { return singular_met_; }
+  /// Forget what earlier solves learnt (the sticky regularisation and its pivot level), as a
+  /// new solver would start: a new run on a reused Data.
+  void reset() {
+    singular_met_ = false;
+    regularized_ = false;
+    mass_floor_ = 10.0 * kTrigger;
+  }
 
  private:
   const Model& m_;
