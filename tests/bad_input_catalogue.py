@@ -77,7 +77,7 @@ CASES = [
         "skew",
     ),
     (
-        "inertia-not-pd",
+        "inertia-not-psd",
         "body",
         "inertia with a negative principal value",
         lambda: _b().add_body("flat", 1.0, [1.0, 1.0, -1.0]),

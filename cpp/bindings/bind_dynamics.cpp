@@ -74,6 +74,8 @@ py::dict result_dict(const Model& md, const SimResult& r) {
   s["events"] = r.stats.events;
   s["singular_evaluations"] = r.singular_evaluations;
   s["singular_note"] = r.singular_note;
+  s["augmented_solves"] = r.augmented_solves;
+  s["augmented_note"] = r.augmented_note;
   s["integrator"] = r.integrator;
   s["integrator_reason"] = r.integrator_reason;
   s["solver_bodies"] = r.solver_bodies;

@@ -61,6 +61,7 @@ void reset_pipeline(Data& d) {
   d.with_coordinate_forces = true;
   d.track_ref.setZero();
   d.swept = false;
+  d.augmented = false;
   d.stats = PipelineStats{};
   d.kkt.reset();
 }

@@ -65,15 +65,23 @@ def test_non_symmetric_inertia():
     "inertia",
     [
         np.diag([0.1, 0.1, -0.05]),
-        np.diag([0.1, 0.0, 0.1]),
         np.array([[0.1, 0.2, 0], [0.2, 0.1, 0], [0, 0, 0.1]]),
+        np.diag([0.1, -1e-9, 0.1]),
     ],
-    ids=["negative_eig", "zero_eig", "indefinite_offdiag"],
+    ids=["negative_eig", "indefinite_offdiag", "slightly_negative"],
 )
-def test_inertia_not_positive_definite(inertia):
+def test_inertia_not_positive_semidefinite(inertia):
     b = ad.ModelBuilder()
-    with pytest.raises(ad.ModelError, match="flat_link"):
+    with pytest.raises(ad.ModelError, match="flat_link.*positive semidefinite"):
         b.add_body("flat_link", 1.0, inertia)
+
+
+def test_thin_rod_and_point_mass_inertias_are_physical():
+    # a zero principal moment is a thin rod (about its axis) and three are a point mass: both
+    # are accepted (light bodies: tests/algorithm/test_light_bodies.py simulates them)
+    b = ad.ModelBuilder()
+    assert b.add_body("rod", 1.0, np.diag([0.1, 0.0, 0.1])) == 0
+    assert b.add_body("point", 1.0, np.zeros((3, 3))) == 1
 
 
 def test_inertia_triangle_inequality():

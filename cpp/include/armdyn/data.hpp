@@ -29,6 +29,11 @@ struct PipelineStats {
   /// assembly (a singular configuration); the first one is described in singular_note.
   long singular_evaluations = 0;
   std::string singular_note;
+  /// body_accelerations evaluations solved in augmented form (KktSolver::accelerations_augmented)
+  /// because of light bodies or a range-space solve whose constraint residual showed lost
+  /// accuracy; why, in augmented_note
+  long augmented_solves = 0;
+  std::string augmented_note;
 };
 
 class Data {
@@ -90,11 +95,14 @@ class Data {
   std::vector<int> joint_block;  ///< per joint: its row block in ce.blocks (-1: no rows)
   CoordJetCache jets;            ///< coordinate jets at the loaded state (ce.coord_cache)
   VecX track_ref;  ///< (n) unwrapped reference of the angle coordinates (ce.track_ref)
-  std::vector<ScalarJet> tau_jets;   ///< (n) with joint_torques: each coordinate's jet (no value)
-  VecX cq, cqd;                      ///< (n) the coordinates the force laws read, from the jets
-  KktSolver kkt;                     ///< the factor of the KKT system's Schur complement
-  TreeSweep sweep;                   ///< the O(n) solve of a fully driven tree
-  bool swept = false;                ///< the last body_accelerations took the sweep (kkt not used)
+  std::vector<ScalarJet> tau_jets;  ///< (n) with joint_torques: each coordinate's jet (no value)
+  VecX cq, cqd;                     ///< (n) the coordinates the force laws read, from the jets
+  KktSolver kkt;                    ///< the factor of the KKT system's Schur complement
+  TreeSweep sweep;                  ///< the O(n) solve of a fully driven tree
+  bool swept = false;               ///< the last body_accelerations took the sweep (kkt not used)
+  /// the range-space solve lost accuracy once on this Data (its constraint residual): every later
+  /// body_accelerations takes the augmented solve (reset_pipeline clears it)
+  bool augmented = false;
   VecX delta;                        ///< (nc) multipliers of the last body_accelerations
   VecX vd_work, tmp_nv, tmp_nc, mu;  ///< (nv, nv, nc, nc) scratch
   double tol_f = 1e-13;              ///< position residual accepted by project without a correction

@@ -296,6 +296,8 @@ void finish(const Model& m, const Model& ms, const PipelineStats& st, SimResult&
   out.newton_iterations = st.newton_iterations;
   out.singular_evaluations = st.singular_evaluations;
   out.singular_note = st.singular_note;
+  out.augmented_solves = st.augmented_solves;
+  out.augmented_note = st.augmented_note;
   const size_t n = static_cast<size_t>(out.n), nco = m.coords.size(), nj = m.joints.size();
   out.t.resize(n);
   out.u.resize(n * m.nq);

@@ -49,9 +49,11 @@ int ModelBuilder::add_body(const std::string& name, double mass, const Mat3& ine
     throw ModelError(msg(who, ": inertia is not symmetric"));
   Eigen::SelfAdjointEigenSolver<Mat3> es(0.5 * (inertia + inertia.transpose()));
   const Vec3 p = es.eigenvalues();  // ascending
-  if (!(p[0] > 0.0))
-    throw ModelError(msg(who, ": inertia is not positive definite (principal moments ", p[0], ", ",
-                         p[1], ", ", p[2], ")"));
+  // positive semidefinite: zero moments are point masses (and thin rods), which every path
+  // simulates while the joint-space mass matrix stays positive definite (light_bodies)
+  if (!(p[0] >= -1e-12 * std::max(scale, 1e-300)))
+    throw ModelError(msg(who, ": inertia is not positive semidefinite (principal moments ", p[0],
+                         ", ", p[1], ", ", p[2], ")"));
   if (p[0] + p[1] < p[2] * (1.0 - 1e-9))
     throw ModelError(msg(who, ": inertia violates the triangle inequality (principal moments ",
                          p[0], " + ", p[1], " < ", p[2], ")"));

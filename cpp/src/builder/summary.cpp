@@ -5,6 +5,7 @@
 
 #include "armdyn/builder/weld.hpp"
 #include "armdyn/solver/block_sparse.hpp"
+#include "armdyn/solver/kkt.hpp"
 
 namespace armdyn {
 
@@ -24,6 +25,8 @@ std::string summary(const Model& m) {
     os << "\n  multipliers: minimum-norm (reactions of redundant joints are not unique)\n";
   }
   os << "  KKT path: " << kkt_path(m) << " -- " << kkt_path_description(m) << "\n";
+  if (const LightBodies& light = light_bodies(m); !light.bodies.empty())
+    os << "  " << light.note << "\n";
   const Welding* w = welding(m);
   if (w) {
     int merged = 0;

@@ -1,13 +1,41 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "armdyn/solver/kkt.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
 #include "armdyn/errors.hpp"
 
 namespace armdyn {
+
+const LightBodies& light_bodies(const Model& m) {
+  return m.derived.get<LightBodies>([&] {
+    LightBodies lb;
+    double mmax = 0.0;
+    for (const Body& b : m.bodies) mmax = std::max(mmax, b.mass);
+    const double l2 = m.length_scale * m.length_scale;
+    for (int i = 0; i < m.nb; ++i) {
+      const Body& b = m.bodies[i];
+      const double jmin = Eigen::SelfAdjointEigenSolver<Mat3>(b.inertia).eigenvalues()[0];
+      const double ratio = std::min(jmin / (b.mass * l2), b.mass / mmax * 1e3);
+      if (ratio < 1e-6) {
+        lb.bodies.push_back(i);
+        lb.note += msg(lb.note.empty() ? "" : ", ", "'", b.name, "' (", ratio, ")");
+      }
+    }
+    if (!lb.bodies.empty())
+      lb.note =
+          msg("light bodies (smallest principal moment / (m l^2), or 1e3 mass / heaviest, "
+              "below 1e-6): ",
+              lb.note,
+              "; the dynamics is solved in augmented form (LU of [Gamma zeta^T; zeta 0]), "
+              "without Gamma^-1");
+    return lb;
+  });
+}
 
 KktSolver::KktSolver(const Model& m)
     : m_(m),
@@ -25,6 +53,17 @@ KktSolver::KktSolver(const Model& m)
     minv_[i].setZero();
     minv_[i].topLeftCorner<3, 3>() = Mat3::Identity() / m.bodies[i].mass;
     minv_[i].bottomRightCorner<3, 3>() = m.bodies[i].inertia.inverse();
+  }
+  // light bodies: the mass-weighted metric of the projections floored at 1e-6 m l^2 (their
+  // dynamics never uses Gamma^-1: accelerations_augmented), so that a correction is not carried
+  // by an almost free rotation of a nearly inertia-less body
+  double mmax = 0.0;
+  for (const Body& b : m.bodies) mmax = std::max(mmax, b.mass);
+  for (int i : light_bodies(m).bodies) {
+    const double mass = std::max(m.bodies[i].mass, 1e-9 * mmax);
+    const double floor = 1e-6 * mass * m.length_scale * m.length_scale;
+    minv_[i].topLeftCorner<3, 3>() = Mat3::Identity() / mass;
+    minv_[i].bottomRightCorner<3, 3>() = (m.bodies[i].inertia + floor * Mat3::Identity()).inverse();
   }
   // the block-sparse plans unless the model is redundant or forced onto the dense path
   const bool sparse = !m.redundant && !m.force_dense_kkt && m.nc > 0;
@@ -308,6 +347,42 @@ void KktSolver::accelerations(const ConstraintEval& ce, const VecX& eta, VecX& v
     vdot.segment<3>(6 * b + 3).noalias() -=
         minv_[b].bottomRightCorner<3, 3>() * tmp_nv_.segment<3>(6 * b + 3);
   }
+}
+
+bool KktSolver::accelerations_augmented(const ConstraintEval& ce, int nrows, const VecX& eta,
+                                        VecX& vdot, VecX& delta) {
+  const int nv = m_.nv, n = nv + nrows;
+  if (aug_.rows() != n) {
+    aug_ = MatX::Zero(n, n);
+    aug_b_ = VecX::Zero(n);
+    aug_x_ = VecX::Zero(n);
+    aug_lu_ = Eigen::PartialPivLU<MatX>(n);
+  }
+  aug_.setZero();
+  for (int b = 0; b < m_.nb; ++b) {
+    const Body& bd = m_.bodies[b];
+    aug_.block<3, 3>(6 * b, 6 * b).diagonal().setConstant(bd.mass);
+    aug_.block<3, 3>(6 * b + 3, 6 * b + 3) = bd.inertia;
+  }
+  for (const ConstraintBlock& blk : ce.blocks) {
+    if (blk.row0 >= nrows) continue;
+    for (int k = 0; k < blk.nbody; ++k) {
+      const int body = blk.body[k];
+      if (body == kGround) continue;
+      const auto Z = blk.J.block(0, 6 * k, blk.nrows, 6);
+      aug_.block(nv + blk.row0, 6 * body, blk.nrows, 6) += Z;
+      aug_.block(6 * body, nv + blk.row0, 6, blk.nrows) += Z.transpose();
+    }
+  }
+  aug_b_.head(nv) = eta;
+  aug_b_.tail(nrows) = -ce.xi.head(nrows);
+  aug_lu_.compute(aug_);
+  aug_x_ = aug_lu_.solve(aug_b_);
+  if (!aug_x_.allFinite()) return false;
+  vdot = aug_x_.head(nv);
+  delta.setZero();
+  delta.head(nrows) = aug_x_.tail(nrows);
+  return true;
 }
 
 }  // namespace armdyn

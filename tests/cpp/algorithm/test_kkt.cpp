@@ -5,7 +5,9 @@
 // drive, and a free body falling at g and spinning by Euler's equations.
 #include <cmath>
 
+#include "armdyn/algorithm/dynamics.hpp"
 #include "armdyn/algorithm/kkt.hpp"
+#include "armdyn/analysis/joint_space.hpp"
 #include "armdyn/math/quaternion.hpp"
 #include "check.hpp"
 #include "models.hpp"
@@ -96,6 +98,55 @@ TEST_CASE(free_body_falls_at_g_and_spins_by_euler) {
   CHECK_MAT_NEAR(vdot.head<3>(), Vec3(0.5, 0.0, -9.81), 1e-14);
   const Vec3 w = v.tail<3>();
   CHECK_MAT_NEAR(vdot.tail<3>(), Vec3(J.inverse() * (-w.cross(J * w))), 1e-13);
+}
+
+TEST_CASE(light_link_takes_the_augmented_solve_and_keeps_its_accuracy) {
+  // the two-link arm with link 2's inertia scaled by 1e-12 (about its centre of mass, off the
+  // elbow: the joint-space mass matrix stays well conditioned)
+  armdyn_test::TwoLink arm;
+  ModelBuilder b(Vec3(0, 0, -arm.g));
+  b.add_body("link1", arm.m1, Vec3(0.02, arm.i1, 0.1).asDiagonal(), Vec3(arm.lc1, 0, 0),
+             armdyn_test::kIdentityQuat);
+  b.add_body("link2", arm.m2, 1e-12 * Vec3(0.03, arm.i2, 0.05).asDiagonal(),
+             Vec3(arm.l1 + arm.lc2, 0, 0), armdyn_test::kIdentityQuat);
+  b.add_revolute("shoulder", "ground", "link1", Vec3::Zero(), Vec3::UnitY());
+  b.add_revolute("elbow", "link1", "link2", Vec3(arm.l1, 0, 0), Vec3::UnitY());
+  const ModelPtr m = b.finalize();
+  CHECK(light_bodies(*m).bodies == std::vector<int>{1});
+  CHECK(light_bodies(*arm.model()).bodies.empty());
+  Data d(*m);
+  const VecX q = (VecX(2) << 0.4, -1.1).finished(), qd = (VecX(2) << 1.3, -0.7).finished();
+  VecX u, v, vd(m->nv);
+  state_from_joints(*m, q, qd, u, v);
+  body_accelerations(*m, d, 0.0, u.data(), v.data(), vd.data());
+  CHECK(d.stats.augmented_solves == 1);
+  CHECK(d.stats.augmented_note.find("'link2'") != std::string::npos);
+  CHECK(constraint_residual(d.ce, m->nc, vd) < 1e-14);
+  // the elbow's angular acceleration against the joint-space path (CRBA, no Gamma^-1)
+  Data dj(*m);
+  const VecX qdd = forward_dynamics(*m, dj, q, qd, VecX::Zero(2), 0.0, DynamicsMethod::Joint);
+  CHECK_NEAR(vd[6 * 1 + 4], qdd[0] + qdd[1], 1e-12 * qdd.cwiseAbs().maxCoeff());
+}
+
+TEST_CASE(augmented_and_range_space_solves_agree_on_a_normal_model) {
+  const ModelPtr m = armdyn_test::spatial_arm_builder().finalize();
+  Data d(*m);
+  VecX u, v;
+  state_from_joints(*m, (VecX(4) << 0.3, -0.6, 0.05, 1.1).finished(),
+                    (VecX(4) << 0.9, -1.4, 0.2, 2.0).finished(), u, v);
+  VecX vd(m->nv);
+  body_accelerations(*m, d, 0.0, u.data(), v.data(), vd.data());
+  CHECK(d.stats.augmented_solves == 0);  // no light body, residual at round-off
+  CHECK(constraint_residual(d.ce, m->nc, vd) < 1e-13);
+  const VecX delta = d.delta;
+  VecX vd2(m->nv), delta2(m->nc);
+  CHECK(d.kkt.accelerations_augmented(d.ce, m->nc, d.eta, vd2, delta2));
+  CHECK_MAT_NEAR(vd2, vd, 1e-12 * vd.cwiseAbs().maxCoeff());
+  CHECK_MAT_NEAR(delta2, delta, 1e-12 * delta.cwiseAbs().maxCoeff());
+  // accelerations that break the constraints show in the residual
+  VecX wrong = vd;
+  wrong[3] += 1e-3 * vd.cwiseAbs().maxCoeff();
+  CHECK(constraint_residual(d.ce, m->nc, wrong) > 1e-5);
 }
 
 ARMDYN_TEST_MAIN()

@@ -6,7 +6,9 @@
 // data.delta by the Schur complement of the KKT system (armdyn/solver/kkt.hpp), or, for the
 // square zeta of a fully driven tree, by two O(n) sweeps (armdyn/solver/tree_sweep.hpp). A
 // configuration where the Jacobian has lost rank against assembly is counted and described in
-// data.stats.
+// data.stats. Never silently inaccurate: a model with light bodies (solver/kkt.hpp
+// light_bodies) is solved in augmented form without Gamma^-1, and a range-space solve whose
+// constraint residual shows lost accuracy is redone in that form (data.stats.augmented_*).
 #pragma once
 
 #include <string>
@@ -21,6 +23,11 @@ namespace armdyn {
 /// @throws SolverError when a force or the accelerations are not finite.
 void body_accelerations(const Model& m, Data& d, double t, const double* u, const double* v,
                         double* vdot, bool reuse_factor = false);
+
+/// The largest relative residual of zeta vd = -xi over rows [0, nrows), row by row:
+/// |sum_j zeta_rj vd_j + xi_r| / (sum_j |zeta_rj| max|vd| + |xi_r|), round-off (1e-16) for an
+/// exact solve. O(rows).
+double constraint_residual(const ConstraintEval& ce, int nrows, const VecX& vd);
 
 /// body_accelerations at the kinematics already loaded in data.kin (load_kinematics or
 /// load_joint_kinematics).

@@ -53,6 +53,9 @@ struct SimResult {
   long kkt_solves = 0, factorizations = 0, position_projections = 0, newton_iterations = 0;
   long singular_evaluations = 0;
   std::string singular_note;
+  /// accelerations solved in augmented form (light bodies, or lost accuracy), and why
+  long augmented_solves = 0;
+  std::string augmented_note;
   /// located events: gear contact onset (+1) and separation (-1), by gear index
   std::vector<double> event_t;
   std::vector<int> event_index, event_direction;

@@ -29,7 +29,9 @@
 #pragma once
 
 #include <Eigen/Cholesky>
+#include <Eigen/LU>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "armdyn/solver/block_sparse.hpp"
@@ -38,6 +40,19 @@
 namespace armdyn {
 
 enum class Metric { Mass, Identity };
+
+/// Bodies whose own inertia is tiny against the model's scale: smallest principal moment below
+/// 1e-6 m l^2 (l the model's length scale; point masses have none) or mass below 1e-9 of the
+/// heaviest body's. The range-space solve forms Gamma^-1 and loses about 1e-18 / ratio of
+/// relative accuracy on them (the UR5 with one link's inertia scaled by 1e-8: 5e-9; by 1e-14:
+/// 0.8), so the dynamics of a model with any takes the augmented solve
+/// (KktSolver::accelerations_augmented) and its projections a floored metric. Derived once per
+/// model (Model::derived).
+struct LightBodies {
+  std::vector<int> bodies;
+  std::string note;  ///< names the bodies and their ratios; empty when none
+};
+const LightBodies& light_bodies(const Model& m);
 
 class KktSolver {
  public:
@@ -73,6 +88,13 @@ class KktSolver {
   }
   /// A singular configuration was met: the solver runs regularised from then on.
   bool near_singular() const { return singular_met_; }
+  /// The accelerations from the whole augmented system [Gamma zeta^T; zeta 0] over rows
+  /// [0, nrows), factored densely (LU, partial pivoting) without forming Gamma^-1: accurate
+  /// whatever the inertias of single bodies, down to point masses, while the joint-space mass
+  /// matrix is positive definite. O((nv + nrows)^3); its buffers are sized on first use.
+  /// Returns false when the augmented matrix is singular (no finite solution).
+  bool accelerations_augmented(const ConstraintEval& ce, int nrows, const VecX& eta, VecX& vdot,
+                               VecX& delta);
   /// Forget what earlier solves learnt (the sticky regularisation and its pivot level), as a
   /// new solver would start: a new run on a reused Data.
   void reset() {
@@ -105,6 +127,9 @@ class KktSolver {
   MatX A_;
   Eigen::LLT<MatX> llt_;
   void assemble(const ConstraintEval& ce, int nrows, Metric metric);
+  MatX aug_;  // the augmented matrix and its LU (accelerations_augmented), sized on first use
+  Eigen::PartialPivLU<MatX> aug_lu_;
+  VecX aug_b_, aug_x_;
   void factor_pivoted(int n, double tol = 1e-10);
   void solve_pivoted(const VecX& b, VecX& x) const;
   // pivoted path: factor of P A P^T in A_ (lower), permutation, M = L11^-T L21^T and the
