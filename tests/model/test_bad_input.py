@@ -72,7 +72,7 @@ def test_non_symmetric_inertia():
 )
 def test_inertia_not_positive_semidefinite(inertia):
     b = ad.ModelBuilder()
-    with pytest.raises(ad.ModelError, match="flat_link.*positive semidefinite"):
+    with pytest.raises(ad.ModelError, match=r"flat_link.*positive semidefinite"):
         b.add_body("flat_link", 1.0, inertia)
 
 
