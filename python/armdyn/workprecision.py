@@ -168,13 +168,8 @@ def _cpu_time(fn, repeats: int):
 
 def _angular_mask(model) -> np.ndarray:
     """True for the joint coordinates that are angles (revolute, the angle of a cylindrical
-    joint, both angles of a universal joint)."""
-    per_type = {
-        "revolute": (True,),
-        "prismatic": (False,),
-        "cylindrical": (True, False),
-        "universal": (True, True),
-    }
+    joint; spherical, universal and the rest have no joint coordinates)."""
+    per_type = {"revolute": (True,), "prismatic": (False,), "cylindrical": (True, False)}
     mask = []
     for jt in model.joint_types:
         mask.extend(per_type.get(str(jt).split(".")[-1].lower(), ()))
@@ -384,6 +379,11 @@ def work_precision(
         raise _bad("qd0 given without q0")
     if (q0 is not None) and (u0 is not None or v0 is not None):
         raise _bad("give either q0/qd0 or u0/v0, not both")
+    if observe is None and model.n_coords == 0:
+        raise _bad(
+            "the model has no joint coordinates to compare (spherical, universal or free joints "
+            "only); pass observe= and reference="
+        )
     if observe is not None and reference is None:
         raise _bad("observe needs reference= (the default reference compares joint coordinates)")
 

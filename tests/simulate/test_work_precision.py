@@ -324,6 +324,26 @@ def test_joint_coordinates_on_a_closed_loop_is_a_model_error():
         ad.work_precision(standard.andrews_squeezer(), 0.01, coordinates="joint")
 
 
+def test_angles_are_wrapped_and_a_model_without_coordinates_is_a_model_error():
+    b = ad.ModelBuilder()
+    b.add_body("a", 1.0, [0.01, 0.01, 0.01], position=(0.3, 0, 0))
+    b.add_body("c", 1.0, [0.01, 0.012, 0.015], position=(0.6, 0, 0))
+    b.add_cylindrical("j1", "ground", "a", point=(0, 0, 0), axis=(0, 1, 0))
+    b.add_spherical("j2", "a", "c", point=(0.45, 0, 0))
+    model = b.finalize()
+    np.testing.assert_array_equal(ad.workprecision._angular_mask(model), [True, False])
+    np.testing.assert_array_equal(ad.workprecision._angular_mask(five_dof_arm()), [True] * 5)
+    # an angle across the cut at pi is 0.2 rad off, not 2 pi - 0.2; displacements are not wrapped
+    err = ad.workprecision._max_error
+    assert err([[np.pi - 0.1, 1.0]], [[-np.pi + 0.1, 1.0]], [True, False]) == pytest.approx(0.2)
+    assert err([[0.0, 7.0]], [[0.0, 0.0]], [True, False]) == 7.0
+    b = ad.ModelBuilder()
+    b.add_body("ball", 1.0, [0.01, 0.01, 0.01], position=(0.3, 0, 0))
+    b.add_spherical("s", "ground", "ball", point=(0, 0, 0))
+    with pytest.raises(ad.ModelError, match="no joint coordinates to compare"):
+        ad.work_precision(b.finalize(), 1.0)
+
+
 def test_plot_draws_one_line_per_integrator(sweep, tmp_path):
     path = tmp_path / "wp.png"
     fig = sweep.plot(path, title="five-DOF arm")
