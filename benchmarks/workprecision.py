@@ -7,7 +7,9 @@ or step (RK4, MuJoCo) is swept; each point records the error against an independ
 in minimal coordinates), the CPU time of the whole solve (median of warm repeats, one warm-up
 run first) and the counters (steps, right-hand sides, KKT solves, factorisations). On trees
 (the UR5, the geared arm) armdyn's integrators also run on ``simulate(coordinates="joint")``,
-the joint-space path (curves "armdyn <integrator> (joint)"). Peers run the same problem in the
+the joint-space path (curves "armdyn <integrator> (joint)"). armdyn's curves are
+:func:`armdyn.work_precision`, the function a user runs on their own model, given the problem's
+reference, observed quantity and error measure. Peers run the same problem in the
 same process:
 
 - SciPy ``solve_ivp`` (DOP853, RK45) on the minimal-coordinate equations of the reference
@@ -37,7 +39,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from armdyn import _core, simulate
+from armdyn import _core, work_precision
 from armdyn.reproduce import efforts_in_coord_order
 from armdyn.scenes import paper, standard
 from armdyn.scenes.geared_arm import geared_arm_6dof
@@ -472,37 +474,43 @@ def sweep_armdyn(
     repeats: int = 5,
     coordinates: str = "cartesian",
 ) -> list[dict]:
-    """armdyn's curve; ``ref`` is the reference on the output times."""
+    """armdyn's curve, by :func:`armdyn.work_precision` (the function users run on their own
+    models) with the problem's reference ``ref`` (on the output times), observed quantity and
+    error measure; tolerances with atol = rtol (RK4: the steps). Its table's rows become the
+    points of the curve."""
     model = problem.build()
-    kwargs = dict(problem.init(model) if problem.init else {}, coordinates=coordinates)
+    opts = dict(
+        problem.init(model) if problem.init else {},
+        integrators=[integrator],
+        n_out=problem.n_out,
+        coordinates=coordinates,
+        reference=(output_times(problem), ref),
+        observe=lambda res: problem.observe(model, res),
+        angular=problem.angular,
+        error_measure=problem.quantity,
+        repeats=repeats,
+        max_steps=10_000_000,  # simulate's default
+    )
+    if integrator == "rk4":
+        opts["dts"] = settings
+    elif integrator != "kinematic":  # no setting: each output is solved exactly
+        opts["rtols"] = settings
+    table = work_precision(model, problem.t_end, **opts).table
     points = []
-    for s in settings:
-        opts = dict(kwargs, output_dt=problem.t_end / problem.n_out)
-        if integrator == "rk4":
-            opts["dt"] = s
-        elif integrator != "kinematic":  # no setting: each output is solved exactly
-            opts.update(rtol=s, atol=s)
-
-        def call(opts=opts):
-            return simulate(model, problem.t_end, integrator=integrator, **opts)
-
+    for s, row in zip(settings, table.itertuples(index=False), strict=True):
         point = {"setting": s}
-        try:
-            sec, reps, res = common.cpu_time(call, repeats)
-            obs = problem.observe(model, res)
+        if row.status == "failed":
+            point.update(failed=row.message[:200], error=float("nan"))
+        else:
+            counters = ("steps", "rejected", "rhs_evals", "kkt_solves", "factorizations")
             point.update(
-                cpu_s=sec,
-                repeats=reps,
-                error=error(problem, obs, ref),
-                **{
-                    k: res.stats[k]
-                    for k in ("steps", "rejected", "rhs_evals", "kkt_solves", "factorizations")
-                },
-                singular_evaluations=res.stats.get("singular_evaluations", 0),
-                max_position_residual=float(res.position_residual.max()),
+                cpu_s=row.cpu_s,
+                repeats=int(row.repeats),
+                error=row.error,
+                **{k: int(getattr(row, k)) for k in counters},
+                singular_evaluations=int(row.singular_evaluations),
+                max_position_residual=row.max_position_residual,
             )
-        except _core.SolverError as exc:
-            point.update(failed=str(exc).split(";")[0][:200], error=float("nan"))
         points.append(point)
     return points
 

@@ -144,6 +144,9 @@ void bind_model(py::module_& m) {
                              })
       .def_readonly("is_tree", &Model::is_tree)
       .def_readonly("joint_space", &Model::joint_space_ok)
+      // why simulate(coordinates="joint") does not take the model; empty when it does
+      .def_property_readonly("joint_path_reason",
+                             [](const Model& md) { return md.joint_path_reason(); })
       .def_readonly("mobility", &Model::mobility)
       .def_readonly("mobility_driven", &Model::mobility_driven)
       .def_readonly("redundant_rows", &Model::redundant_rows)

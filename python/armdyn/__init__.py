@@ -32,6 +32,7 @@ from armdyn._core import (
 from armdyn.dynamics import InverseDynamicsResult, driven_inverse_dynamics
 from armdyn.simulation import SimulationResult, load_urdf, simulate
 from armdyn.validation import LagrangeValidator
+from armdyn.workprecision import WorkPrecisionResult, work_precision
 
 __version__ = "0.1.0"
 
@@ -46,6 +47,7 @@ __all__ = [
     "SimulationResult",
     "SolverError",
     "UrdfError",
+    "WorkPrecisionResult",
     "body_accelerations",
     "body_forces",
     "body_mass_matrix",
@@ -63,4 +65,5 @@ __all__ = [
     "state_from_joints",
     "urdf_builder",
     "validation",
+    "work_precision",
 ]

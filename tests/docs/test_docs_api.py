@@ -60,3 +60,8 @@ def test_python_blocks_run():
     np.testing.assert_array_equal(ns["rows"][2], ns["qdd"])
     assert ns["M"].shape == (2, 2) and ns["vdot"].shape == (12,)
     assert np.abs(ns["res"].q - ns["joint"].q).max() <= 1e-6
+    # the work-precision block: DOPRI5's error follows its tolerance; RK4's coarse step fails
+    # on the motor's damping and is a row, not an exception
+    tab = ns["wp"].table
+    assert tab["status"].tolist() == ["ok", "ok", "failed", "ok"]
+    assert tab["error"].iloc[1] < 1e-8 < tab["error"].iloc[0] < 1e-5
