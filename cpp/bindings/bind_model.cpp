@@ -417,7 +417,11 @@ void bind_model(py::module_& m) {
           [cast_model](const ModelBuilder& b, bool mass_weighted) {
             FinalizeOptions o;
             o.mass_weighted_assembly = mass_weighted;
-            return cast_model(b.finalize(o));
+            ModelPtr m = b.finalize(o);
+            for (const std::string& w : m->warnings)
+              if (PyErr_WarnEx(PyExc_UserWarning, ("armdyn: " + w).c_str(), 1) != 0)
+                throw py::error_already_set();
+            return cast_model(m);
           },
           py::arg("mass_weighted_assembly") = true,
           "Validate, analyse topology and rank, assemble; returns an immutable Model.")

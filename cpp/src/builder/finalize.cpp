@@ -155,15 +155,30 @@ std::shared_ptr<Model> finalize_draft(const Model& draft, const FinalizeOptions&
     ce.init(m);
     eval_constraints(m, kin, 0.0, false, ce);
     MatX z;
+    // Rows whose pivot falls below 1e-6 of the largest are dependent: the threshold of the
+    // block-sparse factor of zeta zeta^T below (1e-12 on the squared pivots) and of the KKT
+    // solver's pivoted path, so that axes or points that agree to 1e-6 (CAD round-off: two
+    // bearings of one shaft whose axes differ by 1e-9 rad) are taken as aligned rather than
+    // leaving the mechanism immobile. Those above round-off (1e-12) are named in a warning.
+    std::vector<std::string> near;
+    double near_level = 0.0;
     auto analyse = [&](int nrows, std::vector<std::string>* names) {
       if (nrows == 0) return 0;
       if (z.size() == 0) z = dense_zeta(m, ce);
       Eigen::ColPivHouseholderQR<MatX> qr(z.topRows(nrows).transpose());
-      qr.setThreshold(1e-10);
+      qr.setThreshold(1e-6);
       const int r = static_cast<int>(qr.rank());
-      if (names)
-        for (int k = r; k < nrows; ++k)
-          names->push_back(m.row_name(qr.colsPermutation().indices()[k]));
+      const MatX& R = qr.matrixQR();
+      const double r00 = std::abs(R(0, 0));
+      for (int k = r; k < nrows; ++k) {
+        const std::string name = m.row_name(qr.colsPermutation().indices()[k]);
+        if (names) names->push_back(name);
+        const double level = k < R.rows() ? std::abs(R(k, k)) / r00 : 0.0;
+        if (level > 1e-12 && std::find(near.begin(), near.end(), name) == near.end()) {
+          near.push_back(name);
+          near_level = std::max(near_level, level);
+        }
+      }
       return r;
     };
     // fast path: when the block-sparse Cholesky of zeta zeta^T succeeds on all rows, every row
@@ -187,6 +202,15 @@ std::shared_ptr<Model> finalize_draft(const Model& draft, const FinalizeOptions&
               m.redundant_rows.end() &&
           n.rfind("drive", 0) == 0)
         m.redundant_rows.push_back(n);
+    if (!near.empty()) {
+      std::string rows;
+      for (const auto& n : near) rows += (rows.empty() ? "" : "; ") + n;
+      m.warnings.push_back(
+          msg("finalize: constraint rows dependent only to ", near_level,
+              " (relative; axes or points aligned to round-off, not exactly) are treated as "
+              "dependent: ",
+              rows));
+    }
     m.mobility = m.nv - m.rank_joint;
     m.mobility_driven = m.nv - m.rank_all;
     m.redundant = m.rank_joint < m.nc_joint || m.rank_all < m.nc;

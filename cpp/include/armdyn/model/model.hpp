@@ -226,6 +226,9 @@ class Model {
   int mobility = 0;         ///< nv - rank of joint rows (degrees of freedom without drives)
   int mobility_driven = 0;  ///< nv - rank of all rows (what the drives leave free)
   std::vector<std::string> redundant_rows;  ///< named redundant constraint rows
+  /// what finalize() treated as exact though it holds only to round-off (the Python finalize
+  /// issues each as a UserWarning)
+  std::vector<std::string> warnings;
   bool redundant = false;
   double length_scale = 1.0;  ///< characteristic length for tolerances [m]
   /// true: the KKT solves take the dense pivoted path whatever the plan (the reference path;
