@@ -6,6 +6,7 @@
 #include <memory>
 #include <vector>
 
+#include "armdyn/algorithm/cost_model.hpp"
 #include "armdyn/algorithm/crba.hpp"
 #include "armdyn/algorithm/dynamics.hpp"
 #include "common.hpp"
@@ -158,10 +159,43 @@ void bind_algorithm(py::module_& m) {
       py::arg("model"), py::arg("q"), py::arg("qd"), py::arg("tau"), py::arg("t") = 0.0,
       py::arg("method") = "auto", py::arg("data") = py::none(),
       "Joint accelerations qdd of a tree for joint torques/forces tau at (q, qd) and time t "
-      "[s] (n_coords each; 2-D: one state per row). method: 'joint' (CRBA mass matrix, "
-      "recursive Newton-Euler bias, Cholesky), 'cartesian' (the constrained Newton-Euler KKT "
-      "system of the bodies), 'auto' (joint). The model's force elements act; drives are "
-      "ignored.");
+      "[s] (n_coords each; 2-D: one state per row). method: 'crba' (CRBA mass matrix, "
+      "recursive Newton-Euler bias, Cholesky), 'aba' (articulated-body algorithm, O(n)), "
+      "'cartesian' (the constrained Newton-Euler KKT system of the bodies), 'joint' (the "
+      "cheaper of crba and aba for this model), 'auto' (the cheapest of the three); the choice "
+      "comes from a measured cost model (dynamics_cost). The model's force elements act; "
+      "drives are ignored.");
+
+  m.def(
+      "dynamics_cost",
+      [](const ModelHolder& md) {
+        if (!md) throw ModelError("dynamics_cost: no model");
+        const DynamicsCost& c = dynamics_cost(*md);
+        auto lower = [](DynamicsMethod x) {
+          return x == DynamicsMethod::Aba    ? "aba"
+                 : x == DynamicsMethod::Crba ? "crba"
+                                             : "cartesian";
+        };
+        py::dict r;
+        r["nb"] = c.nb;
+        r["n"] = c.n;
+        r["path"] = c.path;
+        r["crba_us"] = c.crba;
+        r["aba_us"] = c.aba;
+        r["cartesian_us"] = c.cartesian;
+        r["joint"] = lower(c.joint);
+        r["auto"] = lower(c.best);
+        r["joint_rhs_us"] = c.joint_rhs;
+        r["cartesian_rhs_us"] = c.cartesian_rhs;
+        r["simulate"] = c.joint_rhs_cheaper ? "joint" : "cartesian";
+        return r;
+      },
+      py::arg("model"),
+      "The measured cost model's prediction for a model (derived once per model): microseconds "
+      "per forward_dynamics call by 'crba', 'aba' and 'cartesian', the algorithms method='joint' "
+      "and method='auto' take, and the microseconds per right-hand side of simulate in joint "
+      "space and in Cartesian coordinates with the formulation coordinates='auto' takes where "
+      "both apply.");
 
   m.def(
       "inverse_dynamics",
@@ -169,7 +203,7 @@ void bind_algorithm(py::module_& m) {
          const py::object& t, const std::string& method, const py::object& data) {
         constexpr const char* fn = "inverse_dynamics";
         Data& d = data_for(md, data, fn);
-        const DynamicsMethod mth = dynamics_method(method, fn);
+        const DynamicsMethod mth = dynamics_method(method, fn, false);
         const Model& mm = *md;
         if (is_batch(q))
           return batch(fn, d.n, q, qd, "qd", qdd, "qdd", t, {d.n},

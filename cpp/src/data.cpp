@@ -45,6 +45,11 @@ Data::Data(const Model& m) : model(&m), n(static_cast<int>(m.coords.size())), kk
     if (m.joints[j].child != kGround) joint_of_body[m.joints[j].child] = static_cast<int>(j);
   ic.assign(m.nb, Composite{});
   s.assign(n, Vec6::Zero());
+  aba.IA.assign(m.nb, Mat6::Zero());
+  for (auto* x : {&aba.pA, &aba.v, &aba.a}) x->assign(m.nb, Vec6::Zero());
+  for (auto* x : {&aba.U, &aba.c}) x->assign(n, Vec6::Zero());
+  aba.Dinv.assign(n, 0.0);
+  aba.u.assign(n, 0.0);
   M = MatX::Zero(n, n);
   rhs = VecX::Zero(n);
   qdd = VecX::Zero(n);

@@ -169,7 +169,9 @@ def test_joint_path_bad_input():
         td(z, z, np.zeros(2))
     with pytest.raises(ad.ModelError, match="closed loops"):
         _core._TreeDynamics(ad.scenes.four_bar())
-    with pytest.raises(ad.ModelError, match="method must be 'auto', 'joint' or 'cartesian'"):
-        ad.forward_dynamics(model, z, z, z, method="aba")
+    with pytest.raises(
+        ad.ModelError, match="method must be 'auto', 'joint', 'crba', 'aba' or 'cartesian'"
+    ):
+        ad.forward_dynamics(model, z, z, z, method="lu")
     # the model and a run after the errors are intact
     assert ad.simulate(model, 0.1, coordinates="auto").stats["formulation"].startswith("joint")

@@ -69,6 +69,13 @@ class Data {
   std::vector<Composite> ic;  ///< per body: its subtree's spatial inertia
   std::vector<Vec6> s;        ///< per coordinate: its motion (angular; velocity of origin)
   MatX M;                     ///< (n, n) joint-space mass matrix
+  // --- articulated-body algorithm (aba) ---
+  struct AbaWork {
+    std::vector<Mat6> IA;         ///< per body: its subtree's articulated inertia (world origin)
+    std::vector<Vec6> pA, v, a;   ///< per body: bias force, spatial velocity, acceleration
+    std::vector<Vec6> U, c;       ///< per coordinate: I^A s and the velocity product v_p x s qd
+    std::vector<double> Dinv, u;  ///< per coordinate: 1 / (s^T I^A s) and tau - s^T p^A
+  } aba;
   // --- forward dynamics ---
   VecX rhs, qdd, zero;
   MatX L;  ///< (n, n) Cholesky factor of M in its lower triangle (math/cholesky.hpp)

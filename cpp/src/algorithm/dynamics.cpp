@@ -3,6 +3,8 @@
 
 #include <cmath>
 
+#include "armdyn/algorithm/aba.hpp"
+#include "armdyn/algorithm/cost_model.hpp"
 #include "armdyn/algorithm/crba.hpp"
 #include "armdyn/algorithm/forces.hpp"
 #include "armdyn/algorithm/kinematics.hpp"
@@ -117,20 +119,32 @@ void joint_space_equations(const Model& m, Data& d, const double* q, const doubl
   crba_loaded(m, d);
 }
 
-DynamicsMethod dynamics_method(const std::string& name, const char* fn) {
+DynamicsMethod dynamics_method(const std::string& name, const char* fn, bool forward) {
   if (name == "auto") return DynamicsMethod::Auto;
   if (name == "joint") return DynamicsMethod::Joint;
   if (name == "cartesian") return DynamicsMethod::Cartesian;
-  throw ModelError(msg(fn, ": method must be 'auto', 'joint' or 'cartesian', got '", name, "'"));
+  if (forward && name == "crba") return DynamicsMethod::Crba;
+  if (forward && name == "aba") return DynamicsMethod::Aba;
+  throw ModelError(msg(fn,
+                       forward
+                           ? ": method must be 'auto', 'joint', 'crba', 'aba' or 'cartesian', got '"
+                           : ": method must be 'auto', 'joint' or 'cartesian', got '",
+                       name, "'"));
 }
 
 const VecX& forward_dynamics(const Model& m, Data& d, Eigen::Ref<const VecX> q,
                              Eigen::Ref<const VecX> qd, Eigen::Ref<const VecX> tau, double t,
                              DynamicsMethod method) {
   check_inputs(m, d, q, qd, tau, t, "forward_dynamics", "tau");
-  if (method == DynamicsMethod::Cartesian) {
-    forward_cartesian(m, d, q, qd, tau, t);
-    return d.qdd;
+  switch (resolve_method(m, method)) {
+    case DynamicsMethod::Cartesian:
+      forward_cartesian(m, d, q, qd, tau, t);
+      return d.qdd;
+    case DynamicsMethod::Aba:
+      aba_accelerations(m, d, q.data(), qd.data(), nullptr, tau.data(), t, d.qdd.data());
+      return d.qdd;
+    default:
+      break;
   }
   joint_space_equations(m, d, q.data(), qd.data(), nullptr, tau.data(), t);
   if (!cholesky_factor(d.M, d.L))

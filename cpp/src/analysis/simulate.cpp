@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "armdyn/algorithm/constraints.hpp"
+#include "armdyn/algorithm/cost_model.hpp"
 #include "armdyn/algorithm/kinematics.hpp"
 #include "armdyn/algorithm/projection.hpp"
 #include "armdyn/analysis/inverse_dynamics.hpp"
@@ -156,6 +157,7 @@ struct RunPlan {
   Integrator integrator = Integrator::Dopri5;
   std::string reason;
   bool joint = false;
+  std::string why_coordinates;  ///< coordinates "auto": why this formulation
 };
 
 RunPlan plan_run(const Model& m, double t_end, const SimOptions& opt) {
@@ -198,10 +200,20 @@ RunPlan plan_run(const Model& m, double t_end, const SimOptions& opt) {
     default:
       p.integrator = opt.integrator;
   }
-  // Auto: joint space wherever it applies (a tree without drives), the Cartesian path else
-  p.joint = opt.coordinates == Coordinates::Joint ||
-            (opt.coordinates == Coordinates::Auto && p.integrator != Integrator::Kinematic &&
-             p.ms->joint_path_reason().empty());
+  // Auto: where joint space applies (a tree without drives), the formulation whose right-hand
+  // side the measured cost model predicts cheaper; the Cartesian path elsewhere
+  p.joint = opt.coordinates == Coordinates::Joint;
+  if (opt.coordinates == Coordinates::Auto) {
+    if (p.integrator == Integrator::Kinematic) {
+      p.why_coordinates = "joint space does not apply: fully driven";
+    } else if (const std::string why = p.ms->joint_path_reason(); !why.empty()) {
+      p.why_coordinates = msg("joint space does not apply: ", why);
+    } else {
+      const DynamicsCost& c = dynamics_cost(*p.ms);
+      p.joint = c.joint_rhs_cheaper;
+      p.why_coordinates = msg("auto: ", c.rhs_summary());
+    }
+  }
   if (p.joint && p.integrator == Integrator::Kinematic)
     throw ModelError(
         "simulate: coordinates 'joint' integrates a tree without drives; a fully driven model "
@@ -376,12 +388,8 @@ SimResult simulate(const Model& m, Data& d, double t_end, const SimOptions& opt,
   } else {
     out.formulation = msg("cartesian: ", ms.nb, " bodies, ", ms.nc, " constraint rows, KKT path '",
                           kkt_path(ms), "'");
-    if (opt.coordinates == Coordinates::Auto)
-      out.formulation += msg(" (joint space does not apply: ",
-                             plan.integrator == Integrator::Kinematic ? std::string("fully driven")
-                                                                      : ms.joint_path_reason(),
-                             ")");
   }
+  if (opt.coordinates == Coordinates::Auto) out.formulation += msg(" [", plan.why_coordinates, "]");
   // the initial state (of the composites, in a welded run)
   std::unique_ptr<detail::WeldExpander> expander;
   VecX y = VecX::Zero(ms.nq + ms.nv + ms.n_aux);

@@ -4,6 +4,8 @@
 #include <Eigen/QR>
 #include <cmath>
 
+#include "armdyn/algorithm/aba.hpp"
+#include "armdyn/algorithm/cost_model.hpp"
 #include "armdyn/algorithm/crba.hpp"
 #include "armdyn/algorithm/dynamics.hpp"
 #include "armdyn/algorithm/forces.hpp"
@@ -60,6 +62,9 @@ void TreeDynamics::init(bool ignore_drives) {
   n_ = d_.n;
   rank_ = gs_.rank;
   dof_ = n_ - rank_;
+  // without ideal gears, the cheaper of CRBA + Cholesky and the articulated-body algorithm by
+  // the measured cost model; with them, the null-space reduction needs the mass matrix
+  aba_ = m_.gear_constraints.empty() && dynamics_cost(m_).joint == DynamicsMethod::Aba;
   // the reduced system's scratch (with gears), in the Data
   Data::TreeScratch& w = d_.tree;
   auto size = [](MatX& x, long r, long c) {
@@ -78,7 +83,12 @@ void TreeDynamics::init(bool ignore_drives) {
 }
 
 std::string TreeDynamics::description() const {
-  if (rank_ == 0) return msg("joint space: ", n_, " coordinates, mass matrix by CRBA, Cholesky");
+  if (m_.gear_constraints.empty()) {
+    const DynamicsCost& c = dynamics_cost(m_);
+    return msg("joint space: ", n_, " coordinates, ",
+               aba_ ? "articulated-body algorithm" : "mass matrix by CRBA, Cholesky", " (",
+               c.forward_summary(), ")");
+  }
   return msg("joint space: ", n_, " coordinates, ", m_.gear_constraints.size(),
              " ideal-gear rows (rank ", rank_, ") eliminated by their null space: ", dof_,
              " independent; mass matrix by CRBA, Cholesky of the reduced matrix");
@@ -90,6 +100,10 @@ const MatX& TreeDynamics::mass_matrix(const double* q) {
 
 void TreeDynamics::accelerations(double t, const double* q, const double* qd, const double* z,
                                  const double* tau, double* qdd) {
+  if (aba_) {
+    aba_accelerations(m_, d_, q, qd, z, tau, t, qdd);
+    return;
+  }
   joint_space_equations(m_, d_, q, qd, z, tau, t);
   const VecX& rhs = d_.rhs;
   const MatX& M = d_.M;

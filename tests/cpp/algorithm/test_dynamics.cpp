@@ -83,7 +83,10 @@ TEST_CASE(method_names_and_bad_input) {
   CHECK(dynamics_method("auto", "f") == DynamicsMethod::Auto);
   CHECK(dynamics_method("joint", "f") == DynamicsMethod::Joint);
   CHECK(dynamics_method("cartesian", "f") == DynamicsMethod::Cartesian);
-  CHECK_THROWS(dynamics_method("crba", "f"), ModelError);
+  CHECK(dynamics_method("crba", "f") == DynamicsMethod::Crba);
+  CHECK(dynamics_method("aba", "f") == DynamicsMethod::Aba);
+  CHECK_THROWS(dynamics_method("crba", "f", false), ModelError);  // inverse dynamics
+  CHECK_THROWS(dynamics_method("lu", "f"), ModelError);
   const ModelPtr m = armdyn_test::TwoLink().model();
   Data d(*m);
   CHECK_THROWS(forward_dynamics(*m, d, VecX::Zero(3), VecX::Zero(2), VecX::Zero(2)), ModelError);

@@ -1,25 +1,29 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Joint-space forward and inverse dynamics of a tree, each by two methods that give the same
-// answer to round-off:
-//  - Joint: the recursive joint-space algorithms: forward dynamics by CRBA (mass matrix), the
-//    recursive Newton-Euler bias and a Cholesky solve; inverse dynamics by recursive
-//    Newton-Euler (armdyn/algorithm/rnea.hpp).
-//  - Cartesian: the paper's constrained Newton-Euler system on the bodies' Cartesian state:
-//    forward dynamics with the joint torques as loads (KKT solve for v' and the multipliers);
-//    inverse dynamics with every joint coordinate driven to (q, qd, qdd), the torques being the
-//    drives' multipliers.
-// Auto takes Joint, the faster of the two for every model these functions accept. Both include
-// the model's force elements and ignore its drives.
+// Joint-space forward and inverse dynamics of a tree, by methods that give the same answer to
+// round-off:
+//  - forward dynamics: Crba -- the composite-rigid-body mass matrix, the recursive
+//    Newton-Euler bias and a Cholesky solve (O(n^3) on a chain); Aba -- the articulated-body
+//    algorithm (armdyn/algorithm/aba.hpp, O(n)); Cartesian -- the paper's constrained
+//    Newton-Euler system on the bodies' Cartesian state with the joint torques as loads (KKT
+//    solve for v' and the multipliers). Joint takes the cheaper of Crba and Aba, Auto the
+//    cheapest of the three, both by the measured cost model of armdyn/algorithm/cost_model.hpp
+//    (derived once per model).
+//  - inverse dynamics: Joint (and Auto) -- recursive Newton-Euler (armdyn/algorithm/rnea.hpp);
+//    Cartesian -- every joint coordinate driven to (q, qd, qdd), the torques being the drives'
+//    multipliers.
+// All include the model's force elements and ignore its drives.
 #pragma once
 
 #include "armdyn/data.hpp"
 
 namespace armdyn {
 
-enum class DynamicsMethod { Auto, Joint, Cartesian };
+enum class DynamicsMethod { Auto, Joint, Crba, Aba, Cartesian };
 
-/// "auto" | "joint" | "cartesian"; throws ModelError naming fn for anything else.
-DynamicsMethod dynamics_method(const std::string& name, const char* fn);
+/// forward dynamics: "auto" | "joint" | "crba" | "aba" | "cartesian"; inverse dynamics
+/// (forward = false): "auto" | "joint" | "cartesian". Throws ModelError naming fn for anything
+/// else.
+DynamicsMethod dynamics_method(const std::string& name, const char* fn, bool forward = true);
 
 /// The joint-space equations of motion M(q) qdd = rhs of a tree at (q, qd), auxiliary states z
 /// (model.n_aux; nullptr: all zero) and time t, with extra joint forces tau (nullptr: none):

@@ -14,8 +14,10 @@
 //    an orthonormal basis T of their null space (a QR of G^T at construction):
 //    qdd = T (T^T M T)^-1 T^T (Q - b + J^T eta).
 // The rows are linear in q, so every Runge-Kutta method keeps G q = 0 and G qd = 0 exactly up to
-// round-off; project() removes that round-off. The Cartesian path (algorithm/kkt.hpp) remains the
-// reference: tests compare the two.
+// round-off; project() removes that round-off. Without ideal gears, accelerations() takes the
+// articulated-body algorithm (armdyn/algorithm/aba.hpp, O(n)) where the measured cost model
+// (armdyn/algorithm/cost_model.hpp) predicts it cheaper than CRBA + Cholesky. The Cartesian path
+// (algorithm/kkt.hpp) remains the reference: tests compare the two.
 #pragma once
 
 #include <memory>
@@ -51,6 +53,9 @@ class TreeDynamics {
   int n() const { return n_; }      ///< joint coordinates
   int dof() const { return dof_; }  ///< independent coordinates (n - rank of the gear rows)
   std::string description() const;  ///< one line for the run's statistics
+  /// accelerations() runs the articulated-body algorithm (no ideal gears, and the cost model
+  /// predicts it cheaper than CRBA + Cholesky)
+  bool uses_aba() const { return aba_; }
   const Model& model() const { return m_; }
 
   /// Accelerations qdd (n) at (q, qd) (n each), auxiliary states z (model.n_aux; may be nullptr
@@ -68,7 +73,8 @@ class TreeDynamics {
   void project(double* q, double* qd);
   /// The joint-space mass matrix at q (n x n), by the composite-rigid-body algorithm.
   const MatX& mass_matrix(const double* q);
-  /// The mass matrix of the last accelerations() or mass_matrix() call.
+  /// The mass matrix of the last mass_matrix() call, or of the last accelerations() call when
+  /// it took CRBA (uses_aba() false).
   const MatX& last_mass_matrix() const { return d_.M; }
   /// The ideal gears' multipliers (one per gear, the Cartesian rows' convention
   /// M qdd = rhs - G^T delta) of the last accelerations() call, whose result is qdd: the
@@ -86,6 +92,7 @@ class TreeDynamics {
   Data& d_;
   const GearSpace& gs_;
   int n_ = 0, dof_ = 0, rank_ = 0;
+  bool aba_ = false;  // accelerations by the articulated-body algorithm (no ideal gears)
 };
 
 }  // namespace armdyn
