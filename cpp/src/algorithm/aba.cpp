@@ -25,7 +25,32 @@ inline Vec6 motion_cross(const Vec6& a, const Vec6& b) {
   return r;
 }
 
-// coordinate k of joint j: a turn about the axis line through the joint point, or a slide
+// a motion (w, v) about point `from` expressed about point `to`: v_to = v_from + w x (to - from)
+inline Vec6 shift_motion(const Vec6& a, const Vec3& from, const Vec3& to) {
+  Vec6 r;
+  r.head<3>() = a.head<3>();
+  r.tail<3>() = a.tail<3>() + a.head<3>().cross(to - from);
+  return r;
+}
+
+// out += X^T I X: a spatial inertia I about point a (angular rows first) moved to point b, with
+// r = a - b; X = [1 0; -[r]x 1] maps a motion about b to one about a, X^T a force about a to one
+// about b (n_b = n_a + r x f)
+inline void add_shifted_inertia(const Mat6& I, const Vec3& r, Mat6& out) {
+  const Mat3 R = skew(r);
+  const Mat3 A = I.topLeftCorner<3, 3>(), B = I.topRightCorner<3, 3>();
+  const Mat3 C = I.bottomLeftCorner<3, 3>(), M = I.bottomRightCorner<3, 3>();
+  // I X = [A - B R, B; C - M R, M]; X^T (I X) = [I R; 0 1] (I X) with R^T = -R
+  const Mat3 BR = B * R, MR = M * R;
+  const Mat3 top_left = A - BR, bottom_left = C - MR;
+  out.topLeftCorner<3, 3>() += top_left + R * bottom_left;
+  out.topRightCorner<3, 3>() += B + R * M;
+  out.bottomLeftCorner<3, 3>() += bottom_left;
+  out.bottomRightCorner<3, 3>() += M;
+}
+
+// coordinate k of joint j: a turn about the axis line through the joint point (p, relative to
+// the point the spatial vectors are taken about), or a slide
 inline Vec6 motion_of(const Joint& j, int k, const Vec3& z, const Vec3& p) {
   Vec6 s;
   if (j.type == JointType::Prismatic || k == 1)
@@ -60,45 +85,45 @@ void aba_accelerations(const Model& m, Data& d, const double* q, const double* q
                               m.coords[c].name, "' at t=", t));
   }
   Data::AbaWork& w = d.aba;
-  // each body's spatial inertia about the world origin, its spatial velocity, and its bias
-  // force: the residual wrench about the origin at zero spatial acceleration,
-  //   F = m W x xd - eta_f,  N_O = x x F - R eta_tau
+  // Spatial quantities in world axes, each body's about its own centre of mass x_i (a point
+  // fixed in space at this instant), not about the world origin: there the inertia of a link far
+  // from the origin carries m |x|^2 terms that cancel in D = s^T I^A s, and a link whose own
+  // inertia is tiny (a flange, a sensor, 1e-12 kg m^2) lost its acceleration to that cancellation
+  // (UR5 wrist_3_link inertia x 1e-12: 6.6e-4 relative error; Pinocchio works in local frames).
+  // About the centre of mass the body's inertia is diag(R J R^T, m), its velocity (W, xd) and its
+  // bias force the residual wrench at zero spatial acceleration,
+  //   p = (-R eta_tau, m W x xd - eta_f)   (eta_tau holds the gyroscopic torque).
   for (int i = 0; i < m.nb; ++i) {
     const Body& b = m.bodies[i];
     const BodyKin& k = d.kin[i];
-    const Vec3 h = b.mass * k.x;
     Mat6& I = w.IA[i];
-    const Mat3 RJ = k.R * b.inertia;
-    Mat3 IO;
-    IO.noalias() = RJ * k.R.transpose();
-    IO.noalias() -= h * k.x.transpose();
-    IO.diagonal().array() += h.dot(k.x);
-    const Mat3 H = skew(h);
-    I.topLeftCorner<3, 3>() = IO;
-    I.topRightCorner<3, 3>() = H;
-    I.bottomLeftCorner<3, 3>() = -H;
-    I.bottomRightCorner<3, 3>() = Mat3::Identity() * b.mass;
+    I.setZero();
+    I.topLeftCorner<3, 3>().noalias() = k.R * b.inertia * k.R.transpose();
+    I.bottomRightCorner<3, 3>().diagonal().setConstant(b.mass);
     Vec6& v = w.v[i];
     v.head<3>() = k.W;
-    v.tail<3>() = k.xd - k.W.cross(k.x);
-    const Vec3 F = b.mass * k.W.cross(k.xd) - d.eta.segment<3>(6 * i);
+    v.tail<3>() = k.xd;
     Vec6& p = w.pA[i];
-    p.head<3>().noalias() = k.x.cross(F) - k.R * d.eta.segment<3>(6 * i + 3);
-    p.tail<3>() = F;
+    p.head<3>().noalias() = -(k.R * d.eta.segment<3>(6 * i + 3));
+    p.tail<3>() = b.mass * k.W.cross(k.xd) - d.eta.segment<3>(6 * i);
   }
-  // the coordinates' motions and velocity products, parents first
+  // the coordinates' motions (about the child's centre of mass) and velocity products, parents
+  // first: c = v_parent x (s qd), with the parent's velocity moved to the child's point
   for (int ji : m.tree_order) {
     const Joint& j = m.joints[ji];
+    const Vec3& o = d.kin[j.child].x;
     for (int k = 0; k < joint_coords(j.type); ++k) {
       const int c = j.coord0 + k;
-      d.s[c] = motion_of(j, k, d.rne.axis[ji], d.rne.point[ji]);
-      if (j.parent == kGround)
+      d.s[c] = motion_of(j, k, d.rne.axis[ji], d.rne.point[ji] - o);
+      if (j.parent == kGround) {
         w.c[c].setZero();
-      else
-        w.c[c] = motion_cross(w.v[j.parent], d.s[c] * qd[c]);
+      } else {
+        const Vec6 vp = shift_motion(w.v[j.parent], d.kin[j.parent].x, o);
+        w.c[c] = motion_cross(vp, d.s[c] * qd[c]);
+      }
     }
   }
-  // articulated inertias and bias forces, children first
+  // articulated inertias and bias forces, children first, each passed to the parent's point
   for (auto it = m.tree_order.rbegin(); it != m.tree_order.rend(); ++it) {
     const Joint& j = m.joints[*it];
     const int i = j.child;
@@ -125,18 +150,21 @@ void aba_accelerations(const Model& m, Data& d, const double* q, const double* q
       pA += (u * Dinv) * U;
     }
     if (j.parent != kGround) {
-      w.IA[j.parent] += IA;
-      w.pA[j.parent] += pA;
+      const Vec3 r = d.kin[i].x - d.kin[j.parent].x;  // from the parent's point to the child's
+      add_shifted_inertia(IA, r, w.IA[j.parent]);
+      Vec6& pp = w.pA[j.parent];
+      pp.head<3>() += pA.head<3>() + r.cross(pA.tail<3>());
+      pp.tail<3>() += pA.tail<3>();
     }
   }
-  // accelerations, parents first
+  // accelerations, parents first, each moved from the parent's point to the child's
   for (int ji : m.tree_order) {
     const Joint& j = m.joints[ji];
     Vec6& a = w.a[j.child];
     if (j.parent == kGround)
       a.setZero();
     else
-      a = w.a[j.parent];
+      a = shift_motion(w.a[j.parent], d.kin[j.parent].x, d.kin[j.child].x);
     for (int k = 0; k < joint_coords(j.type); ++k) {
       const int c = j.coord0 + k;
       a += w.c[c];

@@ -42,6 +42,7 @@ void forward_cartesian(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen:
   } restore{d};
   d.nrows = m.nc_joint;
   d.aux = nullptr;
+  d.augmented = false;  // each call decides afresh: the result never depends on earlier calls
   d.with_coordinate_forces = true;
   d.joint_torques = d.tau_in.data();
   load_joint_kinematics(m, d, q, qd);
@@ -83,6 +84,7 @@ void inverse_cartesian(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen:
     d.driven_data->ce.drive_values = false;
   }
   Data& dd = *d.driven_data;
+  dd.augmented = false;  // each call decides afresh
   load_joint_kinematics(m, dd, q, qd);
   for (int c = 0; c < n; ++c) {
     d.drive_ref[3 * c] = q[c];

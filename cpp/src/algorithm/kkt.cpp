@@ -47,9 +47,11 @@ namespace {
 void solve_augmented(const Model& m, Data& d, double t, int nrows, const std::string& why) {
   PipelineStats& st = d.stats;
   if (!d.kkt.accelerations_augmented(d.ce, nrows, d.eta, d.vd_work, d.delta))
-    throw SolverError(msg("the augmented constraint system is singular at t=", t,
-                          " (the joint-space mass matrix is not positive definite: a massless "
-                          "or inertia-less subtree?)"));
+    throw SolverError(
+        msg("the augmented constraint system is singular at t=", t,
+            " (the joint-space mass matrix is not positive definite: a massless "
+            "or inertia-less subtree?",
+            light_bodies(m).bodies.empty() ? std::string(")") : "; " + light_bodies(m).note + ")"));
   if (st.augmented_solves++ == 0) st.augmented_note = why;
   ++st.factorizations;
   ++st.kkt_solves;

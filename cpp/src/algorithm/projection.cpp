@@ -68,7 +68,8 @@ void project(const Model& m, Data& d, double t, double* u, double* v, Metric met
       // rows that finalize() took as dependent though they agree only to round-off (axes
       // aligned to 1e-6, builder/finalize.cpp) cannot all hold: the minimum-norm step then
       // vanishes at their least-squares point, whose residual is that misalignment
-      if (m.redundant && d.vd_work.cwiseAbs().maxCoeff() < 1e-12 * std::max(1.0, m.length_scale) &&
+      if (!m.aligned_rows.empty() &&
+          d.vd_work.cwiseAbs().maxCoeff() < 1e-12 * std::max(1.0, m.length_scale) &&
           rf < kAlignedResidual * std::max(1.0, m.length_scale))
         break;
       if (rf > 0.25 * rprev) {
@@ -79,7 +80,7 @@ void project(const Model& m, Data& d, double t, double* u, double* v, Metric met
       }
       rprev = rf;
     }
-    const double accept = m.redundant ? kAlignedResidual : 1e-9;
+    const double accept = m.aligned_rows.empty() ? 1e-9 : kAlignedResidual;
     if (!(rf < accept * std::max(1.0, m.length_scale))) {
       int worst = 0;
       ce.f.head(nrows).cwiseAbs().maxCoeff(&worst);

@@ -171,11 +171,13 @@ std::shared_ptr<Model> finalize_draft(const Model& draft, const FinalizeOptions&
       const MatX& R = qr.matrixQR();
       const double r00 = std::abs(R(0, 0));
       for (int k = r; k < nrows; ++k) {
-        const std::string name = m.row_name(qr.colsPermutation().indices()[k]);
+        const int row = qr.colsPermutation().indices()[k];
+        const std::string name = m.row_name(row);
         if (names) names->push_back(name);
         const double level = k < R.rows() ? std::abs(R(k, k)) / r00 : 0.0;
         if (level > 1e-12 && std::find(near.begin(), near.end(), name) == near.end()) {
           near.push_back(name);
+          m.aligned_rows.push_back(row);
           near_level = std::max(near_level, level);
         }
       }

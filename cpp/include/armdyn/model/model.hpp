@@ -229,6 +229,10 @@ class Model {
   /// what finalize() treated as exact though it holds only to round-off (the Python finalize
   /// issues each as a UserWarning)
   std::vector<std::string> warnings;
+  /// rows finalize() took as dependent though they are so only to round-off (1e-12 .. 1e-6):
+  /// the projection accepts their least-squares residual (up to 1e-6 l); empty for models whose
+  /// dependent rows are exactly so
+  std::vector<int> aligned_rows;
   bool redundant = false;
   double length_scale = 1.0;  ///< characteristic length for tolerances [m]
   /// true: the KKT solves take the dense pivoted path whatever the plan (the reference path;
