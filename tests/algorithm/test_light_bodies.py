@@ -56,9 +56,9 @@ def test_forward_dynamics_of_a_light_link_equals_pinocchio(tmp_path, eps):
 @pytest.mark.parametrize("eps", [1e-8, 1e-12, 1e-16])
 def test_a_light_leaf_link_keeps_its_acceleration(tmp_path, eps):
     """wrist_3_link, the leaf, with its inertia scaled (its mass kept, centre of mass on its
-    axis): its own axis sees only that inertia. The articulated-body algorithm about each body's
-    centre of mass keeps it (about the world origin it lost 6.6e-4 at 1e-12 and failed at
-    1e-16, as the CRBA path still does); "joint" and "auto" take it."""
+    axis): its own axis sees only that inertia. The articulated-body algorithm and CRBA, both
+    about each body's centre of mass, keep it (about the world origin they lost 6.6e-4 at 1e-12
+    and failed at 1e-16)."""
     path = _ur5_light(tmp_path, eps, link="wrist_3_link")
     model = ad.load_urdf(str(path))
     assert ad.dynamics_cost(model)["joint"] == "aba"
@@ -68,7 +68,7 @@ def test_a_light_leaf_link_keeps_its_acceleration(tmp_path, eps):
     for _ in range(3):
         q, qd, tau = rng.uniform(-1.0, 1.0, size=(3, 6))
         ref = pin.aba(pm, pd, q, qd, tau)
-        for method in ("auto", "joint", "aba", "cartesian"):
+        for method in ("auto", "joint", "aba", "crba", "cartesian"):
             a = ad.forward_dynamics(model, q, qd, tau, method=method)
             # measured <= 5.4e-16
             assert np.abs(a - ref).max() / np.abs(ref).max() <= 1e-12, method
