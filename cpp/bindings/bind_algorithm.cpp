@@ -184,6 +184,7 @@ void bind_algorithm(py::module_& m) {
         r["aba_us"] = c.aba;
         r["cartesian_us"] = c.cartesian;
         r["joint"] = lower(c.joint);
+        r["light"] = c.light;
         r["auto"] = lower(c.best);
         r["joint_rhs_us"] = c.joint_rhs;
         r["cartesian_rhs_us"] = c.cartesian_rhs;

@@ -56,12 +56,14 @@ def test_forward_dynamics_of_a_light_link_equals_pinocchio(tmp_path, eps):
 @pytest.mark.parametrize("eps", [1e-8, 1e-12, 1e-16])
 def test_a_light_leaf_link_keeps_its_acceleration(tmp_path, eps):
     """wrist_3_link, the leaf, with its inertia scaled (its mass kept, centre of mass on its
-    axis): its own axis sees only that inertia. The articulated-body algorithm and CRBA, both
-    about each body's centre of mass, keep it (about the world origin they lost 6.6e-4 at 1e-12
-    and failed at 1e-16)."""
+    axis): its own axis sees only that inertia. The articulated-body algorithm about each body's
+    centre of mass keeps it (about the world origin it lost 6.6e-4 at 1e-12 and failed at
+    1e-16); CRBA's composites about the world origin would lose it, so on a model with light
+    bodies "joint", "auto" and an explicit "crba" run ABA (documented)."""
     path = _ur5_light(tmp_path, eps, link="wrist_3_link")
     model = ad.load_urdf(str(path))
-    assert ad.dynamics_cost(model)["joint"] == "aba"
+    cost = ad.dynamics_cost(model)
+    assert cost["light"] and cost["joint"] == "aba" and cost["auto"] == "aba"
     pm = pin.buildModelFromUrdf(str(path))
     pd = pm.createData()
     rng = np.random.default_rng(3)
@@ -127,6 +129,7 @@ def test_a_link_without_inertia_and_no_mass_beyond_it_is_an_error():
     b.add_body("bead", 1.0, [0.0, 0.0, 0.0], position=(0, 0, 0))
     b.add_revolute("spin", "ground", "bead", point=(0, 0, 0), axis=(0, 0, 1))
     model = b.finalize()
-    for method in ("joint", "cartesian"):
-        with pytest.raises(ad.SolverError, match=r"positive definite|singular"):
+    for method in ("joint", "crba", "cartesian"):
+        # ABA names the joint and the body; the augmented solve the light body
+        with pytest.raises(ad.SolverError, match=r"body 'bead'.*not positive|singular.*'bead'"):
             ad.forward_dynamics(model, [0.0], [0.0], [1.0], method=method)

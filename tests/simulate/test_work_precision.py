@@ -173,7 +173,10 @@ def test_tightest_point_against_an_independent_lagrange_solution(arm, sweep):
     )
     independent = np.abs(res.q - lagrange).max()
     assert 1e-10 < independent == pytest.approx(row["error"], rel=0.02)
-    assert np.abs(res.q - ref).max() == row["error"]  # the table's number, recomputed
+    # the table's number, recomputed as the table measures it (angles wrapped: d + pi rounds d
+    # to the ulp of pi, so the unwrapped difference can differ in its last bits)
+    d = np.remainder(res.q - ref + np.pi, 2 * np.pi) - np.pi
+    assert np.abs(d).max() == row["error"]
 
 
 def test_reference_agrees_with_a_cartesian_run(arm, sweep):

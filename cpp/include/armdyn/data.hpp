@@ -59,16 +59,15 @@ class Data {
   VecX tau;  ///< (n) the last rnea's joint torques/forces
   // --- composite-rigid-body algorithm (crba) ---
   std::vector<int> joint_of_body;  ///< per body: the joint it is the child of (-1: none)
-  /// A subtree's spatial inertia about its root body's centre of mass a (world axes): mass m,
-  /// first moment h = m (c - a), and rotational inertia I about a; momentum
-  /// (I w + h x v_a, m v_a - h x w).
+  /// A subtree's spatial inertia about the world origin: mass m, first moment h = m c, and
+  /// rotational inertia I about the origin; momentum (I w + h x v_O, m v_O - h x w).
   struct Composite {
     double m = 0.0;
     Vec3 h = Vec3::Zero();
     Mat3 I = Mat3::Zero();
   };
   std::vector<Composite> ic;  ///< per body: its subtree's spatial inertia
-  std::vector<Vec6> s;        ///< per coordinate: its motion (angular; velocity of its child's CoM)
+  std::vector<Vec6> s;        ///< per coordinate: its motion (angular; velocity of origin)
   MatX M;                     ///< (n, n) joint-space mass matrix
   // --- articulated-body algorithm (aba) ---
   struct AbaWork {

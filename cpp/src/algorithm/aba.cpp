@@ -33,20 +33,24 @@ inline Vec6 shift_motion(const Vec6& a, const Vec3& from, const Vec3& to) {
   return r;
 }
 
-// out += X^T I X: a spatial inertia I about point a (angular rows first) moved to point b, with
-// r = a - b; X = [1 0; -[r]x 1] maps a motion about b to one about a, X^T a force about a to one
-// about b (n_b = n_a + r x f)
+// out += X^T I X: a symmetric spatial inertia I = [A B; B^T M] about point a (angular rows
+// first) moved to point b, with r = a - b; X = [1 0; -[r]x 1] maps a motion about b to one about
+// a, X^T a force about a to one about b (n_b = n_a + r x f). With R = [r]x (R^T = -R):
+//   X^T I X = [A - BR - (BR)^T - R M R,  B - (MR)^T;  (B - (MR)^T)^T,  M],
+// the products by R as cross products (row b^T R = (b x r)^T, column R c = r x c).
 inline void add_shifted_inertia(const Mat6& I, const Vec3& r, Mat6& out) {
-  const Mat3 R = skew(r);
-  const Mat3 A = I.topLeftCorner<3, 3>(), B = I.topRightCorner<3, 3>();
-  const Mat3 C = I.bottomLeftCorner<3, 3>(), M = I.bottomRightCorner<3, 3>();
-  // I X = [A - B R, B; C - M R, M]; X^T (I X) = [I R; 0 1] (I X) with R^T = -R
-  const Mat3 BR = B * R, MR = M * R;
-  const Mat3 top_left = A - BR, bottom_left = C - MR;
-  out.topLeftCorner<3, 3>() += top_left + R * bottom_left;
-  out.topRightCorner<3, 3>() += B + R * M;
-  out.bottomLeftCorner<3, 3>() += bottom_left;
-  out.bottomRightCorner<3, 3>() += M;
+  Mat3 BR, MR;
+  for (int i = 0; i < 3; ++i) {
+    BR.row(i) = I.block<1, 3>(i, 3).cross(r.transpose());
+    MR.row(i) = I.block<1, 3>(3 + i, 3).cross(r.transpose());
+  }
+  Mat3 RMR;
+  for (int k = 0; k < 3; ++k) RMR.col(k) = r.cross(MR.col(k));
+  Mat3 TR = I.topRightCorner<3, 3>() - MR.transpose();
+  out.topLeftCorner<3, 3>() += I.topLeftCorner<3, 3>() - BR - BR.transpose() - RMR;
+  out.topRightCorner<3, 3>() += TR;
+  out.bottomLeftCorner<3, 3>() += TR.transpose();
+  out.bottomRightCorner<3, 3>() += I.bottomRightCorner<3, 3>();
 }
 
 // coordinate k of joint j: a turn about the axis line through the joint point (p, relative to

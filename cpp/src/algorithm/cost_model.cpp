@@ -7,6 +7,7 @@
 
 #include "armdyn/analysis/tree_dynamics.hpp"
 #include "armdyn/errors.hpp"
+#include "armdyn/solver/kkt.hpp"
 
 namespace armdyn {
 
@@ -82,6 +83,11 @@ const DynamicsCost& dynamics_cost(const Model& m) {
     c.joint = c.aba < c.crba ? DynamicsMethod::Aba : DynamicsMethod::Crba;
     const double jc = std::min(c.crba, c.aba);
     c.best = c.cartesian < jc ? DynamicsMethod::Cartesian : c.joint;
+    // light bodies (solver/kkt.hpp): ABA, about each body's centre of mass, keeps their
+    // accelerations; CRBA's composites about the world origin lose a light leaf link's (UR5
+    // wrist_3_link inertia x 1e-12: 6.6e-4), and the Cartesian path turns to a dense LU
+    c.light = !light_bodies(m).bodies.empty();
+    if (c.light) c.joint = c.best = DynamicsMethod::Aba;
     c.dof = c.n;
     if (!m.gear_constraints.empty() && m.joint_tree) {
       // the null-space reduction needs the mass matrix: CRBA
@@ -105,6 +111,9 @@ DynamicsMethod resolve_method(const Model& m, DynamicsMethod method) {
       return dynamics_cost(m).best;
     case DynamicsMethod::Joint:
       return dynamics_cost(m).joint;
+    case DynamicsMethod::Crba:
+      // a model with light bodies: ABA instead (dynamics_cost), documented
+      return dynamics_cost(m).light ? DynamicsMethod::Aba : method;
     default:
       return method;
   }

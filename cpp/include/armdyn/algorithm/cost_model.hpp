@@ -43,6 +43,9 @@ struct DynamicsCost {
   DynamicsMethod joint = DynamicsMethod::Crba;  ///< the cheaper joint-space algorithm
   DynamicsMethod best = DynamicsMethod::Crba;   ///< the cheapest of crba, aba, cartesian
   bool joint_rhs_cheaper = true;                ///< simulate: joint space is predicted cheaper
+  /// the model has light bodies (solver/kkt.hpp light_bodies): joint, best and an explicit
+  /// "crba" take ABA, the algorithm that keeps their accelerations
+  bool light = false;
   /// e.g. "predicted 41 us (ABA) vs 95 us (CRBA) vs 120 us (Cartesian) per evaluation"
   std::string forward_summary() const;
   std::string rhs_summary() const;
@@ -52,7 +55,8 @@ struct DynamicsCost {
 /// other models only the Cartesian figures.
 const DynamicsCost& dynamics_cost(const Model& m);
 
-/// The algorithm forward_dynamics runs for method (Auto and Joint resolved by the cost model).
+/// The algorithm forward_dynamics runs for method (Auto and Joint resolved by the cost model;
+/// Crba on a model with light bodies runs ABA).
 DynamicsMethod resolve_method(const Model& m, DynamicsMethod method);
 const char* method_name(DynamicsMethod method);
 
