@@ -133,3 +133,28 @@ def test_a_link_without_inertia_and_no_mass_beyond_it_is_an_error():
         # ABA names the joint and the body; the augmented solve the light body
         with pytest.raises(ad.SolverError, match=r"body 'bead'.*not positive|singular.*'bead'"):
             ad.forward_dynamics(model, [0.0], [0.0], [1.0], method=method)
+
+
+def test_ideal_gears_with_a_light_link_refuse_the_joint_path_and_auto_takes_the_cartesian():
+    """With ideal gears the joint-space simulation needs the mass matrix (CRBA about the world
+    origin), which would lose a light link's acceleration: refused with the reason, and
+    coordinates="auto" takes the Cartesian path, which solves it in augmented form."""
+    b = ad.ModelBuilder(gravity=(0.0, 0.0, -9.81))
+    b.add_body("pinion", 0.5, [1e-3, 1e-3, 2e-3], position=(0, 0, 0))
+    b.add_body("wheel", 2.0, [8e-3, 8e-3, 1.6e-2], position=(0.3, 0, 0))
+    b.add_body("flange", 0.2, [1e-14, 1e-14, 1e-14], position=(0.3, 0.0, -0.1))
+    b.add_revolute("pinion_axle", "ground", "pinion", point=(0, 0, 0), axis=(0, 0, 1))
+    b.add_revolute("wheel_axle", "ground", "wheel", point=(0.3, 0, 0), axis=(0, 0, 1))
+    b.add_revolute("flange_pin", "wheel", "flange", point=(0.3, 0.0, -0.1), axis=(1, 0, 0))
+    b.add_gear("mesh", "pinion_axle", "wheel_axle", 0.05, 0.2)
+    b.add_joint_torque("pinion_axle", 0.3)
+    model = b.finalize()
+    with pytest.raises(ad.ModelError, match=r"light bodies.*'flange'"):
+        ad.simulate(model, 0.1, coordinates="joint")
+    res = ad.simulate(model, 0.5, coordinates="auto", output_dt=0.1, rtol=1e-10, atol=1e-12)
+    assert res.stats["formulation"].startswith("cartesian")
+    assert "flange" in res.stats["augmented_note"]
+    # the gear holds: r_a q_a + r_b q_b = 0, the pinion driven by its torque
+    q = res.q
+    assert np.abs(0.05 * q[:, 0] + 0.2 * q[:, 1]).max() <= 1e-9
+    assert q[-1, 0] > 0.1

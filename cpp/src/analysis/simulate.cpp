@@ -208,6 +208,8 @@ RunPlan plan_run(const Model& m, double t_end, const SimOptions& opt) {
       p.why_coordinates = "joint space does not apply: fully driven";
     } else if (const std::string why = p.ms->joint_path_reason(); !why.empty()) {
       p.why_coordinates = msg("joint space does not apply: ", why);
+    } else if (const std::string why = geared_light_reason(*p.ms); !why.empty()) {
+      p.why_coordinates = msg("joint space does not apply: ", why);
     } else {
       const DynamicsCost& c = dynamics_cost(*p.ms);
       p.joint = c.joint_rhs_cheaper;

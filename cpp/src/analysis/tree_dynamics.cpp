@@ -11,6 +11,7 @@
 #include "armdyn/algorithm/forces.hpp"
 #include "armdyn/errors.hpp"
 #include "armdyn/math/cholesky.hpp"
+#include "armdyn/solver/kkt.hpp"
 
 namespace armdyn {
 
@@ -20,6 +21,17 @@ namespace {
                         " (a massless subtree?)"));
 }
 }  // namespace
+
+std::string geared_light_reason(const Model& m) {
+  if (m.gear_constraints.empty()) return {};
+  const LightBodies& light = light_bodies(m);
+  if (light.bodies.empty()) return {};
+  return msg(
+      "with ideal gears the joint-space path needs the mass matrix (CRBA about the world "
+      "origin), which loses the accelerations of light bodies: ",
+      light.note.substr(0, light.note.find(';')),
+      " (the Cartesian path solves them in augmented form: coordinates 'cartesian')");
+}
 
 const GearSpace& gear_space(const Model& m) {
   return m.derived.get<GearSpace>([&] {
@@ -59,6 +71,8 @@ TreeDynamics::TreeDynamics(const Model& m, Data& d, bool ignore_drives)
 void TreeDynamics::init(bool ignore_drives) {
   const std::string why = m_.joint_path_reason(ignore_drives);
   if (!why.empty()) throw ModelError(msg("joint-space dynamics: ", why));
+  if (const std::string light = geared_light_reason(m_); !light.empty())
+    throw ModelError(msg("joint-space dynamics: ", light));
   n_ = d_.n;
   rank_ = gs_.rank;
   dof_ = n_ - rank_;

@@ -36,6 +36,10 @@ struct GearSpace {
   MatX T, range, Gt_pinv;
 };
 const GearSpace& gear_space(const Model& m);
+/// Why TreeDynamics refuses m although it is a joint tree: ideal gears (which need the
+/// mass matrix by CRBA, about the world origin) together with light bodies (solver/kkt.hpp),
+/// whose accelerations that loses; empty otherwise.
+std::string geared_light_reason(const Model& m);
 
 class TreeDynamics {
  public:
