@@ -112,12 +112,13 @@ void body_accelerations_loaded(const Model& m, Data& d, double t, double* vdot, 
                           " (singular constraint Jacobian or invalid state)"));
   // never silently wrong: the range-space solve forms Gamma^-1, and a body whose inertia is small
   // against the constraint forces on it costs accuracy that shows in zeta vdot = -xi (exact
-  // arithmetic holds it; round-off leaves 1e-16 of the terms' sizes). Beyond 1e-10 the
+  // arithmetic holds it; round-off leaves 1e-16 of the terms' sizes; mass and gear ratios a few
+  // digits more: the geared arm reaches 2e-10 at gear contact). Beyond 1e-8 the
   // augmented solve takes over for the rest of this Data's life. (Not near a singular
   // configuration, where the regularised factor leaves a residual on purpose.)
   if (!kkt.near_singular() && !kkt.used_pseudo_inverse()) {
     const double res = constraint_residual(d.ce, nrows, d.vd_work);
-    if (res > 1e-10) {
+    if (res > 1e-8) {
       d.augmented = true;
       solve_augmented(
           m, d, t, nrows,
