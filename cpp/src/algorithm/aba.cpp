@@ -10,12 +10,6 @@ namespace armdyn {
 
 namespace {
 
-inline Mat3 skew(const Vec3& x) {
-  Mat3 s;
-  s << 0.0, -x.z(), x.y(), x.z(), 0.0, -x.x(), -x.y(), x.x(), 0.0;
-  return s;
-}
-
 // motion cross product (w, v) x (w2, v2) = (w x w2, w x v2 + v x w2)
 inline Vec6 motion_cross(const Vec6& a, const Vec6& b) {
   Vec6 r;
