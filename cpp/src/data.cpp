@@ -22,6 +22,7 @@ Data::Data(const Model& m) : model(&m), n(static_cast<int>(m.coords.size())), kk
   tol_f = 1e-13 * std::max(1.0, m.length_scale);
   kin.resize(m.nb);
   ce.init(m);
+  light = &light_bodies(m);
   joint_block.assign(m.joints.size(), -1);
   for (size_t j = 0; j < m.joints.size(); ++j)
     for (size_t b = 0; b < ce.blocks.size(); ++b)

@@ -110,6 +110,8 @@ class Data {
   /// the range-space solve lost accuracy once on this Data (its constraint residual): every later
   /// body_accelerations takes the augmented solve (reset_pipeline clears it)
   bool augmented = false;
+  /// the model's light bodies (light_bodies(model), looked up once here, not per evaluation)
+  const LightBodies* light = nullptr;
   VecX delta;                        ///< (nc) multipliers of the last body_accelerations
   VecX vd_work, tmp_nv, tmp_nc, mu;  ///< (nv, nv, nc, nc) scratch
   double tol_f = 1e-13;              ///< position residual accepted by project without a correction

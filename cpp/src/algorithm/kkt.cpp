@@ -72,7 +72,7 @@ void body_accelerations_loaded(const Model& m, Data& d, double t, double* vdot, 
   const int nrows = d.nrows;
   PipelineStats& st = d.stats;
   d.swept = false;
-  const LightBodies& light = light_bodies(m);
+  const LightBodies& light = *d.light;
   if (!light.bodies.empty() || d.augmented) {
     // no Gamma^-1: light bodies (known from the model), or a range-space solve on this Data
     // that lost accuracy
