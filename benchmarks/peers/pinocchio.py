@@ -94,17 +94,21 @@ def pinocchio_tree(model: _core.Model):
 
 class PinPair:
     """The same URDF in armdyn (``am``) and Pinocchio (``pm``, ``pd``), with the coordinate map
-    between them: ``q_armdyn[perm] = q_pinocchio`` (:meth:`to_armdyn`)."""
+    between them: ``q_armdyn[perm] = q_pinocchio`` (:meth:`to_armdyn`). ``mimic``: both read
+    ``<mimic>`` as couplings (Pinocchio's ``mimic=True``; q then holds the independent
+    coordinates) or both give each mimicking joint its own coordinate (``False``)."""
 
-    def __init__(self, path: Path):
+    def __init__(self, path: Path, mimic: bool = False):
         import pinocchio as pin
 
         self.pin = pin
-        self.pm = pin.buildModelFromUrdf(str(path))
+        self.pm = pin.buildModelFromUrdf(str(path), mimic=mimic)
         self.pd = self.pm.createData()
-        self.am = ad.load_urdf(str(path))
+        self.am = ad.load_urdf(str(path), mimic=mimic)
         names = list(self.am.coord_names)
-        pin_names = [self.pm.names[i] for i in range(1, self.pm.njoints)]
+        pin_names = [
+            self.pm.names[i] for i in range(1, self.pm.njoints) if self.pm.joints[i].nq > 0
+        ]
         if self.pm.nq != self.pm.nv or self.pm.nq != len(names):
             raise ValueError("only revolute/prismatic arms are compared")
         self.perm = np.array([names.index(n) for n in pin_names])

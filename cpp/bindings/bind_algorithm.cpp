@@ -148,18 +148,20 @@ void bind_algorithm(py::module_& m) {
         const DynamicsMethod mth = dynamics_method(method, fn);
         const Model& mm = *md;
         if (is_batch(q))
-          return batch(fn, d.n, q, qd, "qd", tau, "tau", t, {d.n},
+          return batch(fn, d.ni, q, qd, "qd", tau, "tau", t, {d.ni},
                        [&](auto qi, auto qdi, auto ti, double tt, double* out) {
                          const VecX& r = forward_dynamics(mm, d, qi, qdi, ti, tt, mth);
-                         std::copy(r.data(), r.data() + d.n, out);
+                         std::copy(r.data(), r.data() + d.ni, out);
                        });
-        const VecArg qa(q, "q", d.n), qda(qd, "qd", d.n), ta(tau, "tau", d.n);
+        const VecArg qa(q, "q", d.ni), qda(qd, "qd", d.ni), ta(tau, "tau", d.ni);
         return vector_out(forward_dynamics(mm, d, *qa, *qda, *ta, scalar_time(t, fn), mth));
       },
       py::arg("model"), py::arg("q"), py::arg("qd"), py::arg("tau"), py::arg("t") = 0.0,
       py::arg("method") = "auto", py::arg("data") = py::none(),
       "Joint accelerations qdd of a tree for joint torques/forces tau at (q, qd) and time t "
-      "[s] (n_coords each; 2-D: one state per row). method: 'crba' (CRBA mass matrix, "
+      "[s] (n_coords each: a coupled model's independent coordinates, followers of couplings "
+      "removed, as Pinocchio's mimic=True models; 2-D: one state per row). method: 'crba' (CRBA "
+      "mass matrix, "
       "recursive Newton-Euler bias, Cholesky), 'aba' (articulated-body algorithm, O(n)), "
       "'cartesian' (the constrained Newton-Euler KKT system of the bodies), 'joint' (the "
       "cheaper of crba and aba for this model), 'auto' (the cheapest of the three); the choice "
@@ -207,18 +209,19 @@ void bind_algorithm(py::module_& m) {
         const DynamicsMethod mth = dynamics_method(method, fn, false);
         const Model& mm = *md;
         if (is_batch(q))
-          return batch(fn, d.n, q, qd, "qd", qdd, "qdd", t, {d.n},
+          return batch(fn, d.ni, q, qd, "qd", qdd, "qdd", t, {d.ni},
                        [&](auto qi, auto qdi, auto ai, double tt, double* out) {
                          const VecX& r = inverse_dynamics(mm, d, qi, qdi, ai, tt, mth);
-                         std::copy(r.data(), r.data() + d.n, out);
+                         std::copy(r.data(), r.data() + d.ni, out);
                        });
-        const VecArg qa(q, "q", d.n), qda(qd, "qd", d.n), aa(qdd, "qdd", d.n);
+        const VecArg qa(q, "q", d.ni), qda(qd, "qd", d.ni), aa(qdd, "qdd", d.ni);
         return vector_out(inverse_dynamics(mm, d, *qa, *qda, *aa, scalar_time(t, fn), mth));
       },
       py::arg("model"), py::arg("q"), py::arg("qd"), py::arg("qdd"), py::arg("t") = 0.0,
       py::arg("method") = "auto", py::arg("data") = py::none(),
-      "Joint torques/forces tau realising qdd at (q, qd) and time t [s] (n_coords each; 2-D: "
-      "one state per row): what each joint's actuator applies to its child about/along the "
+      "Joint torques/forces tau realising qdd at (q, qd) and time t [s] (n_coords each: a "
+      "coupled model's independent coordinates, tau = G^T tau_full; 2-D: one state per row): what "
+      "each joint's actuator applies to its child about/along the "
       "joint axis, gravity and the model's force elements included, drives ignored. method: "
       "'joint' (recursive Newton-Euler), 'cartesian' (every coordinate driven, the drives' KKT "
       "multipliers), 'auto' (joint).");
@@ -229,7 +232,7 @@ void bind_algorithm(py::module_& m) {
         constexpr const char* fn = "mass_matrix";
         Data& d = data_for(md, data, fn);
         const Model& mm = *md;
-        const long n = d.n;
+        const long n = d.ni;
         // M is symmetric: its column-major storage is also its row-major one
         if (is_batch(q))
           return batch(fn, n, q, q, "q", q, "q", py::float_(0.0), {n, n},
@@ -245,7 +248,8 @@ void bind_algorithm(py::module_& m) {
       },
       py::arg("model"), py::arg("q"), py::arg("data") = py::none(),
       "The joint-space mass matrix M(q) (n_coords, n_coords) of a tree, by the "
-      "composite-rigid-body algorithm; 2-D q (one state per row) gives (rows, n, n).");
+      "composite-rigid-body algorithm (a coupled model's in its independent coordinates, "
+      "G^T M G); 2-D q (one state per row) gives (rows, n, n).");
 }
 
 }  // namespace armdyn

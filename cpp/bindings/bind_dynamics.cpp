@@ -131,24 +131,39 @@ void bind_dynamics(py::module_& m) {
   m.def(
       "state_from_joints",
       [](const Model& md, py::object q, py::object qd) {
-        const long n = static_cast<long>(md.coords.size());
-        VecX u, v;
-        state_from_joints(md, to_vec(q, "q", n), qd.is_none() ? VecX::Zero(n) : to_vec(qd, "qd", n),
-                          u, v);
+        require_joint_space(md, "state_from_joints", true);
+        const IndependentCoords& ic = md.independent;
+        const long n = ic.n, nf = static_cast<long>(md.coords.size());
+        const VecX qi = to_vec(q, "q", n), qdi = qd.is_none() ? VecX::Zero(n) : to_vec(qd, "qd", n);
+        check_joint_vector(qi, n, "state_from_joints", "q");
+        check_joint_vector(qdi, n, "state_from_joints", "qd");
+        VecX qf(nf), qdf(nf), u, v;
+        ic.expand(qi.data(), qf.data(), true);
+        ic.expand(qdi.data(), qdf.data(), false);
+        state_from_joints(md, qf, qdf, u, v);
         return py::make_tuple(to_numpy(u), to_numpy(v));
       },
       py::arg("model"), py::arg("q"), py::arg("qd") = py::none(),
-      "Cartesian state (u, v) of a joint-space tree model from joint coordinates and rates.");
+      "Cartesian state (u, v) of a joint-space tree model from joint coordinates and rates "
+      "(n_coords each: a coupled model's independent coordinates, the followers set by their "
+      "couplings).");
 
   m.def(
       "joint_coordinates",
       [](const Model& md, py::object u, py::object v) {
         VecX q, qd;
         joint_coordinates(md, to_vec(u, "u", md.nq), to_vec(v, "v", md.nv), q, qd);
-        return py::make_tuple(to_numpy(q), to_numpy(qd));
+        const IndependentCoords& ic = md.independent;
+        VecX qi(ic.n), qdi(ic.n);
+        for (int k = 0; k < ic.n; ++k) {
+          qi[k] = q[ic.full[k]];
+          qdi[k] = qd[ic.full[k]];
+        }
+        return py::make_tuple(to_numpy(qi), to_numpy(qdi));
       },
       py::arg("model"), py::arg("u"), py::arg("v"),
-      "Joint coordinates (angles in (-pi, pi]) and rates at the Cartesian state (u, v).");
+      "Joint coordinates (angles in (-pi, pi]) and rates at the Cartesian state (u, v) "
+      "(n_coords each: a coupled model's independent coordinates, as state_from_joints takes).");
 
   m.def(
       "evaluate_constraints",

@@ -87,7 +87,33 @@ void bind_model(py::module_& m) {
       .def_readonly("nv", &Model::nv)
       .def_readonly("nc", &Model::nc)
       .def_readonly("nc_joint", &Model::nc_joint)
-      .def_property_readonly("n_coords", [](const Model& md) { return md.coords.size(); })
+      // joint-space functions take the independent coordinates (couplings' followers removed;
+      // every coordinate without couplings); simulation results report every joint coordinate
+      .def_property_readonly("n_coords", [](const Model& md) { return md.independent.n; })
+      .def_property_readonly("n_joint_coords", [](const Model& md) { return md.coords.size(); })
+      .def_property_readonly("joint_coord_names",
+                             [](const Model& md) {
+                               std::vector<std::string> r;
+                               for (const auto& c : md.coords) r.push_back(c.name);
+                               return r;
+                             })
+      .def_property_readonly("independent_coords",
+                             [](const Model& md) { return md.independent.full; })
+      .def_property_readonly("couplings",
+                             [](const Model& md) {
+                               py::list r;
+                               for (const auto& g : md.gear_constraints) {
+                                 if (!g.coupling) continue;
+                                 py::dict c;
+                                 c["name"] = g.name;
+                                 c["follower"] = md.joints[md.coords[g.coord_a].joint].name;
+                                 c["leader"] = md.joints[md.coords[g.coord_b].joint].name;
+                                 c["multiplier"] = g.multiplier();
+                                 c["offset"] = g.offset;
+                                 r.append(c);
+                               }
+                               return r;
+                             })
       .def_property_readonly("n_drives", [](const Model& md) { return md.drives.size(); })
       .def_property_readonly("body_names",
                              [](const Model& md) {
@@ -110,7 +136,7 @@ void bind_model(py::module_& m) {
       .def_property_readonly("coord_names",
                              [](const Model& md) {
                                std::vector<std::string> r;
-                               for (const auto& c : md.coords) r.push_back(c.name);
+                               for (int c : md.independent.full) r.push_back(md.coords[c].name);
                                return r;
                              })
       .def_property_readonly("drive_names",
@@ -377,6 +403,14 @@ void bind_model(py::module_& m) {
            py::arg("joint_b"), py::arg("r_a"), py::arg("r_b"),
            "Ideal gear (no backlash) between two revolute joints: the rolling constraint "
            "r_a q_a + r_b q_b = 0 (external mesh, multi-turn angles).")
+      .def("add_coupling", &ModelBuilder::add_coupling, py::arg("name"), py::arg("follower"),
+           py::arg("leader"), py::arg("multiplier"), py::arg("offset") = 0.0,
+           "Coupling q_follower = multiplier * q_leader + offset [rad or m] between two revolute "
+           "(continuous) or two prismatic joints (URDF <mimic>): one constraint row; the "
+           "follower becomes a dependent coordinate, and forward_dynamics, inverse_dynamics, "
+           "mass_matrix, state_from_joints and simulate(q0=...) take the independent ones "
+           "(model.coord_names). Chains allowed; cycles, a follower coupled twice, joints of "
+           "different types and a zero or non-finite multiplier are refused (ModelError).")
       .def("add_gear_pair", &ModelBuilder::add_gear_pair, py::arg("name"), py::arg("joint_a"),
            py::arg("joint_b"), py::arg("r_a"), py::arg("r_b"), py::arg("backlash") = 0.0,
            py::arg("stiffness") = 1e8, py::arg("exponent") = 1.5, py::arg("hc_damping") = 0.0,
@@ -433,11 +467,11 @@ void bind_model(py::module_& m) {
 
   m.def(
       "urdf_builder",
-      [](const std::string& src, bool fixed_base, py::object g) {
-        return urdf_builder(src, fixed_base, to_vec3(g, "gravity"));
+      [](const std::string& src, bool fixed_base, py::object g, bool mimic) {
+        return urdf_builder(src, fixed_base, to_vec3(g, "gravity"), mimic);
       },
       py::arg("path_or_xml"), py::arg("fixed_base") = true,
-      py::arg("gravity") = py::make_tuple(0.0, 0.0, -9.81),
+      py::arg("gravity") = py::make_tuple(0.0, 0.0, -9.81), py::arg("mimic") = true,
       "A ModelBuilder holding a URDF robot (add drives or loads, then finalize()).");
 }
 

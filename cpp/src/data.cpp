@@ -56,6 +56,13 @@ Data::Data(const Model& m) : model(&m), n(static_cast<int>(m.coords.size())), kk
   qdd = VecX::Zero(n);
   zero = VecX::Zero(n);
   L = MatX::Zero(n, n);
+  ni = m.independent.source.empty() ? n : m.independent.n;
+  if (ni != n) {
+    for (VecX* x : {&coupled.q, &coupled.qd, &coupled.qdd, &coupled.tau_full}) *x = VecX::Zero(n);
+    for (VecX* x : {&coupled.tau, &coupled.qdd_out, &coupled.rhs}) *x = VecX::Zero(ni);
+    coupled.M = MatX::Zero(ni, ni);
+    coupled.L = MatX::Zero(ni, ni);
+  }
 }
 
 Data::~Data() = default;

@@ -17,8 +17,9 @@ class SimulationResult:
         t: (n,) output times [s].
         u: (n, nq) positions: per body CoM (3) and Euler parameters (4, scalar first).
         v: (n, nv) velocities: per body CoM velocity (3, world) and angular velocity (3, body).
-        q, qd, qdd: (n, n_coords) joint coordinates (angles unwrapped along the run), rates and
-            accelerations (from the constrained accelerations at each output state).
+        q, qd, qdd: (n, n_joint_coords) joint coordinates (angles unwrapped along the run),
+            rates and accelerations (from the constrained accelerations at each output state),
+            every joint's (``model.joint_coord_names``): the followers of couplings included.
         drive_forces: (n, n_drives) actuator torque/force of each drive, applied to the child
             about/along the joint axis (the RNEA/URDF effort convention).
         reaction_forces, reaction_torques: (n, n_joints, 3) joint reaction on the child body at
@@ -97,8 +98,9 @@ def simulate(
         dt: RK4 step (required for rk4); DOPRI5/DOP853/TR-BDF2 initial step (optional).
         output_dt: spacing of output times (default: every accepted step). Output states are
             interpolated (the integrator's dense output) and projected onto the constraints.
-        q0, qd0: initial joint coordinates and rates (n_coords,) for joint-space tree models;
-            default: the model's assembled state at rest.
+        q0, qd0: initial joint coordinates and rates (n_coords,) for joint-space tree models
+            (a coupled model's independent coordinates, ``model.coord_names``: the followers
+            are set by their couplings); default: the model's assembled state at rest.
         u0, v0: initial Cartesian state (nq,), (nv,) instead of q0/qd0 (projected onto the
             constraints first); default: the model's assembled state.
         projection: metric of the minimum-norm projection: ``"mass"`` (kinetic-energy metric,
@@ -164,13 +166,21 @@ def simulate(
     return result
 
 
-def load_urdf(path_or_xml, fixed_base: bool = True, gravity=(0.0, 0.0, -9.81)) -> _core.Model:
+def load_urdf(
+    path_or_xml, fixed_base: bool = True, gravity=(0.0, 0.0, -9.81), mimic: bool = True
+) -> _core.Model:
     """Load a URDF file (or XML string) through urdfdom into a finalized Model.
 
     Links joined by fixed joints are merged into one body; joint-space arrays follow the URDF's
     document order of its moving joints. With ``fixed_base`` the root link is welded to ground.
+    With ``mimic`` (default), each ``<mimic joint= multiplier= offset=>`` becomes a coupling
+    ``q = multiplier * q_joint + offset`` (:meth:`ModelBuilder.add_coupling`, named after the
+    mimicking joint): the joint-space functions then take the independent coordinates
+    (``model.coord_names``, followers removed), as Pinocchio's ``mimic=True`` models do, while
+    simulation results report every joint (``model.joint_coord_names``). ``mimic=False`` gives
+    every mimicking joint its own coordinate (Pinocchio's default).
 
     Raises:
         UrdfError: missing file, malformed XML, unsupported joint type, invalid inertial data.
     """
-    return _core.urdf_builder(str(path_or_xml), fixed_base, gravity).finalize()
+    return _core.urdf_builder(str(path_or_xml), fixed_base, gravity, mimic).finalize()

@@ -46,7 +46,8 @@ class Data {
   Data& operator=(const Data&) = delete;
 
   const Model* model;  ///< the model the buffers are sized for (identity only, not owned)
-  int n = 0;           ///< joint coordinates
+  int n = 0;           ///< joint coordinates (every joint's, followers of couplings included)
+  int ni = 0;          ///< independent joint coordinates (Model::independent; n without couplings)
 
   // --- kinematics: joint_space_kinematics, load_kinematics (shared by the joint-space and the
   // Cartesian algorithms; each loads it before use) ---
@@ -131,6 +132,14 @@ class Data {
   /// a run of the welded model (builder/weld.hpp) evaluates on this Data of it (made on first
   /// use); this Data then holds the full model's outputs
   std::unique_ptr<Data> welded_data;
+
+  /// the public joint-space functions on a coupled model: the full coordinates (n) expanded
+  /// from the independent ones, and the reduced results (ni)
+  struct Coupled {
+    VecX q, qd, qdd, tau_full;  ///< (n)
+    VecX tau, qdd_out, rhs;     ///< (ni)
+    MatX M, L;                  ///< (ni, ni)
+  } coupled;
 
   // --- the public Cartesian forward and inverse dynamics (algorithm/dynamics) ---
   VecX vd, tau_in;                    ///< (nv) accelerations; (n) the joint torques of the call

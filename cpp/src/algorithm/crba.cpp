@@ -62,10 +62,14 @@ void crba_loaded(const Model& m, Data& d) {
 }
 
 const MatX& crba(const Model& m, Data& d, Eigen::Ref<const VecX> q) {
-  require_joint_space(m, "mass_matrix");
+  require_joint_space(m, "mass_matrix", true);
   check_data(m, d, "mass_matrix");
-  check_joint_vector(q, d.n, "mass_matrix", "q");
-  return mass_matrix_at(m, d, q);
+  check_joint_vector(q, d.ni, "mass_matrix", "q");
+  if (d.ni == d.n) return mass_matrix_at(m, d, q);
+  // a coupled model: M_r = G^T M G in the independent coordinates (Model::independent)
+  m.independent.expand(q.data(), d.coupled.q.data(), true);
+  m.independent.reduce(mass_matrix_at(m, d, d.coupled.q), d.coupled.M);
+  return d.coupled.M;
 }
 
 const MatX& mass_matrix_at(const Model& m, Data& d, Eigen::Ref<const VecX> q) {

@@ -10,6 +10,7 @@
 #include "armdyn/algorithm/kinematics.hpp"
 #include "armdyn/algorithm/kkt.hpp"
 #include "armdyn/algorithm/rnea.hpp"
+#include "armdyn/analysis/tree_dynamics.hpp"
 #include "armdyn/errors.hpp"
 #include "armdyn/math/cholesky.hpp"
 
@@ -20,13 +21,20 @@ namespace {
 void check_inputs(const Model& m, const Data& d, Eigen::Ref<const VecX> q,
                   Eigen::Ref<const VecX> qd, Eigen::Ref<const VecX> x, double t, const char* fn,
                   const char* xname) {
-  require_joint_space(m, fn);
+  require_joint_space(m, fn, true);
   check_data(m, d, fn);
-  check_joint_vector(q, d.n, fn, "q");
-  check_joint_vector(qd, d.n, fn, "qd");
-  check_joint_vector(x, d.n, fn, xname);
+  check_joint_vector(q, d.ni, fn, "q");
+  check_joint_vector(qd, d.ni, fn, "qd");
+  check_joint_vector(x, d.ni, fn, xname);
   if (!std::isfinite(t)) throw ModelError(msg(fn, ": t is not finite"));
 }
+
+// forward dynamics of a coupled model in its independent coordinates: the Cartesian KKT path
+// with the couplings' rows (the torques on the independent coordinates, none on the followers:
+// G^T tau_full = tau), or the joint-space equations reduced by G (M_r = G^T M G)
+const VecX& forward_coupled(const Model& m, Data& d, Eigen::Ref<const VecX> q,
+                            Eigen::Ref<const VecX> qd, Eigen::Ref<const VecX> tau, double t,
+                            DynamicsMethod method);
 
 // forward dynamics through the Cartesian KKT system, the joint torques as loads: the joint rows
 // only, the coordinate forces mapped onto the bodies
@@ -52,22 +60,26 @@ void forward_cartesian(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen:
   for (int c = 0; c < d.n; ++c) d.qdd[c] = coord_acceleration(m, d.tau_jets[c], c, d.vd);
 }
 
-// inverse dynamics through the KKT system with every joint coordinate driven to (q, qd, qdd)
+// inverse dynamics through the KKT system with every independent joint coordinate driven to
+// (q, qd, qdd) (a coupled model: its followers through the couplings' rows); q and qd the full
+// coordinates, qdd the independent ones; the torques into tau (independent)
 void inverse_cartesian(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
-                       Eigen::Ref<const VecX> qdd, double t) {
-  const int n = d.n;
+                       Eigen::Ref<const VecX> qdd, double t, VecX& tau) {
+  const int n = d.ni;
+  const IndependentCoords& ic = m.independent;
   if (!d.driven_data) {
     auto driven = std::make_unique<Model>(m);
     driven->drives.clear();
     driven->drive_index.clear();
-    for (int c = 0; c < n; ++c) {
+    for (int k = 0; k < n; ++k) {
+      const int c = ic.full[k];
       Drive dr;
       dr.name = driven->coords[c].name;
       dr.joint = driven->coords[c].joint;
       dr.coord = driven->coords[c].sub;
       dr.profile = Profile::constant(0.0);
-      dr.row = driven->nc_joint + c;
-      driven->drive_index[dr.name] = c;
+      dr.row = driven->nc_joint + k;
+      driven->drive_index[dr.name] = k;
       driven->drives.push_back(dr);
     }
     driven->nc = driven->nc_joint + n;
@@ -86,14 +98,54 @@ void inverse_cartesian(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen:
   Data& dd = *d.driven_data;
   dd.augmented = false;  // each call decides afresh
   load_joint_kinematics(m, dd, q, qd);
-  for (int c = 0; c < n; ++c) {
-    d.drive_ref[3 * c] = q[c];
-    d.drive_ref[3 * c + 1] = qd[c];
-    d.drive_ref[3 * c + 2] = qdd[c];
+  for (int k = 0; k < n; ++k) {
+    d.drive_ref[3 * k] = q[ic.full[k]];
+    d.drive_ref[3 * k + 1] = qd[ic.full[k]];
+    d.drive_ref[3 * k + 2] = qdd[k];
   }
   // square zeta: the O(n) tree sweep (KKT factorisation only when singular)
   body_accelerations_loaded(*d.driven, dd, t, d.vd.data());
-  for (int c = 0; c < n; ++c) d.tau[c] = -dd.delta[d.driven->nc_joint + c];
+  for (int k = 0; k < n; ++k) tau[k] = -dd.delta[d.driven->nc_joint + k];
+}
+
+const VecX& forward_coupled(const Model& m, Data& d, Eigen::Ref<const VecX> q,
+                            Eigen::Ref<const VecX> qd, Eigen::Ref<const VecX> tau, double t,
+                            DynamicsMethod method) {
+  constexpr const char* fn = "forward_dynamics";
+  const IndependentCoords& ic = m.independent;
+  Data::Coupled& w = d.coupled;
+  // CRBA about the world origin loses light bodies' accelerations (geared_light_reason); the
+  // articulated-body algorithm has no place for the couplings' rows
+  const bool light = dynamics_cost(m).light;
+  if (method == DynamicsMethod::Aba)
+    throw ModelError(msg(fn,
+                         ": method 'aba' does not apply to a model with couplings (the "
+                         "articulated-body recursion has no place for their rows); use 'crba' or "
+                         "'cartesian'"));
+  if (method == DynamicsMethod::Auto)
+    method = light ? DynamicsMethod::Cartesian : DynamicsMethod::Crba;
+  if (method != DynamicsMethod::Cartesian && light)
+    throw ModelError(msg(fn, ": ", geared_light_reason(m)));
+  ic.expand(q.data(), w.q.data(), true);
+  ic.expand(qd.data(), w.qd.data(), false);
+  if (method == DynamicsMethod::Cartesian) {
+    w.tau_full.setZero();
+    for (int k = 0; k < d.ni; ++k) w.tau_full[ic.full[k]] = tau[k];
+    forward_cartesian(m, d, w.q, w.qd, w.tau_full, t);
+    for (int k = 0; k < d.ni; ++k) w.qdd_out[k] = d.qdd[ic.full[k]];
+    return w.qdd_out;
+  }
+  joint_space_equations(m, d, w.q.data(), w.qd.data(), nullptr, nullptr, t);
+  ic.reduce(d.rhs.data(), w.rhs.data());
+  w.rhs += tau;
+  ic.reduce(d.M, w.M);
+  if (!cholesky_factor(w.M, w.L))
+    throw SolverError(
+        "forward_dynamics: the joint-space mass matrix (in the independent coordinates) is not "
+        "positive definite (a massless subtree?)");
+  w.qdd_out = w.rhs;
+  cholesky_solve(w.L, w.qdd_out);
+  return w.qdd_out;
 }
 
 }  // namespace
@@ -138,6 +190,7 @@ const VecX& forward_dynamics(const Model& m, Data& d, Eigen::Ref<const VecX> q,
                              Eigen::Ref<const VecX> qd, Eigen::Ref<const VecX> tau, double t,
                              DynamicsMethod method) {
   check_inputs(m, d, q, qd, tau, t, "forward_dynamics", "tau");
+  if (d.ni != d.n) return forward_coupled(m, d, q, qd, tau, t, method);
   switch (resolve_method(m, method)) {
     case DynamicsMethod::Cartesian:
       forward_cartesian(m, d, q, qd, tau, t);
@@ -163,8 +216,15 @@ const VecX& inverse_dynamics(const Model& m, Data& d, Eigen::Ref<const VecX> q,
                              DynamicsMethod method) {
   if (method != DynamicsMethod::Cartesian) return rnea(m, d, q, qd, qdd, t);
   check_inputs(m, d, q, qd, qdd, t, "inverse_dynamics", "qdd");
-  inverse_cartesian(m, d, q, qd, qdd, t);
-  return d.tau;
+  if (d.ni == d.n) {
+    inverse_cartesian(m, d, q, qd, qdd, t, d.tau);
+    return d.tau;
+  }
+  Data::Coupled& w = d.coupled;
+  m.independent.expand(q.data(), w.q.data(), true);
+  m.independent.expand(qd.data(), w.qd.data(), false);
+  inverse_cartesian(m, d, w.q, w.qd, qdd, t, w.tau);
+  return w.tau;
 }
 
 }  // namespace armdyn

@@ -10,12 +10,29 @@ namespace armdyn {
 
 const VecX& rnea(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
                  Eigen::Ref<const VecX> qdd, double t) {
-  require_joint_space(m, "inverse_dynamics");
+  require_joint_space(m, "inverse_dynamics", true);
   check_data(m, d, "inverse_dynamics");
-  check_joint_vector(q, d.n, "inverse_dynamics", "q");
-  check_joint_vector(qd, d.n, "inverse_dynamics", "qd");
-  check_joint_vector(qdd, d.n, "inverse_dynamics", "qdd");
+  check_joint_vector(q, d.ni, "inverse_dynamics", "q");
+  check_joint_vector(qd, d.ni, "inverse_dynamics", "qd");
+  check_joint_vector(qdd, d.ni, "inverse_dynamics", "qdd");
   if (!std::isfinite(t)) throw ModelError("inverse_dynamics: t is not finite");
+  if (d.ni != d.n) {
+    // a coupled model: the full coordinates, tau = G^T tau_full
+    Data::Coupled& w = d.coupled;
+    const IndependentCoords& ic = m.independent;
+    ic.expand(q.data(), w.q.data(), true);
+    ic.expand(qd.data(), w.qd.data(), false);
+    ic.expand(qdd.data(), w.qdd.data(), false);
+    rnea_full(m, d, w.q, w.qd, w.qdd, t);
+    ic.reduce(d.tau.data(), w.tau.data());
+    return w.tau;
+  }
+  rnea_full(m, d, q, qd, qdd, t);
+  return d.tau;
+}
+
+void rnea_full(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
+               Eigen::Ref<const VecX> qdd, double t) {
   joint_space_kinematics(m, q, qd, d.kin, d.rne);
   body_forces(m, d.kin, t, d.eta);
   rne_residual(m, d.kin, qd, qdd, d.eta, d.rne, d.tau);
@@ -23,7 +40,6 @@ const VecX& rnea(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen::Ref<c
     coordinate_forces(m, q.data(), qd.data(), nullptr, t, d.coord_tau);
     d.tau -= d.coord_tau;
   }
-  return d.tau;
 }
 
 }  // namespace armdyn

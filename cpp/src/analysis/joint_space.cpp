@@ -8,8 +8,8 @@
 
 namespace armdyn {
 
-void require_joint_space(const Model& m, const char* what) {
-  if (!m.joint_space_ok)
+void require_joint_space(const Model& m, const char* what, bool coupled_ok) {
+  if (!m.joint_space_ok && !(coupled_ok && m.coupled_joint_space))
     throw ModelError(msg(what,
                          ": needs a tree of revolute, prismatic, cylindrical or fixed "
                          "joints defined parent -> child; here ",
@@ -173,7 +173,7 @@ void rne_residual(const Model& m, const std::vector<BodyKin>& kin, Eigen::Ref<co
 
 void state_from_joints(const Model& m, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd, VecX& u,
                        VecX& v, TreeFkWork& work) {
-  require_joint_space(m, "state_from_joints");
+  require_joint_space(m, "state_from_joints", true);
   const long nc = static_cast<long>(m.coords.size());
   check_joint_vector(q, nc, "state_from_joints", "q");
   check_joint_vector(qd, nc, "state_from_joints", "qd");

@@ -269,6 +269,8 @@ VecX joint_state(const Model& ms, detail::MbsSystem& sys, VecX& y, Metric projec
   project(ms, d, 0.0, y.data(), y.data() + ms.nq, projection);
   VecX q, qd;
   joint_coordinates(ms, y.head(ms.nq), y.segment(ms.nq, ms.nv), q, qd);
+  // couplings' angle followers: the turn their leaders give (their poses give it modulo 2 pi)
+  if (!ms.independent.identity()) ms.independent.align(ms.coords, q.data());
   VecX yj(2 * q.size() + ms.n_aux);
   yj << q, qd, y.tail(ms.n_aux);
   return yj;

@@ -53,6 +53,10 @@ const GearSpace& gear_space(const Model& m) {
     Eigen::CompleteOrthogonalDecomposition<MatX> cod(Gt);
     cod.setThreshold(1e-12);
     gs.Gt_pinv = cod.pseudoInverse();
+    // a solution of G q = offsets (the least-norm one), seen in the range basis
+    VecX offsets(ng);
+    for (int g = 0; g < ng; ++g) offsets[g] = m.gear_constraints[g].offset;
+    gs.range_value = gs.range.transpose() * (gs.Gt_pinv.transpose() * offsets);
     return gs;
   });
 }
@@ -103,8 +107,10 @@ std::string TreeDynamics::description() const {
                aba_ ? "articulated-body algorithm" : "mass matrix by CRBA, Cholesky", " (",
                c.forward_summary(), ")");
   }
+  const bool couplings = m_.independent.n != n_;
   return msg("joint space: ", n_, " coordinates, ", m_.gear_constraints.size(),
-             " ideal-gear rows (rank ", rank_, ") eliminated by their null space: ", dof_,
+             couplings ? " ideal-gear and coupling rows (rank " : " ideal-gear rows (rank ", rank_,
+             ") eliminated by their null space: ", dof_,
              " independent; mass matrix by CRBA, Cholesky of the reduced matrix");
 }
 
@@ -166,6 +172,7 @@ void TreeDynamics::project(double* q, double* qd) {
   for (double* x : {q, qd}) {
     Eigen::Map<VecX> xv(x, n_);
     w.noalias() = gs_.range.transpose() * xv;
+    if (x == q) w -= gs_.range_value;
     xv.noalias() -= gs_.range * w;
   }
 }

@@ -381,6 +381,64 @@ void ModelBuilder::add_gear(const std::string& name, const std::string& joint_a,
   m_.gear_constraints.push_back(g);
 }
 
+void ModelBuilder::add_coupling(const std::string& name, const std::string& follower,
+                                const std::string& leader, double multiplier, double offset) {
+  const std::string who = msg("coupling '", name, "'");
+  if (name.empty()) throw ModelError("coupling: empty name");
+  for (const GearConstraint& g : m_.gear_constraints)
+    if (g.name == name)
+      throw ModelError(msg(who, ": duplicate name (an ideal gear or coupling has it)"));
+  auto joint_of = [&](const std::string& joint, const char* role) -> const Joint& {
+    auto it = m_.joint_index.find(joint);
+    if (it == m_.joint_index.end())
+      throw ModelError(msg(who, ": unknown ", role, " joint '", joint, "'"));
+    const Joint& j = m_.joints[it->second];
+    if (j.type != JointType::Revolute && j.type != JointType::Prismatic)
+      throw ModelError(msg(who, ": ", role, " joint '", joint, "' is ", joint_type_name(j.type),
+                           joint_coords(j.type) == 0 ? " (no joint coordinate)" : "",
+                           "; a coupling needs revolute (continuous) or prismatic joints"));
+    return j;
+  };
+  const Joint& jf = joint_of(follower, "follower");
+  const Joint& jl = joint_of(leader, "leader");
+  if (&jf == &jl) throw ModelError(msg(who, ": joint '", follower, "' cannot follow itself"));
+  if (jf.type != jl.type)
+    throw ModelError(msg(who, ": follower joint '", follower, "' is ", joint_type_name(jf.type),
+                         " but leader joint '", leader, "' is ", joint_type_name(jl.type),
+                         "; both must be of the same type (as Pinocchio requires)"));
+  if (!std::isfinite(multiplier) || multiplier == 0.0)
+    throw ModelError(msg(who, ": multiplier must be finite and nonzero, got ", multiplier));
+  require_finite(offset, who + ": offset");
+  const int cf = jf.coord0, cl = jl.coord0;
+  // the coupling that makes coordinate c follow another, or nullptr
+  auto following = [&](int c) -> const GearConstraint* {
+    for (const GearConstraint& g : m_.gear_constraints)
+      if (g.coupling && g.coord_a == c) return &g;
+    return nullptr;
+  };
+  if (const GearConstraint* g = following(cf))
+    throw ModelError(msg(who, ": joint '", follower, "' already follows joint '",
+                         m_.joints[m_.coords[g->coord_b].joint].name, "' (coupling '", g->name,
+                         "'); a joint can follow only one leader"));
+  // up the leader's chain: reaching the follower closes a cycle
+  std::string chain = msg("'", follower, "' -> '", leader, "'");
+  for (int c = cl; const GearConstraint* g = following(c);) {
+    c = g->coord_b;
+    const std::string& jn = m_.joints[m_.coords[c].joint].name;
+    chain += msg(" -> '", jn, "'");
+    if (c == cf) throw ModelError(msg(who, ": the couplings would form a cycle ", chain));
+  }
+  GearConstraint g;
+  g.name = name;
+  g.coord_a = cf;
+  g.coord_b = cl;
+  g.r_a = 1.0;
+  g.r_b = -multiplier;
+  g.offset = offset;
+  g.coupling = true;
+  m_.gear_constraints.push_back(g);
+}
+
 void ModelBuilder::add_gear_pair(const std::string& name, const std::string& joint_a,
                                  const std::string& joint_b, double r_a, double r_b,
                                  double backlash, double stiffness, double exponent,

@@ -92,12 +92,58 @@ std::shared_ptr<Model> finalize_draft(const Model& draft, const FinalizeOptions&
     m.joint_tree = ok;
     if (ok && !m.gear_constraints.empty()) {
       ok = false;
-      m.joint_space_reason =
-          msg("ideal gear '", m.gear_constraints[0].name, "' couples joint coordinates");
+      const GearConstraint* gear = nullptr;
+      for (const GearConstraint& g : m.gear_constraints)
+        if (!g.coupling && !gear) gear = &g;
+      if (gear) {
+        m.joint_space_reason = msg("ideal gear '", gear->name, "' couples joint coordinates");
+      } else {
+        const GearConstraint& g = m.gear_constraints[0];
+        m.coupled_joint_space = true;
+        m.joint_space_reason =
+            msg("coupling '", g.name, "' makes joint '", m.joints[m.coords[g.coord_a].joint].name,
+                "' follow joint '", m.joints[m.coords[g.coord_b].joint].name,
+                "' (forward_dynamics, inverse_dynamics, mass_matrix and state_from_joints take "
+                "the independent coordinates of a coupled model)");
+      }
     }
     m.joint_space_ok = ok;
   } else {
     m.joint_space_reason = "the model has closed loops";
+  }
+
+  // the independent coordinates: every coupling's follower expressed in its chain's leader
+  {
+    IndependentCoords& ic = m.independent;
+    const int nf = static_cast<int>(m.coords.size());
+    std::vector<const GearConstraint*> follows(nf, nullptr);
+    for (const GearConstraint& g : m.gear_constraints)
+      if (g.coupling) follows[g.coord_a] = &g;
+    ic = IndependentCoords();
+    ic.source.assign(nf, -1);
+    ic.scale.assign(nf, 1.0);
+    ic.shift.assign(nf, 0.0);
+    std::vector<int> index(nf, -1);
+    for (int c = 0; c < nf; ++c) {
+      if (follows[c]) continue;
+      index[c] = ic.n++;
+      ic.full.push_back(c);
+    }
+    for (int c = 0; c < nf; ++c) {
+      double scale = 1.0, shift = 0.0;
+      int k = c;
+      // q_c = scale q_k + shift; q_k = multiplier q_leader + offset (chains; no cycles)
+      for (int steps = 0; follows[k]; ++steps) {
+        if (steps > nf) throw ModelError("finalize: the couplings form a cycle");
+        const GearConstraint& g = *follows[k];
+        shift += scale * g.offset;
+        scale *= g.multiplier();
+        k = g.coord_b;
+      }
+      ic.source[c] = index[k];
+      ic.scale[c] = scale;
+      ic.shift[c] = shift;
+    }
   }
 
   // characteristic length for tolerances
@@ -119,10 +165,16 @@ std::shared_ptr<Model> finalize_draft(const Model& draft, const FinalizeOptions&
   m.v0 = VecX::Zero(m.nv);
   // a driven joint-space tree starts from the forward kinematics of the drives' initial values:
   // Newton from the build pose could otherwise land on a flipped branch of the joint rows
-  if (m.joint_space_ok && !m.drives.empty()) {
+  // (a coupled tree: from its followers at their offsets, each q_f = multiplier q_l + offset)
+  if ((m.joint_space_ok && !m.drives.empty()) || m.coupled_joint_space) {
     VecX q, qd;
     joint_coordinates(m, m.u0, m.v0, q, qd);
     for (const Drive& d : m.drives) q[m.joints[d.joint].coord0 + d.coord] = d.profile.eval(0.0).y;
+    if (m.coupled_joint_space) {
+      VecX qi(m.independent.n);
+      for (int k = 0; k < m.independent.n; ++k) qi[k] = q[m.independent.full[k]];
+      m.independent.expand(qi.data(), q.data(), true);
+    }
     if (q.allFinite()) {
       VecX u, v;
       state_from_joints(m, q, VecX::Zero(q.size()), u, v);

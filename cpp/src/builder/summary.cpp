@@ -59,8 +59,12 @@ std::string summary(const Model& m) {
     os << "    " << j.name << "  " << joint_type_name(j.type) << "  " << m.body_name(j.parent)
        << " -> " << m.body_name(j.child) << "\n";
   for (const GearConstraint& g : m.gear_constraints)
-    os << "  gear " << g.name << ": " << m.coords[g.coord_a].name << " (r " << g.r_a << ") - "
-       << m.coords[g.coord_b].name << " (r " << g.r_b << "), ideal\n";
+    if (g.coupling)
+      os << "  coupling " << g.name << ": " << m.coords[g.coord_a].name << " = " << g.multiplier()
+         << " " << m.coords[g.coord_b].name << " + " << g.offset << "\n";
+    else
+      os << "  gear " << g.name << ": " << m.coords[g.coord_a].name << " (r " << g.r_a << ") - "
+         << m.coords[g.coord_b].name << " (r " << g.r_b << "), ideal\n";
   for (const GearPair& g : m.gears)
     os << "  gear pair " << g.name << ": " << m.coords[g.coord_a].name << " (r " << g.r_a << ") - "
        << m.coords[g.coord_b].name << " (r " << g.r_b << "), backlash " << g.backlash << " m\n";

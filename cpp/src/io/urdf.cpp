@@ -304,7 +304,8 @@ std::string list_names(const std::vector<std::string>& names, size_t from) {
 
 }  // namespace
 
-ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const Vec3& gravity) {
+ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const Vec3& gravity,
+                          bool mimic) {
   std::string where;
   const std::string xml = read_source(path_or_xml, &where);
   const Document document = scan_document(xml, where);
@@ -504,6 +505,31 @@ ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const
       throw;
     } catch (const ModelError& e) {
       throw UrdfError(msg("URDF joint '", d.name, "': ", e.what()));
+    }
+  }
+
+  // <mimic joint= multiplier= offset=>: q_joint = multiplier q_mimicked + offset, a coupling
+  // named after the mimicking joint (a fixed joint's mimic has nothing to couple: ignored)
+  if (mimic) {
+    for (const JointDecl& d : decls) {
+      if (d.type == "fixed") continue;
+      const urdf::JointConstSharedPtr j = urdf_model->getJoint(d.name);
+      if (!j || !j->mimic) continue;
+      const std::string& leader = j->mimic->joint_name;
+      const urdf::JointConstSharedPtr lj = urdf_model->getJoint(leader);
+      if (!lj)
+        throw UrdfError(
+            msg("URDF joint '", d.name, "': <mimic> names unknown joint '", leader, "'"));
+      if (lj->type == urdf::Joint::FIXED)
+        throw UrdfError(msg("URDF joint '", d.name, "': <mimic> names fixed joint '", leader,
+                            "', which has no coordinate to follow"));
+      try {
+        builder.add_coupling(d.name, d.name, leader, j->mimic->multiplier, j->mimic->offset);
+      } catch (const UrdfError&) {
+        throw;
+      } catch (const ModelError& e) {
+        throw UrdfError(msg("URDF joint '", d.name, "' <mimic joint='", leader, "'>: ", e.what()));
+      }
     }
   }
   return builder;

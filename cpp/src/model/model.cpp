@@ -73,7 +73,7 @@ std::string Model::row_name(int row) const {
     }
   }
   for (const GearConstraint& g : gear_constraints)
-    if (row == g.row) return msg("gear '", g.name, "'");
+    if (row == g.row) return msg(g.coupling ? "coupling '" : "gear '", g.name, "'");
   for (const Drive& d : drives)
     if (d.row == row) return msg("drive '", d.name, "'");
   return msg("row ", row);
@@ -86,6 +86,35 @@ std::string Model::joint_path_reason(bool ignore_drives) const {
     return "drive '" + drives[0].name +
            "' prescribes a coordinate (the joint-space path has no driving rows)";
   return {};
+}
+
+void IndependentCoords::expand(const double* x, double* x_full, bool with_shift) const {
+  const int nf = static_cast<int>(source.size());
+  for (int c = 0; c < nf; ++c) x_full[c] = scale[c] * x[source[c]] + (with_shift ? shift[c] : 0.0);
+}
+
+void IndependentCoords::reduce(const double* f_full, double* f) const {
+  const int nf = static_cast<int>(source.size());
+  for (int k = 0; k < n; ++k) f[k] = 0.0;
+  for (int c = 0; c < nf; ++c) f[source[c]] += scale[c] * f_full[c];
+}
+
+void IndependentCoords::reduce(const MatX& M, MatX& Mr) const {
+  const int nf = static_cast<int>(source.size());
+  Mr.setZero();
+  for (int j = 0; j < nf; ++j) {
+    const int sj = source[j];
+    for (int i = 0; i < nf; ++i) Mr(source[i], sj) += scale[i] * M(i, j) * scale[j];
+  }
+}
+
+void IndependentCoords::align(const std::vector<Coord>& coords, double* q_full) const {
+  const int nf = static_cast<int>(source.size());
+  for (int c = 0; c < nf; ++c) {
+    if (full[source[c]] == c || !coords[c].angular) continue;
+    const double want = scale[c] * q_full[full[source[c]]] + shift[c];
+    q_full[c] = want + wrap_angle(q_full[c] - want);
+  }
 }
 
 double gear_force(const GearPair& g, double s, double sd, double& penetration) {

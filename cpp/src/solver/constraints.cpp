@@ -168,17 +168,19 @@ void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t,
         break;
     }
   }
-  // ideal gears: r_a q_a + r_b q_b = 0 (multi-turn angles), over up to four bodies
+  // ideal gears and couplings: r_a q_a + r_b q_b = offset (multi-turn angles), over up to four
+  // bodies
   for (const GearConstraint& g : m.gear_constraints) {
     ConstraintBlock& b = ce.blocks[bi++];
-    double f = 0.0, xi = 0.0;
+    double f = -g.offset, xi = 0.0;
     b.J.setZero();
+    const bool angular = m.coords[g.coord_a].angular;
     for (int k = 0; k < 2; ++k) {
       const int c = k == 0 ? g.coord_a : g.coord_b;
       const double r = k == 0 ? g.r_a : g.r_b;
       const ScalarJet& q = ce.coord_cache ? ce.coord_cache->get(m, kin, c) : coord_jet(m, kin, c);
-      const double ref = ce.track_ref ? (*ce.track_ref)[c] : 0.0;
-      f += r * (ref + wrap_angle(q.val - ref));
+      const double ref = ce.track_ref && angular ? (*ce.track_ref)[c] : 0.0;
+      f += r * (angular ? ref + wrap_angle(q.val - ref) : q.val);
       xi += r * q.bias;
       const Joint& j = m.joints[m.coords[c].joint];
       const int ends[2] = {j.parent, j.child};
@@ -189,7 +191,9 @@ void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t,
         b.J.block<1, 6>(0, 6 * slot) += r * q.J.segment<6>(6 * e);
       }
     }
-    ce.f[b.row0] = f;
+    // a revolute follower's pose gives its angle only modulo a turn (r_a = 1): the row is
+    // the follower's angle error, wrapped
+    ce.f[b.row0] = g.coupling && angular ? wrap_angle(f) : f;
     ce.rhs[b.row0] = 0.0;
     if (with_xi) ce.xi[b.row0] = xi;
   }

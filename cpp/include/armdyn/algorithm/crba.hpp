@@ -8,7 +8,8 @@
 
 namespace armdyn {
 
-/// M(q) (n_coords x n_coords) into data.M. Allocates nothing.
+/// M(q) (n_coords x n_coords) into data.M; a coupled model's in its independent coordinates,
+/// G^T M G (Model::independent), into data.coupled.M. Allocates nothing.
 /// @throws ModelError when the model is not a joint-space tree, on a wrong size or non-finite q.
 const MatX& crba(const Model& m, Data& d, Eigen::Ref<const VecX> q);
 

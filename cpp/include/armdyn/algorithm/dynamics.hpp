@@ -11,7 +11,12 @@
 //  - inverse dynamics: Joint (and Auto) -- recursive Newton-Euler (armdyn/algorithm/rnea.hpp);
 //    Cartesian -- every joint coordinate driven to (q, qd, qdd), the torques being the drives'
 //    multipliers.
-// All include the model's force elements and ignore its drives.
+// All include the model's force elements and ignore its drives. A model with couplings
+// (ModelBuilder::add_coupling, URDF <mimic>) is taken in its independent coordinates
+// (Model::independent: q_full = G q + shift), as Pinocchio's mimic=True models: forward
+// dynamics solves (G^T M G) qdd = G^T rhs_full + tau by CRBA (or the Cartesian KKT system with
+// the couplings' rows, tau on the independent coordinates); inverse dynamics returns
+// G^T tau_full(q_full, G qd, G qdd); 'aba' is refused there.
 #pragma once
 
 #include "armdyn/data.hpp"
@@ -34,7 +39,8 @@ DynamicsMethod dynamics_method(const std::string& name, const char* fn, bool for
 void joint_space_equations(const Model& m, Data& d, const double* q, const double* qd,
                            const double* z, const double* tau, double t);
 
-/// Joint accelerations (n_coords) into data.qdd for joint torques/forces tau at (q, qd), time t.
+/// Joint accelerations (n_coords; a coupled model's independent ones, into
+/// data.coupled.qdd_out) into data.qdd for joint torques/forces tau at (q, qd), time t.
 /// Allocates nothing. The Cartesian method runs the pipeline of data on the joint rows
 /// (data.nrows = nc_joint, the torques as data.joint_torques) and restores its defaults.
 /// @throws ModelError when the model is not a joint-space tree, on wrong sizes or non-finite

@@ -10,7 +10,14 @@
 
 namespace armdyn {
 
-/// Joint torques/forces (n_coords) into data.tau at (q, qd, qdd) and time t. O(n): forward,
+/// rnea() on every coordinate of the model (followers of couplings included), unchecked, into
+/// data.tau.
+void rnea_full(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
+               Eigen::Ref<const VecX> qdd, double t);
+
+/// Joint torques/forces (n_coords: a coupled model's independent coordinates, tau = G^T
+/// tau_full of Model::independent; then the result is data.coupled.tau) into data.tau at
+/// (q, qd, qdd) and time t. O(n): forward,
 /// parents first, the bodies' accelerations; backward, children first, each subtree's residual
 /// wrench projected on its joint's axis. Allocates nothing.
 /// @throws ModelError when the model is not a joint-space tree, on wrong sizes or non-finite

@@ -76,7 +76,8 @@ void tree_body_accelerations(const Model& m, const std::vector<BodyKin>& kin, co
 void rne_residual(const Model& m, const std::vector<BodyKin>& kin, Eigen::Ref<const VecX> qd,
                   Eigen::Ref<const VecX> qdd, const VecX& eta, RneWork& w, Eigen::Ref<VecX> tau);
 
-/// Cartesian (u, v) from joint coordinates q and rates qd (n_coords each).
+/// Cartesian (u, v) from joint coordinates q and rates qd (every coordinate of the model,
+/// followers of couplings included: expand independent ones by Model::independent first).
 /// @throws ModelError when the model is not a joint-space tree or sizes are wrong.
 void state_from_joints(const Model& m, const VecX& q, const VecX& qd, VecX& u, VecX& v);
 /// The same with caller-owned scratch (no allocation once u, v and work are sized).
@@ -87,7 +88,9 @@ void cartesian_state(const Model& m, const std::vector<BodyKin>& kin, double* u,
 /// Joint coordinates (angles in (-pi, pi]) and rates at (u, v).
 void joint_coordinates(const Model& m, const VecX& u, const VecX& v, VecX& q, VecX& qd);
 /// Check that the model supports joint-space calls; throws ModelError naming the reason.
-void require_joint_space(const Model& m, const char* what);
+/// coupled_ok: a coupled tree (Model::coupled_joint_space) is accepted too (the caller maps
+/// its independent coordinates by Model::independent).
+void require_joint_space(const Model& m, const char* what, bool coupled_ok = false);
 /// Check a joint-space vector's length (n) and values; throws ModelError "fn: name ...".
 void check_joint_vector(Eigen::Ref<const VecX> x, long n, const char* fn, const char* name);
 

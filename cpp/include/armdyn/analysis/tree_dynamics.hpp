@@ -34,6 +34,8 @@ namespace armdyn {
 struct GearSpace {
   int rank = 0;
   MatX T, range, Gt_pinv;
+  /// range^T q on the rows' solution set G q = offsets (couplings' offsets; 0 for gears)
+  VecX range_value;
 };
 const GearSpace& gear_space(const Model& m);
 /// Why TreeDynamics refuses m although it is a joint tree: ideal gears (which need the
@@ -73,7 +75,8 @@ class TreeDynamics {
   /// Gear pair g's mesh displacement s, rate and penetration |s| - backlash/2.
   void gear_mesh(int g, const double* q, const double* qd, double& s, double& sd,
                  double& penetration) const;
-  /// Remove the round-off from G q = 0 and G qd = 0 (Euclidean projection onto the null space).
+  /// Remove the round-off from G q = offsets and G qd = 0 (Euclidean projection onto their
+  /// solution sets).
   void project(double* q, double* qd);
   /// The joint-space mass matrix at q (n x n), by the composite-rigid-body algorithm.
   const MatX& mass_matrix(const double* q);

@@ -80,6 +80,16 @@ class ModelBuilder {
   /// Ideal gear between two revolute joints: the constraint r_a q_a + r_b q_b = 0.
   void add_gear(const std::string& name, const std::string& joint_a, const std::string& joint_b,
                 double r_a, double r_b);
+  /// Coupling q_follower = multiplier q_leader + offset [rad or m] between two revolute (or
+  /// continuous) or two prismatic joints (URDF <mimic>): one constraint row; the follower is a
+  /// dependent coordinate (Model::independent). Chains (a leader that follows another) are
+  /// allowed, cycles are not.
+  /// @throws ModelError (naming the coupling and the culprit) on a duplicate name, an unknown
+  ///   joint, the same joint twice, a joint without exactly one coordinate, joints of different
+  ///   types, a non-finite or zero multiplier, a non-finite offset, a follower coupled twice or
+  ///   a cycle of couplings.
+  void add_coupling(const std::string& name, const std::string& follower, const std::string& leader,
+                    double multiplier, double offset = 0.0);
   /// Gear pair with backlash between two revolute joints (see GearPair).
   void add_gear_pair(const std::string& name, const std::string& joint_a,
                      const std::string& joint_b, double r_a, double r_b, double backlash,

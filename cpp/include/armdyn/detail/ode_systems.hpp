@@ -170,6 +170,9 @@ class MbsSystem : public OdeSystem {
       out_.qd.push_back(q.rate);
       out_.qdd.push_back(coord_acceleration(m_, q, static_cast<int>(c), vd));
     }
+    // couplings' angle followers: the turn their leaders give
+    if (!m_.independent.identity())
+      m_.independent.align(m_.coords, out_.q.data() + out_.q.size() - m_.coords.size());
     // gear mesh forces: contact law of the gear pairs, multipliers of the ideal gears
     for (int gi = 0; gi < static_cast<int>(m_.gears.size()); ++gi) {
       double sm, sd, pen;

@@ -20,11 +20,18 @@ namespace armdyn {
 ///   fixed_base = false: the root group becomes a body declared free (joint "root_free").
 /// - Moving joints are added in document order, so it defines every joint-space array.
 /// - <limit> sets joint limits (continuous joints keep unbounded positions).
-/// - Ignored: visual, collision, material, transmission, gazebo, mimic, safety, calibration and
+/// - <mimic joint multiplier offset> (with mimic = true, the default): a coupling
+///   q = multiplier q_joint + offset (ModelBuilder::add_coupling, named after the mimicking
+///   joint; both joints revolute/continuous or both prismatic); the joint-space functions then
+///   take the independent coordinates, as Pinocchio's mimic=True models. mimic = false: each
+///   mimicking joint keeps its own coordinate (Pinocchio's default).
+/// - Ignored: visual, collision, material, transmission, gazebo, safety, calibration and
 ///   joint dynamics (damping/friction).
 ///
 /// @throws UrdfError on a missing file, malformed XML or URDF, floating/planar/unknown joints,
-///   zero joint axes, massless moving links or invalid inertial data (naming the culprit).
-ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const Vec3& gravity);
+///   zero joint axes, massless moving links or invalid inertial data (naming the culprit); a
+///   <mimic> naming an unknown or fixed joint, or one add_coupling refuses (naming both joints).
+ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const Vec3& gravity,
+                          bool mimic = true);
 
 }  // namespace armdyn

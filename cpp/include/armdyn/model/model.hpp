@@ -161,13 +161,24 @@ struct GearPair {
   double stiffness = 0.0, exponent = 1.5, hc_damping = 0.0;  ///< k [N/m^n], n, alpha [s/m]
 };
 
-/// Ideal gear (no backlash) between the angle coordinates of two revolute joints: the rolling
-/// condition r_a q_a + r_b q_b = 0 as a constraint row (external mesh; multi-turn angles).
+/// A linear coupling of two joint coordinates as one constraint row
+///   r_a q_a + r_b q_b = offset
+/// (multi-turn angles). Two kinds share it (and the Cartesian row, the joint-space null-space
+/// reduction of TreeDynamics and the reports):
+///  - an ideal gear (ModelBuilder::add_gear, no backlash): two revolute joints, the rolling
+///    condition of an external mesh with pitch radii r_a, r_b > 0 and offset 0;
+///  - a coupling (ModelBuilder::add_coupling, URDF <mimic>): q_follower = multiplier q_leader +
+///    offset between two revolute or two prismatic joints, coord_a the follower, coord_b the
+///    leader, r_a = 1, r_b = -multiplier. The follower is a dependent coordinate: the public
+///    joint-space functions take the independent ones (IndependentCoords).
 struct GearConstraint {
   std::string name;
   int coord_a = 0, coord_b = 0;
   double r_a = 0.0, r_b = 0.0;
+  double offset = 0.0;    ///< the row's value [rad or m]
+  bool coupling = false;  ///< a coupling (coord_a follows coord_b), not an ideal gear
   int row = 0;
+  double multiplier() const { return -r_b / r_a; }
 };
 
 /// Mesh force F >= 0 of a gear pair for mesh displacement s and rate sd; also returns the
@@ -180,6 +191,35 @@ struct Coord {
   int joint = 0;
   int sub = 0;  ///< 0: angle (or prismatic displacement), 1: cylindrical displacement
   bool angular = true;
+};
+
+/// The independent joint coordinates of a model with couplings (GearConstraint::coupling):
+/// every coordinate c is q_c = scale_c q[source_c] + shift_c of an independent coordinate
+/// (scale 1, shift 0 for the independent ones themselves; chains of couplings resolved), i.e.
+///   q_full = G q + shift,  qd_full = G qd,  qdd_full = G qdd,
+/// with G (n_coords_full x n) one entry per row. The joint-space functions of a coupled model
+/// take q (the independent coordinates, model order, followers removed), as Pinocchio's
+/// mimic=True models do, and reduce forces and the mass matrix by G: tau = G^T tau_full,
+/// M = G^T M_full G. Without couplings G is the identity (identity() true). The one place
+/// where full and independent coordinates meet: a floating base's configuration map would
+/// compose with it here.
+struct IndependentCoords {
+  int n = 0;              ///< independent coordinates
+  std::vector<int> full;  ///< per independent coordinate: its index in Model::coords
+  /// per coordinate: the independent coordinate it follows (its own index when independent)
+  std::vector<int> source;
+  std::vector<double> scale, shift;  ///< per coordinate
+  bool identity() const { return n == static_cast<int>(source.size()); }
+  /// q_full = G q + shift (positions, with_shift) or G x (rates, accelerations)
+  void expand(const double* x, double* x_full, bool with_shift) const;
+  /// f = G^T f_full (generalised forces)
+  void reduce(const double* f_full, double* f) const;
+  /// Mr = G^T M G (Mr sized n x n by the caller)
+  void reduce(const MatX& M, MatX& Mr) const;
+  /// Each angle follower of q_full (every coordinate) moved by whole turns to the value
+  /// nearest its coupling's, scale q_leader + shift: a follower's pose gives its angle only
+  /// modulo a turn.
+  void align(const std::vector<Coord>& coords, double* q_full) const;
 };
 
 /// Options of ModelBuilder::finalize(), kept with the model (the welded model simulate()
@@ -203,6 +243,8 @@ class Model {
   std::vector<int> tracked_coords;  ///< angle coordinates unwrapped over turns (gears)
   int n_aux = 0;  ///< auxiliary states of the simulation (integral terms of PI motors)
   std::vector<Coord> coords;
+  /// the independent coordinates (couplings removed; finalize). n_coords of the bindings.
+  IndependentCoords independent;
   Vec3 gravity = Vec3(0, 0, -9.81);
 
   // --- sizes ---
@@ -215,6 +257,10 @@ class Model {
   bool joint_space_ok =
       false;  ///< tree of revolute/prismatic/cylindrical/fixed joints, parent->child
   std::string joint_space_reason;
+  /// joint_space_ok but for couplings: the public joint-space functions (forward and inverse
+  /// dynamics, mass matrix, state_from_joints) take the independent coordinates
+  /// (IndependentCoords); the others refuse such a model (joint_space_reason names the coupling)
+  bool coupled_joint_space = false;
   /// a tree of joint-coordinate joints defined parent -> child, ideal gears allowed (the
   /// joint-space path of simulate, armdyn/analysis/tree_dynamics.hpp)
   bool joint_tree = false;
