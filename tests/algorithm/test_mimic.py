@@ -415,3 +415,24 @@ def test_urdf_mimic_becomes_a_coupling_and_mimic_false_keeps_it_free():
 def test_urdf_bad_mimic_is_refused_naming_both_joints(kw, message):
     with pytest.raises(ad.UrdfError, match=message):
         ad.load_urdf(urdf(**kw))
+
+
+def test_welded_run_keeps_the_coupling():
+    # a fixed joint merged by the welded run (merge_welded): the coupling's coordinates and
+    # offset survive the weld, the run equals the unmerged one
+    b = ad.ModelBuilder()
+    b.add_body("l1", 1.0, [0.01, 0.01, 0.01], position=(0.25, 0, 0))
+    b.add_body("l1b", 0.2, [0.001, 0.001, 0.001], position=(0.5, 0, 0.05))
+    b.add_body("l2", 0.8, [0.008, 0.008, 0.008], position=(0.75, 0, 0))
+    b.add_revolute("shoulder", "ground", "l1", point=(0, 0, 0), axis=(0, 1, 0))
+    b.add_fixed("weld", "l1", "l1b", point=(0.5, 0, 0))
+    b.add_revolute("elbow", "l1b", "l2", point=(0.5, 0, 0), axis=(0, 1, 0))
+    b.add_coupling("k", "elbow", "shoulder", -1.5, 0.2)
+    model = b.finalize()
+    assert "coupling k: elbow = -1.5 shoulder + 0.2" in model.summary()
+    kw = dict(q0=[0.3], rtol=1e-11, atol=1e-13, output_dt=0.1)
+    merged = ad.simulate(model, 0.5, merge_welded=True, **kw)
+    full = ad.simulate(model, 0.5, merge_welded=False, **kw)
+    assert merged.stats["solver_bodies"] == 2
+    np.testing.assert_allclose(merged.q, full.q, atol=1e-9)
+    assert np.abs(merged.q[:, 1] - (-1.5 * merged.q[:, 0] + 0.2)).max() <= 1e-10
