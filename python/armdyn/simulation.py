@@ -140,6 +140,7 @@ def simulate(
             raise _core.ModelError("simulate: give either q0/qd0 or u0/v0, not both")
         if q0 is None:
             raise _core.ModelError("simulate: qd0 given without q0")
+        _check_coupled_start(model, q0)
         u0, v0 = _core.state_from_joints(model, q0, qd0)
     raw = _core._simulate(
         model,
@@ -164,6 +165,38 @@ def simulate(
         exc.result = result
         raise exc
     return result
+
+
+def _check_coupled_start(model: _core.Model, q0) -> None:
+    """Refuse a q0 whose coupled angles the run cannot start from: the run reads its initial
+    angles from the bodies' poses, in (−π, π], and a revolute leader beyond ±π with a
+    non-integer multiplier gives its follower another pose than the one q0 asks for."""
+    couplings = model.couplings
+    if not couplings:
+        return
+    q0 = np.asarray(q0, dtype=float)
+    if q0.shape != (model.n_coords,):
+        return  # state_from_joints names the wrong shape
+    value = dict(zip(model.coord_names, q0, strict=True))
+    follows = {c["follower"]: c for c in couplings}
+
+    def angle(joint):  # a joint's coordinate from q0 through its chain of couplings
+        c = follows.get(joint)
+        return value[joint] if c is None else c["multiplier"] * angle(c["leader"]) + c["offset"]
+
+    types = dict(zip(model.joint_names, model.joint_types, strict=True))
+    for c in couplings:
+        lead, m = c["leader"], c["multiplier"]
+        if types[lead] != "revolute" or float(m).is_integer():
+            continue
+        ql = angle(lead)
+        if abs(ql) > np.pi:
+            raise _core.ModelError(
+                f"simulate: q0 puts joint '{lead}' at {ql:.6g} rad, beyond ±π, and coupling "
+                f"'{c['name']}' follows it with the non-integer multiplier {m:g}: the run reads "
+                "its initial angles in (−π, π] and would start the follower elsewhere; give "
+                "the angle within (−π, π]"
+            )
 
 
 def load_urdf(

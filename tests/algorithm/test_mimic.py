@@ -436,3 +436,14 @@ def test_welded_run_keeps_the_coupling():
     assert merged.stats["solver_bodies"] == 2
     np.testing.assert_allclose(merged.q, full.q, atol=1e-9)
     assert np.abs(merged.q[:, 1] - (-1.5 * merged.q[:, 0] + 0.2)).max() <= 1e-10
+
+
+def test_simulate_refuses_a_leader_beyond_pi_with_a_non_integer_multiplier():
+    # the run reads its initial angles from the poses, in (−π, π]: shoulder 3.5 rad is read as
+    # 3.5 − 2π, which with the multiplier 0.5 puts the elbow half a turn from where q0 asks
+    model = coupled_arm()
+    with pytest.raises(ad.ModelError, match=r"joint 'shoulder' at 3.5 rad.*'elbow_follows'.*0.5"):
+        ad.simulate(model, 0.1, q0=[3.5, 0.0])
+    # within (−π, π] the run starts where asked
+    run = ad.simulate(model, 0.1, q0=[3.1, 0.0], output_dt=0.1)
+    np.testing.assert_allclose(run.q[0], [3.1, 0.5 * 3.1 + 0.3, 0.0], atol=1e-12)
