@@ -81,15 +81,15 @@ py::array_t<double> rows_of(const py::handle& obj, const char* fn, const char* n
   return a;
 }
 
-/// f(i, q_i, a_i, b_i, t_i, out_i) for every row i of the 2-D arguments q, a, b (shape (N, n)),
-/// t a number or one per row; out has shape (N, *out_shape). Runs without the GIL; an error
-/// names its row.
+/// f(i, q_i, a_i, b_i, t_i, out_i) for every row i of the 2-D arguments q (shape (N, nq)), a, b
+/// (shape (N, n)), t a number or one per row; out has shape (N, *out_shape). Runs without the
+/// GIL; an error names its row.
 template <class Fn>
-py::array_t<double> batch(const char* fn, long n, const py::handle& q, const py::handle& a,
+py::array_t<double> batch(const char* fn, long nq, long n, const py::handle& q, const py::handle& a,
                           const char* an, const py::handle& b, const char* bn, const py::handle& t,
                           std::vector<py::ssize_t> out_shape, Fn&& f) {
   const long rows = static_cast<long>(py::reinterpret_borrow<py::array>(q).shape(0));
-  const auto Q = rows_of(q, fn, "q", rows, n), A = rows_of(a, fn, an, rows, n),
+  const auto Q = rows_of(q, fn, "q", rows, nq), A = rows_of(a, fn, an, rows, n),
              B = rows_of(b, fn, bn, rows, n);
   VecX ts;
   double t0 = 0.0;
@@ -108,7 +108,7 @@ py::array_t<double> batch(const char* fn, long n, const py::handle& q, const py:
   for (long i = 0; i < rows; ++i) {
     using Row = Eigen::Map<const VecX>;
     try {
-      f(Row(qp + i * n, n), Row(ap + i * n, n), Row(bp + i * n, n), per_row_t ? ts[i] : t0,
+      f(Row(qp + i * nq, nq), Row(ap + i * n, n), Row(bp + i * n, n), per_row_t ? ts[i] : t0,
         op + i * out_size);
     } catch (const SolverError& e) {
       throw SolverError(msg("row ", i, ": ", e.what()));
@@ -148,18 +148,19 @@ void bind_algorithm(py::module_& m) {
         const DynamicsMethod mth = dynamics_method(method, fn);
         const Model& mm = *md;
         if (is_batch(q))
-          return batch(fn, d.n, q, qd, "qd", tau, "tau", t, {d.n},
+          return batch(fn, d.nq, d.n, q, qd, "qd", tau, "tau", t, {d.n},
                        [&](auto qi, auto qdi, auto ti, double tt, double* out) {
                          const VecX& r = forward_dynamics(mm, d, qi, qdi, ti, tt, mth);
                          std::copy(r.data(), r.data() + d.n, out);
                        });
-        const VecArg qa(q, "q", d.n), qda(qd, "qd", d.n), ta(tau, "tau", d.n);
+        const VecArg qa(q, "q", d.nq), qda(qd, "qd", d.n), ta(tau, "tau", d.n);
         return vector_out(forward_dynamics(mm, d, *qa, *qda, *ta, scalar_time(t, fn), mth));
       },
       py::arg("model"), py::arg("q"), py::arg("qd"), py::arg("tau"), py::arg("t") = 0.0,
       py::arg("method") = "auto", py::arg("data") = py::none(),
       "Joint accelerations qdd of a tree for joint torques/forces tau at (q, qd) and time t "
-      "[s] (n_coords each; 2-D: one state per row). method: 'crba' (CRBA mass matrix, "
+      "[s] (q: n_coords, the others n_dofs; 2-D: one state per row). method: 'crba' (CRBA mass "
+      "matrix, "
       "recursive Newton-Euler bias, Cholesky), 'aba' (articulated-body algorithm, O(n)), "
       "'cartesian' (the constrained Newton-Euler KKT system of the bodies), 'joint' (the "
       "cheaper of crba and aba for this model), 'auto' (the cheapest of the three); the choice "
@@ -207,17 +208,18 @@ void bind_algorithm(py::module_& m) {
         const DynamicsMethod mth = dynamics_method(method, fn, false);
         const Model& mm = *md;
         if (is_batch(q))
-          return batch(fn, d.n, q, qd, "qd", qdd, "qdd", t, {d.n},
+          return batch(fn, d.nq, d.n, q, qd, "qd", qdd, "qdd", t, {d.n},
                        [&](auto qi, auto qdi, auto ai, double tt, double* out) {
                          const VecX& r = inverse_dynamics(mm, d, qi, qdi, ai, tt, mth);
                          std::copy(r.data(), r.data() + d.n, out);
                        });
-        const VecArg qa(q, "q", d.n), qda(qd, "qd", d.n), aa(qdd, "qdd", d.n);
+        const VecArg qa(q, "q", d.nq), qda(qd, "qd", d.n), aa(qdd, "qdd", d.n);
         return vector_out(inverse_dynamics(mm, d, *qa, *qda, *aa, scalar_time(t, fn), mth));
       },
       py::arg("model"), py::arg("q"), py::arg("qd"), py::arg("qdd"), py::arg("t") = 0.0,
       py::arg("method") = "auto", py::arg("data") = py::none(),
-      "Joint torques/forces tau realising qdd at (q, qd) and time t [s] (n_coords each; 2-D: "
+      "Joint torques/forces tau realising qdd at (q, qd) and time t [s] (q: n_coords, the others "
+      "n_dofs; 2-D: "
       "one state per row): what each joint's actuator applies to its child about/along the "
       "joint axis, gravity and the model's force elements included, drives ignored. method: "
       "'joint' (recursive Newton-Euler), 'cartesian' (every coordinate driven, the drives' KKT "
@@ -232,19 +234,19 @@ void bind_algorithm(py::module_& m) {
         const long n = d.n;
         // M is symmetric: its column-major storage is also its row-major one
         if (is_batch(q))
-          return batch(fn, n, q, q, "q", q, "q", py::float_(0.0), {n, n},
+          return batch(fn, d.nq, d.nq, q, q, "q", q, "q", py::float_(0.0), {n, n},
                        [&](auto qi, auto, auto, double, double* out) {
                          const MatX& M = crba(mm, d, qi);
                          std::copy(M.data(), M.data() + n * n, out);
                        });
-        const VecArg qa(q, "q", n);
+        const VecArg qa(q, "q", d.nq);
         const MatX& M = crba(mm, d, *qa);
         py::array_t<double> a({n, n});
         std::copy(M.data(), M.data() + n * n, a.mutable_data());
         return a;
       },
       py::arg("model"), py::arg("q"), py::arg("data") = py::none(),
-      "The joint-space mass matrix M(q) (n_coords, n_coords) of a tree, by the "
+      "The joint-space mass matrix M(q) (n_dofs, n_dofs) of a tree, by the "
       "composite-rigid-body algorithm; 2-D q (one state per row) gives (rows, n, n).");
 }
 

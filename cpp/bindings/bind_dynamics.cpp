@@ -37,9 +37,9 @@ py::dict result_dict(const Model& md, const SimResult& r) {
   d["t"] = to_numpy(r.t.data(), {n});
   d["u"] = to_numpy(r.u.data(), {n, md.nq});
   d["v"] = to_numpy(r.v.data(), {n, md.nv});
-  d["q"] = to_numpy(r.q.data(), {n, static_cast<py::ssize_t>(md.coords.size())});
-  d["qd"] = to_numpy(r.qd.data(), {n, static_cast<py::ssize_t>(md.coords.size())});
-  d["qdd"] = to_numpy(r.qdd.data(), {n, static_cast<py::ssize_t>(md.coords.size())});
+  d["q"] = to_numpy(r.q.data(), {n, static_cast<py::ssize_t>(md.nq_joint)});
+  d["qd"] = to_numpy(r.qd.data(), {n, static_cast<py::ssize_t>(md.nv_joint)});
+  d["qdd"] = to_numpy(r.qdd.data(), {n, static_cast<py::ssize_t>(md.nv_joint)});
   d["drive_forces"] =
       to_numpy(r.drive_forces.data(), {n, static_cast<py::ssize_t>(md.drives.size())});
   d["reaction_forces"] = to_numpy(r.reaction_forces.data(), {n, nj, 3});
@@ -102,8 +102,10 @@ void bind_dynamics(py::module_& m) {
       "_simulate",
       [](const Model& md, double t_end, const std::string& integrator, double rtol, double atol,
          double dt, double output_dt, py::object u0, py::object v0, const std::string& projection,
-         long max_steps, double max_step, bool merge_welded, const std::string& coordinates) {
+         long max_steps, double max_step, bool merge_welded, const std::string& coordinates,
+         py::object q_start) {
         SimOptions o;
+        if (!q_start.is_none()) o.q_start = to_vec(q_start, "q0", md.nq_joint);
         o.merge_welded = merge_welded;
         o.coordinates = coordinates_from_name(coordinates);
         o.step.max_step = max_step;
@@ -126,19 +128,20 @@ void bind_dynamics(py::module_& m) {
       py::arg("model"), py::arg("t_end"), py::arg("integrator"), py::arg("rtol"), py::arg("atol"),
       py::arg("dt"), py::arg("output_dt"), py::arg("u0"), py::arg("v0"), py::arg("projection"),
       py::arg("max_steps"), py::arg("max_step") = 0.0, py::arg("merge_welded") = true,
-      py::arg("coordinates") = "cartesian");
+      py::arg("coordinates") = "cartesian", py::arg("q_start") = py::none());
 
   m.def(
       "state_from_joints",
       [](const Model& md, py::object q, py::object qd) {
-        const long n = static_cast<long>(md.coords.size());
+        const long nq = md.nq_joint, n = md.nv_joint;
         VecX u, v;
-        state_from_joints(md, to_vec(q, "q", n), qd.is_none() ? VecX::Zero(n) : to_vec(qd, "qd", n),
-                          u, v);
+        state_from_joints(md, to_vec(q, "q", nq),
+                          qd.is_none() ? VecX::Zero(n) : to_vec(qd, "qd", n), u, v);
         return py::make_tuple(to_numpy(u), to_numpy(v));
       },
       py::arg("model"), py::arg("q"), py::arg("qd") = py::none(),
-      "Cartesian state (u, v) of a joint-space tree model from joint coordinates and rates.");
+      "Cartesian state (u, v) of a joint-space tree model from joint-space q (n_coords) and qd "
+      "(n_dofs; default zero).");
 
   m.def(
       "joint_coordinates",
@@ -148,7 +151,8 @@ void bind_dynamics(py::module_& m) {
         return py::make_tuple(to_numpy(q), to_numpy(qd));
       },
       py::arg("model"), py::arg("u"), py::arg("v"),
-      "Joint coordinates (angles in (-pi, pi]) and rates at the Cartesian state (u, v).");
+      "Joint-space q (n_coords: floating bases' poses, then joint coordinates with angles in "
+      "(-pi, pi]) and qd (n_dofs) at the Cartesian state (u, v).");
 
   m.def(
       "evaluate_constraints",

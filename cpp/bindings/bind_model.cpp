@@ -87,7 +87,14 @@ void bind_model(py::module_& m) {
       .def_readonly("nv", &Model::nv)
       .def_readonly("nc", &Model::nc)
       .def_readonly("nc_joint", &Model::nc_joint)
-      .def_property_readonly("n_coords", [](const Model& md) { return md.coords.size(); })
+      .def_readonly("n_coords", &Model::nq_joint,
+                    "Length of the joint-space q: 7 per floating base (position, scalar-first "
+                    "quaternion), then one per joint coordinate.")
+      .def_readonly("n_dofs", &Model::nv_joint,
+                    "Length of qd, qdd and tau: 6 per floating base (linear, angular velocity in "
+                    "the base frame), then one per joint coordinate (= n_coords without a "
+                    "floating base).")
+      .def_readonly("n_free", &Model::n_free, "Free joints (floating bases) of the joint space.")
       .def_property_readonly("n_drives", [](const Model& md) { return md.drives.size(); })
       .def_property_readonly("body_names",
                              [](const Model& md) {
@@ -107,12 +114,12 @@ void bind_model(py::module_& m) {
                                for (const auto& j : md.joints) r.push_back(joint_type_name(j.type));
                                return r;
                              })
-      .def_property_readonly("coord_names",
-                             [](const Model& md) {
-                               std::vector<std::string> r;
-                               for (const auto& c : md.coords) r.push_back(c.name);
-                               return r;
-                             })
+      .def_readonly("coord_names", &Model::q_names,
+                    "Names of the entries of q (n_coords): a floating base's 'name:x' .. "
+                    "'name:e3', then the joint coordinates.")
+      .def_readonly("dof_names", &Model::dof_names,
+                    "Names of the entries of qd, qdd and tau (n_dofs): a floating base's "
+                    "'name:vx' .. 'name:wz', then the joint coordinates.")
       .def_property_readonly("drive_names",
                              [](const Model& md) {
                                std::vector<std::string> r;
@@ -123,7 +130,7 @@ void bind_model(py::module_& m) {
                              [](const Model& md) {
                                std::vector<int> r;
                                for (const auto& d : md.drives)
-                                 r.push_back(md.joints[d.joint].coord0 + d.coord);
+                                 r.push_back(md.joints[d.joint].dof0 + d.coord);
                                return r;
                              })
       .def_property_readonly("gravity", [](const Model& md) { return to_numpy(VecX(md.gravity)); })
@@ -318,7 +325,18 @@ void bind_model(py::module_& m) {
           },
           py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point"), py::arg("axis1"),
           py::arg("axis2"))
-      .def("add_free", &ModelBuilder::add_free, py::arg("name"), py::arg("child"))
+      .def(
+          "add_free",
+          [](ModelBuilder& b, const std::string& n, const std::string& c, py::object origin) {
+            if (origin.is_none()) return b.add_free(n, c);
+            const Vec3 o = to_vec3(origin, "free joint '" + n + "': origin");
+            return b.add_free(n, c, &o);
+          },
+          py::arg("name"), py::arg("child"), py::arg("origin") = py::none(),
+          "Declare body `child` free (a floating base). In joint space its frame -- the body's "
+          "axes at `origin` (world at assembly, m; default its centre of mass) -- takes 7 entries "
+          "of q (x, y, z, then the scalar-first unit quaternion e0..e3) and 6 of qd (linear, "
+          "then angular velocity, both in the frame's own axes).")
       .def("set_joint_limits", &ModelBuilder::set_joint_limits, py::arg("joint"), py::arg("lower"),
            py::arg("upper"), py::arg("effort") = 0.0, py::arg("velocity") = 0.0)
       .def(

@@ -17,8 +17,11 @@ class SimulationResult:
         t: (n,) output times [s].
         u: (n, nq) positions: per body CoM (3) and Euler parameters (4, scalar first).
         v: (n, nv) velocities: per body CoM velocity (3, world) and angular velocity (3, body).
-        q, qd, qdd: (n, n_coords) joint coordinates (angles unwrapped along the run), rates and
-            accelerations (from the constrained accelerations at each output state).
+        q: (n, n_coords) joint-space coordinates (angles unwrapped along the run; a floating
+            base's position and scalar-first quaternion first, ``model.coord_names``).
+        qd, qdd: (n, n_dofs) rates and accelerations (from the constrained accelerations at
+            each output state; a floating base's linear and angular velocity in its own frame
+            first, ``model.dof_names``).
         drive_forces: (n, n_drives) actuator torque/force of each drive, applied to the child
             about/along the joint axis (the RNEA/URDF effort convention).
         reaction_forces, reaction_torques: (n, n_joints, 3) joint reaction on the child body at
@@ -97,8 +100,13 @@ def simulate(
         dt: RK4 step (required for rk4); DOPRI5/DOP853/TR-BDF2 initial step (optional).
         output_dt: spacing of output times (default: every accepted step). Output states are
             interpolated (the integrator's dense output) and projected onto the constraints.
-        q0, qd0: initial joint coordinates and rates (n_coords,) for joint-space tree models;
-            default: the model's assembled state at rest.
+        q0, qd0: initial joint-space coordinates (``model.n_coords``,) and rates
+            (``model.n_dofs``,) for tree models; default: the model's assembled state at rest.
+            Angles are multi-turn: the run starts from q0's turns (3.5 rad stays 3.5, not
+            -2.78). A floating base leads both: ``q = (x, y, z, e0, e1, e2, e3, joints…)``,
+            its frame's position and scalar-first unit quaternion, and ``qd = (v, ω, rates…)``,
+            its linear and angular velocity in its own frame (Pinocchio's free-flyer convention
+            with the quaternion scalar first).
         u0, v0: initial Cartesian state (nq,), (nv,) instead of q0/qd0 (projected onto the
             constraints first); default: the model's assembled state.
         projection: metric of the minimum-norm projection: ``"mass"`` (kinetic-energy metric,
@@ -139,6 +147,9 @@ def simulate(
         if q0 is None:
             raise _core.ModelError("simulate: qd0 given without q0")
         u0, v0 = _core.state_from_joints(model, q0, qd0)
+        q_start = np.asarray(q0, dtype=float)
+    else:
+        q_start = None
     raw = _core._simulate(
         model,
         float(t_end),
@@ -154,6 +165,7 @@ def simulate(
         float(max_step or 0.0),
         bool(merge_welded),
         coordinates,
+        q_start,
     )
     error = raw.pop("error")
     result = SimulationResult(**raw)

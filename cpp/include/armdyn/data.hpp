@@ -46,14 +46,16 @@ class Data {
   Data& operator=(const Data&) = delete;
 
   const Model* model;  ///< the model the buffers are sized for (identity only, not owned)
-  int n = 0;           ///< joint coordinates
+  int n = 0;           ///< joint-space degrees of freedom: len(qd) (model.nv_joint)
+  int nq = 0;          ///< len(q) (model.nq_joint: 7 per floating base where n has 6)
+  int nco = 0;  ///< joint coordinates of Model::coords (n without the floating bases' 6 each)
 
   // --- kinematics: joint_space_kinematics, load_kinematics (shared by the joint-space and the
   // Cartesian algorithms; each loads it before use) ---
   std::vector<BodyKin> kin;  ///< per body: pose and velocity
   // --- forces (body_forces, coordinate_forces, cartesian_forces) ---
   VecX eta;        ///< (nv) applied and gyroscopic forces on the bodies
-  VecX coord_tau;  ///< (n) joint-coordinate forces and gear contact forces (coordinate_forces)
+  VecX coord_tau;  ///< (nco) joint-coordinate forces and gear contact forces (coordinate_forces)
   // --- recursive Newton-Euler (rnea) ---
   RneWork rne;
   VecX tau;  ///< (n) the last rnea's joint torques/forces
@@ -92,7 +94,8 @@ class Data {
   // settings of the calls that follow, set by the caller:
   int nrows = 0;  ///< rows taking part: model.nc (joints and drives, the default) or nc_joint
   const double* aux = nullptr;  ///< auxiliary states z (model.n_aux); nullptr: all zero
-  /// Joint-space generalised forces (n) added to eta by cartesian_forces; nullptr: none.
+  /// Joint-space generalised forces (n: the floating bases' wrenches, then the coordinates')
+  /// added to eta by cartesian_forces; nullptr: none.
   const double* joint_torques = nullptr;
   /// false: cartesian_forces leaves out the joint-coordinate forces and gear pairs (a
   /// joint-space caller adds them to its generalised forces directly).
@@ -101,9 +104,9 @@ class Data {
   ConstraintEval ce;             ///< f, zeta, rhs, xi at the loaded state
   std::vector<int> joint_block;  ///< per joint: its row block in ce.blocks (-1: no rows)
   CoordJetCache jets;            ///< coordinate jets at the loaded state (ce.coord_cache)
-  VecX track_ref;  ///< (n) unwrapped reference of the angle coordinates (ce.track_ref)
-  std::vector<ScalarJet> tau_jets;  ///< (n) with joint_torques: each coordinate's jet (no value)
-  VecX cq, cqd;                     ///< (n) the coordinates the force laws read, from the jets
+  VecX track_ref;  ///< (nco) unwrapped reference of the angle coordinates (ce.track_ref)
+  std::vector<ScalarJet> tau_jets;  ///< (nco) with joint_torques: each coordinate's jet (no value)
+  VecX cq, cqd;                     ///< (nco) the coordinates the force laws read, from the jets
   KktSolver kkt;                    ///< the factor of the KKT system's Schur complement
   TreeSweep sweep;                  ///< the O(n) solve of a fully driven tree
   bool swept = false;               ///< the last body_accelerations took the sweep (kkt not used)

@@ -22,10 +22,18 @@ void check_inputs(const Model& m, const Data& d, Eigen::Ref<const VecX> q,
                   const char* xname) {
   require_joint_space(m, fn);
   check_data(m, d, fn);
-  check_joint_vector(q, d.n, fn, "q");
+  check_joint_vector(q, d.nq, fn, "q");
   check_joint_vector(qd, d.n, fn, "qd");
   check_joint_vector(x, d.n, fn, xname);
   if (!std::isfinite(t)) throw ModelError(msg(fn, ": t is not finite"));
+  check_base_quaternions(m, q, fn);
+}
+
+void refuse_floating_cartesian(const Model& m, const char* fn) {
+  if (m.n_free)
+    throw ModelError(msg(fn,
+                         ": method 'cartesian' takes fixed-base models only (this one has a "
+                         "floating base); use 'auto' or 'joint'"));
 }
 
 // forward dynamics through the Cartesian KKT system, the joint torques as loads: the joint rows
@@ -48,8 +56,10 @@ void forward_cartesian(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen:
   load_joint_kinematics(m, d, q, qd);
   d.tau_in = tau;
   body_accelerations_loaded(m, d, t, d.vd.data());
-  // the coordinate jets of the torques, at this state
-  for (int c = 0; c < d.n; ++c) d.qdd[c] = coord_acceleration(m, d.tau_jets[c], c, d.vd);
+  // the coordinate jets of the torques, at this state; the floating bases' from their bodies
+  for (int c = 0; c < d.nco; ++c)
+    d.qdd[6 * m.n_free + c] = coord_acceleration(m, d.tau_jets[c], c, d.vd);
+  if (m.n_free) base_accelerations(m, d.kin, d.vd.data(), d.qdd.data());
 }
 
 // inverse dynamics through the KKT system with every joint coordinate driven to (q, qd, qdd)
@@ -100,7 +110,7 @@ void inverse_cartesian(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen:
 
 void joint_space_equations(const Model& m, Data& d, const double* q, const double* qd,
                            const double* z, const double* tau, double t) {
-  const Eigen::Map<const VecX> qv(q, d.n), qdv(qd, d.n);
+  const Eigen::Map<const VecX> qv(q, d.nq), qdv(qd, d.n);
   joint_space_kinematics(m, qv, qdv, d.kin, d.rne);
   body_forces(m, d.kin, t, d.eta);
   // rhs = tau + Q - (b - J^T eta): the residual of the Newton-Euler equations at qdd = 0
@@ -109,14 +119,14 @@ void joint_space_equations(const Model& m, Data& d, const double* q, const doubl
   rhs = -rhs;
   if (tau) rhs += Eigen::Map<const VecX>(tau, d.n);
   if (!m.coord_forces.empty() || !m.gears.empty()) {
-    coordinate_forces(m, q, qd, z, t, d.coord_tau);
-    rhs += d.coord_tau;
+    coordinate_forces(m, q + 7 * m.n_free, qd + 6 * m.n_free, z, t, d.coord_tau);
+    rhs.tail(d.nco) += d.coord_tau;
   }
   if (!rhs.allFinite()) {
     for (int c = 0; c < d.n; ++c)
       if (!std::isfinite(rhs[c]))
-        throw SolverError(msg("non-finite generalised force on joint coordinate '",
-                              m.coords[c].name, "' at t=", t));
+        throw SolverError(msg("non-finite generalised force on joint coordinate '", m.dof_names[c],
+                              "' at t=", t));
   }
   crba_loaded(m, d);
 }
@@ -163,6 +173,7 @@ const VecX& inverse_dynamics(const Model& m, Data& d, Eigen::Ref<const VecX> q,
                              DynamicsMethod method) {
   if (method != DynamicsMethod::Cartesian) return rnea(m, d, q, qd, qdd, t);
   check_inputs(m, d, q, qd, qdd, t, "inverse_dynamics", "qdd");
+  refuse_floating_cartesian(m, "inverse_dynamics");
   inverse_cartesian(m, d, q, qd, qdd, t);
   return d.tau;
 }

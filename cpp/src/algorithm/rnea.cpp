@@ -12,16 +12,19 @@ const VecX& rnea(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen::Ref<c
                  Eigen::Ref<const VecX> qdd, double t) {
   require_joint_space(m, "inverse_dynamics");
   check_data(m, d, "inverse_dynamics");
-  check_joint_vector(q, d.n, "inverse_dynamics", "q");
+  check_joint_vector(q, d.nq, "inverse_dynamics", "q");
   check_joint_vector(qd, d.n, "inverse_dynamics", "qd");
   check_joint_vector(qdd, d.n, "inverse_dynamics", "qdd");
   if (!std::isfinite(t)) throw ModelError("inverse_dynamics: t is not finite");
+  check_base_quaternions(m, q, "inverse_dynamics");
   joint_space_kinematics(m, q, qd, d.kin, d.rne);
   body_forces(m, d.kin, t, d.eta);
   rne_residual(m, d.kin, qd, qdd, d.eta, d.rne, d.tau);
   if (!m.coord_forces.empty() || !m.gears.empty()) {
-    coordinate_forces(m, q.data(), qd.data(), nullptr, t, d.coord_tau);
-    d.tau -= d.coord_tau;
+    // the coordinates follow the floating bases' blocks in q and qd
+    coordinate_forces(m, q.data() + 7 * m.n_free, qd.data() + 6 * m.n_free, nullptr, t,
+                      d.coord_tau);
+    d.tau.tail(d.nco) -= d.coord_tau;
   }
   return d.tau;
 }

@@ -97,6 +97,9 @@ int ModelBuilder::add_joint(const std::string& name, JointType type, const std::
   if (type == JointType::Revolute || type == JointType::Prismatic ||
       type == JointType::Cylindrical || type == JointType::Inline) {
     fw_parent = fw_child = frame_from_z(unit_axis(axis, who + ": axis"));
+  } else if (type == JointType::Free && ch != kGround) {
+    // a floating base's frame: the child body's axes (at `point`)
+    fw_parent = fw_child = quat_to_rot(m_.bodies[ch].orientation);
   } else if (type == JointType::Universal) {
     const Vec3 a1 = unit_axis(axis, who + ": axis1");
     const Vec3 a2 = unit_axis(*axis2, who + ": axis2");
@@ -189,11 +192,11 @@ int ModelBuilder::add_distance(const std::string& name, const std::string& body_
   m_.joints[idx].length = len;
   return idx;
 }
-int ModelBuilder::add_free(const std::string& name, const std::string& child) {
+int ModelBuilder::add_free(const std::string& name, const std::string& child, const Vec3* origin) {
   const int c = resolve_body(child, msg("free joint '", name, "'"));
   if (c == kGround) throw ModelError(msg("free joint '", name, "': child must be a body"));
-  return add_joint(name, JointType::Free, "ground", child, m_.bodies[c].position, Vec3::UnitZ(),
-                   nullptr);
+  return add_joint(name, JointType::Free, "ground", child, origin ? *origin : m_.bodies[c].position,
+                   Vec3::UnitZ(), nullptr);
 }
 
 void ModelBuilder::set_joint_limits(const std::string& joint, double lower, double upper,

@@ -458,7 +458,9 @@ ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const
     std::string free_name = "root_free";
     while (urdf_model->getJoint(free_name)) free_name += "_";
     try {
-      builder.add_free(free_name, root_name);
+      // the floating base's frame is the root link's frame (q: its pose, qd: its velocity)
+      const Vec3 origin = frame.at(root_name).p;
+      builder.add_free(free_name, root_name, &origin);
     } catch (const UrdfError&) {
       throw;
     } catch (const ModelError& e) {

@@ -67,7 +67,8 @@ constexpr int joint_rows(JointType t) {
   }
   return 0;
 }
-/// Number of joint coordinates (angle and/or displacement) a joint type defines.
+/// Number of joint coordinates (angle and/or displacement) a joint type defines (the Cartesian
+/// coordinate list Model::coords; a free joint has none there).
 constexpr int joint_coords(JointType t) {
   switch (t) {
     case JointType::Revolute:
@@ -79,6 +80,14 @@ constexpr int joint_coords(JointType t) {
       return 0;
   }
 }
+
+/// Degrees of freedom a joint type contributes to the joint-space velocity vector qd: its
+/// coordinates, and 6 for a free joint (a floating base: linear and angular velocity of its frame
+/// in its own axes).
+constexpr int joint_dofs(JointType t) { return t == JointType::Free ? 6 : joint_coords(t); }
+/// Entries a joint type contributes to the joint-space configuration q: its coordinates, and 7
+/// for a free joint (position, then the scalar-first unit quaternion of its frame).
+constexpr int joint_configs(JointType t) { return t == JointType::Free ? 7 : joint_coords(t); }
 
 struct Joint {
   std::string name;
@@ -93,6 +102,11 @@ struct Joint {
   double length = 0.0;                        ///< distance joint: the held distance [m]
   int row0 = 0;                               ///< first constraint row
   int coord0 = -1;                            ///< first joint coordinate index, -1 if none
+  /// Joint-space layout (finalize; -1 when the joint adds nothing): first entry of the joint's
+  /// configuration in q and of its degrees of freedom in qd, qdd, tau and M. Free joints
+  /// (floating bases) come first, 7 and 6 entries each; then the coordinates in Model::coords
+  /// order (q0 = 7 n_free + coord0, dof0 = 6 n_free + coord0).
+  int q0 = -1, dof0 = -1;
 };
 
 /// Prescribed joint coordinate: q_joint[coord](t) = profile(t).
@@ -203,6 +217,11 @@ class Model {
   std::vector<int> tracked_coords;  ///< angle coordinates unwrapped over turns (gears)
   int n_aux = 0;  ///< auxiliary states of the simulation (integral terms of PI motors)
   std::vector<Coord> coords;
+  /// Joint-space sizes (finalize): nq_joint = len(q) = 7 n_free + coords, nv_joint = len(qd) =
+  /// 6 n_free + coords; n_free the free joints (floating bases), whose blocks lead q and qd.
+  int n_free = 0, nq_joint = 0, nv_joint = 0;
+  std::vector<int> dof_joint;  ///< the joint of each joint-space degree of freedom (nv_joint)
+  std::vector<std::string> q_names, dof_names;  ///< names of the entries of q and of qd
   Vec3 gravity = Vec3(0, 0, -9.81);
 
   // --- sizes ---
