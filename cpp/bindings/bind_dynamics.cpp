@@ -103,6 +103,9 @@ void bind_dynamics(py::module_& m) {
       [](const Model& md, double t_end, const std::string& integrator, double rtol, double atol,
          double dt, double output_dt, py::object u0, py::object v0, const std::string& projection,
          long max_steps, double max_step, bool merge_welded, const std::string& coordinates) {
+        // armdyn.simulate answers a model with no bodies itself (nothing to integrate)
+        if (md.nb == 0)
+          throw ModelError("_simulate: the model has no bodies (use armdyn.simulate)");
         SimOptions o;
         o.merge_welded = merge_welded;
         o.coordinates = coordinates_from_name(coordinates);
