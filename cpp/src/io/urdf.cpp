@@ -222,8 +222,10 @@ std::string read_source(const std::string& path_or_xml, std::string* where) {
   if (::stat(path.c_str(), &st) != 0) {
     const int err = errno;
     if (err == ENOENT || err == ENOTDIR) {
+      // text with spaces is more likely XML gone wrong than a path
+      const bool text = path.find_first_of(" \t") != std::string::npos;
       throw UrdfError(msg("URDF file '", shown, "' not found",
-                          looks_like_xml(path) ? "" : " (a URDF string must start with '<')"));
+                          text ? " (a URDF string must start with '<')" : ""));
     }
     throw UrdfError(msg("URDF file '", shown, "' cannot be accessed: ", std::strerror(err)));
   }
