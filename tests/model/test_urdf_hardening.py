@@ -447,3 +447,21 @@ def test_tests_data_urdfs_still_load():
     data = Path(__file__).resolve().parents[1] / "data" / "urdf"
     for name in ("arm6.urdf", "slider.urdf"):
         assert ad.load_urdf(data / name).nb > 0
+
+
+def test_urdfdom_message_is_cut_short():
+    # a vector armdyn accepts but urdfdom does not (a tab between components): urdfdom's own
+    # message quotes the value, and armdyn passes on only an excerpt of it
+    value = "1." + "0" * 5000
+    text = replaced('xyz="0 0 1.5"', f'xyz="0 0\t{value}"')
+    with pytest.raises(ad.UrdfError, match="urdfdom could not parse the URDF") as err:
+        ad.load_urdf(text)
+    assert len(str(err.value)) < 600, len(str(err.value))
+
+
+def test_long_names_are_shortened_in_messages():
+    name = "n" * 10000
+    text = replaced('<link name="hand">', f'<link name="{name}"/><link name="{name}">')
+    with pytest.raises(ad.UrdfError, match=r"URDF link 'n+\.\.\.' is defined twice") as err:
+        ad.load_urdf(text)
+    assert len(str(err.value)) < 200

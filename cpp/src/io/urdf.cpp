@@ -481,10 +481,10 @@ void check_joint_numbers(const tinyxml2::XMLElement* joint, const std::string& n
 void check_number(const tinyxml2::XMLElement* e, const char* element, const char* name,
                   const std::string& link) {
   double v = 0.0;
-  if (!e) throw UrdfError(msg("URDF link '", link, "': <inertial> without <", element, ">"));
+  if (!e) throw UrdfError(msg("URDF link '", nm(link), "': <inertial> without <", element, ">"));
   if (e->QueryDoubleAttribute(name, &v) != tinyxml2::XML_SUCCESS) {
-    throw UrdfError(msg("URDF link '", link, "': <", element, "> needs a number in '", name,
-                        "', got '", attribute(e, name), "'"));
+    throw UrdfError(msg("URDF link '", nm(link), "': <", element, "> needs a number in '", name,
+                        "', got '", excerpt(attribute(e, name)), "'"));
   }
 }
 
@@ -649,8 +649,10 @@ urdf::ModelInterfaceSharedPtr parse_urdfdom(const std::string& xml, const std::s
   if (reason.empty()) reason = capture.text_;
 #endif
   if (!model) {
-    throw UrdfError(msg(where, ": urdfdom could not parse the URDF",
-                        reason.empty() ? std::string(" (see its log on stderr)") : ": " + reason));
+    // urdfdom's log may quote the input: a short excerpt only
+    throw UrdfError(msg(
+        where, ": urdfdom could not parse the URDF",
+        reason.empty() ? std::string(" (see its log on stderr)") : ": " + excerpt(reason, 400)));
   }
   if (!model->getRoot()) throw UrdfError(msg(where, ": urdfdom found no root link"));
   return model;
