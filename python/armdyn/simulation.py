@@ -222,7 +222,7 @@ def _urdf_source(path_or_xml) -> str:
                 f"URDF bytes are not valid UTF-8 (byte offset {err.start}); pass XML as UTF-8 "
                 "bytes or str, or a path as str"
             ) from None
-        if not text.lstrip().startswith("<"):
+        if not text.lstrip("\ufeff").lstrip().startswith("<"):
             raise _core.UrdfError(
                 f"URDF bytes must hold XML (starting with '<'), got {data[:40]!r}"
                 + ("..." if len(data) > 40 else "")

@@ -465,3 +465,11 @@ def test_long_names_are_shortened_in_messages():
     with pytest.raises(ad.UrdfError, match=r"URDF link 'n+\.\.\.' is defined twice") as err:
         ad.load_urdf(text)
     assert len(str(err.value)) < 200
+
+
+def test_byte_order_mark_before_the_xml():
+    plain = ad.load_urdf(PENDULUM)
+    for source in ("\ufeff" + PENDULUM, b"\xef\xbb\xbf" + PENDULUM.encode()):
+        model = ad.load_urdf(source)
+        assert model.body_names == plain.body_names
+        assert np.array_equal(model.u0, plain.u0)

@@ -101,7 +101,10 @@ struct JointDecl {
 };
 
 bool looks_like_xml(const std::string& s) {
-  for (char c : s) {
+  // a UTF-8 byte order mark may precede the XML (tinyxml2 skips it)
+  const size_t from = s.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;
+  for (size_t i = from; i < s.size(); ++i) {
+    const char c = s[i];
     if (std::isspace(static_cast<unsigned char>(c))) continue;
     return c == '<';
   }
