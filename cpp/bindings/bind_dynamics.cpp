@@ -104,6 +104,9 @@ void bind_dynamics(py::module_& m) {
          double dt, double output_dt, py::object u0, py::object v0, const std::string& projection,
          long max_steps, double max_step, bool merge_welded, const std::string& coordinates,
          py::object q_start) {
+        // armdyn.simulate answers a model with no bodies itself (nothing to integrate)
+        if (md.nb == 0)
+          throw ModelError("_simulate: the model has no bodies (use armdyn.simulate)");
         SimOptions o;
         if (!q_start.is_none()) o.q_start = to_vec(q_start, "q0", md.nq_joint);
         o.merge_welded = merge_welded;

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <pybind11/stl.h>
 
+#include <limits>
+
 #include "armdyn/builder/builder.hpp"
 #include "armdyn/builder/summary.hpp"
 #include "armdyn/io/urdf.hpp"
@@ -48,6 +50,46 @@ namespace armdyn {
 
 namespace py = pybind11;
 using namespace py_helpers;
+
+namespace {
+
+enum class CoordLimit { Lower, Upper, Effort, Velocity };
+
+// one limit per joint coordinate; a joint's limits belong to its first coordinate
+py::array_t<double> coord_limit(const Model& md, CoordLimit which) {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  // over q (Lower, Upper: n_coords) or qd (Effort, Velocity: n_dofs); the floating bases' entries
+  // lead and are unbounded
+  const bool position = which == CoordLimit::Lower || which == CoordLimit::Upper;
+  const long off = position ? 7 * md.n_free : 6 * md.n_free;
+  VecX r = VecX::Constant(off + static_cast<long>(md.coords.size()),
+                          which == CoordLimit::Lower ? -inf : inf);
+  for (size_t k = 0; k < md.coords.size(); ++k) {
+    const Coord& c = md.coords[k];
+    const Joint& j = md.joints[c.joint];
+    double v = which == CoordLimit::Lower ? -inf : inf;
+    if (c.sub == 0) {
+      switch (which) {
+        case CoordLimit::Lower:
+          v = j.lower <= -1e300 ? -inf : j.lower;
+          break;
+        case CoordLimit::Upper:
+          v = j.upper >= 1e300 ? inf : j.upper;
+          break;
+        case CoordLimit::Effort:
+          v = j.effort > 0 && j.effort < 1e300 ? j.effort : inf;
+          break;
+        case CoordLimit::Velocity:
+          v = j.velocity_limit > 0 && j.velocity_limit < 1e300 ? j.velocity_limit : inf;
+          break;
+      }
+    }
+    r[off + static_cast<long>(k)] = v;
+  }
+  return to_numpy(r);
+}
+
+}  // namespace
 
 void bind_model(py::module_& m) {
   py::class_<Profile>(m, "Profile", "A time profile y(t) with derivatives, evaluated in C++.")
@@ -159,6 +201,25 @@ void bind_model(py::module_& m) {
       .def_readonly("redundant_rows", &Model::redundant_rows)
       .def_property_readonly("u0", [](const Model& md) { return to_numpy(md.u0); })
       .def_property_readonly("v0", [](const Model& md) { return to_numpy(md.v0); })
+      // URDF <limit> per joint coordinate: +-inf where none (the joints store +-1e300), effort
+      // and velocity limits inf where none or 0 (unset)
+      .def_property_readonly(
+          "coord_lower", [](const Model& md) { return coord_limit(md, CoordLimit::Lower); },
+          "Lower position limit of each entry of q (n_coords; URDF <limit lower>; -inf where none "
+          "and on a floating base).")
+      .def_property_readonly(
+          "coord_upper", [](const Model& md) { return coord_limit(md, CoordLimit::Upper); },
+          "Upper position limit of each entry of q (n_coords; URDF <limit upper>; inf where none "
+          "and on a floating base).")
+      .def_property_readonly(
+          "coord_effort_limit", [](const Model& md) { return coord_limit(md, CoordLimit::Effort); },
+          "Effort limit of each entry of tau (n_dofs) [N m or N] (URDF <limit effort>; inf where "
+          "none or 0, and on a floating base).")
+      .def_property_readonly(
+          "coord_velocity_limit",
+          [](const Model& md) { return coord_limit(md, CoordLimit::Velocity); },
+          "Velocity limit of each entry of qd (n_dofs) [rad/s or m/s] (URDF <limit velocity>; inf "
+          "where none or 0, and on a floating base).")
       .def(
           "joint_limits",
           [](const Model& md, const std::string& name) {
@@ -449,10 +510,21 @@ void bind_model(py::module_& m) {
         return r;
       });
 
+  m.attr("URDF_MAX_BYTES") = kUrdfMaxBytes;
+  m.attr("URDF_MAX_ATTRIBUTES") = kUrdfMaxAttributes;
+  m.attr("URDF_COULOMB_SMOOTHING") = kUrdfCoulombSmoothing;
   m.def(
       "urdf_builder",
       [](const std::string& src, bool fixed_base, py::object g) {
-        return urdf_builder(src, fixed_base, to_vec3(g, "gravity"));
+        const Vec3 gravity = to_vec3(g, "gravity");
+        try {
+          return urdf_builder(src, fixed_base, gravity);
+        } catch (const UrdfError& e) {
+          // the loader escapes what it quotes; this keeps any message valid UTF-8 regardless
+          const std::string text = e.what();
+          throw UrdfError(
+              py::bytes(text).attr("decode")("utf-8", "backslashreplace").cast<std::string>());
+        }
       },
       py::arg("path_or_xml"), py::arg("fixed_base") = true,
       py::arg("gravity") = py::make_tuple(0.0, 0.0, -9.81),

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -150,6 +152,8 @@ def simulate(
         q_start = np.asarray(q0, dtype=float)
     else:
         q_start = None
+    if model.nb == 0:
+        return _zero_dof_result(model, t_end, output_dt)
     raw = _core._simulate(
         model,
         float(t_end),
@@ -176,13 +180,106 @@ def simulate(
     return result
 
 
+def _zero_dof_result(model: _core.Model, t_end: float, output_dt: float | None):
+    """The run of a model with no bodies (a zero-DOF structure): nothing moves, nothing is
+    integrated; the time grid of an ``output_dt`` run (k·output_dt, then ``t_end``) or
+    ``[0, t_end]``, and state arrays with no columns."""
+    if not (np.isfinite(t_end) and t_end > 0):
+        raise _core.ModelError(f"simulate: t_end must be positive and finite, got {t_end}")
+    if output_dt:
+        k = np.arange(int(np.ceil(t_end / output_dt)) + 1)
+        t = k * output_dt
+        t = np.append(t[t < t_end - 1e-9 * output_dt], t_end)
+    else:
+        t = np.array([0.0, float(t_end)])
+    n = len(t)
+    empty = np.zeros((n, 0))
+    return SimulationResult(
+        t=t,
+        u=empty,
+        v=empty.copy(),
+        q=empty.copy(),
+        qd=empty.copy(),
+        qdd=empty.copy(),
+        drive_forces=empty.copy(),
+        reaction_forces=np.zeros((n, len(model.joint_names), 3)),
+        reaction_torques=np.zeros((n, len(model.joint_names), 3)),
+        position_residual=np.zeros(n),
+        velocity_residual=np.zeros(n),
+        kinetic_energy=np.zeros(n),
+        potential_energy=np.zeros(n),
+        stats={
+            "steps": 0,
+            "seconds": 0.0,
+            "integrator": "none",
+            "integrator_reason": "the model has no bodies (no degrees of freedom)",
+            "formulation": "none: the model has no bodies",
+            "solver_bodies": 0,
+            "solver_rows": 0,
+        },
+        events={"t": np.zeros(0), "gear": [], "onset": []},
+        gear_forces={"names": [], "force": np.zeros((n, 0))},
+    )
+
+
+def _urdf_source(path_or_xml) -> str:
+    """The text handed to the C++ loader: a str (XML or path), an os.PathLike, or bytes holding
+    UTF-8 XML; anything else is a TypeError."""
+    if isinstance(path_or_xml, (bytes, bytearray, memoryview)):
+        data = bytes(path_or_xml)
+        try:
+            text = data.decode("utf-8")
+        except UnicodeDecodeError as err:
+            raise _core.UrdfError(
+                f"URDF bytes are not valid UTF-8 (byte offset {err.start}); pass XML as UTF-8 "
+                "bytes or str, or a path as str"
+            ) from None
+        if not text.lstrip("\ufeff").lstrip().startswith("<"):
+            raise _core.UrdfError(
+                f"URDF bytes must hold XML (starting with '<'), got {data[:40]!r}"
+                + ("..." if len(data) > 40 else "")
+                + "; pass a path as str or os.PathLike"
+            )
+        return text
+    if isinstance(path_or_xml, str):
+        return path_or_xml
+    if isinstance(path_or_xml, os.PathLike):
+        path = os.fspath(path_or_xml)
+        return path if isinstance(path, str) else _urdf_source(path)
+    raise TypeError(
+        "load_urdf: expected a path (str or os.PathLike) or URDF XML (str or bytes), got "
+        f"{type(path_or_xml).__name__}"
+    )
+
+
 def load_urdf(path_or_xml, fixed_base: bool = True, gravity=(0.0, 0.0, -9.81)) -> _core.Model:
     """Load a URDF file (or XML string) through urdfdom into a finalized Model.
 
     Links joined by fixed joints are merged into one body; joint-space arrays follow the URDF's
     document order of its moving joints. With ``fixed_base`` the root link is welded to ground.
+    ``<dynamics damping friction>`` becomes joint friction (viscous, and Coulomb smoothed with
+    ``armdyn._core.URDF_COULOMB_SMOOTHING``); ``<limit>`` gives ``model.coord_lower`` /
+    ``coord_upper`` / ``coord_effort_limit`` / ``coord_velocity_limit``. See docs/urdf.md.
+
+    ``path_or_xml``: a path (str or os.PathLike) to a regular file of at most
+    ``armdyn._core.URDF_MAX_BYTES`` bytes, or the XML itself as str or UTF-8 bytes.
+
+    A URDF with no moving joint loaded with ``fixed_base=True`` is a zero-DOF model (a structure
+    that only carries loads): it loads with a ``UserWarning`` suggesting ``fixed_base=False``
+    for a robot meant to move freely.
 
     Raises:
-        UrdfError: missing file, malformed XML, unsupported joint type, invalid inertial data.
+        UrdfError: missing or irregular file, malformed XML, bad numbers or names, unsupported
+            joint type, invalid inertial data (the message names the element and attribute).
+        TypeError: ``path_or_xml`` is neither str, bytes nor os.PathLike.
     """
-    return _core.urdf_builder(str(path_or_xml), fixed_base, gravity).finalize()
+    model = _core.urdf_builder(_urdf_source(path_or_xml), fixed_base, gravity).finalize()
+    if model.nb == 0:
+        warnings.warn(
+            "armdyn: the URDF has no moving joint: with fixed_base=True it loads as a model with "
+            "no degrees of freedom (nb = 0, n_coords = 0); pass fixed_base=False if the robot "
+            "is meant to move freely",
+            UserWarning,
+            stacklevel=2,
+        )
+    return model

@@ -21,7 +21,7 @@ namespace detail {
 std::shared_ptr<Model> finalize_draft(const Model& draft, const FinalizeOptions& options) {
   auto mp = std::make_shared<Model>(draft);
   Model& m = *mp;
-  if (m.bodies.empty()) throw ModelError("finalize: the model has no bodies");
+  // no bodies is a zero-DOF model (a URDF structure fixed to ground): nq = nv = nc = 0
   m.nb = static_cast<int>(m.bodies.size());
   m.nq = 7 * m.nb;
   m.nv = 6 * m.nb;
