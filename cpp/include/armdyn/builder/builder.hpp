@@ -52,6 +52,14 @@ class ModelBuilder {
   /// Declares a body free (6 DOF, no constraint rows) so that it counts as connected to ground.
   int add_free(const std::string& name, const std::string& child);
 
+  /// Add a named frame rigidly attached to `body` (or "ground"): its origin `position` [m] and
+  /// axes `orientation` (unit Euler parameters, scalar first, frame -> world), both in WORLD at
+  /// the assembly pose like every builder input. Stored relative to the body (NamedFrame).
+  /// @throws ModelError on an empty or duplicate frame name, an unknown body, a non-finite
+  /// placement or a quaternion that is not of unit norm.
+  int add_frame(const std::string& name, const std::string& body, const Vec3& position,
+                const Vec4& orientation);
+
   /// Set position limits and informative effort/velocity limits on a joint.
   void set_joint_limits(const std::string& joint, double lower, double upper, double effort,
                         double velocity);
