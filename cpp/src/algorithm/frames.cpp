@@ -32,8 +32,8 @@ void set_pose(Mat4& T, const Mat3& R, const Vec3& p) {
 
 }  // namespace
 
-void joint_jacobian_columns(const Joint& j, const Vec3& point, const Vec3& axis, const Vec3& p,
-                            Mat6X& J) {
+void joint_jacobian_columns(const Joint& j, const Vec3& point, const Vec3& axis,
+                            const BodyKin& /*child*/, const Vec3& p, Mat6X& J) {
   // the first velocity column of the joint (a floating base writes its six here too)
   const int c = j.coord0;
   switch (j.type) {
@@ -74,7 +74,7 @@ const Mat6X& frame_jacobian_loaded(const Model& m, Data& d, int frame) {
     const int ji = d.joint_of_body[b];
     if (ji < 0) break;
     const Joint& j = m.joints[ji];
-    joint_jacobian_columns(j, d.rne.point[ji], d.rne.axis[ji], p, J);
+    joint_jacobian_columns(j, d.rne.point[ji], d.rne.axis[ji], d.kin[b], p, J);
     b = j.parent;
   }
   return J;

@@ -27,12 +27,14 @@ inline void frame_placement(const NamedFrame& f, const BodyKin* body, Mat3& R, V
 }
 
 /// The column writer: joint j's Jacobian columns for a point p moving with its child, from the
-/// joint's child-side point and world axis (RneWork::point, RneWork::axis), into J (6 x n).
-/// Revolute: [axis x (p - point); axis]; prismatic: [axis; 0]; cylindrical: both, angle then
-/// displacement; other joint types have no columns. Columns are indexed by the joint's first
-/// velocity coordinate (today coord0: a joint-space tree has as many velocities as coordinates).
-void joint_jacobian_columns(const Joint& j, const Vec3& point, const Vec3& axis, const Vec3& p,
-                            Mat6X& J);
+/// joint's child-side point and world axis (RneWork::point, RneWork::axis) and the child body's
+/// pose, into J (6 x n). Revolute: [axis x (p - point); axis]; prismatic: [axis; 0];
+/// cylindrical: both, angle then displacement; other joint types have no columns. Columns are
+/// indexed by the joint's first velocity coordinate (today coord0: a joint-space tree has as many
+/// velocities as coordinates). A joint type with more velocities (a floating base's six, from the
+/// child's pose) adds its case here and nowhere else.
+void joint_jacobian_columns(const Joint& j, const Vec3& point, const Vec3& axis,
+                            const BodyKin& child, const Vec3& p, Mat6X& J);
 
 /// The world pose of frame `frame` (index into model.frames) at joint coordinates q, as a 4 x 4
 /// homogeneous transform [R p; 0 1] into data.frame_pose. Allocates nothing.
