@@ -129,8 +129,10 @@ py::array_t<double> vector_out(const VecX& v) {
 /// A frame argument: its name (str) or its index into model.frame_names (int).
 int frame_arg(const Model& md, const py::handle& frame, const char* fn) {
   if (py::isinstance<py::str>(frame)) return md.find_frame(frame.cast<std::string>());
-  if (py::isinstance<py::int_>(frame) && !py::isinstance<py::bool_>(frame)) {
-    const long long k = frame.cast<long long>();
+  // an int, or any integer type (numpy's too), never a bool
+  if (PyIndex_Check(frame.ptr()) && !py::isinstance<py::bool_>(frame)) {
+    const long long k =
+        py::reinterpret_steal<py::int_>(PyNumber_Index(frame.ptr())).cast<long long>();
     const long long nf = static_cast<long long>(md.frames.size());
     if (k < 0 || k >= nf)
       throw ModelError(

@@ -122,7 +122,7 @@ def test_ur5_frames_by_index_rows_and_placement(rng):
     np.testing.assert_allclose(am.frame("ee_link")["point"], [0, 0.0823, 0], atol=1e-15)
     Q = rng.uniform(-np.pi, np.pi, (4, am.n_coords))
     k = names.index("tool0")
-    T_rows, J_rows = ad.frame_pose(am, Q, "tool0"), ad.frame_jacobian(am, Q, k)
+    T_rows, J_rows = ad.frame_pose(am, Q, "tool0"), ad.frame_jacobian(am, Q, np.int64(k))
     assert T_rows.shape == (4, 4, 4) and J_rows.shape == (4, 6, am.n_coords)
     data = ad.Data(am)
     for i in range(4):
@@ -316,6 +316,8 @@ def test_unknown_frame_names_the_known_ones():
         ad.frame_jacobian(am, q, -1)
     with pytest.raises(ad.ModelError, match="frame must be a frame name"):
         ad.frame_pose(am, q, 1.5)
+    with pytest.raises(ad.ModelError, match="frame must be a frame name"):
+        ad.frame_pose(am, q, True)
     with pytest.raises(ad.ModelError, match=r"frame_pose_cartesian: frame index 99"):
         ad.frame_pose_cartesian(am, am.u0, 99)
 
