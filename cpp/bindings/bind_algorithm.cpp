@@ -9,6 +9,7 @@
 #include "armdyn/algorithm/cost_model.hpp"
 #include "armdyn/algorithm/crba.hpp"
 #include "armdyn/algorithm/dynamics.hpp"
+#include "armdyn/algorithm/frames.hpp"
 #include "common.hpp"
 
 namespace armdyn {
@@ -123,6 +124,63 @@ py::array_t<double> vector_out(const VecX& v) {
   py::array_t<double> a(v.size());
   std::copy(v.data(), v.data() + v.size(), a.mutable_data());
   return a;
+}
+
+/// A frame argument: its name (str) or its index into model.frame_names (int).
+int frame_arg(const Model& md, const py::handle& frame, const char* fn) {
+  if (py::isinstance<py::str>(frame)) return md.find_frame(frame.cast<std::string>());
+  // an int, or any integer type (numpy's too), never a bool
+  if (PyIndex_Check(frame.ptr()) && !py::isinstance<py::bool_>(frame)) {
+    const long long k =
+        py::reinterpret_steal<py::int_>(PyNumber_Index(frame.ptr())).cast<long long>();
+    const long long nf = static_cast<long long>(md.frames.size());
+    if (k < 0 || k >= nf)
+      throw ModelError(
+          msg(fn, ": frame index ", k, " out of range (the model has ", nf, " frames)"));
+    return static_cast<int>(k);
+  }
+  throw ModelError(msg(fn, ": frame must be a frame name (str) or an index (int), got ",
+                       py::str(py::type::of(frame)).cast<std::string>()));
+}
+
+/// out (rows, *shape) from f(q_i, out_i) for each row of a 2-D q, or (shape) for a 1-D q; f
+/// writes row-major.
+template <class Fn>
+py::array_t<double> per_state(const char* fn, const char* qname, long n, const py::handle& q,
+                              std::vector<py::ssize_t> shape, Fn&& f) {
+  long size = 1;
+  for (auto s : shape) size *= static_cast<long>(s);
+  const auto qa = as_array(q, msg(fn, ": ", qname));  // nested lists too
+  if (qa.ndim() == 2) {
+    const long rows = static_cast<long>(qa.shape(0));
+    const auto Q = rows_of(qa, fn, qname, rows, n);
+    shape.insert(shape.begin(), rows);
+    py::array_t<double> out(shape);
+    for (long i = 0; i < rows; ++i) {
+      try {
+        f(Eigen::Map<const VecX>(Q.data() + i * n, n), out.mutable_data() + i * size);
+      } catch (const ModelError& e) {
+        throw ModelError(msg("row ", i, ": ", e.what()));
+      }
+    }
+    return out;
+  }
+  const VecArg one(qa, msg(fn, ": ", qname).c_str(), n);
+  py::array_t<double> out(shape);
+  f(*one, out.mutable_data());
+  return out;
+}
+
+void copy_row_major(const Mat4& T, double* out) {
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) out[4 * r + c] = T(r, c);
+}
+
+template <class M>
+void copy_row_major(const M& J, double* out) {
+  const long cols = J.cols();
+  for (long r = 0; r < J.rows(); ++r)
+    for (long c = 0; c < cols; ++c) out[r * cols + c] = J(r, c);
 }
 
 }  // namespace
@@ -248,6 +306,75 @@ void bind_algorithm(py::module_& m) {
       py::arg("model"), py::arg("q"), py::arg("data") = py::none(),
       "The joint-space mass matrix M(q) (n_dofs, n_dofs) of a tree, by the "
       "composite-rigid-body algorithm; 2-D q (one state per row) gives (rows, n, n).");
+
+  m.def(
+      "frame_pose",
+      [](const ModelHolder& md, const py::object& q, const py::object& frame,
+         const py::object& data) {
+        constexpr const char* fn = "frame_pose";
+        Data& d = data_for(md, data, fn);
+        const Model& mm = *md;
+        require_joint_space(mm, fn);
+        const int f = frame_arg(mm, frame, fn);
+        return per_state(fn, "q", d.n, q, {4, 4}, [&](const auto& qi, double* out) {
+          copy_row_major(frame_pose(mm, d, qi, f), out);
+        });
+      },
+      py::arg("model"), py::arg("q"), py::arg("frame"), py::arg("data") = py::none(),
+      "The world pose of a named frame (a name of model.frame_names or its index) at joint "
+      "coordinates q: the 4x4 homogeneous transform [R p; 0 1], R the frame's axes in world "
+      "(frame -> world) and p its origin [m]; 2-D q (one state per row) gives (rows, 4, 4).");
+
+  m.def(
+      "frame_jacobian",
+      [](const ModelHolder& md, const py::object& q, const py::object& frame,
+         const py::object& data) {
+        constexpr const char* fn = "frame_jacobian";
+        Data& d = data_for(md, data, fn);
+        const Model& mm = *md;
+        require_joint_space(mm, fn);
+        const int f = frame_arg(mm, frame, fn);
+        return per_state(fn, "q", d.n, q, {6, d.n}, [&](const auto& qi, double* out) {
+          copy_row_major(frame_jacobian(mm, d, qi, f), out);
+        });
+      },
+      py::arg("model"), py::arg("q"), py::arg("frame"), py::arg("data") = py::none(),
+      "The Jacobian (6, n_coords) of a named frame at joint coordinates q: linear rows then "
+      "angular rows, world axes, at the frame's origin (Pinocchio's LOCAL_WORLD_ALIGNED), so "
+      "that [v; omega] of the frame = J qd. 2-D q gives (rows, 6, n_coords).");
+
+  m.def(
+      "frame_pose_cartesian",
+      [](const ModelHolder& md, const py::object& u, const py::object& frame,
+         const py::object& data) {
+        constexpr const char* fn = "frame_pose_cartesian";
+        Data& d = data_for(md, data, fn);
+        const Model& mm = *md;
+        const int f = frame_arg(mm, frame, fn);
+        return per_state(fn, "u", mm.nq, u, {4, 4}, [&](const auto& ui, double* out) {
+          copy_row_major(frame_pose_cartesian(mm, d, ui, f), out);
+        });
+      },
+      py::arg("model"), py::arg("u"), py::arg("frame"), py::arg("data") = py::none(),
+      "frame_pose from the Cartesian state u (nq; any model, loops included): the 4x4 world "
+      "pose of a named frame; 2-D u gives (rows, 4, 4).");
+
+  m.def(
+      "frame_jacobian_cartesian",
+      [](const ModelHolder& md, const py::object& u, const py::object& frame,
+         const py::object& data) {
+        constexpr const char* fn = "frame_jacobian_cartesian";
+        Data& d = data_for(md, data, fn);
+        const Model& mm = *md;
+        const int f = frame_arg(mm, frame, fn);
+        return per_state(fn, "u", mm.nq, u, {6, mm.nv}, [&](const auto& ui, double* out) {
+          copy_row_major(frame_jacobian_cartesian(mm, d, ui, f), out);
+        });
+      },
+      py::arg("model"), py::arg("u"), py::arg("frame"), py::arg("data") = py::none(),
+      "The Jacobian (6, nv) of a named frame with respect to the bodies' velocities v of the "
+      "Cartesian state (any model): linear rows then angular rows, world axes, at the frame's "
+      "origin, so that [v; omega] of the frame = J v. 2-D u gives (rows, 6, nv).");
 }
 
 }  // namespace armdyn

@@ -162,6 +162,25 @@ void bind_model(py::module_& m) {
       .def_readonly("dof_names", &Model::dof_names,
                     "Names of the entries of qd, qdd and tau (n_dofs): a floating base's "
                     "'name:vx' .. 'name:wz', then the joint coordinates.")
+      .def_property_readonly("frame_names",
+                             [](const Model& md) {
+                               std::vector<std::string> r;
+                               for (const auto& f : md.frames) r.push_back(f.name);
+                               return r;
+                             })
+      .def(
+          "frame",
+          [](const Model& md, const std::string& name) {
+            const int k = md.find_frame(name);
+            const NamedFrame& f = md.frames[k];
+            return py::dict(py::arg("index") = k, py::arg("body") = md.body_name(f.body),
+                            py::arg("point") = to_numpy(VecX(f.point)),
+                            py::arg("rotation") = to_numpy(MatX(f.rotation)));
+          },
+          py::arg("frame"),
+          "A named frame's placement on its body: 'index' (into frame_names), 'body' (or "
+          "'ground'), 'point' (its origin in the body's frame, relative to the centre of mass; "
+          "the world for 'ground') and 'rotation' (its axes as columns in the body's axes).")
       .def_property_readonly("drive_names",
                              [](const Model& md) {
                                std::vector<std::string> r;
@@ -398,6 +417,20 @@ void bind_model(py::module_& m) {
           "axes at `origin` (world at assembly, m; default its centre of mass) -- takes 7 entries "
           "of q (x, y, z, then the scalar-first unit quaternion e0..e3) and 6 of qd (linear, "
           "then angular velocity, both in the frame's own axes).")
+      .def(
+          "add_frame",
+          [](ModelBuilder& b, const std::string& name, const std::string& body, py::object position,
+             py::object orientation) {
+            const std::string who = "frame '" + name + "'";
+            return b.add_frame(name, body, to_vec3(position, who + ": position"),
+                               to_vec4(orientation, who + ": orientation"));
+          },
+          py::arg("name"), py::arg("body"), py::arg("position") = py::make_tuple(0.0, 0.0, 0.0),
+          py::arg("orientation") = py::make_tuple(1.0, 0.0, 0.0, 0.0),
+          "Add a named frame rigidly attached to `body` (or 'ground'): its origin [m] and axes "
+          "(unit Euler parameters [e0, e1, e2, e3], frame -> world), both in world at the "
+          "assembly pose like every builder input. Read it back with armdyn.frame_pose and "
+          "armdyn.frame_jacobian.")
       .def("set_joint_limits", &ModelBuilder::set_joint_limits, py::arg("joint"), py::arg("lower"),
            py::arg("upper"), py::arg("effort") = 0.0, py::arg("velocity") = 0.0)
       .def(
@@ -504,9 +537,15 @@ void bind_model(py::module_& m) {
           },
           py::arg("mass_weighted_assembly") = true,
           "Validate, analyse topology and rank, assemble; returns an immutable Model.")
-      .def_property_readonly("body_names", [](const ModelBuilder& b) {
+      .def_property_readonly("body_names",
+                             [](const ModelBuilder& b) {
+                               std::vector<std::string> r;
+                               for (const auto& x : b.draft().bodies) r.push_back(x.name);
+                               return r;
+                             })
+      .def_property_readonly("frame_names", [](const ModelBuilder& b) {
         std::vector<std::string> r;
-        for (const auto& x : b.draft().bodies) r.push_back(x.name);
+        for (const auto& x : b.draft().frames) r.push_back(x.name);
         return r;
       });
 

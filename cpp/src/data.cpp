@@ -57,6 +57,8 @@ Data::Data(const Model& m)
   qdd = VecX::Zero(n);
   zero = VecX::Zero(n);
   L = MatX::Zero(n, n);
+  frame_jacobian = Mat6X::Zero(6, n);
+  frame_jacobian_v = MatX::Zero(6, m.nv);
 }
 
 Data::~Data() = default;

@@ -140,6 +140,11 @@ class Data {
   std::unique_ptr<Model> driven;      ///< inverse dynamics: the model with every coordinate driven
   std::unique_ptr<Data> driven_data;  ///< made on first use, for *driven
   VecX drive_ref;                     ///< (3 n) drive values (q, qd, qdd) of driven_data
+
+  // --- named frames (algorithm/frames) ---
+  Mat4 frame_pose = Mat4::Identity();  ///< the last frame pose [R p; 0 1]
+  Mat6X frame_jacobian;                ///< (6, n) the last joint-space frame Jacobian
+  MatX frame_jacobian_v;               ///< (6, nv) the last Cartesian frame Jacobian
 };
 
 /// Return the settings and learnt state of d's Cartesian pipeline to those of a new Data (the

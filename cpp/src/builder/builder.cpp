@@ -148,6 +148,39 @@ int ModelBuilder::add_joint(const std::string& name, JointType type, const std::
   return idx;
 }
 
+int ModelBuilder::add_frame(const std::string& name, const std::string& body, const Vec3& position,
+                            const Vec4& orientation) {
+  const std::string who = msg("frame '", name, "'");
+  if (name.empty()) throw ModelError("frame name must not be empty");
+  if (m_.frame_index.count(name)) throw ModelError(msg(who, ": duplicate frame name"));
+  const int b = resolve_body(body, who);
+  require_finite(position, who + ": position");
+  require_finite(orientation, who + ": orientation");
+  if (std::abs(orientation.norm() - 1.0) > 1e-6)
+    throw ModelError(msg(who,
+                         ": orientation must be a unit quaternion [e0, e1, e2, e3] "
+                         "(scalar first), got norm ",
+                         orientation.norm()));
+  NamedFrame f;
+  f.name = name;
+  f.body = b;
+  const Mat3 Rf = quat_to_rot(orientation.normalized());
+  if (b == kGround) {
+    f.point = position;
+    f.rotation = Rf;
+  } else {
+    // relative to the body's assembly pose, as the joint points and frames (add_joint)
+    const Body& bd = m_.bodies[b];
+    const Mat3 R = quat_to_rot(bd.orientation);
+    f.point = R.transpose() * (position - bd.position);
+    f.rotation = R.transpose() * Rf;
+  }
+  const int idx = static_cast<int>(m_.frames.size());
+  m_.frames.push_back(f);
+  m_.frame_index[name] = idx;
+  return idx;
+}
+
 int ModelBuilder::add_revolute(const std::string& name, const std::string& parent,
                                const std::string& child, const Vec3& point, const Vec3& axis) {
   return add_joint(name, JointType::Revolute, parent, child, point, axis, nullptr);

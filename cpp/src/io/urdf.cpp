@@ -901,6 +901,24 @@ ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const
       throw UrdfError(msg("URDF joint '", d.name, "': ", e.what()));
     }
   }
+
+  // every link stays a named frame (its link frame, not its centre of mass) on the body it was
+  // merged into, or on ground: depth-first from the root (children in urdfdom's order)
+  std::vector<urdf::LinkConstSharedPtr> pending{root};
+  while (!pending.empty()) {
+    const urdf::LinkConstSharedPtr link = pending.back();
+    pending.pop_back();
+    const Frame& f = frame.at(link->name);
+    try {
+      builder.add_frame(link->name, body_of(link->name), f.p, rot_to_quat(f.R));
+    } catch (const UrdfError&) {
+      throw;
+    } catch (const ModelError& e) {
+      throw UrdfError(msg("URDF link '", link->name, "': ", e.what()));
+    }
+    for (auto it = link->child_joints.rbegin(); it != link->child_joints.rend(); ++it)
+      pending.push_back(urdf_model->getLink((*it)->child_link_name));
+  }
   return builder;
 }
 

@@ -47,6 +47,19 @@ int Model::find_joint(const std::string& name) const {
   return it->second;
 }
 
+int Model::find_frame(const std::string& name) const {
+  auto it = frame_index.find(name);
+  if (it != frame_index.end()) return it->second;
+  // the known names in model order, at most a few of them
+  constexpr size_t kShown = 10;
+  std::string known;
+  for (size_t k = 0; k < frames.size() && k < kShown; ++k)
+    known += (k ? ", '" : "'") + frames[k].name + "'";
+  if (frames.size() > kShown) known += msg(", ... (", frames.size() - kShown, " more)");
+  if (frames.empty()) known = "none";
+  throw ModelError(msg("unknown frame '", name, "' (known: ", known, ")"));
+}
+
 std::string Model::row_name(int row) const {
   for (const Joint& j : joints) {
     const int r = joint_rows(j.type);

@@ -55,6 +55,14 @@ class ModelBuilder {
   /// and 6 of qd (linear and angular velocity in the frame's own axes).
   int add_free(const std::string& name, const std::string& child, const Vec3* origin = nullptr);
 
+  /// Add a named frame rigidly attached to `body` (or "ground"): its origin `position` [m] and
+  /// axes `orientation` (unit Euler parameters, scalar first, frame -> world), both in WORLD at
+  /// the assembly pose like every builder input. Stored relative to the body (NamedFrame).
+  /// @throws ModelError on an empty or duplicate frame name, an unknown body, a non-finite
+  /// placement or a quaternion that is not of unit norm.
+  int add_frame(const std::string& name, const std::string& body, const Vec3& position,
+                const Vec4& orientation);
+
   /// Set position limits and informative effort/velocity limits on a joint.
   void set_joint_limits(const std::string& joint, double lower, double upper, double effort,
                         double velocity);

@@ -30,6 +30,8 @@ constexpr double kUrdfCoulombSmoothing = 1e-3;
 /// - fixed_base = true: the root link and everything fixed to it become "ground".
 ///   fixed_base = false: the root group becomes a body declared free (joint "root_free").
 /// - Moving joints are added in document order, so it defines every joint-space array.
+/// - Every link stays a named frame (ModelBuilder::add_frame) at its link frame on the body it
+///   was merged into (on ground for the links of a fixed base): `tool0`, flanges, sensors.
 /// - <limit> sets joint limits (continuous joints keep unbounded positions).
 /// - <dynamics damping friction> becomes joint friction (add_joint_friction: viscous damping,
 ///   Coulomb friction smoothed with kUrdfCoulombSmoothing).

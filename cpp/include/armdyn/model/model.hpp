@@ -196,6 +196,17 @@ struct Coord {
   bool angular = true;
 };
 
+/// A named frame rigidly attached to a body (or to ground): a URDF link, a tool flange, a sensor.
+/// Its placement follows the conventions of Joint::point_parent and Joint::frame_parent: the
+/// origin in the body's frame relative to its centre of mass (ground: world), and the frame's
+/// axes as the columns of `rotation` in the body's axes (frame -> body).
+struct NamedFrame {
+  std::string name;
+  int body = kGround;
+  Vec3 point = Vec3::Zero();
+  Mat3 rotation = Mat3::Identity();
+};
+
 /// Options of ModelBuilder::finalize(), kept with the model (the welded model simulate()
 /// derives from it is assembled with the same options).
 struct FinalizeOptions {
@@ -222,6 +233,7 @@ class Model {
   int n_free = 0, nq_joint = 0, nv_joint = 0;
   std::vector<int> dof_joint;  ///< the joint of each joint-space degree of freedom (nv_joint)
   std::vector<std::string> q_names, dof_names;  ///< names of the entries of q and of qd
+  std::vector<NamedFrame> frames;  ///< named frames (builder add_frame; every URDF link)
   Vec3 gravity = Vec3(0, 0, -9.81);
 
   // --- sizes ---
@@ -263,6 +275,10 @@ class Model {
   VecX u0, v0;
 
   std::map<std::string, int> body_index, joint_index, drive_index;
+  std::map<std::string, int> frame_index;
+
+  /// The index of frame `name` in `frames`; throws ModelError "unknown frame 'x' (known: ...)".
+  int find_frame(const std::string& name) const;
 
   int find_body(const std::string& name) const;   ///< -1 for "ground"; throws ModelError
   int find_joint(const std::string& name) const;  ///< throws ModelError
