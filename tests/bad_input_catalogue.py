@@ -402,6 +402,73 @@ CASES = [
         UE,
         "pl",
     ),
+    (
+        "urdf-nan-inertia",
+        "urdf",
+        "an inertia ixx of nan (urdfdom would read 0)",
+        lambda: ad.load_urdf(
+            _urdf(
+                "<joint name='j' type='continuous'><parent link='base'/>"
+                "<child link='arm'/><axis xyz='0 0 1'/></joint>",
+                URDF_LINKS.replace('ixx="0.01"', 'ixx="nan"'),
+            )
+        ),
+        UE,
+        r"link 'arm'.*<inertia> attribute 'ixx'",
+    ),
+    (
+        "urdf-overflow-origin",
+        "urdf",
+        "a joint origin component 1e400",
+        lambda: ad.load_urdf(
+            _urdf(
+                "<joint name='j' type='continuous'><parent link='base'/>"
+                "<child link='arm'/><origin xyz='0 1e400 0'/><axis xyz='0 0 1'/></joint>"
+            )
+        ),
+        UE,
+        r"joint 'j'.*<origin> attribute 'xyz'",
+    ),
+    (
+        "urdf-device",
+        "urdf",
+        "a path to a device (/dev/zero)",
+        lambda: ad.load_urdf("/dev/zero"),
+        UE,
+        "character device",
+    ),
+    (
+        "urdf-bad-utf8-name",
+        "urdf",
+        "a link name that is not valid UTF-8",
+        lambda: ad.urdf_builder(
+            _urdf(
+                "<joint name='j' type='continuous'><parent link='base'/>"
+                "<child link='arm'/><axis xyz='0 0 1'/></joint>"
+            )
+            .encode()
+            .replace(b'name="base"', b'name="ba\xffse"')
+        ),
+        UE,
+        r"not valid UTF-8 \(byte offset 2\)",
+    ),
+    (
+        "urdf-many-attributes",
+        "urdf",
+        "an element with 40000 attributes",
+        lambda: ad.load_urdf(
+            _urdf(
+                "<joint name='j' type='continuous'><parent link='base'/>"
+                "<child link='arm'/><axis xyz='0 0 1'/></joint>",
+                URDF_LINKS.replace(
+                    '<link name="base"/>',
+                    '<link name="base" ' + " ".join(f'a{i}="1"' for i in range(40000)) + "/>",
+                ),
+            )
+        ),
+        UE,
+        "40001 attributes, more than the limit of 1000",
+    ),
     # ---- arrays and joint-space calls
     (
         "fd-q-length",

@@ -4,7 +4,8 @@ Pinocchio.
 :class:`PinPair` loads one URDF in both libraries (armdyn through urdfdom, Pinocchio through its
 own parser) with the map between their joint orders, and cross-checks armdyn's public
 ``forward_dynamics``, ``inverse_dynamics`` and ``mass_matrix`` against ``pin.aba``, ``pin.rnea``
-and ``pin.crba``.
+and ``pin.crba`` (with the URDF's joint damping and friction added to Pinocchio's, which leaves
+them out: :meth:`PinPair.joint_friction`).
 
 :func:`pinocchio_tree` rebuilds a finalized armdyn model whose joints form a tree of revolute,
 prismatic and fixed joints (``model.joint_space``) as a ``pinocchio.Model`` from the model's
@@ -113,6 +114,23 @@ class PinPair:
             raise ValueError("only revolute/prismatic arms are compared")
         self.perm = np.array([names.index(n) for n in pin_names])
 
+    def joint_friction(self, v):
+        """The URDF's ``<dynamics damping friction>`` torques at rates ``v`` (Pinocchio order),
+        from Pinocchio's reading of them (``model.damping``, ``model.friction``): armdyn imports
+        them as joint friction -damping v - friction tanh(v / v_s), v_s
+        ``armdyn._core.URDF_COULOMB_SMOOTHING``; Pinocchio's algorithms leave them out."""
+        v = np.asarray(v, dtype=float)
+        vs = _core.URDF_COULOMB_SMOOTHING
+        return -self.pm.damping * v - self.pm.friction * np.tanh(v / vs)
+
+    def aba(self, q, v, tau):
+        """``pin.aba`` with the URDF's joint friction acting (armdyn's forward dynamics)."""
+        return self.pin.aba(self.pm, self.pd, q, v, tau + self.joint_friction(v))
+
+    def rnea(self, q, v, a):
+        """``pin.rnea`` with the URDF's joint friction acting (armdyn's inverse dynamics)."""
+        return self.pin.rnea(self.pm, self.pd, q, v, a) - self.joint_friction(v)
+
     def to_armdyn(self, x):
         """A vector (or rows of vectors) in Pinocchio's joint order, in armdyn's."""
         x = np.asarray(x, dtype=float)
@@ -135,10 +153,10 @@ class PinPair:
         for _ in range(n):
             q, v, tau, acc = rng.uniform(-np.pi, np.pi, size=(4, pm.nq))
             qa, va, ta, aa = (self.to_armdyn(x) for x in (q, v, tau, acc))
-            a_pin = pin.aba(pm, pd, q, v, tau)
+            a_pin = self.aba(q, v, tau)
             update("fd", ad.forward_dynamics(self.am, qa, va, ta)[p], a_pin)
             update("fd_kkt", ad.forward_dynamics(self.am, qa, va, ta, method="cartesian")[p], a_pin)
-            update("id", ad.inverse_dynamics(self.am, qa, va, aa)[p], pin.rnea(pm, pd, q, v, acc))
+            update("id", ad.inverse_dynamics(self.am, qa, va, aa)[p], self.rnea(q, v, acc))
             update(
                 "mass_matrix",
                 ad.mass_matrix(self.am, qa)[np.ix_(p, p)],

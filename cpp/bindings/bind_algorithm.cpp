@@ -9,6 +9,7 @@
 #include "armdyn/algorithm/cost_model.hpp"
 #include "armdyn/algorithm/crba.hpp"
 #include "armdyn/algorithm/dynamics.hpp"
+#include "armdyn/algorithm/frames.hpp"
 #include "common.hpp"
 
 namespace armdyn {
@@ -81,15 +82,15 @@ py::array_t<double> rows_of(const py::handle& obj, const char* fn, const char* n
   return a;
 }
 
-/// f(i, q_i, a_i, b_i, t_i, out_i) for every row i of the 2-D arguments q, a, b (shape (N, n)),
-/// t a number or one per row; out has shape (N, *out_shape). Runs without the GIL; an error
-/// names its row.
+/// f(i, q_i, a_i, b_i, t_i, out_i) for every row i of the 2-D arguments q (shape (N, nq)), a, b
+/// (shape (N, n)), t a number or one per row; out has shape (N, *out_shape). Runs without the
+/// GIL; an error names its row.
 template <class Fn>
-py::array_t<double> batch(const char* fn, long n, const py::handle& q, const py::handle& a,
+py::array_t<double> batch(const char* fn, long nq, long n, const py::handle& q, const py::handle& a,
                           const char* an, const py::handle& b, const char* bn, const py::handle& t,
                           std::vector<py::ssize_t> out_shape, Fn&& f) {
   const long rows = static_cast<long>(py::reinterpret_borrow<py::array>(q).shape(0));
-  const auto Q = rows_of(q, fn, "q", rows, n), A = rows_of(a, fn, an, rows, n),
+  const auto Q = rows_of(q, fn, "q", rows, nq), A = rows_of(a, fn, an, rows, n),
              B = rows_of(b, fn, bn, rows, n);
   VecX ts;
   double t0 = 0.0;
@@ -108,7 +109,7 @@ py::array_t<double> batch(const char* fn, long n, const py::handle& q, const py:
   for (long i = 0; i < rows; ++i) {
     using Row = Eigen::Map<const VecX>;
     try {
-      f(Row(qp + i * n, n), Row(ap + i * n, n), Row(bp + i * n, n), per_row_t ? ts[i] : t0,
+      f(Row(qp + i * nq, nq), Row(ap + i * n, n), Row(bp + i * n, n), per_row_t ? ts[i] : t0,
         op + i * out_size);
     } catch (const SolverError& e) {
       throw SolverError(msg("row ", i, ": ", e.what()));
@@ -123,6 +124,63 @@ py::array_t<double> vector_out(const VecX& v) {
   py::array_t<double> a(v.size());
   std::copy(v.data(), v.data() + v.size(), a.mutable_data());
   return a;
+}
+
+/// A frame argument: its name (str) or its index into model.frame_names (int).
+int frame_arg(const Model& md, const py::handle& frame, const char* fn) {
+  if (py::isinstance<py::str>(frame)) return md.find_frame(frame.cast<std::string>());
+  // an int, or any integer type (numpy's too), never a bool
+  if (PyIndex_Check(frame.ptr()) && !py::isinstance<py::bool_>(frame)) {
+    const long long k =
+        py::reinterpret_steal<py::int_>(PyNumber_Index(frame.ptr())).cast<long long>();
+    const long long nf = static_cast<long long>(md.frames.size());
+    if (k < 0 || k >= nf)
+      throw ModelError(
+          msg(fn, ": frame index ", k, " out of range (the model has ", nf, " frames)"));
+    return static_cast<int>(k);
+  }
+  throw ModelError(msg(fn, ": frame must be a frame name (str) or an index (int), got ",
+                       py::str(py::type::of(frame)).cast<std::string>()));
+}
+
+/// out (rows, *shape) from f(q_i, out_i) for each row of a 2-D q, or (shape) for a 1-D q; f
+/// writes row-major.
+template <class Fn>
+py::array_t<double> per_state(const char* fn, const char* qname, long n, const py::handle& q,
+                              std::vector<py::ssize_t> shape, Fn&& f) {
+  long size = 1;
+  for (auto s : shape) size *= static_cast<long>(s);
+  const auto qa = as_array(q, msg(fn, ": ", qname));  // nested lists too
+  if (qa.ndim() == 2) {
+    const long rows = static_cast<long>(qa.shape(0));
+    const auto Q = rows_of(qa, fn, qname, rows, n);
+    shape.insert(shape.begin(), rows);
+    py::array_t<double> out(shape);
+    for (long i = 0; i < rows; ++i) {
+      try {
+        f(Eigen::Map<const VecX>(Q.data() + i * n, n), out.mutable_data() + i * size);
+      } catch (const ModelError& e) {
+        throw ModelError(msg("row ", i, ": ", e.what()));
+      }
+    }
+    return out;
+  }
+  const VecArg one(qa, msg(fn, ": ", qname).c_str(), n);
+  py::array_t<double> out(shape);
+  f(*one, out.mutable_data());
+  return out;
+}
+
+void copy_row_major(const Mat4& T, double* out) {
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) out[4 * r + c] = T(r, c);
+}
+
+template <class M>
+void copy_row_major(const M& J, double* out) {
+  const long cols = J.cols();
+  for (long r = 0; r < J.rows(); ++r)
+    for (long c = 0; c < cols; ++c) out[r * cols + c] = J(r, c);
 }
 
 }  // namespace
@@ -148,20 +206,20 @@ void bind_algorithm(py::module_& m) {
         const DynamicsMethod mth = dynamics_method(method, fn);
         const Model& mm = *md;
         if (is_batch(q))
-          return batch(fn, d.ni, q, qd, "qd", tau, "tau", t, {d.ni},
+          return batch(fn, d.niq, d.ni, q, qd, "qd", tau, "tau", t, {d.ni},
                        [&](auto qi, auto qdi, auto ti, double tt, double* out) {
                          const VecX& r = forward_dynamics(mm, d, qi, qdi, ti, tt, mth);
                          std::copy(r.data(), r.data() + d.ni, out);
                        });
-        const VecArg qa(q, "q", d.ni), qda(qd, "qd", d.ni), ta(tau, "tau", d.ni);
+        const VecArg qa(q, "q", d.niq), qda(qd, "qd", d.ni), ta(tau, "tau", d.ni);
         return vector_out(forward_dynamics(mm, d, *qa, *qda, *ta, scalar_time(t, fn), mth));
       },
       py::arg("model"), py::arg("q"), py::arg("qd"), py::arg("tau"), py::arg("t") = 0.0,
       py::arg("method") = "auto", py::arg("data") = py::none(),
       "Joint accelerations qdd of a tree for joint torques/forces tau at (q, qd) and time t "
-      "[s] (n_coords each: a coupled model's independent coordinates, followers of couplings "
-      "removed, as Pinocchio's mimic=True models; 2-D: one state per row). method: 'crba' (CRBA "
-      "mass matrix, "
+      "[s] (q: n_coords, the others n_dofs; a coupled model's independent coordinates, followers "
+      "of couplings removed, as Pinocchio's mimic=True models; 2-D: one state per row). method: "
+      "'crba' (CRBA mass matrix, "
       "recursive Newton-Euler bias, Cholesky), 'aba' (articulated-body algorithm, O(n)), "
       "'cartesian' (the constrained Newton-Euler KKT system of the bodies), 'joint' (the "
       "cheaper of crba and aba for this model), 'auto' (the cheapest of the three); the choice "
@@ -209,19 +267,19 @@ void bind_algorithm(py::module_& m) {
         const DynamicsMethod mth = dynamics_method(method, fn, false);
         const Model& mm = *md;
         if (is_batch(q))
-          return batch(fn, d.ni, q, qd, "qd", qdd, "qdd", t, {d.ni},
+          return batch(fn, d.niq, d.ni, q, qd, "qd", qdd, "qdd", t, {d.ni},
                        [&](auto qi, auto qdi, auto ai, double tt, double* out) {
                          const VecX& r = inverse_dynamics(mm, d, qi, qdi, ai, tt, mth);
                          std::copy(r.data(), r.data() + d.ni, out);
                        });
-        const VecArg qa(q, "q", d.ni), qda(qd, "qd", d.ni), aa(qdd, "qdd", d.ni);
+        const VecArg qa(q, "q", d.niq), qda(qd, "qd", d.ni), aa(qdd, "qdd", d.ni);
         return vector_out(inverse_dynamics(mm, d, *qa, *qda, *aa, scalar_time(t, fn), mth));
       },
       py::arg("model"), py::arg("q"), py::arg("qd"), py::arg("qdd"), py::arg("t") = 0.0,
       py::arg("method") = "auto", py::arg("data") = py::none(),
-      "Joint torques/forces tau realising qdd at (q, qd) and time t [s] (n_coords each: a "
-      "coupled model's independent coordinates, tau = G^T tau_full; 2-D: one state per row): what "
-      "each joint's actuator applies to its child about/along the "
+      "Joint torques/forces tau realising qdd at (q, qd) and time t [s] (q: n_coords, the others "
+      "n_dofs; a coupled model's independent coordinates, tau = G^T tau_full; 2-D: "
+      "one state per row): what each joint's actuator applies to its child about/along the "
       "joint axis, gravity and the model's force elements included, drives ignored. method: "
       "'joint' (recursive Newton-Euler), 'cartesian' (every coordinate driven, the drives' KKT "
       "multipliers), 'auto' (joint).");
@@ -235,21 +293,90 @@ void bind_algorithm(py::module_& m) {
         const long n = d.ni;
         // M is symmetric: its column-major storage is also its row-major one
         if (is_batch(q))
-          return batch(fn, n, q, q, "q", q, "q", py::float_(0.0), {n, n},
+          return batch(fn, d.niq, d.niq, q, q, "q", q, "q", py::float_(0.0), {n, n},
                        [&](auto qi, auto, auto, double, double* out) {
                          const MatX& M = crba(mm, d, qi);
                          std::copy(M.data(), M.data() + n * n, out);
                        });
-        const VecArg qa(q, "q", n);
+        const VecArg qa(q, "q", d.niq);
         const MatX& M = crba(mm, d, *qa);
         py::array_t<double> a({n, n});
         std::copy(M.data(), M.data() + n * n, a.mutable_data());
         return a;
       },
       py::arg("model"), py::arg("q"), py::arg("data") = py::none(),
-      "The joint-space mass matrix M(q) (n_coords, n_coords) of a tree, by the "
+      "The joint-space mass matrix M(q) (n_dofs, n_dofs) of a tree, by the "
       "composite-rigid-body algorithm (a coupled model's in its independent coordinates, "
       "G^T M G); 2-D q (one state per row) gives (rows, n, n).");
+
+  m.def(
+      "frame_pose",
+      [](const ModelHolder& md, const py::object& q, const py::object& frame,
+         const py::object& data) {
+        constexpr const char* fn = "frame_pose";
+        Data& d = data_for(md, data, fn);
+        const Model& mm = *md;
+        require_joint_space(mm, fn);
+        const int f = frame_arg(mm, frame, fn);
+        return per_state(fn, "q", d.n, q, {4, 4}, [&](const auto& qi, double* out) {
+          copy_row_major(frame_pose(mm, d, qi, f), out);
+        });
+      },
+      py::arg("model"), py::arg("q"), py::arg("frame"), py::arg("data") = py::none(),
+      "The world pose of a named frame (a name of model.frame_names or its index) at joint "
+      "coordinates q: the 4x4 homogeneous transform [R p; 0 1], R the frame's axes in world "
+      "(frame -> world) and p its origin [m]; 2-D q (one state per row) gives (rows, 4, 4).");
+
+  m.def(
+      "frame_jacobian",
+      [](const ModelHolder& md, const py::object& q, const py::object& frame,
+         const py::object& data) {
+        constexpr const char* fn = "frame_jacobian";
+        Data& d = data_for(md, data, fn);
+        const Model& mm = *md;
+        require_joint_space(mm, fn);
+        const int f = frame_arg(mm, frame, fn);
+        return per_state(fn, "q", d.n, q, {6, d.n}, [&](const auto& qi, double* out) {
+          copy_row_major(frame_jacobian(mm, d, qi, f), out);
+        });
+      },
+      py::arg("model"), py::arg("q"), py::arg("frame"), py::arg("data") = py::none(),
+      "The Jacobian (6, n_coords) of a named frame at joint coordinates q: linear rows then "
+      "angular rows, world axes, at the frame's origin (Pinocchio's LOCAL_WORLD_ALIGNED), so "
+      "that [v; omega] of the frame = J qd. 2-D q gives (rows, 6, n_coords).");
+
+  m.def(
+      "frame_pose_cartesian",
+      [](const ModelHolder& md, const py::object& u, const py::object& frame,
+         const py::object& data) {
+        constexpr const char* fn = "frame_pose_cartesian";
+        Data& d = data_for(md, data, fn);
+        const Model& mm = *md;
+        const int f = frame_arg(mm, frame, fn);
+        return per_state(fn, "u", mm.nq, u, {4, 4}, [&](const auto& ui, double* out) {
+          copy_row_major(frame_pose_cartesian(mm, d, ui, f), out);
+        });
+      },
+      py::arg("model"), py::arg("u"), py::arg("frame"), py::arg("data") = py::none(),
+      "frame_pose from the Cartesian state u (nq; any model, loops included): the 4x4 world "
+      "pose of a named frame; 2-D u gives (rows, 4, 4).");
+
+  m.def(
+      "frame_jacobian_cartesian",
+      [](const ModelHolder& md, const py::object& u, const py::object& frame,
+         const py::object& data) {
+        constexpr const char* fn = "frame_jacobian_cartesian";
+        Data& d = data_for(md, data, fn);
+        const Model& mm = *md;
+        const int f = frame_arg(mm, frame, fn);
+        return per_state(fn, "u", mm.nq, u, {6, mm.nv}, [&](const auto& ui, double* out) {
+          copy_row_major(frame_jacobian_cartesian(mm, d, ui, f), out);
+        });
+      },
+      py::arg("model"), py::arg("u"), py::arg("frame"), py::arg("data") = py::none(),
+      "The Jacobian (6, nv) of a named frame with respect to the bodies' velocities v of the "
+      "Cartesian state (any model): linear rows then angular rows, world axes, at the frame's "
+      "origin, so that [v; omega] of the frame = J v. 2-D u gives (rows, 6, nv).");
 }
 
 }  // namespace armdyn

@@ -37,9 +37,9 @@ py::dict result_dict(const Model& md, const SimResult& r) {
   d["t"] = to_numpy(r.t.data(), {n});
   d["u"] = to_numpy(r.u.data(), {n, md.nq});
   d["v"] = to_numpy(r.v.data(), {n, md.nv});
-  d["q"] = to_numpy(r.q.data(), {n, static_cast<py::ssize_t>(md.coords.size())});
-  d["qd"] = to_numpy(r.qd.data(), {n, static_cast<py::ssize_t>(md.coords.size())});
-  d["qdd"] = to_numpy(r.qdd.data(), {n, static_cast<py::ssize_t>(md.coords.size())});
+  d["q"] = to_numpy(r.q.data(), {n, static_cast<py::ssize_t>(md.nq_joint)});
+  d["qd"] = to_numpy(r.qd.data(), {n, static_cast<py::ssize_t>(md.nv_joint)});
+  d["qdd"] = to_numpy(r.qdd.data(), {n, static_cast<py::ssize_t>(md.nv_joint)});
   d["drive_forces"] =
       to_numpy(r.drive_forces.data(), {n, static_cast<py::ssize_t>(md.drives.size())});
   d["reaction_forces"] = to_numpy(r.reaction_forces.data(), {n, nj, 3});
@@ -102,8 +102,18 @@ void bind_dynamics(py::module_& m) {
       "_simulate",
       [](const Model& md, double t_end, const std::string& integrator, double rtol, double atol,
          double dt, double output_dt, py::object u0, py::object v0, const std::string& projection,
-         long max_steps, double max_step, bool merge_welded, const std::string& coordinates) {
+         long max_steps, double max_step, bool merge_welded, const std::string& coordinates,
+         py::object q_start) {
+        // armdyn.simulate answers a model with no bodies itself (nothing to integrate)
+        if (md.nb == 0)
+          throw ModelError("_simulate: the model has no bodies (use armdyn.simulate)");
         SimOptions o;
+        if (!q_start.is_none()) {
+          // the independent q0 (a coupled model's followers set by their couplings)
+          const VecX qi = to_vec(q_start, "q0", md.independent.nq());
+          o.q_start = VecX(md.nq_joint);
+          md.independent.expand_q(qi.data(), o.q_start.data());
+        }
         o.merge_welded = merge_welded;
         o.coordinates = coordinates_from_name(coordinates);
         o.step.max_step = max_step;
@@ -126,27 +136,28 @@ void bind_dynamics(py::module_& m) {
       py::arg("model"), py::arg("t_end"), py::arg("integrator"), py::arg("rtol"), py::arg("atol"),
       py::arg("dt"), py::arg("output_dt"), py::arg("u0"), py::arg("v0"), py::arg("projection"),
       py::arg("max_steps"), py::arg("max_step") = 0.0, py::arg("merge_welded") = true,
-      py::arg("coordinates") = "cartesian");
+      py::arg("coordinates") = "cartesian", py::arg("q_start") = py::none());
 
   m.def(
       "state_from_joints",
       [](const Model& md, py::object q, py::object qd) {
         require_joint_space(md, "state_from_joints", true);
         const IndependentCoords& ic = md.independent;
-        const long n = ic.n, nf = static_cast<long>(md.coords.size());
-        const VecX qi = to_vec(q, "q", n), qdi = qd.is_none() ? VecX::Zero(n) : to_vec(qd, "qd", n);
-        check_joint_vector(qi, n, "state_from_joints", "q");
+        const long nq = ic.nq(), n = ic.nv();
+        const VecX qi = to_vec(q, "q", nq),
+                   qdi = qd.is_none() ? VecX::Zero(n) : to_vec(qd, "qd", n);
+        check_joint_vector(qi, nq, "state_from_joints", "q");
         check_joint_vector(qdi, n, "state_from_joints", "qd");
-        VecX qf(nf), qdf(nf), u, v;
-        ic.expand(qi.data(), qf.data(), true);
-        ic.expand(qdi.data(), qdf.data(), false);
+        VecX qf(md.nq_joint), qdf(md.nv_joint), u, v;
+        ic.expand_q(qi.data(), qf.data());
+        ic.expand_v(qdi.data(), qdf.data());
         state_from_joints(md, qf, qdf, u, v);
         return py::make_tuple(to_numpy(u), to_numpy(v));
       },
       py::arg("model"), py::arg("q"), py::arg("qd") = py::none(),
-      "Cartesian state (u, v) of a joint-space tree model from joint coordinates and rates "
-      "(n_coords each: a coupled model's independent coordinates, the followers set by their "
-      "couplings).");
+      "Cartesian state (u, v) of a joint-space tree model from joint-space q (n_coords) and qd "
+      "(n_dofs; default zero): a coupled model's independent coordinates, the followers set by "
+      "their couplings.");
 
   m.def(
       "joint_coordinates",
@@ -154,16 +165,19 @@ void bind_dynamics(py::module_& m) {
         VecX q, qd;
         joint_coordinates(md, to_vec(u, "u", md.nq), to_vec(v, "v", md.nv), q, qd);
         const IndependentCoords& ic = md.independent;
-        VecX qi(ic.n), qdi(ic.n);
+        VecX qi(ic.nq()), qdi(ic.nv());
+        qi.head(ic.lead_q) = q.head(ic.lead_q);
+        qdi.head(ic.lead_v) = qd.head(ic.lead_v);
         for (int k = 0; k < ic.n; ++k) {
-          qi[k] = q[ic.full[k]];
-          qdi[k] = qd[ic.full[k]];
+          qi[ic.lead_q + k] = q[ic.lead_q + ic.full[k]];
+          qdi[ic.lead_v + k] = qd[ic.lead_v + ic.full[k]];
         }
         return py::make_tuple(to_numpy(qi), to_numpy(qdi));
       },
       py::arg("model"), py::arg("u"), py::arg("v"),
-      "Joint coordinates (angles in (-pi, pi]) and rates at the Cartesian state (u, v) "
-      "(n_coords each: a coupled model's independent coordinates, as state_from_joints takes).");
+      "Joint-space q (n_coords: floating bases' poses, then joint coordinates with angles in "
+      "(-pi, pi]) and qd (n_dofs) at the Cartesian state (u, v): a coupled model's independent "
+      "coordinates, as state_from_joints takes.");
 
   m.def(
       "evaluate_constraints",

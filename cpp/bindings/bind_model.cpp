@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <pybind11/stl.h>
 
+#include <limits>
+
 #include "armdyn/builder/builder.hpp"
 #include "armdyn/builder/summary.hpp"
 #include "armdyn/io/urdf.hpp"
@@ -49,6 +51,54 @@ namespace armdyn {
 namespace py = pybind11;
 using namespace py_helpers;
 
+namespace {
+
+enum class CoordLimit { Lower, Upper, Effort, Velocity };
+
+// one limit per joint coordinate; a joint's limits belong to its first coordinate
+py::array_t<double> coord_limit(const Model& md, CoordLimit which) {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  // over q (Lower, Upper: n_coords) or qd (Effort, Velocity: n_dofs); the floating bases' entries
+  // lead and are unbounded
+  const bool position = which == CoordLimit::Lower || which == CoordLimit::Upper;
+  const long off = position ? 7 * md.n_free : 6 * md.n_free;
+  VecX r = VecX::Constant(off + static_cast<long>(md.coords.size()),
+                          which == CoordLimit::Lower ? -inf : inf);
+  for (size_t k = 0; k < md.coords.size(); ++k) {
+    const Coord& c = md.coords[k];
+    const Joint& j = md.joints[c.joint];
+    double v = which == CoordLimit::Lower ? -inf : inf;
+    if (c.sub == 0) {
+      switch (which) {
+        case CoordLimit::Lower:
+          v = j.lower <= -1e300 ? -inf : j.lower;
+          break;
+        case CoordLimit::Upper:
+          v = j.upper >= 1e300 ? inf : j.upper;
+          break;
+        case CoordLimit::Effort:
+          v = j.effort > 0 && j.effort < 1e300 ? j.effort : inf;
+          break;
+        case CoordLimit::Velocity:
+          v = j.velocity_limit > 0 && j.velocity_limit < 1e300 ? j.velocity_limit : inf;
+          break;
+      }
+    }
+    r[off + static_cast<long>(k)] = v;
+  }
+  // a coupled model: the independent entries (n_coords, n_dofs)
+  const IndependentCoords& ic = md.independent;
+  if (!ic.identity()) {
+    VecX ri(off + ic.n);
+    ri.head(off) = r.head(off);
+    for (int k = 0; k < ic.n; ++k) ri[off + k] = r[off + ic.full[k]];
+    return to_numpy(ri);
+  }
+  return to_numpy(r);
+}
+
+}  // namespace
+
 void bind_model(py::module_& m) {
   py::class_<Profile>(m, "Profile", "A time profile y(t) with derivatives, evaluated in C++.")
       .def(
@@ -87,18 +137,36 @@ void bind_model(py::module_& m) {
       .def_readonly("nv", &Model::nv)
       .def_readonly("nc", &Model::nc)
       .def_readonly("nc_joint", &Model::nc_joint)
-      // joint-space functions take the independent coordinates (couplings' followers removed;
-      // every coordinate without couplings); simulation results report every joint coordinate
-      .def_property_readonly("n_coords", [](const Model& md) { return md.independent.n; })
-      .def_property_readonly("n_joint_coords", [](const Model& md) { return md.coords.size(); })
-      .def_property_readonly("joint_coord_names",
-                             [](const Model& md) {
-                               std::vector<std::string> r;
-                               for (const auto& c : md.coords) r.push_back(c.name);
-                               return r;
-                             })
-      .def_property_readonly("independent_coords",
-                             [](const Model& md) { return md.independent.full; })
+      // the joint-space functions take the independent q and qd (a coupled model's followers
+      // removed; all of them without couplings); simulation results report every joint's
+      .def_property_readonly(
+          "n_coords", [](const Model& md) { return md.independent.nq(); },
+          "Length of the joint-space q: 7 per floating base (position, scalar-first quaternion), "
+          "then one per independent joint coordinate (couplings' followers removed).")
+      .def_property_readonly(
+          "n_dofs", [](const Model& md) { return md.independent.nv(); },
+          "Length of qd, qdd and tau: 6 per floating base (linear, angular velocity in the base "
+          "frame), then one per independent joint coordinate (= n_coords without a floating "
+          "base).")
+      .def_readonly("n_free", &Model::n_free, "Free joints (floating bases) of the joint space.")
+      .def_readonly("n_joint_coords", &Model::nq_joint,
+                    "Columns of SimulationResult.q: n_coords with the couplings' followers.")
+      .def_readonly("n_joint_dofs", &Model::nv_joint,
+                    "Columns of SimulationResult.qd, qdd: n_dofs with the couplings' followers.")
+      .def_readonly("joint_coord_names", &Model::q_names,
+                    "Names of the columns of SimulationResult.q (every joint's coordinate).")
+      .def_readonly("joint_dof_names", &Model::dof_names,
+                    "Names of the columns of SimulationResult.qd and qdd.")
+      .def_property_readonly(
+          "independent_coords",
+          [](const Model& md) {
+            const IndependentCoords& ic = md.independent;
+            std::vector<int> r;
+            for (int i = 0; i < ic.lead_q; ++i) r.push_back(i);
+            for (int c : ic.full) r.push_back(ic.lead_q + c);
+            return r;
+          },
+          "Index of each entry of q in joint_coord_names.")
       .def_property_readonly("couplings",
                              [](const Model& md) {
                                py::list r;
@@ -133,12 +201,45 @@ void bind_model(py::module_& m) {
                                for (const auto& j : md.joints) r.push_back(joint_type_name(j.type));
                                return r;
                              })
-      .def_property_readonly("coord_names",
+      .def_property_readonly(
+          "coord_names",
+          [](const Model& md) {
+            const IndependentCoords& ic = md.independent;
+            std::vector<std::string> r(md.q_names.begin(), md.q_names.begin() + ic.lead_q);
+            for (int c : ic.full) r.push_back(md.q_names[ic.lead_q + c]);
+            return r;
+          },
+          "Names of the entries of q (n_coords): a floating base's 'name:x' .. 'name:e3', then "
+          "the independent joint coordinates.")
+      .def_property_readonly(
+          "dof_names",
+          [](const Model& md) {
+            const IndependentCoords& ic = md.independent;
+            std::vector<std::string> r(md.dof_names.begin(), md.dof_names.begin() + ic.lead_v);
+            for (int c : ic.full) r.push_back(md.dof_names[ic.lead_v + c]);
+            return r;
+          },
+          "Names of the entries of qd, qdd and tau (n_dofs): a floating base's 'name:vx' .. "
+          "'name:wz', then the independent joint coordinates.")
+      .def_property_readonly("frame_names",
                              [](const Model& md) {
                                std::vector<std::string> r;
-                               for (int c : md.independent.full) r.push_back(md.coords[c].name);
+                               for (const auto& f : md.frames) r.push_back(f.name);
                                return r;
                              })
+      .def(
+          "frame",
+          [](const Model& md, const std::string& name) {
+            const int k = md.find_frame(name);
+            const NamedFrame& f = md.frames[k];
+            return py::dict(py::arg("index") = k, py::arg("body") = md.body_name(f.body),
+                            py::arg("point") = to_numpy(VecX(f.point)),
+                            py::arg("rotation") = to_numpy(MatX(f.rotation)));
+          },
+          py::arg("frame"),
+          "A named frame's placement on its body: 'index' (into frame_names), 'body' (or "
+          "'ground'), 'point' (its origin in the body's frame, relative to the centre of mass; "
+          "the world for 'ground') and 'rotation' (its axes as columns in the body's axes).")
       .def_property_readonly("drive_names",
                              [](const Model& md) {
                                std::vector<std::string> r;
@@ -149,7 +250,7 @@ void bind_model(py::module_& m) {
                              [](const Model& md) {
                                std::vector<int> r;
                                for (const auto& d : md.drives)
-                                 r.push_back(md.joints[d.joint].coord0 + d.coord);
+                                 r.push_back(md.joints[d.joint].dof0 + d.coord);
                                return r;
                              })
       .def_property_readonly("gravity", [](const Model& md) { return to_numpy(VecX(md.gravity)); })
@@ -178,6 +279,25 @@ void bind_model(py::module_& m) {
       .def_readonly("redundant_rows", &Model::redundant_rows)
       .def_property_readonly("u0", [](const Model& md) { return to_numpy(md.u0); })
       .def_property_readonly("v0", [](const Model& md) { return to_numpy(md.v0); })
+      // URDF <limit> per joint coordinate: +-inf where none (the joints store +-1e300), effort
+      // and velocity limits inf where none or 0 (unset)
+      .def_property_readonly(
+          "coord_lower", [](const Model& md) { return coord_limit(md, CoordLimit::Lower); },
+          "Lower position limit of each entry of q (n_coords; URDF <limit lower>; -inf where none "
+          "and on a floating base; a coupled model's independent entries).")
+      .def_property_readonly(
+          "coord_upper", [](const Model& md) { return coord_limit(md, CoordLimit::Upper); },
+          "Upper position limit of each entry of q (n_coords; URDF <limit upper>; inf where none "
+          "and on a floating base).")
+      .def_property_readonly(
+          "coord_effort_limit", [](const Model& md) { return coord_limit(md, CoordLimit::Effort); },
+          "Effort limit of each entry of tau (n_dofs) [N m or N] (URDF <limit effort>; inf where "
+          "none or 0, and on a floating base).")
+      .def_property_readonly(
+          "coord_velocity_limit",
+          [](const Model& md) { return coord_limit(md, CoordLimit::Velocity); },
+          "Velocity limit of each entry of qd (n_dofs) [rad/s or m/s] (URDF <limit velocity>; inf "
+          "where none or 0, and on a floating base).")
       .def(
           "joint_limits",
           [](const Model& md, const std::string& name) {
@@ -344,7 +464,32 @@ void bind_model(py::module_& m) {
           },
           py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point"), py::arg("axis1"),
           py::arg("axis2"))
-      .def("add_free", &ModelBuilder::add_free, py::arg("name"), py::arg("child"))
+      .def(
+          "add_free",
+          [](ModelBuilder& b, const std::string& n, const std::string& c, py::object origin) {
+            if (origin.is_none()) return b.add_free(n, c);
+            const Vec3 o = to_vec3(origin, "free joint '" + n + "': origin");
+            return b.add_free(n, c, &o);
+          },
+          py::arg("name"), py::arg("child"), py::arg("origin") = py::none(),
+          "Declare body `child` free (a floating base). In joint space its frame -- the body's "
+          "axes at `origin` (world at assembly, m; default its centre of mass) -- takes 7 entries "
+          "of q (x, y, z, then the scalar-first unit quaternion e0..e3) and 6 of qd (linear, "
+          "then angular velocity, both in the frame's own axes).")
+      .def(
+          "add_frame",
+          [](ModelBuilder& b, const std::string& name, const std::string& body, py::object position,
+             py::object orientation) {
+            const std::string who = "frame '" + name + "'";
+            return b.add_frame(name, body, to_vec3(position, who + ": position"),
+                               to_vec4(orientation, who + ": orientation"));
+          },
+          py::arg("name"), py::arg("body"), py::arg("position") = py::make_tuple(0.0, 0.0, 0.0),
+          py::arg("orientation") = py::make_tuple(1.0, 0.0, 0.0, 0.0),
+          "Add a named frame rigidly attached to `body` (or 'ground'): its origin [m] and axes "
+          "(unit Euler parameters [e0, e1, e2, e3], frame -> world), both in world at the "
+          "assembly pose like every builder input. Read it back with armdyn.frame_pose and "
+          "armdyn.frame_jacobian.")
       .def("set_joint_limits", &ModelBuilder::set_joint_limits, py::arg("joint"), py::arg("lower"),
            py::arg("upper"), py::arg("effort") = 0.0, py::arg("velocity") = 0.0)
       .def(
@@ -459,16 +604,33 @@ void bind_model(py::module_& m) {
           },
           py::arg("mass_weighted_assembly") = true,
           "Validate, analyse topology and rank, assemble; returns an immutable Model.")
-      .def_property_readonly("body_names", [](const ModelBuilder& b) {
+      .def_property_readonly("body_names",
+                             [](const ModelBuilder& b) {
+                               std::vector<std::string> r;
+                               for (const auto& x : b.draft().bodies) r.push_back(x.name);
+                               return r;
+                             })
+      .def_property_readonly("frame_names", [](const ModelBuilder& b) {
         std::vector<std::string> r;
-        for (const auto& x : b.draft().bodies) r.push_back(x.name);
+        for (const auto& x : b.draft().frames) r.push_back(x.name);
         return r;
       });
 
+  m.attr("URDF_MAX_BYTES") = kUrdfMaxBytes;
+  m.attr("URDF_MAX_ATTRIBUTES") = kUrdfMaxAttributes;
+  m.attr("URDF_COULOMB_SMOOTHING") = kUrdfCoulombSmoothing;
   m.def(
       "urdf_builder",
       [](const std::string& src, bool fixed_base, py::object g, bool mimic) {
-        return urdf_builder(src, fixed_base, to_vec3(g, "gravity"), mimic);
+        const Vec3 gravity = to_vec3(g, "gravity");
+        try {
+          return urdf_builder(src, fixed_base, gravity, mimic);
+        } catch (const UrdfError& e) {
+          // the loader escapes what it quotes; this keeps any message valid UTF-8 regardless
+          const std::string text = e.what();
+          throw UrdfError(
+              py::bytes(text).attr("decode")("utf-8", "backslashreplace").cast<std::string>());
+        }
       },
       py::arg("path_or_xml"), py::arg("fixed_base") = true,
       py::arg("gravity") = py::make_tuple(0.0, 0.0, -9.81), py::arg("mimic") = true,

@@ -93,9 +93,10 @@ void bind_validate(py::module_& m) {
       .def(
           "__call__",
           [](TreeDynamicsPy& self, py::object q, py::object qd, py::object tau, double t) {
-            const long n = self.td.n();
-            const VecArg qa(q, "q", n), qda(qd, "qd", n), ta(tau, "tau", n);
-            check_joint_vector(*qa, n, "TreeDynamics", "q");
+            const long n = self.td.n(), nq = self.m->nq_joint;
+            const VecArg qa(q, "q", nq), qda(qd, "qd", n), ta(tau, "tau", n);
+            check_joint_vector(*qa, nq, "TreeDynamics", "q");
+            check_base_quaternions(*self.m, *qa, "TreeDynamics");
             check_joint_vector(*qda, n, "TreeDynamics", "qd");
             check_joint_vector(*ta, n, "TreeDynamics", "tau");
             if (!std::isfinite(t)) throw ModelError("TreeDynamics: t is not finite");
@@ -114,9 +115,10 @@ void bind_validate(py::module_& m) {
       .def(
           "mass_matrix",
           [](TreeDynamicsPy& self, py::object q) {
-            const long n = self.td.n();
-            const VecArg qa(q, "q", n);
-            check_joint_vector(*qa, n, "TreeDynamics.mass_matrix", "q");
+            const long n = self.td.n(), nq = self.m->nq_joint;
+            const VecArg qa(q, "q", nq);
+            check_joint_vector(*qa, nq, "TreeDynamics.mass_matrix", "q");
+            check_base_quaternions(*self.m, *qa, "TreeDynamics.mass_matrix");
             const MatX& M = self.td.mass_matrix((*qa).data());
             py::array_t<double> out({n, n});
             Eigen::Map<Eigen::Matrix<double, -1, -1, Eigen::RowMajor>>(out.mutable_data(), n, n) =
@@ -143,8 +145,9 @@ void bind_validate(py::module_& m) {
           "torques",
           [](const LagrangeValidator& self, py::object q, py::object qd, py::object qdd,
              py::object t) {
-            const long n = static_cast<long>(self.model().coords.size());
-            const MatX Q = to_mat(q, "q", n), QD = to_mat(qd, "qd", n), QDD = to_mat(qdd, "qdd", n);
+            const long n = self.model().nv_joint;
+            const MatX Q = to_mat(q, "q", self.model().nq_joint), QD = to_mat(qd, "qd", n),
+                       QDD = to_mat(qdd, "qdd", n);
             if (QD.rows() != Q.rows() || QDD.rows() != Q.rows())
               throw ModelError(
                   "LagrangeValidator.torques: q, qd, qdd need the same number of rows");
@@ -170,7 +173,7 @@ void bind_validate(py::module_& m) {
           "mass_matrix",
           [](const LagrangeValidator& self, py::object q) {
             return to_numpy(
-                self.mass_matrix(to_vec(q, "q", static_cast<long>(self.model().coords.size()))));
+                self.mass_matrix(to_vec(q, "q", static_cast<long>(self.model().nq_joint))));
           },
           py::arg("q"));
 
@@ -202,7 +205,7 @@ void bind_validate(py::module_& m) {
       [](const Model& md, const std::string& body, py::object point, py::object q) {
         const int b = md.find_body(body);
         const Vec3 p = to_vec3(point, "point");
-        const long n = static_cast<long>(md.coords.size());
+        const long n = md.nq_joint;
         const MatX Q = to_mat(q, "q", n);
         MatX out(Q.rows(), 3);
         for (long i = 0; i < Q.rows(); ++i)

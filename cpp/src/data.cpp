@@ -7,7 +7,8 @@
 
 namespace armdyn {
 
-Data::Data(const Model& m) : model(&m), n(static_cast<int>(m.coords.size())), kkt(m) {
+Data::Data(const Model& m)
+    : model(&m), n(m.nv_joint), nq(m.nq_joint), nco(static_cast<int>(m.coords.size())), kkt(m) {
   // the Cartesian pipeline's buffers first, next to the KKT solver's (allocated just above)
   eta = VecX::Zero(m.nv);
   delta = VecX::Zero(m.nc);
@@ -15,9 +16,9 @@ Data::Data(const Model& m) : model(&m), n(static_cast<int>(m.coords.size())), kk
   tmp_nc = VecX::Zero(m.nc);
   mu = VecX::Zero(m.nc);
   vd_work = VecX::Zero(m.nv);
-  track_ref = VecX::Zero(n);
-  cq = VecX::Zero(n);
-  cqd = VecX::Zero(n);
+  track_ref = VecX::Zero(nco);
+  cq = VecX::Zero(nco);
+  cqd = VecX::Zero(nco);
   nrows = m.nc;
   tol_f = 1e-13 * std::max(1.0, m.length_scale);
   kin.resize(m.nb);
@@ -36,9 +37,9 @@ Data::Data(const Model& m) : model(&m), n(static_cast<int>(m.coords.size())), kk
   sweep.plan(m, ce);
   vd = VecX::Zero(m.nv);
   tau_in = VecX::Zero(n);
-  tau_jets.resize(n);
+  tau_jets.resize(nco);
   // the joint-space algorithms'
-  coord_tau = VecX::Zero(n);
+  coord_tau = VecX::Zero(nco);
   rne.resize(m);
   tau = VecX::Zero(n);
   joint_of_body.assign(m.nb, -1);
@@ -56,9 +57,13 @@ Data::Data(const Model& m) : model(&m), n(static_cast<int>(m.coords.size())), kk
   qdd = VecX::Zero(n);
   zero = VecX::Zero(n);
   L = MatX::Zero(n, n);
-  ni = m.independent.source.empty() ? n : m.independent.n;
+  frame_jacobian = Mat6X::Zero(6, n);
+  frame_jacobian_v = MatX::Zero(6, m.nv);
+  niq = m.independent.source.empty() ? nq : m.independent.nq();
+  ni = m.independent.source.empty() ? n : m.independent.nv();
   if (ni != n) {
-    for (VecX* x : {&coupled.q, &coupled.qd, &coupled.qdd, &coupled.tau_full}) *x = VecX::Zero(n);
+    coupled.q = VecX::Zero(nq);
+    for (VecX* x : {&coupled.qd, &coupled.qdd, &coupled.tau_full}) *x = VecX::Zero(n);
     for (VecX* x : {&coupled.tau, &coupled.qdd_out, &coupled.rhs}) *x = VecX::Zero(ni);
     coupled.M = MatX::Zero(ni, ni);
     coupled.L = MatX::Zero(ni, ni);

@@ -26,7 +26,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from armdyn._rotation import quat_to_rot
+from armdyn._core import frame_pose_cartesian
 from armdyn.scenes import paper
 from armdyn.simulation import simulate
 from armdyn.validation import (
@@ -102,11 +102,10 @@ def end_effector_study():
         model = paper.five_dof_arm(hold=q)
         # the Cartesian state comes from the constraint solver (assembly + a short held run)
         res = simulate(model, 0.05, rtol=RTOL, atol=ATOL, output_dt=0.05)
-        body, point = paper.five_dof_tip()
-        b = model.body_names.index(body)
-        u = res.u[-1, 7 * b : 7 * b + 7]
-        sim = u[:3] + quat_to_rot(u[3:]) @ point
-        geo = end_effector_position(model, body, point, res.q[-1])
+        # the rod tip: the model's frame "tip" (paper.five_dof_tip), from the bodies' state and
+        # by the joint-space kinematics
+        sim = frame_pose_cartesian(model, res.u[-1], "tip")[:3, 3]
+        geo = end_effector_position(model, q=res.q[-1], frame="tip")
         th = q[:4]
         absolute = np.array([th[0], th[1], th[1] + th[2], th[1] + th[2] + th[3]])
         eq_ours = paper_end_effector_5dof(absolute, a.h, a.L1, a.L2, a.L3 + a.L4)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -17,9 +19,12 @@ class SimulationResult:
         t: (n,) output times [s].
         u: (n, nq) positions: per body CoM (3) and Euler parameters (4, scalar first).
         v: (n, nv) velocities: per body CoM velocity (3, world) and angular velocity (3, body).
-        q, qd, qdd: (n, n_joint_coords) joint coordinates (angles unwrapped along the run),
-            rates and accelerations (from the constrained accelerations at each output state),
-            every joint's (``model.joint_coord_names``): the followers of couplings included.
+        q: (n, n_joint_coords) joint-space coordinates (angles unwrapped along the run; a
+            floating base's position and scalar-first quaternion first,
+            ``model.joint_coord_names``): every joint's, the couplings' followers included.
+        qd, qdd: (n, n_joint_dofs) rates and accelerations (from the constrained accelerations
+            at each output state; a floating base's linear and angular velocity in its own frame
+            first, ``model.joint_dof_names``).
         drive_forces: (n, n_drives) actuator torque/force of each drive, applied to the child
             about/along the joint axis (the RNEA/URDF effort convention).
         reaction_forces, reaction_torques: (n, n_joints, 3) joint reaction on the child body at
@@ -98,9 +103,15 @@ def simulate(
         dt: RK4 step (required for rk4); DOPRI5/DOP853/TR-BDF2 initial step (optional).
         output_dt: spacing of output times (default: every accepted step). Output states are
             interpolated (the integrator's dense output) and projected onto the constraints.
-        q0, qd0: initial joint coordinates and rates (n_coords,) for joint-space tree models
-            (a coupled model's independent coordinates, ``model.coord_names``: the followers
-            are set by their couplings); default: the model's assembled state at rest.
+        q0, qd0: initial joint-space coordinates (``model.n_coords``,) and rates
+            (``model.n_dofs``,) for tree models; default: the model's assembled state at rest.
+            Angles are multi-turn: the run starts from q0's turns (3.5 rad stays 3.5, not
+            -2.78). A floating base leads both: ``q = (x, y, z, e0, e1, e2, e3, joints…)``,
+            its frame's position and scalar-first unit quaternion, and ``qd = (v, ω, rates…)``,
+            its linear and angular velocity in its own frame (Pinocchio's free-flyer convention
+            with the quaternion scalar first).
+            A coupled model takes its independent coordinates (``model.coord_names``): the
+            followers are set by their couplings.
         u0, v0: initial Cartesian state (nq,), (nv,) instead of q0/qd0 (projected onto the
             constraints first); default: the model's assembled state.
         projection: metric of the minimum-norm projection: ``"mass"`` (kinetic-energy metric,
@@ -140,8 +151,12 @@ def simulate(
             raise _core.ModelError("simulate: give either q0/qd0 or u0/v0, not both")
         if q0 is None:
             raise _core.ModelError("simulate: qd0 given without q0")
-        _check_coupled_start(model, q0)
         u0, v0 = _core.state_from_joints(model, q0, qd0)
+        q_start = np.asarray(q0, dtype=float)
+    else:
+        q_start = None
+    if model.nb == 0:
+        return _zero_dof_result(model, t_end, output_dt)
     raw = _core._simulate(
         model,
         float(t_end),
@@ -157,6 +172,7 @@ def simulate(
         float(max_step or 0.0),
         bool(merge_welded),
         coordinates,
+        q_start,
     )
     error = raw.pop("error")
     result = SimulationResult(**raw)
@@ -167,36 +183,76 @@ def simulate(
     return result
 
 
-def _check_coupled_start(model: _core.Model, q0) -> None:
-    """Refuse a q0 whose coupled angles the run cannot start from: the run reads its initial
-    angles from the bodies' poses, in (−π, π], and a revolute leader beyond ±π with a
-    non-integer multiplier gives its follower another pose than the one q0 asks for."""
-    couplings = model.couplings
-    if not couplings:
-        return
-    q0 = np.asarray(q0, dtype=float)
-    if q0.shape != (model.n_coords,):
-        return  # state_from_joints names the wrong shape
-    value = dict(zip(model.coord_names, q0, strict=True))
-    follows = {c["follower"]: c for c in couplings}
+def _zero_dof_result(model: _core.Model, t_end: float, output_dt: float | None):
+    """The run of a model with no bodies (a zero-DOF structure): nothing moves, nothing is
+    integrated; the time grid of an ``output_dt`` run (k·output_dt, then ``t_end``) or
+    ``[0, t_end]``, and state arrays with no columns."""
+    if not (np.isfinite(t_end) and t_end > 0):
+        raise _core.ModelError(f"simulate: t_end must be positive and finite, got {t_end}")
+    if output_dt:
+        k = np.arange(int(np.ceil(t_end / output_dt)) + 1)
+        t = k * output_dt
+        t = np.append(t[t < t_end - 1e-9 * output_dt], t_end)
+    else:
+        t = np.array([0.0, float(t_end)])
+    n = len(t)
+    empty = np.zeros((n, 0))
+    return SimulationResult(
+        t=t,
+        u=empty,
+        v=empty.copy(),
+        q=empty.copy(),
+        qd=empty.copy(),
+        qdd=empty.copy(),
+        drive_forces=empty.copy(),
+        reaction_forces=np.zeros((n, len(model.joint_names), 3)),
+        reaction_torques=np.zeros((n, len(model.joint_names), 3)),
+        position_residual=np.zeros(n),
+        velocity_residual=np.zeros(n),
+        kinetic_energy=np.zeros(n),
+        potential_energy=np.zeros(n),
+        stats={
+            "steps": 0,
+            "seconds": 0.0,
+            "integrator": "none",
+            "integrator_reason": "the model has no bodies (no degrees of freedom)",
+            "formulation": "none: the model has no bodies",
+            "solver_bodies": 0,
+            "solver_rows": 0,
+        },
+        events={"t": np.zeros(0), "gear": [], "onset": []},
+        gear_forces={"names": [], "force": np.zeros((n, 0))},
+    )
 
-    def angle(joint):  # a joint's coordinate from q0 through its chain of couplings
-        c = follows.get(joint)
-        return value[joint] if c is None else c["multiplier"] * angle(c["leader"]) + c["offset"]
 
-    types = dict(zip(model.joint_names, model.joint_types, strict=True))
-    for c in couplings:
-        lead, m = c["leader"], c["multiplier"]
-        if types[lead] != "revolute" or float(m).is_integer():
-            continue
-        ql = angle(lead)
-        if abs(ql) > np.pi:
-            raise _core.ModelError(
-                f"simulate: q0 puts joint '{lead}' at {ql:.6g} rad, beyond ±π, and coupling "
-                f"'{c['name']}' follows it with the non-integer multiplier {m:g}: the run reads "
-                "its initial angles in (−π, π] and would start the follower elsewhere; give "
-                "the angle within (−π, π]"
+def _urdf_source(path_or_xml) -> str:
+    """The text handed to the C++ loader: a str (XML or path), an os.PathLike, or bytes holding
+    UTF-8 XML; anything else is a TypeError."""
+    if isinstance(path_or_xml, (bytes, bytearray, memoryview)):
+        data = bytes(path_or_xml)
+        try:
+            text = data.decode("utf-8")
+        except UnicodeDecodeError as err:
+            raise _core.UrdfError(
+                f"URDF bytes are not valid UTF-8 (byte offset {err.start}); pass XML as UTF-8 "
+                "bytes or str, or a path as str"
+            ) from None
+        if not text.lstrip("\ufeff").lstrip().startswith("<"):
+            raise _core.UrdfError(
+                f"URDF bytes must hold XML (starting with '<'), got {data[:40]!r}"
+                + ("..." if len(data) > 40 else "")
+                + "; pass a path as str or os.PathLike"
             )
+        return text
+    if isinstance(path_or_xml, str):
+        return path_or_xml
+    if isinstance(path_or_xml, os.PathLike):
+        path = os.fspath(path_or_xml)
+        return path if isinstance(path, str) else _urdf_source(path)
+    raise TypeError(
+        "load_urdf: expected a path (str or os.PathLike) or URDF XML (str or bytes), got "
+        f"{type(path_or_xml).__name__}"
+    )
 
 
 def load_urdf(
@@ -213,7 +269,29 @@ def load_urdf(
     simulation results report every joint (``model.joint_coord_names``). ``mimic=False`` gives
     every mimicking joint its own coordinate (Pinocchio's default).
 
+    ``<dynamics damping friction>`` becomes joint friction (viscous, and Coulomb smoothed with
+    ``armdyn._core.URDF_COULOMB_SMOOTHING``); ``<limit>`` gives ``model.coord_lower`` /
+    ``coord_upper`` / ``coord_effort_limit`` / ``coord_velocity_limit``. See docs/urdf.md.
+
+    ``path_or_xml``: a path (str or os.PathLike) to a regular file of at most
+    ``armdyn._core.URDF_MAX_BYTES`` bytes, or the XML itself as str or UTF-8 bytes.
+
+    A URDF with no moving joint loaded with ``fixed_base=True`` is a zero-DOF model (a structure
+    that only carries loads): it loads with a ``UserWarning`` suggesting ``fixed_base=False``
+    for a robot meant to move freely.
+
     Raises:
-        UrdfError: missing file, malformed XML, unsupported joint type, invalid inertial data.
+        UrdfError: missing or irregular file, malformed XML, bad numbers or names, unsupported
+            joint type, invalid inertial data (the message names the element and attribute).
+        TypeError: ``path_or_xml`` is neither str, bytes nor os.PathLike.
     """
-    return _core.urdf_builder(str(path_or_xml), fixed_base, gravity, mimic).finalize()
+    model = _core.urdf_builder(_urdf_source(path_or_xml), fixed_base, gravity, mimic).finalize()
+    if model.nb == 0:
+        warnings.warn(
+            "armdyn: the URDF has no moving joint: with fixed_base=True it loads as a model with "
+            "no degrees of freedom (nb = 0, n_coords = 0); pass fixed_base=False if the robot "
+            "is meant to move freely",
+            UserWarning,
+            stacklevel=2,
+        )
+    return model

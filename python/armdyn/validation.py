@@ -7,7 +7,8 @@
 * :func:`paper_model_3dof` — the paper's printed 3-DOF equations (9)–(11), kept as an explicitly
   named *paper model*: they are ``−∂L/∂θᵢ`` of a planar point-mass arm, without the
   ``d/dt ∂L/∂θ̇ᵢ`` terms.
-* :func:`end_effector_position` — generic geometric validator (composed joint transforms), and
+* :func:`end_effector_position` — generic geometric validator (composed joint transforms, or a
+  named frame by :func:`armdyn.frame_pose`), and
   :func:`paper_end_effector_5dof`, the paper's equations (22)–(25).
 * :func:`torque_error_metrics` — equation (26) percentage errors and their equation (27) RMS.
 """
@@ -126,7 +127,28 @@ def paper_end_effector_5dof(theta, h, l1, l2, l34) -> np.ndarray:
     return _core.paper_5dof_end_effector(float(h), float(l1), float(l2), float(l34), theta)
 
 
-def end_effector_position(model: _core.Model, body: str, point, q) -> np.ndarray:
-    """World position of ``point`` (body frame, relative to the body's centre of mass) on
-    ``body`` at joint coordinates ``q`` ((n_coords,) or rows), by composed joint transforms."""
-    return _core.end_effector_position(model, body, point, q)
+def end_effector_position(
+    model: _core.Model, body: str | None = None, point=None, q=None, *, frame: str | None = None
+) -> np.ndarray:
+    """World position of the end effector at joint coordinates ``q`` ((n_coords,) or rows).
+
+    Either ``body`` and ``point`` (body frame, relative to the body's centre of mass), by composed
+    joint transforms; or a named ``frame`` of the model (``model.frame_names``, e.g. a URDF
+    ``tool0``) with ``point`` an optional offset in the frame's axes (default its origin), by
+    :func:`armdyn.frame_pose`.
+    """
+    if q is None:
+        raise _core.ModelError("end_effector_position: q is required")
+    if frame is None:
+        if body is None or point is None:
+            raise _core.ModelError("end_effector_position: give body and point, or frame")
+        return _core.end_effector_position(model, body, point, q)
+    if body is not None:
+        raise _core.ModelError("end_effector_position: give body and point, or frame, not both")
+    offset = np.zeros(3) if point is None else np.asarray(point, dtype=float)
+    if offset.shape != (3,) or not np.all(np.isfinite(offset)):
+        raise _core.ModelError(
+            f"end_effector_position: point must be 3 finite numbers, got {offset!r}"
+        )
+    pose = _core.frame_pose(model, q, frame)
+    return pose[..., :3, 3] + pose[..., :3, :3] @ offset

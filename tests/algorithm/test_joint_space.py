@@ -170,6 +170,7 @@ def urdf_geometry(path):
                     j.find("axis").get("xyz") if j.find("axis") is not None else None,
                     [1.0, 0.0, 0.0],
                 )
+                dyn = j.find("dynamics")
                 joints.append(
                     dict(
                         name=j.get("name"),
@@ -178,6 +179,8 @@ def urdf_geometry(path):
                         child=child,
                         point=world[child][0],
                         axis=world[child][1] @ axis,
+                        damping=float(dyn.get("damping", 0.0)) if dyn is not None else 0.0,
+                        friction=float(dyn.get("friction", 0.0)) if dyn is not None else 0.0,
                     )
                 )
             else:
@@ -230,7 +233,18 @@ def build_by_hand(bodies, joints):
     for j in joints:
         add = b.add_revolute if j["type"] == "R" else b.add_prismatic
         add(j["name"], j["parent"], j["child"], j["point"], j["axis"])
+        if j["damping"] or j["friction"]:
+            b.add_joint_friction(
+                j["name"], j["damping"], j["friction"], ad._core.URDF_COULOMB_SMOOTHING
+            )
     return b.finalize()
+
+
+def joint_friction(joints, qd):
+    """The URDF's <dynamics> torques at rates qd: -damping qd - friction tanh(qd / v_s)."""
+    c = np.array([j["damping"] for j in joints])
+    f = np.array([j["friction"] for j in joints])
+    return -c * qd - f * np.tanh(qd / ad._core.URDF_COULOMB_SMOOTHING)
 
 
 def reference_chain(bodies, joints):
@@ -277,7 +291,7 @@ def test_urdf_arm_matches_hand_built(rng):
                 by_hand, to_armdyn(perm_h, q), to_armdyn(perm_h, qd), to_armdyn(perm_h, tau)
             ),
         )
-        qdd_ref = chain.forward(q, qd, tau)
+        qdd_ref = chain.forward(q, qd, tau + joint_friction(joints, qd))
         # same model through two input paths: agreement at round-off level
         assert rel_err(qdd_l, qdd_h) <= tol(1e-12)
         assert rel_err(qdd_l, qdd_ref) <= tol(REL)

@@ -4,6 +4,9 @@ Pinocchio's ``mimic=True`` models do. Checked against Pinocchio 4.1 (PR2 with it
 mimic joints, Panda with its fingers), against closed forms (three sliders coupled in a
 chain), between the joint-space and Cartesian paths, in simulations, and on bad input."""
 
+import re
+from pathlib import Path
+
 import armdyn as ad
 import numpy as np
 import pytest
@@ -24,6 +27,16 @@ def urdf_path(rel):
 
 def rel(a, b):
     return float(np.max(np.abs(a - b)) / np.max(np.abs(b)))
+
+
+def without_joint_dynamics(path, tmp_dir):
+    """A copy of the URDF without its ``<dynamics damping friction>`` elements: armdyn imports
+    them as joint friction, which Pinocchio's rnea, crba and aba leave out (the subject here is
+    the mimic joints)."""
+    text = re.sub(r"<dynamics\b[^>]*/>", "", Path(path).read_text())
+    out = Path(tmp_dir) / Path(path).name
+    out.write_text(text)
+    return str(out)
 
 
 class MimicPair:
@@ -60,9 +73,9 @@ class MimicPair:
 
 
 @pytest.fixture(scope="module", params=["panda", "pr2"])
-def pair(request):
+def pair(request, tmp_path_factory):
     path = str(common.robot_urdf("panda")) if request.param == "panda" else urdf_path(PR2)
-    return MimicPair(path)
+    return MimicPair(without_joint_dynamics(path, tmp_path_factory.mktemp(request.param)))
 
 
 def test_coordinate_counts_equal_pinocchio_mimic_models(pair):
@@ -438,12 +451,47 @@ def test_welded_run_keeps_the_coupling():
     assert np.abs(merged.q[:, 1] - (-1.5 * merged.q[:, 0] + 0.2)).max() <= 1e-10
 
 
-def test_simulate_refuses_a_leader_beyond_pi_with_a_non_integer_multiplier():
-    # the run reads its initial angles from the poses, in (−π, π]: shoulder 3.5 rad is read as
-    # 3.5 − 2π, which with the multiplier 0.5 puts the elbow half a turn from where q0 asks
+def test_q0_keeps_the_turns_of_leaders_and_followers():
+    # shoulder 3.5 rad is the pose of 3.5 - 2 pi, but with the multiplier 0.5 the elbow's pose
+    # differs by half a turn: the run starts from q0's turns (armdyn passes them to the tracking)
     model = coupled_arm()
-    with pytest.raises(ad.ModelError, match=r"joint 'shoulder' at 3.5 rad.*'elbow_follows'.*0.5"):
-        ad.simulate(model, 0.1, q0=[3.5, 0.0])
-    # within (−π, π] the run starts where asked
-    run = ad.simulate(model, 0.1, q0=[3.1, 0.0], output_dt=0.1)
-    np.testing.assert_allclose(run.q[0], [3.1, 0.5 * 3.1 + 0.3, 0.0], atol=1e-12)
+    for coordinates in ("cartesian", "joint"):
+        run = ad.simulate(model, 0.2, q0=[3.5, 0.0], output_dt=0.1, coordinates=coordinates)
+        np.testing.assert_allclose(run.q[0], [3.5, 0.5 * 3.5 + 0.3, 0.0], atol=1e-12)
+        assert np.abs(run.q[:, 1] - (0.5 * run.q[:, 0] + 0.3)).max() <= 1e-10
+
+
+def test_floating_base_with_mimic_equals_pinocchio_free_flyer_mimic(tmp_path):
+    # the floating base's block leads q (7) and qd (6) and passes the couplings' map unchanged
+    path = without_joint_dynamics(common.robot_urdf("panda"), tmp_path)
+    am = ad.load_urdf(path, fixed_base=False)
+    pm = pin.buildModelFromUrdf(path, pin.JointModelFreeFlyer(), mimic=True)
+    pd = pm.createData()
+    assert (am.n_coords, am.n_dofs, am.n_free) == (pm.nq, pm.nv, 1) == (15, 14, 1)
+    assert (am.n_joint_coords, am.n_joint_dofs) == (16, 15)
+    names = am.coord_names[7:]
+    iq = np.array([pm.idx_qs[pm.getJointId(n)] for n in names])
+    iv = np.array([pm.idx_vs[pm.getJointId(n)] for n in names])
+    perm = np.concatenate([np.arange(6), iv])
+    rng = np.random.default_rng(8)
+    worst = dict.fromkeys(("rnea", "crba", "fd", "fd_cartesian"), 0.0)
+    for _ in range(10):
+        e = rng.normal(size=4)
+        e /= np.linalg.norm(e)
+        q = np.concatenate([rng.normal(size=3), e, rng.uniform(-2, 2, am.n_coords - 7)])
+        v, a, tau = rng.normal(size=(3, am.n_dofs))
+        qp = np.zeros(pm.nq)
+        qp[:3], qp[3:6], qp[6], qp[iq] = q[:3], q[4:7], q[3], q[7:]
+        vp, ap, tp = (np.zeros(pm.nv) for _ in range(3))
+        vp[perm], ap[perm], tp[perm] = v, a, tau
+        tau_ref = pin.rnea(pm, pd, qp, vp, ap)[perm]
+        worst["rnea"] = max(worst["rnea"], rel(ad.inverse_dynamics(am, q, v, a), tau_ref))
+        m_ref = pin.crba(pm, pd, qp)
+        m_ref = (np.triu(m_ref) + np.triu(m_ref, 1).T)[np.ix_(perm, perm)]
+        worst["crba"] = max(worst["crba"], rel(ad.mass_matrix(am, q), m_ref))
+        nle = pin.rnea(pm, pd, qp, vp, np.zeros(pm.nv))[perm]
+        a_ref = np.linalg.solve(m_ref, tau - nle)
+        worst["fd"] = max(worst["fd"], rel(ad.forward_dynamics(am, q, v, tau), a_ref))
+        a_kkt = ad.forward_dynamics(am, q, v, tau, method="cartesian")
+        worst["fd_cartesian"] = max(worst["fd_cartesian"], rel(a_kkt, a_ref))
+    assert max(worst.values()) <= 1e-10, worst

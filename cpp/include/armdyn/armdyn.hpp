@@ -27,10 +27,12 @@
 #include "armdyn/builder/summary.hpp"
 #include "armdyn/builder/weld.hpp"
 
-// joint-space algorithms: forces, recursive Newton-Euler, CRBA, forward/inverse dynamics
+// joint-space algorithms: forces, recursive Newton-Euler, CRBA, forward/inverse dynamics, frame
+// poses and Jacobians
 #include "armdyn/algorithm/crba.hpp"
 #include "armdyn/algorithm/dynamics.hpp"
 #include "armdyn/algorithm/forces.hpp"
+#include "armdyn/algorithm/frames.hpp"
 #include "armdyn/algorithm/rnea.hpp"
 
 // the Cartesian pipeline on the bodies' state (u, v): kinematics, constraints, forces

@@ -46,15 +46,19 @@ class Data {
   Data& operator=(const Data&) = delete;
 
   const Model* model;  ///< the model the buffers are sized for (identity only, not owned)
-  int n = 0;           ///< joint coordinates (every joint's, followers of couplings included)
-  int ni = 0;          ///< independent joint coordinates (Model::independent; n without couplings)
+  int n = 0;           ///< joint-space degrees of freedom: len(qd) (model.nv_joint)
+  int nq = 0;          ///< len(q) (model.nq_joint: 7 per floating base where n has 6)
+  int nco = 0;  ///< joint coordinates of Model::coords (n without the floating bases' 6 each)
+  /// the independent joint-space sizes (Model::independent): len(q) and len(qd) a coupled
+  /// model's public joint-space functions take (nq and n without couplings)
+  int niq = 0, ni = 0;
 
   // --- kinematics: joint_space_kinematics, load_kinematics (shared by the joint-space and the
   // Cartesian algorithms; each loads it before use) ---
   std::vector<BodyKin> kin;  ///< per body: pose and velocity
   // --- forces (body_forces, coordinate_forces, cartesian_forces) ---
   VecX eta;        ///< (nv) applied and gyroscopic forces on the bodies
-  VecX coord_tau;  ///< (n) joint-coordinate forces and gear contact forces (coordinate_forces)
+  VecX coord_tau;  ///< (nco) joint-coordinate forces and gear contact forces (coordinate_forces)
   // --- recursive Newton-Euler (rnea) ---
   RneWork rne;
   VecX tau;  ///< (n) the last rnea's joint torques/forces
@@ -93,7 +97,8 @@ class Data {
   // settings of the calls that follow, set by the caller:
   int nrows = 0;  ///< rows taking part: model.nc (joints and drives, the default) or nc_joint
   const double* aux = nullptr;  ///< auxiliary states z (model.n_aux); nullptr: all zero
-  /// Joint-space generalised forces (n) added to eta by cartesian_forces; nullptr: none.
+  /// Joint-space generalised forces (n: the floating bases' wrenches, then the coordinates')
+  /// added to eta by cartesian_forces; nullptr: none.
   const double* joint_torques = nullptr;
   /// false: cartesian_forces leaves out the joint-coordinate forces and gear pairs (a
   /// joint-space caller adds them to its generalised forces directly).
@@ -102,9 +107,9 @@ class Data {
   ConstraintEval ce;             ///< f, zeta, rhs, xi at the loaded state
   std::vector<int> joint_block;  ///< per joint: its row block in ce.blocks (-1: no rows)
   CoordJetCache jets;            ///< coordinate jets at the loaded state (ce.coord_cache)
-  VecX track_ref;  ///< (n) unwrapped reference of the angle coordinates (ce.track_ref)
-  std::vector<ScalarJet> tau_jets;  ///< (n) with joint_torques: each coordinate's jet (no value)
-  VecX cq, cqd;                     ///< (n) the coordinates the force laws read, from the jets
+  VecX track_ref;  ///< (nco) unwrapped reference of the angle coordinates (ce.track_ref)
+  std::vector<ScalarJet> tau_jets;  ///< (nco) with joint_torques: each coordinate's jet (no value)
+  VecX cq, cqd;                     ///< (nco) the coordinates the force laws read, from the jets
   KktSolver kkt;                    ///< the factor of the KKT system's Schur complement
   TreeSweep sweep;                  ///< the O(n) solve of a fully driven tree
   bool swept = false;               ///< the last body_accelerations took the sweep (kkt not used)
@@ -136,7 +141,7 @@ class Data {
   /// the public joint-space functions on a coupled model: the full coordinates (n) expanded
   /// from the independent ones, and the reduced results (ni)
   struct Coupled {
-    VecX q, qd, qdd, tau_full;  ///< (n)
+    VecX q, qd, qdd, tau_full;  ///< (nq; n)
     VecX tau, qdd_out, rhs;     ///< (ni)
     MatX M, L;                  ///< (ni, ni)
   } coupled;
@@ -146,6 +151,11 @@ class Data {
   std::unique_ptr<Model> driven;      ///< inverse dynamics: the model with every coordinate driven
   std::unique_ptr<Data> driven_data;  ///< made on first use, for *driven
   VecX drive_ref;                     ///< (3 n) drive values (q, qd, qdd) of driven_data
+
+  // --- named frames (algorithm/frames) ---
+  Mat4 frame_pose = Mat4::Identity();  ///< the last frame pose [R p; 0 1]
+  Mat6X frame_jacobian;                ///< (6, n) the last joint-space frame Jacobian
+  MatX frame_jacobian_v;               ///< (6, nv) the last Cartesian frame Jacobian
 };
 
 /// Return the settings and learnt state of d's Cartesian pipeline to those of a new Data (the

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "armdyn/algorithm/aba.hpp"
 
+#include <Eigen/Cholesky>
 #include <cmath>
 
 #include "armdyn/algorithm/forces.hpp"
@@ -63,7 +64,7 @@ inline Vec6 motion_of(const Joint& j, int k, const Vec3& z, const Vec3& p) {
 void aba_accelerations(const Model& m, Data& d, const double* q, const double* qd, const double* z,
                        const double* tau, double t, double* qdd) {
   const int n = d.n;
-  const Eigen::Map<const VecX> qv(q, n), qdv(qd, n);
+  const Eigen::Map<const VecX> qv(q, d.nq), qdv(qd, n);
   joint_space_kinematics(m, qv, qdv, d.kin, d.rne);
   body_forces(m, d.kin, t, d.eta);
   // the joint forces tau + Q
@@ -73,14 +74,14 @@ void aba_accelerations(const Model& m, Data& d, const double* q, const double* q
   else
     f.setZero();
   if (!m.coord_forces.empty() || !m.gears.empty()) {
-    coordinate_forces(m, q, qd, z, t, d.coord_tau);
-    f += d.coord_tau;
+    coordinate_forces(m, q + 7 * m.n_free, qd + 6 * m.n_free, z, t, d.coord_tau);
+    f.tail(d.nco) += d.coord_tau;
   }
   if (!f.allFinite()) {
     for (int c = 0; c < n; ++c)
       if (!std::isfinite(f[c]))
-        throw SolverError(msg("non-finite generalised force on joint coordinate '",
-                              m.coords[c].name, "' at t=", t));
+        throw SolverError(msg("non-finite generalised force on joint coordinate '", m.dof_names[c],
+                              "' at t=", t));
   }
   Data::AbaWork& w = d.aba;
   // Spatial quantities in world axes, each body's about its own centre of mass x_i (a point
@@ -110,8 +111,21 @@ void aba_accelerations(const Model& m, Data& d, const double* q, const double* q
   for (int ji : m.tree_order) {
     const Joint& j = m.joints[ji];
     const Vec3& o = d.kin[j.child].x;
+    if (j.type == JointType::Free) {
+      // a floating base: slides along and turns about its frame's axes through its origin P;
+      // the axes move with the body, so the velocity product v x (S qd) = v x v vanishes
+      const Mat3 B = free_frame(j, d.kin[j.child]);
+      const Vec3 r = d.rne.point[ji] - o;
+      for (int k = 0; k < 3; ++k) {
+        d.s[j.dof0 + k] << Vec3::Zero(), B.col(k);
+        d.s[j.dof0 + 3 + k] << B.col(k), r.cross(B.col(k));
+        w.c[j.dof0 + k].setZero();
+        w.c[j.dof0 + 3 + k].setZero();
+      }
+      continue;
+    }
     for (int k = 0; k < joint_coords(j.type); ++k) {
-      const int c = j.coord0 + k;
+      const int c = j.dof0 + k;
       d.s[c] = motion_of(j, k, d.rne.axis[ji], d.rne.point[ji] - o);
       if (j.parent == kGround) {
         w.c[c].setZero();
@@ -128,7 +142,7 @@ void aba_accelerations(const Model& m, Data& d, const double* q, const double* q
     Mat6& IA = w.IA[i];
     Vec6& pA = w.pA[i];
     for (int k = joint_coords(j.type) - 1; k >= 0; --k) {
-      const int c = j.coord0 + k;
+      const int c = j.dof0 + k;
       const Vec6& s = d.s[c];
       Vec6& U = w.U[c];
       U.noalias() = IA * s;
@@ -137,7 +151,7 @@ void aba_accelerations(const Model& m, Data& d, const double* q, const double* q
         throw SolverError(msg(
             "forward dynamics (articulated-body algorithm): the articulated "
             "inertia of joint '",
-            j.name, "' (coordinate '", m.coords[c].name, "', body '", m.bodies[i].name,
+            j.name, "' (coordinate '", m.dof_names[c], "', body '", m.bodies[i].name,
             "') along its coordinate is not positive (", D, ") at t=", t, ": a massless subtree?"));
       const double Dinv = 1.0 / D;
       w.Dinv[c] = Dinv;
@@ -159,12 +173,30 @@ void aba_accelerations(const Model& m, Data& d, const double* q, const double* q
   for (int ji : m.tree_order) {
     const Joint& j = m.joints[ji];
     Vec6& a = w.a[j.child];
+    if (j.type == JointType::Free) {
+      // the floating base's 6 x 6 block: (S^T I^A S) qdd = f - S^T p^A, a = S qdd
+      Mat6 S;
+      for (int k = 0; k < 6; ++k) S.col(k) = d.s[j.dof0 + k];
+      const Mat6 U = w.IA[j.child] * S;
+      const Mat6 D = S.transpose() * U;
+      const Eigen::LLT<Mat6> llt(D);
+      if (llt.info() != Eigen::Success)
+        throw SolverError(
+            msg("forward dynamics (articulated-body algorithm): the articulated "
+                "inertia of floating base '",
+                j.name, "' (body '", m.bodies[j.child].name, "') is not positive definite at t=", t,
+                ": a massless model?"));
+      const Vec6 x = llt.solve(f.segment<6>(j.dof0) - S.transpose() * w.pA[j.child]);
+      Eigen::Map<Vec6>(qdd + j.dof0) = x;
+      a.noalias() = S * x;
+      continue;
+    }
     if (j.parent == kGround)
       a.setZero();
     else
       a = shift_motion(w.a[j.parent], d.kin[j.parent].x, d.kin[j.child].x);
     for (int k = 0; k < joint_coords(j.type); ++k) {
-      const int c = j.coord0 + k;
+      const int c = j.dof0 + k;
       a += w.c[c];
       const double x = w.Dinv[c] * (w.u[c] - w.U[c].dot(a));
       qdd[c] = x;
@@ -178,10 +210,11 @@ const VecX& aba(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen::Ref<co
   const char* fn = "forward_dynamics";
   require_joint_space(m, fn);
   check_data(m, d, fn);
-  check_joint_vector(q, d.n, fn, "q");
+  check_joint_vector(q, d.nq, fn, "q");
   check_joint_vector(qd, d.n, fn, "qd");
   check_joint_vector(tau, d.n, fn, "tau");
   if (!std::isfinite(t)) throw ModelError(msg(fn, ": t is not finite"));
+  check_base_quaternions(m, q, fn);
   aba_accelerations(m, d, q.data(), qd.data(), nullptr, tau.data(), t, d.qdd.data());
   return d.qdd;
 }

@@ -62,7 +62,7 @@ const DynamicsCost& dynamics_cost(const Model& m) {
     const CostConstants& k = cost_constants();
     DynamicsCost c;
     c.nb = m.nb;
-    c.n = static_cast<int>(m.coords.size());
+    c.n = m.nv_joint;
     c.rows = m.nc_joint;
     // coordinates on each coordinate's path to the root (the CRBA's inner loop)
     if (m.is_tree && !m.tree_order.empty()) {
@@ -72,7 +72,7 @@ const DynamicsCost& dynamics_cost(const Model& m) {
       for (int ji : m.tree_order) {
         const Joint& j = m.joints[ji];
         const int up = j.parent == kGround ? -1 : joint_of[j.parent];
-        depth[ji] = (up >= 0 ? depth[up] : 0) + joint_coords(j.type);
+        depth[ji] = (up >= 0 ? depth[up] : 0) + joint_dofs(j.type);
         c.path += joint_coords(j.type) * static_cast<double>(depth[ji]);
       }
     }
@@ -108,7 +108,8 @@ const DynamicsCost& dynamics_cost(const Model& m) {
 DynamicsMethod resolve_method(const Model& m, DynamicsMethod method) {
   switch (method) {
     case DynamicsMethod::Auto:
-      return dynamics_cost(m).best;
+      // floating bases: the joint-space methods (the Cartesian method takes fixed bases only)
+      return m.n_free ? dynamics_cost(m).joint : dynamics_cost(m).best;
     case DynamicsMethod::Joint:
       return dynamics_cost(m).joint;
     case DynamicsMethod::Crba:

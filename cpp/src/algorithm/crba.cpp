@@ -30,11 +30,20 @@ void crba_loaded(const Model& m, Data& d) {
   // joint frames of the Newton-Euler sweep)
   for (int ji : m.tree_order) {
     const Joint& j = m.joints[ji];
-    if (j.coord0 < 0) continue;
+    if (j.dof0 < 0) continue;
     const Vec3& z = d.rne.axis[ji];
     const Vec3& p = d.rne.point[ji];
+    if (j.type == JointType::Free) {
+      // a floating base: slides along, then turns about, its frame's axes through its origin
+      const Mat3 B = free_frame(j, d.kin[j.child]);
+      for (int k = 0; k < 3; ++k) {
+        d.s[j.dof0 + k] << Vec3::Zero(), B.col(k);
+        d.s[j.dof0 + 3 + k] << B.col(k), p.cross(B.col(k));
+      }
+      continue;
+    }
     for (int k = 0; k < joint_coords(j.type); ++k) {
-      Vec6& s = d.s[j.coord0 + k];
+      Vec6& s = d.s[j.dof0 + k];
       if (j.type == JointType::Prismatic || k == 1) {
         s << Vec3::Zero(), z;
       } else {
@@ -42,9 +51,9 @@ void crba_loaded(const Model& m, Data& d) {
       }
     }
   }
-  // M_jk for j among the coordinates of k's joint and of the joints towards ground
+  // M_jk for j among the degrees of freedom of k's joint and of the joints towards ground
   for (int k = 0; k < d.n; ++k) {
-    const int jk = m.coords[k].joint;
+    const int jk = m.dof_joint[k];
     // the subtree's momentum for the motion s = (w, v_O)
     const Data::Composite& I = d.ic[m.joints[jk].child];
     const Vec3 w = d.s[k].head<3>(), v = d.s[k].tail<3>();
@@ -54,7 +63,7 @@ void crba_loaded(const Model& m, Data& d) {
     f.tail<3>() = I.m * v - I.h.cross(w);
     for (int ji = jk; ji >= 0;) {
       const Joint& j = m.joints[ji];
-      for (int c = j.coord0; c < j.coord0 + joint_coords(j.type); ++c)
+      for (int c = j.dof0; c < j.dof0 + joint_dofs(j.type); ++c)
         d.M(c, k) = d.M(k, c) = d.s[c].dot(f);
       ji = j.parent == kGround ? -1 : d.joint_of_body[j.parent];
     }
@@ -64,10 +73,11 @@ void crba_loaded(const Model& m, Data& d) {
 const MatX& crba(const Model& m, Data& d, Eigen::Ref<const VecX> q) {
   require_joint_space(m, "mass_matrix", true);
   check_data(m, d, "mass_matrix");
-  check_joint_vector(q, d.ni, "mass_matrix", "q");
+  check_joint_vector(q, d.niq, "mass_matrix", "q");
+  check_base_quaternions(m, q, "mass_matrix");
   if (d.ni == d.n) return mass_matrix_at(m, d, q);
   // a coupled model: M_r = G^T M G in the independent coordinates (Model::independent)
-  m.independent.expand(q.data(), d.coupled.q.data(), true);
+  m.independent.expand_q(q.data(), d.coupled.q.data());
   m.independent.reduce(mass_matrix_at(m, d, d.coupled.q), d.coupled.M);
   return d.coupled.M;
 }

@@ -23,10 +23,18 @@ void check_inputs(const Model& m, const Data& d, Eigen::Ref<const VecX> q,
                   const char* xname) {
   require_joint_space(m, fn, true);
   check_data(m, d, fn);
-  check_joint_vector(q, d.ni, fn, "q");
+  check_joint_vector(q, d.niq, fn, "q");
   check_joint_vector(qd, d.ni, fn, "qd");
   check_joint_vector(x, d.ni, fn, xname);
   if (!std::isfinite(t)) throw ModelError(msg(fn, ": t is not finite"));
+  check_base_quaternions(m, q, fn);
+}
+
+void refuse_floating_cartesian(const Model& m, const char* fn) {
+  if (m.n_free)
+    throw ModelError(msg(fn,
+                         ": method 'cartesian' takes fixed-base models only (this one has a "
+                         "floating base); use 'auto' or 'joint'"));
 }
 
 // forward dynamics of a coupled model in its independent coordinates: the Cartesian KKT path
@@ -56,8 +64,10 @@ void forward_cartesian(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen:
   load_joint_kinematics(m, d, q, qd);
   d.tau_in = tau;
   body_accelerations_loaded(m, d, t, d.vd.data());
-  // the coordinate jets of the torques, at this state
-  for (int c = 0; c < d.n; ++c) d.qdd[c] = coord_acceleration(m, d.tau_jets[c], c, d.vd);
+  // the coordinate jets of the torques, at this state; the floating bases' from their bodies
+  for (int c = 0; c < d.nco; ++c)
+    d.qdd[6 * m.n_free + c] = coord_acceleration(m, d.tau_jets[c], c, d.vd);
+  if (m.n_free) base_accelerations(m, d.kin, d.vd.data(), d.qdd.data());
 }
 
 // inverse dynamics through the KKT system with every independent joint coordinate driven to
@@ -126,13 +136,17 @@ const VecX& forward_coupled(const Model& m, Data& d, Eigen::Ref<const VecX> q,
     method = light ? DynamicsMethod::Cartesian : DynamicsMethod::Crba;
   if (method != DynamicsMethod::Cartesian && light)
     throw ModelError(msg(fn, ": ", geared_light_reason(m)));
-  ic.expand(q.data(), w.q.data(), true);
-  ic.expand(qd.data(), w.qd.data(), false);
+  ic.expand_q(q.data(), w.q.data());
+  ic.expand_v(qd.data(), w.qd.data());
   if (method == DynamicsMethod::Cartesian) {
+    // the floating bases' entries as they are, the followers' torques zero
+    const int lead = ic.lead_v;
     w.tau_full.setZero();
-    for (int k = 0; k < d.ni; ++k) w.tau_full[ic.full[k]] = tau[k];
+    w.tau_full.head(lead) = tau.head(lead);
+    for (int k = 0; k < ic.n; ++k) w.tau_full[lead + ic.full[k]] = tau[lead + k];
     forward_cartesian(m, d, w.q, w.qd, w.tau_full, t);
-    for (int k = 0; k < d.ni; ++k) w.qdd_out[k] = d.qdd[ic.full[k]];
+    w.qdd_out.head(lead) = d.qdd.head(lead);
+    for (int k = 0; k < ic.n; ++k) w.qdd_out[lead + k] = d.qdd[lead + ic.full[k]];
     return w.qdd_out;
   }
   joint_space_equations(m, d, w.q.data(), w.qd.data(), nullptr, nullptr, t);
@@ -152,7 +166,7 @@ const VecX& forward_coupled(const Model& m, Data& d, Eigen::Ref<const VecX> q,
 
 void joint_space_equations(const Model& m, Data& d, const double* q, const double* qd,
                            const double* z, const double* tau, double t) {
-  const Eigen::Map<const VecX> qv(q, d.n), qdv(qd, d.n);
+  const Eigen::Map<const VecX> qv(q, d.nq), qdv(qd, d.n);
   joint_space_kinematics(m, qv, qdv, d.kin, d.rne);
   body_forces(m, d.kin, t, d.eta);
   // rhs = tau + Q - (b - J^T eta): the residual of the Newton-Euler equations at qdd = 0
@@ -161,14 +175,14 @@ void joint_space_equations(const Model& m, Data& d, const double* q, const doubl
   rhs = -rhs;
   if (tau) rhs += Eigen::Map<const VecX>(tau, d.n);
   if (!m.coord_forces.empty() || !m.gears.empty()) {
-    coordinate_forces(m, q, qd, z, t, d.coord_tau);
-    rhs += d.coord_tau;
+    coordinate_forces(m, q + 7 * m.n_free, qd + 6 * m.n_free, z, t, d.coord_tau);
+    rhs.tail(d.nco) += d.coord_tau;
   }
   if (!rhs.allFinite()) {
     for (int c = 0; c < d.n; ++c)
       if (!std::isfinite(rhs[c]))
-        throw SolverError(msg("non-finite generalised force on joint coordinate '",
-                              m.coords[c].name, "' at t=", t));
+        throw SolverError(msg("non-finite generalised force on joint coordinate '", m.dof_names[c],
+                              "' at t=", t));
   }
   crba_loaded(m, d);
 }
@@ -216,13 +230,14 @@ const VecX& inverse_dynamics(const Model& m, Data& d, Eigen::Ref<const VecX> q,
                              DynamicsMethod method) {
   if (method != DynamicsMethod::Cartesian) return rnea(m, d, q, qd, qdd, t);
   check_inputs(m, d, q, qd, qdd, t, "inverse_dynamics", "qdd");
+  refuse_floating_cartesian(m, "inverse_dynamics");
   if (d.ni == d.n) {
     inverse_cartesian(m, d, q, qd, qdd, t, d.tau);
     return d.tau;
   }
   Data::Coupled& w = d.coupled;
-  m.independent.expand(q.data(), w.q.data(), true);
-  m.independent.expand(qd.data(), w.qd.data(), false);
+  m.independent.expand_q(q.data(), w.q.data());
+  m.independent.expand_v(qd.data(), w.qd.data());
   inverse_cartesian(m, d, w.q, w.qd, qdd, t, w.tau);
   return w.tau;
 }

@@ -133,12 +133,24 @@ void cartesian_forces(const Model& m, Data& d, double t) {
   if (d.with_coordinate_forces) coordinate_forces_on_bodies(m, d, t);
   // joint-space torques of a joint-space call
   if (d.joint_torques) {
-    const double* tau = d.joint_torques;
+    const double* tau = d.joint_torques + 6 * m.n_free;
     for (int c = 0; c < static_cast<int>(m.coords.size()); ++c) {
       const ScalarJet& q = d.tau_jets[c] = coord_jet(m, d.kin, c, false);
       if (tau[c] == 0.0) continue;
       const Joint& j = m.joints[m.coords[c].joint];
       add_pair(d.eta, tau[c] * q.J, j.parent, j.child);
+    }
+    // a floating base's wrench (force, torque in its frame's axes, at its origin P)
+    for (const Joint& j : m.joints) {
+      if (j.type != JointType::Free || j.dof0 < 0) continue;
+      const double* w = d.joint_torques + j.dof0;
+      const BodyKin& k = d.kin[j.child];
+      const Mat3 B = k.R * j.frame_child;
+      const Vec3 f = B * Vec3(w[0], w[1], w[2]);
+      d.eta.segment<3>(6 * j.child) += f;
+      // torque about the centre of mass, body axes: R^T (B n) + s x (R^T f), s = P - x in body
+      d.eta.segment<3>(6 * j.child + 3) +=
+          j.frame_child * Vec3(w[3], w[4], w[5]) + j.point_child.cross(k.R.transpose() * f);
     }
   }
   check_finite(m, d.eta, t);

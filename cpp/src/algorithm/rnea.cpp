@@ -12,17 +12,18 @@ const VecX& rnea(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen::Ref<c
                  Eigen::Ref<const VecX> qdd, double t) {
   require_joint_space(m, "inverse_dynamics", true);
   check_data(m, d, "inverse_dynamics");
-  check_joint_vector(q, d.ni, "inverse_dynamics", "q");
+  check_joint_vector(q, d.niq, "inverse_dynamics", "q");
   check_joint_vector(qd, d.ni, "inverse_dynamics", "qd");
   check_joint_vector(qdd, d.ni, "inverse_dynamics", "qdd");
   if (!std::isfinite(t)) throw ModelError("inverse_dynamics: t is not finite");
+  check_base_quaternions(m, q, "inverse_dynamics");
   if (d.ni != d.n) {
     // a coupled model: the full coordinates, tau = G^T tau_full
     Data::Coupled& w = d.coupled;
     const IndependentCoords& ic = m.independent;
-    ic.expand(q.data(), w.q.data(), true);
-    ic.expand(qd.data(), w.qd.data(), false);
-    ic.expand(qdd.data(), w.qdd.data(), false);
+    ic.expand_q(q.data(), w.q.data());
+    ic.expand_v(qd.data(), w.qd.data());
+    ic.expand_v(qdd.data(), w.qdd.data());
     rnea_full(m, d, w.q, w.qd, w.qdd, t);
     ic.reduce(d.tau.data(), w.tau.data());
     return w.tau;
@@ -37,8 +38,10 @@ void rnea_full(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen::Ref<con
   body_forces(m, d.kin, t, d.eta);
   rne_residual(m, d.kin, qd, qdd, d.eta, d.rne, d.tau);
   if (!m.coord_forces.empty() || !m.gears.empty()) {
-    coordinate_forces(m, q.data(), qd.data(), nullptr, t, d.coord_tau);
-    d.tau -= d.coord_tau;
+    // the coordinates follow the floating bases' blocks in q and qd
+    coordinate_forces(m, q.data() + 7 * m.n_free, qd.data() + 6 * m.n_free, nullptr, t,
+                      d.coord_tau);
+    d.tau.tail(d.nco) -= d.coord_tau;
   }
 }
 

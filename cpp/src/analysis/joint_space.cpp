@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "armdyn/analysis/joint_space.hpp"
 
+#include <cmath>
 #include <utility>
 
 #include "armdyn/errors.hpp"
@@ -22,6 +23,38 @@ void check_joint_vector(Eigen::Ref<const VecX> x, long n, const char* fn, const 
   if (!x.allFinite()) throw ModelError(msg(fn, ": ", name, " contains NaN or inf"));
 }
 
+void check_base_quaternions(const Model& m, Eigen::Ref<const VecX> q, const char* fn) {
+  for (const Joint& j : m.joints) {
+    if (j.type != JointType::Free || j.q0 < 0) continue;
+    const double n = q.segment<4>(j.q0 + 3).norm();
+    if (!(std::abs(n - 1.0) <= 1e-6))
+      throw ModelError(msg(fn, ": q[", j.q0 + 3, ":", j.q0 + 7, "], the quaternion of free joint '",
+                           j.name, "' (scalar first), has norm ", n,
+                           "; expected a unit quaternion"));
+  }
+}
+
+void configuration_rate(const Model& m, const double* q, const double* qd, double* qdot) {
+  const int F = m.n_free, nc = static_cast<int>(m.coords.size());
+  for (int c = 0; c < nc; ++c) qdot[7 * F + c] = qd[6 * F + c];
+  for (const Joint& j : m.joints) {
+    if (j.type != JointType::Free || j.q0 < 0) continue;
+    const Vec4 e(q[j.q0 + 3], q[j.q0 + 4], q[j.q0 + 5], q[j.q0 + 6]);
+    const Vec3 v(qd[j.dof0], qd[j.dof0 + 1], qd[j.dof0 + 2]);
+    const Vec3 w(qd[j.dof0 + 3], qd[j.dof0 + 4], qd[j.dof0 + 5]);
+    Eigen::Map<Vec3>(qdot + j.q0) = quat_to_rot(e.normalized()) * v;
+    Eigen::Map<Vec4>(qdot + j.q0 + 3) = quat_rate(e, w);  // w in the base frame
+  }
+}
+
+void normalize_bases(const Model& m, double* q) {
+  for (const Joint& j : m.joints) {
+    if (j.type != JointType::Free || j.q0 < 0) continue;
+    Eigen::Map<Vec4> e(q + j.q0 + 3);
+    e.normalize();
+  }
+}
+
 void state_from_joints(const Model& m, const VecX& q, const VecX& qd, VecX& u, VecX& v) {
   TreeFkWork work;
   state_from_joints(m, q, qd, u, v, work);
@@ -36,11 +69,33 @@ void tree_kinematics(const Model& m, Eigen::Ref<const VecX> q, const double* qd,
   const BodyKin ground{};
   for (int ji : m.tree_order) {
     const Joint& j = m.joints[ji];
+    if (j.type == JointType::Free) {
+      // a floating base: its frame's origin P and rotation B from q, its velocity (v, w) in B
+      const int i0 = j.q0;
+      const Vec3 P(q[i0], q[i0 + 1], q[i0 + 2]);
+      const Mat3 B = quat_to_rot(Vec4(q[i0 + 3], q[i0 + 4], q[i0 + 5], q[i0 + 6]).normalized());
+      if (frames) {
+        frames->point[ji] = P;
+        frames->axis[ji] = B.col(2);
+      }
+      BodyKin& c = kin[j.child];
+      c.R.noalias() = B * j.frame_child.transpose();
+      c.x = P - c.R * j.point_child;
+      if constexpr (Velocities) {
+        const double* v = qd + j.dof0;
+        c.W = B * Vec3(v[3], v[4], v[5]);
+        c.xd = B * Vec3(v[0], v[1], v[2]) + c.W.cross(c.x - P);
+        c.w.noalias() = c.R.transpose() * c.W;
+      } else {
+        c.W = c.xd = c.w = Vec3::Zero();
+      }
+      continue;
+    }
     const BodyKin& p = j.parent != kGround ? kin[j.parent] : ground;
     const Mat3 A = p.R * j.frame_parent;
     const Vec3 z = A.col(2);
     double th, d;
-    joint_components(j, q, th, d);
+    joint_components(j, q.data(), j.q0, th, d);
     // child joint frame B = A Rz(th), placed at P + d z
     const double ct = std::cos(th), st = std::sin(th);
     Mat3 B;
@@ -58,7 +113,7 @@ void tree_kinematics(const Model& m, Eigen::Ref<const VecX> q, const double* qd,
     c.x = Pc - c.R * j.point_child;
     if constexpr (Velocities) {
       double thd, dd;
-      joint_components(j, Eigen::Map<const VecX>(qd, q.size()), thd, dd);
+      joint_components(j, qd, j.dof0, thd, dd);
       c.W = p.W + thd * z;
       const Vec3 Pcd = p.xd + p.W.cross(Pc - p.x) + dd * z;
       c.xd = Pcd + c.W.cross(c.x - Pc);
@@ -102,13 +157,25 @@ void rne_forward(const Model& m, const std::vector<BodyKin>& kin, Eigen::Ref<con
   // of joint_space_kinematics)
   for (int ji : m.tree_order) {
     const Joint& j = m.joints[ji];
-    const bool on_ground = j.parent == kGround;
     const BodyKin& c = kin[j.child];
-    double thd, thdd, dd, ddd;
-    joint_components(j, qd, thd, dd);
-    joint_components(j, qdd, thdd, ddd);
-    const Vec3& z = w.axis[ji];
     const Vec3& pc = w.point[ji];
+    if (j.type == JointType::Free) {
+      // a floating base: alpha = B w', the origin's acceleration W x (B v) + B v'
+      const Mat3 B = free_frame(j, c);
+      const double* a = qdd.data() + j.dof0;
+      const double* v = qd.data() + j.dof0;
+      Vec3& alpha = w.alpha[j.child];
+      alpha.noalias() = B * Vec3(a[3], a[4], a[5]);
+      const Vec3 acc = c.W.cross(B * Vec3(v[0], v[1], v[2])) + B * Vec3(a[0], a[1], a[2]);
+      const Vec3 e = c.x - pc;
+      w.acc[j.child] = acc + alpha.cross(e) + c.W.cross(c.W.cross(e));
+      continue;
+    }
+    const bool on_ground = j.parent == kGround;
+    double thd, thdd, dd, ddd;
+    joint_components(j, qd.data(), j.dof0, thd, dd);
+    joint_components(j, qdd.data(), j.dof0, thdd, ddd);
+    const Vec3& z = w.axis[ji];
     Vec3 acc = ddd * z;
     Vec3& alpha = w.alpha[j.child];
     alpha = thdd * z;
@@ -152,15 +219,23 @@ void rne_residual(const Model& m, const std::vector<BodyKin>& kin, Eigen::Ref<co
     const Vec3 arm = kin[c].x - w.point[*it];
     switch (j.type) {
       case JointType::Revolute:
-        tau[j.coord0] = z.dot(w.moment[c] + arm.cross(w.force[c]));
+        tau[j.dof0] = z.dot(w.moment[c] + arm.cross(w.force[c]));
         break;
       case JointType::Prismatic:
-        tau[j.coord0] = z.dot(w.force[c]);
+        tau[j.dof0] = z.dot(w.force[c]);
         break;
       case JointType::Cylindrical:
-        tau[j.coord0] = z.dot(w.moment[c] + arm.cross(w.force[c]));
-        tau[j.coord0 + 1] = z.dot(w.force[c]);
+        tau[j.dof0] = z.dot(w.moment[c] + arm.cross(w.force[c]));
+        tau[j.dof0 + 1] = z.dot(w.force[c]);
         break;
+      case JointType::Free: {
+        // the subtree's wrench at the base frame's origin, in the base frame's axes
+        const Mat3 B = free_frame(j, kin[c]);
+        tau.segment<3>(j.dof0).noalias() = B.transpose() * w.force[c];
+        tau.segment<3>(j.dof0 + 3).noalias() =
+            B.transpose() * (w.moment[c] + arm.cross(w.force[c]));
+        break;
+      }
       default:
         break;
     }
@@ -174,13 +249,24 @@ void rne_residual(const Model& m, const std::vector<BodyKin>& kin, Eigen::Ref<co
 void state_from_joints(const Model& m, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd, VecX& u,
                        VecX& v, TreeFkWork& work) {
   require_joint_space(m, "state_from_joints", true);
-  const long nc = static_cast<long>(m.coords.size());
-  check_joint_vector(q, nc, "state_from_joints", "q");
-  check_joint_vector(qd, nc, "state_from_joints", "qd");
+  check_joint_vector(q, m.nq_joint, "state_from_joints", "q");
+  check_joint_vector(qd, m.nv_joint, "state_from_joints", "qd");
+  check_base_quaternions(m, q, "state_from_joints");
   u.resize(m.nq);
   v.resize(m.nv);
   joint_space_kinematics(m, q, qd, work.kin);
   cartesian_state(m, work.kin, u.data(), v.data());
+  base_orientations(m, q.data(), u.data());
+}
+
+void base_orientations(const Model& m, const double* q, double* u) {
+  for (const Joint& j : m.joints) {
+    if (j.type != JointType::Free || j.q0 < 0) continue;
+    // R(e_body) = B frame_child^T: e_body = e_B (x) conj(e_frame), e_B's sign kept
+    const Vec4 ef = rot_to_quat(j.frame_child);
+    Eigen::Map<Vec4>(u + 7 * j.child + 3) = quat_mul(
+        Eigen::Map<const Vec4>(q + j.q0 + 3).normalized(), Vec4(ef[0], -ef[1], -ef[2], -ef[3]));
+  }
 }
 
 void cartesian_state(const Model& m, const std::vector<BodyKin>& kin, double* u, double* v) {
@@ -193,19 +279,57 @@ void cartesian_state(const Model& m, const std::vector<BodyKin>& kin, double* u,
   }
 }
 
+void base_coordinates(const Model& m, const std::vector<BodyKin>& kin, const double* u, double* q,
+                      double* qd) {
+  for (const Joint& j : m.joints) {
+    if (j.type != JointType::Free || j.q0 < 0) continue;
+    const BodyKin& c = kin[j.child];
+    const Mat3 B = free_frame(j, c);
+    const Vec3 P = c.x + c.R * j.point_child;
+    Eigen::Map<Vec3>(q + j.q0) = P;
+    // from the body's Euler parameters when given: continuous along a run (no sign flips)
+    Eigen::Map<Vec4>(q + j.q0 + 3) =
+        u ? quat_mul(Eigen::Map<const Vec4>(u + 7 * j.child + 3).normalized(),
+                     rot_to_quat(j.frame_child))
+          : rot_to_quat(B);
+    if (qd) {
+      Eigen::Map<Vec3>(qd + j.dof0) = B.transpose() * (c.xd + c.W.cross(P - c.x));
+      Eigen::Map<Vec3>(qd + j.dof0 + 3) = B.transpose() * c.W;
+    }
+  }
+}
+
+void base_accelerations(const Model& m, const std::vector<BodyKin>& kin, const double* vd,
+                        double* qdd) {
+  for (const Joint& j : m.joints) {
+    if (j.type != JointType::Free || j.dof0 < 0) continue;
+    const BodyKin& c = kin[j.child];
+    const Mat3 B = free_frame(j, c);
+    const Vec3 r = c.R * j.point_child;  // from the centre of mass to the frame's origin P
+    const Vec3 alpha = c.R * Vec3(vd[6 * j.child + 3], vd[6 * j.child + 4], vd[6 * j.child + 5]);
+    const Vec3 vP = c.xd + c.W.cross(r);
+    const Vec3 aP = Vec3(vd[6 * j.child], vd[6 * j.child + 1], vd[6 * j.child + 2]) +
+                    alpha.cross(r) + c.W.cross(c.W.cross(r));
+    // d/dt (B^T vP) = B^T (aP - W x vP), d/dt (B^T W) = B^T alpha
+    Eigen::Map<Vec3>(qdd + j.dof0) = B.transpose() * (aP - c.W.cross(vP));
+    Eigen::Map<Vec3>(qdd + j.dof0 + 3) = B.transpose() * alpha;
+  }
+}
+
 void joint_coordinates(const Model& m, const VecX& u, const VecX& v, VecX& q, VecX& qd) {
   check_joint_vector(u, m.nq, "joint_coordinates", "u");
   check_joint_vector(v, m.nv, "joint_coordinates", "v");
   std::vector<BodyKin> kin;
   body_kinematics(m, u.data(), v.data(), kin);
   const int nc = static_cast<int>(m.coords.size());
-  q.resize(nc);
-  qd.resize(nc);
+  q.resize(m.nq_joint);
+  qd.resize(m.nv_joint);
   for (int c = 0; c < nc; ++c) {
     const ScalarJet s = coord_jet(m, kin, c);
-    q[c] = s.val;
-    qd[c] = s.rate;
+    q[7 * m.n_free + c] = s.val;
+    qd[6 * m.n_free + c] = s.rate;
   }
+  base_coordinates(m, kin, u.data(), q.data(), qd.data());
 }
 
 }  // namespace armdyn

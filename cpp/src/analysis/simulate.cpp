@@ -144,6 +144,9 @@ void check_options(const Model& m, double t_end, const SimOptions& opt, const Ve
   if (u0.size() != m.nq || v0.size() != m.nv)
     throw ModelError(msg("simulate: initial state has sizes (", u0.size(), ", ", v0.size(),
                          "), expected (", m.nq, ", ", m.nv, ")"));
+  if (opt.q_start.size() != 0 && opt.q_start.size() != m.nq_joint)
+    throw ModelError(msg("simulate: q0 has length ", opt.q_start.size(), ", expected ", m.nq_joint,
+                         " (model.n_coords)"));
   if (!u0.allFinite() || !v0.allFinite())
     throw ModelError("simulate: initial state contains NaN or inf");
 }
@@ -269,9 +272,15 @@ VecX joint_state(const Model& ms, detail::MbsSystem& sys, VecX& y, Metric projec
   project(ms, d, 0.0, y.data(), y.data() + ms.nq, projection);
   VecX q, qd;
   joint_coordinates(ms, y.head(ms.nq), y.segment(ms.nq, ms.nv), q, qd);
+  // angles over turns, as the projection's tracking followed them from the initial reference
+  for (size_t c = 0; c < ms.coords.size(); ++c)
+    if (ms.coords[c].angular) {
+      double& x = q[7 * ms.n_free + static_cast<long>(c)];
+      x = tracked(d, static_cast<int>(c), x);
+    }
   // couplings' angle followers: the turn their leaders give (their poses give it modulo 2 pi)
-  if (!ms.independent.identity()) ms.independent.align(ms.coords, q.data());
-  VecX yj(2 * q.size() + ms.n_aux);
+  if (!ms.independent.identity()) ms.independent.align(ms.coords, q.data() + 7 * ms.n_free);
+  VecX yj(q.size() + qd.size() + ms.n_aux);
   yj << q, qd, y.tail(ms.n_aux);
   return yj;
 }
@@ -314,11 +323,13 @@ void finish(const Model& m, const Model& ms, const PipelineStats& st, SimResult&
   out.singular_note = st.singular_note;
   out.augmented_solves = st.augmented_solves;
   out.augmented_note = st.augmented_note;
-  const size_t n = static_cast<size_t>(out.n), nco = m.coords.size(), nj = m.joints.size();
+  const size_t n = static_cast<size_t>(out.n), nj = m.joints.size();
   out.t.resize(n);
   out.u.resize(n * m.nq);
   out.v.resize(n * m.nv);
-  for (auto* table : {&out.q, &out.qd, &out.qdd}) table->resize(n * nco);
+  out.q.resize(n * static_cast<size_t>(m.nq_joint));
+  out.qd.resize(n * static_cast<size_t>(m.nv_joint));
+  out.qdd.resize(n * static_cast<size_t>(m.nv_joint));
   out.drive_forces.resize(n * m.drives.size());
   out.reaction_forces.resize(n * 3 * nj);
   out.reaction_torques.resize(n * 3 * nj);
@@ -369,6 +380,17 @@ SimResult simulate(const Model& m, Data& d, double t_end, const SimOptions& opt,
   Data& ds = plan.welded ? *d.welded_data : d;
   reset_pipeline(ds);
   if (plan.welded) reset_pipeline(d);
+  // the initial angles' turns, from the q the initial state was made from (multi-turn)
+  if (opt.q_start.size() == m.nq_joint) {
+    const int off = 7 * m.n_free;
+    for (size_t c = 0; c < m.coords.size(); ++c) {
+      if (!m.coords[c].angular) continue;
+      const double q = opt.q_start[off + static_cast<long>(c)];
+      const int cs = plan.welded ? plan.welding->coord_map[c] : static_cast<int>(c);
+      if (cs >= 0) ds.track_ref[cs] = q;
+      if (plan.welded) d.track_ref[static_cast<long>(c)] = q;
+    }
+  }
   const StepOptions& s = opt.step;
   SimResult out;
   out.integrator = integrator_name(plan.integrator);

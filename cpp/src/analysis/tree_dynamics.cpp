@@ -36,13 +36,14 @@ std::string geared_light_reason(const Model& m) {
 const GearSpace& gear_space(const Model& m) {
   return m.derived.get<GearSpace>([&] {
     GearSpace gs;
-    const int n = static_cast<int>(m.coords.size());
+    // over the joint-space degrees of freedom (the floating bases' first: no gear rows there)
+    const int n = m.nv_joint, off = 6 * m.n_free;
     const int ng = static_cast<int>(m.gear_constraints.size());
     if (ng == 0) return gs;
     MatX Gt = MatX::Zero(n, ng);
     for (int g = 0; g < ng; ++g) {
-      Gt(m.gear_constraints[g].coord_a, g) += m.gear_constraints[g].r_a;
-      Gt(m.gear_constraints[g].coord_b, g) += m.gear_constraints[g].r_b;
+      Gt(off + m.gear_constraints[g].coord_a, g) += m.gear_constraints[g].r_a;
+      Gt(off + m.gear_constraints[g].coord_b, g) += m.gear_constraints[g].r_b;
     }
     Eigen::ColPivHouseholderQR<MatX> qr(Gt);
     qr.setThreshold(1e-12);
@@ -115,7 +116,7 @@ std::string TreeDynamics::description() const {
 }
 
 const MatX& TreeDynamics::mass_matrix(const double* q) {
-  return mass_matrix_at(m_, d_, Eigen::Map<const VecX>(q, n_));
+  return mass_matrix_at(m_, d_, Eigen::Map<const VecX>(q, d_.nq));
 }
 
 void TreeDynamics::accelerations(double t, const double* q, const double* qd, const double* z,
@@ -154,26 +155,34 @@ const VecX& TreeDynamics::gear_multipliers(const double* qdd) {
 
 void TreeDynamics::aux_rates(double t, const double* q, const double* qd, const double* z,
                              double* zdot) const {
+  // the coordinates follow the floating bases' blocks
+  const double* qc = q + 7 * m_.n_free;
+  const double* qdc = qd + 6 * m_.n_free;
   for (const CoordForce& cf : m_.coord_forces) {
     if (cf.aux < 0) continue;
-    coord_force_value(cf, m_.coords[cf.coord].angular, q[cf.coord], qd[cf.coord], t,
+    coord_force_value(cf, m_.coords[cf.coord].angular, qc[cf.coord], qdc[cf.coord], t,
                       z ? z[cf.aux] : 0.0, &zdot[cf.aux]);
   }
 }
 
 void TreeDynamics::gear_mesh(int gi, const double* q, const double* qd, double& s, double& sd,
                              double& penetration) const {
-  armdyn::gear_mesh(m_, gi, q, qd, s, sd, penetration);
+  armdyn::gear_mesh(m_, gi, q + 7 * m_.n_free, qd + 6 * m_.n_free, s, sd, penetration);
 }
 
 void TreeDynamics::project(double* q, double* qd) {
+  normalize_bases(m_, q);
   if (rank_ == 0) return;
   VecX& w = d_.tree.w;
-  for (double* x : {q, qd}) {
-    Eigen::Map<VecX> xv(x, n_);
-    w.noalias() = gs_.range.transpose() * xv;
-    if (x == q) w -= gs_.range_value;
-    xv.noalias() -= gs_.range * w;
+  // the gear rows touch the coordinates only (the bases' rows of range are zero); the
+  // couplings' offsets on the positions
+  const int nb = 6 * m_.n_free, nc = n_ - nb;
+  double* qc = q + 7 * m_.n_free;
+  for (double* x : {qc, qd + nb}) {
+    Eigen::Map<VecX> xv(x, nc);
+    w.noalias() = gs_.range.bottomRows(nc).transpose() * xv;
+    if (x == qc) w -= gs_.range_value;
+    xv.noalias() -= gs_.range.bottomRows(nc) * w;
   }
 }
 

@@ -97,6 +97,9 @@ int ModelBuilder::add_joint(const std::string& name, JointType type, const std::
   if (type == JointType::Revolute || type == JointType::Prismatic ||
       type == JointType::Cylindrical || type == JointType::Inline) {
     fw_parent = fw_child = frame_from_z(unit_axis(axis, who + ": axis"));
+  } else if (type == JointType::Free && ch != kGround) {
+    // a floating base's frame: the child body's axes (at `point`)
+    fw_parent = fw_child = quat_to_rot(m_.bodies[ch].orientation);
   } else if (type == JointType::Universal) {
     const Vec3 a1 = unit_axis(axis, who + ": axis1");
     const Vec3 a2 = unit_axis(*axis2, who + ": axis2");
@@ -145,6 +148,39 @@ int ModelBuilder::add_joint(const std::string& name, JointType type, const std::
   return idx;
 }
 
+int ModelBuilder::add_frame(const std::string& name, const std::string& body, const Vec3& position,
+                            const Vec4& orientation) {
+  const std::string who = msg("frame '", name, "'");
+  if (name.empty()) throw ModelError("frame name must not be empty");
+  if (m_.frame_index.count(name)) throw ModelError(msg(who, ": duplicate frame name"));
+  const int b = resolve_body(body, who);
+  require_finite(position, who + ": position");
+  require_finite(orientation, who + ": orientation");
+  if (std::abs(orientation.norm() - 1.0) > 1e-6)
+    throw ModelError(msg(who,
+                         ": orientation must be a unit quaternion [e0, e1, e2, e3] "
+                         "(scalar first), got norm ",
+                         orientation.norm()));
+  NamedFrame f;
+  f.name = name;
+  f.body = b;
+  const Mat3 Rf = quat_to_rot(orientation.normalized());
+  if (b == kGround) {
+    f.point = position;
+    f.rotation = Rf;
+  } else {
+    // relative to the body's assembly pose, as the joint points and frames (add_joint)
+    const Body& bd = m_.bodies[b];
+    const Mat3 R = quat_to_rot(bd.orientation);
+    f.point = R.transpose() * (position - bd.position);
+    f.rotation = R.transpose() * Rf;
+  }
+  const int idx = static_cast<int>(m_.frames.size());
+  m_.frames.push_back(f);
+  m_.frame_index[name] = idx;
+  return idx;
+}
+
 int ModelBuilder::add_revolute(const std::string& name, const std::string& parent,
                                const std::string& child, const Vec3& point, const Vec3& axis) {
   return add_joint(name, JointType::Revolute, parent, child, point, axis, nullptr);
@@ -189,11 +225,11 @@ int ModelBuilder::add_distance(const std::string& name, const std::string& body_
   m_.joints[idx].length = len;
   return idx;
 }
-int ModelBuilder::add_free(const std::string& name, const std::string& child) {
+int ModelBuilder::add_free(const std::string& name, const std::string& child, const Vec3* origin) {
   const int c = resolve_body(child, msg("free joint '", name, "'"));
   if (c == kGround) throw ModelError(msg("free joint '", name, "': child must be a body"));
-  return add_joint(name, JointType::Free, "ground", child, m_.bodies[c].position, Vec3::UnitZ(),
-                   nullptr);
+  return add_joint(name, JointType::Free, "ground", child, origin ? *origin : m_.bodies[c].position,
+                   Vec3::UnitZ(), nullptr);
 }
 
 void ModelBuilder::set_joint_limits(const std::string& joint, double lower, double upper,

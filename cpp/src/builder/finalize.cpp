@@ -21,7 +21,7 @@ namespace detail {
 std::shared_ptr<Model> finalize_draft(const Model& draft, const FinalizeOptions& options) {
   auto mp = std::make_shared<Model>(draft);
   Model& m = *mp;
-  if (m.bodies.empty()) throw ModelError("finalize: the model has no bodies");
+  // no bodies is a zero-DOF model (a URDF structure fixed to ground): nq = nv = nc = 0
   m.nb = static_cast<int>(m.bodies.size());
   m.nq = 7 * m.nb;
   m.nv = 6 * m.nb;
@@ -80,8 +80,9 @@ std::shared_ptr<Model> finalize_draft(const Model& draft, const FinalizeOptions&
       }
     }
     for (const Joint& j : m.joints) {
+      // a free joint from ground is a floating base: 7 entries of q, 6 of qd (joint_dofs)
       if (j.type == JointType::Spherical || j.type == JointType::Universal ||
-          j.type == JointType::Free || j.type == JointType::Inline ||
+          (j.type == JointType::Free && j.parent != kGround) || j.type == JointType::Inline ||
           j.type == JointType::Distance) {
         if (ok)
           m.joint_space_reason =
@@ -112,6 +113,45 @@ std::shared_ptr<Model> finalize_draft(const Model& draft, const FinalizeOptions&
     m.joint_space_reason = "the model has closed loops";
   }
 
+  // the joint-space layout: the free joints' blocks first (7 entries of q, 6 of qd each), then
+  // the coordinates in Model::coords order
+  m.n_free = 0;
+  for (const Joint& j : m.joints)
+    if (j.type == JointType::Free) ++m.n_free;
+  {
+    int qi = 0, vi = 0;
+    m.q_names.clear();
+    m.dof_names.clear();
+    m.dof_joint.clear();
+    for (size_t ji = 0; ji < m.joints.size(); ++ji) {
+      Joint& j = m.joints[ji];
+      j.q0 = j.dof0 = -1;
+      if (j.type != JointType::Free) continue;
+      j.q0 = qi;
+      j.dof0 = vi;
+      qi += 7;
+      vi += 6;
+      for (const char* s : {":x", ":y", ":z", ":e0", ":e1", ":e2", ":e3"})
+        m.q_names.push_back(j.name + s);
+      for (const char* s : {":vx", ":vy", ":vz", ":wx", ":wy", ":wz"}) {
+        m.dof_names.push_back(j.name + s);
+        m.dof_joint.push_back(static_cast<int>(ji));
+      }
+    }
+    for (Joint& j : m.joints)
+      if (j.coord0 >= 0) {
+        j.q0 = qi + j.coord0;
+        j.dof0 = vi + j.coord0;
+      }
+    for (const Coord& c : m.coords) {
+      m.q_names.push_back(c.name);
+      m.dof_names.push_back(c.name);
+      m.dof_joint.push_back(c.joint);
+    }
+    m.nq_joint = qi + static_cast<int>(m.coords.size());
+    m.nv_joint = vi + static_cast<int>(m.coords.size());
+  }
+
   // the independent coordinates: every coupling's follower expressed in its chain's leader
   {
     IndependentCoords& ic = m.independent;
@@ -120,6 +160,8 @@ std::shared_ptr<Model> finalize_draft(const Model& draft, const FinalizeOptions&
     for (const GearConstraint& g : m.gear_constraints)
       if (g.coupling) follows[g.coord_a] = &g;
     ic = IndependentCoords();
+    ic.lead_q = 7 * m.n_free;
+    ic.lead_v = 6 * m.n_free;
     ic.source.assign(nf, -1);
     ic.scale.assign(nf, 1.0);
     ic.shift.assign(nf, 0.0);
@@ -169,15 +211,18 @@ std::shared_ptr<Model> finalize_draft(const Model& draft, const FinalizeOptions&
   if ((m.joint_space_ok && !m.drives.empty()) || m.coupled_joint_space) {
     VecX q, qd;
     joint_coordinates(m, m.u0, m.v0, q, qd);
-    for (const Drive& d : m.drives) q[m.joints[d.joint].coord0 + d.coord] = d.profile.eval(0.0).y;
+    for (const Drive& d : m.drives) q[m.joints[d.joint].q0 + d.coord] = d.profile.eval(0.0).y;
     if (m.coupled_joint_space) {
-      VecX qi(m.independent.n);
-      for (int k = 0; k < m.independent.n; ++k) qi[k] = q[m.independent.full[k]];
-      m.independent.expand(qi.data(), q.data(), true);
+      // each follower at its coupling's value (the coordinates follow the bases' blocks)
+      const IndependentCoords& ic = m.independent;
+      double* qc = q.data() + ic.lead_q;
+      for (int k = 0; k < static_cast<int>(ic.source.size()); ++k)
+        if (ic.full[ic.source[k]] != k)
+          qc[k] = ic.scale[k] * qc[ic.full[ic.source[k]]] + ic.shift[k];
     }
     if (q.allFinite()) {
       VecX u, v;
-      state_from_joints(m, q, VecX::Zero(q.size()), u, v);
+      state_from_joints(m, q, VecX::Zero(m.nv_joint), u, v);
       m.u0 = u;
     }
   }

@@ -1,34 +1,51 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// URDF loader. Two passes over the XML:
-//  1. tinyxml2: the document order of <joint> elements (urdfdom keeps joints in a std::map sorted
-//     by name), joint types and the tree structure, with error messages that name the culprit;
+// URDF loader (documented element by element in docs/urdf.md). Passes over the input:
+//  0. the source: a string starting with '<' is XML, anything else a path, which must name a
+//     regular file (stat before open: a FIFO or a device is refused, never read) of at most
+//     kUrdfMaxBytes; then a linear pre-scan of the raw text refuses NUL bytes and elements with
+//     more than kUrdfMaxAttributes attributes (tinyxml2 is quadratic in them);
+//  1. tinyxml2: names valid UTF-8; every numeric attribute (origins, axes, inertials, limits,
+//     dynamics, mimic, safety_controller, calibration, visual/collision geometry, colours)
+//     parsed completely as a finite double before urdfdom sees it (urdfdom zeroes nan, inf and
+//     1e400 silently); the document order of <joint> elements (urdfdom keeps joints in a
+//     std::map sorted by name), joint types and the tree structure, with error messages that
+//     name the culprit and quote short, escaped excerpts only;
 //  2. urdfdom (urdf::parseURDF): the full parse of poses, axes, limits and inertials.
 // Then every group of links joined by fixed joints is merged into one body, bodies are added
-// parent-before-child, and the moving joints are added in document order.
+// parent-before-child, and the moving joints are added in document order with their <limit>
+// and their <dynamics> (damping: viscous friction; friction: Coulomb friction smoothed with
+// kUrdfCoulombSmoothing). With a fixed base and no moving joint the builder has no bodies: a
+// zero-DOF model. Then (mimic = true) each <mimic> becomes a coupling (add_coupling).
 //
-// Ignored silently: <visual>, <collision>, <material>, <transmission>, <gazebo>, <mimic>,
-// <safety_controller>, <calibration>, and joint <dynamics> (damping/friction are not imported;
-// add them with add_joint_spring_damper / add_joint_friction on the returned builder).
+// Ignored (numbers checked, nothing imported): <visual>, <collision>, <material>,
+// <transmission>, <gazebo>, <safety_controller>, <calibration>; <mimic> with mimic = false.
 //
 // urdfdom reports its own parse errors through console_bridge. When the build defines
 // ARMDYN_HAVE_CONSOLE_BRIDGE (and links console_bridge::console_bridge) those messages are
 // captured into the UrdfError; otherwise they only reach stderr.
 #include "armdyn/io/urdf.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <tinyxml2.h>
+#include <unistd.h>
 #include <urdf_parser/urdf_parser.h>
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
+#include <charconv>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <exception>
-#include <filesystem>
-#include <fstream>
+#include <initializer_list>
 #include <map>
 #include <set>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "armdyn/errors.hpp"
@@ -84,33 +101,242 @@ struct JointDecl {
 };
 
 bool looks_like_xml(const std::string& s) {
-  for (char c : s) {
+  // a UTF-8 byte order mark may precede the XML (tinyxml2 skips it)
+  const size_t from = s.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;
+  for (size_t i = from; i < s.size(); ++i) {
+    const char c = s[i];
     if (std::isspace(static_cast<unsigned char>(c))) continue;
     return c == '<';
   }
   return false;
 }
 
-// the XML text, and a description of where it came from for error messages
+// length of the valid UTF-8 sequence starting at s[i], or 0 when the bytes there are not one
+// (overlong forms, surrogates and code points beyond U+10FFFF are invalid)
+size_t utf8_sequence(const std::string_view s, size_t i) {
+  const auto b = [&](size_t k) { return static_cast<unsigned char>(s[k]); };
+  const unsigned char c = b(i);
+  if (c < 0x80) return 1;
+  size_t len = 0;
+  unsigned lo = 0x80, hi = 0xBF;  // allowed range of the second byte
+  if (c >= 0xC2 && c <= 0xDF) {
+    len = 2;
+  } else if (c >= 0xE0 && c <= 0xEF) {
+    len = 3;
+    if (c == 0xE0) lo = 0xA0;
+    if (c == 0xED) hi = 0x9F;
+  } else if (c >= 0xF0 && c <= 0xF4) {
+    len = 4;
+    if (c == 0xF0) lo = 0x90;
+    if (c == 0xF4) hi = 0x8F;
+  } else {
+    return 0;
+  }
+  if (i + len > s.size()) return 0;
+  if (b(i + 1) < lo || b(i + 1) > hi) return 0;
+  for (size_t k = 2; k < len; ++k) {
+    if (b(i + k) < 0x80 || b(i + k) > 0xBF) return 0;
+  }
+  return len;
+}
+
+// byte offset of the first invalid UTF-8 byte of s, or npos
+size_t utf8_error(const std::string_view s) {
+  for (size_t i = 0; i < s.size();) {
+    const size_t n = utf8_sequence(s, i);
+    if (n == 0) return i;
+    i += n;
+  }
+  return std::string::npos;
+}
+
+// s with its control characters and invalid UTF-8 bytes escaped as \xNN, cut to at most about
+// `max_chars` characters (an ellipsis marks the cut): always valid UTF-8, always short
+std::string excerpt(const std::string_view s, size_t max_chars = 40) {
+  std::string out;
+  size_t shown = 0;
+  for (size_t i = 0; i < s.size();) {
+    if (shown >= max_chars) {
+      out += "...";
+      break;
+    }
+    const size_t n = utf8_sequence(s, i);
+    const unsigned char c = static_cast<unsigned char>(s[i]);
+    if (n == 0 || (n == 1 && (c < 0x20 || c == 0x7F))) {
+      static const char* hex = "0123456789abcdef";
+      out += "\\x";
+      out += hex[c >> 4];
+      out += hex[c & 15];
+      i += 1;
+    } else {
+      out.append(s.data() + i, n);
+      i += n;
+    }
+    ++shown;
+  }
+  return out;
+}
+
+// a name as quoted in messages: escaped and at most 80 characters
+std::string nm(const std::string& name) { return excerpt(name, 80); }
+
+// a path as quoted in messages: its head and its tail when it is long
+std::string shown_path(const std::string& path) {
+  if (path.size() <= 120) return excerpt(path, 120);
+  return excerpt(path.substr(0, 40), 40) + "..." + excerpt(path.substr(path.size() - 60), 60);
+}
+
+const char* file_kind(mode_t mode) {
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISFIFO(mode)) return "a FIFO (named pipe)";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISSOCK(mode)) return "a socket";
+  return "not a regular file";
+}
+
+std::string too_large(const std::string& what, uint64_t bytes) {
+  return msg(what, " is ", bytes, " bytes, more than the limit of ", kUrdfMaxBytes, " bytes (",
+             kUrdfMaxBytes >> 20, " MiB)");
+}
+
+// the XML text, and a description of where it came from for error messages. A path must name a
+// regular file (checked with stat before it is opened, so that a FIFO or a device never blocks
+// or streams) of at most kUrdfMaxBytes.
 std::string read_source(const std::string& path_or_xml, std::string* where) {
   if (looks_like_xml(path_or_xml)) {
     *where = "URDF string";
+    if (path_or_xml.size() > kUrdfMaxBytes)
+      throw UrdfError(too_large("URDF string", path_or_xml.size()));
     return path_or_xml;
   }
-  *where = msg("URDF file '", path_or_xml, "'");
-  std::error_code ec;
-  if (path_or_xml.empty() || !std::filesystem::exists(path_or_xml, ec)) {
-    throw UrdfError(msg("URDF file '", path_or_xml, "' not found"));
+  const std::string& path = path_or_xml;
+  if (path.find_first_not_of(" \t\r\n") == std::string::npos) {
+    throw UrdfError("URDF source is empty: expected a file path or URDF XML (starting with '<')");
   }
-  if (std::filesystem::is_directory(path_or_xml, ec)) {
-    throw UrdfError(msg("URDF file '", path_or_xml, "' is a directory"));
+  if (path.size() > 4096 || path.find('\0') != std::string::npos ||
+      path.find('\n') != std::string::npos) {
+    throw UrdfError(msg("URDF source is neither XML (it does not start with '<') nor a file path (",
+                        path.size(), " bytes): '", excerpt(path), "'"));
   }
-  std::ifstream in(path_or_xml, std::ios::in | std::ios::binary);
-  if (!in) throw UrdfError(msg("URDF file '", path_or_xml, "' cannot be opened"));
-  std::ostringstream os;
-  os << in.rdbuf();
-  if (in.bad()) throw UrdfError(msg("URDF file '", path_or_xml, "' cannot be read"));
-  return os.str();
+  const std::string shown = shown_path(path);
+  *where = msg("URDF file '", shown, "'");
+  struct stat st;
+  if (::stat(path.c_str(), &st) != 0) {
+    const int err = errno;
+    if (err == ENOENT || err == ENOTDIR) {
+      // text with spaces is more likely XML gone wrong than a path
+      const bool text = path.find_first_of(" \t") != std::string::npos;
+      throw UrdfError(msg("URDF file '", shown, "' not found",
+                          text ? " (a URDF string must start with '<')" : ""));
+    }
+    throw UrdfError(msg("URDF file '", shown, "' cannot be accessed: ", std::strerror(err)));
+  }
+  if (!S_ISREG(st.st_mode)) {
+    throw UrdfError(
+        msg("URDF file '", shown, "' is ", file_kind(st.st_mode), ", not a regular file"));
+  }
+  if (static_cast<uint64_t>(st.st_size) > kUrdfMaxBytes) {
+    throw UrdfError(too_large(msg("URDF file '", shown, "'"), static_cast<uint64_t>(st.st_size)));
+  }
+  // O_NONBLOCK: should the path have been replaced by a FIFO since the stat, open does not wait
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) {
+    throw UrdfError(msg("URDF file '", shown, "' cannot be opened: ", std::strerror(errno)));
+  }
+  struct Close {
+    int fd;
+    ~Close() { ::close(fd); }
+  } close_fd{fd};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    throw UrdfError(msg("URDF file '", shown, "' is not a regular file"));
+  }
+  std::string text;
+  text.reserve(static_cast<size_t>(st.st_size));
+  char buf[65536];
+  for (;;) {
+    const ssize_t r = ::read(fd, buf, sizeof buf);
+    if (r < 0) {
+      if (errno == EINTR) continue;
+      throw UrdfError(msg("URDF file '", shown, "' cannot be read: ", std::strerror(errno)));
+    }
+    if (r == 0) break;
+    text.append(buf, static_cast<size_t>(r));
+    if (text.size() > kUrdfMaxBytes)
+      throw UrdfError(too_large(msg("URDF file '", shown, "'"), text.size()));
+  }
+  return text;
+}
+
+// Linear pre-scan of the raw text before tinyxml2 (whose duplicate-attribute check is quadratic
+// in the attributes of one element): refuses an element with more than kUrdfMaxAttributes
+// attributes, and NUL bytes (urdfdom would read the text only up to the first).
+void prescan(const std::string& xml, const std::string& where) {
+  if (const size_t z = xml.find('\0'); z != std::string::npos) {
+    throw UrdfError(msg(where, ": contains a NUL byte at byte offset ", z));
+  }
+  const size_t n = xml.size();
+  size_t i = 0;
+  long line = 1;
+  // skip to just past `end`, counting lines
+  auto skip_past = [&](const char* end) {
+    const size_t e = xml.find(end, i);
+    const size_t stop = e == std::string::npos ? n : e + std::strlen(end);
+    line +=
+        std::count(xml.begin() + static_cast<long>(i), xml.begin() + static_cast<long>(stop), '\n');
+    i = stop;
+  };
+  while (i < n) {
+    const char c = xml[i];
+    if (c == '\n') ++line;
+    if (c != '<') {
+      ++i;
+      continue;
+    }
+    if (xml.compare(i, 4, "<!--") == 0) {
+      skip_past("-->");
+      continue;
+    }
+    if (xml.compare(i, 9, "<![CDATA[") == 0) {
+      skip_past("]]>");
+      continue;
+    }
+    if (xml.compare(i, 2, "<?") == 0) {
+      skip_past("?>");
+      continue;
+    }
+    if (xml.compare(i, 2, "<!") == 0 || xml.compare(i, 2, "</") == 0) {
+      skip_past(">");
+      continue;
+    }
+    // a start tag: count the '=' outside quoted values up to its '>'
+    const long tag_line = line;
+    const size_t name0 = ++i;
+    while (i < n && !std::isspace(static_cast<unsigned char>(xml[i])) && xml[i] != '>' &&
+           xml[i] != '/')
+      ++i;
+    const std::string name = xml.substr(name0, i - name0);
+    long attributes = 0;
+    char quote = 0;
+    for (; i < n; ++i) {
+      const char t = xml[i];
+      if (t == '\n') ++line;
+      if (quote) {
+        if (t == quote) quote = 0;
+      } else if (t == '"' || t == '\'') {
+        quote = t;
+      } else if (t == '=') {
+        ++attributes;
+      } else if (t == '>') {
+        ++i;
+        break;
+      }
+    }
+    if (attributes > kUrdfMaxAttributes) {
+      throw UrdfError(msg(where, ": element <", excerpt(name), "> on line ", tag_line, " has ",
+                          attributes, " attributes, more than the limit of ", kUrdfMaxAttributes));
+    }
+  }
 }
 
 std::string attribute(const tinyxml2::XMLElement* e, const char* name) {
@@ -118,15 +344,150 @@ std::string attribute(const tinyxml2::XMLElement* e, const char* name) {
   return v ? std::string(v) : std::string();
 }
 
+// every name-like attribute (name, link, joint) of every element must be valid UTF-8: names
+// reach body_names, summary() and every message
+void check_names_utf8(const tinyxml2::XMLElement* e, const std::string& where) {
+  for (; e; e = e->NextSiblingElement()) {
+    for (const tinyxml2::XMLAttribute* a = e->FirstAttribute(); a; a = a->Next()) {
+      const std::string key = a->Name();
+      if (key != "name" && key != "link" && key != "joint") continue;
+      const std::string value = a->Value();
+      const size_t bad = utf8_error(value);
+      if (bad != std::string::npos) {
+        throw UrdfError(msg(where, ": <", excerpt(e->Name()), "> on line ", e->GetLineNum(),
+                            ": attribute '", key, "' is not valid UTF-8 (byte offset ", bad, "): '",
+                            excerpt(value), "'"));
+      }
+    }
+    check_names_utf8(e->FirstChildElement(), where);
+  }
+}
+
+// one number, parsed completely: empty reason when it is a finite double
+std::string number_problem(std::string_view s, double* value) {
+  if (!s.empty() && s[0] == '+') s.remove_prefix(1);
+  if (s.empty()) return "is empty";
+  double v = 0.0;
+  const auto r = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (r.ec == std::errc::invalid_argument) return "is not a number";
+  if (r.ec == std::errc::result_out_of_range) return "is out of the range of a double";
+  if (r.ptr != s.data() + s.size()) return "has trailing characters after the number";
+  if (!std::isfinite(v)) return "is not finite";
+  if (value) *value = v;
+  return "";
+}
+
+// The attribute `attr` of element `e` (when present) holds `count` whitespace-separated finite
+// numbers. owner: "link 'x'" or "joint 'y'"; path: the elements from the owner down, "<origin>".
+void check_numbers(const tinyxml2::XMLElement* e, const std::string& owner, const std::string& path,
+                   const char* attr, int count) {
+  const char* raw = e->Attribute(attr);
+  if (!raw) return;
+  const std::string_view value(raw);
+  auto fail = [&](const std::string& what) {
+    throw UrdfError(msg("URDF ", owner, ": ", path, " attribute '", attr, "' ", what, ": \"",
+                        excerpt(value), "\" (line ", e->GetLineNum(), ")"));
+  };
+  std::vector<std::string_view> parts;
+  size_t i = 0;
+  const char* space = " \t\r\n";
+  while (i < value.size()) {
+    const size_t a = value.find_first_not_of(space, i);
+    if (a == std::string_view::npos) break;
+    size_t b = value.find_first_of(space, a);
+    if (b == std::string_view::npos) b = value.size();
+    parts.push_back(value.substr(a, b - a));
+    i = b;
+  }
+  if (static_cast<int>(parts.size()) != count) {
+    if (count == 1 && parts.empty()) fail("is empty");
+    if (count == 1) fail(msg("needs one number, got ", parts.size(), " values"));
+    fail(msg("needs ", count, " numbers, got ", parts.size()));
+  }
+  for (size_t k = 0; k < parts.size(); ++k) {
+    const std::string why = number_problem(parts[k], nullptr);
+    if (!why.empty()) {
+      fail(count == 1
+               ? why
+               : msg("component ", k + 1, " of ", count, " (\"", excerpt(parts[k]), "\") ", why));
+    }
+  }
+}
+
+// every numeric attribute of the children named `child` of `parent`
+struct NumberSpec {
+  const char* attr;
+  int count;
+};
+void check_children(const tinyxml2::XMLElement* parent, const char* child, const std::string& owner,
+                    const std::string& path, std::initializer_list<NumberSpec> specs) {
+  for (auto* e = parent->FirstChildElement(child); e; e = e->NextSiblingElement(child)) {
+    for (const NumberSpec& s : specs)
+      check_numbers(e, owner, path + "<" + child + ">", s.attr, s.count);
+  }
+}
+
+// visual and collision: origins, geometry sizes, material colours (armdyn ignores them, urdfdom
+// reads them)
+void check_shape_numbers(const tinyxml2::XMLElement* link, const std::string& owner) {
+  for (const char* kind : {"visual", "collision"}) {
+    for (auto* v = link->FirstChildElement(kind); v; v = v->NextSiblingElement(kind)) {
+      const std::string path = msg("<", kind, ">");
+      check_children(v, "origin", owner, path, {{"xyz", 3}, {"rpy", 3}});
+      for (auto* g = v->FirstChildElement("geometry"); g; g = g->NextSiblingElement("geometry")) {
+        const std::string gp = path + "<geometry>";
+        check_children(g, "box", owner, gp, {{"size", 3}});
+        check_children(g, "cylinder", owner, gp, {{"radius", 1}, {"length", 1}});
+        check_children(g, "capsule", owner, gp, {{"radius", 1}, {"length", 1}});
+        check_children(g, "sphere", owner, gp, {{"radius", 1}});
+        check_children(g, "mesh", owner, gp, {{"scale", 3}});
+      }
+      for (auto* mt = v->FirstChildElement("material"); mt;
+           mt = mt->NextSiblingElement("material")) {
+        check_children(mt, "color", owner, path + "<material>", {{"rgba", 4}});
+      }
+    }
+  }
+}
+
+// every numeric attribute urdfdom reads, before it reads them (it turns nan, inf and 1e400 into
+// zeros silently)
+void check_link_numbers(const tinyxml2::XMLElement* link, const std::string& name) {
+  const std::string owner = msg("link '", nm(name), "'");
+  for (auto* in = link->FirstChildElement("inertial"); in;
+       in = in->NextSiblingElement("inertial")) {
+    check_children(in, "origin", owner, "<inertial>", {{"xyz", 3}, {"rpy", 3}});
+    check_children(in, "mass", owner, "<inertial>", {{"value", 1}});
+    check_children(in, "inertia", owner, "<inertial>",
+                   {{"ixx", 1}, {"ixy", 1}, {"ixz", 1}, {"iyy", 1}, {"iyz", 1}, {"izz", 1}});
+  }
+  check_shape_numbers(link, owner);
+}
+
+void check_joint_numbers(const tinyxml2::XMLElement* joint, const std::string& name) {
+  const std::string owner = msg("joint '", nm(name), "'");
+  check_children(joint, "origin", owner, "", {{"xyz", 3}, {"rpy", 3}});
+  check_children(joint, "axis", owner, "", {{"xyz", 3}});
+  check_children(joint, "limit", owner, "",
+                 {{"lower", 1}, {"upper", 1}, {"effort", 1}, {"velocity", 1}});
+  check_children(joint, "dynamics", owner, "", {{"damping", 1}, {"friction", 1}});
+  check_children(joint, "mimic", owner, "", {{"multiplier", 1}, {"offset", 1}});
+  check_children(
+      joint, "safety_controller", owner, "",
+      {{"soft_lower_limit", 1}, {"soft_upper_limit", 1}, {"k_position", 1}, {"k_velocity", 1}});
+  check_children(joint, "calibration", owner, "",
+                 {{"rising", 1}, {"falling", 1}, {"reference_position", 1}});
+}
+
 // an <inertial> number urdfdom needs: without it urdfdom logs an error and keeps a partly filled
 // (or no) inertial, which must not pass for a massless link
 void check_number(const tinyxml2::XMLElement* e, const char* element, const char* name,
                   const std::string& link) {
   double v = 0.0;
-  if (!e) throw UrdfError(msg("URDF link '", link, "': <inertial> without <", element, ">"));
+  if (!e) throw UrdfError(msg("URDF link '", nm(link), "': <inertial> without <", element, ">"));
   if (e->QueryDoubleAttribute(name, &v) != tinyxml2::XML_SUCCESS) {
-    throw UrdfError(msg("URDF link '", link, "': <", element, "> needs a number in '", name,
-                        "', got '", attribute(e, name), "'"));
+    throw UrdfError(msg("URDF link '", nm(link), "': <", element, "> needs a number in '", name,
+                        "', got '", excerpt(attribute(e, name)), "'"));
   }
 }
 
@@ -139,12 +500,19 @@ struct Document {
 // first pass: XML well-formedness, link names, and the <joint> elements in document order with
 // their types and the tree structure checked
 Document scan_document(const std::string& xml, const std::string& where) {
+  prescan(xml, where);
   tinyxml2::XMLDocument doc;
   if (doc.Parse(xml.c_str(), xml.size()) != tinyxml2::XML_SUCCESS) {
-    throw UrdfError(msg(where, ": malformed XML: ", doc.ErrorStr()));
+    throw UrdfError(msg(where, ": malformed XML: ", excerpt(doc.ErrorStr(), 200)));
   }
   const tinyxml2::XMLElement* robot = doc.FirstChildElement("robot");
   if (!robot) throw UrdfError(msg(where, ": no <robot> root element"));
+  check_names_utf8(doc.FirstChildElement(), where);
+  for (auto* mt = robot->FirstChildElement("material"); mt;
+       mt = mt->NextSiblingElement("material")) {
+    check_children(mt, "color", msg("material '", nm(attribute(mt, "name")), "'"), "",
+                   {{"rgba", 4}});
+  }
 
   // links: named and unique; an <inertial> needs <mass> and <inertia> (urdfdom would drop it)
   Document out;
@@ -154,7 +522,10 @@ Document scan_document(const std::string& xml, const std::string& where) {
     if (name.empty()) {
       throw UrdfError(msg(where, ": <link> without a name (line ", e->GetLineNum(), ")"));
     }
-    if (!links.insert(name).second) throw UrdfError(msg("URDF link '", name, "' is defined twice"));
+    if (!links.insert(name).second) {
+      throw UrdfError(msg("URDF link '", nm(name), "' is defined twice"));
+    }
+    check_link_numbers(e, name);
     if (const tinyxml2::XMLElement* in = e->FirstChildElement("inertial")) {
       check_number(in->FirstChildElement("mass"), "mass", "value", name);
       for (const char* a : {"ixx", "ixy", "ixz", "iyy", "iyz", "izz"}) {
@@ -179,42 +550,47 @@ Document scan_document(const std::string& xml, const std::string& where) {
       throw UrdfError(msg(where, ": <joint> without a name (line ", e->GetLineNum(), ")"));
     }
     if (!joint_names.insert(d.name).second) {
-      throw UrdfError(msg("URDF joint '", d.name, "' is defined twice"));
+      throw UrdfError(msg("URDF joint '", nm(d.name), "' is defined twice"));
     }
+    check_joint_numbers(e, d.name);
 
     // supported types: revolute, continuous, prismatic, fixed
     if (d.type == "floating" || d.type == "planar") {
-      throw UrdfError(msg("URDF joint '", d.name, "': unsupported joint type '", d.type,
+      throw UrdfError(msg("URDF joint '", nm(d.name), "': unsupported joint type '", nm(d.type),
                           "' (supported: revolute, continuous, prismatic, fixed)"));
     }
     if (d.type != "revolute" && d.type != "continuous" && d.type != "prismatic" &&
         d.type != "fixed") {
-      throw UrdfError(msg("URDF joint '", d.name, "': unknown joint type '", d.type,
+      throw UrdfError(msg("URDF joint '", nm(d.name), "': unknown joint type '", nm(d.type),
                           "' (supported: revolute, continuous, prismatic, fixed)"));
     }
 
     // parent and child: present, defined, distinct, one parent joint per link
-    if (d.parent.empty()) throw UrdfError(msg("URDF joint '", d.name, "': no <parent link=...>"));
-    if (d.child.empty()) throw UrdfError(msg("URDF joint '", d.name, "': no <child link=...>"));
+    if (d.parent.empty())
+      throw UrdfError(msg("URDF joint '", nm(d.name), "': no <parent link=...>"));
+    if (d.child.empty()) throw UrdfError(msg("URDF joint '", nm(d.name), "': no <child link=...>"));
     if (!links.count(d.parent)) {
       throw UrdfError(
-          msg("URDF joint '", d.name, "': parent link '", d.parent, "' is not defined"));
+          msg("URDF joint '", nm(d.name), "': parent link '", nm(d.parent), "' is not defined"));
     }
     if (!links.count(d.child)) {
-      throw UrdfError(msg("URDF joint '", d.name, "': child link '", d.child, "' is not defined"));
+      throw UrdfError(
+          msg("URDF joint '", nm(d.name), "': child link '", nm(d.child), "' is not defined"));
     }
     if (d.parent == d.child) {
-      throw UrdfError(msg("URDF joint '", d.name, "' connects link '", d.parent, "' to itself"));
+      throw UrdfError(
+          msg("URDF joint '", nm(d.name), "' connects link '", nm(d.parent), "' to itself"));
     }
     auto [it, fresh] = parent_joint.emplace(d.child, d.name);
     if (!fresh) {
-      throw UrdfError(msg("URDF link '", d.child, "' is the child of two joints, '", it->second,
-                          "' and '", d.name, "'"));
+      throw UrdfError(msg("URDF link '", nm(d.child), "' is the child of two joints, '",
+                          nm(it->second), "' and '", nm(d.name), "'"));
     }
 
     // the URDF spec requires <limit> on revolute and prismatic joints (urdfdom enforces it)
     if ((d.type == "revolute" || d.type == "prismatic") && !e->FirstChildElement("limit")) {
-      throw UrdfError(msg("URDF joint '", d.name, "': a ", d.type, " joint needs a <limit>"));
+      throw UrdfError(
+          msg("URDF joint '", nm(d.name), "': a ", nm(d.type), " joint needs a <limit>"));
     }
     joints.push_back(d);
   }
@@ -229,7 +605,10 @@ Document scan_document(const std::string& xml, const std::string& where) {
   }
   if (roots.size() > 1) {
     std::string names;
-    for (const std::string& r : roots) names += (names.empty() ? "'" : ", '") + r + "'";
+    for (size_t k = 0; k < roots.size() && k < 8; ++k) {
+      names += (k ? ", '" : "'") + nm(roots[k]) + "'";
+    }
+    if (roots.size() > 8) names += msg(", ... (", roots.size(), " in all)");
     throw UrdfError(msg(where, ": several root links (", names,
                         "); a URDF must be one tree, connect them with joints"));
   }
@@ -273,8 +652,10 @@ urdf::ModelInterfaceSharedPtr parse_urdfdom(const std::string& xml, const std::s
   if (reason.empty()) reason = capture.text_;
 #endif
   if (!model) {
-    throw UrdfError(msg(where, ": urdfdom could not parse the URDF",
-                        reason.empty() ? std::string(" (see its log on stderr)") : ": " + reason));
+    // urdfdom's log may quote the input: a short excerpt only
+    throw UrdfError(msg(
+        where, ": urdfdom could not parse the URDF",
+        reason.empty() ? std::string(" (see its log on stderr)") : ": " + excerpt(reason, 400)));
   }
   if (!model->getRoot()) throw UrdfError(msg(where, ": urdfdom found no root link"));
   return model;
@@ -459,7 +840,9 @@ ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const
     std::string free_name = "root_free";
     while (urdf_model->getJoint(free_name)) free_name += "_";
     try {
-      builder.add_free(free_name, root_name);
+      // the floating base's frame is the root link's frame (q: its pose, qd: its velocity)
+      const Vec3 origin = frame.at(root_name).p;
+      builder.add_free(free_name, root_name, &origin);
     } catch (const UrdfError&) {
       throw;
     } catch (const ModelError& e) {
@@ -501,6 +884,18 @@ ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const
                                  continuous ? kUnbounded : clamp_limit(lim.upper),
                                  clamp_limit(lim.effort), clamp_limit(lim.velocity));
       }
+      // <dynamics>: viscous damping and Coulomb friction on the joint coordinate
+      if (j->dynamics) {
+        const double damping = j->dynamics->damping, friction = j->dynamics->friction;
+        if (damping < 0 || friction < 0) {
+          throw UrdfError(msg("URDF joint '", d.name,
+                              "': <dynamics> damping and friction must be >= 0, got damping ",
+                              damping, " and friction ", friction));
+        }
+        if (damping > 0 || friction > 0) {
+          builder.add_joint_friction(d.name, damping, friction, kUrdfCoulombSmoothing);
+        }
+      }
     } catch (const UrdfError&) {
       throw;
     } catch (const ModelError& e) {
@@ -531,6 +926,24 @@ ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const
         throw UrdfError(msg("URDF joint '", d.name, "' <mimic joint='", leader, "'>: ", e.what()));
       }
     }
+  }
+
+  // every link stays a named frame (its link frame, not its centre of mass) on the body it was
+  // merged into, or on ground: depth-first from the root (children in urdfdom's order)
+  std::vector<urdf::LinkConstSharedPtr> pending{root};
+  while (!pending.empty()) {
+    const urdf::LinkConstSharedPtr link = pending.back();
+    pending.pop_back();
+    const Frame& f = frame.at(link->name);
+    try {
+      builder.add_frame(link->name, body_of(link->name), f.p, rot_to_quat(f.R));
+    } catch (const UrdfError&) {
+      throw;
+    } catch (const ModelError& e) {
+      throw UrdfError(msg("URDF link '", link->name, "': ", e.what()));
+    }
+    for (auto it = link->child_joints.rbegin(); it != link->child_joints.rend(); ++it)
+      pending.push_back(urdf_model->getLink((*it)->child_link_name));
   }
   return builder;
 }

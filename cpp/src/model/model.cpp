@@ -47,6 +47,19 @@ int Model::find_joint(const std::string& name) const {
   return it->second;
 }
 
+int Model::find_frame(const std::string& name) const {
+  auto it = frame_index.find(name);
+  if (it != frame_index.end()) return it->second;
+  // the known names in model order, at most a few of them
+  constexpr size_t kShown = 10;
+  std::string known;
+  for (size_t k = 0; k < frames.size() && k < kShown; ++k)
+    known += (k ? ", '" : "'") + frames[k].name + "'";
+  if (frames.size() > kShown) known += msg(", ... (", frames.size() - kShown, " more)");
+  if (frames.empty()) known = "none";
+  throw ModelError(msg("unknown frame '", name, "' (known: ", known, ")"));
+}
+
 std::string Model::row_name(int row) const {
   for (const Joint& j : joints) {
     const int r = joint_rows(j.type);
@@ -88,32 +101,44 @@ std::string Model::joint_path_reason(bool ignore_drives) const {
   return {};
 }
 
-void IndependentCoords::expand(const double* x, double* x_full, bool with_shift) const {
+void IndependentCoords::expand_q(const double* q, double* q_full) const {
+  for (int i = 0; i < lead_q; ++i) q_full[i] = q[i];
   const int nf = static_cast<int>(source.size());
-  for (int c = 0; c < nf; ++c) x_full[c] = scale[c] * x[source[c]] + (with_shift ? shift[c] : 0.0);
+  for (int c = 0; c < nf; ++c) q_full[lead_q + c] = scale[c] * q[lead_q + source[c]] + shift[c];
+}
+
+void IndependentCoords::expand_v(const double* x, double* x_full) const {
+  for (int i = 0; i < lead_v; ++i) x_full[i] = x[i];
+  const int nf = static_cast<int>(source.size());
+  for (int c = 0; c < nf; ++c) x_full[lead_v + c] = scale[c] * x[lead_v + source[c]];
 }
 
 void IndependentCoords::reduce(const double* f_full, double* f) const {
+  for (int i = 0; i < lead_v; ++i) f[i] = f_full[i];
+  for (int k = 0; k < n; ++k) f[lead_v + k] = 0.0;
   const int nf = static_cast<int>(source.size());
-  for (int k = 0; k < n; ++k) f[k] = 0.0;
-  for (int c = 0; c < nf; ++c) f[source[c]] += scale[c] * f_full[c];
+  for (int c = 0; c < nf; ++c) f[lead_v + source[c]] += scale[c] * f_full[lead_v + c];
 }
 
 void IndependentCoords::reduce(const MatX& M, MatX& Mr) const {
-  const int nf = static_cast<int>(source.size());
+  // G = blockdiag(I (lead_v), G_coords): entry i of the full vector is s(i) x[r(i)]
+  const int nf = lead_v + static_cast<int>(source.size());
+  auto r = [&](int i) { return i < lead_v ? i : lead_v + source[i - lead_v]; };
+  auto s = [&](int i) { return i < lead_v ? 1.0 : scale[i - lead_v]; };
   Mr.setZero();
   for (int j = 0; j < nf; ++j) {
-    const int sj = source[j];
-    for (int i = 0; i < nf; ++i) Mr(source[i], sj) += scale[i] * M(i, j) * scale[j];
+    const int rj = r(j);
+    const double sj = s(j);
+    for (int i = 0; i < nf; ++i) Mr(r(i), rj) += s(i) * M(i, j) * sj;
   }
 }
 
-void IndependentCoords::align(const std::vector<Coord>& coords, double* q_full) const {
+void IndependentCoords::align(const std::vector<Coord>& coords, double* coord_q) const {
   const int nf = static_cast<int>(source.size());
   for (int c = 0; c < nf; ++c) {
     if (full[source[c]] == c || !coords[c].angular) continue;
-    const double want = scale[c] * q_full[full[source[c]]] + shift[c];
-    q_full[c] = want + wrap_angle(q_full[c] - want);
+    const double want = scale[c] * coord_q[full[source[c]]] + shift[c];
+    coord_q[c] = want + wrap_angle(coord_q[c] - want);
   }
 }
 

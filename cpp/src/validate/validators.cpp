@@ -37,12 +37,24 @@ LagrangeValidator::LagrangeValidator(std::shared_ptr<const Model> m, bool rotati
                            "coordinates; validate the model without it"));
 }
 
+namespace {
+// the chart coordinates of joint_fk at q (joint-space sizes): the coordinates' values, and zero
+// for the floating bases' charts (about the pose in q itself)
+VecX chart_of(const Model& m, const VecX& q) {
+  VecX x = VecX::Zero(m.nv_joint);
+  const int nc = static_cast<int>(m.coords.size());
+  x.tail(nc) = q.tail(nc);
+  return x;
+}
+}  // namespace
+
 MatX LagrangeValidator::mass_matrix(const VecX& q) const {
   const Model& m = *m_;
-  const int n = static_cast<int>(m.coords.size());
-  check(q, n, "q");
+  const int n = m.nv_joint;
+  check(q, m.nq_joint, "q");
+  check_base_quaternions(m, q, "LagrangeValidator");
   JointFk<double> fk;
-  joint_fk<double>(m, q, fk, true);
+  joint_fk<double>(m, chart_of(m, q), fk, true, q.data());
   MatX M = MatX::Zero(n, n);
   for (int i = 0; i < m.nb; ++i) {
     const Body& b = m.bodies[i];
@@ -55,18 +67,27 @@ MatX LagrangeValidator::mass_matrix(const VecX& q) const {
   return M;
 }
 
-VecX LagrangeValidator::torques(const VecX& q, const VecX& qd, const VecX& qdd, double t) const {
+VecX LagrangeValidator::torques(const VecX& q, const VecX& qd, const VecX& qdd_in, double t) const {
   const Model& m = *m_;
-  const int n = static_cast<int>(m.coords.size());
-  check(q, n, "q");
+  const int n = m.nv_joint, F = m.n_free;
+  check(q, m.nq_joint, "q");
   check(qd, n, "qd");
-  check(qdd, n, "qdd");
+  check(qdd_in, n, "qdd");
+  check_base_quaternions(m, q, "LagrangeValidator");
   if (!std::isfinite(t)) throw ModelError("LagrangeValidator: t is not finite");
-  // kinematics with derivatives with respect to every coordinate
+  // kinematics with derivatives with respect to every coordinate (a floating base's chart
+  // about its pose in q: chart rates (v, w); chart accelerations (v' + w x v, w'), joint_fk)
+  const VecX x = chart_of(m, q);
+  VecX qdd = qdd_in;
+  for (const Joint& j : m.joints) {
+    if (j.type != JointType::Free) continue;
+    const Vec3 v = qd.segment<3>(j.dof0), w = qd.segment<3>(j.dof0 + 3);
+    qdd.segment<3>(j.dof0) += w.cross(v);
+  }
   ADVec qa(n);
-  for (int k = 0; k < n; ++k) qa[k] = AD(q[k], n, k);
+  for (int k = 0; k < n; ++k) qa[k] = AD(x[k], n, k);
   JointFk<AD> fk;
-  joint_fk<AD>(m, qa, fk, true);
+  joint_fk<AD>(m, qa, fk, true, q.data());
   ADMat M = ADMat::Constant(n, n, constant(0.0, n));
   AD V = constant(0.0, n);
   const ADV3 g = m.gravity.cast<AD>();
@@ -94,17 +115,22 @@ VecX LagrangeValidator::torques(const VecX& q, const VecX& qd, const VecX& qdd, 
     Q -= sd.damping * dL.dot(qd) * dL;
   }
   // joint springs, dampers, friction and inputs on the coordinates
+  // (the coordinates follow the floating bases' blocks: 7 entries each in q, 6 in qd and Q)
+  const double* qc = q.data() + 7 * F;
+  const double* qdc = qd.data() + 6 * F;
+  double* Qc = Q.data() + 6 * F;
   for (const CoordForce& cf : m.coord_forces)
-    Q[cf.coord] += coord_force_value(cf, m.coords[cf.coord].angular, q[cf.coord], qd[cf.coord], t);
+    Qc[cf.coord] +=
+        coord_force_value(cf, m.coords[cf.coord].angular, qc[cf.coord], qdc[cf.coord], t);
   // gear pairs (q are unwrapped here)
   for (const GearPair& g : m.gears) {
-    const double s = g.r_a * q[g.coord_a] + g.r_b * q[g.coord_b];
-    const double sd = g.r_a * qd[g.coord_a] + g.r_b * qd[g.coord_b];
+    const double s = g.r_a * qc[g.coord_a] + g.r_b * qc[g.coord_b];
+    const double sd = g.r_a * qdc[g.coord_a] + g.r_b * qdc[g.coord_b];
     double pen;
     const double f = gear_force(g, s, sd, pen);
     const double fs = s >= 0 ? f : -f;
-    Q[g.coord_a] -= g.r_a * fs;
-    Q[g.coord_b] -= g.r_b * fs;
+    Qc[g.coord_a] -= g.r_a * fs;
+    Qc[g.coord_b] -= g.r_b * fs;
   }
   // body loads: world force at a body point and world torque
   for (const BodyLoad& l : m.body_loads) {
@@ -168,15 +194,16 @@ Vec3 paper_5dof_end_effector(double h, double L1, double L2, double L34, const V
 
 Vec3 end_effector_position(const Model& m, int body, const Vec3& point, const VecX& q) {
   require_joint_space(m, "end_effector_position");
-  const long n = static_cast<long>(m.coords.size());
+  const long n = m.nq_joint;
   if (q.size() != n)
     throw ModelError(msg("end_effector_position: q has length ", q.size(), ", expected ", n));
   if (!q.allFinite()) throw ModelError("end_effector_position: q contains NaN or inf");
   if (!point.allFinite()) throw ModelError("end_effector_position: point contains NaN or inf");
   if (body == kGround) return point;
   if (body < 0 || body >= m.nb) throw ModelError(msg("end_effector_position: no body ", body));
+  check_base_quaternions(m, q, "end_effector_position");
   JointFk<double> fk;
-  joint_fk<double>(m, q, fk, false);
+  joint_fk<double>(m, chart_of(m, q), fk, false, q.data());
   return fk.x[body] + fk.R[body] * point;
 }
 

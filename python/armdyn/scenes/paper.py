@@ -183,6 +183,8 @@ def five_dof_arm(point_masses: bool = False, hold=None, drives: bool = True) -> 
     b.add_revolute("elbow", "link1", "link2", point=(x1, 0, h), axis=PITCH)
     b.add_revolute("wrist", "link2", "link3", point=(x2, 0, h), axis=PITCH)
     b.add_prismatic("extend", "link3", "rod", point=(x3, 0, h), axis=(1, 0, 0))
+    # the end effector: the rod tip (five_dof_tip's point), world axes at the assembly pose
+    b.add_frame("tip", "rod", position=(a.reach, 0, h))
     if hold is not None:
         hold = np.asarray(hold, dtype=float)
         if hold.shape != (5,):
@@ -198,7 +200,8 @@ def five_dof_arm(point_masses: bool = False, hold=None, drives: bool = True) -> 
 
 
 def five_dof_tip(model_is_point_mass: bool = False):
-    """(body, point) of the end effector: the rod tip, in the rod's body frame."""
+    """(body, point) of the end effector: the rod tip, in the rod's body frame (also the model's
+    frame ``tip``)."""
     offset = 0.0 if model_is_point_mass else ARM5.L4 / 2
     return "rod", np.array([offset, 0.0, 0.0])
 

@@ -111,7 +111,10 @@ TEST_CASE(invalid_input_throws_and_leaves_the_builder_unchanged) {
   b.add_revolute("j", "ground", "a", Vec3::Zero(), Vec3::UnitZ());
   const std::string why = THROWN_MESSAGE(b.finalize(), ModelError);
   CHECK(why.find("loose") != std::string::npos);
-  CHECK_THROWS(ModelBuilder().finalize(), ModelError);  // no bodies
+  // no bodies: a zero-DOF model (a URDF structure fixed to ground)
+  const ModelPtr empty = ModelBuilder().finalize();
+  CHECK(empty->nb == 0 && empty->nq == 0 && empty->nv == 0 && empty->nc == 0);
+  CHECK(empty->coords.empty() && empty->mobility == 0);
 }
 
 ARMDYN_TEST_MAIN()

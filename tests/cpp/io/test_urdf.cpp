@@ -138,4 +138,44 @@ TEST_CASE(malformed_files_raise_urdf_error) {
   CHECK_THROWS(urdf_builder(dir + "bad_syntax.urdf", true, g), ModelError);
 }
 
+TEST_CASE(hardening_and_joint_dynamics) {
+  const Vec3 g(0, 0, -9.81);
+  auto pendulum = [](const std::string& inertia_ixx, const std::string& dynamics) {
+    return "<robot name=\"p\"><link name=\"base\"/><link name=\"bob\"><inertial>"
+           "<origin xyz=\"0 0 -0.5\"/><mass value=\"1\"/><inertia ixx=\"" +
+           inertia_ixx +
+           "\" ixy=\"0\" ixz=\"0\" iyy=\"0.02\" iyz=\"0\" izz=\"0.015\"/></inertial>"
+           "</link><joint name=\"hinge\" type=\"continuous\"><parent link=\"base\"/>"
+           "<child link=\"bob\"/><axis xyz=\"0 1 0\"/>" +
+           dynamics + "</joint></robot>";
+  };
+  // urdfdom would read nan as 0: refused first, naming link, element and attribute
+  const std::string nan = THROWN_MESSAGE(urdf_builder(pendulum("nan", ""), true, g), UrdfError);
+  CHECK(nan.find("link 'bob'") != std::string::npos);
+  CHECK(nan.find("<inertial><inertia> attribute 'ixx' is not finite") != std::string::npos);
+  const std::string big = THROWN_MESSAGE(urdf_builder(pendulum("1e400", ""), true, g), UrdfError);
+  CHECK(big.find("out of the range of a double") != std::string::npos);
+  // devices are refused before they are opened
+  const std::string dev = THROWN_MESSAGE(urdf_builder("/dev/zero", true, g), UrdfError);
+  CHECK(dev.find("character device") != std::string::npos);
+  // <dynamics> is joint friction on the joint's coordinate
+  const ModelPtr m =
+      urdf_builder(pendulum("0.03", "<dynamics damping=\"0.25\" friction=\"0.5\"/>"), true, g)
+          .finalize();
+  CHECK(m->coord_forces.size() == 1);
+  CHECK(m->coord_forces[0].coord == 0);
+  CHECK(m->coord_forces[0].damping == 0.25);
+  CHECK(m->coord_forces[0].coulomb == 0.5);
+  CHECK(m->coord_forces[0].v_smooth == kUrdfCoulombSmoothing);
+  // no moving joint with a fixed base: a zero-DOF model
+  const ModelPtr empty =
+      urdf_builder(
+          "<robot name=\"s\"><link name=\"a\"><inertial><mass value=\"1\"/>"
+          "<inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/>"
+          "</inertial></link></robot>",
+          true, g)
+          .finalize();
+  CHECK(empty->nb == 0 && empty->coords.empty());
+}
+
 ARMDYN_TEST_MAIN()

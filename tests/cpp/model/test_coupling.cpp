@@ -50,9 +50,9 @@ TEST_CASE(chain_of_couplings_resolves_to_the_root_leader) {
   const VecX shift = (VecX(4) << 0, 0.1, -0.05, 0).finished();
   const VecX q = (VecX(2) << 0.3, -0.2).finished();
   VecX qf(4);
-  ic.expand(q.data(), qf.data(), true);
+  ic.expand_q(q.data(), qf.data());
   CHECK_MAT_NEAR(qf, G * q + shift, 1e-15);
-  ic.expand(q.data(), qf.data(), false);
+  ic.expand_v(q.data(), qf.data());
   CHECK_MAT_NEAR(qf, G * q, 1e-15);
   const VecX f = (VecX(4) << 1.0, -2.0, 3.0, 0.5).finished();
   VecX fr(2);
@@ -79,9 +79,9 @@ TEST_CASE(public_functions_reduce_the_full_ones) {
   const MatX Mr = crba(*m, d, q);
   const VecX tau = rnea(*m, d, q, qd, qdd);
   VecX qf(4), qdf(4), qddf(4);
-  m->independent.expand(q.data(), qf.data(), true);
-  m->independent.expand(qd.data(), qdf.data(), false);
-  m->independent.expand(qdd.data(), qddf.data(), false);
+  m->independent.expand_q(q.data(), qf.data());
+  m->independent.expand_v(qd.data(), qdf.data());
+  m->independent.expand_v(qdd.data(), qddf.data());
   const MatX M = mass_matrix_at(*m, d, qf);
   rnea_full(*m, d, qf, qdf, qddf, 0.0);
   VecX tr(2);

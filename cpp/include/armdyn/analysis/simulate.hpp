@@ -39,6 +39,9 @@ struct SimOptions {
   /// gears' null space); the outputs are the same Cartesian tables, built from (q, qd). Auto:
   /// Joint wherever it applies (a tree without drives), else Cartesian.
   Coordinates coordinates = Coordinates::Cartesian;
+  /// The joint-space q (model.nq_joint) the initial state was made from, or empty: its angles
+  /// start the run's multi-turn tracking (q0 = 3.5 rad is reported as 3.5, not -2.78).
+  VecX q_start;
 };
 
 /// Row-major output tables: one row per output time.

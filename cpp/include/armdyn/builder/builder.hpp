@@ -49,8 +49,19 @@ class ModelBuilder {
   /// points in world coordinates at the assembly pose; 1 row.
   int add_distance(const std::string& name, const std::string& body_a, const Vec3& point_a,
                    const std::string& body_b, const Vec3& point_b);
-  /// Declares a body free (6 DOF, no constraint rows) so that it counts as connected to ground.
-  int add_free(const std::string& name, const std::string& child);
+  /// Declares a body free (6 DOF, no constraint rows) so that it counts as connected to ground: a
+  /// floating base. In joint space its frame -- the body's axes at `origin` (world at assembly;
+  /// default the centre of mass) -- gives 7 entries of q (position, scalar-first unit quaternion)
+  /// and 6 of qd (linear and angular velocity in the frame's own axes).
+  int add_free(const std::string& name, const std::string& child, const Vec3* origin = nullptr);
+
+  /// Add a named frame rigidly attached to `body` (or "ground"): its origin `position` [m] and
+  /// axes `orientation` (unit Euler parameters, scalar first, frame -> world), both in WORLD at
+  /// the assembly pose like every builder input. Stored relative to the body (NamedFrame).
+  /// @throws ModelError on an empty or duplicate frame name, an unknown body, a non-finite
+  /// placement or a quaternion that is not of unit norm.
+  int add_frame(const std::string& name, const std::string& body, const Vec3& position,
+                const Vec4& orientation);
 
   /// Set position limits and informative effort/velocity limits on a joint.
   void set_joint_limits(const std::string& joint, double lower, double upper, double effort,

@@ -160,8 +160,19 @@ class MbsSystem : public OdeSystem {
   /// Record the outputs at (u, v, t); data() holds the dynamics evaluated there.
   void record(double t, const double* u, const double* v, const VecX& vd, double rf, double rv,
               const double* aux = nullptr) {
-    // joint coordinates (angles unwrapped along the run) and rates
+    // the floating bases' poses, velocities and accelerations (their frames' axes), then the
+    // joint coordinates (angles unwrapped along the run), rates and accelerations
     const long row = out_.n;
+    if (m_.n_free) {
+      base_q_.resize(m_.nq_joint);
+      base_qd_.resize(m_.nv_joint);
+      base_qdd_.resize(m_.nv_joint);
+      base_coordinates(m_, d_.kin, u, base_q_.data(), base_qd_.data());
+      base_accelerations(m_, d_.kin, vd.data(), base_qdd_.data());
+      out_.q.insert(out_.q.end(), base_q_.data(), base_q_.data() + 7 * m_.n_free);
+      out_.qd.insert(out_.qd.end(), base_qd_.data(), base_qd_.data() + 6 * m_.n_free);
+      out_.qdd.insert(out_.qdd.end(), base_qdd_.data(), base_qdd_.data() + 6 * m_.n_free);
+    }
     for (size_t c = 0; c < m_.coords.size(); ++c) {
       const ScalarJet q = coord_jet(m_, d_.kin, static_cast<int>(c));
       // angles unwrapped over turns, followed at every projection
@@ -236,6 +247,7 @@ class MbsSystem : public OdeSystem {
   Metric metric_;
   SimResult& out_;
   VecX &yo_, &vd_;
+  VecX base_q_, base_qd_, base_qdd_;  // floating bases' outputs (sized on first use)
   WeldExpander* ex_ = nullptr;
 };
 
@@ -254,6 +266,7 @@ class JointSystem : public OdeSystem {
         td_(m, cart.data()),
         cart_(cart),
         n_(td_.n()),
+        nq_(m.nq_joint),
         u_(cart.data().run.u),
         v_(cart.data().run.v),
         vd_(cart.data().run.vd),
@@ -266,23 +279,27 @@ class JointSystem : public OdeSystem {
       if (joint_rows(m.joints[*it].type) > 0) sweep_.emplace_back(*it, m.joints[*it].child);
   }
 
+  // y = (q (nq_), qd (n_), z); q holds the floating bases' quaternions where qd has 3 rates
   void rhs(double t, const VecX& y, VecX& dy) override {
     const double* q = y.data();
-    const double* qd = q + n_;
+    const double* qd = q + nq_;
     const double* z = qd + n_;
-    dy.head(n_) = y.segment(n_, n_);
-    td_.accelerations(t, q, qd, z, nullptr, dy.data() + n_);
-    if (m_.n_aux) td_.aux_rates(t, q, qd, z, dy.data() + 2 * n_);
+    if (m_.n_free)
+      configuration_rate(m_, q, qd, dy.data());
+    else
+      dy.head(n_) = y.segment(n_, n_);
+    td_.accelerations(t, q, qd, z, nullptr, dy.data() + nq_);
+    if (m_.n_aux) td_.aux_rates(t, q, qd, z, dy.data() + nq_ + n_);
   }
 
   void project_and_rhs(double t, VecX& y, VecX& dy) override {
-    td_.project(y.data(), y.data() + n_);
+    td_.project(y.data(), y.data() + nq_);
     rhs(t, y, dy);
   }
 
   void output(double t, const VecX& y) override {
-    const double* z = y.data() + 2 * n_;
-    const Eigen::Map<const VecX> q(y.data(), n_), qd(y.data() + n_, n_);
+    const double* z = y.data() + nq_ + n_;
+    const Eigen::Map<const VecX> q(y.data(), nq_), qd(y.data() + nq_, n_);
     td_.accelerations(t, q.data(), qd.data(), z, nullptr, qdd_.data());
     // the same Data: the tree's kinematics and joint frames at (q, qd), read before the
     // Cartesian pipeline loads the same state
@@ -290,8 +307,9 @@ class JointSystem : public OdeSystem {
     rne_forward(m_, d.kin, qd, qdd_, d.rne);
     tree_body_accelerations(m_, d.kin, d.rne, vd_.data());
     cartesian_state(m_, d.kin, u_.data(), v_.data());
+    base_orientations(m_, q.data(), u_.data());
     d.aux = z;
-    d.track_ref = q;
+    d.track_ref = q.tail(d.nco);
     load_kinematics(m_, d, u_.data(), v_.data());
     evaluate_constraints(m_, d, t, false);
     cartesian_forces(m_, d, t);
@@ -308,7 +326,7 @@ class JointSystem : public OdeSystem {
   int n_events() const override { return static_cast<int>(m_.gears.size()); }
   void events(double /*t*/, const VecX& y, double* g) override {
     double s, sd;
-    for (int i = 0; i < n_events(); ++i) td_.gear_mesh(i, y.data(), y.data() + n_, s, sd, g[i]);
+    for (int i = 0; i < n_events(); ++i) td_.gear_mesh(i, y.data(), y.data() + nq_, s, sd, g[i]);
   }
   void on_event(double t, int i, int direction) override { cart_.on_event(t, i, direction); }
 
@@ -318,7 +336,7 @@ class JointSystem : public OdeSystem {
   const Model& m_;
   TreeDynamics td_;
   MbsSystem& cart_;
-  int n_;
+  int n_, nq_;
   VecX u_, v_, vd_, qdd_;
   RneWork rne_;                             // the forward sweep at the output's accelerations
   std::vector<std::pair<int, int>> sweep_;  // (joint, child), children before parents

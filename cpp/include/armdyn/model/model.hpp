@@ -67,7 +67,8 @@ constexpr int joint_rows(JointType t) {
   }
   return 0;
 }
-/// Number of joint coordinates (angle and/or displacement) a joint type defines.
+/// Number of joint coordinates (angle and/or displacement) a joint type defines (the Cartesian
+/// coordinate list Model::coords; a free joint has none there).
 constexpr int joint_coords(JointType t) {
   switch (t) {
     case JointType::Revolute:
@@ -79,6 +80,14 @@ constexpr int joint_coords(JointType t) {
       return 0;
   }
 }
+
+/// Degrees of freedom a joint type contributes to the joint-space velocity vector qd: its
+/// coordinates, and 6 for a free joint (a floating base: linear and angular velocity of its frame
+/// in its own axes).
+constexpr int joint_dofs(JointType t) { return t == JointType::Free ? 6 : joint_coords(t); }
+/// Entries a joint type contributes to the joint-space configuration q: its coordinates, and 7
+/// for a free joint (position, then the scalar-first unit quaternion of its frame).
+constexpr int joint_configs(JointType t) { return t == JointType::Free ? 7 : joint_coords(t); }
 
 struct Joint {
   std::string name;
@@ -93,6 +102,11 @@ struct Joint {
   double length = 0.0;                        ///< distance joint: the held distance [m]
   int row0 = 0;                               ///< first constraint row
   int coord0 = -1;                            ///< first joint coordinate index, -1 if none
+  /// Joint-space layout (finalize; -1 when the joint adds nothing): first entry of the joint's
+  /// configuration in q and of its degrees of freedom in qd, qdd, tau and M. Free joints
+  /// (floating bases) come first, 7 and 6 entries each; then the coordinates in Model::coords
+  /// order (q0 = 7 n_free + coord0, dof0 = 6 n_free + coord0).
+  int q0 = -1, dof0 = -1;
 };
 
 /// Prescribed joint coordinate: q_joint[coord](t) = profile(t).
@@ -194,32 +208,49 @@ struct Coord {
 };
 
 /// The independent joint coordinates of a model with couplings (GearConstraint::coupling):
-/// every coordinate c is q_c = scale_c q[source_c] + shift_c of an independent coordinate
-/// (scale 1, shift 0 for the independent ones themselves; chains of couplings resolved), i.e.
+/// every coordinate c (of Model::coords) is q_c = scale_c q[source_c] + shift_c of an
+/// independent coordinate (scale 1, shift 0 for the independent ones themselves; chains of
+/// couplings resolved). On the joint-space vectors, whose floating bases' blocks lead (lead_q =
+/// 7 n_free entries of q, lead_v = 6 n_free of qd) and pass through unchanged:
 ///   q_full = G q + shift,  qd_full = G qd,  qdd_full = G qdd,
-/// with G (n_coords_full x n) one entry per row. The joint-space functions of a coupled model
-/// take q (the independent coordinates, model order, followers removed), as Pinocchio's
-/// mimic=True models do, and reduce forces and the mass matrix by G: tau = G^T tau_full,
-/// M = G^T M_full G. Without couplings G is the identity (identity() true). The one place
-/// where full and independent coordinates meet: a floating base's configuration map would
-/// compose with it here.
+/// with G one entry per row. The joint-space functions of a coupled model take q (the
+/// independent coordinates, model order, followers removed), as Pinocchio's mimic=True models
+/// do, and reduce forces and the mass matrix by G: tau = G^T tau_full, M = G^T M_full G.
+/// Without couplings G is the identity (identity() true). The one place where full and
+/// independent joint-space vectors meet.
 struct IndependentCoords {
-  int n = 0;              ///< independent coordinates
-  std::vector<int> full;  ///< per independent coordinate: its index in Model::coords
+  int n = 0;                   ///< independent coordinates (of Model::coords)
+  int lead_q = 0, lead_v = 0;  ///< floating bases' entries leading q and qd (passed through)
+  std::vector<int> full;       ///< per independent coordinate: its index in Model::coords
   /// per coordinate: the independent coordinate it follows (its own index when independent)
   std::vector<int> source;
   std::vector<double> scale, shift;  ///< per coordinate
   bool identity() const { return n == static_cast<int>(source.size()); }
-  /// q_full = G q + shift (positions, with_shift) or G x (rates, accelerations)
-  void expand(const double* x, double* x_full, bool with_shift) const;
+  int nq() const { return lead_q + n; }  ///< length of the independent q
+  int nv() const { return lead_v + n; }  ///< length of the independent qd, qdd, tau
+  /// q_full = G q + shift (joint-space configurations)
+  void expand_q(const double* q, double* q_full) const;
+  /// x_full = G x (rates, accelerations)
+  void expand_v(const double* x, double* x_full) const;
   /// f = G^T f_full (generalised forces)
   void reduce(const double* f_full, double* f) const;
-  /// Mr = G^T M G (Mr sized n x n by the caller)
+  /// Mr = G^T M G (Mr sized nv() x nv() by the caller)
   void reduce(const MatX& M, MatX& Mr) const;
-  /// Each angle follower of q_full (every coordinate) moved by whole turns to the value
-  /// nearest its coupling's, scale q_leader + shift: a follower's pose gives its angle only
-  /// modulo a turn.
-  void align(const std::vector<Coord>& coords, double* q_full) const;
+  /// Each angle follower among the coordinates coord_q (Model::coords order, every one) moved
+  /// by whole turns to the value nearest its coupling's, scale q_leader + shift: a follower's
+  /// pose gives its angle only modulo a turn.
+  void align(const std::vector<Coord>& coords, double* coord_q) const;
+};
+
+/// A named frame rigidly attached to a body (or to ground): a URDF link, a tool flange, a sensor.
+/// Its placement follows the conventions of Joint::point_parent and Joint::frame_parent: the
+/// origin in the body's frame relative to its centre of mass (ground: world), and the frame's
+/// axes as the columns of `rotation` in the body's axes (frame -> body).
+struct NamedFrame {
+  std::string name;
+  int body = kGround;
+  Vec3 point = Vec3::Zero();
+  Mat3 rotation = Mat3::Identity();
 };
 
 /// Options of ModelBuilder::finalize(), kept with the model (the welded model simulate()
@@ -243,6 +274,12 @@ class Model {
   std::vector<int> tracked_coords;  ///< angle coordinates unwrapped over turns (gears)
   int n_aux = 0;  ///< auxiliary states of the simulation (integral terms of PI motors)
   std::vector<Coord> coords;
+  /// Joint-space sizes (finalize): nq_joint = len(q) = 7 n_free + coords, nv_joint = len(qd) =
+  /// 6 n_free + coords; n_free the free joints (floating bases), whose blocks lead q and qd.
+  int n_free = 0, nq_joint = 0, nv_joint = 0;
+  std::vector<int> dof_joint;  ///< the joint of each joint-space degree of freedom (nv_joint)
+  std::vector<std::string> q_names, dof_names;  ///< names of the entries of q and of qd
+  std::vector<NamedFrame> frames;  ///< named frames (builder add_frame; every URDF link)
   /// the independent coordinates (couplings removed; finalize). n_coords of the bindings.
   IndependentCoords independent;
   Vec3 gravity = Vec3(0, 0, -9.81);
@@ -290,6 +327,10 @@ class Model {
   VecX u0, v0;
 
   std::map<std::string, int> body_index, joint_index, drive_index;
+  std::map<std::string, int> frame_index;
+
+  /// The index of frame `name` in `frames`; throws ModelError "unknown frame 'x' (known: ...)".
+  int find_frame(const std::string& name) const;
 
   int find_body(const std::string& name) const;   ///< -1 for "ground"; throws ModelError
   int find_joint(const std::string& name) const;  ///< throws ModelError

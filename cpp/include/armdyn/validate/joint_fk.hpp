@@ -7,12 +7,22 @@
 //
 // Per body: rotation R (body -> world), centre of mass x (world) and, when asked, the Jacobians
 // of the CoM velocity Jv and of the world angular velocity Jw with respect to qdot (3 x n each).
+//
+// The coordinates are those of the joint-space velocity vector (n = model.nv_joint). A floating
+// base (free joint) has no coordinates whose rates are its velocities (its orientation is a
+// quaternion), so it takes a local chart about a reference pose (P0, R0) from the joint-space q
+// (`base`): six coordinates (xi, phi) with P = P0 + R0 xi and R = R0 exp([phi]), evaluated at
+// xi = phi = 0. There xi' = v and phi' = w (the base frame's velocities in its own axes), and the
+// chart's generalised forces are the base wrench's components; exp is taken to second order,
+// exact in value and first derivative at phi = 0, which is all the Lagrange validator
+// differentiates.
 #pragma once
 
 #include <cmath>
 #include <vector>
 
 #include "armdyn/analysis/joint_space.hpp"
+#include "armdyn/math/quaternion.hpp"
 
 namespace armdyn {
 
@@ -28,13 +38,13 @@ struct JointFk {
 
 template <class T>
 void joint_fk(const Model& m, const Eigen::Matrix<T, Eigen::Dynamic, 1>& q, JointFk<T>& r,
-              bool jacobians) {
+              bool jacobians, const double* base = nullptr) {
   using V3 = typename JointFk<T>::V3;
   using M3 = typename JointFk<T>::M3;
   using J3 = typename JointFk<T>::J3;
   using std::cos;
   using std::sin;
-  const int n = static_cast<int>(m.coords.size());
+  const int n = m.nv_joint;
   r.R.assign(m.nb, M3::Identity());
   r.x.assign(m.nb, V3::Zero());
   if (jacobians) {
@@ -46,6 +56,37 @@ void joint_fk(const Model& m, const Eigen::Matrix<T, Eigen::Dynamic, 1>& q, Join
   const J3 Z = jacobians ? J3::Zero(3, n) : J3();
   for (int ji : m.tree_order) {
     const Joint& j = m.joints[ji];
+    if (j.type == JointType::Free) {
+      // a floating base: the chart (xi, phi) about the reference pose in base[q0 .. q0 + 7)
+      const int d0 = j.dof0;
+      const Vec3 P0(base[j.q0], base[j.q0 + 1], base[j.q0 + 2]);
+      const M3 R0 =
+          quat_to_rot(
+              Vec4(base[j.q0 + 3], base[j.q0 + 4], base[j.q0 + 5], base[j.q0 + 6]).normalized())
+              .cast<T>();
+      const V3 xi(q[d0], q[d0 + 1], q[d0 + 2]);
+      M3 S = M3::Zero();  // [phi]x
+      S(0, 1) = -q[d0 + 5];
+      S(0, 2) = q[d0 + 4];
+      S(1, 0) = q[d0 + 5];
+      S(1, 2) = -q[d0 + 3];
+      S(2, 0) = -q[d0 + 4];
+      S(2, 1) = q[d0 + 3];
+      const M3 E = I3 + S + T(0.5) * S * S;
+      const V3 P = P0.cast<T>() + R0 * xi;
+      const int b = j.child;
+      r.R[b] = R0 * E * j.frame_child.transpose().cast<T>();
+      r.x[b] = P - r.R[b] * j.point_child.cast<T>();
+      if (!jacobians) continue;
+      // w (world) = R0 (1 + [phi]/2) phi' to first order; v_P = R0 xi'
+      const M3 Jw = R0 * (I3 + T(0.5) * S);
+      for (int k = 0; k < 3; ++k) {
+        r.Jv[b].col(d0 + k) = R0.col(k);
+        r.Jw[b].col(d0 + 3 + k) = Jw.col(k);
+        r.Jv[b].col(d0 + 3 + k) = V3(Jw.col(k)).cross(V3(r.x[b] - P));
+      }
+      continue;
+    }
     const bool grounded = j.parent == kGround;
     const M3& Rp = grounded ? I3 : r.R[j.parent];
     const V3& xp = grounded ? O3 : r.x[j.parent];
@@ -56,14 +97,14 @@ void joint_fk(const Model& m, const Eigen::Matrix<T, Eigen::Dynamic, 1>& q, Join
     int c_th = -1, c_d = -1;
     switch (j.type) {
       case JointType::Revolute:
-        c_th = j.coord0;
+        c_th = j.dof0;
         break;
       case JointType::Prismatic:
-        c_d = j.coord0;
+        c_d = j.dof0;
         break;
       case JointType::Cylindrical:
-        c_th = j.coord0;
-        c_d = j.coord0 + 1;
+        c_th = j.dof0;
+        c_d = j.dof0 + 1;
         break;
       default:
         break;

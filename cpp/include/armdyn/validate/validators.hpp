@@ -29,7 +29,8 @@ class LagrangeValidator {
  public:
   /// @throws ModelError when the model is not a joint-space tree.
   explicit LagrangeValidator(std::shared_ptr<const Model> m, bool rotational_inertia = true);
-  /// Generalised actuator forces (joint order) for (q, qd, qdd) at time t.
+  /// Generalised actuator forces (n_dofs) for q (n_coords), qd, qdd (n_dofs) at time t; a
+  /// floating base by a local chart about its pose in q (validate/joint_fk.hpp).
   VecX torques(const VecX& q, const VecX& qd, const VecX& qdd, double t = 0.0) const;
   /// Joint-space mass matrix M(q).
   MatX mass_matrix(const VecX& q) const;
