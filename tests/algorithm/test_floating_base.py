@@ -56,6 +56,12 @@ class FreeFlyerPair:
         vp[self.perm] = v
         return vp
 
+    def friction(self, vp):
+        """The URDF's <dynamics> torques (Pinocchio order), which armdyn imports as joint
+        friction and Pinocchio's algorithms leave out (its model.damping, model.friction)."""
+        vs = armdyn._core.URDF_COULOMB_SMOOTHING
+        return -self.pm.damping * vp - self.pm.friction * np.tanh(vp / vs)
+
     def random_state(self, rng):
         e = rng.normal(size=4)
         e /= np.linalg.norm(e)
@@ -81,8 +87,9 @@ def test_free_flyer_dynamics_equal_pinocchio(robot):
         Mp = np.triu(Mp) + np.triu(Mp, 1).T
         assert _rel(armdyn.mass_matrix(am, q), Mp[np.ix_(pair.perm, pair.perm)]) <= 1e-10
         tau = armdyn.inverse_dynamics(am, q, v, a)
-        assert _rel(tau, pin.rnea(pm, pd, qp, vp, ap)[pair.perm]) <= 1e-10
-        ref = pin.aba(pm, pd, qp, vp, pair.v_pin(tau))[pair.perm]
+        ref_tau = pin.rnea(pm, pd, qp, vp, ap) - pair.friction(vp)
+        assert _rel(tau, ref_tau[pair.perm]) <= 1e-10
+        ref = pin.aba(pm, pd, qp, vp, pair.v_pin(tau) + pair.friction(vp))[pair.perm]
         assert _rel(ref, a) <= 1e-9  # Pinocchio's own round trip
         for method in ("auto", "crba", "aba", "cartesian"):
             qdd = armdyn.forward_dynamics(am, q, v, tau, method=method)
@@ -103,6 +110,29 @@ def test_lagrange_validator_takes_floating_bases(robot):
         v, a = rng.normal(size=m.n_dofs), rng.normal(size=m.n_dofs)
         assert _rel(lv.torques(q, v, a), armdyn.inverse_dynamics(m, q, v, a)) <= 1e-12
         np.testing.assert_allclose(lv.mass_matrix(q), armdyn.mass_matrix(m, q), atol=1e-12)
+
+
+@pytest.mark.parametrize("robot", ["ur5", "solo12"])
+def test_floating_base_frames_equal_pinocchio(robot):
+    pair = FreeFlyerPair(_robot_path(ROBOTS[robot]))
+    am, pm, pd = pair.am, pair.pm, pair.pd
+    rng = np.random.default_rng(9)
+    frames = [f for f in am.frame_names if pm.existFrame(f)]
+    assert len(frames) >= 8
+    for _ in range(3):
+        q, _, _ = pair.random_state(rng)
+        qp = pair.q_pin(q)
+        pin.framesForwardKinematics(pm, pd, qp)
+        pin.computeJointJacobians(pm, pd, qp)
+        for f in frames:
+            fid = pm.getFrameId(f)
+            np.testing.assert_allclose(
+                armdyn.frame_pose(am, q, f), pd.oMf[fid].homogeneous, rtol=0, atol=1e-12
+            )
+            Jp = pin.getFrameJacobian(pm, pd, fid, pin.LOCAL_WORLD_ALIGNED)
+            np.testing.assert_allclose(
+                armdyn.frame_jacobian(am, q, f), Jp[:, pair.perm], rtol=0, atol=1e-12
+            )
 
 
 def _free_brick(origin=None):
