@@ -108,3 +108,56 @@ def test_the_comparison_sees_a_different_robot():
     assert min(out["M"], out["fd"], out["id"]) > 0.1, out
     rec = {**sweep.compare(_urdf("ur_description/ur5_robot.urdf"), False), **out}
     assert "differs from Pinocchio beyond 1e-10" in sweep.meets_target(rec)
+
+
+class _FloatingStandIn:
+    """A stand-in for armdyn's floating-base joint space (Pinocchio's free-flyer model behind the
+    issue's convention: ``q = (x, y, z, e0, e1, e2, e3, joints)``, ``qd = (v, w, joint rates)``,
+    joints in reverse order, ``coord_names`` the joints' only), to check the sweep's plumbing of
+    the floating base before armdyn has one. ``xyzw``: read the quaternion in Pinocchio's order
+    instead, a convention error the comparison must see."""
+
+    def __init__(self, path, xyzw=False):
+        self.pm = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+        self.pd = self.pm.createData()
+        n = self.pm.nv - 6
+        self.n_coords, self.n_dofs = 7 + n, 6 + n
+        self.coord_names = [self.pm.names[j] for j in range(2, self.pm.njoints)][::-1]
+        self.iv = np.r_[0:6, 6 + n - 1 : 5 : -1]  # qd = v_pin[iv]: joints reversed
+        self.xyzw = xyzw
+
+    def q_pin(self, q):
+        q = np.asarray(q)
+        quat = q[3:7] if self.xyzw else np.r_[q[4:7], q[3]]
+        return np.r_[q[:3], quat, q[7:][::-1]]
+
+    def v_pin(self, v):
+        out = np.empty(self.pm.nv)
+        out[self.iv] = v
+        return out
+
+
+def test_the_floating_base_comparison_follows_the_issues_convention(monkeypatch):
+    # with the stand-in in the issue's convention the sweep's floating-base comparison finds
+    # round-off; with the quaternion read in Pinocchio's order, gravity points elsewhere in the
+    # root frame: large errors in fd and id (M, in root-frame velocities, does not depend on the
+    # base's pose)
+    path = _urdf("ur_description/ur5_robot.urdf")
+    ref = sweep.reference(path, True)
+    states = [(*s, ref.mass_matrix(s[0])) for s in ref.states(3, seed=2)]
+    for name, fn in {
+        "mass_matrix": lambda m, q: sweep.mass_matrix(pin, m.pm, m.pd, m.q_pin(q))[
+            np.ix_(m.iv, m.iv)
+        ],
+        "forward_dynamics": lambda m, q, v, t: pin.aba(
+            m.pm, m.pd, m.q_pin(q), m.v_pin(v), m.v_pin(t)
+        )[m.iv],
+        "inverse_dynamics": lambda m, q, v, a: pin.rnea(
+            m.pm, m.pd, m.q_pin(q), m.v_pin(v), m.v_pin(a)
+        )[m.iv],
+    }.items():
+        monkeypatch.setattr(sweep.ad, name, fn)
+    right = sweep.compare_models(ref, _FloatingStandIn(path), states)
+    assert right["failure"] is None and max(right[k] for k in ("M", "fd", "id")) <= 1e-14, right
+    wrong = sweep.compare_models(ref, _FloatingStandIn(path, xyzw=True), states)
+    assert wrong["failure"] is None and min(wrong["fd"], wrong["id"]) > 1e-2, wrong
