@@ -158,6 +158,17 @@ class Reference:
             return
         pm = self.model
         self.data = pm.createData()
+        # the URDF's <dynamics damping friction>, which armdyn imports as joint friction
+        # (-damping v - friction tanh(v / v_s)) and Pinocchio's algorithms leave out; a mimic=True
+        # model drops the followers' entries, so a file with friction on a follower takes the
+        # projected reference (the follower's joint turns, its friction acts)
+        if self.how == "mimic=True" and any(
+            pm_plain_has_friction(path, name) for name in self.couplings
+        ):
+            self.model = pin.buildModelFromUrdf(str(path), *root)
+            self.how = "mimic=True drops the followers' friction; projected"
+            pm = self.model
+            self.data = pm.createData()
         # independent joints with coordinates: name -> (index in q, index in v, kind)
         self.joints: dict[str, tuple[int, int, str]] = {}
         projected = self.how.endswith("projected")
@@ -217,6 +228,11 @@ class Reference:
             out.append((q, v, tau, a))
         return out
 
+    def friction(self, v_full):
+        """The joint friction torques at the model's velocity v_full (Pinocchio order)."""
+        vs = ad._core.URDF_COULOMB_SMOOTHING
+        return -self.model.damping * v_full - self.model.friction * np.tanh(v_full / vs)
+
     def _lift(self, u):
         return u if self.G is None else self.G @ u
 
@@ -228,16 +244,31 @@ class Reference:
         return m if self.G is None else self.G.T @ m @ self.G
 
     def rnea(self, q, v, a) -> np.ndarray:
-        return self._reduce(self.pin.rnea(self.model, self.data, q, self._lift(v), self._lift(a)))
+        vf = self._lift(v)
+        tau = self.pin.rnea(self.model, self.data, q, vf, self._lift(a)) - self.friction(vf)
+        return self._reduce(tau)
 
     def forward_dynamics(self, q, v, tau, m=None) -> np.ndarray:
         if self._aba:
-            return self.pin.aba(self.model, self.data, q, v, tau)
+            return self.pin.aba(self.model, self.data, q, v, tau + self.friction(v))
         m = self.mass_matrix(q) if m is None else m
         return np.linalg.solve(m, tau - self.rnea(q, v, np.zeros(self.nv)))
 
 
 @functools.cache
+def pm_plain_has_friction(path: Path, joint: str) -> bool:
+    """Whether the URDF gives joint ``joint`` a nonzero <dynamics damping/friction>."""
+    import xml.etree.ElementTree as ET
+
+    for e in ET.parse(path).getroot().findall("joint"):
+        if e.get("name") == joint:
+            d = e.find("dynamics")
+            return d is not None and any(
+                float(d.get(k, "0") or 0) != 0.0 for k in ("damping", "friction")
+            )
+    return False
+
+
 def reference(path: Path, floating: bool) -> Reference:
     return Reference(path, floating)
 
