@@ -164,13 +164,33 @@ def simulate(
     return result
 
 
-def load_urdf(path_or_xml, fixed_base: bool = True, gravity=(0.0, 0.0, -9.81)) -> _core.Model:
+def load_urdf(
+    path_or_xml,
+    fixed_base: bool = True,
+    gravity=(0.0, 0.0, -9.81),
+    *,
+    physical_inertia: bool = True,
+) -> _core.Model:
     """Load a URDF file (or XML string) through urdfdom into a finalized Model.
 
     Links joined by fixed joints are merged into one body; joint-space arrays follow the URDF's
     document order of its moving joints. With ``fixed_base`` the root link is welded to ground.
+    Massless links (no ``<inertial>``, e.g. the "virtual" links between the joints of a 3-DOF
+    hip) are massless bodies, accepted wherever every joint motion still carries inertia.
+
+    Args:
+        physical_inertia: True (default) refuses a link inertia that is not positive
+            semi-definite or violates the triangle inequality, listing every such link with its
+            principal moments. False accepts any positive semi-definite tensor (published or
+            identified parameter sets, point masses); negative round-off moments down to
+            -1e-12 of the largest are clamped to zero with a warning.
 
     Raises:
         UrdfError: missing file, malformed XML, unsupported joint type, invalid inertial data.
+        ModelError: a joint whose motion carries no inertia (a massless leaf link, a point mass
+            on its own joint axis), naming the joint and the body.
     """
-    return _core.urdf_builder(str(path_or_xml), fixed_base, gravity).finalize()
+    builder = _core.urdf_builder(
+        str(path_or_xml), fixed_base, gravity, physical_inertia=physical_inertia
+    )
+    return builder.finalize()

@@ -304,7 +304,8 @@ std::string list_names(const std::vector<std::string>& names, size_t from) {
 
 }  // namespace
 
-ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const Vec3& gravity) {
+ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const Vec3& gravity,
+                          bool physical_inertia) {
   std::string where;
   const std::string xml = read_source(path_or_xml, &where);
   const Document document = scan_document(xml, where);
@@ -366,10 +367,15 @@ ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const
   };
 
   // merge each group: total mass, centre of mass, inertia about it (parallel-axis theorem),
-  // every link inertia rotated by its inertial rpy and its link frame into world axes first
+  // every link inertia rotated by its inertial rpy and its link frame into world axes first.
+  // Each moving link's own tensor is checked (physical_inertia: physically consistent; otherwise
+  // positive semidefinite, round-off negatives clamped) and every offender is listed at once.
+  // A group without mass (massless links between joints) is a massless body at its top link's
+  // origin; finalize() checks that every joint motion still carries inertia.
+  std::vector<std::string> bad_inertia;  // "'link' (principal moments a, b, c kg m^2: why)"
+  std::vector<std::string> clamp_notes;
   for (const std::string& top : group_order) {
     Group& g = groups.at(top);
-    const bool merged = g.links.size() > 1;
     struct Part {
       double m;
       Vec3 c;
@@ -387,16 +393,18 @@ ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const
       }
       if (in.mass < 0) throw UrdfError(msg("URDF link '", name, "': negative mass ", in.mass));
       if (is_ground(top)) continue;
-      // a merged link may be a point mass, but its inertia must still be positive semi-definite
-      // (a lone link is checked fully by add_body)
-      if (merged) {
-        const double smallest = Eigen::SelfAdjointEigenSolver<Mat3>(i_local).eigenvalues()(0);
-        if (smallest < -1e-12 * std::max(1.0, i_local.trace())) {
-          throw UrdfError(msg("URDF link '", name, "': inertia is not positive semi-definite ",
-                              "(smallest principal moment ", smallest, " kg m^2)"));
-        }
+      const InertiaCheck ic = check_inertia(i_local, physical_inertia);
+      if (!ic.problem.empty()) {
+        const Vec3& p = ic.moments;
+        bad_inertia.push_back(msg("'", name, "' (principal moments ", p[0], ", ", p[1], ", ", p[2],
+                                  " kg m^2: ", ic.problem, ")"));
+        continue;
       }
-      parts.push_back({in.mass, f.p, f.R * i_local * f.R.transpose()});
+      if (ic.warn) {
+        clamp_notes.push_back(msg("URDF link '", name, "': negative principal moment ", ic.smallest,
+                                  " kg m^2 (round-off) clamped to zero"));
+      }
+      parts.push_back({in.mass, f.p, f.R * ic.tensor * f.R.transpose()});
     }
     if (is_ground(top)) continue;
 
@@ -404,18 +412,7 @@ ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const
       g.mass += p.m;
       g.com += p.m * p.c;
     }
-    if (!(g.mass > 0)) {
-      const std::string also =
-          merged ? msg(" (nor do the links fixed to it: ", list_names(g.links, 1), ")") : "";
-      if (top == root_name) {
-        throw UrdfError(msg("URDF link '", top, "' is the root and has no mass", also,
-                            "; a floating base (fixed_base=false) needs one"));
-      }
-      const urdf::LinkConstSharedPtr link = urdf_model->getLink(top);
-      throw UrdfError(msg("URDF link '", top, "' has no mass", also, " but moves on joint '",
-                          link->parent_joint->name, "'"));
-    }
-    g.com /= g.mass;
+    g.com = g.mass > 0 ? Vec3(g.com / g.mass) : frame.at(top).p;
     Mat3 i_world = Mat3::Zero();
     for (const Part& p : parts) {
       const Vec3 d = p.c - g.com;
@@ -425,8 +422,22 @@ ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const
     const Mat3 i_body = r_top.transpose() * i_world * r_top;
     g.inertia = 0.5 * (i_body + i_body.transpose());
   }
+  if (!bad_inertia.empty()) {
+    std::string list;
+    for (const std::string& b : bad_inertia) list += (list.empty() ? "" : "; ") + b;
+    const std::string links =
+        msg(bad_inertia.size(), bad_inertia.size() == 1 ? " link: " : " links: ");
+    throw UrdfError(
+        physical_inertia
+            ? msg(where, ": inertia not physically consistent on ", links, list,
+                  "; load with physical_inertia=False to accept any positive semidefinite tensor")
+            : msg(where, ": inertia not positive semidefinite on ", links, list,
+                  " (physical_inertia=False clamps only round-off, down to -1e-12 of the largest "
+                  "moment)"));
+  }
 
-  ModelBuilder builder(gravity);
+  ModelBuilder builder(gravity, physical_inertia);
+  for (const std::string& note : clamp_notes) builder.add_warning(note);
   std::set<std::string> added;  // groups whose body exists
   auto add_group_body = [&](const std::string& top) {
     const Group& g = groups.at(top);

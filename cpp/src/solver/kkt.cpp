@@ -20,7 +20,9 @@ const LightBodies& light_bodies(const Model& m) {
     for (int i = 0; i < m.nb; ++i) {
       const Body& b = m.bodies[i];
       const double jmin = Eigen::SelfAdjointEigenSolver<Mat3>(b.inertia).eigenvalues()[0];
-      const double ratio = std::min(jmin / (b.mass * l2), b.mass / mmax * 1e3);
+      // a massless body (mass 0: finalize checked that its motions carry inertia) is as light
+      // as a body gets (jmin / 0 would be NaN and pass every test)
+      const double ratio = b.mass > 0.0 ? std::min(jmin / (b.mass * l2), b.mass / mmax * 1e3) : 0.0;
       if (ratio < 1e-6) {
         lb.bodies.push_back(i);
         lb.note += msg(lb.note.empty() ? "" : ", ", "'", b.name, "' (", ratio, ")");
@@ -60,7 +62,8 @@ KktSolver::KktSolver(const Model& m)
   double mmax = 0.0;
   for (const Body& b : m.bodies) mmax = std::max(mmax, b.mass);
   for (int i : light_bodies(m).bodies) {
-    const double mass = std::max(m.bodies[i].mass, 1e-9 * mmax);
+    double mass = std::max(m.bodies[i].mass, 1e-9 * mmax);
+    if (!(mass > 0.0)) mass = 1.0;  // no body has mass (finalize refuses it after assembly)
     const double floor = 1e-6 * mass * m.length_scale * m.length_scale;
     minv_[i].topLeftCorner<3, 3>() = Mat3::Identity() / mass;
     minv_[i].bottomRightCorner<3, 3>() = (m.bodies[i].inertia + floor * Mat3::Identity()).inverse();

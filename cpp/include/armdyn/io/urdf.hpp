@@ -20,11 +20,19 @@ namespace armdyn {
 ///   fixed_base = false: the root group becomes a body declared free (joint "root_free").
 /// - Moving joints are added in document order, so it defines every joint-space array.
 /// - <limit> sets joint limits (continuous joints keep unbounded positions).
+/// - Massless links (no <inertial>, or mass 0) are massless bodies: accepted wherever every
+///   joint motion still carries inertia (finalize() checks it and names the joint otherwise).
+/// - physical_inertia = true: every moving link's inertia must be physically consistent
+///   (positive semidefinite, triangle inequality); the refusal lists every offending link with
+///   its principal moments. false: any positive semidefinite tensor (round-off negatives down to
+///   -1e-12 of the largest moment clamped to zero, with a warning); the returned builder keeps
+///   the setting (ModelBuilder::set_physical_inertia).
 /// - Ignored: visual, collision, material, transmission, gazebo, mimic, safety, calibration and
 ///   joint dynamics (damping/friction).
 ///
 /// @throws UrdfError on a missing file, malformed XML or URDF, floating/planar/unknown joints,
-///   zero joint axes, massless moving links or invalid inertial data (naming the culprit).
-ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const Vec3& gravity);
+///   zero joint axes or invalid inertial data (naming the culprit).
+ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const Vec3& gravity,
+                          bool physical_inertia = true);
 
 }  // namespace armdyn

@@ -1,0 +1,439 @@
+"""Massless links and the physical_inertia option (issue 21).
+
+Massless bodies (mass 0, zero inertia) and singular inertias (point masses, thin rods) are
+accepted wherever every motion the joints allow still carries inertia (the joint-space mass
+matrix is positive definite; for closed loops, Gamma positive definite on the null space of the
+joint Jacobian); finalize() refuses the others naming the joint and the body. References:
+Pinocchio (which loads any tensor) on example-robot-data's human.urdf (19 massless "virtual"
+links between the joints of its 3-DOF hips, shoulders and spine) and on the published PUMA 560
+parameters (tests/data/urdf/puma560_published_inertia.urdf), closed forms, and equivalent
+models without the massless link.
+"""
+
+import re
+import site
+import warnings
+from pathlib import Path
+
+import armdyn as ad
+import numpy as np
+import pytest
+
+from benchmarks.peers.pinocchio import mass_matrix as pin_mass_matrix
+from benchmarks.peers.pinocchio import pinocchio_tree
+
+pin = pytest.importorskip("pinocchio")
+
+DATA = Path(__file__).resolve().parents[1] / "data" / "urdf"
+PUMA = DATA / "puma560_published_inertia.urdf"
+METHODS = ("auto", "joint", "crba", "aba", "cartesian")
+
+
+def _human():
+    for base in [*site.getsitepackages(), site.getusersitepackages()]:
+        path = Path(base) / "cmeel.prefix/share/example-robot-data/robots"
+        path = path / "human_description/robots/human.urdf"
+        if path.is_file():
+            return path
+    pytest.skip("example-robot-data's human.urdf not installed")
+
+
+def _pair(path, **kw):
+    """(armdyn model, pinocchio model, perm) with q_armdyn[perm] = q_pinocchio."""
+    model = ad.load_urdf(str(path), **kw)
+    pm = pin.buildModelFromUrdf(str(path))
+    names = list(model.coord_names)
+    perm = np.array([names.index(pm.names[i]) for i in range(1, pm.njoints)])
+    return model, pm, perm
+
+
+def _worst_errors(model, pm, perm, n, seed):
+    """Worst relative errors (to the largest entry of Pinocchio's answer) of mass_matrix,
+    forward_dynamics (every method) and inverse_dynamics at n random states."""
+    pd = pm.createData()
+    rng = np.random.default_rng(seed)
+    worst = dict.fromkeys(("M", "id", *METHODS), 0.0)
+
+    def rel(a, b):
+        return float(np.abs(a - b).max() / np.abs(b).max())
+
+    for _ in range(n):
+        q, v, tau, acc = rng.uniform(-np.pi, np.pi, size=(4, pm.nq))
+        qa, va, ta, aa = (np.empty_like(x) for x in (q, v, tau, acc))
+        for x, xa in ((q, qa), (v, va), (tau, ta), (acc, aa)):
+            xa[perm] = x
+        m_ref = pin_mass_matrix(pin, pm, pd, q)
+        worst["M"] = max(worst["M"], rel(ad.mass_matrix(model, qa)[np.ix_(perm, perm)], m_ref))
+        a_ref = pin.aba(pm, pd, q, v, tau)
+        for method in METHODS:
+            a = ad.forward_dynamics(model, qa, va, ta, method=method)[perm]
+            worst[method] = max(worst[method], rel(a, a_ref))
+        t_ref = pin.rnea(pm, pd, q, v, acc)
+        worst["id"] = max(worst["id"], rel(ad.inverse_dynamics(model, qa, va, aa)[perm], t_ref))
+    return worst
+
+
+# ---------------------------------------------------------------- human.urdf (massless links
+
+
+def test_human_urdf_loads_with_its_massless_virtual_links():
+    model = ad.load_urdf(str(_human()))
+    masses = np.asarray(model.masses)
+    virtual = [n for n, m in zip(model.body_names, masses, strict=True) if m == 0.0]
+    # the 19 "virtual" links between the joints of the 3-DOF hips, shoulders, spine, ...
+    assert len(virtual) == 19 and all("virtual" in n for n in virtual)
+    assert model.n_coords == 36 and model.joint_space
+
+
+def test_human_urdf_dynamics_equal_pinocchio():
+    model, pm, perm = _pair(_human())
+    worst = _worst_errors(model, pm, perm, n=20, seed=21)
+    # measured: M 1.2e-15, forward dynamics 3.9e-14 (aba; crba/joint/auto run ABA on a model
+    # with light bodies), 6.0e-15 (cartesian), inverse dynamics 9.6e-16
+    assert max(worst.values()) <= 1e-10, worst
+
+
+def test_human_urdf_simulates_in_joint_and_cartesian_coordinates():
+    model = ad.load_urdf(str(_human()))
+    rng = np.random.default_rng(5)
+    q0 = rng.uniform(-0.5, 0.5, model.n_coords)
+    qd0 = rng.uniform(-0.5, 0.5, model.n_coords)
+    runs = {
+        c: ad.simulate(
+            model, 0.05, rtol=1e-10, atol=1e-12, q0=q0, qd0=qd0, output_dt=0.01, coordinates=c
+        )
+        for c in ("joint", "cartesian")
+    }
+    joint, cart = runs["joint"], runs["cartesian"]
+    assert "joint space" in joint.stats["formulation"]
+    assert cart.stats["formulation"].startswith("cartesian")
+    assert cart.stats["augmented_solves"] > 0  # massless bodies: no Gamma^-1
+    np.testing.assert_allclose(joint.q[0], q0, atol=1e-12)
+    # the two formulations of the same motion (measured 2.3e-13 rad, 8.1e-12 rad/s), energy
+    # conserved (measured drift 4.6e-12 and 1.0e-12 J, kinetic energy up to 6.4 J)
+    assert np.abs(joint.q - cart.q).max() <= 1e-10
+    assert np.abs(joint.qd - cart.qd).max() <= 1e-9
+    for r in (joint, cart):
+        e = np.asarray(r.total_energy)
+        assert np.abs(e - e[0]).max() <= 1e-10 * np.abs(r.kinetic_energy).max()
+    # the accelerations reported along the joint-space run are Pinocchio's ABA at its states
+    pm = pin.buildModelFromUrdf(str(_human()))
+    pd = pm.createData()
+    names = list(model.coord_names)
+    perm = np.array([names.index(pm.names[i]) for i in range(1, pm.njoints)])
+    for q, qd, qdd in zip(joint.q, joint.qd, joint.qdd, strict=True):
+        ref = pin.aba(pm, pd, q[perm], qd[perm], np.zeros(pm.nv))
+        assert np.abs(qdd[perm] - ref).max() <= 1e-10 * np.abs(ref).max()
+
+
+# ------------------------------------------------------------- hand-built massless links
+
+
+def _gimbal(massless_mass=0.0, builder=None):
+    """Two revolute joints through the origin, z (in ground) then x (in the massless link), a
+    massless link between them and an arm below: a 2-DOF universal-like chain."""
+    b = builder or ad.ModelBuilder()
+    b.add_body("virtual", massless_mass, np.zeros((3, 3)), position=(0.0, 0.0, 0.0))
+    b.add_revolute("yaw", "ground", "virtual", (0, 0, 0), (0, 0, 1))
+    b.add_body("arm", 2.0, np.diag([0.03, 0.02, 0.01]), position=(0.1, 0.2, -0.5))
+    b.add_revolute("roll", "virtual", "arm", (0, 0, 0), (1, 0, 0))
+    return b.finalize()
+
+
+GIMBAL_MASS, GIMBAL_C0 = 2.0, np.array([0.1, 0.2, -0.5])
+GIMBAL_IC = np.diag([0.03, 0.02, 0.01])
+
+
+def _rz(a):
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+
+
+def _rx(a):
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
+
+
+def _gimbal_closed_form(q):
+    """M(q) and the gravity torques G(q) of the gimbal: R = Rz(q1) Rx(q2), angular velocity
+    q1' z + q2' Rz(q1) x; M = J^T I_O J with I_O the arm's inertia about the pivot in world axes,
+    G_i = -m g . (axis_i x R c0)."""
+    m, c0, ic = GIMBAL_MASS, GIMBAL_C0, GIMBAL_IC
+    r = _rz(q[0]) @ _rx(q[1])
+    i_pivot = ic + m * (c0 @ c0 * np.eye(3) - np.outer(c0, c0))
+    i_o = r @ i_pivot @ r.T
+    axes = np.column_stack([[0, 0, 1], _rz(q[0]) @ [1, 0, 0]])
+    g = np.array([0.0, 0.0, -9.81])
+    grav = np.array([-m * g @ np.cross(axes[:, k], r @ c0) for k in range(2)])
+    return axes.T @ i_o @ axes, grav
+
+
+def test_massless_intermediate_link_equals_the_closed_form():
+    model = _gimbal()
+    assert list(model.masses) == [0.0, 2.0]
+    rng = np.random.default_rng(2)
+    for _ in range(10):
+        q = rng.uniform(-np.pi, np.pi, 2)
+        m_ref, g_ref = _gimbal_closed_form(q)
+        # measured 2.2e-16 (|M| <= 0.61 kg m^2), 1.8e-15 (|G| <= 8.7 N m), 2.2e-15 relative
+        np.testing.assert_allclose(ad.mass_matrix(model, q), m_ref, rtol=0, atol=1e-14)
+        tau = ad.inverse_dynamics(model, q, np.zeros(2), np.zeros(2))
+        np.testing.assert_allclose(tau, g_ref, rtol=0, atol=1e-13)
+        # forward dynamics at rest: M qdd = tau_in - G, every method
+        tau_in = rng.uniform(-1, 1, 2)
+        qdd_ref = np.linalg.solve(m_ref, tau_in - g_ref)
+        for method in METHODS:
+            qdd = ad.forward_dynamics(model, q, np.zeros(2), tau_in, method=method)
+            assert np.abs(qdd - qdd_ref).max() <= 1e-12 * np.abs(qdd_ref).max(), method
+
+
+def test_massless_intermediate_link_equals_pinocchio_with_velocities():
+    # the same chain rebuilt in Pinocchio from the model's own data (a different library's
+    # ABA, RNEA and CRBA; a massless body is a zero Inertia there)
+    model = _gimbal()
+    pm, idx = pinocchio_tree(model)
+    worst = _worst_errors(model, pm, np.argsort(idx), n=20, seed=4)
+    # measured <= 2.4e-15
+    assert max(worst.values()) <= 1e-12, worst
+
+
+def test_massless_intermediate_link_equals_a_universal_joint():
+    # merged away, the massless link is a universal joint (axis 1 fixed in ground, axis 2 in
+    # the arm): the arm's Cartesian accelerations agree at random joint states
+    chain = _gimbal()
+    b = ad.ModelBuilder()
+    b.add_body("arm", 2.0, np.diag([0.03, 0.02, 0.01]), position=(0.1, 0.2, -0.5))
+    b.add_universal("cardan", "ground", "arm", (0, 0, 0), (0, 0, 1), (1, 0, 0))
+    cardan = b.finalize()
+    rng = np.random.default_rng(8)
+    for _ in range(10):
+        q, qd = rng.uniform(-1.2, 1.2, size=(2, 2))
+        u, v = ad.state_from_joints(chain, q, qd)
+        vdot_chain, _ = ad.body_accelerations(chain, u, v)
+        vdot_cardan, _ = ad.body_accelerations(cardan, u[7:], v[6:])
+        ref = vdot_cardan
+        # measured <= 9.7e-15
+        assert np.abs(vdot_chain[6:] - ref).max() <= 1e-12 * np.abs(ref).max()
+        # and the joint-space path gives the same arm motion
+        qdd = ad.forward_dynamics(chain, q, qd, np.zeros(2))
+        _, v1 = ad.state_from_joints(chain, q + 1e-6 * qd, qd + 1e-6 * qdd)
+        _, v0 = ad.state_from_joints(chain, q - 1e-6 * qd, qd - 1e-6 * qdd)
+        fd = (v1[6:] - v0[6:]) / 2e-6  # d/dt of the arm's (xdot, omega_body)
+        # central difference, O(h^2): measured <= 2.1e-11
+        assert np.abs(fd - ref).max() <= 1e-8 * np.abs(ref).max()
+
+
+def test_massless_coupler_in_a_closed_loop_equals_a_distance_joint():
+    # a planar four-bar whose coupler is a massless link on revolute joints moves as the same
+    # four-bar with the coupler replaced by a distance joint (a massless rod with ball ends):
+    # Gamma is positive definite on the loop's null space though the coupler has no mass
+    a, bpt, c, d = (
+        np.array(p, float) for p in ((0, 0, 0), (0.3, 0, 0.4), (1.1, 0, 0.7), (1, 0, 0))
+    )
+    y = (0, 1, 0)
+
+    def four_bar(massless_coupler):
+        b = ad.ModelBuilder()
+        b.add_body("crank", 1.0, np.diag([0.02, 0.02, 0.001]), position=(a + bpt) / 2)
+        b.add_body("rocker", 1.5, np.diag([0.05, 0.05, 0.002]), position=(c + d) / 2)
+        b.add_revolute("A", "ground", "crank", a, y)
+        b.add_revolute("D", "ground", "rocker", d, y)
+        if massless_coupler:
+            b.add_body("coupler", 0.0, np.zeros((3, 3)), position=(bpt + c) / 2)
+            b.add_revolute("B", "crank", "coupler", bpt, y)
+            b.add_revolute("C", "coupler", "rocker", c, y)
+        else:
+            b.add_distance("rod", "crank", bpt, "rocker", c)
+        return b.finalize()
+
+    loop, rod = four_bar(True), four_bar(False)
+    assert loop.mobility == 1 and rod.mobility == 1
+    vdot_loop, _ = ad.body_accelerations(loop, loop.u0, loop.v0)
+    vdot_rod, _ = ad.body_accelerations(rod, rod.u0, rod.v0)
+    ref = vdot_rod[:12]
+    # measured 8.8e-16
+    assert np.abs(vdot_loop[:12] - ref).max() <= 1e-10 * np.abs(ref).max()
+    # and a swing under gravity: the crank's and rocker's motion agree
+    r_loop = ad.simulate(loop, 0.3, rtol=1e-10, atol=1e-12, output_dt=0.05)
+    r_rod = ad.simulate(rod, 0.3, rtol=1e-10, atol=1e-12, output_dt=0.05)
+    # measured 7.5e-13 (the loop's run takes the augmented solve: massless coupler)
+    assert r_loop.stats["augmented_solves"] > 0
+    assert np.abs(r_loop.u[:, :14] - r_rod.u[:, :14]).max() <= 1e-10
+    assert np.abs(r_loop.u[-1, :3] - r_loop.u[0, :3]).max() > 1e-2  # it moved
+
+
+# ------------------------------------------------------------------------- refusals
+
+
+def test_massless_leaf_is_refused_naming_the_joint_and_the_body():
+    b = ad.ModelBuilder()
+    b.add_body("arm", 1.0, np.diag([0.01, 0.01, 0.01]), position=(0.5, 0, 0))
+    b.add_revolute("shoulder", "ground", "arm", (0, 0, 0), (0, 0, 1))
+    b.add_body("hand", 0.0, np.zeros((3, 3)), position=(1.0, 0, 0))
+    b.add_revolute("wrist", "arm", "hand", (1.0, 0, 0), (0, 1, 0))
+    with pytest.raises(ad.ModelError, match=r"joint 'wrist' carries no inertia.*body 'hand'"):
+        b.finalize()
+    # a point mass on its own joint axis: that joint's motion carries no inertia either
+    b2 = ad.ModelBuilder()
+    b2.add_body("arm", 1.0, np.diag([0.01, 0.01, 0.01]), position=(0.5, 0, 0))
+    b2.add_revolute("shoulder", "ground", "arm", (0, 0, 0), (0, 0, 1))
+    b2.add_body("ball", 2.0, np.zeros((3, 3)), position=(1.0, 0, 0))
+    b2.add_revolute("spin", "arm", "ball", (1.0, 0, 0), (1, 0, 0))
+    with pytest.raises(ad.ModelError, match=r"joint 'spin' carries no inertia.*body 'ball'"):
+        b2.finalize()
+    # off its axis, the point mass carries the joint's motion
+    b3 = ad.ModelBuilder()
+    b3.add_body("ball", 2.0, np.zeros((3, 3)), position=(1.0, 0, 0))
+    b3.add_revolute("swing", "ground", "ball", (0, 0, 0), (0, 1, 0))
+    m = b3.finalize()
+    np.testing.assert_allclose(ad.mass_matrix(m, [0.3]), [[2.0]], rtol=1e-14)
+
+
+def test_massless_link_between_aligned_axes_is_refused_naming_both_joints():
+    # the massless link can spin between two coaxial joints with nothing moving
+    b = ad.ModelBuilder()
+    b.add_body("virtual", 0.0, np.zeros((3, 3)))
+    b.add_revolute("j1", "ground", "virtual", (0, 0, 0), (0, 0, 1))
+    b.add_body("arm", 1.0, np.diag([0.01, 0.01, 0.01]), position=(0.5, 0, 0))
+    b.add_revolute("j2", "virtual", "arm", (0, 0, 0), (0, 0, 1))
+    with pytest.raises(
+        ad.ModelError, match=r"joints 'j1', 'j2' carries no inertia.*body 'virtual'"
+    ):
+        b.finalize()
+
+
+def test_massless_coupler_on_ball_joints_is_refused():
+    # a massless coupler with spherical ends spins freely about its own line (Cartesian check)
+    b = ad.ModelBuilder()
+    b.add_body("crank", 1.0, np.diag([0.02, 0.02, 0.001]), position=(0.15, 0, 0.2))
+    b.add_body("rocker", 1.5, np.diag([0.05, 0.05, 0.002]), position=(1.05, 0, 0.35))
+    b.add_revolute("A", "ground", "crank", (0, 0, 0), (0, 1, 0))
+    b.add_revolute("D", "ground", "rocker", (1, 0, 0), (0, 1, 0))
+    b.add_body("coupler", 0.0, np.zeros((3, 3)), position=(0.7, 0, 0.55))
+    b.add_spherical("B", "crank", "coupler", (0.3, 0, 0.4))
+    b.add_spherical("C", "coupler", "rocker", (1.1, 0, 0.7))
+    with pytest.raises(ad.ModelError, match=r"joints 'B', 'C'.*no inertia.*'coupler'"):
+        b.finalize()
+
+
+def test_massless_leaf_urdf_is_refused_at_finalize():
+    with pytest.raises(ad.ModelError, match=r"'wrist'.*'hand'"):
+        ad.load_urdf(DATA / "bad_massless_moving.urdf")
+    # the refusal comes from finalize: the builder itself holds the massless body
+    builder = ad.urdf_builder(str(DATA / "bad_massless_moving.urdf"))
+    assert "hand" in builder.body_names
+
+
+def test_a_model_with_no_mass_at_all_is_refused():
+    b = ad.ModelBuilder()
+    b.add_body("ghost", 0.0, np.zeros((3, 3)), position=(0.0, 0.0, -1.0))
+    b.add_revolute("hinge", "ground", "ghost", (0, 0, 0), (0, 1, 0))
+    with pytest.raises(ad.ModelError, match=r"'hinge'.*'ghost'"):
+        b.finalize()
+
+
+def test_negative_mass_is_still_refused():
+    with pytest.raises(ad.ModelError, match=r"heavy.*negative"):
+        ad.ModelBuilder().add_body("heavy", -1e-9, np.zeros((3, 3)))
+
+
+# ------------------------------------------------------------------- physical_inertia
+
+
+def test_builder_option_accepts_a_triangle_violation():
+    bad = np.diag([0.1, 0.1, 0.3])
+    b = ad.ModelBuilder()
+    assert b.physical_inertia is True
+    with pytest.raises(ad.ModelError, match=r"weird.*triangle.*physical_inertia=False"):
+        b.add_body("weird", 1.0, bad)
+    b = ad.ModelBuilder(physical_inertia=False)
+    assert b.add_body("weird", 1.0, bad, position=(0, 0, -1)) == 0
+    b.add_revolute("hinge", "ground", "weird", (0, 0, 0), (1, 0, 0))
+    m = b.finalize()
+    # about the hinge (x): J_xx + m l^2 = 0.1 + 1
+    np.testing.assert_allclose(ad.mass_matrix(m, [0.2]), [[1.1]], rtol=1e-14)
+    # the attribute switches it for the bodies added afterwards
+    b = ad.ModelBuilder(physical_inertia=False)
+    b.physical_inertia = True
+    with pytest.raises(ad.ModelError, match="weird"):
+        b.add_body("weird", 1.0, bad)
+
+
+@pytest.mark.parametrize("physical", [True, False])
+def test_negative_moments_beyond_round_off_are_refused_in_both_modes(physical):
+    b = ad.ModelBuilder(physical_inertia=physical)
+    with pytest.raises(ad.ModelError, match=r"flat.*not positive semidefinite"):
+        b.add_body("flat", 1.0, np.diag([0.1, 0.1, -1e-9]))
+    assert b.body_names == []
+
+
+def test_round_off_negative_moment_is_clamped_with_a_warning():
+    b = ad.ModelBuilder(physical_inertia=False)
+    b.add_body("rod", 1.0, np.diag([1.0, 1.0, -3e-13]), position=(0, 0, -1))
+    b.add_revolute("hinge", "ground", "rod", (0, 0, 0), (0, 1, 0))
+    with pytest.warns(UserWarning, match=r"body 'rod'.*clamped to zero") as rec:
+        m = b.finalize()
+    assert _clamped_moment(rec) == pytest.approx(-3e-13, rel=1e-12)
+    np.testing.assert_array_equal(np.asarray(m.inertias)[0], np.diag([1.0, 1.0, 0.0]))
+    # pure rotation round-off (below 64 eps of the largest moment) is clamped silently
+    r = _rz(0.3) @ _rx(0.7)
+    b = ad.ModelBuilder(physical_inertia=False)
+    b.add_body("rod", 1.0, r @ np.diag([1.0, 1.0, 0.0]) @ r.T, position=(0, 0, -1))
+    b.add_revolute("hinge", "ground", "rod", (0, 0, 0), (0, 1, 0))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        b.finalize()
+
+
+def _clamped_moment(record):
+    """The negative principal moment a clamping warning reports."""
+    (text,) = [str(w.message) for w in record if "clamped" in str(w.message)]
+    return float(re.search(r"negative principal moment (\S+) kg m\^2", text).group(1))
+
+
+def test_puma560_published_inertias_are_refused_listing_every_link():
+    with pytest.raises(ad.UrdfError) as err:
+        ad.load_urdf(PUMA)
+    text = str(err.value)
+    # both offenders, each with its principal moments, and the option
+    assert "2 links" in text
+    assert "'link1' (principal moments 0, 0, 0.34999999999999998 kg m^2" in text
+    assert "'link3' (principal moments 0.012499999999999999, 0.066000000000000003, " in text
+    assert text.count("triangle inequality") == 2
+    assert "physical_inertia=False" in text
+    assert "'link2'" not in text
+
+
+def test_puma560_published_inertias_load_with_the_option_and_equal_pinocchio():
+    model, pm, perm = _pair(PUMA, physical_inertia=False)
+    assert list(model.masses) == [0.0, 17.4, 4.8]
+    worst = _worst_errors(model, pm, perm, n=30, seed=560)
+    # measured: 2.3e-15 (M), 2.9e-15 (forward, every method), 3.7e-15 (inverse)
+    assert max(worst.values()) <= 1e-10, worst
+    # link1: mass 0, 0.35 kg m^2 about the joint-1 axis (its y axis turned onto z)
+    assert np.isclose(np.asarray(model.inertias)[0][2, 2], 0.35, rtol=1e-15, atol=0)
+
+
+def test_urdf_option_clamps_round_off_with_a_warning_naming_the_link(tmp_path):
+    text = PUMA.read_text().replace(
+        'ixx="0.066" ixy="0" ixz="0" iyy="0.086" iyz="0" izz="0.0125"',
+        'ixx="0.066" ixy="0" ixz="0" iyy="0.086" iyz="0" izz="-2e-14"',
+    )
+    path = tmp_path / "puma_round_off.urdf"
+    path.write_text(text)
+    with pytest.warns(UserWarning, match=r"URDF link 'link3'.*clamped to zero") as rec:
+        model = ad.load_urdf(path, physical_inertia=False)
+    assert _clamped_moment(rec) == pytest.approx(-2e-14, rel=1e-12)
+    assert np.linalg.eigvalsh(np.asarray(model.inertias)[2]).min() >= 0.0
+    # beyond round-off it is refused even with the option, naming the link
+    path.write_text(text.replace('izz="-2e-14"', 'izz="-1e-6"'))
+    with pytest.raises(ad.UrdfError, match=r"'link3'.*not positive semidefinite"):
+        ad.load_urdf(path, physical_inertia=False)
+
+
+def test_urdf_builder_keeps_the_option():
+    builder = ad.urdf_builder(str(PUMA), physical_inertia=False)
+    assert builder.physical_inertia is False
+    builder.add_body("tool", 0.5, np.diag([0.1, 0.1, 0.3]), position=(0.5, 0.0, 0.6604))
+    builder.add_revolute("tool_joint", "link3", "tool", (0.5, 0.0, 0.6604), (1, 0, 0))
+    assert builder.finalize().n_coords == 4
