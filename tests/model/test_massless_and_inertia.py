@@ -324,6 +324,16 @@ def test_massless_leaf_urdf_is_refused_at_finalize():
     assert "hand" in builder.body_names
 
 
+def test_an_inertial_urdfdom_resets_is_not_taken_for_a_massless_link():
+    # urdfdom resets an <inertial> whose origin holds a NaN to mass 0 and zero inertia: the
+    # loader compares with the file's declaration instead of loading a massless carriage
+    text = (DATA / "slider.urdf").read_text()
+    bad = text.replace('<origin xyz="0.01 0 -0.005"', '<origin xyz="nan 0 -0.005"')
+    assert bad != text
+    with pytest.raises(ad.UrdfError, match=r"'carriage'.*could not read.*declares 1.5 kg"):
+        ad.load_urdf(bad)
+
+
 def test_a_model_with_no_mass_at_all_is_refused():
     b = ad.ModelBuilder()
     b.add_body("ghost", 0.0, np.zeros((3, 3)), position=(0.0, 0.0, -1.0))

@@ -20,6 +20,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <exception>
@@ -302,6 +303,52 @@ std::string list_names(const std::vector<std::string>& names, size_t from) {
   return s;
 }
 
+// What the file declares in the <inertial> of the links urdfdom reports as massless. urdfdom
+// resets an <inertial> it cannot fully read (a NaN in its origin) to mass 0 and zero inertia but
+// keeps it, which a massless link must not hide: parsed once, only when such a link exists.
+class DeclaredInertials {
+ public:
+  explicit DeclaredInertials(const std::string& xml) : xml_(xml) {}
+  // throws when the file's <inertial> of `link` differs from urdfdom's (mass 0) reading
+  void check(const std::string& link, const urdf::Inertial& in) {
+    if (!parsed_) parse();
+    auto it = declared_.find(link);
+    if (it == declared_.end()) return;
+    const std::array<double, 7>& d = it->second;
+    const std::array<double, 7> got{in.mass, in.ixx, in.ixy, in.ixz, in.iyy, in.iyz, in.izz};
+    if (d != got) {
+      throw UrdfError(msg("URDF link '", link, "': urdfdom could not read its <inertial> (it ",
+                          "reports mass ", in.mass, " kg, the file declares ", d[0], " kg)"));
+    }
+  }
+
+ private:
+  void parse() {
+    parsed_ = true;
+    tinyxml2::XMLDocument doc;
+    if (doc.Parse(xml_.c_str(), xml_.size()) != tinyxml2::XML_SUCCESS) return;
+    const tinyxml2::XMLElement* robot = doc.FirstChildElement("robot");
+    if (!robot) return;
+    for (auto* e = robot->FirstChildElement("link"); e; e = e->NextSiblingElement("link")) {
+      const tinyxml2::XMLElement* in = e->FirstChildElement("inertial");
+      if (!in) continue;
+      std::array<double, 7> d{};
+      const tinyxml2::XMLElement* mass = in->FirstChildElement("mass");
+      const tinyxml2::XMLElement* inertia = in->FirstChildElement("inertia");
+      if (mass) mass->QueryDoubleAttribute("value", &d[0]);
+      int k = 1;
+      for (const char* a : {"ixx", "ixy", "ixz", "iyy", "iyz", "izz"}) {
+        if (inertia) inertia->QueryDoubleAttribute(a, &d[k]);
+        ++k;
+      }
+      declared_[attribute(e, "name")] = d;
+    }
+  }
+  const std::string& xml_;
+  bool parsed_ = false;
+  std::map<std::string, std::array<double, 7>> declared_;
+};
+
 }  // namespace
 
 ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const Vec3& gravity,
@@ -374,6 +421,7 @@ ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const
   // origin; finalize() checks that every joint motion still carries inertia.
   std::vector<std::string> bad_inertia;  // "'link' (principal moments a, b, c kg m^2: why)"
   std::vector<std::string> clamp_notes;
+  DeclaredInertials declared(xml);
   for (const std::string& top : group_order) {
     Group& g = groups.at(top);
     struct Part {
@@ -393,6 +441,7 @@ ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const
       }
       if (in.mass < 0) throw UrdfError(msg("URDF link '", name, "': negative mass ", in.mass));
       if (is_ground(top)) continue;
+      if (in.mass == 0.0) declared.check(name, in);
       const InertiaCheck ic = check_inertia(i_local, physical_inertia);
       if (!ic.problem.empty()) {
         const Vec3& p = ic.moments;
