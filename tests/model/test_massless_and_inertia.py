@@ -29,13 +29,16 @@ PUMA = DATA / "puma560_published_inertia.urdf"
 METHODS = ("auto", "joint", "crba", "aba", "cartesian")
 
 
-def _human():
+def _erd(name):
     for base in [*site.getsitepackages(), site.getusersitepackages()]:
-        path = Path(base) / "cmeel.prefix/share/example-robot-data/robots"
-        path = path / "human_description/robots/human.urdf"
+        path = Path(base) / "cmeel.prefix/share/example-robot-data/robots" / name
         if path.is_file():
             return path
-    pytest.skip("example-robot-data's human.urdf not installed")
+    pytest.skip(f"example-robot-data's {name} not installed")
+
+
+def _human():
+    return _erd("human_description/robots/human.urdf")
 
 
 def _pair(path, **kw):
@@ -447,3 +450,48 @@ def test_urdf_builder_keeps_the_option():
     builder.add_body("tool", 0.5, np.diag([0.1, 0.1, 0.3]), position=(0.5, 0.0, 0.6604))
     builder.add_revolute("tool_joint", "link3", "tool", (0.5, 0.0, 0.6604), (1, 0, 0))
     assert builder.finalize().n_coords == 4
+
+
+def test_cad_point_mass_noise_is_clamped_against_the_robot_scale(tmp_path):
+    # CAD exports write point masses as tensors of 1e-20 with either sign (icub): round-off
+    # against the robot's largest link moment (0.539 kg m^2 here), though not against the
+    # tensor's own (0)
+    text = PUMA.read_text().replace(
+        'ixx="0.066" ixy="0" ixz="0" iyy="0.086" iyz="0" izz="0.0125"',
+        'ixx="-5.42101e-20" ixy="0" ixz="0" iyy="-5.42101e-20" iyz="0" izz="0"',
+    )
+    path = tmp_path / "puma_cad_point_mass.urdf"
+    path.write_text(text)
+    with pytest.raises(
+        ad.UrdfError, match=r"'link3' \(principal moments -5.42100999.*not positive semidefinite"
+    ):
+        ad.load_urdf(path)
+    with pytest.warns(UserWarning, match=r"URDF link 'link3'.*clamped to zero") as rec:
+        model = ad.load_urdf(path, physical_inertia=False)
+    assert _clamped_moment(rec) == pytest.approx(-5.42101e-20, rel=1e-12)
+    # a point mass: no negative moment left, the others zero to the eigensolver's round-off
+    # (measured 1.5e-32)
+    inertia = np.asarray(model.inertias)[2]
+    assert np.linalg.eigvalsh(inertia).min() >= 0.0 and np.abs(inertia).max() <= 1e-30
+    # a point mass off its joint axis: the model is well posed and equals Pinocchio
+    pm = pin.buildModelFromUrdf(str(path))
+    worst = _worst_errors(model, pm, np.arange(3), n=10, seed=3)
+    assert max(worst.values()) <= 1e-10, worst
+
+
+def test_icub_reduced_loads_with_the_option_and_equals_pinocchio():
+    # six links of icub_reduced.urdf hold point masses written as tensors of +-1e-20: refused by
+    # default (listing them), loaded with physical_inertia=False (clamped, with warnings)
+    path = _erd("icub_description/robots/icub_reduced.urdf")
+    with pytest.raises(ad.UrdfError, match=r"'r_hip_2'.*physical_inertia=False"):
+        ad.load_urdf(path)
+    with warnings.catch_warnings(record=True) as rec:
+        warnings.simplefilter("always")
+        model, pm, perm = _pair(path, physical_inertia=False)
+    clamped = sorted(re.search(r"URDF link '(\w+)'", str(w.message)).group(1) for w in rec)
+    assert clamped == sorted(
+        ["head", "r_hip_2", "r_upper_leg", "r_lower_leg", "r_ankle_2", "l_ankle_2"]
+    )
+    worst = _worst_errors(model, pm, perm, n=5, seed=29)
+    # measured 2.5e-14
+    assert max(worst.values()) <= 1e-10, worst

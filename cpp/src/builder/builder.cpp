@@ -31,7 +31,7 @@ Vec3 unit_axis(const Vec3& a, const std::string& what) {
 
 }  // namespace
 
-InertiaCheck check_inertia(const Mat3& inertia, bool physical) {
+InertiaCheck check_inertia(const Mat3& inertia, bool physical, double scale) {
   InertiaCheck c;
   c.tensor = inertia;
   Eigen::SelfAdjointEigenSolver<Mat3> es(inertia);
@@ -51,13 +51,13 @@ InertiaCheck check_inertia(const Mat3& inertia, bool physical) {
   // any positive semidefinite tensor; negatives down to -1e-12 of the largest moment are
   // round-off, clamped to zero (a warning unless they are the round-off of a rotation)
   const double largest = std::max(p[2], 0.0);
-  if (!(p[0] >= -1e-12 * largest)) {
+  if (!(p[0] >= -1e-12 * std::max(largest, scale))) {
     c.problem = "is not positive semidefinite";
     return c;
   }
   if (p[0] < 0.0) {
     c.clamped = true;
-    c.warn = p[0] < -64.0 * std::numeric_limits<double>::epsilon() * largest;
+    c.warn = !(p[0] >= -64.0 * std::numeric_limits<double>::epsilon() * largest);
     const Vec3 q = p.cwiseMax(0.0);
     c.moments = q;
     const Mat3 t = es.eigenvectors() * q.asDiagonal() * es.eigenvectors().transpose();

@@ -110,7 +110,8 @@ void check_motions_carry_inertia(const Model& m) {
     }
   if (nbod > 8) bodies += ", ...";
   throw ModelError(msg("finalize: the motion of joint", nj > 1 ? "s " : " ", joints,
-                       " carries no inertia: it moves only body", nbod > 1 ? "s " : " ", bodies,
+                       " carries no inertia: it moves only ", nbod > 1 ? "bodies " : "body ",
+                       bodies,
                        ", so the mass matrix is singular (give the body mass or inertia about "
                        "that motion, or make the joint fixed)"));
 }

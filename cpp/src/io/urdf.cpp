@@ -422,6 +422,20 @@ ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const
   std::vector<std::string> bad_inertia;  // "'link' (principal moments a, b, c kg m^2: why)"
   std::vector<std::string> clamp_notes;
   DeclaredInertials declared(xml);
+  // the robot's largest link moment: the scale of round-off in its tensors (physical_inertia
+  // false: CAD exports write point masses as tensors of 1e-20 with either sign)
+  double robot_moment = 0.0;
+  for (const std::string& top : group_order) {
+    if (is_ground(top)) continue;
+    for (const std::string& name : groups.at(top).links) {
+      const urdf::LinkConstSharedPtr link = urdf_model->getLink(name);
+      if (!link->inertial) continue;
+      const Mat3 i_local = inertia_matrix(*link->inertial);
+      if (!i_local.allFinite()) continue;  // refused below
+      robot_moment =
+          std::max(robot_moment, Eigen::SelfAdjointEigenSolver<Mat3>(i_local).eigenvalues()(2));
+    }
+  }
   for (const std::string& top : group_order) {
     Group& g = groups.at(top);
     struct Part {
@@ -442,7 +456,7 @@ ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const
       if (in.mass < 0) throw UrdfError(msg("URDF link '", name, "': negative mass ", in.mass));
       if (is_ground(top)) continue;
       if (in.mass == 0.0) declared.check(name, in);
-      const InertiaCheck ic = check_inertia(i_local, physical_inertia);
+      const InertiaCheck ic = check_inertia(i_local, physical_inertia, robot_moment);
       if (!ic.problem.empty()) {
         const Vec3& p = ic.moments;
         bad_inertia.push_back(msg("'", name, "' (principal moments ", p[0], ", ", p[1], ", ", p[2],
@@ -481,8 +495,9 @@ ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const
             ? msg(where, ": inertia not physically consistent on ", links, list,
                   "; load with physical_inertia=False to accept any positive semidefinite tensor")
             : msg(where, ": inertia not positive semidefinite on ", links, list,
-                  " (physical_inertia=False clamps only round-off, down to -1e-12 of the largest "
-                  "moment)"));
+                  " (physical_inertia=False clamps only round-off, down to -1e-12 of the "
+                  "largest moment, ",
+                  robot_moment, " kg m^2)"));
   }
 
   ModelBuilder builder(gravity, physical_inertia);

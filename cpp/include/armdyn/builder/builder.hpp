@@ -25,7 +25,11 @@ struct InertiaCheck {
   bool warn = false;            ///< ... and they exceed the round-off of rotating a tensor
   double smallest = 0.0;        ///< the smallest principal moment before clamping
 };
-InertiaCheck check_inertia(const Mat3& inertia, bool physical);
+/// physical = false: negative moments down to -1e-12 max(largest moment, scale) are round-off,
+/// clamped (the URDF reader passes the robot's largest link moment as scale: CAD exports write
+/// point masses as tensors of 1e-20 with either sign); a warning when below -64 eps of the
+/// tensor's own largest moment (above it, they are the round-off of rotating the tensor).
+InertiaCheck check_inertia(const Mat3& inertia, bool physical, double scale = 0.0);
 
 class ModelBuilder {
  public:
