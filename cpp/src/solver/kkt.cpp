@@ -61,10 +61,16 @@ KktSolver::KktSolver(const Model& m)
   // by an almost free rotation of a nearly inertia-less body
   double mmax = 0.0;
   for (const Body& b : m.bodies) mmax = std::max(mmax, b.mass);
+  // A massless body (mass 0: a "virtual" link between joints) has no mass to weight by at all:
+  // its metric is a thousandth of the heaviest body's, and its inertia floor a thousandth of
+  // that times l^2, which keeps the projections' Schur complement conditioned like a model of
+  // ordinary links (the 1e-9 and 1e-6 floors of light bodies made it ~1e15 there, and the
+  // position projection of a falling human.urdf stalled at 1e-9)
   for (int i : light_bodies(m).bodies) {
-    double mass = std::max(m.bodies[i].mass, 1e-9 * mmax);
+    const bool massless = !(m.bodies[i].mass > 0.0);
+    double mass = massless ? 1e-3 * mmax : std::max(m.bodies[i].mass, 1e-9 * mmax);
     if (!(mass > 0.0)) mass = 1.0;  // no body has mass (finalize refuses it after assembly)
-    const double floor = 1e-6 * mass * m.length_scale * m.length_scale;
+    const double floor = (massless ? 1e-3 : 1e-6) * mass * m.length_scale * m.length_scale;
     minv_[i].topLeftCorner<3, 3>() = Mat3::Identity() / mass;
     minv_[i].bottomRightCorner<3, 3>() = (m.bodies[i].inertia + floor * Mat3::Identity()).inverse();
   }
