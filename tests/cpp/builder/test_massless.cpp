@@ -5,10 +5,14 @@
 #include <string>
 
 #include "armdyn/algorithm/crba.hpp"
+#include "armdyn/algorithm/dynamics.hpp"
+#include "armdyn/algorithm/kkt.hpp"
+#include "armdyn/analysis/joint_space.hpp"
 #include "armdyn/builder/builder.hpp"
 #include "armdyn/builder/weld.hpp"
 #include "armdyn/data.hpp"
 #include "armdyn/errors.hpp"
+#include "armdyn/solver/kkt.hpp"
 #include "check.hpp"
 #include "models.hpp"
 
@@ -139,6 +143,27 @@ TEST_CASE(physical_inertia_option) {
   Data d(*m);
   const VecX q = VecX::Zero(2);
   CHECK_NEAR(crba(*m, d, q)(0, 0), 0.1 + 1.0 + 4.0 + 1.0, 1e-13);
+}
+
+TEST_CASE(massless_link_dynamics_refined_range_space_equals_the_augmented_solve) {
+  const ModelPtr m = gimbal().finalize();
+  CHECK(light_bodies(*m).massless_only);
+  Data d(*m);
+  const VecX q = Eigen::Vector2d(0.4, -1.1), qd = Eigen::Vector2d(1.3, -0.7);
+  VecX u, v, vd(m->nv);
+  state_from_joints(*m, q, qd, u, v);
+  body_accelerations(*m, d, 0.0, u.data(), v.data(), vd.data());
+  CHECK(d.stats.augmented_solves == 0);  // the refined solve converged
+  CHECK(constraint_residual(d.ce, m->nc, vd) < 1e-14);
+  // the dense LU of [Gamma zeta^T; zeta 0] at the same evaluation
+  VecX vd2(m->nv), delta2(m->nc);
+  CHECK(d.kkt.accelerations_augmented(d.ce, m->nc, d.eta, vd2, delta2));
+  CHECK_MAT_NEAR(vd.tail<6>(), vd2.tail<6>(), 1e-13 * vd2.cwiseAbs().maxCoeff());
+  // and the joint-space path
+  Data dj(*m);
+  const VecX qdd = forward_dynamics(*m, dj, q, qd, VecX::Zero(2), 0.0, DynamicsMethod::Aba);
+  VecX qdd2 = forward_dynamics(*m, dj, q, qd, VecX::Zero(2), 0.0, DynamicsMethod::Cartesian);
+  CHECK_MAT_NEAR(qdd2, qdd, 1e-12 * qdd.cwiseAbs().maxCoeff());
 }
 
 ARMDYN_TEST_MAIN()
