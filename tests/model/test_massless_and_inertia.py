@@ -460,6 +460,43 @@ def test_urdf_option_clamps_round_off_with_a_warning_naming_the_link(tmp_path):
         ad.load_urdf(path, physical_inertia=False)
 
 
+def _link(name, mass, diag, xyz="0 0 0"):
+    ixx, iyy, izz = diag
+    return (
+        f'<link name="{name}"><inertial><origin xyz="{xyz}"/><mass value="{mass}"/>'
+        f'<inertia ixx="{ixx}" ixy="0" ixz="0" iyy="{iyy}" iyz="0" izz="{izz}"/></inertial></link>'
+    )
+
+
+def _two_link_urdf(sensor_mass, sensor_diag):
+    """An arm on a hinge with a sensor link fixed to it (merged into the arm's body)."""
+    return (
+        '<robot name="r"><link name="base"/>'
+        + _link("arm", 2.0, (0.01, 0.02, 0.02), "0.2 0 0")
+        + _link("sensor", sensor_mass, sensor_diag)
+        + '<joint name="hinge" type="continuous"><parent link="base"/><child link="arm"/>'
+        '<axis xyz="0 0 1"/></joint>'
+        '<joint name="mount" type="fixed"><parent link="arm"/><child link="sensor"/>'
+        '<origin xyz="0.4 0 0"/></joint></robot>'
+    )
+
+
+def test_merged_links_are_judged_by_their_body_as_before():
+    # a sensor link whose own tensor violates the triangle inequality (pr2's sensor_mount_link:
+    # 0.001, 0.001, 0.01) merged into a physical body loads by default, as it always did
+    model = ad.load_urdf(_two_link_urdf(0.05, (0.001, 0.001, 0.01)))
+    assert model.body_names == ["arm"]
+    # alone on its body (the arm massless), the violation is the body's: refused, naming it
+    text = _two_link_urdf(0.05, (0.001, 0.001, 0.01)).replace('"2.0"', '"0"')
+    text = text.replace(
+        'ixx="0.01" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.02"',
+        'ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"',
+    )
+    with pytest.raises(ad.UrdfError, match=r"'arm' \(merged with 'sensor'\).*triangle"):
+        ad.load_urdf(text)
+    assert ad.load_urdf(text, physical_inertia=False).masses[0] == pytest.approx(0.05, rel=1e-15)
+
+
 def test_urdf_builder_keeps_the_option():
     builder = ad.urdf_builder(str(PUMA), physical_inertia=False)
     assert builder.physical_inertia is False

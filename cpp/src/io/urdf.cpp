@@ -415,8 +415,9 @@ ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const
 
   // merge each group: total mass, centre of mass, inertia about it (parallel-axis theorem),
   // every link inertia rotated by its inertial rpy and its link frame into world axes first.
-  // Each moving link's own tensor is checked (physical_inertia: physically consistent; otherwise
-  // positive semidefinite, round-off negatives clamped) and every offender is listed at once.
+  // The tensors are checked (physical_inertia: each body's is physically consistent and each
+  // merged link's positive semidefinite, as add_body would; otherwise each link's is positive
+  // semidefinite, round-off negatives clamped) and every offender is listed at once.
   // A group without mass (massless links between joints) is a massless body at its top link's
   // origin; finalize() checks that every joint motion still carries inertia.
   std::vector<std::string> bad_inertia;  // "'link' (principal moments a, b, c kg m^2: why)"
@@ -438,6 +439,7 @@ ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const
   }
   for (const std::string& top : group_order) {
     Group& g = groups.at(top);
+    const bool merged = g.links.size() > 1;
     struct Part {
       double m;
       Vec3 c;
@@ -456,7 +458,22 @@ ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const
       if (in.mass < 0) throw UrdfError(msg("URDF link '", name, "': negative mass ", in.mass));
       if (is_ground(top)) continue;
       if (in.mass == 0.0) declared.check(name, in);
-      const InertiaCheck ic = check_inertia(i_local, physical_inertia, robot_moment);
+      if (physical_inertia) {
+        // a link merged with others may be a point mass, but its inertia must still be positive
+        // semi-definite; the triangle inequality is the body's (checked below, as add_body does)
+        // (a lone link's tensor is its body's: checked here, in its own axes)
+        const InertiaCheck ic = check_inertia(i_local, true);
+        const Vec3& p = ic.moments;
+        if (merged ? p[0] < -1e-12 * std::max(1.0, i_local.trace()) : !ic.problem.empty()) {
+          bad_inertia.push_back(
+              msg("'", name, "' (principal moments ", p[0], ", ", p[1], ", ", p[2],
+                  " kg m^2: ", merged ? "is not positive semidefinite" : ic.problem, ")"));
+          continue;
+        }
+        parts.push_back({in.mass, f.p, f.R * i_local * f.R.transpose()});
+        continue;
+      }
+      const InertiaCheck ic = check_inertia(i_local, false, robot_moment);
       if (!ic.problem.empty()) {
         const Vec3& p = ic.moments;
         bad_inertia.push_back(msg("'", name, "' (principal moments ", p[0], ", ", p[1], ", ", p[2],
@@ -484,6 +501,16 @@ ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const
     const Mat3& r_top = frame.at(top).R;
     const Mat3 i_body = r_top.transpose() * i_world * r_top;
     g.inertia = 0.5 * (i_body + i_body.transpose());
+    if (physical_inertia && merged) {
+      // the body's tensor, as add_body checks it: its links' sum
+      const InertiaCheck ic = check_inertia(g.inertia, true);
+      if (!ic.problem.empty()) {
+        const Vec3& p = ic.moments;
+        const std::string also = msg(" (merged with ", list_names(g.links, 1), ")");
+        bad_inertia.push_back(msg("'", top, "'", also, " (principal moments ", p[0], ", ", p[1],
+                                  ", ", p[2], " kg m^2: ", ic.problem, ")"));
+      }
+    }
   }
   if (!bad_inertia.empty()) {
     std::string list;
