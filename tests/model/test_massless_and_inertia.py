@@ -353,6 +353,14 @@ def test_an_inertial_urdfdom_resets_is_not_taken_for_a_massless_link():
         ad.load_urdf(bad)
 
 
+def test_massless_floating_root_is_refused_naming_its_free_joint():
+    # slider.urdf's root link has no mass: fixed to ground it is no body; floating, the root can
+    # slide along the rail with the carriage at rest, a motion that carries no inertia
+    assert ad.load_urdf(DATA / "slider.urdf").n_coords == 2
+    with pytest.raises(ad.ModelError, match=r"'root_free', 'rail' carries no inertia.*'base'"):
+        ad.load_urdf(DATA / "slider.urdf", fixed_base=False)
+
+
 def test_a_model_with_no_mass_at_all_is_refused():
     b = ad.ModelBuilder()
     b.add_body("ghost", 0.0, np.zeros((3, 3)), position=(0.0, 0.0, -1.0))
