@@ -27,8 +27,9 @@ namespace {
 // the joint-space mass matrix positive definite). Velocities are scaled to one unit (angular
 // ones by the length scale l), the null space is the orthonormal complement of zeta^T's range
 // (column-pivoted QR at the rank analysis' threshold), and a motion carries no inertia when
-// N^T Gamma N has an eigenvalue below 1e-12 of its largest: exact degeneracies sit at
-// round-off (1e-16), genuine ones at the ratio of the motion's inertia to the heaviest body's.
+// N^T Gamma N has an eigenvalue below 1e-10 of its largest whose eigenvector's inertia, summed
+// body by body, is below 1e-14 of it: exact degeneracies sit at (eps lmax / gap)^2, genuine
+// ones at the ratio of the motion's inertia to the heaviest body's.
 // The message names the joints that move in such a motion and the bodies it moves.
 void check_motions_carry_inertia(const Model& m) {
   const int nb = m.nb, nv = m.nv;
@@ -68,12 +69,25 @@ void check_motions_carry_inertia(const Model& m) {
   const MatX K = N.transpose() * GN;
   Eigen::SelfAdjointEigenSolver<MatX> es(0.5 * (K + K.transpose()));
   const VecX& lam = es.eigenvalues();
-  const double threshold = 1e-12 * std::max(lam.maxCoeff(), 0.0);
-  if (lam[0] > threshold) return;
+  const double lmax = std::max(lam.maxCoeff(), 0.0);
+  if (lam[0] > 1e-10 * lmax) return;
   // the motions that carry no inertia: the joints they move and the bodies they move
   std::vector<char> joint_moves(m.joints.size(), 0), body_moves(nb, 0);
-  for (int k = 0; k < lam.size() && lam[k] <= threshold; ++k) {
+  bool degenerate = false;
+  for (int k = 0; k < lam.size() && lam[k] <= 1e-10 * lmax; ++k) {
     const VecX v = N * es.eigenvectors().col(k);
+    // the candidate's inertia as a sum of the bodies' (non-negative) shares, exact to round-off
+    // relative to itself (the eigenvalue is so only relative to the largest): below 1e-14 of
+    // the largest the mass matrix is singular to round-off (romeo's massless fingers: 1e-29;
+    // icub's neck, two point masses on nearly one axis: 1.7e-16; a 1 g bead 0.1 mm off its
+    // axis on a 1000 kg arm, accepted: 2e-13)
+    double rq = 0.0;
+    for (int b = 0; b < nb; ++b)
+      rq += m.bodies[b].mass * v.segment<3>(6 * b).squaredNorm() +
+            v.segment<3>(6 * b + 3).dot(m.bodies[b].inertia * v.segment<3>(6 * b + 3)) / (l * l);
+    if (lmax > 0.0 && rq > 1e-14 * lmax) continue;
+    degenerate = true;
+
     auto W = [&](int b) {
       return b == kGround ? Vec3(Vec3::Zero()) : Vec3(kin[b].R * v.segment<3>(6 * b + 3) / l);
     };
@@ -97,6 +111,7 @@ void check_motions_carry_inertia(const Model& m) {
     for (int b = 0; b < nb; ++b)
       if (bm[b] > 1e-6 * bmax) body_moves[b] = 1;
   }
+  if (!degenerate) return;
   std::string joints, bodies;
   int nj = 0, nbod = 0;
   for (size_t j = 0; j < joint_moves.size(); ++j)
