@@ -35,6 +35,13 @@ constexpr double kUrdfCoulombSmoothing = 1e-3;
 /// - <limit> sets joint limits (continuous joints keep unbounded positions).
 /// - <dynamics damping friction> becomes joint friction (add_joint_friction: viscous damping,
 ///   Coulomb friction smoothed with kUrdfCoulombSmoothing).
+/// - Massless links (no <inertial>, or mass 0) are massless bodies: accepted wherever every
+///   joint motion still carries inertia (finalize() checks it and names the joint otherwise).
+/// - physical_inertia = true: every moving link's inertia must be physically consistent
+///   (positive semidefinite, triangle inequality); the refusal lists every offending link with
+///   its principal moments. false: any positive semidefinite tensor (round-off negatives down to
+///   -1e-12 of the largest moment clamped to zero, with a warning); the returned builder keeps
+///   the setting (ModelBuilder::set_physical_inertia).
 /// - Ignored: visual, collision, material, transmission, gazebo, mimic, safety_controller and
 ///   calibration (their numbers are still checked).
 /// - No moving joint with fixed_base = true: a builder with no bodies (a zero-DOF model).
@@ -44,8 +51,9 @@ constexpr double kUrdfCoulombSmoothing = 1e-3;
 ///   and are valid UTF-8.
 ///
 /// @throws UrdfError on a bad source (missing, not a regular file, too large), malformed XML or
-///   URDF, bad numbers or names, floating/planar/unknown joints, zero joint axes, massless moving
-///   links or invalid inertial data (naming the culprit).
-ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const Vec3& gravity);
+///   URDF, bad numbers or names, floating/planar/unknown joints, zero joint axes or invalid
+///   inertial data (naming the culprit).
+ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const Vec3& gravity,
+                          bool physical_inertia = true);
 
 }  // namespace armdyn
