@@ -125,7 +125,7 @@ class Reference:
     else ``M^-1 (tau - bias)`` (``pin.aba`` refuses mimic joints). A ``<mimic>`` that follows a
     joint the file does not have leaves no reference (``model`` None, ``error`` says why)."""
 
-    def __init__(self, path: Path, floating: bool, project: bool = False):
+    def __init__(self, path: Path, floating: bool, project: bool = False, friction: bool = True):
         import pinocchio as pin
 
         self.pin = pin
@@ -162,8 +162,11 @@ class Reference:
         # (-damping v - friction tanh(v / v_s)) and Pinocchio's algorithms leave out; a mimic=True
         # model drops the followers' entries, so a file with friction on a follower takes the
         # projected reference (the follower's joint turns, its friction acts)
-        if self.how == "mimic=True" and any(
-            pm_plain_has_friction(path, name) for name in self.couplings
+        self.with_friction = friction
+        if (
+            friction
+            and self.how == "mimic=True"
+            and any(pm_plain_has_friction(path, name) for name in self.couplings)
         ):
             self.model = pin.buildModelFromUrdf(str(path), *root)
             self.how = "mimic=True drops the followers' friction; projected"
@@ -230,6 +233,8 @@ class Reference:
 
     def friction(self, v_full):
         """The joint friction torques at the model's velocity v_full (Pinocchio order)."""
+        if not self.with_friction:
+            return np.zeros_like(v_full)
         vs = ad._core.URDF_COULOMB_SMOOTHING
         return -self.model.damping * v_full - self.model.friction * np.tanh(v_full / vs)
 

@@ -31,7 +31,7 @@ namespace {
 // body by body, is below 1e-14 of it: exact degeneracies sit at (eps lmax / gap)^2, genuine
 // ones at the ratio of the motion's inertia to the heaviest body's.
 // The message names the joints that move in such a motion and the bodies it moves.
-void check_motions_carry_inertia(const Model& m) {
+void check_motions_carry_inertia(const Model& m, const VecX& u) {
   const int nb = m.nb, nv = m.nv;
   auto moments = [&](int b) {
     return Vec3(Eigen::SelfAdjointEigenSolver<Mat3>(m.bodies[b].inertia).eigenvalues());
@@ -44,7 +44,7 @@ void check_motions_carry_inertia(const Model& m) {
   if (!weak) return;  // every body has mass and a definite inertia: nothing to check
   const double l = m.length_scale;
   std::vector<BodyKin> kin;
-  body_kinematics(m, m.u0.data(), nullptr, kin);
+  body_kinematics(m, u.data(), nullptr, kin);
   MatX N;
   if (m.nc_joint > 0) {
     ConstraintEval ce;
@@ -380,7 +380,38 @@ std::shared_ptr<Model> finalize_draft(const Model& draft, const FinalizeOptions&
     Data d(m);
     project(m, d, 0.0, m.u0.data(), m.v0.data(), metric);
   }
-  check_motions_carry_inertia(m);
+  try {
+    check_motions_carry_inertia(m, m.u0);
+  } catch (const ModelError& at_assembly) {
+    // singular at the assembled configuration only (two joint axes aligned there, as icub's
+    // neck at q = 0) or everywhere (a massless leaf)? A tree is tried at two more
+    // configurations; well posed at either, the model is accepted with a warning
+    if (!m.joint_space_ok) throw;
+    bool somewhere = false;
+    for (const double phase : {0.37, 1.91}) {
+      VecX q = VecX::Zero(m.nq_joint), u, v;
+      for (const Joint& j : m.joints) {
+        if (j.type == JointType::Free) {
+          q[j.q0 + 3] = 1.0;
+          continue;
+        }
+        for (int k = 0; k < joint_coords(j.type); ++k)
+          q[j.q0 + k] = 0.6 * std::sin(phase * (j.q0 + k + 1));
+      }
+      state_from_joints(m, q, VecX::Zero(m.nv_joint), u, v);
+      try {
+        check_motions_carry_inertia(m, u);
+        somewhere = true;
+        break;
+      } catch (const ModelError&) {
+      }
+    }
+    if (!somewhere) throw;
+    m.warnings.push_back(msg(at_assembly.what(),
+                             " -- at the assembled configuration only: elsewhere every motion "
+                             "carries inertia, but near that configuration the mass matrix is "
+                             "singular and forward dynamics ill-conditioned"));
+  }
   return mp;
 }
 

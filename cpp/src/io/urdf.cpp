@@ -797,8 +797,9 @@ ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const
   // merge each group: total mass, centre of mass, inertia about it (parallel-axis theorem),
   // every link inertia rotated by its inertial rpy and its link frame into world axes first.
   // The tensors are checked (physical_inertia: each body's is physically consistent and each
-  // merged link's positive semidefinite, as add_body would; otherwise each link's is positive
-  // semidefinite, round-off negatives clamped) and every offender is listed at once.
+  // merged link's positive semidefinite, as add_body would; otherwise each body's -- a lone
+  // link's, or a merged group's sum -- is positive semidefinite, round-off negatives clamped)
+  // and every offender is listed at once.
   // A group without mass (massless links between joints) is a massless body at its top link's
   // origin; finalize() checks that every joint motion still carries inertia.
   std::vector<std::string> bad_inertia;  // "'link' (principal moments a, b, c kg m^2: why)"
@@ -854,6 +855,13 @@ ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const
         parts.push_back({in.mass, f.p, f.R * i_local * f.R.transpose()});
         continue;
       }
+      if (merged) {
+        // a link merged into a body is no rigid body of its own: only the body's tensor, its
+        // links' sum, must be positive semidefinite (checked below); tiago's antenna links
+        // (-3.5e-8 kg m^2) on its 28 kg base
+        parts.push_back({in.mass, f.p, f.R * i_local * f.R.transpose()});
+        continue;
+      }
       const InertiaCheck ic = check_inertia(i_local, false, robot_moment);
       if (!ic.problem.empty()) {
         const Vec3& p = ic.moments;
@@ -882,14 +890,20 @@ ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const
     const Mat3& r_top = frame.at(top).R;
     const Mat3 i_body = r_top.transpose() * i_world * r_top;
     g.inertia = 0.5 * (i_body + i_body.transpose());
-    if (physical_inertia && merged) {
-      // the body's tensor, as add_body checks it: its links' sum
-      const InertiaCheck ic = check_inertia(g.inertia, true);
+    if (merged) {
+      // the body's tensor, as add_body checks it: its links' sum (round-off clamped without
+      // physical_inertia)
+      const InertiaCheck ic = check_inertia(g.inertia, physical_inertia, robot_moment);
+      const std::string also = msg(" (merged with ", list_names(g.links, 1), ")");
       if (!ic.problem.empty()) {
         const Vec3& p = ic.moments;
-        const std::string also = msg(" (merged with ", list_names(g.links, 1), ")");
         bad_inertia.push_back(msg("'", top, "'", also, " (principal moments ", p[0], ", ", p[1],
                                   ", ", p[2], " kg m^2: ", ic.problem, ")"));
+      } else if (!physical_inertia) {
+        if (ic.warn)
+          clamp_notes.push_back(msg("URDF link '", top, "'", also, ": negative principal moment ",
+                                    ic.smallest, " kg m^2 (round-off) clamped to zero"));
+        g.inertia = ic.tensor;
       }
     }
   }
