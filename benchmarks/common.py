@@ -6,6 +6,7 @@ Nothing here imports another module of ``benchmarks``, so every peer and script 
 
 from __future__ import annotations
 
+import importlib.metadata
 import json
 import os
 import platform
@@ -25,13 +26,25 @@ ROBOTS = {
 UR5_Q0 = (0.3, -1.0, 1.2, -0.5, 0.8, 0.1)  # the UR5 problem's start, Pinocchio joint order
 
 
+def robots_dir() -> Path | None:
+    """The ``robots`` folder of the installed example-robot-data (the cmeel wheel ships the data
+    under ``cmeel.prefix/share/example-robot-data``, without a Python module), or None when the
+    package is not installed."""
+    sub = Path("cmeel.prefix") / "share" / "example-robot-data" / "robots"
+    try:
+        dist = importlib.metadata.distribution("example-robot-data")
+        candidates = [Path(dist.locate_file(sub))]
+    except importlib.metadata.PackageNotFoundError:
+        candidates = []
+    candidates += [Path(b) / sub for b in [*site.getsitepackages(), site.getusersitepackages()]]
+    return next((p for p in candidates if p.is_dir()), None)
+
+
 def robot_urdf(name: str) -> Path | None:
     """Path of an example-robot-data URDF, or None when the package is not installed."""
-    for base in [*site.getsitepackages(), site.getusersitepackages()]:
-        p = Path(base) / "cmeel.prefix" / "share" / "example-robot-data" / "robots" / ROBOTS[name]
-        if p.is_file():
-            return p
-    return None
+    base = robots_dir()
+    p = None if base is None else base / ROBOTS[name]
+    return p if p is not None and p.is_file() else None
 
 
 def cpu_time(fn, repeats: int):

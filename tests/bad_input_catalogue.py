@@ -32,6 +32,13 @@ def _hinged():
     return b
 
 
+def _massless_leaf():
+    b = ad.ModelBuilder()
+    b.add_body("heavy", 0.0, np.zeros((3, 3)), position=(0.0, 0.0, -0.5))
+    b.add_revolute("hinge", "ground", "heavy", (0, 0, 0), (0, 1, 0))
+    return b.finalize()
+
+
 def _pendulum():
     return _hinged().finalize()
 
@@ -66,7 +73,14 @@ ME, UE, SE = ad.ModelError, ad.UrdfError, ad.SolverError
 CASES = [
     # ---- bodies
     ("mass-negative", "body", "mass −1", lambda: _b().add_body("heavy", -1.0, I3), ME, "heavy"),
-    ("mass-zero", "body", "mass 0", lambda: _b().add_body("heavy", 0.0, I3), ME, "heavy"),
+    (
+        "mass-zero-leaf",
+        "model",
+        "a massless leaf body on a hinge (its motion carries no inertia)",
+        _massless_leaf,
+        ME,
+        "hinge.*heavy",
+    ),
     ("mass-nan", "body", "mass NaN", lambda: _b().add_body("heavy", np.nan, I3), ME, "heavy"),
     (
         "inertia-nonsym",
@@ -343,10 +357,10 @@ CASES = [
     (
         "urdf-massless-moving",
         "urdf",
-        "a massless link on a moving joint",
+        "a massless leaf link on a moving joint",
         lambda: ad.load_urdf(DATA / "bad_massless_moving.urdf"),
-        UE,
-        "(?i)mass",
+        ME,
+        "wrist.*hand",
     ),
     (
         "urdf-unknown-parent",
@@ -388,6 +402,14 @@ CASES = [
         ),
         UE,
         "arm",
+    ),
+    (
+        "urdf-inertia-triangle",
+        "urdf",
+        "published PUMA 560 inertias violating I1 + I2 ≥ I3 on two links",
+        lambda: ad.load_urdf(DATA / "puma560_published_inertia.urdf"),
+        UE,
+        "'link1'.*'link3'.*physical_inertia=False",
     ),
     (
         "urdf-planar",

@@ -371,8 +371,18 @@ void bind_model(py::module_& m) {
 
   py::class_<ModelBuilder>(
       m, "ModelBuilder", "Build a model: bodies, joints, drives, force elements; then finalize().")
-      .def(py::init([](py::object g) { return ModelBuilder(to_vec3(g, "gravity")); }),
-           py::arg("gravity") = py::make_tuple(0.0, 0.0, -9.81))
+      .def(py::init([](py::object g, bool physical_inertia) {
+             return ModelBuilder(to_vec3(g, "gravity"), physical_inertia);
+           }),
+           py::arg("gravity") = py::make_tuple(0.0, 0.0, -9.81), py::kw_only(),
+           py::arg("physical_inertia") = true)
+      .def_property("physical_inertia", &ModelBuilder::physical_inertia,
+                    &ModelBuilder::set_physical_inertia,
+                    "True (default): add_body accepts physically consistent inertias only "
+                    "(positive semidefinite, triangle inequality). False: any positive "
+                    "semidefinite tensor; negative round-off moments down to -1e-12 of the "
+                    "largest are clamped to zero with a warning. Applies to bodies added after "
+                    "it is set.")
       .def(
           "add_body",
           [](ModelBuilder& b, const std::string& name, double mass, py::object inertia,
@@ -621,10 +631,10 @@ void bind_model(py::module_& m) {
   m.attr("URDF_COULOMB_SMOOTHING") = kUrdfCoulombSmoothing;
   m.def(
       "urdf_builder",
-      [](const std::string& src, bool fixed_base, py::object g, bool mimic) {
+      [](const std::string& src, bool fixed_base, py::object g, bool physical_inertia, bool mimic) {
         const Vec3 gravity = to_vec3(g, "gravity");
         try {
-          return urdf_builder(src, fixed_base, gravity, mimic);
+          return urdf_builder(src, fixed_base, gravity, physical_inertia, mimic);
         } catch (const UrdfError& e) {
           // the loader escapes what it quotes; this keeps any message valid UTF-8 regardless
           const std::string text = e.what();
@@ -633,7 +643,8 @@ void bind_model(py::module_& m) {
         }
       },
       py::arg("path_or_xml"), py::arg("fixed_base") = true,
-      py::arg("gravity") = py::make_tuple(0.0, 0.0, -9.81), py::arg("mimic") = true,
+      py::arg("gravity") = py::make_tuple(0.0, 0.0, -9.81), py::kw_only(),
+      py::arg("physical_inertia") = true, py::arg("mimic") = true,
       "A ModelBuilder holding a URDF robot (add drives or loads, then finalize()).");
 }
 

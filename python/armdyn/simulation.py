@@ -256,12 +256,20 @@ def _urdf_source(path_or_xml) -> str:
 
 
 def load_urdf(
-    path_or_xml, fixed_base: bool = True, gravity=(0.0, 0.0, -9.81), mimic: bool = True
+    path_or_xml,
+    fixed_base: bool = True,
+    gravity=(0.0, 0.0, -9.81),
+    *,
+    physical_inertia: bool = True,
+    mimic: bool = True,
 ) -> _core.Model:
     """Load a URDF file (or XML string) through urdfdom into a finalized Model.
 
     Links joined by fixed joints are merged into one body; joint-space arrays follow the URDF's
     document order of its moving joints. With ``fixed_base`` the root link is welded to ground.
+    Massless links (no ``<inertial>``, e.g. the "virtual" links between the joints of a 3-DOF
+    hip) are massless bodies, accepted wherever every joint motion still carries inertia.
+
     With ``mimic`` (default), each ``<mimic joint= multiplier= offset=>`` becomes a coupling
     ``q = multiplier * q_joint + offset`` (:meth:`ModelBuilder.add_coupling`, named after the
     mimicking joint): the joint-space functions then take the independent coordinates
@@ -280,12 +288,27 @@ def load_urdf(
     that only carries loads): it loads with a ``UserWarning`` suggesting ``fixed_base=False``
     for a robot meant to move freely.
 
+    Args:
+        physical_inertia: True (default) refuses a link inertia that is not positive
+            semi-definite or violates the triangle inequality, listing every such link with its
+            principal moments. False accepts any positive semi-definite tensor (published or
+            identified parameter sets, point masses); negative round-off moments down to
+            -1e-12 of the largest are clamped to zero with a warning.
+
     Raises:
         UrdfError: missing or irregular file, malformed XML, bad numbers or names, unsupported
             joint type, invalid inertial data (the message names the element and attribute).
         TypeError: ``path_or_xml`` is neither str, bytes nor os.PathLike.
+        ModelError: a joint whose motion carries no inertia (a massless leaf link, a point mass
+            on its own joint axis), naming the joint and the body.
     """
-    model = _core.urdf_builder(_urdf_source(path_or_xml), fixed_base, gravity, mimic).finalize()
+    model = _core.urdf_builder(
+        _urdf_source(path_or_xml),
+        fixed_base,
+        gravity,
+        physical_inertia=physical_inertia,
+        mimic=mimic,
+    ).finalize()
     if model.nb == 0:
         warnings.warn(
             "armdyn: the URDF has no moving joint: with fixed_base=True it loads as a model with "

@@ -57,6 +57,12 @@ class FreeFlyerPair:
         vp[self.perm] = v
         return vp
 
+    def friction(self, vp):
+        """The URDF's <dynamics> torques (Pinocchio order), which armdyn imports as joint
+        friction and Pinocchio's algorithms leave out (its model.damping, model.friction)."""
+        vs = armdyn._core.URDF_COULOMB_SMOOTHING
+        return -self.pm.damping * vp - self.pm.friction * np.tanh(vp / vs)
+
     def random_state(self, rng):
         e = rng.normal(size=4)
         e /= np.linalg.norm(e)
@@ -82,8 +88,9 @@ def test_free_flyer_dynamics_equal_pinocchio(robot):
         Mp = np.triu(Mp) + np.triu(Mp, 1).T
         assert _rel(armdyn.mass_matrix(am, q), Mp[np.ix_(pair.perm, pair.perm)]) <= 1e-10
         tau = armdyn.inverse_dynamics(am, q, v, a)
-        assert _rel(tau, pin.rnea(pm, pd, qp, vp, ap)[pair.perm]) <= 1e-10
-        ref = pin.aba(pm, pd, qp, vp, pair.v_pin(tau))[pair.perm]
+        ref_tau = pin.rnea(pm, pd, qp, vp, ap) - pair.friction(vp)
+        assert _rel(tau, ref_tau[pair.perm]) <= 1e-10
+        ref = pin.aba(pm, pd, qp, vp, pair.v_pin(tau) + pair.friction(vp))[pair.perm]
         assert _rel(ref, a) <= 1e-9  # Pinocchio's own round trip
         for method in ("auto", "crba", "aba", "cartesian"):
             qdd = armdyn.forward_dynamics(am, q, v, tau, method=method)
@@ -104,6 +111,29 @@ def test_lagrange_validator_takes_floating_bases(robot):
         v, a = rng.normal(size=m.n_dofs), rng.normal(size=m.n_dofs)
         assert _rel(lv.torques(q, v, a), armdyn.inverse_dynamics(m, q, v, a)) <= 1e-12
         np.testing.assert_allclose(lv.mass_matrix(q), armdyn.mass_matrix(m, q), atol=1e-12)
+
+
+@pytest.mark.parametrize("robot", ["ur5", "solo12"])
+def test_floating_base_frames_equal_pinocchio(robot):
+    pair = FreeFlyerPair(_robot_path(ROBOTS[robot]))
+    am, pm, pd = pair.am, pair.pm, pair.pd
+    rng = np.random.default_rng(9)
+    frames = [f for f in am.frame_names if pm.existFrame(f)]
+    assert len(frames) >= 8
+    for _ in range(3):
+        q, _, _ = pair.random_state(rng)
+        qp = pair.q_pin(q)
+        pin.framesForwardKinematics(pm, pd, qp)
+        pin.computeJointJacobians(pm, pd, qp)
+        for f in frames:
+            fid = pm.getFrameId(f)
+            np.testing.assert_allclose(
+                armdyn.frame_pose(am, q, f), pd.oMf[fid].homogeneous, rtol=0, atol=1e-12
+            )
+            Jp = pin.getFrameJacobian(pm, pd, fid, pin.LOCAL_WORLD_ALIGNED)
+            np.testing.assert_allclose(
+                armdyn.frame_jacobian(am, q, f), Jp[:, pair.perm], rtol=0, atol=1e-12
+            )
 
 
 def _free_brick(origin=None):
@@ -242,3 +272,48 @@ def test_floating_base_bad_inputs_name_the_culprit():
         armdyn.LagrangeValidator(m).torques(bad, v, v)
     with pytest.raises(armdyn.ModelError, match=r"expected shape \(13,\), got \(12,\)"):
         armdyn.simulate(m, 0.1, q0=np.zeros(12))
+
+
+def test_floating_base_with_a_welded_body_runs_alike_in_every_formulation():
+    # a builder model: a free base (its frame 0.1 m below the centre of mass), a plate welded to
+    # it (simulate merges the pair into one composite body) and an arm on a hinge started at
+    # 7 rad (multi-turn)
+    b = armdyn.ModelBuilder()
+    b.add_body("base", 2.0, np.diag([0.02, 0.05, 0.06]), [0.3, -0.1, 0.5], [1.0, 0.0, 0.0, 0.0])
+    b.add_body("plate", 0.5, np.diag([0.01, 0.01, 0.02]), [0.3, 0.2, 0.5], [1.0, 0.0, 0.0, 0.0])
+    b.add_body("arm", 1.0, np.diag([0.01, 0.01, 0.002]), [0.6, -0.1, 0.5], [1.0, 0.0, 0.0, 0.0])
+    b.add_free("float", "base", origin=[0.3, -0.1, 0.4])
+    b.add_fixed("weld", "base", "plate", [0.3, 0.1, 0.5])
+    b.add_revolute("hinge", "base", "arm", [0.45, -0.1, 0.5], [0.0, 0.0, 1.0])
+    m = b.finalize()
+    assert m.coord_names[-1] == "hinge" and (m.n_coords, m.n_dofs) == (8, 7)
+    rng = np.random.default_rng(0)
+    e = rng.normal(size=4)
+    e /= np.linalg.norm(e)
+    q0 = np.concatenate([[0.0, 0.0, 1.0], e, [7.0]])
+    qd0 = rng.normal(size=7)
+    runs = {
+        (c, merge): armdyn.simulate(
+            m,
+            0.3,
+            q0=q0,
+            qd0=qd0,
+            rtol=1e-10,
+            atol=1e-12,
+            output_dt=0.1,
+            coordinates=c,
+            merge_welded=merge,
+        )
+        for c in ("cartesian", "joint")
+        for merge in (True, False)
+    }
+    ref = runs[("cartesian", False)]
+    assert ref.stats["solver_bodies"] == 3 and runs[("cartesian", True)].stats["solver_bodies"] == 2
+    for key, r in runs.items():
+        np.testing.assert_allclose(r.q[0], q0, atol=1e-14, err_msg=str(key))
+        assert r.q[-1, -1] > 6.0, key  # the hinge keeps its turns
+        np.testing.assert_allclose(r.q, ref.q, atol=1e-10, err_msg=str(key))
+        np.testing.assert_allclose(r.qd, ref.qd, atol=1e-9, err_msg=str(key))
+        np.testing.assert_allclose(
+            r.reaction_forces, ref.reaction_forces, atol=1e-9, err_msg=str(key)
+        )

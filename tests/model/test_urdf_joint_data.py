@@ -238,7 +238,8 @@ def test_structure_with_a_floating_base_falls_freely(relative):
     pin = pytest.importorskip("pinocchio")
     path = erd_path(relative)
     model = ad.load_urdf(path, fixed_base=False)
-    assert model.nb == 1 and model.n_coords == 0
+    # one free body: q is its frame's pose (7), qd its velocity (6)
+    assert model.nb == 1 and (model.n_coords, model.n_dofs) == (7, 6)
     # one body with every link's mass: Pinocchio's total (the universe's composite inertia)
     pm = pin.buildModelFromUrdf(str(path))
     assert pm.nq == 0
@@ -250,6 +251,9 @@ def test_structure_with_a_floating_base_falls_freely(relative):
         expected = x0 + 0.5 * np.array([0.0, 0.0, -G]) * t**2
         assert np.allclose(u[:3], expected, rtol=0, atol=1e-9)
         assert np.allclose(u[3:], model.u0[3:], rtol=0, atol=1e-12)  # no rotation
+    # the base frame (the root link's) falls with its velocity in its own axes
+    np.testing.assert_allclose(r.q[:, 2] - r.q[0, 2], -0.5 * G * r.t**2, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(r.qd[:, 2], -G * r.t, rtol=0, atol=1e-9)
 
 
 def test_empty_builder_finalizes_to_an_empty_model():

@@ -20,7 +20,8 @@ void load_poses(const Model& m, Data& d, Eigen::Ref<const VecX> q, int frame, co
   require_joint_space(m, fn);
   check_data(m, d, fn);
   checked_frame(m, frame, fn);
-  check_joint_vector(q, d.n, fn, "q");
+  check_joint_vector(q, d.nq, fn, "q");
+  check_base_quaternions(m, q, fn);
   joint_space_poses(m, q, d.kin, d.rne);
 }
 
@@ -33,10 +34,19 @@ void set_pose(Mat4& T, const Mat3& R, const Vec3& p) {
 }  // namespace
 
 void joint_jacobian_columns(const Joint& j, const Vec3& point, const Vec3& axis,
-                            const BodyKin& /*child*/, const Vec3& p, Mat6X& J) {
-  // the first velocity column of the joint (a floating base writes its six here too)
-  const int c = j.coord0;
+                            const BodyKin& child, const Vec3& p, Mat6X& J) {
+  // the joint's first column in qd
+  const int c = j.dof0;
   switch (j.type) {
+    case JointType::Free: {
+      // a floating base: slides along and turns about its frame's axes through its origin
+      const Mat3 B = free_frame(j, child);
+      for (int k = 0; k < 3; ++k) {
+        J.col(c + k) << B.col(k), Vec3::Zero();
+        J.col(c + 3 + k) << B.col(k).cross(p - point), B.col(k);
+      }
+      break;
+    }
     case JointType::Revolute:
       J.col(c) << axis.cross(p - point), axis;
       break;

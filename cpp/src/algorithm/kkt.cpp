@@ -73,6 +73,31 @@ void body_accelerations_loaded(const Model& m, Data& d, double t, double* vdot, 
   PipelineStats& st = d.stats;
   d.swept = false;
   const LightBodies& light = *d.light;
+  if (!light.bodies.empty() && !d.augmented && light.massless_only) {
+    // massless bodies only ("virtual" links between joints): the floored range-space factor
+    // refined against the exact system, O(n) per step; the augmented LU when it does not
+    // converge (then for the rest of this Data's life)
+    KktSolver& kkt = d.kkt;
+    if (!(reuse_factor && kkt.metric() == Metric::Mass && kkt.nrows() == nrows)) {
+      kkt.factor(d.ce, nrows, Metric::Mass);
+      ++st.factorizations;
+    }
+    int iterations = 0;
+    if (kkt.accelerations_refined(d.ce, nrows, d.eta, d.vd_work, d.delta, 30, iterations)) {
+      ++st.kkt_solves;
+      vd = d.vd_work;
+      return;
+    }
+    d.augmented = true;
+    solve_augmented(
+        m, d, t, nrows,
+        msg("at t=", t,
+            " the refined range-space solve of the massless bodies did not "
+            "converge in ",
+            iterations, " steps (", light.note, "): solved in augmented form from there on"));
+    vd = d.vd_work;
+    return;
+  }
   if (!light.bodies.empty() || d.augmented) {
     // no Gamma^-1: light bodies (known from the model), or a range-space solve on this Data
     // that lost accuracy

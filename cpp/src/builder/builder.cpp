@@ -4,6 +4,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "armdyn/errors.hpp"
 #include "armdyn/math/quaternion.hpp"
@@ -30,7 +31,43 @@ Vec3 unit_axis(const Vec3& a, const std::string& what) {
 
 }  // namespace
 
-ModelBuilder::ModelBuilder(const Vec3& gravity) {
+InertiaCheck check_inertia(const Mat3& inertia, bool physical, double scale) {
+  InertiaCheck c;
+  c.tensor = inertia;
+  Eigen::SelfAdjointEigenSolver<Mat3> es(inertia);
+  const Vec3 p = es.eigenvalues();  // ascending
+  c.moments = p;
+  c.smallest = p[0];
+  if (physical) {
+    // positive semidefinite: zero moments are point masses (and thin rods), which every path
+    // simulates while the joint-space mass matrix stays positive definite (finalize checks)
+    const double scale = inertia.cwiseAbs().maxCoeff();
+    if (!(p[0] >= -1e-12 * std::max(scale, 1e-300)))
+      c.problem = "is not positive semidefinite";
+    else if (p[0] + p[1] < p[2] * (1.0 - 1e-9))
+      c.problem = "violates the triangle inequality";
+    return c;
+  }
+  // any positive semidefinite tensor; negatives down to -1e-12 of the largest moment are
+  // round-off, clamped to zero (a warning unless they are the round-off of a rotation)
+  const double largest = std::max(p[2], 0.0);
+  if (!(p[0] >= -1e-12 * std::max(largest, scale))) {
+    c.problem = "is not positive semidefinite";
+    return c;
+  }
+  if (p[0] < 0.0) {
+    c.clamped = true;
+    c.warn = !(p[0] >= -64.0 * std::numeric_limits<double>::epsilon() * largest);
+    const Vec3 q = p.cwiseMax(0.0);
+    c.moments = q;
+    const Mat3 t = es.eigenvectors() * q.asDiagonal() * es.eigenvectors().transpose();
+    c.tensor = 0.5 * (t + t.transpose());
+  }
+  return c;
+}
+
+ModelBuilder::ModelBuilder(const Vec3& gravity, bool physical_inertia)
+    : physical_inertia_(physical_inertia) {
   require_finite(gravity, "gravity");
   m_.gravity = gravity;
 }
@@ -42,21 +79,22 @@ int ModelBuilder::add_body(const std::string& name, double mass, const Mat3& ine
   if (name == "ground") throw ModelError("body name 'ground' is reserved");
   if (m_.body_index.count(name)) throw ModelError(msg(who, ": duplicate body name"));
   require_finite(mass, who + ": mass");
-  if (!(mass > 0.0)) throw ModelError(msg(who, ": mass must be positive, got ", mass));
+  // mass 0: a massless link between joints (finalize checks the mass matrix stays definite)
+  if (!(mass >= 0.0)) throw ModelError(msg(who, ": mass must not be negative, got ", mass));
   require_finite(inertia, who + ": inertia");
   const double scale = inertia.cwiseAbs().maxCoeff();
   if ((inertia - inertia.transpose()).cwiseAbs().maxCoeff() > 1e-9 * std::max(scale, 1e-300))
     throw ModelError(msg(who, ": inertia is not symmetric"));
-  Eigen::SelfAdjointEigenSolver<Mat3> es(0.5 * (inertia + inertia.transpose()));
-  const Vec3 p = es.eigenvalues();  // ascending
-  // positive semidefinite: zero moments are point masses (and thin rods), which every path
-  // simulates while the joint-space mass matrix stays positive definite (light_bodies)
-  if (!(p[0] >= -1e-12 * std::max(scale, 1e-300)))
-    throw ModelError(msg(who, ": inertia is not positive semidefinite (principal moments ", p[0],
-                         ", ", p[1], ", ", p[2], ")"));
-  if (p[0] + p[1] < p[2] * (1.0 - 1e-9))
-    throw ModelError(msg(who, ": inertia violates the triangle inequality (principal moments ",
-                         p[0], " + ", p[1], " < ", p[2], ")"));
+  const InertiaCheck ic = check_inertia(0.5 * (inertia + inertia.transpose()), physical_inertia_);
+  const Vec3& p = ic.moments;
+  if (!ic.problem.empty()) {
+    if (ic.problem == "violates the triangle inequality")
+      throw ModelError(msg(who, ": inertia violates the triangle inequality (principal moments ",
+                           p[0], " + ", p[1], " < ", p[2],
+                           "); physical_inertia=False accepts any positive semidefinite tensor"));
+    throw ModelError(msg(who, ": inertia ", ic.problem, " (principal moments ", p[0], ", ", p[1],
+                         ", ", p[2], ")"));
+  }
   require_finite(position, who + ": position");
   require_finite(orientation, who + ": orientation");
   if (std::abs(orientation.norm() - 1.0) > 1e-6)
@@ -67,12 +105,15 @@ int ModelBuilder::add_body(const std::string& name, double mass, const Mat3& ine
   Body b;
   b.name = name;
   b.mass = mass;
-  b.inertia = 0.5 * (inertia + inertia.transpose());
+  b.inertia = ic.tensor;
   b.position = position;
   b.orientation = orientation.normalized();
   const int idx = static_cast<int>(m_.bodies.size());
   m_.bodies.push_back(b);
   m_.body_index[name] = idx;
+  if (ic.warn)
+    m_.warnings.push_back(msg(who, ": negative principal moment ", ic.smallest,
+                              " kg m^2 (round-off) clamped to zero"));
   return idx;
 }
 

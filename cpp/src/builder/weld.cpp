@@ -65,7 +65,8 @@ std::shared_ptr<const Welding> build_welding(const Model& m) {
       mass[comp[b]] += m.bodies[b].mass;
       com[comp[b]] += m.bodies[b].mass * pos(b);
     }
-  for (int c = 0; c < nc; ++c) com[c] /= mass[c];
+  // a massless composite (massless links welded together) keeps its root's frame origin
+  for (int c = 0; c < nc; ++c) com[c] = mass[c] > 0.0 ? Vec3(com[c] / mass[c]) : pos(roots[c]);
   std::vector<Weld> weld(nb);
   std::vector<Mat3> inertia(nc, Mat3::Zero());
   for (int b = 0; b < nb; ++b) {

@@ -33,6 +33,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cerrno>
 #include <charconv>
@@ -683,10 +684,56 @@ std::string list_names(const std::vector<std::string>& names, size_t from) {
   return s;
 }
 
+// What the file declares in the <inertial> of the links urdfdom reports as massless. urdfdom
+// resets an <inertial> it cannot fully read (a NaN in its origin) to mass 0 and zero inertia but
+// keeps it, which a massless link must not hide: parsed once, only when such a link exists.
+class DeclaredInertials {
+ public:
+  explicit DeclaredInertials(const std::string& xml) : xml_(xml) {}
+  // throws when the file's <inertial> of `link` differs from urdfdom's (mass 0) reading
+  void check(const std::string& link, const urdf::Inertial& in) {
+    if (!parsed_) parse();
+    auto it = declared_.find(link);
+    if (it == declared_.end()) return;
+    const std::array<double, 7>& d = it->second;
+    const std::array<double, 7> got{in.mass, in.ixx, in.ixy, in.ixz, in.iyy, in.iyz, in.izz};
+    if (d != got) {
+      throw UrdfError(msg("URDF link '", link, "': urdfdom could not read its <inertial> (it ",
+                          "reports mass ", in.mass, " kg, the file declares ", d[0], " kg)"));
+    }
+  }
+
+ private:
+  void parse() {
+    parsed_ = true;
+    tinyxml2::XMLDocument doc;
+    if (doc.Parse(xml_.c_str(), xml_.size()) != tinyxml2::XML_SUCCESS) return;
+    const tinyxml2::XMLElement* robot = doc.FirstChildElement("robot");
+    if (!robot) return;
+    for (auto* e = robot->FirstChildElement("link"); e; e = e->NextSiblingElement("link")) {
+      const tinyxml2::XMLElement* in = e->FirstChildElement("inertial");
+      if (!in) continue;
+      std::array<double, 7> d{};
+      const tinyxml2::XMLElement* mass = in->FirstChildElement("mass");
+      const tinyxml2::XMLElement* inertia = in->FirstChildElement("inertia");
+      if (mass) mass->QueryDoubleAttribute("value", &d[0]);
+      int k = 1;
+      for (const char* a : {"ixx", "ixy", "ixz", "iyy", "iyz", "izz"}) {
+        if (inertia) inertia->QueryDoubleAttribute(a, &d[k]);
+        ++k;
+      }
+      declared_[attribute(e, "name")] = d;
+    }
+  }
+  const std::string& xml_;
+  bool parsed_ = false;
+  std::map<std::string, std::array<double, 7>> declared_;
+};
+
 }  // namespace
 
 ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const Vec3& gravity,
-                          bool mimic) {
+                          bool physical_inertia, bool mimic) {
   std::string where;
   const std::string xml = read_source(path_or_xml, &where);
   const Document document = scan_document(xml, where);
@@ -748,7 +795,30 @@ ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const
   };
 
   // merge each group: total mass, centre of mass, inertia about it (parallel-axis theorem),
-  // every link inertia rotated by its inertial rpy and its link frame into world axes first
+  // every link inertia rotated by its inertial rpy and its link frame into world axes first.
+  // The tensors are checked (physical_inertia: each body's is physically consistent and each
+  // merged link's positive semidefinite, as add_body would; otherwise each body's -- a lone
+  // link's, or a merged group's sum -- is positive semidefinite, round-off negatives clamped)
+  // and every offender is listed at once.
+  // A group without mass (massless links between joints) is a massless body at its top link's
+  // origin; finalize() checks that every joint motion still carries inertia.
+  std::vector<std::string> bad_inertia;  // "'link' (principal moments a, b, c kg m^2: why)"
+  std::vector<std::string> clamp_notes;
+  DeclaredInertials declared(xml);
+  // the robot's largest link moment: the scale of round-off in its tensors (physical_inertia
+  // false: CAD exports write point masses as tensors of 1e-20 with either sign)
+  double robot_moment = 0.0;
+  for (const std::string& top : group_order) {
+    if (is_ground(top)) continue;
+    for (const std::string& name : groups.at(top).links) {
+      const urdf::LinkConstSharedPtr link = urdf_model->getLink(name);
+      if (!link->inertial) continue;
+      const Mat3 i_local = inertia_matrix(*link->inertial);
+      if (!i_local.allFinite()) continue;  // refused below
+      robot_moment =
+          std::max(robot_moment, Eigen::SelfAdjointEigenSolver<Mat3>(i_local).eigenvalues()(2));
+    }
+  }
   for (const std::string& top : group_order) {
     Group& g = groups.at(top);
     const bool merged = g.links.size() > 1;
@@ -769,16 +839,41 @@ ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const
       }
       if (in.mass < 0) throw UrdfError(msg("URDF link '", name, "': negative mass ", in.mass));
       if (is_ground(top)) continue;
-      // a merged link may be a point mass, but its inertia must still be positive semi-definite
-      // (a lone link is checked fully by add_body)
-      if (merged) {
-        const double smallest = Eigen::SelfAdjointEigenSolver<Mat3>(i_local).eigenvalues()(0);
-        if (smallest < -1e-12 * std::max(1.0, i_local.trace())) {
-          throw UrdfError(msg("URDF link '", name, "': inertia is not positive semi-definite ",
-                              "(smallest principal moment ", smallest, " kg m^2)"));
+      if (in.mass == 0.0) declared.check(name, in);
+      if (physical_inertia) {
+        // a link merged with others may be a point mass, but its inertia must still be positive
+        // semi-definite; the triangle inequality is the body's (checked below, as add_body does)
+        // (a lone link's tensor is its body's: checked here, in its own axes)
+        const InertiaCheck ic = check_inertia(i_local, true);
+        const Vec3& p = ic.moments;
+        if (merged ? p[0] < -1e-12 * std::max(1.0, i_local.trace()) : !ic.problem.empty()) {
+          bad_inertia.push_back(
+              msg("'", name, "' (principal moments ", p[0], ", ", p[1], ", ", p[2],
+                  " kg m^2: ", merged ? "is not positive semidefinite" : ic.problem, ")"));
+          continue;
         }
+        parts.push_back({in.mass, f.p, f.R * i_local * f.R.transpose()});
+        continue;
       }
-      parts.push_back({in.mass, f.p, f.R * i_local * f.R.transpose()});
+      if (merged) {
+        // a link merged into a body is no rigid body of its own: only the body's tensor, its
+        // links' sum, must be positive semidefinite (checked below); tiago's antenna links
+        // (-3.5e-8 kg m^2) on its 28 kg base
+        parts.push_back({in.mass, f.p, f.R * i_local * f.R.transpose()});
+        continue;
+      }
+      const InertiaCheck ic = check_inertia(i_local, false, robot_moment);
+      if (!ic.problem.empty()) {
+        const Vec3& p = ic.moments;
+        bad_inertia.push_back(msg("'", name, "' (principal moments ", p[0], ", ", p[1], ", ", p[2],
+                                  " kg m^2: ", ic.problem, ")"));
+        continue;
+      }
+      if (ic.warn) {
+        clamp_notes.push_back(msg("URDF link '", name, "': negative principal moment ", ic.smallest,
+                                  " kg m^2 (round-off) clamped to zero"));
+      }
+      parts.push_back({in.mass, f.p, f.R * ic.tensor * f.R.transpose()});
     }
     if (is_ground(top)) continue;
 
@@ -786,18 +881,7 @@ ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const
       g.mass += p.m;
       g.com += p.m * p.c;
     }
-    if (!(g.mass > 0)) {
-      const std::string also =
-          merged ? msg(" (nor do the links fixed to it: ", list_names(g.links, 1), ")") : "";
-      if (top == root_name) {
-        throw UrdfError(msg("URDF link '", top, "' is the root and has no mass", also,
-                            "; a floating base (fixed_base=false) needs one"));
-      }
-      const urdf::LinkConstSharedPtr link = urdf_model->getLink(top);
-      throw UrdfError(msg("URDF link '", top, "' has no mass", also, " but moves on joint '",
-                          link->parent_joint->name, "'"));
-    }
-    g.com /= g.mass;
+    g.com = g.mass > 0 ? Vec3(g.com / g.mass) : frame.at(top).p;
     Mat3 i_world = Mat3::Zero();
     for (const Part& p : parts) {
       const Vec3 d = p.c - g.com;
@@ -806,9 +890,40 @@ ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const
     const Mat3& r_top = frame.at(top).R;
     const Mat3 i_body = r_top.transpose() * i_world * r_top;
     g.inertia = 0.5 * (i_body + i_body.transpose());
+    if (merged) {
+      // the body's tensor, as add_body checks it: its links' sum (round-off clamped without
+      // physical_inertia)
+      const InertiaCheck ic = check_inertia(g.inertia, physical_inertia, robot_moment);
+      const std::string also = msg(" (merged with ", list_names(g.links, 1), ")");
+      if (!ic.problem.empty()) {
+        const Vec3& p = ic.moments;
+        bad_inertia.push_back(msg("'", top, "'", also, " (principal moments ", p[0], ", ", p[1],
+                                  ", ", p[2], " kg m^2: ", ic.problem, ")"));
+      } else if (!physical_inertia) {
+        if (ic.warn)
+          clamp_notes.push_back(msg("URDF link '", top, "'", also, ": negative principal moment ",
+                                    ic.smallest, " kg m^2 (round-off) clamped to zero"));
+        g.inertia = ic.tensor;
+      }
+    }
+  }
+  if (!bad_inertia.empty()) {
+    std::string list;
+    for (const std::string& b : bad_inertia) list += (list.empty() ? "" : "; ") + b;
+    const std::string links =
+        msg(bad_inertia.size(), bad_inertia.size() == 1 ? " link: " : " links: ");
+    throw UrdfError(
+        physical_inertia
+            ? msg(where, ": inertia not physically consistent on ", links, list,
+                  "; load with physical_inertia=False to accept any positive semidefinite tensor")
+            : msg(where, ": inertia not positive semidefinite on ", links, list,
+                  " (physical_inertia=False clamps only round-off, down to -1e-12 of the "
+                  "largest moment, ",
+                  robot_moment, " kg m^2)"));
   }
 
-  ModelBuilder builder(gravity);
+  ModelBuilder builder(gravity, physical_inertia);
+  for (const std::string& note : clamp_notes) builder.add_warning(note);
   std::set<std::string> added;  // groups whose body exists
   auto add_group_body = [&](const std::string& top) {
     const Group& g = groups.at(top);

@@ -20,19 +20,27 @@ const LightBodies& light_bodies(const Model& m) {
     for (int i = 0; i < m.nb; ++i) {
       const Body& b = m.bodies[i];
       const double jmin = Eigen::SelfAdjointEigenSolver<Mat3>(b.inertia).eigenvalues()[0];
-      const double ratio = std::min(jmin / (b.mass * l2), b.mass / mmax * 1e3);
+      // a massless body (mass 0: finalize checked that its motions carry inertia) is as light
+      // as a body gets (jmin / 0 would be NaN and pass every test)
+      const double ratio = b.mass > 0.0 ? std::min(jmin / (b.mass * l2), b.mass / mmax * 1e3) : 0.0;
       if (ratio < 1e-6) {
         lb.bodies.push_back(i);
         lb.note += msg(lb.note.empty() ? "" : ", ", "'", b.name, "' (", ratio, ")");
       }
     }
+    lb.massless_only = !lb.bodies.empty();
+    for (int i : lb.bodies) lb.massless_only = lb.massless_only && !(m.bodies[i].mass > 0.0);
     if (!lb.bodies.empty())
       lb.note =
           msg("light bodies (smallest principal moment / (m l^2), or 1e3 mass / heaviest, "
               "below 1e-6): ",
               lb.note,
-              "; the dynamics is solved in augmented form (LU of [Gamma zeta^T; zeta 0]), "
-              "without Gamma^-1");
+              lb.massless_only
+                  ? "; the dynamics is solved by the range-space factor with a floored Gamma, "
+                    "refined against the exact system (the augmented LU of [Gamma zeta^T; zeta "
+                    "0] where that does not converge)"
+                  : "; the dynamics is solved in augmented form (LU of [Gamma zeta^T; zeta 0]), "
+                    "without Gamma^-1");
     return lb;
   });
 }
@@ -47,7 +55,11 @@ KktSolver::KktSolver(const Model& m)
       ref_r_(VecX::Zero(m.nc)),
       ref_d_(VecX::Zero(m.nc)),
       ref_nv_(VecX::Zero(m.nv)),
-      ref_nv2_(VecX::Zero(m.nv)) {
+      ref_nv2_(VecX::Zero(m.nv)),
+      rf_r1_(VecX::Zero(m.nv)),
+      rf_r2_(VecX::Zero(m.nc)),
+      rf_dv_(VecX::Zero(m.nv)),
+      rf_dd_(VecX::Zero(m.nc)) {
   minv_.resize(m.nb);
   for (int i = 0; i < m.nb; ++i) {
     minv_[i].setZero();
@@ -59,9 +71,16 @@ KktSolver::KktSolver(const Model& m)
   // by an almost free rotation of a nearly inertia-less body
   double mmax = 0.0;
   for (const Body& b : m.bodies) mmax = std::max(mmax, b.mass);
+  // A massless body (mass 0: a "virtual" link between joints) has no mass to weight by at all:
+  // its metric is a thousandth of the heaviest body's, and its inertia floor a thousandth of
+  // that times l^2, which keeps the projections' Schur complement conditioned like a model of
+  // ordinary links (the 1e-9 and 1e-6 floors of light bodies made it ~1e15 there, and the
+  // position projection of a falling human.urdf stalled at 1e-9)
   for (int i : light_bodies(m).bodies) {
-    const double mass = std::max(m.bodies[i].mass, 1e-9 * mmax);
-    const double floor = 1e-6 * mass * m.length_scale * m.length_scale;
+    const bool massless = !(m.bodies[i].mass > 0.0);
+    double mass = massless ? 1e-3 * mmax : std::max(m.bodies[i].mass, 1e-9 * mmax);
+    if (!(mass > 0.0)) mass = 1.0;  // no body has mass (finalize refuses it after assembly)
+    const double floor = (massless ? 1e-3 : 1e-6) * mass * m.length_scale * m.length_scale;
     minv_[i].topLeftCorner<3, 3>() = Mat3::Identity() / mass;
     minv_[i].bottomRightCorner<3, 3>() = (m.bodies[i].inertia + floor * Mat3::Identity()).inverse();
   }
@@ -347,6 +366,54 @@ void KktSolver::accelerations(const ConstraintEval& ce, const VecX& eta, VecX& v
     vdot.segment<3>(6 * b + 3).noalias() -=
         minv_[b].bottomRightCorner<3, 3>() * tmp_nv_.segment<3>(6 * b + 3);
   }
+}
+
+bool KktSolver::accelerations_refined(const ConstraintEval& ce, int nrows, const VecX& eta,
+                                      VecX& vdot, VecX& delta, int max_iter, int& iterations) {
+  iterations = 0;
+  // the preconditioned first solution: K_f x = (eta, -xi), K_f with the floored Gamma_f
+  accelerations(ce, eta, vdot, delta);
+  if (!vdot.allFinite() || !delta.allFinite()) return false;
+  for (int it = 1; it <= max_iter; ++it) {
+    iterations = it;
+    // residual of the exact system: r1 = eta - Gamma vdot - zeta^T delta, r2 = -xi - zeta vdot
+    zeta_transpose_times(ce, nrows, delta, rf_r1_);
+    for (int b = 0; b < m_.nb; ++b) {
+      const Body& bd = m_.bodies[b];
+      rf_r1_.segment<3>(6 * b) += bd.mass * vdot.segment<3>(6 * b);
+      rf_r1_.segment<3>(6 * b + 3).noalias() += bd.inertia * vdot.segment<3>(6 * b + 3);
+    }
+    rf_r1_ = eta - rf_r1_;
+    if (nrows > 0) {
+      zeta_times(ce, nrows, vdot, rf_r2_);
+      rf_r2_.head(nrows) = -ce.xi.head(nrows) - rf_r2_.head(nrows);
+    }
+    // the correction K_f (dv, dd) = (r1, r2): a = Gamma_f^-1 r1, A dd = zeta a - r2,
+    // dv = a - Gamma_f^-1 zeta^T dd
+    for (int b = 0; b < m_.nb; ++b)
+      apply_minv(b, rf_r1_.segment<6>(6 * b), rf_dv_.segment<6>(6 * b));
+    rf_dd_.setZero();
+    if (nrows > 0) {
+      zeta_times(ce, nrows, rf_dv_, b_);
+      b_.head(nrows) -= rf_r2_.head(nrows);
+      solve_schur(b_, rf_dd_);
+      zeta_transpose_times(ce, nrows, rf_dd_, tmp_nv_);
+      for (int b = 0; b < m_.nb; ++b) {
+        rf_dv_.segment<3>(6 * b) -= minv_[b](0, 0) * tmp_nv_.segment<3>(6 * b);
+        rf_dv_.segment<3>(6 * b + 3).noalias() -=
+            minv_[b].bottomRightCorner<3, 3>() * tmp_nv_.segment<3>(6 * b + 3);
+      }
+    }
+    vdot += rf_dv_;
+    delta.head(nrows) += rf_dd_.head(nrows);
+    if (!vdot.allFinite() || !delta.allFinite()) return false;
+    const double dv = rf_dv_.cwiseAbs().maxCoeff(), v = vdot.cwiseAbs().maxCoeff();
+    const double dd = nrows > 0 ? rf_dd_.head(nrows).cwiseAbs().maxCoeff() : 0.0;
+    const double d = nrows > 0 ? delta.head(nrows).cwiseAbs().maxCoeff() : 0.0;
+    // (redundant rows: the multipliers are the minimum-norm ones, only vdot is unique)
+    if (dv <= 1e-13 * v && (pinv_ || dd <= 1e-13 * d)) return true;
+  }
+  return false;
 }
 
 bool KktSolver::accelerations_augmented(const ConstraintEval& ce, int nrows, const VecX& eta,

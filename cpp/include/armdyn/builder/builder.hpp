@@ -16,13 +16,43 @@
 
 namespace armdyn {
 
+/// The verdict on a (symmetric) inertia tensor under ModelBuilder::set_physical_inertia.
+struct InertiaCheck {
+  Vec3 moments = Vec3::Zero();  ///< principal moments, ascending [kg m^2]
+  std::string problem;          ///< why it is refused ("violates the triangle inequality"), or ""
+  Mat3 tensor = Mat3::Zero();   ///< the tensor to use: the input, or its clamped version
+  bool clamped = false;         ///< negative round-off moments were set to zero
+  bool warn = false;            ///< ... and they exceed the round-off of rotating a tensor
+  double smallest = 0.0;        ///< the smallest principal moment before clamping
+};
+/// physical = false: negative moments down to -1e-12 max(largest moment, scale) are round-off,
+/// clamped (the URDF reader passes the robot's largest link moment as scale: CAD exports write
+/// point masses as tensors of 1e-20 with either sign); a warning when below -64 eps of the
+/// tensor's own largest moment (above it, they are the round-off of rotating the tensor).
+InertiaCheck check_inertia(const Mat3& inertia, bool physical, double scale = 0.0);
+
 class ModelBuilder {
  public:
-  explicit ModelBuilder(const Vec3& gravity = Vec3(0, 0, -9.81));
+  explicit ModelBuilder(const Vec3& gravity = Vec3(0, 0, -9.81), bool physical_inertia = true);
+
+  /// Which inertia tensors add_body() accepts (for the bodies added after the call).
+  /// true (default): physically consistent ones only -- positive semidefinite (to -1e-12 of the
+  /// largest coefficient) and satisfying the triangle inequality J1 + J2 >= J3 of the principal
+  /// moments. false: any positive semidefinite tensor (published or identified parameter sets
+  /// that violate the triangle inequality); negative principal moments down to -1e-12 of the
+  /// largest moment are round-off and clamped to zero, with a warning (Model::warnings) when
+  /// they lie below -64 eps of it (smaller ones are the round-off of rotating a tensor).
+  void set_physical_inertia(bool physical) { physical_inertia_ = physical; }
+  bool physical_inertia() const { return physical_inertia_; }
 
   /// Add a rigid body. inertia: 3x3 about the centre of mass in body axes [kg m^2];
-  /// position: centre of mass [m]; orientation: unit Euler parameters, scalar-first.
-  /// @throws ModelError on bad mass, inertia, pose or a duplicate name.
+  /// position: centre of mass [m] (of a massless body: any point of it, its frame origin);
+  /// orientation: unit Euler parameters, scalar-first. mass may be 0 and the inertia singular
+  /// (massless links between joints, point masses): finalize() then checks that every motion
+  /// the joints allow still carries inertia (the joint-space mass matrix is positive definite)
+  /// and names the joint and body when one does not.
+  /// @throws ModelError on bad mass, inertia (see set_physical_inertia), pose or a duplicate
+  ///   name.
   int add_body(const std::string& name, double mass, const Mat3& inertia, const Vec3& position,
                const Vec4& orientation);
 
@@ -117,6 +147,9 @@ class ModelBuilder {
 
   const Model& draft() const { return m_; }
 
+  /// A note finalize() passes on in Model::warnings (the URDF reader's clamped inertias).
+  void add_warning(const std::string& text) { m_.warnings.push_back(text); }
+
  private:
   /// The joint named `joint`, checked to have coordinate `coord` (messages name `who`).
   const Joint& coord_joint(const std::string& who, const std::string& joint, int coord) const;
@@ -130,6 +163,7 @@ class ModelBuilder {
                 const Vec3* point_child = nullptr);
   int resolve_body(const std::string& name, const std::string& context) const;
   Model m_;
+  bool physical_inertia_ = true;
 };
 
 namespace detail {

@@ -40,6 +40,13 @@ constexpr double kUrdfCoulombSmoothing = 1e-3;
 ///   joint; both joints revolute/continuous or both prismatic); the joint-space functions then
 ///   take the independent coordinates, as Pinocchio's mimic=True models. mimic = false: each
 ///   mimicking joint keeps its own coordinate (Pinocchio's default).
+/// - Massless links (no <inertial>, or mass 0) are massless bodies: accepted wherever every
+///   joint motion still carries inertia (finalize() checks it and names the joint otherwise).
+/// - physical_inertia = true: every moving link's inertia must be physically consistent
+///   (positive semidefinite, triangle inequality); the refusal lists every offending link with
+///   its principal moments. false: any positive semidefinite tensor (round-off negatives down to
+///   -1e-12 of the largest moment clamped to zero, with a warning); the returned builder keeps
+///   the setting (ModelBuilder::set_physical_inertia).
 /// - Ignored: visual, collision, material, transmission, gazebo, safety_controller and
 ///   calibration (their numbers are still checked).
 /// - No moving joint with fixed_base = true: a builder with no bodies (a zero-DOF model).
@@ -49,10 +56,10 @@ constexpr double kUrdfCoulombSmoothing = 1e-3;
 ///   and are valid UTF-8.
 ///
 /// @throws UrdfError on a bad source (missing, not a regular file, too large), malformed XML or
-///   URDF, bad numbers or names, floating/planar/unknown joints, zero joint axes, massless moving
-///   links or invalid inertial data (naming the culprit); a <mimic> naming an unknown or fixed
-///   joint, or one add_coupling refuses (naming both joints).
+///   URDF, bad numbers or names, floating/planar/unknown joints, zero joint axes or invalid
+///   inertial data (naming the culprit); a <mimic> naming an unknown or fixed joint, or one
+///   add_coupling refuses (naming both joints).
 ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const Vec3& gravity,
-                          bool mimic = true);
+                          bool physical_inertia = true, bool mimic = true);
 
 }  // namespace armdyn

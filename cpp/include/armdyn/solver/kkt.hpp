@@ -51,6 +51,9 @@ enum class Metric { Mass, Identity };
 struct LightBodies {
   std::vector<int> bodies;
   std::string note;  ///< names the bodies and their ratios; empty when none
+  /// every light body is massless (mass 0): the dynamics takes the refined range-space solve
+  /// (KktSolver::accelerations_refined) before the augmented one
+  bool massless_only = false;
 };
 const LightBodies& light_bodies(const Model& m);
 
@@ -95,6 +98,16 @@ class KktSolver {
   /// Returns false when the augmented matrix is singular (no finite solution).
   bool accelerations_augmented(const ConstraintEval& ce, int nrows, const VecX& eta, VecX& vdot,
                                VecX& delta);
+  /// The accelerations of a model whose light bodies are all massless (mass 0), without the
+  /// augmented LU: the current factor (metric Mass, whose Gamma is floored on those bodies) as
+  /// the preconditioner of iterative refinement against the exact system [Gamma zeta^T; zeta 0]
+  /// over rows [0, nrows). A mode moving a massless body carries the inertia of the bodies it
+  /// moves (finalize checked it), so each step shrinks the error by about floor / (floor +
+  /// that inertia). Returns false when the corrections have not fallen below 1e-13 of the
+  /// solution within max_iter steps (the caller then takes the augmented solve); `iterations`
+  /// receives the steps taken. O(n) per step on the block-sparse paths, nothing allocated.
+  bool accelerations_refined(const ConstraintEval& ce, int nrows, const VecX& eta, VecX& vdot,
+                             VecX& delta, int max_iter, int& iterations);
   /// Forget what earlier solves learnt (the sticky regularisation and its pivot level), as a
   /// new solver would start: a new run on a reused Data.
   void reset() {
@@ -141,7 +154,8 @@ class KktSolver {
   VecX scale_;               // Jacobi scaling diag(A)^-1/2, in pivot order
   mutable VecX tmp2_, ref_r_, ref_d_;
   mutable VecX ref_nv_, ref_nv2_;
-  MatX DM_;  // S1^2 M
+  VecX rf_r1_, rf_r2_, rf_dv_, rf_dd_;  // accelerations_refined: residuals and corrections
+  MatX DM_;                             // S1^2 M
   int nrows_ = 0, rank_ = 0;
   Metric metric_ = Metric::Mass;
   bool pinv_ = false;
