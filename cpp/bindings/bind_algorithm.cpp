@@ -316,9 +316,9 @@ void bind_algorithm(py::module_& m) {
         constexpr const char* fn = "frame_pose";
         Data& d = data_for(md, data, fn);
         const Model& mm = *md;
-        require_joint_space(mm, fn);
+        require_joint_space(mm, fn, true);
         const int f = frame_arg(mm, frame, fn);
-        return per_state(fn, "q", d.nq, q, {4, 4}, [&](const auto& qi, double* out) {
+        return per_state(fn, "q", d.niq, q, {4, 4}, [&](const auto& qi, double* out) {
           copy_row_major(frame_pose(mm, d, qi, f), out);
         });
       },
@@ -334,17 +334,17 @@ void bind_algorithm(py::module_& m) {
         constexpr const char* fn = "frame_jacobian";
         Data& d = data_for(md, data, fn);
         const Model& mm = *md;
-        require_joint_space(mm, fn);
+        require_joint_space(mm, fn, true);
         const int f = frame_arg(mm, frame, fn);
-        return per_state(fn, "q", d.nq, q, {6, d.n}, [&](const auto& qi, double* out) {
+        return per_state(fn, "q", d.niq, q, {6, d.ni}, [&](const auto& qi, double* out) {
           copy_row_major(frame_jacobian(mm, d, qi, f), out);
         });
       },
       py::arg("model"), py::arg("q"), py::arg("frame"), py::arg("data") = py::none(),
       "The Jacobian (6, n_dofs) of a named frame at joint-space q (n_coords): linear rows then "
       "angular rows, world axes, at the frame's origin (Pinocchio's LOCAL_WORLD_ALIGNED), so "
-      "that [v; omega] of the frame = J qd (a floating base's six columns first). 2-D q gives "
-      "(rows, 6, n_dofs).");
+      "that [v; omega] of the frame = J qd (a floating base's six columns first; a coupled "
+      "model's independent coordinates, J G). 2-D q gives (rows, 6, n_dofs).");
 
   m.def(
       "frame_pose_cartesian",

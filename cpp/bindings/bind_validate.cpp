@@ -145,8 +145,8 @@ void bind_validate(py::module_& m) {
           "torques",
           [](const LagrangeValidator& self, py::object q, py::object qd, py::object qdd,
              py::object t) {
-            const long n = self.model().nv_joint;
-            const MatX Q = to_mat(q, "q", self.model().nq_joint), QD = to_mat(qd, "qd", n),
+            const long n = self.nv();
+            const MatX Q = to_mat(q, "q", self.nq()), QD = to_mat(qd, "qd", n),
                        QDD = to_mat(qdd, "qdd", n);
             if (QD.rows() != Q.rows() || QDD.rows() != Q.rows())
               throw ModelError(
@@ -172,8 +172,7 @@ void bind_validate(py::module_& m) {
       .def(
           "mass_matrix",
           [](const LagrangeValidator& self, py::object q) {
-            return to_numpy(
-                self.mass_matrix(to_vec(q, "q", static_cast<long>(self.model().nq_joint))));
+            return to_numpy(self.mass_matrix(to_vec(q, "q", self.nq())));
           },
           py::arg("q"));
 

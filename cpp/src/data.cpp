@@ -61,6 +61,7 @@ Data::Data(const Model& m)
   frame_jacobian_v = MatX::Zero(6, m.nv);
   niq = m.independent.source.empty() ? nq : m.independent.nq();
   ni = m.independent.source.empty() ? n : m.independent.nv();
+  frame_jacobian_independent = Mat6X::Zero(6, ni);
   if (ni != n) {
     coupled.q = VecX::Zero(nq);
     for (VecX* x : {&coupled.qd, &coupled.qdd, &coupled.tau_full}) *x = VecX::Zero(n);

@@ -274,13 +274,22 @@ def test_joint_and_cartesian_runs_match():
     assert np.abs(joint.qd - cart.qd).max() <= 1e-7
 
 
-def test_other_joint_space_functions_refuse_coupled_models_naming_the_coupling():
+def test_lagrange_validator_takes_the_independent_coordinates(pair):
+    # an independent derivation (Euler-Lagrange by automatic differentiation of the composed
+    # joint transforms, every joint) reduced by the couplings: G^T tau_full, G^T M G
+    am = pair.am
+    lv = ad.LagrangeValidator(am)
+    rng = np.random.default_rng(13)
+    for _ in range(3):
+        q, v, a = rng.uniform(-1.0, 1.0, size=(3, am.n_coords))
+        tau = ad.inverse_dynamics(am, q, v, a)
+        assert np.abs(lv.torques(q, v, a) - tau).max() <= 1e-12 * max(1.0, np.abs(tau).max())
+        np.testing.assert_allclose(lv.mass_matrix(q), ad.mass_matrix(am, q), rtol=0, atol=1e-12)
+
+
+def test_aba_refuses_coupled_models_naming_why():
     model = coupled_arm()
     assert not model.joint_space
-    with pytest.raises(
-        ad.ModelError, match="coupling 'elbow_follows' makes joint 'elbow' follow joint 'shoulder'"
-    ):
-        ad.LagrangeValidator(model)
     with pytest.raises(
         ad.ModelError, match="method 'aba' does not apply to a model with couplings"
     ):
@@ -495,3 +504,25 @@ def test_floating_base_with_mimic_equals_pinocchio_free_flyer_mimic(tmp_path):
         a_kkt = ad.forward_dynamics(am, q, v, tau, method="cartesian")
         worst["fd_cartesian"] = max(worst["fd_cartesian"], rel(a_kkt, a_ref))
     assert max(worst.values()) <= 1e-10, worst
+
+
+def test_frames_of_a_coupled_model_equal_pinocchio_mimic_model(pair):
+    # frame_pose and frame_jacobian take the independent coordinates; the Jacobian is J G (a
+    # follower's column added to its leader's), as Pinocchio's mimic=True model's
+    am, pm, pd = pair.am, pair.pm, pair.pd
+    frames = [f for f in am.frame_names if pm.existFrame(f)]
+    assert len(frames) >= 10
+    rng = np.random.default_rng(12)
+    for _ in range(3):
+        qa = rng.uniform(-1.0, 1.0, am.n_coords)
+        q = pair.pin_q(qa)
+        pin.framesForwardKinematics(pm, pd, q)
+        pin.computeJointJacobians(pm, pd, q)
+        for f in frames:
+            fid = pm.getFrameId(f)
+            np.testing.assert_allclose(
+                ad.frame_pose(am, qa, f), pd.oMf[fid].homogeneous, rtol=0, atol=1e-12, err_msg=f
+            )
+            J = ad.frame_jacobian(am, qa, f)
+            Jp = pin.getFrameJacobian(pm, pd, fid, pin.LOCAL_WORLD_ALIGNED)
+            np.testing.assert_allclose(J[:, pair.perm], Jp, rtol=0, atol=1e-12, err_msg=f)

@@ -155,6 +155,7 @@ class Data {
   // --- named frames (algorithm/frames) ---
   Mat4 frame_pose = Mat4::Identity();  ///< the last frame pose [R p; 0 1]
   Mat6X frame_jacobian;                ///< (6, n) the last joint-space frame Jacobian
+  Mat6X frame_jacobian_independent;    ///< (6, ni) ... of a coupled model: J G
   MatX frame_jacobian_v;               ///< (6, nv) the last Cartesian frame Jacobian
 };
 

@@ -16,13 +16,19 @@ const NamedFrame& checked_frame(const Model& m, int frame, const char* fn) {
 }
 
 // the checks of the joint-space calls, and the poses (with the joint frames) of every body
+// (a coupled model's q holds its independent coordinates: expanded to every joint's first)
 void load_poses(const Model& m, Data& d, Eigen::Ref<const VecX> q, int frame, const char* fn) {
-  require_joint_space(m, fn);
+  require_joint_space(m, fn, true);
   check_data(m, d, fn);
   checked_frame(m, frame, fn);
-  check_joint_vector(q, d.nq, fn, "q");
+  check_joint_vector(q, d.niq, fn, "q");
   check_base_quaternions(m, q, fn);
-  joint_space_poses(m, q, d.kin, d.rne);
+  if (d.ni == d.n) {
+    joint_space_poses(m, q, d.kin, d.rne);
+    return;
+  }
+  m.independent.expand_q(q.data(), d.coupled.q.data());
+  joint_space_poses(m, d.coupled.q, d.kin, d.rne);
 }
 
 void set_pose(Mat4& T, const Mat3& R, const Vec3& p) {
@@ -97,7 +103,16 @@ const Mat4& frame_pose(const Model& m, Data& d, Eigen::Ref<const VecX> q, int fr
 
 const Mat6X& frame_jacobian(const Model& m, Data& d, Eigen::Ref<const VecX> q, int frame) {
   load_poses(m, d, q, frame, "frame_jacobian");
-  return frame_jacobian_loaded(m, d, frame);
+  const Mat6X& J = frame_jacobian_loaded(m, d, frame);
+  if (d.ni == d.n) return J;
+  // a coupled model: J G, each follower's column onto its leader's (Model::independent)
+  const IndependentCoords& ic = m.independent;
+  Mat6X& Jr = d.frame_jacobian_independent;
+  Jr.leftCols(ic.lead_v) = J.leftCols(ic.lead_v);
+  Jr.rightCols(ic.n).setZero();
+  for (int c = 0; c < static_cast<int>(ic.source.size()); ++c)
+    Jr.col(ic.lead_v + ic.source[c]) += ic.scale[c] * J.col(ic.lead_v + c);
+  return Jr;
 }
 
 const Mat4& frame_pose(const Model& m, Data& d, Eigen::Ref<const VecX> q,

@@ -29,7 +29,7 @@ AD constant(double v, int n) { return AD(v, VecX::Zero(n)); }
 LagrangeValidator::LagrangeValidator(std::shared_ptr<const Model> m, bool rotational_inertia)
     : m_(std::move(m)), rot_(rotational_inertia) {
   if (!m_) throw ModelError("LagrangeValidator: no model");
-  require_joint_space(*m_, "LagrangeValidator");
+  require_joint_space(*m_, "LagrangeValidator", true);
   for (const CoordForce& cf : m_->coord_forces)
     if (cf.aux >= 0)
       throw ModelError(msg("LagrangeValidator: ", cf.name,
@@ -48,7 +48,40 @@ VecX chart_of(const Model& m, const VecX& q) {
 }
 }  // namespace
 
+bool LagrangeValidator::coupled() const {
+  const IndependentCoords& ic = m_->independent;
+  return !ic.source.empty() && !ic.identity();
+}
+long LagrangeValidator::nq() const { return coupled() ? m_->independent.nq() : m_->nq_joint; }
+long LagrangeValidator::nv() const { return coupled() ? m_->independent.nv() : m_->nv_joint; }
+
 MatX LagrangeValidator::mass_matrix(const VecX& q) const {
+  if (!coupled()) return full_mass_matrix(q);
+  const IndependentCoords& ic = m_->independent;
+  check(q, ic.nq(), "q");
+  VecX qf(m_->nq_joint);
+  ic.expand_q(q.data(), qf.data());
+  MatX Mr(ic.nv(), ic.nv());
+  ic.reduce(full_mass_matrix(qf), Mr);
+  return Mr;
+}
+
+VecX LagrangeValidator::torques(const VecX& q, const VecX& qd, const VecX& qdd, double t) const {
+  if (!coupled()) return full_torques(q, qd, qdd, t);
+  // the couplings' rows are linear in q: G qd and G qdd are the full rates and accelerations
+  const IndependentCoords& ic = m_->independent;
+  check(q, ic.nq(), "q");
+  check(qd, ic.nv(), "qd");
+  check(qdd, ic.nv(), "qdd");
+  VecX qf(m_->nq_joint), qdf(m_->nv_joint), qddf(m_->nv_joint), tau(ic.nv());
+  ic.expand_q(q.data(), qf.data());
+  ic.expand_v(qd.data(), qdf.data());
+  ic.expand_v(qdd.data(), qddf.data());
+  ic.reduce(full_torques(qf, qdf, qddf, t).data(), tau.data());
+  return tau;
+}
+
+MatX LagrangeValidator::full_mass_matrix(const VecX& q) const {
   const Model& m = *m_;
   const int n = m.nv_joint;
   check(q, m.nq_joint, "q");
@@ -67,7 +100,8 @@ MatX LagrangeValidator::mass_matrix(const VecX& q) const {
   return M;
 }
 
-VecX LagrangeValidator::torques(const VecX& q, const VecX& qd, const VecX& qdd_in, double t) const {
+VecX LagrangeValidator::full_torques(const VecX& q, const VecX& qd, const VecX& qdd_in,
+                                     double t) const {
   const Model& m = *m_;
   const int n = m.nv_joint, F = m.n_free;
   check(q, m.nq_joint, "q");

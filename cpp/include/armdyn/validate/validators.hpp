@@ -30,14 +30,21 @@ class LagrangeValidator {
   /// @throws ModelError when the model is not a joint-space tree.
   explicit LagrangeValidator(std::shared_ptr<const Model> m, bool rotational_inertia = true);
   /// Generalised actuator forces (n_dofs) for q (n_coords), qd, qdd (n_dofs) at time t; a
-  /// floating base by a local chart about its pose in q (validate/joint_fk.hpp).
+  /// floating base by a local chart about its pose in q (validate/joint_fk.hpp); a coupled
+  /// model's in its independent coordinates (G^T tau_full at the expanded state).
   VecX torques(const VecX& q, const VecX& qd, const VecX& qdd, double t = 0.0) const;
-  /// Joint-space mass matrix M(q).
+  /// Joint-space mass matrix M(q) (a coupled model's G^T M G).
   MatX mass_matrix(const VecX& q) const;
   const Model& model() const { return *m_; }
   bool rotational_inertia() const { return rot_; }
+  /// Lengths of q and of qd the calls take (a coupled model's independent ones).
+  long nq() const;
+  long nv() const;
 
  private:
+  bool coupled() const;
+  VecX full_torques(const VecX& q, const VecX& qd, const VecX& qdd, double t) const;
+  MatX full_mass_matrix(const VecX& q) const;
   std::shared_ptr<const Model> m_;
   bool rot_;
 };
