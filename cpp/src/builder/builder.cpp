@@ -29,6 +29,17 @@ Vec3 unit_axis(const Vec3& a, const std::string& what) {
   return a / n;
 }
 
+// a position and a unit quaternion [e0, e1, e2, e3] (scalar first), checked for `who`
+void require_pose(const std::string& who, const Vec3& position, const Vec4& orientation) {
+  require_finite(position, who + ": position");
+  require_finite(orientation, who + ": orientation");
+  if (std::abs(orientation.norm() - 1.0) > 1e-6)
+    throw ModelError(msg(who,
+                         ": orientation must be a unit quaternion [e0, e1, e2, e3] "
+                         "(scalar first), got norm ",
+                         orientation.norm()));
+}
+
 }  // namespace
 
 InertiaCheck check_inertia(const Mat3& inertia, bool physical, double scale) {
@@ -95,13 +106,7 @@ int ModelBuilder::add_body(const std::string& name, double mass, const Mat3& ine
     throw ModelError(msg(who, ": inertia ", ic.problem, " (principal moments ", p[0], ", ", p[1],
                          ", ", p[2], ")"));
   }
-  require_finite(position, who + ": position");
-  require_finite(orientation, who + ": orientation");
-  if (std::abs(orientation.norm() - 1.0) > 1e-6)
-    throw ModelError(msg(who,
-                         ": orientation must be a unit quaternion [e0, e1, e2, e3] "
-                         "(scalar first), got norm ",
-                         orientation.norm()));
+  require_pose(who, position, orientation);
   Body b;
   b.name = name;
   b.mass = mass;
@@ -195,13 +200,7 @@ int ModelBuilder::add_frame(const std::string& name, const std::string& body, co
   if (name.empty()) throw ModelError("frame name must not be empty");
   if (m_.frame_index.count(name)) throw ModelError(msg(who, ": duplicate frame name"));
   const int b = resolve_body(body, who);
-  require_finite(position, who + ": position");
-  require_finite(orientation, who + ": orientation");
-  if (std::abs(orientation.norm() - 1.0) > 1e-6)
-    throw ModelError(msg(who,
-                         ": orientation must be a unit quaternion [e0, e1, e2, e3] "
-                         "(scalar first), got norm ",
-                         orientation.norm()));
+  require_pose(who, position, orientation);
   NamedFrame f;
   f.name = name;
   f.body = b;
