@@ -24,6 +24,7 @@ void check_joint_vector(Eigen::Ref<const VecX> x, long n, const char* fn, const 
 }
 
 void check_base_quaternions(const Model& m, Eigen::Ref<const VecX> q, const char* fn) {
+  if (m.n_free == 0) return;
   for (const Joint& j : m.joints) {
     if (j.type != JointType::Free || j.q0 < 0) continue;
     const double n = q.segment<4>(j.q0 + 3).norm();
