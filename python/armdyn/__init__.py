@@ -36,6 +36,7 @@ from armdyn._core import (
 )
 from armdyn.dynamics import InverseDynamicsResult, driven_inverse_dynamics
 from armdyn.simulation import SimulationResult, load_urdf, simulate
+from armdyn.sizing import SizingReport, limit_violations, sizing_report
 from armdyn.validation import LagrangeValidator
 from armdyn.workprecision import WorkPrecisionResult, work_precision
 
@@ -50,6 +51,7 @@ __all__ = [
     "ModelError",
     "Profile",
     "SimulationResult",
+    "SizingReport",
     "SolverError",
     "UrdfError",
     "WorkPrecisionResult",
@@ -67,11 +69,13 @@ __all__ = [
     "frame_pose_cartesian",
     "inverse_dynamics",
     "joint_coordinates",
+    "limit_violations",
     "load_urdf",
     "mass_matrix",
     "profiles",
     "scenes",
     "simulate",
+    "sizing_report",
     "state_from_joints",
     "urdf_builder",
     "validation",

@@ -40,6 +40,15 @@ class InverseDynamicsResult:
     velocity_residual: np.ndarray
     stats: dict = field(default_factory=dict)
 
+    def limit_violations(self, model):
+        """Spans where this run exceeds the model's velocity and effort limits, as a DataFrame
+        (joint, kind, t_start, t_end, worst, limit, samples); see
+        :func:`armdyn.sizing.limit_violations`. The result does not hold its model, so the model
+        the run was made with is passed (and checked against the result's columns)."""
+        from armdyn.sizing import limit_violations
+
+        return limit_violations(model, self)
+
 
 def driven_inverse_dynamics(model: _core.Model, t) -> InverseDynamicsResult:
     """Actuator efforts and joint reactions of a *driven* model along its prescribed motion.

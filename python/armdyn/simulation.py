@@ -57,6 +57,15 @@ class SimulationResult:
     events: dict = field(default_factory=dict)
     gear_forces: dict = field(default_factory=dict)
 
+    def limit_violations(self, model):
+        """Spans where this run exceeds the model's velocity and effort limits, as a DataFrame
+        (joint, kind, t_start, t_end, worst, limit, samples); see
+        :func:`armdyn.sizing.limit_violations`. The result does not hold its model, so the model
+        the run was made with is passed (and checked against the result's columns)."""
+        from armdyn.sizing import limit_violations
+
+        return limit_violations(model, self)
+
     @property
     def total_energy(self) -> np.ndarray:
         return self.kinetic_energy + self.potential_energy

@@ -6,6 +6,7 @@ import re
 from pathlib import Path
 
 import armdyn as ad
+import pytest
 from armdyn import validation
 
 API = (Path(__file__).resolve().parents[2] / "docs" / "api.md").read_text("utf-8")
@@ -65,3 +66,13 @@ def test_python_blocks_run():
     tab = ns["wp"].table
     assert tab["status"].tolist() == ["ok", "ok", "failed", "ok"]
     assert tab["error"].iloc[1] < 1e-8 < tab["error"].iloc[0] < 1e-5
+    # the sizing block: a rotor of 0.2 kg m² driven by q = sin(π t) needs 0.2 π² N m at
+    # t = 0.5 and 1.5 s (output samples), above its 1 N m effort limit; its peak speed π rad/s
+    # is within 4 rad/s
+    sizing = ns["sizing"].loc["spin"]
+    assert sizing["peak_torque"] == pytest.approx(0.2 * np.pi**2, rel=1e-12)
+    assert sizing["torque_margin"] == pytest.approx(1.0 / (0.2 * np.pi**2), rel=1e-12)
+    assert not sizing["ok"]
+    spans = ns["spans"]
+    assert spans["kind"].tolist() == ["effort", "effort"]
+    np.testing.assert_allclose(spans["worst"], 0.2 * np.pi**2 * np.array([-1.0, 1.0]), rtol=1e-12)
