@@ -25,6 +25,7 @@ and a command-line tool are not part of it.
 
 from __future__ import annotations
 
+import html
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -173,10 +174,8 @@ class SizingReport:
         """Write ``table.csv``, ``report.html`` (the table and one torque-against-time figure per
         driven joint) and the figures ``torque_<k>.png`` into ``directory`` (created if missing).
         Needs matplotlib (the ``plot`` extra). Returns the HTML page's path."""
-        import matplotlib
-
-        matplotlib.use("Agg", force=False)
-        import matplotlib.pyplot as plt
+        # a bare Figure (Agg canvas): no pyplot state, the user's backend is left alone
+        from matplotlib.figure import Figure
 
         out = Path(os.fspath(directory))
         out.mkdir(parents=True, exist_ok=True)
@@ -186,7 +185,8 @@ class SizingReport:
             tau = self.torque[:, k]
             if np.all(np.isnan(tau)):
                 continue
-            fig, ax = plt.subplots(figsize=(6.0, 3.0))
+            fig = Figure(figsize=(6.0, 3.0))
+            ax = fig.subplots()
             ax.plot(self.t, tau, lw=1.0, label="drive torque/force")
             limit = self.table["effort_limit"].iloc[k]
             if np.isfinite(limit):
@@ -199,7 +199,6 @@ class SizingReport:
             fig.tight_layout()
             png = f"torque_{k}.png"
             fig.savefig(out / png, dpi=100)
-            plt.close(fig)
             figures.append((name, png))
         parts = [
             "<!DOCTYPE html>",
@@ -208,7 +207,8 @@ class SizingReport:
             self.table.to_html(float_format=lambda v: f"{v:.6g}"),
         ]
         for name, png in figures:
-            parts.append(f'<h2>{name}</h2><img src="{png}" alt="torque of {name}">')
+            label = html.escape(str(name))
+            parts.append(f'<h2>{label}</h2><img src="{png}" alt="torque of {label}">')
         parts.append("</body></html>")
         page = out / "report.html"
         page.write_text("\n".join(parts), encoding="utf-8")
