@@ -29,11 +29,14 @@ import html
 import os
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from armdyn import _core
+
+if TYPE_CHECKING:  # pandas is imported when a table is built: `import armdyn` stays light
+    import pandas as pd
 
 _VIOLATION_COLUMNS = ["joint", "kind", "t_start", "t_end", "worst", "limit", "samples"]
 
@@ -130,6 +133,8 @@ def limit_violations(model, result) -> pd.DataFrame:
     Raises:
         ModelError: the result's columns do not match the model (names the mismatch).
     """
+    import pandas as pd
+
     t, names, qd, tau = _checked(model, result, "limit_violations")
     effort_limit, velocity_limit = _column_limits(model, names)
     rows = []
@@ -251,6 +256,8 @@ def sizing_report(result, model) -> SizingReport:
         ModelError: the result's columns do not match the model, or fewer than two samples /
             a zero time span.
     """
+    import pandas as pd
+
     t, names, qd, tau = _checked(model, result, "sizing_report")
     if len(t) < 2 or not (t[-1] > t[0]):
         raise _core.ModelError(
