@@ -101,7 +101,10 @@ def batch_timings(pair: PinPair, n: int = BATCH, number: int = 5) -> dict:
 
     a_ad = ad.forward_dynamics(am, Qa, Va, Ua)[:, pair.perm]
     t_ad = ad.inverse_dynamics(am, Qa, Va, Ua)[:, pair.perm]
-    a_pin, t_pin = np.array(aba_loop()), np.array(rnea_loop())
+    # the reference adds the URDF's <dynamics> joint friction, which armdyn imports and
+    # Pinocchio's algorithms leave out (PinPair.aba, PinPair.rnea); the timed loops are plain
+    a_pin = np.array([pair.aba(Q[i], V[i], U[i]) for i in range(n)])
+    t_pin = np.array([pair.rnea(Q[i], V[i], U[i]) for i in range(n)])
     t = common.interleaved_times(
         {
             "pin_aba_loop": aba_loop,
