@@ -490,6 +490,9 @@ def sweep_armdyn(
         error_measure=problem.quantity,
         repeats=repeats,
         max_steps=10_000_000,  # simulate's default
+        # the problems are free motions, as the peers and references integrate them (the UR5's
+        # URDF limits would stop its fall at the elbow after 1 s)
+        limits="ignore",
     )
     if integrator == "rk4":
         opts["dts"] = settings

@@ -54,6 +54,13 @@ py::dict result_dict(const Model& md, const SimResult& r) {
     gf["force"] = to_numpy(r.gear_forces.data(), {n, ng});
     d["gear_forces"] = gf;
   }
+  {
+    py::dict lf;
+    lf["names"] = r.limit_joints;
+    lf["force"] =
+        to_numpy(r.limit_forces.data(), {n, static_cast<py::ssize_t>(r.limit_joints.size())});
+    d["limit_forces"] = lf;
+  }
   d["position_residual"] = to_numpy(r.position_residual.data(), {n});
   d["velocity_residual"] = to_numpy(r.velocity_residual.data(), {n});
   d["kinetic_energy"] = to_numpy(r.kinetic_energy.data(), {n});
@@ -90,6 +97,18 @@ py::dict result_dict(const Model& md, const SimResult& r) {
   std::vector<bool> onset;
   for (int dir : r.event_direction) onset.push_back(dir > 0);
   ev["onset"] = onset;
+  {
+    py::dict lim;
+    lim["t"] = to_numpy(r.limit_event_t.data(), {static_cast<py::ssize_t>(r.limit_event_t.size())});
+    lim["joint"] = r.limit_event_joint;
+    std::vector<std::string> side, kind;
+    static const char* kinds[] = {"rest", "bounce", "release"};
+    for (int sd : r.limit_event_side) side.emplace_back(sd > 0 ? "lower" : "upper");
+    for (int k : r.limit_event_kind) kind.emplace_back(kinds[k]);
+    lim["side"] = side;
+    lim["kind"] = kind;
+    ev["limits"] = lim;
+  }
   d["events"] = ev;
   d["error"] = r.error;
   return d;
@@ -103,7 +122,7 @@ void bind_dynamics(py::module_& m) {
       [](const Model& md, double t_end, const std::string& integrator, double rtol, double atol,
          double dt, double output_dt, py::object u0, py::object v0, const std::string& projection,
          long max_steps, double max_step, bool merge_welded, const std::string& coordinates,
-         py::object q_start) {
+         py::object q_start, bool limits, double restitution) {
         // armdyn.simulate answers a model with no bodies itself (nothing to integrate)
         if (md.nb == 0)
           throw ModelError("_simulate: the model has no bodies (use armdyn.simulate)");
@@ -115,6 +134,8 @@ void bind_dynamics(py::module_& m) {
           md.independent.expand_q(qi.data(), o.q_start.data());
         }
         o.merge_welded = merge_welded;
+        o.limits = limits;
+        o.restitution = restitution;
         o.coordinates = coordinates_from_name(coordinates);
         o.step.max_step = max_step;
         o.integrator = integrator_from_name(integrator);
@@ -136,7 +157,8 @@ void bind_dynamics(py::module_& m) {
       py::arg("model"), py::arg("t_end"), py::arg("integrator"), py::arg("rtol"), py::arg("atol"),
       py::arg("dt"), py::arg("output_dt"), py::arg("u0"), py::arg("v0"), py::arg("projection"),
       py::arg("max_steps"), py::arg("max_step") = 0.0, py::arg("merge_welded") = true,
-      py::arg("coordinates") = "cartesian", py::arg("q_start") = py::none());
+      py::arg("coordinates") = "cartesian", py::arg("q_start") = py::none(),
+      py::arg("limits") = true, py::arg("restitution") = 0.0);
 
   m.def(
       "state_from_joints",

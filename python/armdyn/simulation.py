@@ -37,7 +37,12 @@ class SimulationResult:
             mesh force along the line of action [N] (positive when the mesh displacement
             s = r_a q_a + r_b q_b is positive); the torque on gear b is −r_b × force.
         events: located events (gear contact): ``t`` (times), ``gear`` (names), ``onset``
-            (True at contact onset, False at separation).
+            (True at contact onset, False at separation); ``limits``: the joint stops' events,
+            ``t``, ``joint``, ``side`` ("lower"/"upper") and ``kind`` ("rest": the joint hit
+            its stop and stays on it, "bounce": it rebounded, "release": it left the stop).
+        limit_forces: ``names`` (the joints held by stops when limits are enforced) and
+            ``force`` (n, n_limited): the stop's torque [N m] or force [N] on the joint's
+            coordinate, positive along it (a lower stop pushes up), 0 off the stops.
     """
 
     t: np.ndarray
@@ -56,6 +61,7 @@ class SimulationResult:
     stats: dict = field(default_factory=dict)
     events: dict = field(default_factory=dict)
     gear_forces: dict = field(default_factory=dict)
+    limit_forces: dict = field(default_factory=dict)
 
     def limit_violations(self, model):
         """Spans where this run exceeds the model's velocity and effort limits, as a DataFrame
@@ -88,6 +94,8 @@ def simulate(
     v0=None,
     merge_welded: bool = True,
     coordinates: str = "cartesian",
+    limits: str = "enforce",
+    restitution: float = 0.0,
 ) -> SimulationResult:
     """Integrate the model from t = 0 to ``t_end``; the stepping loop runs in C++ without the GIL.
 
@@ -140,6 +148,17 @@ def simulate(
             the error control then acts on (q, qd)). Outputs are the same tables, built from
             (q, qd). ``"auto"``: joint space wherever it applies, else Cartesian.
             ``stats["formulation"]`` names the path taken (and for ``"auto"`` why).
+        limits: ``"enforce"`` (default): every joint with one coordinate (revolute,
+            prismatic), a finite position limit (``set_joint_limits``, the URDF ``<limit>``;
+            ``model.coord_lower``/``coord_upper``) and no drive is held within it by a
+            unilateral stop: the contact is located as an event, the impact is an impulse of the
+            whole mechanism (kinetic energy never rises), and the joint then rests on its stop,
+            held by a torque in ``limit_forces``, until the load pulls it off. A run that starts
+            outside a limit is refused. ``"ignore"``: the limits play no part in the dynamics
+            (they are still checked by :func:`armdyn.limit_violations`).
+        restitution: the stops' coefficient of restitution in [0, 1]: 0 (default) a plastic
+            impact, the joint stays on its stop; e > 0 rebounds at e times the impact rate
+            (rebounds slower than 1e-6 rad/s or m/s rest on the stop).
 
     Returns:
         SimulationResult.
@@ -155,6 +174,8 @@ def simulate(
         raise _core.ModelError(f"simulate: max_step must be positive, got {max_step}")
     if output_dt is not None and not (output_dt > 0):
         raise _core.ModelError(f"simulate: output_dt must be positive, got {output_dt}")
+    if limits not in ("enforce", "ignore"):
+        raise _core.ModelError(f"simulate: limits must be 'enforce' or 'ignore', got {limits!r}")
     if q0 is not None or qd0 is not None:
         if u0 is not None or v0 is not None:
             raise _core.ModelError("simulate: give either q0/qd0 or u0/v0, not both")
@@ -182,6 +203,8 @@ def simulate(
         bool(merge_welded),
         coordinates,
         q_start,
+        limits == "enforce",
+        float(restitution),
     )
     error = raw.pop("error")
     result = SimulationResult(**raw)
@@ -229,8 +252,14 @@ def _zero_dof_result(model: _core.Model, t_end: float, output_dt: float | None):
             "solver_bodies": 0,
             "solver_rows": 0,
         },
-        events={"t": np.zeros(0), "gear": [], "onset": []},
+        events={
+            "t": np.zeros(0),
+            "gear": [],
+            "onset": [],
+            "limits": {"t": np.zeros(0), "joint": [], "side": [], "kind": []},
+        },
         gear_forces={"names": [], "force": np.zeros((n, 0))},
+        limit_forces={"names": [], "force": np.zeros((n, 0))},
     )
 
 

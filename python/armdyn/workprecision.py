@@ -274,6 +274,7 @@ def work_precision(
     error_measure: str | None = None,
     repeats: int = 1,
     max_steps: int = 1_000_000,
+    limits: str = "enforce",
 ):
     """Error against CPU time of :func:`armdyn.simulate`'s integrators on the user's model.
 
@@ -317,6 +318,8 @@ def work_precision(
         repeats: CPU time of each point: 1 (default) one run; more: one warm-up run, then the
             median of ``repeats`` runs.
         max_steps: step limit of each run: a run that needs more is a failed row.
+        limits: :func:`armdyn.simulate`'s ``limits`` for every run (``"ignore"`` to compare with
+            a reference that knows no joint stops).
 
     The default reference is DOP853 at rtol = atol = 1e-13 on the other formulation: the joint
     coordinates when the sweep is Cartesian and the model is a tree without drives
@@ -422,7 +425,13 @@ def work_precision(
         start = {"u0": u0, "v0": v0}
 
     def run(integ, coords, rtol=None, dt=None, max_steps=max_steps):
-        opts = dict(start, output_dt=output_dt, coordinates=coords, max_steps=int(max_steps))
+        opts = dict(
+            start,
+            output_dt=output_dt,
+            coordinates=coords,
+            max_steps=int(max_steps),
+            limits=limits,
+        )
         if integ == "rk4":
             opts["dt"] = dt
         elif integ != "kinematic":

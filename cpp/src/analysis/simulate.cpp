@@ -141,6 +141,8 @@ void check_options(const Model& m, double t_end, const SimOptions& opt, const Ve
   if (!(s.output_dt >= 0) || !std::isfinite(s.output_dt))
     throw ModelError(msg("simulate: output_dt must be positive, got ", s.output_dt));
   if (s.max_steps <= 0) throw ModelError("simulate: max_steps must be positive");
+  if (!(opt.restitution >= 0.0 && opt.restitution <= 1.0))
+    throw ModelError(msg("simulate: restitution must lie in [0, 1], got ", opt.restitution));
   if (u0.size() != m.nq || v0.size() != m.nv)
     throw ModelError(msg("simulate: initial state has sizes (", u0.size(), ", ", v0.size(),
                          "), expected (", m.nq, ", ", m.nv, ")"));
@@ -337,6 +339,18 @@ void finish(const Model& m, const Model& ms, const PipelineStats& st, SimResult&
        {&out.position_residual, &out.velocity_residual, &out.kinetic_energy, &out.potential_energy})
     col->resize(n);
   out.gear_forces.resize(n * (m.gears.size() + m.gear_constraints.size()));
+  out.limit_forces.resize(n * out.limit_joints.size());
+}
+
+/// The stops' events in the result (by joint name and side).
+void record_stop_events(const Model& ms, const detail::LimitStops& stops, SimResult& out) {
+  for (size_t e = 0; e < stops.event_t.size(); ++e) {
+    const auto& s = stops.stops()[static_cast<size_t>(stops.event_stop[e])];
+    out.limit_event_t.push_back(stops.event_t[e]);
+    out.limit_event_joint.push_back(ms.joints[static_cast<size_t>(s.joint)].name);
+    out.limit_event_side.push_back(s.side);
+    out.limit_event_kind.push_back(stops.event_kind[e]);
+  }
 }
 
 }  // namespace
@@ -416,6 +430,21 @@ SimResult simulate(const Model& m, Data& d, double t_end, const SimOptions& opt,
                           kkt_path(ms), "'");
   }
   if (opt.coordinates == Coordinates::Auto) out.formulation += msg(" [", plan.why_coordinates, "]");
+  // the joint position limits' stops (none on a fully driven model)
+  std::unique_ptr<detail::LimitStops> stops;
+  if (opt.limits && plan.integrator != Integrator::Kinematic) {
+    stops = std::make_unique<detail::LimitStops>(ms, opt.restitution);
+    if (stops->size() == 0) {
+      stops.reset();
+    } else {
+      sys.set_stops(stops.get());
+      for (int j : stops->limited_joints())
+        out.limit_joints.push_back(ms.joints[static_cast<size_t>(j)].name);
+      if (s.output_dt > 0)
+        out.limit_forces.reserve((static_cast<size_t>(t_end / s.output_dt) + 2) *
+                                 out.limit_joints.size());
+    }
+  }
   // the initial state (of the composites, in a welded run)
   std::unique_ptr<detail::WeldExpander> expander;
   VecX y = VecX::Zero(ms.nq + ms.nv + ms.n_aux);
@@ -437,8 +466,14 @@ SimResult simulate(const Model& m, Data& d, double t_end, const SimOptions& opt,
       run_kinematic(ms, sys, y, t_end, s.output_dt, out, t_last);
     } else if (plan.joint) {
       VecX yj = joint_state(ms, sys, y, opt.projection);
+      if (stops) stops->start(*jsys, 0.0, yj);
       integrate(plan.integrator, *jsys, yj, t_end, s, out.stats, d.integrator);
     } else {
+      if (stops) {
+        sys.data().aux = y.data() + ms.nq + ms.nv;
+        project(ms, sys.data(), 0.0, y.data(), y.data() + ms.nq, opt.projection);
+        stops->start(sys, 0.0, y);
+      }
       integrate(plan.integrator, sys, y, t_end, s, out.stats, d.integrator);
     }
   } catch (const SolverError& err) {
@@ -449,6 +484,7 @@ SimResult simulate(const Model& m, Data& d, double t_end, const SimOptions& opt,
     if (!plan.joint) explain_failure(ms, sys, y, t_last, kinematic, out.error);
   }
   out.cpu_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (stops) record_stop_events(ms, *stops, out);
   finish(m, ms, sys.data().stats, out);
   return out;
 }

@@ -44,12 +44,11 @@ double err_norm(const VecX& e, const VecX& a, const VecX& b, double rtol, double
   return s;
 }
 
-// Signs of the event functions at (t, y) (a zero keeps the default +1).
+// Signs of the event functions at (t, y) (a zero takes +1).
 void init_event_signs(OdeSystem& sys, double t, const VecX& y, std::vector<int>& sgn, VecX& gbuf) {
   if (sgn.empty()) return;
   sys.events(t, y, gbuf.data());
-  for (size_t i = 0; i < sgn.size(); ++i)
-    if (gbuf[i] != 0.0) sgn[i] = gbuf[i] > 0 ? 1 : -1;
+  for (size_t i = 0; i < sgn.size(); ++i) sgn[i] = gbuf[i] < 0 ? -1 : 1;
 }
 
 // Event location on a step [t, t + h] with dense output dense(theta, y_out). sgn holds the sign
@@ -203,6 +202,7 @@ struct AdaptiveRun {
   bool every_step;
   size_t ko = 1;
   bool last_rejected = false;
+  bool resign = false;  // an event changed the system: take the signs afresh
   int ne;
   std::vector<int>&sgn, &crossed;
   VecX &gend, &gbuf, &ybuf, &yo;
@@ -273,8 +273,15 @@ struct AdaptiveRun {
       take_events(sys, t, h, th, dense, crossed, sgn, st, tn, y1);
     }
     serve_outputs(sys, touts, ko, t, h, tn, dense, yo);
+    resign = events && !crossed.empty() && sys.apply_events(tn, y1);
     y = y1;
-    return tn != t_end_step;
+    return tn != t_end_step || resign;
+  }
+  /// After an event changed the system (resign), the event functions' signs at the new,
+  /// projected start of the next step.
+  void signs_after_events(OdeSystem& sys, double tn, const VecX& y) {
+    if (resign) init_event_signs(sys, tn, y, sgn, gbuf);
+    resign = false;
   }
   /// The clock moves to tn (y and the first stage there in place); the next step is hnew.
   void advance(OdeSystem& sys, double tn, const VecX& y, double hnew, StepStats& st) {
@@ -396,6 +403,7 @@ void integrate_dopri5(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
       } else {
         k1 = k7;
       }
+      run.signs_after_events(sys, tn, y);
       run.advance(sys, tn, y, hnew, st);
     } else {
       run.reject(h / std::min(1.0 / fac_min, fac11 / safe), st);
@@ -611,6 +619,7 @@ void integrate_dop853(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
     } else {
       std::swap(k[0], k[12]);
     }
+    run.signs_after_events(sys, tn, y);
     run.advance(sys, tn, y, hnew, st);
   }
 }
@@ -658,6 +667,7 @@ void integrate_rk4(OdeSystem& sys, VecX& y, double t0, double t1, const StepOpti
     // final location uses stages on the near side of it (the Hermite interpolant of a step whose
     // end already feels, e.g., a contact force is only a first guess)
     double tn = t;
+    bool changed = false;  // an event changed the state or the event functions
     for (int round = 0;; ++round) {
       yt = y + 0.5 * h * k1;
       sys.rhs(t + 0.5 * h, yt, k2);
@@ -685,6 +695,7 @@ void integrate_rk4(OdeSystem& sys, VecX& y, double t0, double t1, const StepOpti
         continue;
       }
       take_events(sys, t, h, th, dense, crossed, sgn, st, tn, y1);
+      changed = !crossed.empty() && sys.apply_events(tn, y1);
       creeps = 0;
       break;
     }
@@ -692,6 +703,7 @@ void integrate_rk4(OdeSystem& sys, VecX& y, double t0, double t1, const StepOpti
     t = tn;
     sys.project_and_rhs(t, y, k1);
     ++st.rhs_evals;
+    if (changed) init_event_signs(sys, t, y, sgn, gbuf);
     ++st.steps;
     if (every_step) {
       sys.output(t, y);
@@ -861,6 +873,7 @@ void integrate_trbdf2(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
       // event cut overwrites before the outputs inside the step are served
       yh = y1;
       auto dense = [&](double th, VecX& out) { hermite(th, h, y, K1, yh, K3, out); };
+      bool changed = false;  // an event changed the state or the event functions
       if (ne > 0) {
         sys.events(tn, y1, gend.data());
         const double th = locate_events(sys, t, h, dense, sgn, gend, gbuf, ybuf, crossed);
@@ -870,9 +883,11 @@ void integrate_trbdf2(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
         dense((touts[ko] - t) / h, yo);
         sys.output(touts[ko], yo);
       }
+      if (ne > 0 && !crossed.empty()) changed = sys.apply_events(tn, y1);
       y = y1;
       sys.project_and_rhs(tn, y, K1);
       ++st.rhs_evals;
+      if (changed) init_event_signs(sys, tn, y, sgn, gbuf);
       t = tn;
       ++st.steps;
       if (every_step) sys.output(t, y);

@@ -42,6 +42,13 @@ struct SimOptions {
   /// The joint-space q (model.nq_joint) the initial state was made from, or empty: its angles
   /// start the run's multi-turn tracking (q0 = 3.5 rad is reported as 3.5, not -2.78).
   VecX q_start;
+  /// Joint position limits as unilateral stops (detail/limit_stops.hpp): every joint with one
+  /// coordinate, a finite limit and no drive is held within it (impacts located as events,
+  /// then the joint rests on its stop until the load pulls it off). false: limits ignored.
+  bool limits = true;
+  /// The stops' coefficient of restitution in [0, 1]: 0 (default) a plastic impact (the joint
+  /// stays on the stop), 1 an elastic one.
+  double restitution = 0.0;
 };
 
 /// Row-major output tables: one row per output time.
@@ -52,6 +59,15 @@ struct SimResult {
   /// mesh force along the line of action of every gear pair, then every ideal gear [N]
   /// (positive when s > 0: pushes q_a and q_b back), one row per output
   std::vector<double> gear_forces;
+  /// the joints held by stops (limits enforced), and the stops' torque/force on each joint's
+  /// coordinate (positive along the coordinate: a lower stop pushes up), one row per output
+  std::vector<std::string> limit_joints;
+  std::vector<double> limit_forces;
+  /// located stop events: time, joint, side (+1 lower, -1 upper), kind (0 the joint came to
+  /// rest on the stop, 1 it bounced, 2 it left the stop)
+  std::vector<double> limit_event_t;
+  std::vector<std::string> limit_event_joint;
+  std::vector<int> limit_event_side, limit_event_kind;
   StepStats stats;
   long kkt_solves = 0, factorizations = 0, position_projections = 0, newton_iterations = 0;
   long singular_evaluations = 0;

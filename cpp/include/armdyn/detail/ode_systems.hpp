@@ -23,6 +23,7 @@
 #include "armdyn/analysis/tree_dynamics.hpp"
 #include "armdyn/builder/weld.hpp"
 #include "armdyn/data.hpp"
+#include "armdyn/detail/limit_stops.hpp"
 #include "armdyn/math/quaternion.hpp"
 
 namespace armdyn::detail {
@@ -115,7 +116,7 @@ class WeldExpander {
 };
 
 // the constrained equations of motion as an ODE on y = (u, v), with projection and recording
-class MbsSystem : public OdeSystem {
+class MbsSystem : public OdeSystem, public StopAccess {
  public:
   /// On d, a Data of m (its pipeline; its run buffers hold the output state).
   MbsSystem(const Model& m, Data& d, Metric metric, SimResult& out)
@@ -130,14 +131,22 @@ class MbsSystem : public OdeSystem {
     body_accelerations(m_, d_, t, y.data(), y.data() + m_.nq, dy.data() + m_.nq);
     udot(m_, y.data(), y.data() + m_.nq, dy.data());
     if (m_.n_aux) aux_rates(m_, d_, t, dy.data() + m_.nq + m_.nv);
+    if (stops_ && stops_->any_engaged()) stops_->solve(*this, t, y, dy);
   }
 
   void project_and_rhs(double t, VecX& y, VecX& dy) override {
     d_.aux = y.data() + m_.nq + m_.nv;
     project(m_, d_, t, y.data(), y.data() + m_.nq, metric_);
-    body_accelerations(m_, d_, t, y.data(), y.data() + m_.nq, dy.data() + m_.nq, true);
+    bool reuse = true;
+    if (stops_ && stops_->any_engaged()) {
+      // the engaged stops' joints back on their limits (the projection knows only the joints)
+      body_accelerations(m_, d_, t, y.data(), y.data() + m_.nq, dy.data() + m_.nq, true);
+      reuse = !stops_->hold(*this, t, y, dy);
+    }
+    body_accelerations(m_, d_, t, y.data(), y.data() + m_.nq, dy.data() + m_.nq, reuse);
     udot(m_, y.data(), y.data() + m_.nq, dy.data());
     if (m_.n_aux) aux_rates(m_, d_, t, dy.data() + m_.nq + m_.nv);
+    if (stops_ && stops_->any_engaged()) stops_->solve(*this, t, y, dy);
   }
 
   void output(double t, const VecX& y) override {
@@ -147,6 +156,20 @@ class MbsSystem : public OdeSystem {
     d_.aux = yo_.data() + m_.nq + m_.nv;
     project(m_, d_, t, u, v, metric_);
     body_accelerations(m_, d_, t, u, v, vd_.data(), true);
+    if (stops_ && stops_->any_engaged()) {
+      // the engaged stops' joints on their limits, their torques, then the accelerations and
+      // multipliers with them
+      fo_.resize(yo_.size());
+      fo_.segment(m_.nq, m_.nv) = vd_;
+      if (stops_->hold(*this, t, yo_, fo_)) {
+        body_accelerations(m_, d_, t, u, v, vd_.data());
+        fo_.segment(m_.nq, m_.nv) = vd_;
+      }
+      stops_->solve(*this, t, yo_, fo_);
+      d_.joint_torques = stops_->torques().data();
+      body_accelerations(m_, d_, t, u, v, vd_.data(), true);
+      d_.joint_torques = nullptr;
+    }
     double rf, rv;
     loaded_residuals(m_, d_, v, rf, rv);
     record(t, u, v, vd_, rf, rv, yo_.data() + m_.nq + m_.nv);
@@ -156,6 +179,39 @@ class MbsSystem : public OdeSystem {
 
   /// Report in the bodies and joints of the full model (a welded run).
   void set_expander(WeldExpander* ex) { ex_ = ex; }
+  /// Enforce the joint position limits (simulate's limits="enforce").
+  void set_stops(LimitStops* stops) { stops_ = stops; }
+  LimitStops* stops() const { return stops_; }
+
+  // StopAccess: the Cartesian state y = (u, v, z)
+  void stop_eval(double t, const VecX& y, const double* tau, VecX& dy, bool again) override {
+    d_.aux = y.data() + m_.nq + m_.nv;
+    d_.joint_torques = tau;
+    if (again)
+      body_accelerations_loaded(m_, d_, t, dy.data() + m_.nq, true);
+    else
+      body_accelerations(m_, d_, t, y.data(), y.data() + m_.nq, dy.data() + m_.nq);
+    d_.joint_torques = nullptr;
+    udot(m_, y.data(), y.data() + m_.nq, dy.data());
+    if (m_.n_aux) aux_rates(m_, d_, t, dy.data() + m_.nq + m_.nv);
+  }
+  void stop_load(const VecX& y) override { load_kinematics(m_, d_, y.data(), y.data() + m_.nq); }
+  void stop_coordinate(const VecX& /*y*/, int c, double& q, double& qd) override {
+    const ScalarJet jet = coord_jet(m_, d_.kin, c);
+    q = m_.coords[c].angular ? tracked(d_, c, jet.val) : jet.val;
+    qd = jet.rate;
+  }
+  double stop_acceleration(const VecX& /*y*/, const VecX& dy, int c) override {
+    return coord_acceleration(m_, coord_jet(m_, d_.kin, c, false), c, dy.segment(m_.nq, m_.nv));
+  }
+  long stop_velocity_offset() const override { return m_.nq; }
+  long stop_velocity_size() const override { return m_.nv; }
+  void stop_displace(VecX& y, const VecX& dv) override {
+    du_.resize(m_.nq);
+    udot(m_, y.data(), dv.data(), du_.data());
+    y.head(m_.nq) += du_;
+    load_kinematics(m_, d_, y.data(), y.data() + m_.nq);
+  }
 
   /// Record the outputs at (u, v, t); data() holds the dynamics evaluated there.
   void record(double t, const double* u, const double* v, const VecX& vd, double rf, double rv,
@@ -194,6 +250,9 @@ class MbsSystem : public OdeSystem {
     for (const GearConstraint& g : m_.gear_constraints) out_.gear_forces.push_back(d_.delta[g.row]);
     // actuator efforts: tau = -delta of the drive rows
     for (const Drive& d : m_.drives) out_.drive_forces.push_back(-d_.delta[d.row]);
+    // the joint stops' torques/forces on their joints' coordinates
+    if (stops_)
+      for (int j : stops_->limited_joints()) out_.limit_forces.push_back(stops_->joint_force(j));
     Data* rd = &d_;  // the pipeline of the bodies and joints reported
     if (ex_) {
       ex_->expand(u, v, vd.data());
@@ -224,19 +283,28 @@ class MbsSystem : public OdeSystem {
     out_.n = row + 1;
   }
 
-  int n_events() const override { return static_cast<int>(m_.gears.size()); }
-  void events(double /*t*/, const VecX& y, double* g) override {
-    load_kinematics(m_, d_, y.data(), y.data() + m_.nq);
-    for (int i = 0; i < n_events(); ++i) {
-      double s, sd;
-      gear_mesh(m_, d_, i, s, sd, g[i]);
+  int n_events() const override {
+    return static_cast<int>(m_.gears.size()) + (stops_ ? stops_->size() : 0);
+  }
+  void events(double t, const VecX& y, double* g) override {
+    const int ng = static_cast<int>(m_.gears.size());
+    if (ng) {
+      load_kinematics(m_, d_, y.data(), y.data() + m_.nq);
+      for (int i = 0; i < ng; ++i) {
+        double s, sd;
+        gear_mesh(m_, d_, i, s, sd, g[i]);
+      }
     }
+    if (stops_) stops_->events(*this, t, y, fe_, g + ng);
   }
   void on_event(double t, int i, int direction) override {
+    const int ng = static_cast<int>(m_.gears.size());
+    if (i >= ng) return stops_->on_event(i - ng, direction);
     out_.event_t.push_back(t);
     out_.event_index.push_back(i);
     out_.event_direction.push_back(direction);
   }
+  bool apply_events(double t, VecX& y) override { return stops_ && stops_->apply(*this, t, y); }
 
   /// The model's Cartesian pipeline (settings, tracking, counters).
   Data& data() { return d_; }
@@ -249,6 +317,8 @@ class MbsSystem : public OdeSystem {
   VecX &yo_, &vd_;
   VecX base_q_, base_qd_, base_qdd_;  // floating bases' outputs (sized on first use)
   WeldExpander* ex_ = nullptr;
+  LimitStops* stops_ = nullptr;
+  VecX fo_, fe_, du_;  // the stops' scratch at outputs and events
 };
 
 // The joint-space equations of motion of a tree (TreeDynamics) as an ODE on y = (q, qd, z).
@@ -257,7 +327,7 @@ class MbsSystem : public OdeSystem {
 // Newton-Euler balances, children first, give every joint's multipliers (sweep_multipliers):
 // no Cartesian KKT solve and no projection. The Cartesian system then records the same tables
 // a Cartesian run reports (poses, reactions, gear forces, residuals, energies).
-class JointSystem : public OdeSystem {
+class JointSystem : public OdeSystem, public StopAccess {
  public:
   /// On the Data of the Cartesian system (its joint-space buffers; its run buffers hold the
   /// output state).
@@ -290,6 +360,36 @@ class JointSystem : public OdeSystem {
       dy.head(n_) = y.segment(n_, n_);
     td_.accelerations(t, q, qd, z, nullptr, dy.data() + nq_);
     if (m_.n_aux) td_.aux_rates(t, q, qd, z, dy.data() + nq_ + n_);
+    if (LimitStops* st = cart_.stops(); st && st->any_engaged()) st->solve(*this, t, y, dy);
+  }
+
+  // StopAccess: the joint state y = (q, qd, z)
+  void stop_eval(double t, const VecX& y, const double* tau, VecX& dy, bool /*again*/) override {
+    const double* q = y.data();
+    const double* qd = q + nq_;
+    const double* z = qd + n_;
+    if (m_.n_free)
+      configuration_rate(m_, q, qd, dy.data());
+    else
+      dy.head(n_) = y.segment(n_, n_);
+    td_.accelerations(t, q, qd, z, tau, dy.data() + nq_);
+    if (m_.n_aux) td_.aux_rates(t, q, qd, z, dy.data() + nq_ + n_);
+  }
+  void stop_load(const VecX& /*y*/) override {}
+  void stop_coordinate(const VecX& y, int c, double& q, double& qd) override {
+    q = y[7 * m_.n_free + c];
+    qd = y[nq_ + 6 * m_.n_free + c];
+  }
+  double stop_acceleration(const VecX& /*y*/, const VecX& dy, int c) override {
+    return dy[nq_ + 6 * m_.n_free + c];
+  }
+  long stop_velocity_offset() const override { return nq_; }
+  long stop_velocity_size() const override { return n_; }
+  void stop_place(VecX& y, int c, double q) override {
+    // exactly on the stop, unless the coordinate is tied to others by a gear or coupling row
+    for (const GearConstraint& g : m_.gear_constraints)
+      if (g.coord_a == c || g.coord_b == c) return;
+    y[7 * m_.n_free + c] = q;
   }
 
   void project_and_rhs(double t, VecX& y, VecX& dy) override {
@@ -301,6 +401,16 @@ class JointSystem : public OdeSystem {
     const double* z = y.data() + nq_ + n_;
     const Eigen::Map<const VecX> q(y.data(), nq_), qd(y.data() + nq_, n_);
     td_.accelerations(t, q.data(), qd.data(), z, nullptr, qdd_.data());
+    LimitStops* stops = cart_.stops();
+    const double* stop_tau = nullptr;
+    if (stops && stops->any_engaged()) {
+      // the engaged stops' torques, then the accelerations with them
+      fo_.resize(y.size());
+      fo_.segment(nq_, n_) = qdd_;
+      stops->solve(*this, t, y, fo_);
+      stop_tau = stops->torques().data();
+      td_.accelerations(t, q.data(), qd.data(), z, stop_tau, qdd_.data());
+    }
     // the same Data: the tree's kinematics and joint frames at (q, qd), read before the
     // Cartesian pipeline loads the same state
     Data& d = cart_.data();
@@ -312,23 +422,31 @@ class JointSystem : public OdeSystem {
     d.track_ref = q.tail(d.nco);
     load_kinematics(m_, d, u_.data(), v_.data());
     evaluate_constraints(m_, d, t, false);
+    d.joint_torques = stop_tau;
     cartesian_forces(m_, d, t);
     const VecX& gear_delta = td_.gear_multipliers(qdd_.data());
     d.delta.setZero();
     for (size_t g = 0; g < m_.gear_constraints.size(); ++g)
       d.delta[m_.gear_constraints[g].row] = gear_delta[static_cast<long>(g)];
     sweep_multipliers(m_, d, vd_, sweep_);
+    d.joint_torques = nullptr;
     double rf, rv;
     loaded_residuals(m_, d, v_.data(), rf, rv);
     cart_.record(t, u_.data(), v_.data(), vd_, rf, rv, z);
   }
 
-  int n_events() const override { return static_cast<int>(m_.gears.size()); }
-  void events(double /*t*/, const VecX& y, double* g) override {
+  int n_events() const override { return cart_.n_events(); }
+  void events(double t, const VecX& y, double* g) override {
     double s, sd;
-    for (int i = 0; i < n_events(); ++i) td_.gear_mesh(i, y.data(), y.data() + nq_, s, sd, g[i]);
+    const int ng = static_cast<int>(m_.gears.size());
+    for (int i = 0; i < ng; ++i) td_.gear_mesh(i, y.data(), y.data() + nq_, s, sd, g[i]);
+    if (LimitStops* st = cart_.stops()) st->events(*this, t, y, fe_, g + ng);
   }
   void on_event(double t, int i, int direction) override { cart_.on_event(t, i, direction); }
+  bool apply_events(double t, VecX& y) override {
+    LimitStops* st = cart_.stops();
+    return st && st->apply(*this, t, y);
+  }
 
   const TreeDynamics& dynamics() const { return td_; }
 
@@ -338,6 +456,7 @@ class JointSystem : public OdeSystem {
   MbsSystem& cart_;
   int n_, nq_;
   VecX u_, v_, vd_, qdd_;
+  VecX fo_, fe_;                            // the stops' scratch at outputs and events
   RneWork rne_;                             // the forward sweep at the output's accelerations
   std::vector<std::pair<int, int>> sweep_;  // (joint, child), children before parents
 };

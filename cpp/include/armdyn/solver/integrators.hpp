@@ -49,6 +49,12 @@ class OdeSystem {
   virtual void events(double /*t*/, const VecX& /*y*/, double* /*g*/) {}
   /// Called for each located crossing; direction +1 when g goes from negative to positive.
   virtual void on_event(double /*t*/, int /*i*/, int /*direction*/) {}
+  /// Called once after the on_event calls of a step's crossings, at the end of the cut step
+  /// (the outputs inside it already served): the system may change the state y in place (an
+  /// impact's velocity jump) and redefine its event functions (a stop engaging or releasing).
+  /// Returns whether it did: the integrator then evaluates f afresh at the (projected) y and
+  /// takes the event functions' signs there.
+  virtual bool apply_events(double /*t*/, VecX& /*y*/) { return false; }
 };
 
 struct StepStats {
