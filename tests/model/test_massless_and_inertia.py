@@ -146,7 +146,7 @@ def test_falling_human_cartesian_run_follows_the_joint_space_run():
     # metric floored for the massless bodies (solver/kkt.cpp; with the light-body floors, 1e-9
     # of the heaviest mass, a 1 s fall stalled at t = 0.13 s with |f| = 1.4e-9)
     model = ad.load_urdf(str(_human()))
-    # (the stops' contact sequence is not part of this comparison: tests/simulate/test_joint_limits.py)
+    # (the stops' contact sequence is tested in tests/simulate/test_joint_limits.py)
     runs = {
         c: ad.simulate(model, 0.2, output_dt=0.05, coordinates=c, limits="ignore")
         for c in ("joint", "cartesian")

@@ -9,10 +9,9 @@ formulations against each other.
 
 from __future__ import annotations
 
+import armdyn as ad
 import numpy as np
 import pytest
-
-import armdyn as ad
 
 G = 9.81
 INTEGRATORS = ["dopri5", "dop853", "rk4", "trbdf2"]
@@ -209,7 +208,7 @@ def test_both_formulations_see_the_same_impacts():
 
 def test_limits_bad_input_is_refused_and_driven_joints_have_no_stop():
     model = pendulum(-0.2, 0.2).finalize()
-    with pytest.raises(ad.ModelError, match="'hinge' starts at 0.3.*upper limit 0.2"):
+    with pytest.raises(ad.ModelError, match=r"'hinge' starts at 0\.3.*upper limit 0\.2"):
         ad.simulate(model, 1.0, q0=[0.3], qd0=[0.0])
     with pytest.raises(ad.ModelError, match="limits must be 'enforce' or 'ignore'"):
         ad.simulate(model, 1.0, limits="on")
