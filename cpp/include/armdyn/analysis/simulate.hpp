@@ -52,6 +52,10 @@ struct SimResult {
   /// mesh force along the line of action of every gear pair, then every ideal gear [N]
   /// (positive when s > 0: pushes q_a and q_b back), one row per output
   std::vector<double> gear_forces;
+  /// applied generalised force on every joint dof (Model::dof_names; floating bases' zero),
+  /// joint side: drive efforts + torque inputs + motor torques (after their torque limits);
+  /// springs, dampers and friction excluded. One row per output.
+  std::vector<double> joint_torques;
   StepStats stats;
   long kkt_solves = 0, factorizations = 0, position_projections = 0, newton_iterations = 0;
   long singular_evaluations = 0;
