@@ -224,8 +224,9 @@ void bind_model(py::module_& m) {
       .def_readonly("gyroscopic", &ActuatorView::gyroscopic)
       .def_readonly("motor", &ActuatorView::motor)
       .def("__repr__", [](const ActuatorView& a) {
-        return msg("<armdyn.Actuator on '", a.joint, "': gear_ratio ", a.gear_ratio,
-                   ", rotor_inertia ", a.rotor_inertia, " kg m^2",
+        auto num = [](double x) { return py::repr(py::float_(x)).cast<std::string>(); };
+        return msg("<armdyn.Actuator on '", a.joint, "': gear_ratio ", num(a.gear_ratio),
+                   ", rotor_inertia ", num(a.rotor_inertia), " kg m^2",
                    a.gyroscopic ? ", gyroscopic" : "", ">");
       });
 

@@ -345,6 +345,34 @@ def test_passive_actuated_double_pendulum_conserves_energy(gyroscopic, coords):
     assert np.max(np.abs(e - e[0])) <= 1e-8 * max(1.0, np.max(np.abs(r.kinetic_energy)))
 
 
+@pytest.mark.parametrize("gyroscopic", [False, True])
+def test_rotor_on_a_welded_carrier_runs_the_same_merged_or_not(gyroscopic):
+    # the pitch rotor's carrier 'bracket' is welded to 'base': merge_welded integrates them as
+    # one composite (the rotor joint then sits on it); the joint-space run agrees too
+    b = ad.ModelBuilder()
+    b.add_body("base", 2.0, np.diag([0.02, 0.02, 0.03]), (0.0, 0.0, 0.1), (1.0, 0.0, 0.0, 0.0))
+    b.add_revolute("yaw", "ground", "base", (0.0, 0.0, 0.0), (0.0, 0.0, 1.0))
+    b.add_body("bracket", 0.5, np.diag([1e-3, 1e-3, 1e-3]), (0.1, 0.0, 0.2), (1.0, 0.0, 0.0, 0.0))
+    b.add_fixed("weld", "base", "bracket", (0.1, 0.0, 0.2))
+    b.add_body("arm", 1.0, np.diag([0.002, 0.03, 0.03]), (0.4, 0.0, 0.2), (1.0, 0.0, 0.0, 0.0))
+    b.add_revolute("pitch", "bracket", "arm", (0.1, 0.0, 0.2), (0.0, 1.0, 0.0))
+    b.add_actuator("pitch", 50.0, 1e-4, gyroscopic=gyroscopic)
+    b.add_actuator("yaw", 80.0, 1e-4, gyroscopic=gyroscopic)
+    m = b.finalize()
+    kw = {"q0": [0.2, 0.3], "qd0": [2.0, -1.0], "rtol": 1e-10, "atol": 1e-12, "output_dt": 0.1}
+    merged = ad.simulate(m, 0.5, merge_welded=True, **kw)
+    full = ad.simulate(m, 0.5, merge_welded=False, **kw)
+    joint = ad.simulate(m, 0.5, coordinates="joint", **kw)
+    assert merged.stats["solver_bodies"] == full.stats["solver_bodies"] - 1
+    assert np.allclose(merged.q, full.q, rtol=0, atol=1e-7)
+    assert np.allclose(joint.q, full.q, rtol=0, atol=1e-7)
+    # the rotors turn at N qdot (motor side) in the results
+    assert np.allclose(full.qd[:, 2], 50.0 * full.qd[:, 1], rtol=1e-9, atol=1e-9)
+    assert np.allclose(full.qd[:, 3], 80.0 * full.qd[:, 0], rtol=1e-9, atol=1e-9)
+    e = full.total_energy
+    assert np.max(np.abs(e - e[0])) <= 1e-8 * np.max(full.kinetic_energy)
+
+
 # ----------------------------------------------------------------------------------------------
 # the model's view of its actuators
 # ----------------------------------------------------------------------------------------------
