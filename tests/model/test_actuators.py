@@ -165,6 +165,42 @@ def test_reduced_rotor_in_motion_equals_pinocchio_armature(robot):
     assert worst_fd <= 1e-11 and worst_id <= 1e-11, (worst_fd, worst_id)
 
 
+def _dofs(x, dof, n):
+    """A Pinocchio free-flyer velocity-space vector in armdyn's order (base block first)."""
+    out = np.zeros(n)
+    out[:6], out[dof] = x[:6], x[6:]
+    return out
+
+
+def test_reduced_rotor_on_a_floating_base_equals_pinocchio_armature():
+    # the ground-fixed rotor of a floating robot: still 1/2 N^2 J qdot^2, Pinocchio's armature
+    # on the joint dofs (the free-flyer's quaternion is scalar-last there)
+    path = str(common.robot_urdf("ur5"))
+    b = ad.urdf_builder(path, fixed_base=False)
+    pm = pin.buildModelFromUrdf(path, pin.JointModelFreeFlyer())
+    pd = pm.createData()
+    names = [pm.names[i] for i in range(2, pm.njoints)]
+    ratios, inertias = GEARS["ur5"]
+    for name, n, j in zip(names, ratios, inertias, strict=True):
+        b.add_actuator(name, n, j)
+    am = b.finalize()
+    pm.armature = np.concatenate([np.zeros(6), np.square(ratios) * inertias])
+    dof = np.array([list(am.dof_names).index(n) for n in names])
+    rng = np.random.default_rng(4)
+    worst = 0.0
+    for _ in range(5):
+        qp = pin.randomConfiguration(pm, -np.ones(pm.nq), np.ones(pm.nq))
+        qp[3:7] /= np.linalg.norm(qp[3:7])
+        v, tau = rng.normal(size=pm.nv), rng.normal(scale=10.0, size=pm.nv)
+        q = np.zeros(am.n_coords)
+        q[:7] = [*qp[:3], qp[6], *qp[3:6]]
+        q[dof + 1] = qp[7:]
+        ref = pin.aba(pm, pd, qp, v, tau + _urdf_friction(pm, v))
+        qd, t, ref = (_dofs(x, dof, am.n_dofs) for x in (v, tau, ref))
+        worst = max(worst, rel_err(ad.forward_dynamics(am, q, qd, t), ref))
+    assert worst <= 1e-11
+
+
 def test_coupled_aba_is_refused_by_name():
     am, *_ = _arm("ur5")
     with pytest.raises(ad.ModelError, match="aba"):
