@@ -42,6 +42,7 @@ py::dict result_dict(const Model& md, const SimResult& r) {
   d["qdd"] = to_numpy(r.qdd.data(), {n, static_cast<py::ssize_t>(md.nv_joint)});
   d["drive_forces"] =
       to_numpy(r.drive_forces.data(), {n, static_cast<py::ssize_t>(md.drives.size())});
+  d["joint_torques"] = to_numpy(r.joint_torques.data(), {n, static_cast<py::ssize_t>(md.nv_joint)});
   d["reaction_forces"] = to_numpy(r.reaction_forces.data(), {n, nj, 3});
   d["reaction_torques"] = to_numpy(r.reaction_torques.data(), {n, nj, 3});
   {

@@ -97,9 +97,139 @@ py::array_t<double> coord_limit(const Model& md, CoordLimit which) {
   return to_numpy(r);
 }
 
+// what Model.actuators lists: an Actuator with its joints named and its degree of freedom
+struct ActuatorView {
+  std::string joint, rotor_joint;
+  int dof = -1;
+  double gear_ratio = 1.0, rotor_inertia = 0.0, efficiency = 1.0;
+  double friction_viscous = 0.0, friction_coulomb = 0.0, friction_smoothing = 0.0;
+  bool gyroscopic = false;
+  py::object motor = py::none();
+};
+
+// the independent degree of freedom (into qd, model.dof_names) that moves coordinate c
+int independent_dof(const Model& md, int c) {
+  const IndependentCoords& ic = md.independent;
+  return ic.lead_v + ic.source[c];
+}
+
+// a Motor field from Python: None (not given) or a number, NaN refused
+double motor_field(const py::object& v, const char* name) {
+  if (v.is_none()) return MotorSpec::kUnset;
+  double x;
+  try {
+    x = v.cast<double>();
+  } catch (const py::cast_error&) {
+    throw ModelError(msg("Motor: ", name, " must be a number or None"));
+  }
+  if (std::isnan(x)) throw ModelError(msg("Motor: ", name, " must be finite and > 0, got nan"));
+  return x;
+}
+
+py::object motor_get(const MotorSpec& s, double MotorSpec::* p) {
+  const double v = s.*p;
+  return std::isnan(v) ? py::none() : py::object(py::float_(v));
+}
+
+std::string motor_repr(const MotorSpec& s) {
+  std::string r = "armdyn.Motor(";
+  bool first = true;
+  if (!s.name.empty()) {
+    r += "name=" + py::repr(py::str(s.name)).cast<std::string>();
+    first = false;
+  }
+  for (const auto& [n, p] : MotorSpec::fields()) {
+    if (std::isnan(s.*p)) continue;
+    r += msg(first ? "" : ", ", n, "=", py::repr(py::float_(s.*p)).cast<std::string>());
+    first = false;
+  }
+  return r + ")";
+}
+
 }  // namespace
 
 void bind_model(py::module_& m) {
+  {
+    py::class_<MotorSpec> motor(
+        m, "Motor",
+        "A motor's datasheet values, motor side, SI units, every one optional (None when not "
+        "given): torque_constant [N m/A], resistance [ohm, terminal], voltage [V, supply], "
+        "no_load_speed [rad/s], continuous_torque [N m], peak_torque [N m], max_speed [rad/s], "
+        "thermal_resistance [K/W, winding to ambient], thermal_time_constant [s], and a name. "
+        "Given values must be finite and > 0 (ModelError naming the field). Attach one with "
+        "ModelBuilder.add_actuator(..., motor=armdyn.Motor(...)); it does not enter the "
+        "dynamics (the rotor inertia, gear ratio and friction do), the motor-side sizing reads "
+        "it. Keyword-only constructor; comparable (==) and picklable.");
+    motor.def(py::init([](const std::string& name, py::object kt, py::object r, py::object u,
+                          py::object w0, py::object tc, py::object tp, py::object wmax,
+                          py::object rth, py::object tau_th) {
+                MotorSpec s;
+                s.name = name;
+                const py::object given[] = {kt, r, u, w0, tc, tp, wmax, rth, tau_th};
+                int k = 0;
+                for (const auto& [n, p] : MotorSpec::fields()) s.*p = motor_field(given[k++], n);
+                s.validate("Motor");
+                return s;
+              }),
+              py::kw_only(), py::arg("name") = "", py::arg("torque_constant") = py::none(),
+              py::arg("resistance") = py::none(), py::arg("voltage") = py::none(),
+              py::arg("no_load_speed") = py::none(), py::arg("continuous_torque") = py::none(),
+              py::arg("peak_torque") = py::none(), py::arg("max_speed") = py::none(),
+              py::arg("thermal_resistance") = py::none(),
+              py::arg("thermal_time_constant") = py::none());
+    motor.def_readonly("name", &MotorSpec::name);
+    for (const auto& [n, p] : MotorSpec::fields()) {
+      auto ptr = p;
+      motor.def_property_readonly(n, [ptr](const MotorSpec& s) { return motor_get(s, ptr); });
+    }
+    motor.def("__repr__", &motor_repr);
+    motor.def("__eq__", [](const MotorSpec& a, py::object b) {
+      return py::isinstance<MotorSpec>(b) && a == b.cast<const MotorSpec&>();
+    });
+    motor.attr("__hash__") = py::none();
+    motor.def(py::pickle(
+        [](const MotorSpec& s) {
+          py::dict d;
+          d["name"] = s.name;
+          for (const auto& [n, p] : MotorSpec::fields()) d[n] = motor_get(s, p);
+          return d;
+        },
+        [](const py::dict& d) {
+          MotorSpec s;
+          s.name = d["name"].cast<std::string>();
+          for (const auto& [n, p] : MotorSpec::fields())
+            if (d.contains(n)) s.*p = motor_field(d[n], n);
+          s.validate("Motor");
+          return s;
+        }));
+  }
+  py::class_<ActuatorView>(
+      m, "Actuator",
+      "A gearbox and motor rotor on a joint (ModelBuilder.add_actuator), as Model.actuators "
+      "lists it: joint (the actuated joint's name), rotor_joint (the rotor's revolute joint and "
+      "body, '<joint>_rotor', a coupling follower turning at gear_ratio * qdot), dof (the "
+      "index into the independent qd / model.dof_names the actuator moves), gear_ratio, "
+      "rotor_inertia [kg m^2], efficiency, friction_viscous [N m s/rad, motor side], "
+      "friction_coulomb [N m, motor side], friction_smoothing [rad/s, motor side], gyroscopic, "
+      "motor (armdyn.Motor or None).")
+      .def_readonly("joint", &ActuatorView::joint)
+      .def_readonly("rotor_joint", &ActuatorView::rotor_joint)
+      .def_readonly("dof", &ActuatorView::dof)
+      .def_readonly("gear_ratio", &ActuatorView::gear_ratio)
+      .def_readonly("rotor_inertia", &ActuatorView::rotor_inertia)
+      .def_readonly("efficiency", &ActuatorView::efficiency)
+      .def_readonly("friction_viscous", &ActuatorView::friction_viscous)
+      .def_readonly("friction_coulomb", &ActuatorView::friction_coulomb)
+      .def_readonly("friction_smoothing", &ActuatorView::friction_smoothing)
+      .def_readonly("gyroscopic", &ActuatorView::gyroscopic)
+      .def_readonly("motor", &ActuatorView::motor)
+      .def("__repr__", [](const ActuatorView& a) {
+        auto num = [](double x) { return py::repr(py::float_(x)).cast<std::string>(); };
+        return msg("<armdyn.Actuator on '", a.joint, "': gear_ratio ", num(a.gear_ratio),
+                   ", rotor_inertia ", num(a.rotor_inertia), " kg m^2",
+                   a.gyroscopic ? ", gyroscopic" : "", ">");
+      });
+
   py::class_<Profile>(m, "Profile", "A time profile y(t) with derivatives, evaluated in C++.")
       .def(
           "eval",
@@ -182,6 +312,45 @@ void bind_model(py::module_& m) {
                                }
                                return r;
                              })
+      .def_property_readonly(
+          "actuators",
+          [](const Model& md) {
+            std::vector<ActuatorView> r;
+            for (const Actuator& a : md.actuators) {
+              ActuatorView v;
+              v.joint = md.joints[a.joint].name;
+              v.rotor_joint = md.joints[a.rotor_joint].name;
+              v.dof = independent_dof(md, md.joints[a.joint].coord0);
+              v.gear_ratio = a.gear_ratio;
+              v.rotor_inertia = a.rotor_inertia;
+              v.efficiency = a.efficiency;
+              v.friction_viscous = a.friction_viscous;
+              v.friction_coulomb = a.friction_coulomb;
+              v.friction_smoothing = a.friction_smoothing;
+              v.gyroscopic = a.gyroscopic;
+              if (a.has_motor) v.motor = py::cast(a.motor);
+              r.push_back(v);
+            }
+            return r;
+          },
+          "The actuators (ModelBuilder.add_actuator), as armdyn.Actuator objects.")
+      .def_property_readonly(
+          "reflected_inertia",
+          [](const Model& md) {
+            // G^T diag(J) G over the rotors: (N s)^2 J at the independent dof of each rotor,
+            // s the actuated joint's own coupling scale (1 unless it follows another joint)
+            const IndependentCoords& ic = md.independent;
+            VecX r = VecX::Zero(ic.nv());
+            for (const Actuator& a : md.actuators) {
+              const int c = md.joints[a.rotor_joint].coord0;
+              r[independent_dof(md, c)] += ic.scale[c] * ic.scale[c] * a.rotor_inertia;
+            }
+            return to_numpy(r);
+          },
+          "(n_dofs,) the rotors' inertia reflected through their gears, N^2 J at each "
+          "actuated dof and 0 elsewhere [kg m^2, or kg for a prismatic joint]: the armature of "
+          "Pinocchio's model (the gear-reduced rotor model adds exactly this to the mass "
+          "matrix's diagonal).")
       .def_property_readonly("n_drives", [](const Model& md) { return md.drives.size(); })
       .def_property_readonly("body_names",
                              [](const Model& md) {
@@ -566,6 +735,46 @@ void bind_model(py::module_& m) {
            "mass_matrix, state_from_joints and simulate(q0=...) take the independent ones "
            "(model.coord_names). Chains allowed; cycles, a follower coupled twice, joints of "
            "different types and a zero or non-finite multiplier are refused (ModelError).")
+      .def(
+          "add_actuator",
+          [](ModelBuilder& b, const std::string& joint, double gear_ratio, double rotor_inertia,
+             double efficiency, double friction_viscous, double friction_coulomb, py::object motor,
+             bool gyroscopic, py::object friction_smoothing) {
+            MotorSpec spec;
+            const MotorSpec* mp = nullptr;
+            if (!motor.is_none()) {
+              if (!py::isinstance<MotorSpec>(motor))
+                throw ModelError(msg("add_actuator on joint '", joint,
+                                     "': motor must be an armdyn.Motor or None"));
+              spec = motor.cast<MotorSpec>();
+              mp = &spec;
+            }
+            const double vs =
+                friction_smoothing.is_none() ? 0.0 : friction_smoothing.cast<double>();
+            if (!friction_smoothing.is_none() && !(vs > 0.0))
+              throw ModelError(msg("add_actuator on joint '", joint,
+                                   "': friction_smoothing must be positive, got ", vs));
+            b.add_actuator(joint, gear_ratio, rotor_inertia, efficiency, friction_viscous,
+                           friction_coulomb, mp, gyroscopic, vs);
+          },
+          py::arg("joint"), py::arg("gear_ratio"), py::arg("rotor_inertia"),
+          py::arg("efficiency") = 1.0, py::arg("friction_viscous") = 0.0,
+          py::arg("friction_coulomb") = 0.0, py::arg("motor") = py::none(),
+          py::arg("gyroscopic") = false, py::arg("friction_smoothing") = py::none(),
+          "A gearbox and motor rotor on a revolute (continuous) or prismatic joint. "
+          "gear_ratio N = rotor speed / joint speed (negative reverses the rotor; rad/m for a "
+          "prismatic joint, a ball screw); rotor_inertia J [kg m^2] about the rotor axis; "
+          "efficiency in (0, 1] (stored for the motor-side maths, not in the dynamics); "
+          "friction_viscous [N m s/rad] and friction_coulomb [N m] on the motor side "
+          "(reflected as N^2 b and |N| c), Coulomb smoothed by tanh(omega / friction_smoothing), "
+          "friction_smoothing [rad/s, motor side] default 1e-3 |N|; motor: an armdyn.Motor or "
+          "None. Adds body, revolute joint and coupling '<joint>_rotor' (zero mass, thin-disc "
+          "inertia) along the joint axis through its origin, turning at N qdot: on ground "
+          "(gyroscopic=False: the gear-reduced model, Pinocchio's armature N^2 J exactly) or on "
+          "the joint's parent body (gyroscopic=True: the rotor's full kinetic energy, with its "
+          "carrier's rotation). ModelError, builder unchanged, on an unknown joint, a joint not "
+          "revolute or prismatic, a second actuator, gear_ratio zero or not finite, "
+          "rotor_inertia < 0, efficiency outside (0, 1], negative frictions.")
       .def("add_gear_pair", &ModelBuilder::add_gear_pair, py::arg("name"), py::arg("joint_a"),
            py::arg("joint_b"), py::arg("r_a"), py::arg("r_b"), py::arg("backlash") = 0.0,
            py::arg("stiffness") = 1e8, py::arg("exponent") = 1.5, py::arg("hc_damping") = 0.0,

@@ -9,10 +9,12 @@ projection keeps the constraints satisfied to round-off.
 
 from armdyn import scenes, validation
 from armdyn._core import (
+    Actuator,
     Data,
     Model,
     ModelBuilder,
     ModelError,
+    Motor,
     Profile,
     SolverError,
     UrdfError,
@@ -43,12 +45,14 @@ from armdyn.workprecision import WorkPrecisionResult, work_precision
 __version__ = "0.1.0"
 
 __all__ = [
+    "Actuator",
     "Data",
     "InverseDynamicsResult",
     "LagrangeValidator",
     "Model",
     "ModelBuilder",
     "ModelError",
+    "Motor",
     "Profile",
     "SimulationResult",
     "SizingReport",

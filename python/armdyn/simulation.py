@@ -27,6 +27,11 @@ class SimulationResult:
             first, ``model.joint_dof_names``).
         drive_forces: (n, n_drives) actuator torque/force of each drive, applied to the child
             about/along the joint axis (the RNEA/URDF effort convention).
+        joint_torques: (n, n_joint_dofs) the applied generalised force on every joint dof
+            (columns ``model.joint_dof_names``, like ``qd``), joint side [N m or N]: drive
+            efforts (prescribed motion) + ``add_joint_torque`` inputs + ``add_motor``
+            controller torques after their ``torque_limit``; springs, dampers and friction are
+            not included. Zero on floating bases' dofs and on actuator rotors (followers).
         reaction_forces, reaction_torques: (n, n_joints, 3) joint reaction on the child body at
             the joint point, in the child's joint frame (z = joint axis).
         position_residual: (n,) max |f| of the constraints [m or rad].
@@ -43,6 +48,8 @@ class SimulationResult:
         limit_forces: ``names`` (the joints held by stops when limits are enforced) and
             ``force`` (n, n_limited): the stop's torque [N m] or force [N] on the joint's
             coordinate, positive along it (a lower stop pushes up), 0 off the stops.
+        actuators: for a model with actuators (``model.actuators``), the motor-side values of
+            each (:func:`armdyn.actuators.motor_side_of_result`); empty otherwise.
     """
 
     t: np.ndarray
@@ -52,6 +59,7 @@ class SimulationResult:
     qd: np.ndarray
     qdd: np.ndarray
     drive_forces: np.ndarray
+    joint_torques: np.ndarray
     reaction_forces: np.ndarray
     reaction_torques: np.ndarray
     position_residual: np.ndarray
@@ -62,6 +70,7 @@ class SimulationResult:
     events: dict = field(default_factory=dict)
     gear_forces: dict = field(default_factory=dict)
     limit_forces: dict = field(default_factory=dict)
+    actuators: dict = field(default_factory=dict)
 
     def limit_violations(self, model):
         """Spans where this run exceeds the model's velocity and effort limits, as a DataFrame
@@ -208,11 +217,26 @@ def simulate(
     )
     error = raw.pop("error")
     result = SimulationResult(**raw)
+    if model.actuators:
+        _attach_motor_side(model, result)
     if error:
         exc = _core.SolverError(error)
         exc.result = result
         raise exc
     return result
+
+
+def _attach_motor_side(model: _core.Model, result: SimulationResult) -> None:
+    """result.actuators: the motor-side values of the model's actuators (armdyn.actuators),
+    where that module is available (it arrives with the motor-side sizing; imported by name
+    until then, so that the package holds no import of a missing module)."""
+    import importlib
+
+    try:
+        motor_side = importlib.import_module("armdyn.actuators")
+    except ImportError:
+        return
+    result.actuators = motor_side.motor_side_of_result(model, result)
 
 
 def _zero_dof_result(model: _core.Model, t_end: float, output_dt: float | None):
@@ -237,6 +261,7 @@ def _zero_dof_result(model: _core.Model, t_end: float, output_dt: float | None):
         qd=empty.copy(),
         qdd=empty.copy(),
         drive_forces=empty.copy(),
+        joint_torques=empty.copy(),
         reaction_forces=np.zeros((n, len(model.joint_names), 3)),
         reaction_torques=np.zeros((n, len(model.joint_names), 3)),
         position_residual=np.zeros(n),

@@ -86,7 +86,8 @@ const DynamicsCost& dynamics_cost(const Model& m) {
     // light bodies (solver/kkt.hpp): ABA, about each body's centre of mass, keeps their
     // accelerations; CRBA's composites about the world origin lose a light leaf link's (UR5
     // wrist_3_link inertia x 1e-12: 6.6e-4), and the Cartesian path turns to a dense LU
-    c.light = !light_bodies(m).bodies.empty();
+    // (actuator rotors, massless coupling followers, are exact in CRBA: LightBodies)
+    c.light = !light_bodies(m).joint_space.empty();
     if (c.light) c.joint = c.best = DynamicsMethod::Aba;
     c.dof = c.n;
     if (!m.gear_constraints.empty() && m.joint_tree) {

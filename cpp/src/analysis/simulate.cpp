@@ -333,6 +333,7 @@ void finish(const Model& m, const Model& ms, const PipelineStats& st, SimResult&
   out.qd.resize(n * static_cast<size_t>(m.nv_joint));
   out.qdd.resize(n * static_cast<size_t>(m.nv_joint));
   out.drive_forces.resize(n * m.drives.size());
+  out.joint_torques.resize(n * static_cast<size_t>(m.nv_joint));
   out.reaction_forces.resize(n * 3 * nj);
   out.reaction_torques.resize(n * 3 * nj);
   for (auto* col :

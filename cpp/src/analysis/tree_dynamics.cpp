@@ -25,11 +25,11 @@ namespace {
 std::string geared_light_reason(const Model& m) {
   if (m.gear_constraints.empty()) return {};
   const LightBodies& light = light_bodies(m);
-  if (light.bodies.empty()) return {};
+  if (light.joint_space.empty()) return {};
   return msg(
       "with ideal gears the joint-space path needs the mass matrix (CRBA about the world "
       "origin), which loses the accelerations of light bodies: ",
-      light.note.substr(0, light.note.find(';')),
+      light.joint_space_note,
       " (the Cartesian path solves them in augmented form: coordinates 'cartesian')");
 }
 

@@ -459,6 +459,12 @@ void ModelBuilder::add_gear(const std::string& name, const std::string& joint_a,
 
 void ModelBuilder::add_coupling(const std::string& name, const std::string& follower,
                                 const std::string& leader, double multiplier, double offset) {
+  add_coupling_impl(name, follower, leader, multiplier, offset, false);
+}
+
+void ModelBuilder::add_coupling_impl(const std::string& name, const std::string& follower,
+                                     const std::string& leader, double multiplier, double offset,
+                                     bool mixed) {
   const std::string who = msg("coupling '", name, "'");
   if (name.empty()) throw ModelError("coupling: empty name");
   for (const GearConstraint& g : m_.gear_constraints)
@@ -478,7 +484,7 @@ void ModelBuilder::add_coupling(const std::string& name, const std::string& foll
   const Joint& jf = joint_of(follower, "follower");
   const Joint& jl = joint_of(leader, "leader");
   if (&jf == &jl) throw ModelError(msg(who, ": joint '", follower, "' cannot follow itself"));
-  if (jf.type != jl.type)
+  if (jf.type != jl.type && !mixed)
     throw ModelError(msg(who, ": follower joint '", follower, "' is ", joint_type_name(jf.type),
                          " but leader joint '", leader, "' is ", joint_type_name(jl.type),
                          "; both must be of the same type (as Pinocchio requires)"));
@@ -513,6 +519,85 @@ void ModelBuilder::add_coupling(const std::string& name, const std::string& foll
   g.offset = offset;
   g.coupling = true;
   m_.gear_constraints.push_back(g);
+}
+
+void ModelBuilder::add_actuator(const std::string& joint, double gear_ratio, double rotor_inertia,
+                                double efficiency, double friction_viscous, double friction_coulomb,
+                                const MotorSpec* motor, bool gyroscopic,
+                                double friction_smoothing) {
+  const std::string who = msg("add_actuator on joint '", joint, "'");
+  auto it = m_.joint_index.find(joint);
+  if (it == m_.joint_index.end()) throw ModelError(msg(who, ": unknown joint"));
+  const int ji = it->second;
+  const Joint& j = m_.joints[ji];
+  if (j.type != JointType::Revolute && j.type != JointType::Prismatic)
+    throw ModelError(msg(who, ": the joint is ", joint_type_name(j.type),
+                         "; an actuator needs a revolute (continuous) or prismatic joint"));
+  for (const Actuator& a : m_.actuators)
+    if (a.joint == ji)
+      throw ModelError(msg(who, ": the joint already has an actuator (rotor '",
+                           m_.joints[a.rotor_joint].name, "')"));
+  if (!std::isfinite(gear_ratio) || gear_ratio == 0.0)
+    throw ModelError(msg(who, ": gear_ratio must be finite and nonzero, got ", gear_ratio));
+  if (!std::isfinite(rotor_inertia) || rotor_inertia < 0.0)
+    throw ModelError(msg(who, ": rotor_inertia must be finite and >= 0, got ", rotor_inertia));
+  if (!std::isfinite(efficiency) || !(efficiency > 0.0 && efficiency <= 1.0))
+    throw ModelError(msg(who, ": efficiency must be in (0, 1], got ", efficiency));
+  for (auto [v, n] : {std::pair{friction_viscous, "friction_viscous"},
+                      std::pair{friction_coulomb, "friction_coulomb"}})
+    if (!std::isfinite(v) || v < 0.0)
+      throw ModelError(msg(who, ": ", n, " must be finite and >= 0, got ", v));
+  if (!std::isfinite(friction_smoothing))
+    throw ModelError(msg(who, ": friction_smoothing must be finite, got ", friction_smoothing));
+  if (motor) motor->validate(who + ": motor");
+  const std::string rotor = joint + "_rotor";
+  if (m_.body_index.count(rotor) || rotor == "ground")
+    throw ModelError(msg(who, ": a body named '", rotor, "' exists (the rotor's name)"));
+  if (m_.joint_index.count(rotor))
+    throw ModelError(msg(who, ": a joint named '", rotor, "' exists (the rotor's name)"));
+  for (const GearConstraint& g : m_.gear_constraints)
+    if (g.name == rotor)
+      throw ModelError(msg(who, ": a coupling or gear named '", rotor, "' exists (the rotor's)"));
+  // the joint's origin and axis in world at the build pose
+  Vec3 point = j.point_parent, axis = j.frame_parent.col(2);
+  if (j.parent != kGround) {
+    const Body& p = m_.bodies[j.parent];
+    const Mat3 R = quat_to_rot(p.orientation);
+    point = p.position + R * j.point_parent;
+    axis = R * j.frame_parent.col(2);
+  }
+  const std::string carrier =
+      gyroscopic && j.parent != kGround ? m_.bodies[j.parent].name : std::string("ground");
+  // thin disc: axial J, transverse J / 2 (the rotor's mass belongs to the link's inertia)
+  const Mat3 inertia = 0.5 * rotor_inertia * (Mat3::Identity() + axis * axis.transpose());
+  const double smoothing =
+      friction_smoothing > 0.0 ? friction_smoothing : 1e-3 * std::abs(gear_ratio);
+  Model saved = m_;  // every step below validated its input; restore on any failure regardless
+  try {
+    add_body(rotor, 0.0, inertia, point, Vec4(1, 0, 0, 0));
+    const int rj = add_revolute(rotor, carrier, rotor, point, axis);
+    add_coupling_impl(rotor, rotor, joint, gear_ratio, 0.0, true);
+    if (friction_viscous > 0.0 || friction_coulomb > 0.0)
+      add_joint_friction(rotor, friction_viscous, friction_coulomb, smoothing);
+    Actuator a;
+    a.joint = ji;
+    a.rotor_joint = rj;
+    a.gear_ratio = gear_ratio;
+    a.rotor_inertia = rotor_inertia;
+    a.efficiency = efficiency;
+    a.friction_viscous = friction_viscous;
+    a.friction_coulomb = friction_coulomb;
+    a.friction_smoothing = smoothing;
+    a.gyroscopic = gyroscopic;
+    if (motor) {
+      a.has_motor = true;
+      a.motor = *motor;
+    }
+    m_.actuators.push_back(a);
+  } catch (...) {
+    m_ = std::move(saved);
+    throw;
+  }
 }
 
 void ModelBuilder::add_gear_pair(const std::string& name, const std::string& joint_a,

@@ -141,6 +141,11 @@ std::shared_ptr<const Welding> build_welding(const Model& m) {
   d.coord_forces = draft.coord_forces;
   d.gears = draft.gears;
   d.gear_constraints = draft.gear_constraints;
+  d.actuators = draft.actuators;  // their joints are revolute or prismatic: never merged
+  for (Actuator& a : d.actuators) {
+    a.joint = weld_joint[a.joint];
+    a.rotor_joint = weld_joint[a.rotor_joint];
+  }
   d.tracked_coords = draft.tracked_coords;
   d.n_aux = draft.n_aux;
   std::shared_ptr<Model> w;

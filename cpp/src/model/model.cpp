@@ -150,23 +150,77 @@ double gear_force(const GearPair& g, double s, double sd, double& penetration) {
   return std::max(f, 0.0);
 }
 
+namespace {
+// the PD/PI motor's torque after its limit (0 without a motor), and the rate of its integral
+double motor_value(const CoordForce& cf, bool angular, double q, double qdot, double t, double z,
+                   double* zdot) {
+  if (!cf.motor) {
+    if (zdot) *zdot = 0.0;
+    return 0.0;
+  }
+  const ProfileValue r = cf.reference.eval(t);
+  const double e = angular ? wrap_angle(r.y - q) : r.y - q;
+  const double u = cf.kp * e + cf.kd * (r.yd - qdot) + cf.ki * z;
+  const double uc = std::clamp(u, -cf.torque_limit, cf.torque_limit);
+  if (zdot) *zdot = (uc != u && e * u > 0) ? 0.0 : e;  // stop integrating into saturation
+  return uc;
+}
+}  // namespace
+
+double coord_actuation_value(const CoordForce& cf, bool angular, double q, double qdot, double t,
+                             double z, double* zdot) {
+  double tau = 0.0;
+  if (cf.has_input) tau += cf.input.eval(t).y;
+  if (cf.motor)
+    tau += motor_value(cf, angular, q, qdot, t, z, zdot);
+  else if (zdot)
+    *zdot = 0.0;
+  return tau;
+}
+
 double coord_force_value(const CoordForce& cf, bool angular, double q, double qdot, double t,
                          double z, double* zdot) {
-  auto diff = [&](double a, double b) { return angular ? wrap_angle(a - b) : a - b; };
-  double tau = -cf.stiffness * diff(q, cf.rest) - cf.damping * qdot;
+  const double dq = angular ? wrap_angle(q - cf.rest) : q - cf.rest;
+  double tau = -cf.stiffness * dq - cf.damping * qdot;
   if (cf.coulomb > 0) tau -= cf.coulomb * std::tanh(qdot / cf.v_smooth);
   if (cf.has_input) tau += cf.input.eval(t).y;
-  if (cf.motor) {
-    const ProfileValue r = cf.reference.eval(t);
-    const double e = diff(r.y, q);
-    const double u = cf.kp * e + cf.kd * (r.yd - qdot) + cf.ki * z;
-    const double uc = std::clamp(u, -cf.torque_limit, cf.torque_limit);
-    tau += uc;
-    if (zdot) *zdot = (uc != u && e * u > 0) ? 0.0 : e;  // stop integrating into saturation
-  } else if (zdot) {
+  if (cf.motor)
+    tau += motor_value(cf, angular, q, qdot, t, z, zdot);
+  else if (zdot)
     *zdot = 0.0;
-  }
   return tau;
+}
+
+const std::vector<std::pair<const char*, double MotorSpec::*>>& MotorSpec::fields() {
+  static const std::vector<std::pair<const char*, double MotorSpec::*>> f = {
+      {"torque_constant", &MotorSpec::torque_constant},
+      {"resistance", &MotorSpec::resistance},
+      {"voltage", &MotorSpec::voltage},
+      {"no_load_speed", &MotorSpec::no_load_speed},
+      {"continuous_torque", &MotorSpec::continuous_torque},
+      {"peak_torque", &MotorSpec::peak_torque},
+      {"max_speed", &MotorSpec::max_speed},
+      {"thermal_resistance", &MotorSpec::thermal_resistance},
+      {"thermal_time_constant", &MotorSpec::thermal_time_constant}};
+  return f;
+}
+
+void MotorSpec::validate(const std::string& who) const {
+  for (const auto& [n, p] : fields()) {
+    const double v = this->*p;
+    if (std::isnan(v)) continue;  // not given
+    if (!std::isfinite(v) || !(v > 0))
+      throw ModelError(msg(who, ": ", n, " must be finite and > 0 (or not given), got ", v));
+  }
+}
+
+bool MotorSpec::operator==(const MotorSpec& o) const {
+  if (name != o.name) return false;
+  for (const auto& [n, p] : fields()) {
+    const double a = this->*p, b = o.*p;
+    if (!(a == b || (std::isnan(a) && std::isnan(b)))) return false;
+  }
+  return true;
 }
 
 }  // namespace armdyn

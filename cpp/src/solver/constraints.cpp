@@ -179,8 +179,10 @@ void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t,
       const int c = k == 0 ? g.coord_a : g.coord_b;
       const double r = k == 0 ? g.r_a : g.r_b;
       const ScalarJet& q = ce.coord_cache ? ce.coord_cache->get(m, kin, c) : coord_jet(m, kin, c);
-      const double ref = ce.track_ref && angular ? (*ce.track_ref)[c] : 0.0;
-      f += r * (angular ? ref + wrap_angle(q.val - ref) : q.val);
+      // per coordinate: an actuator's revolute rotor may follow a prismatic joint
+      const bool ang_c = m.coords[c].angular;
+      const double ref = ce.track_ref && ang_c ? (*ce.track_ref)[c] : 0.0;
+      f += r * (ang_c ? ref + wrap_angle(q.val - ref) : q.val);
       xi += r * q.bias;
       const Joint& j = m.joints[m.coords[c].joint];
       const int ends[2] = {j.parent, j.child};

@@ -17,6 +17,14 @@ const LightBodies& light_bodies(const Model& m) {
     double mmax = 0.0;
     for (const Body& b : m.bodies) mmax = std::max(mmax, b.mass);
     const double l2 = m.length_scale * m.length_scale;
+    // massless children of revolute coupling followers (actuator rotors) are exact in CRBA
+    std::vector<char> follower(m.coords.size(), 0), rotor(m.nb, 0);
+    for (const GearConstraint& g : m.gear_constraints)
+      if (g.coupling) follower[g.coord_a] = 1;
+    for (const Joint& j : m.joints)
+      if (j.child != kGround && j.type == JointType::Revolute && follower[j.coord0] &&
+          !(m.bodies[j.child].mass > 0.0))
+        rotor[j.child] = 1;
     for (int i = 0; i < m.nb; ++i) {
       const Body& b = m.bodies[i];
       const double jmin = Eigen::SelfAdjointEigenSolver<Mat3>(b.inertia).eigenvalues()[0];
@@ -26,6 +34,11 @@ const LightBodies& light_bodies(const Model& m) {
       if (ratio < 1e-6) {
         lb.bodies.push_back(i);
         lb.note += msg(lb.note.empty() ? "" : ", ", "'", b.name, "' (", ratio, ")");
+        if (!rotor[i]) {
+          lb.joint_space.push_back(i);
+          lb.joint_space_note +=
+              msg(lb.joint_space_note.empty() ? "" : ", ", "'", b.name, "' (", ratio, ")");
+        }
       }
     }
     lb.massless_only = !lb.bodies.empty();

@@ -68,6 +68,10 @@ struct SimResult {
   std::vector<double> limit_event_t;
   std::vector<std::string> limit_event_joint;
   std::vector<int> limit_event_side, limit_event_kind;
+  /// applied generalised force on every joint dof (Model::dof_names; floating bases' zero),
+  /// joint side: drive efforts + torque inputs + motor torques (after their torque limits);
+  /// springs, dampers and friction excluded. One row per output.
+  std::vector<double> joint_torques;
   StepStats stats;
   long kkt_solves = 0, factorizations = 0, position_projections = 0, newton_iterations = 0;
   long singular_evaluations = 0;

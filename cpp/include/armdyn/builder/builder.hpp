@@ -131,6 +131,24 @@ class ModelBuilder {
   ///   a cycle of couplings.
   void add_coupling(const std::string& name, const std::string& follower, const std::string& leader,
                     double multiplier, double offset = 0.0);
+  /// A gearbox and motor rotor on revolute or prismatic joint `joint` (see Actuator): the
+  /// builder adds body and revolute joint `<joint>_rotor` (zero mass, thin-disc inertia: axial
+  /// rotor_inertia [kg m^2], transverse half of it) along the joint's axis through its origin,
+  /// on ground (gyroscopic false: the gear-reduced model, kinetic energy 1/2 N^2 J qdot^2) or on
+  /// the joint's parent body (gyroscopic true: the rotor's full kinetic energy, gyroscopic
+  /// terms included), and the coupling `<joint>_rotor` q_rotor = gear_ratio q_joint [a
+  /// prismatic joint's ratio in rad/m]. Motor-side viscous [N m s/rad] and Coulomb [N m]
+  /// friction act on the rotor joint (smoothing velocity friction_smoothing [rad/s] on the
+  /// rotor; <= 0: 1e-3 |gear_ratio|, i.e. 1e-3 joint side), so they reach the joint as N^2 b and
+  /// N c. efficiency and motor are stored (Model::actuators), not in the dynamics.
+  /// @throws ModelError naming the joint and the culprit on an unknown joint, a joint that is
+  ///   not revolute or prismatic, a second actuator on the joint, a zero or non-finite
+  ///   gear_ratio, a negative or non-finite rotor_inertia, an efficiency outside (0, 1],
+  ///   negative or non-finite frictions, an invalid motor, or a name `<joint>_rotor` taken.
+  void add_actuator(const std::string& joint, double gear_ratio, double rotor_inertia,
+                    double efficiency = 1.0, double friction_viscous = 0.0,
+                    double friction_coulomb = 0.0, const MotorSpec* motor = nullptr,
+                    bool gyroscopic = false, double friction_smoothing = 0.0);
   /// Gear pair with backlash between two revolute joints (see GearPair).
   void add_gear_pair(const std::string& name, const std::string& joint_a,
                      const std::string& joint_b, double r_a, double r_b, double backlash,
@@ -158,6 +176,9 @@ class ModelBuilder {
   std::pair<int, int> gear_coords(const std::string& who, const std::string& joint_a,
                                   const std::string& joint_b, double r_a, double r_b) const;
 
+  /// add_coupling; mixed: a revolute follower may follow a prismatic leader (actuator rotors)
+  void add_coupling_impl(const std::string& name, const std::string& follower,
+                         const std::string& leader, double multiplier, double offset, bool mixed);
   int add_joint(const std::string& name, JointType type, const std::string& parent,
                 const std::string& child, const Vec3& point, const Vec3& axis, const Vec3* axis2,
                 const Vec3* point_child = nullptr);

@@ -253,6 +253,22 @@ class MbsSystem : public OdeSystem, public StopAccess {
     // the joint stops' torques/forces on their joints' coordinates
     if (stops_)
       for (int j : stops_->limited_joints()) out_.limit_forces.push_back(stops_->joint_force(j));
+    // applied joint torques, every joint dof (floating bases' zero): the drives' efforts, the
+    // torque inputs and the motors' torques after their limits; not springs, dampers, friction
+    {
+      const size_t nco = m_.coords.size(), off = out_.joint_torques.size();
+      out_.joint_torques.resize(off + 6 * static_cast<size_t>(m_.n_free) + nco, 0.0);
+      double* jt = out_.joint_torques.data() + off + 6 * m_.n_free;
+      const double* qc = out_.q.data() + out_.q.size() - nco;
+      const double* qdc = out_.qd.data() + out_.qd.size() - nco;
+      for (const CoordForce& cf : m_.coord_forces) {
+        if (!cf.motor && !cf.has_input) continue;
+        const double z = (cf.aux >= 0 && aux) ? aux[cf.aux] : 0.0;
+        jt[cf.coord] += coord_actuation_value(cf, m_.coords[cf.coord].angular, qc[cf.coord],
+                                              qdc[cf.coord], t, z);
+      }
+      for (const Drive& d : m_.drives) jt[m_.joints[d.joint].coord0 + d.coord] -= d_.delta[d.row];
+    }
     Data* rd = &d_;  // the pipeline of the bodies and joints reported
     if (ex_) {
       ex_->expand(u, v, vd.data());

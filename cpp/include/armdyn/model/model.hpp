@@ -8,9 +8,11 @@
 // omega_i [rad/s] in the BODY frame). nq = 7 nb, nv = 6 nb. Body index -1 is ground.
 #pragma once
 
+#include <limits>
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "armdyn/math/types.hpp"
@@ -160,6 +162,10 @@ struct CoordForce {
 /// the rate of z (the tracking error, or 0 while saturated).
 double coord_force_value(const CoordForce& cf, bool angular, double q, double qdot, double t,
                          double z = 0.0, double* zdot = nullptr);
+/// The actuation part of coord_force_value: input(t) + motor (after its torque limit), without
+/// the spring, damper and friction terms (the applied joint torque a run reports).
+double coord_actuation_value(const CoordForce& cf, bool angular, double q, double qdot, double t,
+                             double z = 0.0, double* zdot = nullptr);
 
 /// Gear pair with backlash between the angle coordinates of two revolute joints (external
 /// mesh): the mesh displacement along the line of action is s = r_a q_a + r_b q_b (zero when
@@ -242,6 +248,50 @@ struct IndependentCoords {
   void align(const std::vector<Coord>& coords, double* coord_q) const;
 };
 
+/// A motor's datasheet values, motor side, SI units; NaN = not given (every field optional).
+/// Informative for the dynamics (the rotor inertia, gear ratio and friction of an Actuator are
+/// what enters them); the motor-side sizing maths (Python armdyn.actuators) reads them.
+struct MotorSpec {
+  static constexpr double kUnset = std::numeric_limits<double>::quiet_NaN();
+  std::string name;
+  double torque_constant = kUnset;        ///< [N m/A]
+  double resistance = kUnset;             ///< terminal resistance [ohm]
+  double voltage = kUnset;                ///< supply voltage [V]
+  double no_load_speed = kUnset;          ///< [rad/s]
+  double continuous_torque = kUnset;      ///< rated continuous torque [N m]
+  double peak_torque = kUnset;            ///< [N m]
+  double max_speed = kUnset;              ///< [rad/s]
+  double thermal_resistance = kUnset;     ///< winding to ambient [K/W]
+  double thermal_time_constant = kUnset;  ///< winding [s]
+  /// The numeric fields, in declaration order, with their names (bindings, validation).
+  static const std::vector<std::pair<const char*, double MotorSpec::*>>& fields();
+  /// @throws ModelError naming the field when a given value is not finite and > 0.
+  void validate(const std::string& who) const;
+  /// Equal names and fields (two unset fields compare equal).
+  bool operator==(const MotorSpec& o) const;
+};
+
+/// A gearbox and motor rotor on a revolute or prismatic joint (ModelBuilder::add_actuator). The
+/// builder adds the rotor as a body of its own (zero mass, thin-disc inertia: axial
+/// rotor_inertia, transverse half of it) on a revolute joint `rotor_joint` along the actuated
+/// joint's axis through its origin, coupled to it (q_rotor = gear_ratio q_joint) -- on ground
+/// (gyroscopic false: the gear-reduced model, kinetic energy 1/2 N^2 J qdot^2, Pinocchio's
+/// armature N^2 J) or on the actuated joint's parent body (gyroscopic true: the rotor's full
+/// kinetic energy with its carrier's rotation). Motor-side friction acts on the rotor joint.
+struct Actuator {
+  int joint = 0;                    ///< the actuated joint
+  int rotor_joint = 0;              ///< the rotor's revolute joint (a coupling follower)
+  double gear_ratio = 1.0;          ///< N: rotor speed / joint speed [1, or rad/m for prismatic]
+  double rotor_inertia = 0.0;       ///< J about the rotor axis [kg m^2]
+  double efficiency = 1.0;          ///< gear efficiency in (0, 1] (not in the dynamics)
+  double friction_viscous = 0.0;    ///< motor side [N m s/rad]
+  double friction_coulomb = 0.0;    ///< motor side [N m]
+  double friction_smoothing = 0.0;  ///< motor-side tanh smoothing velocity [rad/s]
+  bool gyroscopic = false;
+  bool has_motor = false;
+  MotorSpec motor;
+};
+
 /// A named frame rigidly attached to a body (or to ground): a URDF link, a tool flange, a sensor.
 /// Its placement follows the conventions of Joint::point_parent and Joint::frame_parent: the
 /// origin in the body's frame relative to its centre of mass (ground: world), and the frame's
@@ -271,6 +321,7 @@ class Model {
   std::vector<CoordForce> coord_forces;
   std::vector<GearPair> gears;
   std::vector<GearConstraint> gear_constraints;
+  std::vector<Actuator> actuators;  ///< gearboxes and rotors (ModelBuilder::add_actuator)
   std::vector<int> tracked_coords;  ///< angle coordinates unwrapped over turns (gears)
   int n_aux = 0;  ///< auxiliary states of the simulation (integral terms of PI motors)
   std::vector<Coord> coords;

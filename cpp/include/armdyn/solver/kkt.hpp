@@ -54,6 +54,12 @@ struct LightBodies {
   /// every light body is massless (mass 0): the dynamics takes the refined range-space solve
   /// (KktSolver::accelerations_refined) before the augmented one
   bool massless_only = false;
+  /// the light bodies that matter to the joint-space mass matrix (CRBA about the world
+  /// origin): all but the massless children of a revolute coupling follower (actuator rotors:
+  /// zero mass adds no parallel-axis terms, and the follower is no degree of freedom), and
+  /// their note
+  std::vector<int> joint_space;
+  std::string joint_space_note;
 };
 const LightBodies& light_bodies(const Model& m);
 
