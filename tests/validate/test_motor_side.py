@@ -63,7 +63,8 @@ def test_rotor_only_joint_under_constant_acceleration():
     np.testing.assert_allclose(s.torque, a_ + b_ * t, rtol=1e-13)
     np.testing.assert_allclose(s.load_torque, 0.0, atol=1e-13)
     np.testing.assert_allclose(s.current, (a_ + b_ * t) / k_t, rtol=1e-13)
-    # mechanical: f = (A + B t) W t, f' = W (A + 2 B t); copper: f = R/k² (A + B t)², f' = 2RB/k² (A+Bt)
+    # mechanical: f = (A + B t) W t, f' = W (A + 2 B t)
+    # copper: f = R/k² (A + B t)², f' = 2 R B/k² (A + B t)
     mech = w_ * (a_ * tend**2 / 2 + b_ * tend**3 / 3) + h**2 / 12 * w_ * 2 * b_ * tend
     copper = r / k_t**2 * (a_**2 * tend + a_ * b_ * tend**2 + b_**2 * tend**3 / 3)
     copper += h**2 / 12 * 2 * r * b_ / k_t**2 * (b_ * tend)
