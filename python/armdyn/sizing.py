@@ -537,11 +537,11 @@ def sizing_report(result, model, out=None) -> SizingReport:
           ``temperature_rise_peak``: the largest rise along the run of the first-order model
           τ_th dΔT/dt = R_th R i² − ΔT from ΔT(0) = 0 (reported, not checked),
 
-        (these columns only when the model has actuators) and ``ok``: every check passes: peak
-        ≤ effort and velocity limit (the same test as :func:`limit_violations`) and, on actuated joints, every motor margin ≥ 1. A motor
-        check that cannot be made (no motor, a missing datasheet value) is not a pass: ``ok``
-        is then False and ``unchecked`` (a column of models with actuators) names the checks
-        (``""`` when all were made).
+        (these columns only when the model has actuators) and ``ok``: every check passes:
+        peak ≤ effort and velocity limit (the same test as :func:`limit_violations`) and, on
+        actuated joints, every motor margin ≥ 1. A motor check that cannot be made (no motor,
+        a missing datasheet value) is not a pass: ``ok`` is then False and ``unchecked`` (a
+        column of models with actuators) names the checks (``""`` when all were made).
 
         Integrals use the trapezoid rule over the output samples, T = t[-1] − t[0]; peaks are
         the largest sampled values. τ is ``result.joint_torques`` when the result has it, else
