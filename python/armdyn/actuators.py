@@ -36,6 +36,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from armdyn import _core
+from armdyn._runs import checked
 
 #: v_s [rad/s] of the rotor's Coulomb friction law ``c tanh(ω / v_s)`` (``add_actuator``).
 ROTOR_COULOMB_SMOOTHING = 1e-3
@@ -202,15 +203,6 @@ def motor_side(actuator, t, qd, qdd, tau, joint: str | None = None) -> MotorSide
     )
 
 
-def joint_torques(model, result, caller: str = "motor_side_of_result") -> np.ndarray:
-    """(n, len(model.joint_dof_names)) joint-side actuation of a run: ``result.joint_torques``
-    when the result has it, else the drives' efforts summed per driven coordinate (NaN on
-    coordinates without a drive)."""
-    from armdyn.sizing import _checked
-
-    return _checked(model, result, caller)[3]
-
-
 def motor_side_of_result(model, result) -> dict[str, MotorSide]:
     """Motor-side values of every actuator of ``model`` along ``result``.
 
@@ -230,9 +222,7 @@ def motor_side_of_result(model, result) -> dict[str, MotorSide]:
     actuators = list(getattr(model, "actuators", None) or [])
     if not actuators:
         return {}
-    from armdyn.sizing import _checked
-
-    t, names, _, tau = _checked(model, result, "motor_side_of_result")
+    t, names, _, tau = checked(model, result, "motor_side_of_result")
     qd = np.asarray(result.qd, dtype=float)
     qdd = np.asarray(result.qdd, dtype=float)
     out = {}
