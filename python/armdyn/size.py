@@ -7,9 +7,12 @@ optionally ``<joint>.qd`` and ``<joint>.qdd`` (rates and accelerations). Joints 
 are differentiated by a not-a-knot cubic spline through the positions (scipy's
 ``CubicSpline``: scipy is in the ``test`` and ``bench`` extras; without scipy give the columns).
 
-Actuators TOML (optional; needs the actuator model, ``ModelBuilder.add_actuator``): one table
-per joint, its keys ``add_actuator``'s, and an optional ``motor`` sub-table of
-:class:`armdyn.Motor` keywords (SI, motor side)::
+Actuators TOML (optional): one table per joint with ``gear_ratio`` and ``rotor_inertia``
+(kg m², motor side) and optionally ``efficiency``, ``friction_viscous`` (N m s/rad) and
+``friction_coulomb`` (N m), motor side, and a ``motor`` sub-table of :class:`armdyn.Motor`
+keywords (SI, motor side). They are evaluated on the URDF's rotor-free dynamics by the closed
+form of :func:`armdyn.sizing_report`'s ``actuators=`` (what the model with
+``add_actuator(..., gyroscopic=False)`` gives along the same motion)::
 
     [shoulder_pan_joint]
     gear_ratio = 100.0
@@ -172,36 +175,17 @@ def read_actuators(path) -> dict[str, dict]:
     return out
 
 
-def build_model(urdf, actuators: dict | None):
-    """The URDF's model, with ``add_actuator`` for each entry of ``actuators``."""
-    from armdyn.simulation import _urdf_source
-
-    builder = _core.urdf_builder(_urdf_source(urdf), True, (0.0, 0.0, -9.81))
-    if actuators:
-        if not hasattr(builder, "add_actuator"):
-            raise _core.ModelError(
-                "--actuators: this armdyn build has no actuator model (ModelBuilder.add_actuator)"
-            )
-        import armdyn
-
-        for joint, spec in actuators.items():
-            kw = dict(spec)
-            motor = kw.pop("motor", None)
-            if motor is not None:
-                kw["motor"] = armdyn.Motor(**motor)
-            builder.add_actuator(joint, **kw)
-    return builder.finalize()
-
-
 def run(urdf, trajectory, actuators=None, out=None, echo=print) -> int:
     """The ``armdyn size`` command: returns the exit code (0 all ok, 1 some joint not ok)."""
     import pandas as pd
 
+    from armdyn.simulation import load_urdf
     from armdyn.sizing import sizing_report, trajectory_run
 
-    model = build_model(urdf, read_actuators(actuators) if actuators else None)
+    spec = read_actuators(actuators) if actuators else None
+    model = load_urdf(urdf)
     t, q, qd, qdd = read_trajectory(trajectory, model)
-    report = sizing_report(trajectory_run(model, t, q, qd, qdd), model, out=out)
+    report = sizing_report(trajectory_run(model, t, q, qd, qdd), model, out=out, actuators=spec)
     with pd.option_context("display.max_columns", None, "display.width", 200):
         echo(report.table.to_string(float_format=lambda v: f"{v:.4g}"))
     bad = [str(j) for j, ok in report.table["ok"].items() if not ok]

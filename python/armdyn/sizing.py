@@ -300,12 +300,14 @@ def _mass_matrix(model, q: np.ndarray) -> np.ndarray:
     return np.asarray(_core.mass_matrix(model, q), dtype=float)
 
 
-def inertia_ratios(model, result) -> dict[str, float]:
+def inertia_ratios(model, result, extra=()) -> dict[str, float]:
     """Per actuated joint, the largest ratio along the run of the load inertia reflected to the
     motor to the rotor inertia: ``(M_jj(q) − N² J) / (N² J)``, ``M_jj`` the joint's diagonal of
-    ``armdyn.mass_matrix`` (which includes the rotor's N² J). NaN when the mass matrix is not
+    ``armdyn.mass_matrix`` (which includes the rotor's N² J); for the ``extra`` (what-if)
+    actuators, which are not in the model, ``M_jj / (N² J)``. NaN when the mass matrix is not
     available (not a joint-space model, no coordinates in the result) or J = 0."""
-    actuators = list(getattr(model, "actuators", None) or [])
+    own = list(getattr(model, "actuators", None) or [])
+    actuators = own + list(extra)
     out = {str(a.joint): np.nan for a in actuators}
     q = _independent_q(model, result)
     if not actuators or q is None:
@@ -314,10 +316,122 @@ def inertia_ratios(model, result) -> dict[str, float]:
         m = _mass_matrix(model, q)
     except (_core.ModelError, _core.SolverError):
         return out
-    for a in actuators:
+    for k, a in enumerate(actuators):
         rotor = float(a.gear_ratio) ** 2 * float(a.rotor_inertia)
         if rotor > 0.0:
-            out[str(a.joint)] = float(np.max(m[:, a.dof, a.dof] - rotor) / rotor)
+            load = m[:, a.dof, a.dof] - (rotor if k < len(own) else 0.0)
+            out[str(a.joint)] = float(np.max(load) / rotor)
+    return out
+
+
+MOTOR_FIELDS = (
+    "torque_constant",
+    "resistance",
+    "voltage",
+    "no_load_speed",
+    "continuous_torque",
+    "peak_torque",
+    "max_speed",
+    "thermal_resistance",
+    "thermal_time_constant",
+    "name",
+)
+
+
+def make_motor(**datasheet):
+    """An :class:`armdyn.Motor` from datasheet keywords (SI, motor side: ``torque_constant``
+    N m/A, ``resistance`` ohm, ``voltage`` V, ``no_load_speed`` rad/s, ``continuous_torque`` and
+    ``peak_torque`` N m, ``max_speed`` rad/s, ``thermal_resistance`` K/W,
+    ``thermal_time_constant`` s, ``name``); on a build without the actuator model, a namespace
+    with the same attributes (None where absent), which the sizing functions take alike."""
+    from types import SimpleNamespace
+
+    unknown = sorted(set(datasheet) - set(MOTOR_FIELDS))
+    if unknown:
+        raise _core.ModelError(f"motor: unknown datasheet key(s) {unknown}; known {MOTOR_FIELDS}")
+    motor_cls = getattr(_core, "Motor", None)
+    if motor_cls is not None:
+        return motor_cls(**datasheet)
+    return SimpleNamespace(**{f: datasheet.get(f) for f in MOTOR_FIELDS})
+
+
+_ACTUATOR_FIELDS = (
+    "gear_ratio",
+    "rotor_inertia",
+    "efficiency",
+    "friction_viscous",
+    "friction_coulomb",
+    "motor",
+    "gyroscopic",
+)
+
+
+def rotor_torque(actuator, qd, qdd) -> np.ndarray:
+    """T_rot = J N q̈ + b N q̇ + c tanh(N q̇ / v_s): the motor-side torque spinning the rotor."""
+    from armdyn.actuators import ROTOR_COULOMB_SMOOTHING
+
+    n = float(actuator.gear_ratio)
+    w = n * np.asarray(qd, dtype=float)
+    return (
+        float(actuator.rotor_inertia) * n * np.asarray(qdd, dtype=float)
+        + float(actuator.friction_viscous) * w
+        + float(actuator.friction_coulomb) * np.tanh(w / ROTOR_COULOMB_SMOOTHING)
+    )
+
+
+def what_if_actuators(model, names, actuators) -> list:
+    """Stand-in actuators (the attributes of ``model.actuators`` entries) from
+    ``{joint: spec}``: ``gear_ratio`` and ``rotor_inertia`` required, ``efficiency`` (1),
+    ``friction_viscous``, ``friction_coulomb`` (0) and ``motor`` (an :class:`armdyn.Motor`, a
+    dict of its keywords, or None) optional; a dict or an object with those attributes."""
+    from types import SimpleNamespace
+
+    own = {str(a.joint) for a in (getattr(model, "actuators", None) or [])}
+    dofs = list(model.dof_names)
+    out = []
+    for joint, spec in actuators.items():
+        joint = str(joint)
+        if joint in own:
+            raise _core.ModelError(
+                f"actuators: joint {joint!r} already has an actuator in the model; size it with "
+                "the model's own, or sweep it with gear_ratio_sweep"
+            )
+        if joint not in names or joint not in dofs:
+            raise _core.ModelError(f"actuators: {joint!r} is not a joint coordinate ({dofs})")
+
+        def get(key, default=None, spec=spec):
+            if isinstance(spec, dict):
+                return spec.get(key, default)
+            return getattr(spec, key, default)
+
+        unknown = sorted(set(spec) - set(_ACTUATOR_FIELDS)) if isinstance(spec, dict) else []
+        if unknown:
+            raise _core.ModelError(f"actuators: [{joint}] unknown key(s) {unknown}")
+        for key in ("gear_ratio", "rotor_inertia"):
+            if get(key) is None:
+                raise _core.ModelError(f"actuators: [{joint}] needs {key}")
+        if get("gyroscopic", False):
+            raise _core.ModelError(
+                f"actuators: [{joint}] gyroscopic rotors need the actuator in the model "
+                "(ModelBuilder.add_actuator); the what-if evaluation is the gear-reduced model"
+            )
+        motor = get("motor")
+        if isinstance(motor, dict):
+            motor = make_motor(**motor)
+        out.append(
+            SimpleNamespace(
+                joint=joint,
+                rotor_joint=None,
+                dof=dofs.index(joint),
+                gear_ratio=float(get("gear_ratio")),
+                rotor_inertia=float(get("rotor_inertia")),
+                efficiency=float(get("efficiency", 1.0)),
+                friction_viscous=float(get("friction_viscous", 0.0)),
+                friction_coulomb=float(get("friction_coulomb", 0.0)),
+                motor=motor,
+                gyroscopic=False,
+            )
+        )
     return out
 
 
@@ -445,7 +559,7 @@ class SizingReport:
         return fig
 
 
-def sizing_report(result, model, out=None) -> SizingReport:
+def sizing_report(result, model, out=None, actuators=None) -> SizingReport:
     """Peak and RMS torque and speed, power, energy, limit margins and, for actuated joints, the
     motor-side values and checks.
 
@@ -455,6 +569,13 @@ def sizing_report(result, model, out=None) -> SizingReport:
             spanning a positive time.
         model: the model the run was made with.
         out: a directory: the report is also saved there (:meth:`SizingReport.save`).
+        actuators: what-if actuators ``{joint: spec}`` on joints the model does not actuate
+            (:func:`what_if_actuators`: ``gear_ratio``, ``rotor_inertia``, optional
+            ``efficiency``, ``friction_viscous``, ``friction_coulomb``, ``motor``). The run is
+            then taken as the rotor-free load and each such joint's torque becomes
+            τ + N T_rot (:func:`rotor_torque`): exactly what the model with
+            ``add_actuator(joint, ...)`` (``gyroscopic=False``) gives along the same motion
+            (see :func:`gear_ratio_sweep`), without rebuilding it.
 
     Returns:
         A :class:`SizingReport` whose ``.table`` is indexed by joint (coordinate) name, the
@@ -513,6 +634,18 @@ def sizing_report(result, model, out=None) -> SizingReport:
             f"{t[-1] if len(t) else 'n/a'}]"
         )
     span = t[-1] - t[0]
+    extra = what_if_actuators(model, names, actuators) if actuators else []
+    qdd = (
+        np.asarray(result.qdd, dtype=float) if extra or getattr(model, "actuators", None) else None
+    )
+    for a in extra:
+        k = names.index(a.joint)
+        if np.any(np.isnan(tau[:, k])):
+            raise _core.ModelError(
+                f"sizing_report: the result has no torque for joint {a.joint!r} (no drive and no "
+                "joint_torques)"
+            )
+        tau[:, k] = tau[:, k] + a.gear_ratio * rotor_torque(a, qd[:, k], qdd[:, k])
     effort_limit, velocity_limit = _column_limits(model, names)
     power = tau * qd
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -538,11 +671,10 @@ def sizing_report(result, model, out=None) -> SizingReport:
     ok = torque_ok & (peak_speed <= velocity_limit)
     unchecked = [""] * len(names)
 
-    actuators = list(getattr(model, "actuators", None) or [])
+    actuators = list(getattr(model, "actuators", None) or []) + extra
     motors, envelopes = {}, {}
     if actuators:
-        qdd = np.asarray(result.qdd, dtype=float)
-        ratios = inertia_ratios(model, result)
+        ratios = inertia_ratios(model, result, extra)
         rows = {}
         for a in actuators:
             joint = str(a.joint)
@@ -707,10 +839,7 @@ def gear_ratio_sweep(result, model, ratios, actuators=None) -> GearRatioSweep:
         grid = ratios.get(joint) if isinstance(ratios, dict) else ratios
         for n in np.atleast_1d(np.asarray(grid, dtype=float)):
             act.gear_ratio = float(n)
-            rotor = motor_side(act, t, qd[:, k], qdd[:, k], np.zeros_like(t), joint=joint)
-            # the rotor-only side gives T_rot = torque with τ = 0 and τ_gear = −N T_rot
-            t_rot = -rotor.load_torque / n
-            tau_n = tau_load + n * t_rot
+            tau_n = tau_load + n * rotor_torque(act, qd[:, k], qdd[:, k])
             side = motor_side(act, t, qd[:, k], qdd[:, k], tau_n, joint=joint)
             row = motor_values(side, act, t)
             rotor_j = n * n * float(act.rotor_inertia)

@@ -112,12 +112,9 @@ def test_read_actuators(tmp_path):
 
 
 def test_size_with_actuators(tmp_path):
-    """With the actuator model: the motor-side torque of a geared pendulum,
-    T = J N q̈ + τ_L / (N η) while the gear drives the load, else J N q̈ + τ_L η / N."""
-    import armdyn as ad
-
-    if not hasattr(ad.ModelBuilder, "add_actuator"):
-        pytest.skip("needs the C++ actuator model")
+    """With an actuators file: the motor-side torque of a geared pendulum,
+    T = J N q̈ + τ_L / (N η) while the gear drives the load, else J N q̈ + τ_L η / N; the
+    joint side then carries the reflected rotor, τ = τ_L + N² J q̈."""
     n, j, eta = 40.0, 3e-5, 0.9
     t, q, qd, qdd = swing(0.5, 0.5)
     write_csv(tmp_path / "traj.csv", t, q, qd, qdd)

@@ -134,6 +134,34 @@ def test_motor_columns_against_the_closed_form(run, monkeypatch):
     assert bool(row["ok"]) and row["unchecked"] == ""
 
 
+def test_what_if_actuators_equal_the_stand_in_model(run, monkeypatch):
+    """sizing_report(run, model, actuators={...}) on the rotor-free run equals the report of
+    the run with the rotor in its torques and the actuator in the model, column by column."""
+    model, res, geared = run
+    m = full_motor()
+    monkeypatch.setattr(
+        sizing, "_mass_matrix", lambda md, q: _core.mass_matrix(md._model, q) + N * N * J
+    )
+    a = ad.sizing_report(geared, WithActuators(model, [stand_in(m)])).table
+    monkeypatch.setattr(sizing, "_mass_matrix", lambda md, q: _core.mass_matrix(md, q))
+    spec = {"gear_ratio": N, "rotor_inertia": J, "motor": m}
+    b = ad.sizing_report(res, model, actuators={"spin": spec}).table
+    assert list(a.columns) == list(b.columns)
+    num = [c for c in a.columns if c not in ("ok", "unchecked")]
+    np.testing.assert_allclose(a[num].to_numpy(float), b[num].to_numpy(float), rtol=1e-12)
+    assert a["ok"].tolist() == b["ok"].tolist() == [True]
+    # a motor given as a dict of datasheet keywords
+    spec["motor"] = {"peak_torque": 2.0 * PEAK_T}
+    row = ad.sizing_report(res, model, actuators={"spin": spec}).table.loc["spin"]
+    assert row["peak_torque_margin"] == pytest.approx(2.0, rel=1e-12)
+    with pytest.raises(ad.ModelError, match=r"'elbow' is not a joint coordinate"):
+        ad.sizing_report(res, model, actuators={"elbow": spec})
+    with pytest.raises(ad.ModelError, match=r"\[spin\] needs rotor_inertia"):
+        ad.sizing_report(res, model, actuators={"spin": {"gear_ratio": 3.0}})
+    with pytest.raises(ad.ModelError, match=r"unknown datasheet key\(s\) \['kt'\]"):
+        ad.sizing_report(res, model, actuators={"spin": {**spec, "motor": {"kt": 1.0}}})
+
+
 def test_a_failing_or_missing_check_is_not_ok(run, monkeypatch):
     model, _, geared = run
     monkeypatch.setattr(sizing, "_mass_matrix", lambda md, q: _core.mass_matrix(md._model, q))
@@ -287,3 +315,18 @@ def test_ur5_trajectory_peak_and_rms_equal_pinocchio_rnea():
     np.testing.assert_allclose(tab["rms_torque"].to_numpy(), rms, rtol=1e-9)
     np.testing.assert_allclose(tab["peak_speed"].to_numpy(), np.max(np.abs(qd), axis=0), rtol=0)
     assert np.all(peak > 1e-3)  # every joint carries a load
+
+
+def test_motor_side_from_driven_inverse_dynamics(run):
+    """armdyn.actuators.motor_side_of_result reads an InverseDynamicsResult (drive efforts):
+    with the stand-in actuator (η = 1, no friction) and the drive effort as the joint torque,
+    T = τ / N (J enters only through τ, which here is the rotor-free I q̈)."""
+    from armdyn.actuators import motor_side_of_result
+
+    model, _, _ = run
+    t = np.linspace(0.0, 2.0, 81)
+    idr = ad.driven_inverse_dynamics(model, t)
+    sides = motor_side_of_result(WithActuators(model, [stand_in(None, j=0.0)]), idr)
+    tau = -I_Z * AMP * OMEGA**2 * np.sin(OMEGA * t)
+    np.testing.assert_allclose(sides["spin"].torque, tau / N, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(sides["spin"].speed, N * AMP * OMEGA * np.cos(OMEGA * t), atol=1e-9)
