@@ -514,7 +514,7 @@ class SizingReport:
         from matplotlib.figure import Figure
 
         side, motor = self.motors[joint], self.envelopes.get(joint)
-        fig = Figure(figsize=(6.0, 4.0))
+        fig = Figure(figsize=(7.5, 4.0))
         ax = fig.subplots()
         ax.plot(side.speed, side.torque, ".", ms=2.0, color="C0", label="operating points")
         w_max = float(np.max(np.abs(side.speed))) or 1.0
@@ -545,16 +545,19 @@ class SizingReport:
             w_max = max(w_max, speed_lim)
         ax.set_xlim(-1.1 * w_max, 1.1 * w_max)
         t_top = float(np.max(np.abs(side.torque))) or 1.0
-        for v in (t0, _num(getattr(motor, "peak_torque", None))):
+        # the torque axis spans the operating points and the rated torques (the stall torque
+        # of the envelope is often far above both)
+        for v in (_num(getattr(motor, "peak_torque", None)),):
             if np.isfinite(v):
                 t_top = max(t_top, v)
-        ax.set_ylim(-1.2 * t_top, 1.2 * t_top)
+        ax.set_ylim(-1.3 * t_top, 1.3 * t_top)
         ax.set_xlabel("motor speed [rad/s]")
         ax.set_ylabel("motor torque [N m]")
         ax.set_title(
             f"{joint}: motor speed-torque plane (N = {self.table.loc[joint, 'gear_ratio']:g})"
         )
-        ax.legend(loc="best", fontsize="small")
+        ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize="small")
+        ax.grid(lw=0.3)
         fig.tight_layout()
         return fig
 
