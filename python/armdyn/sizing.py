@@ -757,6 +757,15 @@ class GearRatioSweep:
 def _spec(joint: str, spec, existing):
     from types import SimpleNamespace
 
+    if isinstance(spec, dict):
+        unknown = sorted(set(spec) - set(_ACTUATOR_FIELDS))
+        if unknown:
+            raise _core.ModelError(f"gear_ratio_sweep: [{joint}] unknown key(s) {unknown}")
+        if spec.get("gyroscopic", False):
+            raise _core.ModelError(
+                f"gear_ratio_sweep: [{joint}] the closed-form sweep is the gear-reduced model "
+                "(gyroscopic=False)"
+            )
     values = {}
     for name in _SPEC_FIELDS:
         if isinstance(spec, dict):
@@ -767,6 +776,8 @@ def _spec(joint: str, spec, existing):
             value = getattr(existing, name, _SPEC_DEFAULTS.get(name))
         if value is None and name == "rotor_inertia":
             raise _core.ModelError(f"gear_ratio_sweep: joint {joint!r} needs a rotor_inertia")
+        if name == "motor" and isinstance(value, dict):
+            value = make_motor(**value)
         values[name] = value
     return SimpleNamespace(joint=joint, gear_ratio=1.0, **values)
 

@@ -240,6 +240,10 @@ def test_gear_ratio_sweep_pure_inertia_optimum(run):
     assert lo - 0.01 < s["ok_ratio_min"] - 0.0 <= lo + 0.01
     assert hi - 0.01 <= s["ok_ratio_max"] < hi + 0.01
     assert bool(s["ok_contiguous"]) and bool(s["best_ok"])
+    with pytest.raises(ad.ModelError, match=r"\[spin\] unknown key\(s\) \['inertia'\]"):
+        ad.gear_ratio_sweep(res, model, ratios, {"spin": {"inertia": J}})
+    with pytest.raises(ad.ModelError, match="'spin' needs a rotor_inertia"):
+        ad.gear_ratio_sweep(res, model, ratios, {"spin": {"efficiency": 0.9}})
     grid = sweep.table.loc["spin"]
     n = grid.index.to_numpy()
     np.testing.assert_allclose(grid["motor_rms_torque"], (J * n + I_Z / n) * rms_qdd, rtol=1e-12)
