@@ -1,26 +1,27 @@
-"""Effort and velocity limits along a run, and the joint-side sizing report.
+"""Effort and velocity limits along a run, the sizing report (joint and motor side) and the
+gear-ratio sweep.
 
-Both work on a finished run (:class:`armdyn.SimulationResult` or
-:class:`armdyn.InverseDynamicsResult`) and the model it came from; the results do not hold their
-model, so it is passed explicitly and checked against the result's columns.
+They work on a finished run (:class:`armdyn.SimulationResult`,
+:class:`armdyn.InverseDynamicsResult`, or a planned motion's :class:`TrajectoryRun` from
+:func:`trajectory_run`) and the model it came from; the results do not hold their model, so it
+is passed explicitly and checked against the result's columns.
 
-Conventions shared by both functions:
+Conventions shared by these functions:
 
 - Columns are the result's ``qd`` columns: ``model.joint_dof_names`` (every joint coordinate, the
-  couplings' followers included). The effort and velocity limits of the independent coordinates
-  come from ``model.coord_effort_limit`` / ``model.coord_velocity_limit``; a coupling's follower
-  takes its own joint's limits (``model.joint_limits``). ``inf`` where there is none.
-- Joint torques/forces are the efforts of the run's drives (``result.drive_forces``), summed per
-  driven coordinate (``model.drive_coords``). A coordinate without a drive has no effort in the
-  result (a passive joint, or an ``add_motor`` controller whose torque is not reported yet):
-  its torque-based values are NaN and its effort limit is not checked.
+  couplings' followers included; ``model.dof_names`` for a :class:`TrajectoryRun`). The effort
+  and velocity limits of the independent coordinates come from ``model.coord_effort_limit`` /
+  ``model.coord_velocity_limit``; a coupling's follower takes its own joint's limits
+  (``model.joint_limits``). ``inf`` where there is none.
+- Joint torques/forces are ``result.joint_torques`` when the result has them (every joint's
+  actuation, joint side), else the efforts of the run's drives (``result.drive_forces``) summed
+  per driven coordinate (``model.drive_coords``). A coordinate without either has no effort in
+  the result: its torque-based values are NaN and its effort limit is not checked.
 - Everything is evaluated at the output samples only: peaks are the largest sampled values, RMS
   and energies use the trapezoid rule over the samples, and a limit violation that begins and
   ends between two samples is not seen.
-
-This is the first slice of the sizing work (issue 22): joint-side values only. Motor-side
-values, actuators (gear ratio, rotor inertia, efficiency), motor envelopes, gear-ratio sweeps
-and a command-line tool are not part of it.
+- Motor-side values follow :mod:`armdyn.actuators` (gear efficiency by power-flow direction,
+  current, electrical power, losses).
 """
 
 from __future__ import annotations
