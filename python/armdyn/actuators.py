@@ -12,7 +12,8 @@ or the drives' efforts) already includes the reflected rotor terms
 - ``τ_gear = τ − N T_rot``: the load's share, the torque the gear output delivers to the link;
 - the motor (air-gap) torque ``T = T_rot + τ_gear / (N η)`` while the gear transmits power from
   the motor to the load (``τ_gear q̇ ≥ 0``), else ``T = T_rot + τ_gear η / N`` (the load drives
-  the gear backwards: it returns only ``η`` of its power to the motor).
+  the gear backwards: it returns only ``η`` of its power to the motor). At ``q̇ = 0`` no power
+  flows and the first branch holds: holding a load takes ``τ_gear / (N η)`` (conservative).
 
 With a :class:`armdyn.Motor` attached: current ``i = T / k_t``, copper loss ``R i²``, electrical
 power ``P_el = T ω + R i²`` (negative: the motor regenerates). Without a winding resistance the

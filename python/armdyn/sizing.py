@@ -133,6 +133,8 @@ class TrajectoryRun:
         q: (n, len(model.coord_names)) coordinates.
         qd, qdd: (n, len(model.dof_names)) rates and accelerations.
         joint_torques: (n, len(model.dof_names)) ``armdyn.inverse_dynamics`` at each sample.
+        actuators: ``{joint: armdyn.actuators.MotorSide}`` for every actuator of the model
+            (empty without actuators).
     """
 
     t: np.ndarray
@@ -140,6 +142,7 @@ class TrajectoryRun:
     qd: np.ndarray
     qdd: np.ndarray
     joint_torques: np.ndarray
+    actuators: dict = field(default_factory=dict)
 
     def limit_violations(self, model):
         """See :func:`limit_violations`."""
@@ -170,8 +173,13 @@ def trajectory_run(model, t, q, qd, qdd) -> TrajectoryRun:
         )
     if len(t) > 1 and not np.all(np.diff(t) > 0.0):
         raise _core.ModelError("trajectory_run: times must be strictly increasing")
+    from armdyn.actuators import motor_side_of_result
+
     tau = np.asarray(_core.inverse_dynamics(model, q, qd, qdd, t), dtype=float)
-    return TrajectoryRun(t=t.copy(), q=q.copy(), qd=qd.copy(), qdd=qdd.copy(), joint_torques=tau)
+    run = TrajectoryRun(t=t.copy(), q=q.copy(), qd=qd.copy(), qdd=qdd.copy(), joint_torques=tau)
+    if getattr(model, "actuators", None):
+        run.actuators = motor_side_of_result(model, run)
+    return run
 
 
 # --- motor checks ------------------------------------------------------------------------------

@@ -283,7 +283,16 @@ def test_gear_ratio_sweep_equals_rebuilding_the_model():
         b.add_drive("spin", ad.profiles.sine(AMP, FREQ))
         b.add_actuator("spin", n, J, efficiency=0.85, friction_viscous=1e-4)
         geared = b.finalize()
-        row = ad.sizing_report(ad.simulate(geared, 2.0, output_dt=0.01), geared).table
+        sim = ad.simulate(geared, 2.0, output_dt=0.01)
+        row = ad.sizing_report(sim, geared).table
+        # the driven inverse dynamics carries the same motor side
+        idr = ad.driven_inverse_dynamics(geared, sim.t)
+        np.testing.assert_allclose(
+            idr.actuators["spin"].torque,
+            ad.actuators.motor_side_of_result(geared, sim)["spin"].torque,
+            rtol=1e-9,
+            atol=1e-12,
+        )
         for col in ("motor_rms_torque", "motor_peak_torque", "peak_torque"):
             assert row.loc["spin", col] == pytest.approx(sweep.loc[("spin", n), col], rel=1e-9)
 
@@ -330,6 +339,7 @@ def test_motor_side_from_driven_inverse_dynamics(run):
     model, _, _ = run
     t = np.linspace(0.0, 2.0, 81)
     idr = ad.driven_inverse_dynamics(model, t)
+    assert idr.actuators == {}  # the model has no actuators
     sides = motor_side_of_result(WithActuators(model, [stand_in(None, j=0.0)]), idr)
     tau = -I_Z * AMP * OMEGA**2 * np.sin(OMEGA * t)
     np.testing.assert_allclose(sides["spin"].torque, tau / N, rtol=1e-9, atol=1e-12)
