@@ -3,7 +3,8 @@ energy, regeneration and the losses, from the joint-side motion and torque.
 
 The actuator model (``ModelBuilder.add_actuator``): a rotor of axial inertia ``J`` turning at
 ``ω = N q̇`` behind a gear of ratio ``N`` and efficiency ``η``, with motor-side viscous friction
-``b`` and smoothed Coulomb friction ``c tanh(ω / v_s)`` (``v_s`` = :data:`ROTOR_COULOMB_SMOOTHING`).
+``b`` and smoothed Coulomb friction ``c tanh(ω / v_s)`` (``v_s`` the actuator's
+``friction_smoothing``, default ``1e-3 |N|`` rad/s: :func:`coulomb_smoothing`).
 The rotor is in the dynamics, so the joint-side torque ``τ`` of a run (``result.joint_torques``,
 or the drives' efforts) already includes the reflected rotor terms
 ``N² J q̈ + N² b q̇ + N c tanh(N q̇ / v_s)``. Splitting it:
@@ -39,8 +40,19 @@ import numpy as np
 from armdyn import _core
 from armdyn._runs import checked
 
-#: v_s [rad/s] of the rotor's Coulomb friction law ``c tanh(ω / v_s)`` (``add_actuator``).
+#: add_actuator's default Coulomb smoothing velocity per unit gear ratio: v_s = 1e-3 |N| rad/s
+#: on the motor side, i.e. 1e-3 rad/s (or m/s) at the joint.
 ROTOR_COULOMB_SMOOTHING = 1e-3
+
+
+def coulomb_smoothing(actuator) -> float:
+    """The motor-side smoothing velocity v_s [rad/s] of an actuator's Coulomb friction
+    ``c tanh(ω / v_s)``: its ``friction_smoothing`` when positive, else add_actuator's default
+    ``ROTOR_COULOMB_SMOOTHING · |N|``."""
+    v = getattr(actuator, "friction_smoothing", None)
+    if v is not None and float(v) > 0.0:
+        return float(v)
+    return ROTOR_COULOMB_SMOOTHING * abs(float(actuator.gear_ratio))
 
 
 def cumulative_trapezoid(y: np.ndarray, t: np.ndarray) -> np.ndarray:
@@ -122,7 +134,7 @@ def motor_side(actuator, t, qd, qdd, tau, joint: str | None = None) -> MotorSide
         :class:`MotorSide`.
 
     Raises:
-        ModelError: arrays of different lengths, non-increasing times, an efficiency outside
+        ModelError: arrays of different lengths, decreasing times, an efficiency outside
             (0, 1], a zero gear ratio, negative inertia/friction, non-finite samples.
     """
     name = joint if joint is not None else str(getattr(actuator, "joint", "?"))
@@ -133,8 +145,8 @@ def motor_side(actuator, t, qd, qdd, tau, joint: str | None = None) -> MotorSide
             f"motor_side({name!r}): t, qd, qdd and tau must be 1-D of one length, got shapes "
             f"{t.shape}, {qd.shape}, {qdd.shape}, {tau.shape}"
         )
-    if len(t) > 1 and not np.all(np.diff(t) > 0.0):
-        raise _core.ModelError(f"motor_side({name!r}): times must be strictly increasing")
+    if len(t) > 1 and not np.all(np.diff(t) >= 0.0):
+        raise _core.ModelError(f"motor_side({name!r}): times must not decrease")
     for label, x in (("t", t), ("qd", qd), ("qdd", qdd), ("tau", tau)):
         if not np.all(np.isfinite(x)):
             raise _core.ModelError(f"motor_side({name!r}): {label} has non-finite samples")
@@ -155,7 +167,7 @@ def motor_side(actuator, t, qd, qdd, tau, joint: str | None = None) -> MotorSide
 
     w = n_ratio * qd
     wd = n_ratio * qdd
-    coulomb = c * np.tanh(w / ROTOR_COULOMB_SMOOTHING)
+    coulomb = c * np.tanh(w / coulomb_smoothing(actuator))
     t_rot = j_rot * wd + b * w + coulomb
     tau_gear = tau - n_ratio * t_rot
     p_load = tau_gear * qd

@@ -44,6 +44,7 @@ ACTUATOR_KEYS = (
     "efficiency",
     "friction_viscous",
     "friction_coulomb",
+    "friction_smoothing",
     "gyroscopic",
 )
 MOTOR_KEYS = (

@@ -221,6 +221,9 @@ def thermal_rise(t: np.ndarray, loss: np.ndarray, r_th: float, tau_th: float) ->
     out = np.zeros_like(loss)
     for k in range(1, len(t)):
         h = t[k] - t[k - 1]
+        if h <= 0.0:  # a repeated sample (an event's time): nothing elapses
+            out[k] = out[k - 1]
+            continue
         a = np.exp(-h / tau_th)
         slope = (loss[k] - loss[k - 1]) / h
         p1 = r_th * (loss[k] - tau_th * slope)
@@ -370,29 +373,32 @@ _ACTUATOR_FIELDS = (
     "efficiency",
     "friction_viscous",
     "friction_coulomb",
+    "friction_smoothing",
     "motor",
     "gyroscopic",
 )
 
 
 def rotor_torque(actuator, qd, qdd) -> np.ndarray:
-    """T_rot = J N q̈ + b N q̇ + c tanh(N q̇ / v_s): the motor-side torque spinning the rotor."""
-    from armdyn.actuators import ROTOR_COULOMB_SMOOTHING
+    """T_rot = J N q̈ + b N q̇ + c tanh(N q̇ / v_s): the motor-side torque spinning the rotor
+    (v_s: :func:`armdyn.actuators.coulomb_smoothing`)."""
+    from armdyn.actuators import coulomb_smoothing
 
     n = float(actuator.gear_ratio)
     w = n * np.asarray(qd, dtype=float)
     return (
         float(actuator.rotor_inertia) * n * np.asarray(qdd, dtype=float)
         + float(actuator.friction_viscous) * w
-        + float(actuator.friction_coulomb) * np.tanh(w / ROTOR_COULOMB_SMOOTHING)
+        + float(actuator.friction_coulomb) * np.tanh(w / coulomb_smoothing(actuator))
     )
 
 
 def what_if_actuators(model, names, actuators) -> list:
     """Stand-in actuators (the attributes of ``model.actuators`` entries) from
     ``{joint: spec}``: ``gear_ratio`` and ``rotor_inertia`` required, ``efficiency`` (1),
-    ``friction_viscous``, ``friction_coulomb`` (0) and ``motor`` (an :class:`armdyn.Motor`, a
-    dict of its keywords, or None) optional; a dict or an object with those attributes."""
+    ``friction_viscous``, ``friction_coulomb`` (0), ``friction_smoothing`` (None: 1e-3 |N|)
+    and ``motor`` (an :class:`armdyn.Motor`, a dict of its keywords, or None) optional; a dict
+    or an object with those attributes."""
     from types import SimpleNamespace
 
     own = {str(a.joint) for a in (getattr(model, "actuators", None) or [])}
@@ -437,6 +443,7 @@ def what_if_actuators(model, names, actuators) -> list:
                 efficiency=float(get("efficiency", 1.0)),
                 friction_viscous=float(get("friction_viscous", 0.0)),
                 friction_coulomb=float(get("friction_coulomb", 0.0)),
+                friction_smoothing=get("friction_smoothing"),
                 motor=motor,
                 gyroscopic=False,
             )
@@ -736,7 +743,14 @@ def sizing_report(result, model, out=None, actuators=None) -> SizingReport:
 
 # --- gear-ratio sweep --------------------------------------------------------------------------
 
-_SPEC_FIELDS = ("rotor_inertia", "efficiency", "friction_viscous", "friction_coulomb", "motor")
+_SPEC_FIELDS = (
+    "rotor_inertia",
+    "efficiency",
+    "friction_viscous",
+    "friction_coulomb",
+    "friction_smoothing",
+    "motor",
+)
 _SPEC_DEFAULTS = {
     "efficiency": 1.0,
     "friction_viscous": 0.0,
@@ -783,6 +797,14 @@ def _spec(joint: str, spec, existing):
             value = getattr(spec, name, getattr(existing, name, _SPEC_DEFAULTS.get(name)))
         else:
             value = getattr(existing, name, _SPEC_DEFAULTS.get(name))
+        if (
+            name == "friction_smoothing"
+            and value is not None
+            and existing is not None
+            and not (isinstance(spec, dict) and name in spec)
+            and abs(value - 1e-3 * abs(existing.gear_ratio)) <= 1e-15 * abs(value)
+        ):
+            value = None  # add_actuator's default 1e-3 |N0|: at ratio N it is 1e-3 |N|
         if value is None and name == "rotor_inertia":
             raise _core.ModelError(f"gear_ratio_sweep: joint {joint!r} needs a rotor_inertia")
         if name == "motor" and isinstance(value, dict):

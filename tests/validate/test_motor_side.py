@@ -2,7 +2,8 @@
 balance. The actuators are stand-ins (SimpleNamespace) with the attributes of
 ``model.actuators`` entries, so the maths is tested without the C++ actuator model.
 
-Conventions (armdyn.actuators): ω = N q̇, T_rot = J ω̇ + b ω + c tanh(ω / v_s), the joint torque
+Conventions (armdyn.actuators): ω = N q̇, T_rot = J ω̇ + b ω + c tanh(ω / v_s) (v_s the
+actuator's friction_smoothing, default 1e-3 |N|, add_actuator's), the joint torque
 τ includes N T_rot, τ_gear = τ − N T_rot, T = T_rot + τ_gear / (N η) when τ_gear q̇ ≥ 0 else
 T_rot + τ_gear η / N, i = T / k_t, P_el = T ω + R i².
 """
@@ -12,8 +13,7 @@ from types import SimpleNamespace
 import armdyn as ad
 import numpy as np
 import pytest
-from armdyn.actuators import ROTOR_COULOMB_SMOOTHING as VS
-from armdyn.actuators import motor_side, motor_side_of_result
+from armdyn.actuators import ROTOR_COULOMB_SMOOTHING, motor_side, motor_side_of_result
 
 
 def actuator(n=50.0, j=2e-5, eta=1.0, b=0.0, c=0.0, motor=None, joint="j1"):
@@ -85,7 +85,7 @@ def lift(direction, eta=0.8, n=100.0, b=1e-4, c=0.02, j=1e-4):
     qd = np.full_like(t, direction * v)
     qdd = np.zeros_like(t)
     w = n * direction * v
-    t_rot = b * w + c * np.tanh(w / VS)
+    t_rot = b * w + c * np.tanh(w / (ROTOR_COULOMB_SMOOTHING * n))  # default v_s = 1e-3 |N|
     tau = np.full_like(t, tau_l + n * t_rot)
     act = actuator(n=n, j=j, eta=eta, b=b, c=c, motor=motor(torque_constant=k_t, resistance=r))
     return motor_side(act, t, qd, qdd, tau), dict(
@@ -216,3 +216,27 @@ def test_motor_side_of_result_reads_columns_by_name():
     np.testing.assert_allclose(out["b"].load_torque, 5.0, rtol=1e-14)
     np.testing.assert_allclose(out["b"].torque, 1e-3 * 20 + 5.0 / 10.0, rtol=1e-14)
     assert motor_side_of_result(SimpleNamespace(actuators=[]), res) == {}
+
+
+def test_coulomb_smoothing_and_repeated_samples():
+    """v_s is the actuator's friction_smoothing when set, else add_actuator's 1e-3 |N|; at
+    q̇ = 2e-3 rad/s on a 50:1 gear, ω = 0.1 rad/s: c tanh(0.1 / 0.05) by default and
+    c tanh(0.1 / 0.2) with friction_smoothing = 0.2. A repeated time (an event's output) adds
+    nothing to the integrals."""
+    from armdyn.actuators import coulomb_smoothing
+
+    t = np.array([0.0, 0.5, 0.5, 1.0])
+    qd, qdd, tau = np.full(4, 2e-3), np.zeros(4), np.zeros(4)
+    act = actuator(n=-50.0, j=0.0, c=0.3)
+    assert coulomb_smoothing(act) == pytest.approx(0.05, rel=1e-15)
+    s = motor_side(act, t, qd, qdd, tau)
+    # τ_gear = τ − N T_rot = 50 · 0.3 tanh(−0.1 / 0.05): the rotor friction brakes the joint
+    np.testing.assert_allclose(s.load_torque, 50.0 * 0.3 * np.tanh(-0.1 / 0.05), rtol=1e-14)
+    act.friction_smoothing = 0.2
+    s = motor_side(act, t, qd, qdd, tau)
+    np.testing.assert_allclose(s.load_torque, 50.0 * 0.3 * np.tanh(-0.1 / 0.2), rtol=1e-14)
+    # τ = 0: the gear takes power from the load, so T = T_rot + τ_gear η / N with η = 1: T = 0
+    np.testing.assert_allclose(s.torque, 0.0, atol=1e-15)
+    assert s.energy[2] == s.energy[1]
+    with pytest.raises(ad.ModelError, match="times must not decrease"):
+        motor_side(act, t[::-1], qd, qdd, tau)
