@@ -33,6 +33,16 @@ def checked(model, result, caller: str):
             f"rate columns ({names}) and the result {len(t)} samples: the result is not from "
             "this model"
         )
+    drive_forces = getattr(result, "drive_forces", None)
+    if drive_forces is not None:
+        n_drives = len(model.drive_names)
+        forces = np.asarray(drive_forces, dtype=float)
+        if forces.ndim != 2 or forces.shape != (len(t), n_drives):
+            raise _core.ModelError(
+                f"{caller}: result.drive_forces has shape {forces.shape} but the model has "
+                f"{n_drives} drives ({list(model.drive_names)}) and the result {len(t)} "
+                "samples: the result is not from this model"
+            )
     joint_torques = getattr(result, "joint_torques", None)
     if joint_torques is not None:
         tau = np.asarray(joint_torques, dtype=float)
@@ -42,14 +52,8 @@ def checked(model, result, caller: str):
                 "the result is inconsistent"
             )
         return t, names, qd, tau.copy()
-    forces = np.asarray(result.drive_forces, dtype=float)
-    n_drives = len(model.drive_names)
-    if forces.ndim != 2 or forces.shape != (len(t), n_drives):
-        raise _core.ModelError(
-            f"{caller}: result.drive_forces has shape {forces.shape} but the model has "
-            f"{n_drives} drives ({list(model.drive_names)}) and the result {len(t)} samples: the "
-            "result is not from this model"
-        )
+    if drive_forces is None:
+        raise _core.ModelError(f"{caller}: the result has neither joint_torques nor drive_forces")
     tau = np.full(qd.shape, np.nan)
     for d, col in enumerate(model.drive_coords):
         if not 0 <= col < len(names):

@@ -473,8 +473,8 @@ class SizingReport:
 
     def save(self, directory) -> Path:
         """Write ``table.csv``, ``report.html`` (the table, one torque-against-time figure per
-        joint with a torque, and each motor's operating points on its speed–torque plane) and
-        the figures ``torque_<k>.png`` / ``motor_<k>.png`` into ``directory`` (created if
+        joint with a non-zero torque, and each motor's operating points on its speed–torque
+        plane) and the figures ``torque_<k>.png`` / ``motor_<k>.png`` into ``directory`` (created if
         missing). Needs matplotlib (the ``plot`` extra). Returns the HTML page's path."""
         # a bare Figure (Agg canvas): no pyplot state, the user's backend is left alone
         from matplotlib.figure import Figure
@@ -485,7 +485,7 @@ class SizingReport:
         figures = []
         for k, name in enumerate(self.table.index):
             tau = self.torque[:, k]
-            if np.all(np.isnan(tau)):
+            if np.all(np.isnan(tau) | (tau == 0.0)):  # no actuation on this joint
                 continue
             fig = Figure(figsize=(6.0, 3.0))
             ax = fig.subplots()
@@ -635,7 +635,8 @@ def sizing_report(result, model, out=None, actuators=None) -> SizingReport:
         Integrals use the trapezoid rule over the output samples, T = t[-1] − t[0]; peaks are
         the largest sampled values. τ is ``result.joint_torques`` when the result has it, else
         the drives' efforts summed per driven coordinate; a coordinate without either has NaN
-        in every torque column and ``ok`` then checks its speed only.
+        in every torque column and ``ok`` then checks its speed only (with ``joint_torques``
+        an unactuated joint has a zero torque).
 
     Raises:
         ModelError: the result's columns do not match the model, or fewer than two samples /
