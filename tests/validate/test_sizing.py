@@ -28,6 +28,10 @@ HAS_JOINT_TORQUES = "joint_torques" in ad.SimulationResult.__dataclass_fields__
 UNACTUATED = 0.0 if HAS_JOINT_TORQUES else np.nan
 
 
+def unactuated(value) -> bool:
+    return bool(np.isnan(value)) if np.isnan(UNACTUATED) else value == 0.0
+
+
 def rotor(effort=0.0, velocity=0.0, passive=False):
     b = ad.ModelBuilder(gravity=(0.0, 0.0, 0.0))
     b.add_body("rotor", 1.0, [0.5, 0.5, I_Z], position=(0, 0, 0))
@@ -122,7 +126,7 @@ def test_margins_and_ok():
     # or, from the drives alone, no torque in the result (NaN)
     idle = tab.loc["idle_spin"]
     for col in ("peak_torque", "rms_torque", "peak_power", "energy_regenerated"):
-        np.testing.assert_equal(idle[col], UNACTUATED, err_msg=col)
+        assert unactuated(idle[col]), (col, idle[col])
     np.testing.assert_equal(idle["torque_margin"], np.inf if HAS_JOINT_TORQUES else np.nan)
     assert idle["peak_speed"] == 0.0 and idle["rms_speed"] == 0.0
     assert idle["effort_limit"] == np.inf and idle["speed_margin"] == np.inf
@@ -216,7 +220,7 @@ def test_coupled_follower_takes_its_own_limits():
     assert tab.loc["jf", "velocity_limit"] == 1.5 * SPEED0
     assert tab.loc["jf", "peak_speed"] == pytest.approx(2.0 * SPEED0, rel=SAMPLE_RTOL)
     assert tab.loc["jl", "peak_torque"] == pytest.approx(5.0 * TAU0, rel=1e-12)
-    np.testing.assert_equal(tab.loc["jf", "peak_torque"], UNACTUATED)  # the leader's drive
+    assert unactuated(tab.loc["jf", "peak_torque"])  # the drive acts on the leader
     viol = res.limit_violations(model)
     assert set(viol["joint"]) == {"jf"} and len(viol) == 3  # around t = 0, 1, 2 s
 
