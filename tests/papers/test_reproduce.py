@@ -85,8 +85,8 @@ def test_geared_section_of_the_report(tmp_path):
 def test_sizing_notebook_executes(tmp_path):
     """notebooks/sizing_ur5.ipynb runs end to end (UR5 with a 3 kg payload, pick-and-place
     cycle, joint- and motor-side report, gear-ratio sweep, the geared arm with 1-4 motors); its
-    own checks: the payload's static torques equal J^T m g and every motor's energy balance
-    closes."""
+    own checks: the payload's static torques equal J^T m g, every motor's energy balance
+    closes and (with the actuator model) the rebuilt model's report equals the closed form."""
     import re
 
     import nbclient
@@ -106,3 +106,7 @@ def test_sizing_notebook_executes(tmp_path):
     balances = [float(x) for x in re.findall(r"balance error = (\S+)", outputs)]
     assert len(balances) == 6 and max(balances) <= 1e-9
     assert "waist_4_motor" in outputs
+    # with the actuator model: the model rebuilt with add_actuator gives the closed-form report
+    rebuilt = re.search(r"rebuilt vs closed form: (\S+)", outputs)
+    if rebuilt is not None:
+        assert float(rebuilt.group(1)) <= 1e-9
