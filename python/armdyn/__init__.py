@@ -7,7 +7,7 @@ actuator efforts) come from the augmented system ``[Γ ζᵀ; ζ 0][v'; δ] = [�
 projection keeps the constraints satisfied to round-off.
 """
 
-from armdyn import scenes, validation
+from armdyn import actuators, scenes, validation
 from armdyn._core import (
     Actuator,
     Data,
@@ -38,7 +38,14 @@ from armdyn._core import (
 )
 from armdyn.dynamics import InverseDynamicsResult, driven_inverse_dynamics
 from armdyn.simulation import SimulationResult, load_urdf, simulate
-from armdyn.sizing import SizingReport, limit_violations, sizing_report
+from armdyn.sizing import (
+    SizingReport,
+    TrajectoryRun,
+    gear_ratio_sweep,
+    limit_violations,
+    sizing_report,
+    trajectory_run,
+)
 from armdyn.validation import LagrangeValidator
 from armdyn.workprecision import WorkPrecisionResult, work_precision
 
@@ -57,8 +64,10 @@ __all__ = [
     "SimulationResult",
     "SizingReport",
     "SolverError",
+    "TrajectoryRun",
     "UrdfError",
     "WorkPrecisionResult",
+    "actuators",
     "body_accelerations",
     "body_forces",
     "body_mass_matrix",
@@ -71,6 +80,7 @@ __all__ = [
     "frame_jacobian_cartesian",
     "frame_pose",
     "frame_pose_cartesian",
+    "gear_ratio_sweep",
     "inverse_dynamics",
     "joint_coordinates",
     "limit_violations",
@@ -81,6 +91,7 @@ __all__ = [
     "simulate",
     "sizing_report",
     "state_from_joints",
+    "trajectory_run",
     "urdf_builder",
     "validation",
     "work_precision",

@@ -3,6 +3,10 @@
 * ``armdyn reproduce [--out DIR]`` regenerates the five-DOF validation paper's Tables 1–4 and
   Figures 5–8 beside the paper's own figures, and the six-DOF paper's geared-arm study (Fig. 3
   style), as a Markdown + PNG report.
+* ``armdyn size ROBOT.urdf --trajectory FILE.csv [--actuators FILE.toml] [--out DIR]`` prints
+  the sizing report of a planned motion (joint side, and motor side for the actuators of the
+  TOML file) and writes it to DIR; exit code 0 when every joint is ok, 1 when some joint is
+  not, 2 for bad input. File formats: ``armdyn.size``.
 * ``armdyn verify`` prints the solver's accuracy figures: pendulum period, energy and momentum
   conservation, constraint drift, and forward dynamics against the Euler–Lagrange equations.
 
@@ -29,7 +33,20 @@ def main(argv: list[str] | None = None) -> int:
     rep.add_argument(
         "--no-geared", action="store_true", help="skip the geared-arm study (a few minutes)"
     )
+    size = sub.add_parser(
+        "size", help="sizing report of a planned motion (exit 0: every joint ok, 1: not)"
+    )
+    size.add_argument("urdf", help="the robot's URDF file")
+    size.add_argument(
+        "--trajectory", required=True, help="CSV: t, one column per joint, optional .qd/.qdd"
+    )
+    size.add_argument("--actuators", help="TOML: per joint gear_ratio, rotor_inertia, [motor]")
+    size.add_argument("--out", help="write the report (HTML, CSV, figures) into this folder")
     args = parser.parse_args(argv)
+    if args.command == "size":
+        from armdyn.size import main as size_main
+
+        return size_main(args)
     if args.command == "verify":
         from armdyn.verify import main as verify_main
 

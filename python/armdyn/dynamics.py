@@ -25,6 +25,8 @@ class InverseDynamicsResult:
             joint point, in the child's joint frame.
         position_residual, velocity_residual: (n,) max |f| and max |ζ v − rhs|.
         stats: Newton iterations, factorisations, run time [s].
+        actuators: ``{joint: armdyn.actuators.MotorSide}`` for every actuator of the model
+            (motor-side speed, torque, current, power, energy; empty without actuators).
     """
 
     t: np.ndarray
@@ -39,6 +41,7 @@ class InverseDynamicsResult:
     position_residual: np.ndarray
     velocity_residual: np.ndarray
     stats: dict = field(default_factory=dict)
+    actuators: dict = field(default_factory=dict)
 
     def limit_violations(self, model):
         """Spans where this run exceeds the model's velocity and effort limits, as a DataFrame
@@ -66,5 +69,10 @@ def driven_inverse_dynamics(model: _core.Model, t) -> InverseDynamicsResult:
         SolverError: the driven constraints are kinematically singular at some time (the
             dependent drive/joint rows are named), or the position problem does not converge.
     """
+    from armdyn.actuators import motor_side_of_result
+
     times = np.atleast_1d(np.asarray(t, dtype=float))
-    return InverseDynamicsResult(**_core._inverse_dynamics_driven(model, times))
+    result = InverseDynamicsResult(**_core._inverse_dynamics_driven(model, times))
+    if getattr(model, "actuators", None) and len(times) > 0:
+        result.actuators = motor_side_of_result(model, result)
+    return result

@@ -77,3 +77,27 @@ def test_readme_quotes_the_reproduce_tables():
         if "e-" in line:  # round-off columns vary in the last digit between machines
             line = line.rsplit("|", 3)[0]
         assert line in text, line
+
+
+def test_sizing_example_runs(tmp_path, monkeypatch):
+    """The README's sizing block, after the quick start: the motor-side torque of the shoulder
+    equals the closed form from the run's own samples, T = J N q̈ + τ_gear/(N η) while the gear
+    drives the arm (τ_gear q̇ ≥ 0), else J N q̈ + τ_gear η / N with τ_gear the drive's torque,
+    and the report is written."""
+    monkeypatch.chdir(tmp_path)
+    blocks = re.findall(r"```python\n(.*?)```", README.read_text(), re.S)
+    sizing = next(b for b in blocks if "sizing_report" in b)
+    assert len(sizing.strip().splitlines()) <= 12
+    ns: dict = {}
+    exec(compile(blocks[0], "README quick start", "exec"), ns)
+    exec(compile(sizing, "README sizing", "exec"), ns)
+    res, row = ns["res"], ns["report"].table.loc["shoulder"]
+    n, j, eta = 100.0, 5e-5, 0.85
+    tau, qd, qdd = res.drive_forces[:, 0], res.qd[:, 0], res.qdd[:, 0]
+    motor = j * n * qdd + np.where(tau * qd >= 0, tau / (n * eta), tau * eta / n)
+    np.testing.assert_allclose(row["motor_peak_torque"], np.abs(motor).max(), rtol=1e-12)
+    np.testing.assert_allclose(row["peak_torque"], np.abs(tau + n * n * j * qdd).max(), rtol=1e-12)
+    assert (tmp_path / "sizing-report" / "report.html").is_file()
+    assert (tmp_path / "sizing-report" / "motor_0.png").is_file()
+    best = ns["sweep"].summary.loc["shoulder"]
+    assert 20.0 <= best["ok_ratio_min"] <= 100.0 <= best["ok_ratio_max"] and bool(row["ok"])

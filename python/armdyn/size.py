@@ -1,0 +1,204 @@
+"""``armdyn size ROBOT.urdf --trajectory FILE.csv [--actuators FILE.toml] [--out DIR]``: the
+sizing report of a planned motion from the command line.
+
+Trajectory CSV: a header row, then one row per sample. Columns: ``t`` (strictly increasing, s),
+one column per joint coordinate of the URDF (``model.coord_names``: positions, rad or m), and
+optionally ``<joint>.qd`` and ``<joint>.qdd`` (rates and accelerations). Joints without them
+are differentiated by a not-a-knot cubic spline through the positions (scipy's
+``CubicSpline``: scipy is in the ``test`` and ``bench`` extras; without scipy give the columns).
+
+Actuators TOML (optional): one table per joint with ``gear_ratio`` and ``rotor_inertia``
+(kg m², motor side) and optionally ``efficiency``, ``friction_viscous`` (N m s/rad) and
+``friction_coulomb`` (N m), motor side, and a ``motor`` sub-table of :class:`armdyn.Motor`
+keywords (SI, motor side). They are evaluated on the URDF's rotor-free dynamics by the closed
+form of :func:`armdyn.sizing_report`'s ``actuators=`` (what the model with
+``add_actuator(..., gyroscopic=False)`` gives along the same motion)::
+
+    [shoulder_pan_joint]
+    gear_ratio = 100.0
+    rotor_inertia = 3.3e-5        # kg m^2
+    efficiency = 0.9
+    [shoulder_pan_joint.motor]
+    torque_constant = 0.07        # N m / A
+    continuous_torque = 0.6       # N m
+    peak_torque = 2.0
+
+The command prints the report's table and, with ``--out``, writes the report there
+(``report.html``, ``table.csv``, figures). Exit code: 0 when every joint is ``ok``, 1 when
+some joint is not, 2 for bad input (a message names the file, column or key).
+"""
+
+from __future__ import annotations
+
+import csv
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from armdyn import _core
+
+ACTUATOR_KEYS = (
+    "gear_ratio",
+    "rotor_inertia",
+    "efficiency",
+    "friction_viscous",
+    "friction_coulomb",
+    "friction_smoothing",
+    "gyroscopic",
+)
+MOTOR_KEYS = (
+    "torque_constant",
+    "resistance",
+    "voltage",
+    "no_load_speed",
+    "continuous_torque",
+    "peak_torque",
+    "max_speed",
+    "thermal_resistance",
+    "thermal_time_constant",
+    "name",
+)
+
+
+def _derivative(t: np.ndarray, y: np.ndarray, order: int, joint: str) -> np.ndarray:
+    try:
+        from scipy.interpolate import CubicSpline
+    except ImportError as exc:  # pragma: no cover - scipy is in the test environment
+        raise _core.ModelError(
+            f"trajectory: no {joint}.qd/{joint}.qdd column, and differentiating the positions "
+            "needs scipy (pip install scipy, or the armdyn[test] extra); or give the columns"
+        ) from exc
+    if len(t) < 4:
+        raise _core.ModelError(
+            f"trajectory: {len(t)} samples are too few for a cubic spline of {joint!r} "
+            "(4 at least), or give its .qd and .qdd columns"
+        )
+    return CubicSpline(t, y)(t, order)
+
+
+def read_trajectory(path, model):
+    """``(t, q, qd, qdd)`` from a trajectory CSV (see the module notes), columns ordered as
+    ``model.coord_names`` / ``model.dof_names``. Raises ModelError naming the file and the
+    missing, unknown or bad column."""
+    path = Path(path)
+    with path.open(newline="", encoding="utf-8") as f:
+        rows = list(csv.reader(f))
+    if not rows:
+        raise _core.ModelError(f"{path}: empty trajectory file")
+    header = [h.strip() for h in rows[0]]
+    coords, dofs = list(model.coord_names), list(model.dof_names)
+    if coords != dofs:
+        raise _core.ModelError(
+            f"{path}: the robot's coordinates {coords} differ from its rates {dofs} (a floating "
+            "base): armdyn size takes fixed-base arms"
+        )
+    known = {"t"} | set(coords) | {f"{c}.qd" for c in coords} | {f"{c}.qdd" for c in coords}
+    unknown = [h for h in header if h not in known]
+    if unknown:
+        raise _core.ModelError(
+            f"{path}: unknown column(s) {unknown}; expected t, the joints {coords} and optional "
+            "<joint>.qd / <joint>.qdd"
+        )
+    missing = [c for c in ["t", *coords] if c not in header]
+    if missing:
+        raise _core.ModelError(f"{path}: missing column(s) {missing}")
+    if len(set(header)) != len(header):
+        raise _core.ModelError(f"{path}: repeated column names in {header}")
+    try:
+        data = np.array([[float(x) for x in r] for r in rows[1:] if r], dtype=float)
+    except ValueError as exc:
+        raise _core.ModelError(f"{path}: a value is not a number ({exc})") from exc
+    if data.ndim != 2 or data.shape[0] < 2 or data.shape[1] != len(header):
+        raise _core.ModelError(
+            f"{path}: need at least two rows of {len(header)} values each, got shape {data.shape}"
+        )
+    if not np.all(np.isfinite(data)):
+        raise _core.ModelError(f"{path}: non-finite values")
+    col = {h: data[:, k] for k, h in enumerate(header)}
+    t = col["t"]
+    if not np.all(np.diff(t) > 0.0):
+        raise _core.ModelError(f"{path}: column t must be strictly increasing")
+    q = np.stack([col[c] for c in coords], axis=1)
+    qd = np.stack(
+        [col[f"{c}.qd"] if f"{c}.qd" in col else _derivative(t, col[c], 1, c) for c in coords],
+        axis=1,
+    )
+    qdd = np.stack(
+        [col[f"{c}.qdd"] if f"{c}.qdd" in col else _derivative(t, col[c], 2, c) for c in coords],
+        axis=1,
+    )
+    return t, q, qd, qdd
+
+
+def read_actuators(path) -> dict[str, dict]:
+    """``{joint: {add_actuator keyword: value, "motor": {Motor keyword: value} or None}}`` from
+    an actuators TOML file. Raises ModelError naming the file, joint and key."""
+    try:
+        import tomllib
+    except ImportError:  # Python 3.10
+        try:
+            import tomli as tomllib
+        except ImportError as exc:
+            raise _core.ModelError(
+                f"{path}: reading TOML on Python 3.10 needs tomli (pip install tomli)"
+            ) from exc
+    path = Path(path)
+    try:
+        with path.open("rb") as f:
+            doc = tomllib.load(f)
+    except tomllib.TOMLDecodeError as exc:
+        raise _core.ModelError(f"{path}: not valid TOML ({exc})") from exc
+    out = {}
+    for joint, table in doc.items():
+        if not isinstance(table, dict):
+            raise _core.ModelError(f"{path}: {joint!r} must be a table [{joint}]")
+        spec = {k: v for k, v in table.items() if k != "motor"}
+        bad = [k for k in spec if k not in ACTUATOR_KEYS]
+        if bad:
+            raise _core.ModelError(
+                f"{path}: [{joint}] unknown key(s) {bad}; allowed {ACTUATOR_KEYS}"
+            )
+        for key in ("gear_ratio", "rotor_inertia"):
+            if key not in spec:
+                raise _core.ModelError(f"{path}: [{joint}] needs {key}")
+        motor = table.get("motor")
+        if motor is not None:
+            if not isinstance(motor, dict):
+                raise _core.ModelError(f"{path}: [{joint}.motor] must be a table")
+            bad = [k for k in motor if k not in MOTOR_KEYS]
+            if bad:
+                raise _core.ModelError(
+                    f"{path}: [{joint}.motor] unknown key(s) {bad}; allowed {MOTOR_KEYS}"
+                )
+        spec["motor"] = motor
+        out[str(joint)] = spec
+    return out
+
+
+def run(urdf, trajectory, actuators=None, out=None, echo=print) -> int:
+    """The ``armdyn size`` command: returns the exit code (0 all ok, 1 some joint not ok)."""
+    import pandas as pd
+
+    from armdyn.simulation import load_urdf
+    from armdyn.sizing import sizing_report, trajectory_run
+
+    spec = read_actuators(actuators) if actuators else None
+    model = load_urdf(urdf)
+    t, q, qd, qdd = read_trajectory(trajectory, model)
+    report = sizing_report(trajectory_run(model, t, q, qd, qdd), model, out=out, actuators=spec)
+    with pd.option_context("display.max_columns", None, "display.width", 200):
+        echo(report.table.to_string(float_format=lambda v: f"{v:.4g}"))
+    bad = [str(j) for j, ok in report.table["ok"].items() if not ok]
+    if out is not None:
+        echo(f"report written to {Path(out).resolve() / 'report.html'}")
+    echo("all joints ok" if not bad else f"not ok: {', '.join(bad)}")
+    return 0 if not bad else 1
+
+
+def main(args) -> int:
+    try:
+        return run(args.urdf, args.trajectory, args.actuators, args.out)
+    except (_core.ModelError, _core.UrdfError, OSError) as exc:
+        print(f"armdyn size: {exc}", file=sys.stderr)
+        return 2
