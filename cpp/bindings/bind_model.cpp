@@ -343,7 +343,11 @@ void bind_model(py::module_& m) {
             VecX r = VecX::Zero(ic.nv());
             for (const Actuator& a : md.actuators) {
               const int c = md.joints[a.rotor_joint].coord0;
-              r[independent_dof(md, c)] += ic.scale[c] * ic.scale[c] * a.rotor_inertia;
+              // the armature (gear-reduced) turns with the joint carrying N^2 J; the
+              // gyroscopic rotor turns at N qdot carrying J
+              const double j_el =
+                  a.gyroscopic ? a.rotor_inertia : a.gear_ratio * a.gear_ratio * a.rotor_inertia;
+              r[independent_dof(md, c)] += ic.scale[c] * ic.scale[c] * j_el;
             }
             return to_numpy(r);
           },

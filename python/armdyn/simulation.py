@@ -227,16 +227,10 @@ def simulate(
 
 
 def _attach_motor_side(model: _core.Model, result: SimulationResult) -> None:
-    """result.actuators: the motor-side values of the model's actuators (armdyn.actuators),
-    where that module is available (it arrives with the motor-side sizing; imported by name
-    until then, so that the package holds no import of a missing module)."""
-    import importlib
+    """result.actuators: the motor-side values of the model's actuators (armdyn.actuators)."""
+    from armdyn.actuators import motor_side_of_result
 
-    try:
-        motor_side = importlib.import_module("armdyn.actuators")
-    except ImportError:
-        return
-    result.actuators = motor_side.motor_side_of_result(model, result)
+    result.actuators = motor_side_of_result(model, result)
 
 
 def _zero_dof_result(model: _core.Model, t_end: float, output_dt: float | None):

@@ -75,7 +75,7 @@ def _spans(mask: np.ndarray) -> list[tuple[int, int]]:
 
 
 def limit_violations(model, result) -> pd.DataFrame:
-    """Where a run exceeds its joints' velocity and effort limits.
+    """Where a run exceeds its joints' position, velocity and effort limits.
 
     Args:
         model: the model the run was made with.
@@ -83,8 +83,10 @@ def limit_violations(model, result) -> pd.DataFrame:
 
     Returns:
         A DataFrame with one row per violation span, sorted by ``t_start``: ``joint`` (the
-        coordinate's name, a column of ``result.qd``), ``kind`` (``"velocity"``: ``|qd| > limit``;
-        ``"effort"``: ``|drive torque/force| > limit``), ``t_start`` and ``t_end`` (the first and
+        coordinate's name, a column of ``result.qd``), ``kind`` (``"position"``: ``q`` below its
+        lower or above its upper limit, by more than 1e-8 max(1, |limit|), ``limit`` then the
+        bound crossed; ``"velocity"``: ``|qd| > limit``; ``"effort"``: ``|drive torque/force| >
+        limit``), ``t_start`` and ``t_end`` (the first and
         last output sample beyond the limit), ``worst`` (the sampled value of largest magnitude in
         the span, signed), ``limit`` and ``samples`` (how many output samples the span covers).
         Empty (with these columns) when the run stays within its limits.
@@ -101,7 +103,7 @@ def limit_violations(model, result) -> pd.DataFrame:
 
     t, names, qd, tau = _checked(model, result, "limit_violations")
     effort_limit, velocity_limit = _column_limits(model, names)
-    rows = []
+    rows = _position_rows(model, result, t)
     for kind, values, limits in (("velocity", qd, velocity_limit), ("effort", tau, effort_limit)):
         for k, name in enumerate(names):
             if not np.isfinite(limits[k]):
@@ -115,6 +117,41 @@ def limit_violations(model, result) -> pd.DataFrame:
                 rows.append((name, kind, t[i0], t[i1], float(worst), float(limits[k]), i1 - i0 + 1))
     table = pd.DataFrame(rows, columns=_VIOLATION_COLUMNS)
     return table.sort_values(["t_start", "joint", "kind"], kind="stable", ignore_index=True)
+
+
+# a position within this of its limit (relative to max(1, |limit|)) is on it: simulate's stops
+# fire 1e-9 beyond theirs (detail/limit_stops.hpp)
+_POSITION_TOLERANCE = 1e-8
+
+
+def _position_rows(model, result, t) -> list[tuple]:
+    """Violation rows of the positions ``result.q`` against the joints' position limits
+    (``model.joint_limits``): below the lower or above the upper limit by more than
+    _POSITION_TOLERANCE (a driven motion, an inverse-dynamics plan, a run with limits="ignore")."""
+    q = np.asarray(getattr(result, "q", np.zeros((len(t), 0))), dtype=float)
+    for cols in (list(model.joint_coord_names), list(model.coord_names)):
+        if q.ndim == 2 and q.shape[1] == len(cols):
+            break
+    else:
+        return []
+    joints = set(model.joint_names)
+    rows = []
+    for k, name in enumerate(cols):
+        if name not in joints:
+            continue
+        lim = model.joint_limits(name)
+        for bound, sign in ((lim["lower"], -1.0), (lim["upper"], 1.0)):
+            if not np.isfinite(bound) or abs(bound) >= 1e299:
+                continue
+            x = q[:, k]
+            tol = _POSITION_TOLERANCE * max(1.0, abs(bound))
+            for i0, i1 in _spans(sign * (x - bound) > tol):
+                seg = x[i0 : i1 + 1]
+                worst = seg[np.argmax(sign * seg)]
+                rows.append(
+                    (name, "position", t[i0], t[i1], float(worst), float(bound), i1 - i0 + 1)
+                )
+    return rows
 
 
 def _trapezoid(y: np.ndarray, t: np.ndarray) -> np.ndarray:

@@ -223,3 +223,34 @@ def test_limits_bad_input_is_refused_and_driven_joints_have_no_stop():
     driven = ad.simulate(b.finalize(), 1.0, output_dt=1e-2)
     assert driven.limit_forces["names"] == []
     assert np.abs(driven.q[:, 0]).max() > 0.49
+
+
+def test_limit_violations_report_positions_beyond_the_limits():
+    """A run with limits='ignore' and a driven motion past a limit are reported (kind
+    'position', the bound crossed, the worst sample); an enforced run has none."""
+    model = _ur5_limited()
+    free = ad.simulate(model, 2.0, output_dt=1e-2, limits="ignore")
+    table = ad.limit_violations(model, free)
+    pos = table[table.kind == "position"]
+    names = list(model.joint_coord_names)
+    for row in pos.itertuples():
+        k = names.index(row.joint)
+        i0, i1 = np.searchsorted(free.t, [row.t_start, row.t_end])
+        seg = free.q[i0 : i1 + 1, k]
+        assert row.limit in (model.coord_lower[k], model.coord_upper[k])
+        assert np.all(np.abs(seg) > abs(row.limit))
+        assert row.worst == seg[np.argmax(np.abs(seg))]
+        assert row.samples == i1 - i0 + 1
+    assert len(pos) >= 1
+    enforced = ad.simulate(model, 2.0, output_dt=1e-2)
+    assert (ad.limit_violations(model, enforced).kind == "position").sum() == 0
+    # a drive past the upper limit of a pendulum: one span, worst 0.5 against 0.2
+    b = pendulum(-0.2, 0.2)
+    b.add_drive("hinge", ad.profiles.sine(0.5, 1.0))
+    driven = ad.simulate(b.finalize(), 1.0, output_dt=1e-3)
+    rows = ad.limit_violations(b.finalize(), driven)
+    rows = rows[rows.kind == "position"]
+    assert list(rows.limit) == [0.2, -0.2]
+    np.testing.assert_allclose(rows.worst, [0.5, -0.5], atol=1e-12)
+    t_in = np.arcsin(0.2 / 0.5) / (2 * np.pi)  # sin crosses 0.4 of its amplitude
+    np.testing.assert_allclose(rows.t_start.iloc[0], t_in, atol=1e-3)

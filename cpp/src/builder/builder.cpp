@@ -550,7 +550,13 @@ void ModelBuilder::add_actuator(const std::string& joint, double gear_ratio, dou
   if (!std::isfinite(friction_smoothing))
     throw ModelError(msg(who, ": friction_smoothing must be finite, got ", friction_smoothing));
   if (motor) motor->validate(who + ": motor");
-  const std::string rotor = joint + "_rotor";
+  // the gear-reduced rotor (on ground) is the joint's reflected inertia N^2 J turning with the
+  // joint ("<joint>_armature": the same dynamics as a rotor at N qdot, without a body spinning N
+  // times faster for the Cartesian error control to follow); the gyroscopic one is the rotor
+  // itself on the joint's parent, turning at N qdot relative to it ("<joint>_rotor")
+  const bool reduced = !gyroscopic;
+  const std::string rotor = joint + (reduced ? "_armature" : "_rotor");
+  const double n_abs = std::abs(gear_ratio);
   if (m_.body_index.count(rotor) || rotor == "ground")
     throw ModelError(msg(who, ": a body named '", rotor, "' exists (the rotor's name)"));
   if (m_.joint_index.count(rotor))
@@ -569,16 +575,23 @@ void ModelBuilder::add_actuator(const std::string& joint, double gear_ratio, dou
   const std::string carrier =
       gyroscopic && j.parent != kGround ? m_.bodies[j.parent].name : std::string("ground");
   // thin disc: axial J, transverse J / 2 (the rotor's mass belongs to the link's inertia)
-  const Mat3 inertia = 0.5 * rotor_inertia * (Mat3::Identity() + axis * axis.transpose());
-  const double smoothing =
-      friction_smoothing > 0.0 ? friction_smoothing : 1e-3 * std::abs(gear_ratio);
+  const double axial = reduced ? gear_ratio * gear_ratio * rotor_inertia : rotor_inertia;
+  const Mat3 inertia = 0.5 * axial * (Mat3::Identity() + axis * axis.transpose());
+  const double smoothing = friction_smoothing > 0.0 ? friction_smoothing : 1e-3 * n_abs;
   Model saved = m_;  // every step below validated its input; restore on any failure regardless
   try {
     add_body(rotor, 0.0, inertia, point, Vec4(1, 0, 0, 0));
     const int rj = add_revolute(rotor, carrier, rotor, point, axis);
-    add_coupling_impl(rotor, rotor, joint, gear_ratio, 0.0, true);
-    if (friction_viscous > 0.0 || friction_coulomb > 0.0)
-      add_joint_friction(rotor, friction_viscous, friction_coulomb, smoothing);
+    add_coupling_impl(rotor, rotor, joint, reduced ? 1.0 : gear_ratio, 0.0, true);
+    // motor-side friction b omega + c tanh(omega / v_s) at omega = N qdot: on the armature
+    // (turning at qdot) as N^2 b and |N| c with the joint-side smoothing v_s / |N|
+    if (friction_viscous > 0.0 || friction_coulomb > 0.0) {
+      if (reduced)
+        add_joint_friction(rotor, gear_ratio * gear_ratio * friction_viscous,
+                           n_abs * friction_coulomb, smoothing / n_abs);
+      else
+        add_joint_friction(rotor, friction_viscous, friction_coulomb, smoothing);
+    }
     Actuator a;
     a.joint = ji;
     a.rotor_joint = rj;

@@ -131,20 +131,25 @@ class ModelBuilder {
   ///   a cycle of couplings.
   void add_coupling(const std::string& name, const std::string& follower, const std::string& leader,
                     double multiplier, double offset = 0.0);
-  /// A gearbox and motor rotor on revolute or prismatic joint `joint` (see Actuator): the
-  /// builder adds body and revolute joint `<joint>_rotor` (zero mass, thin-disc inertia: axial
-  /// rotor_inertia [kg m^2], transverse half of it) along the joint's axis through its origin,
-  /// on ground (gyroscopic false: the gear-reduced model, kinetic energy 1/2 N^2 J qdot^2) or on
-  /// the joint's parent body (gyroscopic true: the rotor's full kinetic energy, gyroscopic
-  /// terms included), and the coupling `<joint>_rotor` q_rotor = gear_ratio q_joint [a
-  /// prismatic joint's ratio in rad/m]. Motor-side viscous [N m s/rad] and Coulomb [N m]
-  /// friction act on the rotor joint (smoothing velocity friction_smoothing [rad/s] on the
-  /// rotor; <= 0: 1e-3 |gear_ratio|, i.e. 1e-3 joint side), so they reach the joint as N^2 b and
-  /// N c. efficiency and motor are stored (Model::actuators), not in the dynamics.
+  /// A gearbox and motor rotor on revolute or prismatic joint `joint` (see Actuator), as a
+  /// body of zero mass and thin-disc inertia (axial I, transverse I / 2) on a revolute joint
+  /// along the joint's axis through its origin, coupled to the joint:
+  ///  - gyroscopic false (the gear-reduced model, Pinocchio's armature): body and joint
+  ///    `<joint>_armature` on ground, I = N^2 rotor_inertia, turning with the joint (coupling
+  ///    multiplier 1): kinetic energy 1/2 N^2 J qdot^2, exactly the rotor's at N qdot, without a
+  ///    body spinning N times faster for the Cartesian error control;
+  ///  - gyroscopic true: the rotor itself, `<joint>_rotor`, I = rotor_inertia, on the joint's
+  ///    parent body, turning at q_rotor = gear_ratio q_joint relative to it (its full kinetic
+  ///    energy, gyroscopic terms included).
+  /// A prismatic joint's ratio is in rad/m. Motor-side viscous b [N m s/rad] and Coulomb c
+  /// [N m] friction (smoothing velocity friction_smoothing [rad/s] motor side; <= 0:
+  /// 1e-3 |gear_ratio|, i.e. 1e-3 joint side) act on the rotor joint, reaching the joint as
+  /// N^2 b and |N| c (on the armature directly so). efficiency and motor are stored
+  /// (Model::actuators), not in the dynamics.
   /// @throws ModelError naming the joint and the culprit on an unknown joint, a joint that is
   ///   not revolute or prismatic, a second actuator on the joint, a zero or non-finite
   ///   gear_ratio, a negative or non-finite rotor_inertia, an efficiency outside (0, 1],
-  ///   negative or non-finite frictions, an invalid motor, or a name `<joint>_rotor` taken.
+  ///   negative or non-finite frictions, an invalid motor, or the rotor's name taken.
   void add_actuator(const std::string& joint, double gear_ratio, double rotor_inertia,
                     double efficiency = 1.0, double friction_viscous = 0.0,
                     double friction_coulomb = 0.0, const MotorSpec* motor = nullptr,

@@ -271,16 +271,17 @@ struct MotorSpec {
   bool operator==(const MotorSpec& o) const;
 };
 
-/// A gearbox and motor rotor on a revolute or prismatic joint (ModelBuilder::add_actuator). The
-/// builder adds the rotor as a body of its own (zero mass, thin-disc inertia: axial
-/// rotor_inertia, transverse half of it) on a revolute joint `rotor_joint` along the actuated
-/// joint's axis through its origin, coupled to it (q_rotor = gear_ratio q_joint) -- on ground
-/// (gyroscopic false: the gear-reduced model, kinetic energy 1/2 N^2 J qdot^2, Pinocchio's
-/// armature N^2 J) or on the actuated joint's parent body (gyroscopic true: the rotor's full
-/// kinetic energy with its carrier's rotation). Motor-side friction acts on the rotor joint.
+/// A gearbox and motor rotor on a revolute or prismatic joint (ModelBuilder::add_actuator),
+/// in the dynamics as a body of its own on a revolute joint `rotor_joint` along the actuated
+/// joint's axis, coupled to it: gyroscopic false, the gear-reduced model (Pinocchio's armature):
+/// `<joint>_armature` on ground with axial inertia N^2 J turning with the joint (kinetic energy
+/// 1/2 N^2 J qdot^2); gyroscopic true, the rotor `<joint>_rotor` with axial inertia J on the
+/// actuated joint's parent body turning at N qdot relative to it (its full kinetic energy with
+/// its carrier's rotation). Motor-side friction acts on the rotor joint (reflected onto the
+/// armature).
 struct Actuator {
   int joint = 0;                    ///< the actuated joint
-  int rotor_joint = 0;              ///< the rotor's revolute joint (a coupling follower)
+  int rotor_joint = 0;              ///< the rotor's (armature's) revolute joint, a follower
   double gear_ratio = 1.0;          ///< N: rotor speed / joint speed [1, or rad/m for prismatic]
   double rotor_inertia = 0.0;       ///< J about the rotor axis [kg m^2]
   double efficiency = 1.0;          ///< gear efficiency in (0, 1] (not in the dynamics)
