@@ -391,17 +391,11 @@ def make_motor(**datasheet):
     """An :class:`armdyn.Motor` from datasheet keywords (SI, motor side: ``torque_constant``
     N m/A, ``resistance`` ohm, ``voltage`` V, ``no_load_speed`` rad/s, ``continuous_torque`` and
     ``peak_torque`` N m, ``max_speed`` rad/s, ``thermal_resistance`` K/W,
-    ``thermal_time_constant`` s, ``name``); on a build without the actuator model, a namespace
-    with the same attributes (None where absent), which the sizing functions take alike."""
-    from types import SimpleNamespace
-
+    ``thermal_time_constant`` s, ``name``); an unknown key is a ModelError naming it."""
     unknown = sorted(set(datasheet) - set(MOTOR_FIELDS))
     if unknown:
         raise _core.ModelError(f"motor: unknown datasheet key(s) {unknown}; known {MOTOR_FIELDS}")
-    motor_cls = getattr(_core, "Motor", None)
-    if motor_cls is not None:
-        return motor_cls(**datasheet)
-    return SimpleNamespace(**{f: datasheet.get(f) for f in MOTOR_FIELDS})
+    return _core.Motor(**datasheet)
 
 
 _ACTUATOR_FIELDS = (

@@ -267,9 +267,6 @@ def test_gear_ratio_sweep_strips_the_models_own_rotor(run, monkeypatch):
     np.testing.assert_allclose(a[cols].to_numpy(), b[cols].to_numpy(), rtol=1e-12)
 
 
-@pytest.mark.skipif(
-    not hasattr(ad.ModelBuilder, "add_actuator"), reason="needs the C++ actuator model"
-)
 def test_gear_ratio_sweep_equals_rebuilding_the_model():
     """The closed-form re-evaluation at ratio N equals a model rebuilt with add_actuator(N)."""
     model = rotor_model()
