@@ -241,16 +241,21 @@ def motor_side_of_result(model, result) -> dict[str, MotorSide]:
     out = {}
     for a in actuators:
         joint = str(a.joint)
-        if joint not in names:
-            raise _core.ModelError(
-                f"motor_side_of_result: actuated joint {joint!r} is not a column of the result "
-                f"({names})"
-            )
-        k = names.index(joint)
-        if np.any(np.isnan(tau[:, k])):
-            raise _core.ModelError(
-                f"motor_side_of_result: the result has no torque for actuated joint {joint!r} "
-                "(no drive and no joint_torques)"
-            )
+        k = actuated_column(joint, names, tau, "motor_side_of_result")
         out[joint] = motor_side(a, t, qd[:, k], qdd[:, k], tau[:, k], joint=joint)
     return out
+
+
+def actuated_column(joint: str, names: list[str], tau: np.ndarray, caller: str) -> int:
+    """The result column of an actuated joint, checked to exist and to carry a torque."""
+    if joint not in names:
+        raise _core.ModelError(
+            f"{caller}: actuated joint {joint!r} is not a column of the result ({names})"
+        )
+    k = names.index(joint)
+    if np.any(np.isnan(tau[:, k])):
+        raise _core.ModelError(
+            f"{caller}: the result has no torque for actuated joint {joint!r} (no drive and no "
+            "joint_torques)"
+        )
+    return k

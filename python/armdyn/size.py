@@ -37,6 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from armdyn import _core
+from armdyn.sizing import MOTOR_FIELDS
 
 ACTUATOR_KEYS = (
     "gear_ratio",
@@ -47,18 +48,7 @@ ACTUATOR_KEYS = (
     "friction_smoothing",
     "gyroscopic",
 )
-MOTOR_KEYS = (
-    "torque_constant",
-    "resistance",
-    "voltage",
-    "no_load_speed",
-    "continuous_torque",
-    "peak_torque",
-    "max_speed",
-    "thermal_resistance",
-    "thermal_time_constant",
-    "name",
-)
+MOTOR_KEYS = MOTOR_FIELDS  # armdyn.Motor's keywords
 
 
 def _derivative(t: np.ndarray, y: np.ndarray, order: int, joint: str) -> np.ndarray:

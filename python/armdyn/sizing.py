@@ -675,7 +675,7 @@ def sizing_report(result, model, out=None, actuators=None) -> SizingReport:
     """
     import pandas as pd
 
-    from armdyn.actuators import motor_side
+    from armdyn.actuators import actuated_column, motor_side
 
     t, names, qd, tau = _checked(model, result, "sizing_report")
     if len(t) < 2 or not (t[-1] > t[0]):
@@ -729,17 +729,7 @@ def sizing_report(result, model, out=None, actuators=None) -> SizingReport:
         rows = {}
         for a in actuators:
             joint = str(a.joint)
-            if joint not in names:
-                raise _core.ModelError(
-                    f"sizing_report: actuated joint {joint!r} is not a column of the result "
-                    f"({names})"
-                )
-            k = names.index(joint)
-            if np.any(np.isnan(tau[:, k])):
-                raise _core.ModelError(
-                    f"sizing_report: the result has no torque for actuated joint {joint!r} (no "
-                    "drive and no joint_torques)"
-                )
+            k = actuated_column(joint, names, tau, "sizing_report")
             side = motor_side(a, t, qd[:, k], qdd[:, k], tau[:, k], joint=joint)
             motors[joint], envelopes[joint] = side, getattr(a, "motor", None)
             row = motor_values(side, a, t)

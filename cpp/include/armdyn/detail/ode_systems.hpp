@@ -367,19 +367,11 @@ class JointSystem : public OdeSystem, public StopAccess {
 
   // y = (q (nq_), qd (n_), z); q holds the floating bases' quaternions where qd has 3 rates
   void rhs(double t, const VecX& y, VecX& dy) override {
-    const double* q = y.data();
-    const double* qd = q + nq_;
-    const double* z = qd + n_;
-    if (m_.n_free)
-      configuration_rate(m_, q, qd, dy.data());
-    else
-      dy.head(n_) = y.segment(n_, n_);
-    td_.accelerations(t, q, qd, z, nullptr, dy.data() + nq_);
-    if (m_.n_aux) td_.aux_rates(t, q, qd, z, dy.data() + nq_ + n_);
+    stop_eval(t, y, nullptr, dy, false);
     if (LimitStops* st = cart_.stops(); st && st->any_engaged()) st->solve(*this, t, y, dy);
   }
 
-  // StopAccess: the joint state y = (q, qd, z)
+  // StopAccess: the joint state y = (q, qd, z); stop_eval is also the free right-hand side
   void stop_eval(double t, const VecX& y, const double* tau, VecX& dy, bool /*again*/) override {
     const double* q = y.data();
     const double* qd = q + nq_;
