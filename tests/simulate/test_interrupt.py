@@ -103,6 +103,77 @@ def test_sigint_stops_within_half_a_second_with_the_partial_result(method):
         assert report["last_diff"] <= 1e-12, report
 
 
+ID_CHILD = textwrap.dedent(
+    """
+    import json, sys, time
+    import numpy as np
+    import armdyn as ad
+
+    which = sys.argv[1]
+    b = ad.ModelBuilder(gravity=(0.0, 0.0, -9.81))
+    b.add_body("a", 1.0, np.eye(3) * 1e-2, position=(0.5, 0.0, 0.0))
+    b.add_body("b", 1.0, np.eye(3) * 1e-2, position=(1.5, 0.0, 0.0))
+    b.add_revolute("j1", "ground", "a", (0.0, 0.0, 0.0), (0.0, 1.0, 0.0))
+    b.add_revolute("j2", "a", "b", (1.0, 0.0, 0.0), (0.0, 1.0, 0.0))
+    if which == "driven":
+        b.add_drive("j1", lambda t: (np.sin(t), np.cos(t), -np.sin(t)))
+        b.add_drive("j2", lambda t: (0.5 * t, 0.5, 0.0))
+    model = b.finalize()
+    rng = np.random.default_rng(1)
+    n = 4_000_000 if which == "batch" else 3_000_000
+    if which == "batch":
+        q, qd, qdd = (rng.standard_normal((n, 2)) for _ in range(3))
+    else:
+        ts = np.linspace(0.0, 1e4, n)
+    print("ready", flush=True)
+    start = time.time()
+    try:
+        if which == "batch":
+            out = ad.inverse_dynamics(model, q, qd, qdd)
+        else:
+            out = ad.driven_inverse_dynamics(model, ts)
+        print(json.dumps({"completed": time.time() - start}), flush=True)
+        sys.exit(0)
+    except KeyboardInterrupt as err:
+        caught = time.time()
+        partial = getattr(err, "result", None)
+    report = {"caught": caught}
+    if which == "batch":
+        k = len(partial)
+        ref = ad.inverse_dynamics(model, q[:k], qd[:k], qdd[:k])
+        report.update(rows=k, diff=float(np.max(np.abs(ref - partial))))
+    print(json.dumps(report), flush=True)
+    """
+)
+
+
+@pytest.mark.parametrize("which", ["batch", "driven"])
+def test_sigint_stops_inverse_dynamics_loops(which):
+    proc = subprocess.Popen(
+        [sys.executable, "-c", ID_CHILD, which],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert proc.stdout.readline().strip() == "ready"
+        time.sleep(1.0)
+        sent = time.time()
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 0, err
+    report = json.loads(out.strip().splitlines()[-1])
+    assert "completed" not in report, f"the loop ended before the signal: {report}"
+    latency = report["caught"] - sent
+    print(f"{which}: SIGINT latency {latency * 1e3:.1f} ms")
+    assert latency <= 0.5
+    if which == "batch":  # the rows done, as a batch of those rows computes them
+        assert report["rows"] > 0 and report["diff"] == 0.0
+
+
 # --- callbacks --------------------------------------------------------------------------------
 
 
