@@ -69,11 +69,17 @@ inline bool propagates_as_itself(const py::error_already_set& e) {
 }
 
 /// The poll of a run started from Python (solver/poll.hpp): every 5 ms of wall time it takes
-/// the GIL briefly to run the signal handlers (PyErr_CheckSignals: Ctrl-C raises
-/// KeyboardInterrupt there) and, every 0.1 s and when not None, calls progress(t, t_end). A
-/// Python exception from either stops the run as a PyInterrupted (propagating as itself).
-/// progress (may be null) must outlive the poll.
+/// the GIL briefly (on the main thread, or with a progress callable) to run the signal handlers
+/// (PyErr_CheckSignals: Ctrl-C raises KeyboardInterrupt there) and, every 0.1 s and when not None,
+/// calls progress(t, t_end). A Python exception from either stops the run as a PyInterrupted
+/// (propagating as itself). progress (may be null) must outlive the poll.
 inline Poll python_poll(const py::object* progress = nullptr) {
+  // signal handlers run only on the main thread: elsewhere, without progress, no callback (a
+  // run on a worker thread never takes the GIL for it)
+  const auto main_ident =
+      py::module_::import("threading").attr("main_thread")().attr("ident").cast<unsigned long>();
+  const bool main_thread = PyThread_get_thread_ident() == main_ident;
+  if (!main_thread && (!progress || progress->is_none())) return Poll();
   auto last = std::make_shared<Poll::Clock::time_point>(Poll::Clock::now());
   return Poll(
       [progress, last](double t, double t_end) {
