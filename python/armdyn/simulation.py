@@ -275,6 +275,10 @@ MAX_OUTPUT_BYTES = 2 * 1024**3
 def _check_output_bytes(model, t_end, output_dt, max_output_bytes) -> None:
     """Refuse, before it starts, a run whose outputs would exceed the bound (ModelError)."""
     bound = MAX_OUTPUT_BYTES if max_output_bytes is None else max_output_bytes
+    if not (isinstance(bound, (int, float)) and bound > 0):
+        raise _core.ModelError(
+            f"simulate: max_output_bytes must be a positive number, got {bound!r}"
+        )
     if not (np.isfinite(t_end) and t_end > 0):
         return  # the run's own check names t_end
     rows = float(t_end) / float(output_dt) + 2

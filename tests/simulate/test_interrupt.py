@@ -371,6 +371,8 @@ def test_the_memory_bound_is_adjustable(monkeypatch):
     assert len(r.t) == 1001
     with pytest.raises(ad.ModelError, match=r"output_dt=0\.001"):
         ad.simulate(p.model, 1.0, output_dt=1e-3, max_output_bytes=int(need) - 1)
+    with pytest.raises(ad.ModelError, match="max_output_bytes must be a positive number"):
+        ad.simulate(p.model, 1.0, output_dt=1e-3, max_output_bytes=-1)
     monkeypatch.setattr(ad.simulation, "MAX_OUTPUT_BYTES", int(need) - 1)
     with pytest.raises(ad.ModelError, match="MAX_OUTPUT_BYTES"):
         ad.simulate(p.model, 1.0, output_dt=1e-3)
