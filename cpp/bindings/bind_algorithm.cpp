@@ -105,14 +105,23 @@ py::array_t<double> batch(const char* fn, long nq, long n, const py::handle& q, 
   py::array_t<double> out(out_shape);
   const double *qp = Q.data(), *ap = A.data(), *bp = B.data();
   double* op = out.mutable_data();
+  Poll poll = python_poll();  // Ctrl-C: KeyboardInterrupt with .result, the rows done
   py::gil_scoped_release nogil;
+  poll.start();
   for (long i = 0; i < rows; ++i) {
     using Row = Eigen::Map<const VecX>;
+    try {
+      poll(static_cast<double>(i), static_cast<double>(rows));
+    } catch (PyInterrupted& e) {
+      py::gil_scoped_acquire g;
+      e.err.value().attr("result") = out[py::slice(0, i, 1)];
+      throw;
+    }
     try {
       f(Row(qp + i * nq, nq), Row(ap + i * n, n), Row(bp + i * n, n), per_row_t ? ts[i] : t0,
         op + i * out_size);
     } catch (const SolverError& e) {
-      throw SolverError(msg("row ", i, ": ", e.what()));
+      std::throw_with_nested(SolverError(msg("row ", i, ": ", e.what())));
     } catch (const ModelError& e) {
       throw ModelError(msg("row ", i, ": ", e.what()));
     }

@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <pybind11/stl.h>
 
+#include <chrono>
+#include <memory>
+
 #include "armdyn/algorithm/energy.hpp"
 #include "armdyn/algorithm/forces.hpp"
 #include "armdyn/algorithm/kinematics.hpp"
@@ -115,6 +118,25 @@ py::dict result_dict(const Model& md, const SimResult& r) {
   return d;
 }
 
+/// The Python exceptions that stopped a run, for armdyn.simulate to raise: "interrupt" (to
+/// raise as itself, with .result) and "cause" (a SolverError's __cause__), or None.
+void add_run_exception(const SimResult& r, py::dict& d) {
+  d["interrupt"] = py::none();
+  d["cause"] = py::none();
+  if (!r.exception) return;
+  try {
+    std::rethrow_exception(r.exception);
+  } catch (PyInterrupted& e) {
+    d["interrupt"] = e.err.value();
+  } catch (const SolverError& e) {
+    d["cause"] = py_cause(e);
+  } catch (const Interrupted& e) {
+    d["interrupt"] = py::reinterpret_steal<py::object>(
+        PyObject_CallFunction(PyExc_KeyboardInterrupt, "s", e.what()));
+  } catch (...) {
+  }
+}
+
 }  // namespace
 
 void bind_dynamics(py::module_& m) {
@@ -123,10 +145,11 @@ void bind_dynamics(py::module_& m) {
       [](const Model& md, double t_end, const std::string& integrator, double rtol, double atol,
          double dt, double output_dt, py::object u0, py::object v0, const std::string& projection,
          long max_steps, double max_step, bool merge_welded, const std::string& coordinates,
-         py::object q_start, bool limits, double restitution) {
+         py::object q_start, bool limits, double restitution, py::object progress) {
         // armdyn.simulate answers a model with no bodies itself (nothing to integrate)
         if (md.nb == 0)
           throw ModelError("_simulate: the model has no bodies (use armdyn.simulate)");
+        SimulateGuard guard("simulate");
         SimOptions o;
         if (!q_start.is_none()) {
           // the independent q0 (a coupled model's followers set by their couplings)
@@ -148,18 +171,37 @@ void bind_dynamics(py::module_& m) {
         o.projection = metric_of(projection);
         const VecX u = u0.is_none() ? md.u0 : to_vec(u0, "u0", md.nq);
         const VecX v = v0.is_none() ? md.v0 : to_vec(v0, "v0", md.nv);
+        Poll poll = python_poll(&progress);
+        o.step.poll = &poll;
         SimResult r;
         {
           py::gil_scoped_release release;
           r = simulate(md, t_end, o, u, v);
         }
-        return result_dict(md, r);
+        py::dict d = result_dict(md, r);
+        add_run_exception(r, d);
+        return d;
       },
       py::arg("model"), py::arg("t_end"), py::arg("integrator"), py::arg("rtol"), py::arg("atol"),
       py::arg("dt"), py::arg("output_dt"), py::arg("u0"), py::arg("v0"), py::arg("projection"),
       py::arg("max_steps"), py::arg("max_step") = 0.0, py::arg("merge_welded") = true,
       py::arg("coordinates") = "cartesian", py::arg("q_start") = py::none(),
-      py::arg("limits") = true, py::arg("restitution") = 0.0);
+      py::arg("limits") = true, py::arg("restitution") = 0.0, py::arg("progress") = py::none());
+
+  m.def(
+      "_output_row_bytes",
+      [](const Model& md) {
+        // the columns finish() (simulate.cpp) sizes per output time; limit forces: at most one
+        // per joint
+        const size_t nj = md.joints.size();
+        const size_t cols = 1 + static_cast<size_t>(md.nq + md.nv + md.nq_joint) +
+                            3 * static_cast<size_t>(md.nv_joint) + md.drives.size() + 6 * nj + 4 +
+                            md.gears.size() + md.gear_constraints.size() + nj;
+        return cols * sizeof(double);
+      },
+      py::arg("model"),
+      "Bytes of one output time of simulate (every table's row, the limit forces counted for "
+      "every joint): the bound armdyn.simulate checks an output_dt run against.");
 
   m.def(
       "state_from_joints",

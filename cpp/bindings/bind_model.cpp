@@ -31,7 +31,11 @@ Profile to_profile(const py::handle& obj, const std::string& name) {
             if (r.size() != 3) throw SolverError("");
             return ProfileValue{r[0].cast<double>(), r[1].cast<double>(), r[2].cast<double>()};
           } catch (py::error_already_set& e) {
-            throw SolverError(msg("profile callback ", desc, " raised at t=", t, ": ", e.what()));
+            // SystemExit, KeyboardInterrupt, GeneratorExit: themselves (the run's outputs kept)
+            if (propagates_as_itself(e)) throw PyInterrupted(std::move(e));
+            const std::string what =
+                msg("profile callback ", desc, " raised at t=", t, ": ", py_error_summary(e));
+            throw PyCallbackError(what, std::move(e));
           } catch (...) {
             throw SolverError(msg("profile callback ", desc,
                                   " must return (y, dy/dt, d2y/dt2) as 3 numbers (t=", t, ")"));

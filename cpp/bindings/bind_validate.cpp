@@ -71,9 +71,10 @@ void bind_validate(py::module_& m) {
         const VecX t = to_vec(times, "t");
         std::vector<double> tv(t.data(), t.data() + t.size());
         InverseDynamicsResult r;
+        Poll poll = python_poll();  // Ctrl-C
         {
           py::gil_scoped_release nogil;
-          r = inverse_dynamics_driven(md, tv);
+          r = inverse_dynamics_driven(md, tv, &poll);
         }
         return id_result_dict(md, r);
       },

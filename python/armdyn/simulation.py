@@ -105,6 +105,8 @@ def simulate(
     coordinates: str = "cartesian",
     limits: str = "enforce",
     restitution: float = 0.0,
+    progress=False,
+    max_output_bytes: int | None = None,
 ) -> SimulationResult:
     """Integrate the model from t = 0 to ``t_end``; the stepping loop runs in C++ without the GIL.
 
@@ -168,14 +170,35 @@ def simulate(
         restitution: the stops' coefficient of restitution in [0, 1]: 0 (default) a plastic
             impact, the joint stays on its stop; e > 0 rebounds at e times the impact rate
             (rebounds slower than 1e-6 rad/s or m/s rest on the stop).
+        progress: ``False`` (default): nothing shown. ``True``: a tqdm progress bar of the
+            simulated time (t of ``t_end`` seconds), closed when the run ends. A ``tqdm``
+            instance: that bar, its ``total`` set to ``t_end`` and ``n`` to t (left open, for
+            notebooks and nested bars). A callable ``progress(t, t_end)``: called with the
+            simulated time (e.g. to update a widget), and once more with ``t = t_end`` when the
+            run completes. Updated at most every 0.1 s of wall time, from the run's poll (the
+            GIL taken briefly); an exception it raises stops the run and propagates as itself,
+            with ``.result``.
+        max_output_bytes: bound on the memory of the outputs of an ``output_dt`` run (default
+            ``armdyn.simulation.MAX_OUTPUT_BYTES``, 2 GiB): a run whose tables would exceed it
+            (``t_end / output_dt + 2`` rows of every output, sized from the model) is refused
+            before it starts, with a ModelError naming ``output_dt``. Runs without
+            ``output_dt`` (an output every accepted step) are bounded by ``max_steps``.
 
     Returns:
         SimulationResult.
 
     Raises:
-        ModelError: invalid options or initial state.
+        ModelError: invalid options or initial state; outputs beyond ``max_output_bytes``;
+            ``simulate`` called from inside a running simulation (a profile or progress
+            callable): re-entrant runs are refused.
         SolverError: the run failed (non-finite force, projection not converging, step-size
-            underflow); ``err.result`` holds the outputs up to the last good one.
+            underflow, an exception raised by a profile callable: then chained as
+            ``__cause__``); ``err.result`` holds the outputs up to the last good one.
+        KeyboardInterrupt: Ctrl-C (SIGINT) during the run. The stepping loop checks for
+            signals every 5 ms of wall time, so the run stops within milliseconds;
+            ``err.result`` holds the outputs up to the last good one. ``SystemExit``,
+            ``KeyboardInterrupt`` and ``GeneratorExit`` raised by a profile or progress
+            callable propagate as themselves in the same way (``.result`` set).
     """
     if dt is not None and not (dt > 0):
         raise _core.ModelError(f"simulate: dt must be positive, got {dt}")
@@ -196,34 +219,110 @@ def simulate(
         q_start = None
     if model.nb == 0:
         return _zero_dof_result(model, t_end, output_dt)
-    raw = _core._simulate(
-        model,
-        float(t_end),
-        "default" if integrator is None else integrator,
-        float(rtol),
-        float(atol),
-        float(dt or 0.0),
-        float(output_dt or 0.0),
-        None if u0 is None else u0,
-        None if v0 is None else v0,
-        projection,
-        int(max_steps),
-        float(max_step or 0.0),
-        bool(merge_welded),
-        coordinates,
-        q_start,
-        limits == "enforce",
-        float(restitution),
+    if output_dt is not None:
+        _check_output_bytes(model, t_end, output_dt, max_output_bytes)
+    report, close = _progress_reporter(progress, t_end)
+    try:
+        raw = _core._simulate(
+            model,
+            float(t_end),
+            "default" if integrator is None else integrator,
+            float(rtol),
+            float(atol),
+            float(dt or 0.0),
+            float(output_dt or 0.0),
+            None if u0 is None else u0,
+            None if v0 is None else v0,
+            projection,
+            int(max_steps),
+            float(max_step or 0.0),
+            bool(merge_welded),
+            coordinates,
+            q_start,
+            limits == "enforce",
+            float(restitution),
+            report,
+        )
+        error = raw.pop("error")
+        interrupt = raw.pop("interrupt")
+        cause = raw.pop("cause")
+        result = SimulationResult(**raw)
+        if model.actuators:
+            _attach_motor_side(model, result)
+        if interrupt is not None:
+            # Ctrl-C, or SystemExit / KeyboardInterrupt / GeneratorExit from a callable
+            interrupt.result = result
+            raise interrupt
+        if error:
+            exc = _core.SolverError(error)
+            exc.result = result
+            if cause is not None:
+                raise exc from cause
+            raise exc
+        if report is not None:
+            report(float(t_end), float(t_end))
+        return result
+    finally:
+        if close is not None:
+            close()
+
+
+#: Default bound on the outputs of an ``output_dt`` run [bytes] (``simulate(max_output_bytes=)``
+#: overrides it per run; assign this attribute to change it for the session).
+MAX_OUTPUT_BYTES = 2 * 1024**3
+
+
+def _check_output_bytes(model, t_end, output_dt, max_output_bytes) -> None:
+    """Refuse, before it starts, a run whose outputs would exceed the bound (ModelError)."""
+    bound = MAX_OUTPUT_BYTES if max_output_bytes is None else max_output_bytes
+    if not (isinstance(bound, (int, float)) and bound > 0):
+        raise _core.ModelError(
+            f"simulate: max_output_bytes must be a positive number, got {bound!r}"
+        )
+    if not (np.isfinite(t_end) and t_end > 0):
+        return  # the run's own check names t_end
+    rows = float(t_end) / float(output_dt) + 2
+    need = rows * _core._output_row_bytes(model)
+    if need > bound:
+        raise _core.ModelError(
+            f"simulate: output_dt={output_dt:g} over t_end={t_end:g} s gives {rows:.3g} output "
+            f"rows, {need / 1024**3:.3g} GiB of outputs, above the bound of "
+            f"{bound / 1024**3:.3g} GiB; raise output_dt (at least "
+            f"{float(t_end) * _core._output_row_bytes(model) / bound:.3g} s), or raise "
+            "max_output_bytes= / armdyn.simulation.MAX_OUTPUT_BYTES"
+        )
+
+
+def _progress_reporter(progress, t_end):
+    """(report(t, t_end) or None, close() or None) for simulate's ``progress`` argument; tqdm is
+    imported only here (``import armdyn`` stays light)."""
+    if progress is None or progress is False:
+        return None, None
+    if progress is True:
+        from tqdm.auto import tqdm
+
+        bar = tqdm(total=float(t_end), unit="s", desc="simulate", bar_format=_BAR_FORMAT)
+        return _tqdm_reporter(bar), bar.close
+    if hasattr(progress, "update") and hasattr(progress, "refresh") and hasattr(progress, "n"):
+        progress.total = float(t_end)
+        return _tqdm_reporter(progress), None
+    if callable(progress):
+        return progress, None
+    raise _core.ModelError(
+        "simulate: progress must be True, False, a tqdm instance or a callable (t, t_end), "
+        f"got {type(progress).__name__}"
     )
-    error = raw.pop("error")
-    result = SimulationResult(**raw)
-    if model.actuators:
-        _attach_motor_side(model, result)
-    if error:
-        exc = _core.SolverError(error)
-        exc.result = result
-        raise exc
-    return result
+
+
+_BAR_FORMAT = "{desc}: {percentage:3.0f}%|{bar}| t={n:.4g}/{total:.4g} s [{elapsed}<{remaining}]"
+
+
+def _tqdm_reporter(bar):
+    def report(t, t_end):
+        bar.n = t
+        bar.refresh()
+
+    return report
 
 
 def _attach_motor_side(model: _core.Model, result: SimulationResult) -> None:

@@ -28,6 +28,16 @@ class SolverError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// A run stopped from outside: a Poll's callback threw it (the Python bindings: a signal such as
+/// SIGINT, or an exception raised by a progress or profile callable that must propagate as
+/// itself) or its cancel flag was set. Not a SolverError: the integrators' step rejection does
+/// not swallow it. simulate() returns the outputs up to the last good one with
+/// SimResult::interrupt holding it (as `error` holds a SolverError's message).
+class Interrupted : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 /// Concatenate streamable parts into a message.
 template <typename... Args>
 std::string msg(const Args&... args) {

@@ -2,6 +2,7 @@
 #include "armdyn/algorithm/forces.hpp"
 
 #include <cmath>
+#include <exception>
 
 #include "armdyn/algorithm/kinematics.hpp"
 #include "armdyn/errors.hpp"
@@ -47,7 +48,9 @@ void body_forces(const Model& m, const std::vector<BodyKin>& kin, double t, Eige
       try {
         s = l.profile.eval(t).y;
       } catch (const SolverError& err) {
-        throw SolverError(msg("load on body '", m.bodies[l.body].name, "': ", err.what()));
+        // (nested: a Python callback's exception stays reachable as the cause)
+        std::throw_with_nested(
+            SolverError(msg("load on body '", m.bodies[l.body].name, "': ", err.what())));
       }
     }
     const BodyKin& k = kin[l.body];
@@ -88,7 +91,8 @@ void coordinate_forces(const Model& m, const double* q, const double* qd, const 
       const double zi = (cf.aux >= 0 && z) ? z[cf.aux] : 0.0;
       f = coord_force_value(cf, c.angular, q[cf.coord], qd[cf.coord], t, zi);
     } catch (const SolverError& err) {
-      throw SolverError(msg("force on joint coordinate '", c.name, "': ", err.what()));
+      std::throw_with_nested(
+          SolverError(msg("force on joint coordinate '", c.name, "': ", err.what())));
     }
     if (!std::isfinite(f))
       throw SolverError(msg("non-finite force on joint coordinate '", c.name, "' at t=", t));

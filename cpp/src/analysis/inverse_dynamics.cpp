@@ -166,7 +166,8 @@ void DrivenSolver::solve(double t, VecX& u, VecX& v, VecX& vd, double& rf, doubl
                           m_.rank_all, "; dependent rows: ", dependent_row_names(m_, d_)));
 }
 
-InverseDynamicsResult inverse_dynamics_driven(const Model& m, const std::vector<double>& times) {
+InverseDynamicsResult inverse_dynamics_driven(const Model& m, const std::vector<double>& times,
+                                              Poll* poll) {
   Data d(m);
   const double t0 = (!times.empty() && times.front() < 0.0) ? times.front() : 0.0;
   DrivenSolver solver(m, d, "driven_inverse_dynamics", t0);  // u0 is assembled at t = 0
@@ -195,13 +196,15 @@ InverseDynamicsResult inverse_dynamics_driven(const Model& m, const std::vector<
   out.velocity_residual.reserve(nt);
   VecX u = m.u0, v = VecX::Zero(m.nv), vd = VecX::Zero(m.nv);
   std::vector<double> qprev(nco, 0.0);
+  if (poll) poll->start();
   for (size_t k = 0; k < nt; ++k) {
     const double t = times[k];
+    if (poll) (*poll)(t, times.back());
     double rf, rv;
     try {
       solver.solve(t, u, v, vd, rf, rv);
     } catch (const SolverError& err) {
-      throw SolverError(msg(err.what(), " Times solved before this one: ", k));
+      std::throw_with_nested(SolverError(msg(err.what(), " Times solved before this one: ", k)));
     }
     for (int c = 0; c < nco; ++c) {
       const ScalarJet s = coord_jet(m, d.kin, c);

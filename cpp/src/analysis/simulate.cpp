@@ -247,12 +247,13 @@ void integrate(Integrator method, OdeSystem& ode, VecX& y, double t_end, const S
 /// A fully driven model: each output state solved from the constraints. On failure y holds
 /// the last state solved and t_last its time.
 void run_kinematic(const Model& ms, detail::MbsSystem& sys, VecX& y, double t_end, double output_dt,
-                   SimResult& out, double& t_last) {
+                   Poll* poll, SimResult& out, double& t_last) {
   DrivenSolver solver(ms, sys.data(), "simulate", 0.0);
   solver.throw_on_singular = false;  // counted and noted, as by the integrators
   VecX u = y.head(ms.nq), v = y.segment(ms.nq, ms.nv), vd = VecX::Zero(ms.nv);
   try {
     for (const double t : output_times(0.0, t_end, output_dt)) {
+      if (poll) (*poll)(t, t_end);
       double rf, rv;
       solver.solve(t, u, v, vd, rf, rv);
       ++out.stats.rhs_evals;
@@ -462,9 +463,10 @@ SimResult simulate(const Model& m, Data& d, double t_end, const SimOptions& opt,
   }
   const auto start = std::chrono::steady_clock::now();
   double t_last = 0.0;  // the time of the last good state y
+  if (s.poll) s.poll->start();
   try {
     if (plan.integrator == Integrator::Kinematic) {
-      run_kinematic(ms, sys, y, t_end, s.output_dt, out, t_last);
+      run_kinematic(ms, sys, y, t_end, s.output_dt, s.poll, out, t_last);
     } else if (plan.joint) {
       VecX yj = joint_state(ms, sys, y, opt.projection);
       if (stops) stops->start(*jsys, 0.0, yj);
@@ -479,10 +481,17 @@ SimResult simulate(const Model& m, Data& d, double t_end, const SimOptions& opt,
     }
   } catch (const SolverError& err) {
     out.error = err.what();
+    out.exception = std::current_exception();
     const bool kinematic = plan.integrator == Integrator::Kinematic;
     if (!kinematic) t_last = out.t.empty() ? 0.0 : out.t.back();
     // (the joint-space path has no constraint Jacobian to diagnose but the gears' constant one)
     if (!plan.joint) explain_failure(ms, sys, y, t_last, kinematic, out.error);
+  } catch (const Interrupted& err) {
+    // stopped from outside (opt.step.poll; a profile callback's binding): the outputs so far
+    out.error = err.what();
+    if (out.error.empty()) out.error = "interrupted";
+    out.exception = std::current_exception();
+    out.interrupted = true;
   }
   out.cpu_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (stops) record_stop_events(ms, *stops, out);

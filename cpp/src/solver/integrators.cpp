@@ -156,6 +156,7 @@ double initial_step(OdeSystem& sys, double t, const VecX& y, const VecX& f0, Vec
 // step-size underflow; then h is made a representable step from t.
 void guard_step(const char* name, const StepOptions& opt, const StepStats& st, double t, double t1,
                 double hmin, double& h) {
+  if (opt.poll) (*opt.poll)(t, t1);
   if (st.steps + st.rejected >= opt.max_steps)
     throw SolverError(
         msg(name, ": more than ", opt.max_steps, " steps before t=", t1, " (reached t=", t, ")"));
@@ -655,6 +656,7 @@ void integrate_rk4(OdeSystem& sys, VecX& y, double t0, double t1, const StepOpti
   int creeps = 0;
   constexpr int kMaxCreeps = 3;
   while (t < t1 - eps) {
+    if (opt.poll) (*opt.poll)(t, t1);
     if (st.steps >= opt.max_steps)
       throw SolverError(msg("rk4: more than ", opt.max_steps, " steps before t=", t1));
     // land exactly on the next output time and on t1
@@ -828,6 +830,7 @@ void integrate_trbdf2(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
   bool refreshed_in_step = false;  // the Jacobian went stale within the last step
 
   while (t < t1) {
+    if (opt.poll) (*opt.poll)(t, t1);
     if (st.steps + st.rejected >= opt.max_steps)
       throw SolverError(
           msg("trbdf2: more than ", opt.max_steps, " steps before t=", t1, " (reached t=", t, ")"));

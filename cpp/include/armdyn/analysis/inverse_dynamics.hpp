@@ -14,6 +14,7 @@
 #include "armdyn/analysis/joint_space.hpp"
 #include "armdyn/data.hpp"
 #include "armdyn/model/model.hpp"
+#include "armdyn/solver/poll.hpp"
 
 namespace armdyn {
 
@@ -69,6 +70,9 @@ struct InverseDynamicsResult {
 /// @throws ModelError when the drives leave degrees of freedom (naming the undriven
 ///   coordinates) or the times are invalid; SolverError when the driven constraints become
 ///   singular (naming the dependent drive/joint rows) or the position problem fails.
-InverseDynamicsResult inverse_dynamics_driven(const Model& m, const std::vector<double>& times);
+/// poll (solver/poll.hpp; may be null) is called once per time: an Interrupted (or what its
+/// callback throws) propagates.
+InverseDynamicsResult inverse_dynamics_driven(const Model& m, const std::vector<double>& times,
+                                              Poll* poll = nullptr);
 
 }  // namespace armdyn

@@ -4,6 +4,7 @@
 // derived outputs (joint coordinates, drive forces, joint reactions, residuals, energies).
 #pragma once
 
+#include <exception>
 #include <string>
 #include <vector>
 
@@ -84,6 +85,11 @@ struct SimResult {
   std::vector<int> event_index, event_direction;
   double cpu_seconds = 0.0;
   std::string error;  ///< non-empty when the run stopped early (SolverError message)
+  /// The exception that stopped the run early, when one did: an Interrupted (`error` then
+  /// holds its message) or the SolverError. Callers that carry their own exception types
+  /// (derived from these) through the run -- the Python bindings -- rethrow it.
+  std::exception_ptr exception;
+  bool interrupted = false;  ///< stopped by an Interrupted (opt.step.poll), not a SolverError
   std::string integrator, integrator_reason;  ///< the method used, and why (for "auto")
   int solver_bodies = 0, solver_rows = 0;     ///< bodies and rows of the model integrated
   std::string formulation;  ///< the coordinates integrated and the solver path, one line
@@ -99,7 +105,9 @@ double stiffness_estimate(const Model& m, std::string& culprit);
 Integrator choose_integrator(const Model& m, double t_end, double rtol, std::string& reason);
 
 /// Run from (u0, v0) (projected first) over [0, t_end]. Errors during the run stop it: the
-/// result up to the last good output is returned with `error` set.
+/// result up to the last good output is returned with `error` set. So is an interruption by
+/// an Interrupted (thrown by opt.step.poll or by a profile callback; `interrupted` set): the
+/// caller decides what to raise (SimResult::exception).
 /// @throws ModelError for invalid options or initial-state sizes.
 SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const VecX& u0,
                    const VecX& v0);

@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "armdyn/math/types.hpp"
+#include "armdyn/solver/poll.hpp"
 
 namespace armdyn {
 
@@ -68,6 +69,10 @@ struct StepOptions {
   double max_step = 0.0;   ///< DOPRI5, DOP853, TR-BDF2 (0: no limit)
   double output_dt = 0.0;  ///< 0: output every accepted step
   long max_steps = 10000000;
+  /// Called once per step (accepted or rejected; poll.hpp) with (t, t1): cancellation and
+  /// progress. Null: none. The caller starts it (simulate() does); Interrupted (or whatever its
+  /// callback throws) propagates out of the integrators.
+  Poll* poll = nullptr;
 };
 
 /// Output times t0 + k dt strictly before t1 (within 1e-9 dt), then t1; empty when dt <= 0
