@@ -288,7 +288,8 @@ def rollout(
 
     Raises:
         ModelError: bad shapes (naming the argument), bad options, or when every run failed to
-            start with the same error (the options, not the runs, are at fault).
+            start with the same error (the options or the model are at fault, not the runs:
+            e.g. rk4 without dt, q0 rows for a model without joint coordinates).
         KeyboardInterrupt: Ctrl-C during the batch; the runs in progress finish, no new one
             starts, and ``err.result`` holds the list (runs not started have ``error``
             "interrupted before the run started").
@@ -350,15 +351,10 @@ def rollout(
     if interrupt is not None:
         interrupt.result = results
         raise interrupt
-    # the same error on every run, none started and none refused here: the options are at
-    # fault (e.g. rk4 without dt), not the runs
+    # the same error on every run and none started: the options or the model are at fault
+    # (rk4 without dt, a model without joint coordinates), not the runs
     messages = {r.error for r in results}
-    if (
-        not any(errors)
-        and len(messages) == 1
-        and None not in messages
-        and all(len(r.t) == 0 for r in results)
-    ):
+    if len(messages) == 1 and None not in messages and all(len(r.t) == 0 for r in results):
         raise _core.ModelError(f"rollout: every run failed to start: {messages.pop()}")
     return results
 

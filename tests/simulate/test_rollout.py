@@ -185,6 +185,10 @@ def test_unknown_option_and_option_errors():
     with pytest.raises(ad.ModelError, match=r"every run failed to start.*dt"):
         ad.rollout(model, np.zeros((2, 6)), None, 0.1, integrator="rk4", limits="ignore")
     assert ad.rollout(model, np.zeros((0, 6)), None, 0.1) == []
+    # q0 rows for a closed loop (no joint coordinates): the model's fault, raised
+    loop = ad.scenes.four_bar()
+    with pytest.raises(ad.ModelError, match="every run failed to start"):
+        ad.rollout(loop, np.zeros((2, loop.n_coords)), None, 0.1)
 
 
 def test_interrupt_between_runs_keeps_the_finished_runs():
