@@ -1,8 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
+#include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <memory>
+#include <mutex>
+#include <thread>
 
 #include "armdyn/algorithm/energy.hpp"
 #include "armdyn/algorithm/forces.hpp"
@@ -137,9 +142,44 @@ void add_run_exception(const SimResult& r, py::dict& d) {
   }
 }
 
+SimOptions sim_options(const std::string& integrator, double rtol, double atol, double dt,
+                       double output_dt, const std::string& projection, long max_steps,
+                       double max_step, bool merge_welded, const std::string& coordinates,
+                       bool limits, double restitution) {
+  SimOptions o;
+  o.merge_welded = merge_welded;
+  o.limits = limits;
+  o.restitution = restitution;
+  o.coordinates = coordinates_from_name(coordinates);
+  o.step.max_step = max_step;
+  o.integrator = integrator_from_name(integrator);
+  o.step.rtol = rtol;
+  o.step.atol = atol;
+  o.step.dt = dt;
+  o.step.output_dt = output_dt;
+  o.step.max_steps = max_steps;
+  o.projection = metric_of(projection);
+  return o;
+}
+
+/// The full joint-space q a run starts its multi-turn tracking from, of the independent q0 (a
+/// coupled model's followers set by their couplings).
+VecX expanded_q_start(const Model& md, const VecX& qi) {
+  if (qi.size() != md.independent.nq())
+    throw ModelError(msg("q0 must have ", md.independent.nq(), " entries, got ", qi.size()));
+  VecX q(md.nq_joint);
+  md.independent.expand_q(qi.data(), q.data());
+  return q;
+}
+
 }  // namespace
 
 void bind_dynamics(py::module_& m) {
+  // The simulate options common to _simulate and _rollout (armdyn.simulation._sim_args builds
+  // the Python side of both).
+#define ARMDYN_SIM_OPTION_ARGS                                                          \
+  integrator, rtol, atol, dt, output_dt, projection, max_steps, max_step, merge_welded, \
+      coordinates, limits, restitution
   m.def(
       "_simulate",
       [](const Model& md, double t_end, const std::string& integrator, double rtol, double atol,
@@ -150,25 +190,9 @@ void bind_dynamics(py::module_& m) {
         if (md.nb == 0)
           throw ModelError("_simulate: the model has no bodies (use armdyn.simulate)");
         SimulateGuard guard("simulate");
-        SimOptions o;
-        if (!q_start.is_none()) {
-          // the independent q0 (a coupled model's followers set by their couplings)
-          const VecX qi = to_vec(q_start, "q0", md.independent.nq());
-          o.q_start = VecX(md.nq_joint);
-          md.independent.expand_q(qi.data(), o.q_start.data());
-        }
-        o.merge_welded = merge_welded;
-        o.limits = limits;
-        o.restitution = restitution;
-        o.coordinates = coordinates_from_name(coordinates);
-        o.step.max_step = max_step;
-        o.integrator = integrator_from_name(integrator);
-        o.step.rtol = rtol;
-        o.step.atol = atol;
-        o.step.dt = dt;
-        o.step.output_dt = output_dt;
-        o.step.max_steps = max_steps;
-        o.projection = metric_of(projection);
+        SimOptions o = sim_options(ARMDYN_SIM_OPTION_ARGS);
+        if (!q_start.is_none())
+          o.q_start = expanded_q_start(md, to_vec(q_start, "q0", md.independent.nq()));
         const VecX u = u0.is_none() ? md.u0 : to_vec(u0, "u0", md.nq);
         const VecX v = v0.is_none() ? md.v0 : to_vec(v0, "v0", md.nv);
         Poll poll = python_poll(&progress);
@@ -202,6 +226,131 @@ void bind_dynamics(py::module_& m) {
       py::arg("model"),
       "Bytes of one output time of simulate (every table's row, the limit forces counted for "
       "every joint): the bound armdyn.simulate checks an output_dt run against.");
+
+  m.def(
+      "_rollout",
+      [](const Model& md, double t_end, const std::string& integrator, double rtol, double atol,
+         double dt, double output_dt, const py::array_t<double, py::array::c_style>& u0,
+         const py::array_t<double, py::array::c_style>& v0, const std::string& projection,
+         long max_steps, double max_step, bool merge_welded, const std::string& coordinates,
+         py::object q_start, bool limits, double restitution, std::vector<std::string> errors,
+         int threads) {
+        if (md.nb == 0) throw ModelError("_rollout: the model has no bodies (use armdyn.rollout)");
+        const SimOptions base = sim_options(ARMDYN_SIM_OPTION_ARGS);
+        if (u0.ndim() != 2 || u0.shape(1) != md.nq)
+          throw ModelError(
+              msg("rollout: u0 must have shape (n_runs, ", md.nq, "), got ", shape_str(u0)));
+        const long n = static_cast<long>(u0.shape(0));
+        if (v0.ndim() != 2 || v0.shape(0) != n || v0.shape(1) != md.nv)
+          throw ModelError(
+              msg("rollout: v0 must have shape (", n, ", ", md.nv, "), got ", shape_str(v0)));
+        if (static_cast<long>(errors.size()) != n)
+          throw ModelError(msg("rollout: ", errors.size(), " error entries for ", n, " runs"));
+        if (threads < 1) throw ModelError(msg("rollout: threads must be >= 1, got ", threads));
+        std::vector<VecX> us(n), vs(n), qs;
+        for (long k = 0; k < n; ++k) {
+          us[k] = Eigen::Map<const VecX>(u0.data(k, 0), md.nq);
+          vs[k] = Eigen::Map<const VecX>(v0.data(k, 0), md.nv);
+        }
+        if (!q_start.is_none()) {
+          const auto q = q_start.cast<py::array_t<double, py::array::c_style>>();
+          const long nqi = md.independent.nq();
+          if (q.ndim() != 2 || q.shape(0) != n || q.shape(1) != nqi)
+            throw ModelError(
+                msg("rollout: q0 must have shape (", n, ", ", nqi, "), got ", shape_str(q)));
+          qs.resize(n);
+          for (long k = 0; k < n; ++k)
+            if (errors[k].empty())
+              qs[k] = expanded_q_start(md, Eigen::Map<const VecX>(q.data(k, 0), nqi));
+        }
+        std::vector<SimResult> results(n);
+        const int nt = static_cast<int>(std::min<long>(threads, std::max<long>(n, 1)));
+        // the batch: a work queue (an atomic index) over nt threads, one Data per thread; the
+        // caller's thread waits, checking for signals (Ctrl-C) every 20 ms
+        std::atomic<long> next{0};
+        std::atomic<bool> stop{false};
+        std::mutex mutex;
+        std::condition_variable finished;
+        int running = nt;
+        py::object interrupt = py::none();
+        {
+          py::gil_scoped_release release;
+          auto work = [&] {
+            std::unique_ptr<Data> d;
+            // cancellation: between runs, and inside a run by the stepping loops' poll, which
+            // checks `stop` every few milliseconds (the run then ends with its outputs so far)
+            Poll poll(Poll::Callback(), 0.005, &stop);
+            SimOptions o = base;
+            o.step.poll = &poll;
+            while (!stop.load(std::memory_order_relaxed)) {
+              const long k = next.fetch_add(1);
+              if (k >= n) break;
+              if (!errors[k].empty()) continue;
+              try {
+                if (!d) d = std::make_unique<Data>(md);
+                if (!qs.empty()) o.q_start = qs[k];
+                results[k] = simulate(md, *d, t_end, o, us[k], vs[k]);
+              } catch (const SolverError& e) {
+                errors[k] = e.what();
+                d.reset();  // a run cut short by an exception: the next one starts afresh
+              } catch (const std::exception& e) {
+                errors[k] = e.what();
+                d.reset();
+              }
+            }
+            std::lock_guard<std::mutex> lock(mutex);
+            if (--running == 0) finished.notify_all();
+          };
+          std::vector<std::thread> pool;
+          pool.reserve(nt);
+          try {
+            for (int i = 0; i < nt; ++i) pool.emplace_back(work);
+          } catch (...) {
+            // could not start a thread: the started ones finish the queue
+            std::lock_guard<std::mutex> lock(mutex);
+            running -= nt - static_cast<int>(pool.size());
+          }
+          std::unique_lock<std::mutex> lock(mutex);
+          while (running > 0) {
+            if (finished.wait_for(lock, std::chrono::milliseconds(20),
+                                  [&] { return running == 0; }))
+              break;
+            if (!stop.load()) {
+              lock.unlock();
+              {
+                py::gil_scoped_acquire gil;
+                if (PyErr_CheckSignals() != 0) {
+                  stop = true;
+                  py::error_already_set e;  // fetches (and clears) the handler's exception
+                  interrupt = e.value();
+                }
+              }
+              lock.lock();
+            }
+          }
+          lock.unlock();
+          for (auto& t : pool) t.join();
+        }
+        py::list out;
+        for (long k = 0; k < n; ++k) {
+          SimResult& r = results[k];
+          if (r.error.empty() && !errors[k].empty()) r.error = errors[k];
+          if (r.error.empty() && stop && r.t.empty() && r.n == 0)
+            r.error = "interrupted before the run started";
+          out.append(result_dict(md, r));
+        }
+        return py::make_tuple(out, interrupt);
+      },
+      py::arg("model"), py::arg("t_end"), py::arg("integrator"), py::arg("rtol"), py::arg("atol"),
+      py::arg("dt"), py::arg("output_dt"), py::arg("u0"), py::arg("v0"), py::arg("projection"),
+      py::arg("max_steps"), py::arg("max_step"), py::arg("merge_welded"), py::arg("coordinates"),
+      py::arg("q_start"), py::arg("limits"), py::arg("restitution"), py::arg("errors"),
+      py::arg("threads"),
+      "Runs of simulate from each row of u0/v0 (q_start: the joint-space q0 rows, or None) on "
+      "`threads` C++ threads, the GIL released; (list of result dicts, the interrupting "
+      "exception or None). A run whose `errors` entry is non-empty is not run; a run that "
+      "raises has its message in its dict's 'error'.");
+#undef ARMDYN_SIM_OPTION_ARGS
 
   m.def(
       "state_from_joints",

@@ -5,6 +5,7 @@
 
 #include "armdyn/builder/builder.hpp"
 #include "armdyn/builder/summary.hpp"
+#include "armdyn/io/serialize.hpp"
 #include "armdyn/io/urdf.hpp"
 #include "armdyn/solver/block_sparse.hpp"
 #include "common.hpp"
@@ -242,7 +243,32 @@ void bind_model(py::module_& m) {
             return py::make_tuple(v.y, v.yd, v.ydd);
           },
           py::arg("t"), "Return (y, dy/dt, d2y/dt2) at time t.")
-      .def("__repr__", [](const Profile& p) { return "<armdyn.Profile " + p.describe() + ">"; });
+      .def("__repr__", [](const Profile& p) { return "<armdyn.Profile " + p.describe() + ">"; })
+      .def(py::pickle(
+          [](const Profile& p) {
+            // a user function cannot be stored: ModelError naming it
+            const Profile::Raw r = p.raw();
+            return py::make_tuple(1, static_cast<int>(r.kind),
+                                  py::make_tuple(r.p[0], r.p[1], r.p[2], r.p[3]), r.t, r.y, r.m,
+                                  r.description);
+          },
+          [](const py::tuple& st) {
+            if (st.size() != 7 || st[0].cast<int>() != 1)
+              throw ModelError("Profile: unknown pickled state (another armdyn version?)");
+            Profile::Raw r;
+            const int kind = st[1].cast<int>();
+            if (kind < 0 || kind >= static_cast<int>(Profile::Kind::Callback))
+              throw ModelError(msg("Profile: unknown pickled kind ", kind));
+            r.kind = static_cast<Profile::Kind>(kind);
+            const auto p = st[2].cast<py::tuple>();
+            if (p.size() != 4) throw ModelError("Profile: pickled parameters are not 4 numbers");
+            for (int i = 0; i < 4; ++i) r.p[i] = p[i].cast<double>();
+            r.t = st[3].cast<std::vector<double>>();
+            r.y = st[4].cast<std::vector<double>>();
+            r.m = st[5].cast<std::vector<double>>();
+            r.description = st[6].cast<std::string>();
+            return Profile::restore(r);
+          }));
 
   auto prof = m.def_submodule("profiles", "Built-in drive and load profiles (evaluated in C++).");
   prof.def("constant", &Profile::constant, py::arg("value"));
@@ -539,10 +565,20 @@ void bind_model(py::module_& m) {
             return d;
           },
           "The KKT plan's statistics (path, row blocks, factor entries, fill, flops).")
-      .def("__repr__", [](const Model& md) {
-        return msg("<armdyn.Model nb=", md.nb, " joints=", md.joints.size(),
-                   " drives=", md.drives.size(), " mobility=", md.mobility, ">");
-      });
+      .def("__repr__",
+           [](const Model& md) {
+             return msg("<armdyn.Model nb=", md.nb, " joints=", md.joints.size(),
+                        " drives=", md.drives.size(), " mobility=", md.mobility, ">");
+           })
+      // Pickling (and copy.copy / copy.deepcopy through it): every field of the model, doubles
+      // bit for bit (armdyn/io/serialize.hpp); a Python-callable profile cannot travel
+      // (ModelError naming it).
+      .def(
+          py::pickle([](const Model& md) { return py::make_tuple(py::bytes(serialize_model(md))); },
+                     [](const py::tuple& st) {
+                       if (st.size() != 1) throw ModelError("Model: unknown pickled state");
+                       return std::make_shared<Model>(deserialize_model(st[0].cast<std::string>()));
+                     }));
 
   auto cast_model = [](ModelPtr p) { return std::const_pointer_cast<Model>(p); };
 
@@ -553,6 +589,14 @@ void bind_model(py::module_& m) {
            }),
            py::arg("gravity") = py::make_tuple(0.0, 0.0, -9.81), py::kw_only(),
            py::arg("physical_inertia") = true)
+      .def(py::pickle(
+          [](const ModelBuilder& b) {
+            return py::make_tuple(py::bytes(serialize_model(b.draft())), b.physical_inertia());
+          },
+          [](const py::tuple& st) {
+            if (st.size() != 2) throw ModelError("ModelBuilder: unknown pickled state");
+            return ModelBuilder(deserialize_model(st[0].cast<std::string>()), st[1].cast<bool>());
+          }))
       .def_property("physical_inertia", &ModelBuilder::physical_inertia,
                     &ModelBuilder::set_physical_inertia,
                     "True (default): add_body accepts physically consistent inertias only "

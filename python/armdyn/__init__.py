@@ -37,7 +37,7 @@ from armdyn._core import (
     urdf_builder,
 )
 from armdyn.dynamics import InverseDynamicsResult, driven_inverse_dynamics
-from armdyn.simulation import SimulationResult, load_urdf, simulate
+from armdyn.simulation import SimulationResult, load_urdf, rollout, simulate
 from armdyn.sizing import (
     SizingReport,
     TrajectoryRun,
@@ -87,6 +87,7 @@ __all__ = [
     "load_urdf",
     "mass_matrix",
     "profiles",
+    "rollout",
     "scenes",
     "simulate",
     "sizing_report",

@@ -50,6 +50,10 @@ class SimulationResult:
             coordinate, positive along it (a lower stop pushes up), 0 off the stops.
         actuators: for a model with actuators (``model.actuators``), the motor-side values of
             each (:func:`armdyn.actuators.motor_side_of_result`); empty otherwise.
+        error: None for a complete run; else why it stopped (the ``SolverError`` message of a
+            run cut short, whose tables end at the last good output, or the ``ModelError`` of a
+            run that could not start, whose tables have no rows). :func:`simulate` raises
+            instead; :func:`rollout` records it per run. ``status`` is ``"ok"`` or this message.
     """
 
     t: np.ndarray
@@ -71,6 +75,12 @@ class SimulationResult:
     gear_forces: dict = field(default_factory=dict)
     limit_forces: dict = field(default_factory=dict)
     actuators: dict = field(default_factory=dict)
+    error: str | None = None
+
+    @property
+    def status(self) -> str:
+        """``"ok"`` for a complete run, else the error that stopped it (:attr:`error`)."""
+        return "ok" if self.error is None else self.error
 
     def limit_violations(self, model):
         """Spans where this run exceeds the model's velocity and effort limits, as a DataFrame
@@ -200,14 +210,21 @@ def simulate(
             ``KeyboardInterrupt`` and ``GeneratorExit`` raised by a profile or progress
             callable propagate as themselves in the same way (``.result`` set).
     """
-    if dt is not None and not (dt > 0):
-        raise _core.ModelError(f"simulate: dt must be positive, got {dt}")
-    if max_step is not None and not (max_step > 0):
-        raise _core.ModelError(f"simulate: max_step must be positive, got {max_step}")
-    if output_dt is not None and not (output_dt > 0):
-        raise _core.ModelError(f"simulate: output_dt must be positive, got {output_dt}")
-    if limits not in ("enforce", "ignore"):
-        raise _core.ModelError(f"simulate: limits must be 'enforce' or 'ignore', got {limits!r}")
+    options = _core_options(
+        "simulate",
+        integrator,
+        rtol,
+        atol,
+        dt,
+        output_dt,
+        projection,
+        max_steps,
+        max_step,
+        merge_welded,
+        coordinates,
+        limits,
+        restitution,
+    )
     if q0 is not None or qd0 is not None:
         if u0 is not None or v0 is not None:
             raise _core.ModelError("simulate: give either q0/qd0 or u0/v0, not both")
@@ -224,37 +241,17 @@ def simulate(
     report, close = _progress_reporter(progress, t_end)
     try:
         raw = _core._simulate(
-            model,
-            float(t_end),
-            "default" if integrator is None else integrator,
-            float(rtol),
-            float(atol),
-            float(dt or 0.0),
-            float(output_dt or 0.0),
-            None if u0 is None else u0,
-            None if v0 is None else v0,
-            projection,
-            int(max_steps),
-            float(max_step or 0.0),
-            bool(merge_welded),
-            coordinates,
-            q_start,
-            limits == "enforce",
-            float(restitution),
-            report,
+            model, float(t_end), u0=u0, v0=v0, q_start=q_start, progress=report, **options
         )
-        error = raw.pop("error")
         interrupt = raw.pop("interrupt")
         cause = raw.pop("cause")
-        result = SimulationResult(**raw)
-        if model.actuators:
-            _attach_motor_side(model, result)
+        result = _result_of(model, raw)
         if interrupt is not None:
             # Ctrl-C, or SystemExit / KeyboardInterrupt / GeneratorExit from a callable
             interrupt.result = result
             raise interrupt
-        if error:
-            exc = _core.SolverError(error)
+        if result.error:
+            exc = _core.SolverError(result.error)
             exc.result = result
             if cause is not None:
                 raise exc from cause
@@ -323,6 +320,194 @@ def _tqdm_reporter(bar):
         bar.refresh()
 
     return report
+
+
+_ROLLOUT_OPTIONS = (
+    "integrator",
+    "rtol",
+    "atol",
+    "dt",
+    "output_dt",
+    "projection",
+    "max_steps",
+    "max_step",
+    "merge_welded",
+    "coordinates",
+    "limits",
+    "restitution",
+)
+
+
+def _rows(name: str, x, n_cols: int, n_rows: int | None) -> np.ndarray:
+    """x as a float (n_runs, n_cols) array, or ModelError naming it and its shape."""
+    a = np.asarray(x, dtype=float)
+    if a.ndim != 2 or a.shape[1] != n_cols or (n_rows is not None and a.shape[0] != n_rows):
+        rows = "n_runs" if n_rows is None else str(n_rows)
+        raise _core.ModelError(
+            f"rollout: {name} must have shape ({rows}, {n_cols}) (one row per run), got {a.shape}"
+        )
+    return np.ascontiguousarray(a)
+
+
+def rollout(
+    model: _core.Model,
+    q0=None,
+    qd0=None,
+    t_end: float | None = None,
+    threads: int | None = None,
+    *,
+    u0=None,
+    v0=None,
+    **simulate_options,
+) -> list[SimulationResult]:
+    """Many runs of :func:`simulate` on C++ threads: one per row of the initial states.
+
+    The batch runs with the GIL released, one ``Data`` (work space) per thread, the runs handed
+    out from a shared queue so that slow runs balance. Every result is the one a serial
+    ``simulate(model, t_end, q0=q0[k], qd0=qd0[k], **simulate_options)`` returns, bit for bit.
+
+    Args:
+        model: a finalized :class:`armdyn.Model` (shared by the threads, read only).
+        q0: (n_runs, ``model.n_coords``) initial joint-space coordinates, one row per run (as
+            :func:`simulate`'s ``q0``).
+        qd0: (n_runs, ``model.n_dofs``) initial rates; default zero.
+        t_end: end time [s] of every run.
+        threads: number of threads (default ``os.cpu_count()``; at most n_runs).
+        u0, v0: (n_runs, nq) and (n_runs, nv) initial Cartesian states instead of q0/qd0 (v0
+            default: the model's assembled ``v0``).
+        **simulate_options: the options of :func:`simulate` (integrator, rtol, atol, dt,
+            output_dt, projection, max_steps, max_step, merge_welded, coordinates, limits,
+            restitution), the same for every run.
+
+    Returns:
+        A list of :class:`SimulationResult` in input order. A run that fails does not stop the
+        others: its result has ``error`` set (``status`` is the message, ``"ok"`` otherwise) --
+        a run that could not start (an initial state with NaN, an assembly failure) has tables
+        without rows; a run stopped by a ``SolverError`` has the outputs up to the last good
+        one, as ``SolverError.result`` of :func:`simulate` would.
+
+    Raises:
+        ModelError: bad shapes (naming the argument), bad options, or when every run failed to
+            start with the same error (the options or the model are at fault, not the runs:
+            e.g. rk4 without dt, q0 rows for a model without joint coordinates).
+        KeyboardInterrupt: Ctrl-C during the batch; the runs in progress finish, no new one
+            starts, and ``err.result`` holds the list (runs not started have ``error``
+            "interrupted before the run started").
+    """
+    unknown = sorted(set(simulate_options) - set(_ROLLOUT_OPTIONS))
+    if unknown:
+        raise TypeError(
+            f"rollout: unknown option(s) {', '.join(unknown)} (per-run initial states are q0/qd0"
+            f" or u0/v0 rows; the options are simulate's: {', '.join(_ROLLOUT_OPTIONS)})"
+        )
+    import inspect
+
+    defaults = inspect.signature(simulate).parameters
+    options = _core_options(
+        "rollout", *(simulate_options.get(k, defaults[k].default) for k in _ROLLOUT_OPTIONS)
+    )
+    if t_end is None or not (np.isfinite(t_end) and t_end > 0):
+        raise _core.ModelError(f"rollout: t_end must be positive and finite, got {t_end}")
+    if threads is None:
+        threads = os.cpu_count() or 1
+    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
+        raise _core.ModelError(f"rollout: threads must be a positive integer, got {threads!r}")
+    if q0 is not None or qd0 is not None:
+        if u0 is not None or v0 is not None:
+            raise _core.ModelError("rollout: give either q0/qd0 or u0/v0 rows, not both")
+        if q0 is None:
+            raise _core.ModelError("rollout: qd0 given without q0")
+        q = _rows("q0", q0, model.n_coords, None)
+        n = q.shape[0]
+        qd = np.zeros((n, model.n_dofs)) if qd0 is None else _rows("qd0", qd0, model.n_dofs, n)
+        us, vs, errors = np.empty((n, model.nq)), np.empty((n, model.nv)), [""] * n
+        for k in range(n):
+            try:
+                us[k], vs[k] = _core.state_from_joints(model, q[k], qd[k])
+            except _core.ModelError as err:  # this run cannot start; the others can
+                us[k], vs[k], errors[k] = model.u0, model.v0, str(err)
+    elif u0 is not None:
+        us = _rows("u0", u0, model.nq, None)
+        n, q = us.shape[0], None
+        vs = np.tile(model.v0, (n, 1)) if v0 is None else _rows("v0", v0, model.nv, n)
+        errors = [""] * n
+    else:
+        raise _core.ModelError("rollout: give the initial states, q0 (and qd0) or u0 (and v0)")
+    if n == 0:
+        return []
+    if model.nb == 0:  # nothing to integrate: the zero-DOF result of each run
+        return [simulate(model, t_end, output_dt=options["output_dt"] or None) for _ in range(n)]
+    raws, interrupt = _core._rollout(
+        model,
+        float(t_end),
+        u0=us,
+        v0=vs,
+        q_start=q,
+        errors=errors,
+        threads=int(threads),
+        **options,
+    )
+    results = [_result_of(model, raw) for raw in raws]
+    if interrupt is not None:
+        interrupt.result = results
+        raise interrupt
+    # the same error on every run and none started: the options or the model are at fault
+    # (rk4 without dt, a model without joint coordinates), not the runs
+    messages = {r.error for r in results}
+    if len(messages) == 1 and None not in messages and all(len(r.t) == 0 for r in results):
+        raise _core.ModelError(f"rollout: every run failed to start: {messages.pop()}")
+    return results
+
+
+def _core_options(
+    who,
+    integrator,
+    rtol,
+    atol,
+    dt,
+    output_dt,
+    projection,
+    max_steps,
+    max_step,
+    merge_welded,
+    coordinates,
+    limits,
+    restitution,
+) -> dict:
+    """The run options of :func:`simulate` checked and as ``_core._simulate`` and
+    ``_core._rollout`` take them (keyword arguments)."""
+    if dt is not None and not (dt > 0):
+        raise _core.ModelError(f"{who}: dt must be positive, got {dt}")
+    if max_step is not None and not (max_step > 0):
+        raise _core.ModelError(f"{who}: max_step must be positive, got {max_step}")
+    if output_dt is not None and not (output_dt > 0):
+        raise _core.ModelError(f"{who}: output_dt must be positive, got {output_dt}")
+    if limits not in ("enforce", "ignore"):
+        raise _core.ModelError(f"{who}: limits must be 'enforce' or 'ignore', got {limits!r}")
+    return dict(
+        integrator="default" if integrator is None else integrator,
+        rtol=float(rtol),
+        atol=float(atol),
+        dt=float(dt or 0.0),
+        output_dt=float(output_dt or 0.0),
+        projection=projection,
+        max_steps=int(max_steps),
+        max_step=float(max_step or 0.0),
+        merge_welded=bool(merge_welded),
+        coordinates=coordinates,
+        limits=limits == "enforce",
+        restitution=float(restitution),
+    )
+
+
+def _result_of(model: _core.Model, raw: dict) -> SimulationResult:
+    """A SimulationResult of a C++ result dict (its ``error``: None for a complete run)."""
+    error = raw.pop("error")
+    result = SimulationResult(**raw)
+    result.error = error or None
+    if model.actuators and len(result.t):
+        _attach_motor_side(model, result)
+    return result
 
 
 def _attach_motor_side(model: _core.Model, result: SimulationResult) -> None:

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "armdyn/errors.hpp"
 #include "armdyn/math/quaternion.hpp"
@@ -82,6 +83,9 @@ ModelBuilder::ModelBuilder(const Vec3& gravity, bool physical_inertia)
   require_finite(gravity, "gravity");
   m_.gravity = gravity;
 }
+
+ModelBuilder::ModelBuilder(Model draft, bool physical_inertia)
+    : m_(std::move(draft)), physical_inertia_(physical_inertia) {}
 
 int ModelBuilder::add_body(const std::string& name, double mass, const Mat3& inertia,
                            const Vec3& position, const Vec4& orientation) {

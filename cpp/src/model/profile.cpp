@@ -102,6 +102,37 @@ Profile Profile::callback(Callback fn, std::string description) {
   return p;
 }
 
+Profile::Raw Profile::raw() const {
+  if (kind_ == Kind::Callback)
+    throw ModelError(msg("profile ", describe(),
+                         " is a user function: it cannot be stored (pickled or copied); use a "
+                         "built-in profile (constant, cubic, quintic, sine, spline)"));
+  Raw r;
+  r.kind = kind_;
+  for (int i = 0; i < 4; ++i) r.p[i] = p_[i];
+  r.t = t_;
+  r.y = y_;
+  r.m = m_;
+  r.description = description_;
+  return r;
+}
+
+Profile Profile::restore(const Raw& raw) {
+  if (raw.kind == Kind::Callback)
+    throw ModelError("profile: a callback profile cannot be restored from stored values");
+  if (raw.kind == Kind::Spline &&
+      (raw.t.size() < 2 || raw.y.size() != raw.t.size() || raw.m.size() != raw.t.size()))
+    throw ModelError("profile: stored spline samples are inconsistent");
+  Profile p;
+  p.kind_ = raw.kind;
+  for (int i = 0; i < 4; ++i) p.p_[i] = raw.p[i];
+  p.t_ = raw.t;
+  p.y_ = raw.y;
+  p.m_ = raw.m;
+  p.description_ = raw.description;
+  return p;
+}
+
 ProfileValue Profile::eval(double t) const {
   ProfileValue v;
   switch (kind_) {

@@ -34,6 +34,9 @@ InertiaCheck check_inertia(const Mat3& inertia, bool physical, double scale = 0.
 class ModelBuilder {
  public:
   explicit ModelBuilder(const Vec3& gravity = Vec3(0, 0, -9.81), bool physical_inertia = true);
+  /// A builder holding `draft`, as draft() returned it (a restored builder:
+  /// armdyn/io/serialize.hpp).
+  ModelBuilder(Model draft, bool physical_inertia);
 
   /// Which inertia tensors add_body() accepts (for the bodies added after the call).
   /// true (default): physically consistent ones only -- positive semidefinite (to -1e-12 of the

@@ -38,6 +38,19 @@ class Profile {
   Kind kind() const { return kind_; }
   std::string describe() const;
 
+  /// The stored values of a built-in profile, for serialization (armdyn/io/serialize.hpp):
+  /// restore(raw()) evaluates bit for bit as the original. A callback has none to store.
+  struct Raw {
+    Kind kind = Kind::Constant;
+    double p[4] = {0, 0, 0, 0};
+    std::vector<double> t, y, m;
+    std::string description;
+  };
+  /// @throws ModelError for a callback profile (a user function cannot be stored).
+  Raw raw() const;
+  /// @throws ModelError for a callback kind or inconsistent spline samples.
+  static Profile restore(const Raw& raw);
+
  private:
   Kind kind_ = Kind::Constant;
   double p_[4] = {0, 0, 0, 0};
