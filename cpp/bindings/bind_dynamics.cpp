@@ -234,7 +234,7 @@ void bind_dynamics(py::module_& m) {
          const py::array_t<double, py::array::c_style>& v0, const std::string& projection,
          long max_steps, double max_step, bool merge_welded, const std::string& coordinates,
          py::object q_start, bool limits, double restitution, std::vector<std::string> errors,
-         int threads) {
+         int threads, py::object progress) {
         if (md.nb == 0) throw ModelError("_rollout: the model has no bodies (use armdyn.rollout)");
         const SimOptions base = sim_options(ARMDYN_SIM_OPTION_ARGS);
         if (u0.ndim() != 2 || u0.shape(1) != md.nq)
@@ -267,8 +267,9 @@ void bind_dynamics(py::module_& m) {
         const int nt = static_cast<int>(std::min<long>(threads, std::max<long>(n, 1)));
         // the batch: a work queue (an atomic index) over nt threads, one Data per thread; the
         // caller's thread waits, checking for signals (Ctrl-C) every 20 ms
-        std::atomic<long> next{0};
+        std::atomic<long> next{0}, done{0};
         std::atomic<bool> stop{false};
+        auto last_report = std::chrono::steady_clock::now();
         std::mutex mutex;
         std::condition_variable finished;
         int running = nt;
@@ -297,6 +298,7 @@ void bind_dynamics(py::module_& m) {
                 errors[k] = e.what();
                 d.reset();
               }
+              done.fetch_add(1, std::memory_order_relaxed);
             }
             std::lock_guard<std::mutex> lock(mutex);
             if (--running == 0) finished.notify_all();
@@ -323,6 +325,18 @@ void bind_dynamics(py::module_& m) {
                   stop = true;
                   py::error_already_set e;  // fetches (and clears) the handler's exception
                   interrupt = e.value();
+                } else if (!progress.is_none()) {
+                  // the runs finished so far, every 0.1 s; an exception stops the batch
+                  const auto now = std::chrono::steady_clock::now();
+                  if (std::chrono::duration<double>(now - last_report).count() >= 0.1) {
+                    last_report = now;
+                    try {
+                      progress(done.load(), n);
+                    } catch (py::error_already_set& e) {
+                      stop = true;
+                      interrupt = e.value();
+                    }
+                  }
                 }
               }
               lock.lock();
@@ -345,7 +359,7 @@ void bind_dynamics(py::module_& m) {
       py::arg("dt"), py::arg("output_dt"), py::arg("u0"), py::arg("v0"), py::arg("projection"),
       py::arg("max_steps"), py::arg("max_step"), py::arg("merge_welded"), py::arg("coordinates"),
       py::arg("q_start"), py::arg("limits"), py::arg("restitution"), py::arg("errors"),
-      py::arg("threads"),
+      py::arg("threads"), py::arg("progress") = py::none(),
       "Runs of simulate from each row of u0/v0 (q_start: the joint-space q0 rows, or None) on "
       "`threads` C++ threads, the GIL released; (list of result dicts, the interrupting "
       "exception or None). A run whose `errors` entry is non-empty is not run; a run that "

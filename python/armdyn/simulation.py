@@ -358,6 +358,7 @@ def rollout(
     *,
     u0=None,
     v0=None,
+    progress=False,
     **simulate_options,
 ) -> list[SimulationResult]:
     """Many runs of :func:`simulate` on C++ threads: one per row of the initial states.
@@ -375,6 +376,10 @@ def rollout(
         threads: number of threads (default ``os.cpu_count()``; at most n_runs).
         u0, v0: (n_runs, nq) and (n_runs, nv) initial Cartesian states instead of q0/qd0 (v0
             default: the model's assembled ``v0``).
+        progress: ``False`` (default); ``True``: a tqdm bar of the runs finished; a tqdm
+            instance (its ``total`` set to n_runs); or a callable ``progress(done, n_runs)``.
+            Updated every 0.1 s from the waiting thread; an exception it raises stops the batch
+            as Ctrl-C does (raised as itself, ``.result`` the list).
         **simulate_options: the options of :func:`simulate` (integrator, rtol, atol, dt,
             output_dt, projection, max_steps, max_step, merge_welded, coordinates, limits,
             restitution), the same for every run.
@@ -390,9 +395,10 @@ def rollout(
         ModelError: bad shapes (naming the argument), bad options, or when every run failed to
             start with the same error (the options or the model are at fault, not the runs:
             e.g. rk4 without dt, q0 rows for a model without joint coordinates).
-        KeyboardInterrupt: Ctrl-C during the batch; the runs in progress finish, no new one
-            starts, and ``err.result`` holds the list (runs not started have ``error``
-            "interrupted before the run started").
+        KeyboardInterrupt: Ctrl-C during the batch: no new run starts, the runs in progress
+            stop within milliseconds with their outputs so far (``error`` "run cancelled"), and
+            ``err.result`` holds the list (runs not started have ``error`` "interrupted before
+            the run started").
     """
     unknown = sorted(set(simulate_options) - set(_ROLLOUT_OPTIONS))
     if unknown:
@@ -437,16 +443,24 @@ def rollout(
         return []
     if model.nb == 0:  # nothing to integrate: the zero-DOF result of each run
         return [simulate(model, t_end, output_dt=options["output_dt"] or None) for _ in range(n)]
-    raws, interrupt = _core._rollout(
-        model,
-        float(t_end),
-        u0=us,
-        v0=vs,
-        q_start=q,
-        errors=errors,
-        threads=int(threads),
-        **options,
-    )
+    report, close = _run_progress(progress, n)
+    try:
+        raws, interrupt = _core._rollout(
+            model,
+            float(t_end),
+            u0=us,
+            v0=vs,
+            q_start=q,
+            errors=errors,
+            threads=int(threads),
+            progress=report,
+            **options,
+        )
+        if report is not None and interrupt is None:
+            report(n, n)
+    finally:
+        if close is not None:
+            close()
     results = [_result_of(model, raw) for raw in raws]
     if interrupt is not None:
         interrupt.result = results
@@ -457,6 +471,34 @@ def rollout(
     if len(messages) == 1 and None not in messages and all(len(r.t) == 0 for r in results):
         raise _core.ModelError(f"rollout: every run failed to start: {messages.pop()}")
     return results
+
+
+def _run_progress(progress, n):
+    """(report(done, n) or None, close() or None) for rollout's ``progress``."""
+    if progress is None or progress is False:
+        return None, None
+    if progress is True:
+        from tqdm.auto import tqdm
+
+        bar = tqdm(total=n, unit="run", desc="rollout")
+        return _count_reporter(bar), bar.close
+    if hasattr(progress, "update") and hasattr(progress, "refresh") and hasattr(progress, "n"):
+        progress.total = n
+        return _count_reporter(progress), None
+    if callable(progress):
+        return progress, None
+    raise _core.ModelError(
+        "rollout: progress must be True, False, a tqdm instance or a callable (done, n_runs), "
+        f"got {type(progress).__name__}"
+    )
+
+
+def _count_reporter(bar):
+    def report(done, n):
+        bar.n = done
+        bar.refresh()
+
+    return report
 
 
 def _core_options(

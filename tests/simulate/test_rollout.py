@@ -232,3 +232,30 @@ def test_interrupt_between_runs_keeps_the_finished_runs():
         n = len(runs[k].t)
         np.testing.assert_array_equal(runs[k].t, full.t[:n])
         np.testing.assert_array_equal(runs[k].q, full.q[:n])
+
+
+def test_rollout_progress_reports_the_runs_finished():
+    model = ur5()
+    q0, qd0 = ur5_starts(model, 40, seed=6)
+    seen = []
+    runs = ad.rollout(
+        model, q0, qd0, 0.5, threads=2, limits="ignore", progress=lambda d, n: seen.append((d, n))
+    )
+    assert seen[-1] == (40, 40)
+    assert all(n == 40 and 0 <= d <= 40 for d, n in seen)
+    assert [d for d, _ in seen] == sorted(d for d, _ in seen)
+    assert all(r.error is None for r in runs)
+
+    class Enough(Exception):
+        pass
+
+    def stop(done, n):
+        raise Enough()
+
+    q0, qd0 = ur5_starts(model, 400, seed=7)
+    with pytest.raises(Enough) as exc:
+        ad.rollout(model, q0, qd0, 1.0, threads=2, limits="ignore", progress=stop)
+    assert len(exc.value.result) == 400
+    assert any(r.error is not None for r in exc.value.result)
+    with pytest.raises(ad.ModelError, match="progress must be"):
+        ad.rollout(model, q0[:2], qd0[:2], 0.1, progress="yes")
