@@ -867,6 +867,9 @@ void bind_model(py::module_& m) {
           [cast_model](const ModelBuilder& b, bool mass_weighted) {
             FinalizeOptions o;
             o.mass_weighted_assembly = mass_weighted;
+            // Ctrl-C: the quadratic parts of a large model's analysis check for signals
+            Poll poll = python_poll();
+            ScopedThreadPoll scope(&poll);
             ModelPtr m = b.finalize(o);
             for (const std::string& w : m->warnings)
               if (PyErr_WarnEx(PyExc_UserWarning, ("armdyn: " + w).c_str(), 1) != 0)

@@ -404,3 +404,60 @@ def test_runs_on_worker_threads_equal_the_main_thread_run():
             np.testing.assert_array_equal(r.t, ref.t)
             np.testing.assert_array_equal(r.q, ref.q)
     assert seen[-1] == 5.0
+
+
+URDF_CHILD = textwrap.dedent(
+    """
+    import json, signal, sys, time
+    import armdyn as ad
+
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    inertial = (
+        '<inertial><origin xyz="0 0 0.05"/><mass value="1"/><inertia ixx="0.01" iyy="0.01" '
+        'izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>'
+    )
+    parts = ['<robot name="chain">', f'<link name="l0">{inertial}</link>']
+    for i in range(1, 12001):  # a 12000-link chain: about 4 s to load here
+        parts.append(f'<link name="l{i}">{inertial}</link>')
+        parts.append(
+            f'<joint name="j{i}" type="revolute"><parent link="l{i - 1}"/>'
+            f'<child link="l{i}"/><origin xyz="0 0 0.1"/><axis xyz="0 {i % 2} {1 - i % 2}"/>'
+            '<limit lower="-3" upper="3" effort="1" velocity="1"/></joint>'
+        )
+    parts.append("</robot>")
+    xml = "\\n".join(parts)
+    print("ready", flush=True)
+    start = time.time()
+    try:
+        ad.load_urdf(xml)
+        print(json.dumps({"completed": time.time() - start}), flush=True)
+    except KeyboardInterrupt:
+        print(json.dumps({"caught": time.time()}), flush=True)
+    """
+)
+
+
+def test_sigint_stops_loading_a_large_urdf():
+    """The model analysis of a large URDF (quadratic in its links: plan_kkt's elimination order)
+    checks for signals as it goes."""
+    proc = subprocess.Popen(
+        [sys.executable, "-c", URDF_CHILD],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert proc.stdout.readline().strip() == "ready"
+        time.sleep(0.5)
+        sent = time.time()
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 0, err
+    report = json.loads(out.strip().splitlines()[-1])
+    assert "completed" not in report, f"the load ended before the signal: {report}"
+    latency = report["caught"] - sent
+    print(f"load_urdf: SIGINT latency {latency * 1e3:.1f} ms")
+    assert latency <= 0.5

@@ -9,6 +9,7 @@
 #include <type_traits>
 
 #include "armdyn/errors.hpp"
+#include "armdyn/solver/poll.hpp"
 
 namespace armdyn {
 
@@ -38,6 +39,7 @@ KktPlan plan_kkt(const Model& m, int nrows) {
   for (int g = 0; g < nblk; ++g) remaining += live[g];
   std::vector<char> done(nblk, 0);
   for (int step = 0; step < remaining; ++step) {
+    poll_point();  // O(blocks) per step: a long model's finalize stays interruptible
     int best = -1;
     long bestdeg = 0;
     for (int g = 0; g < nblk; ++g) {

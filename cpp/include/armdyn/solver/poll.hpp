@@ -72,4 +72,31 @@ class Poll {
   long count_ = 0, stride_ = 1;
 };
 
+/// The poll of the calling thread's long call that has no loop options of its own (finalize on
+/// a large model, the URDF reader): set by ScopedThreadPoll, read by poll_point(); null: none.
+inline Poll*& thread_poll() {
+  static thread_local Poll* poll = nullptr;
+  return poll;
+}
+
+/// One unit of work of such a call: the thread's poll, if any, may stop it (its exception).
+inline void poll_point() {
+  if (Poll* p = thread_poll()) (*p)(0.0, 0.0);
+}
+
+/// Sets the thread's poll for a scope (and restores the previous one).
+class ScopedThreadPoll {
+ public:
+  explicit ScopedThreadPoll(Poll* poll) : previous_(thread_poll()) {
+    thread_poll() = poll;
+    if (poll) poll->start();
+  }
+  ~ScopedThreadPoll() { thread_poll() = previous_; }
+  ScopedThreadPoll(const ScopedThreadPoll&) = delete;
+  ScopedThreadPoll& operator=(const ScopedThreadPoll&) = delete;
+
+ private:
+  Poll* previous_;
+};
+
 }  // namespace armdyn
