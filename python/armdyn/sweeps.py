@@ -217,7 +217,7 @@ def sweep(
             n_workers=_cores(),
             threads_per_worker=1,
             processes=True,
-            dashboard_address=None,
+            dashboard_address=":0",
             # a failing point is recorded in `status`: no worker traceback on the console
             silence_logs=logging.CRITICAL,
         )
