@@ -11,6 +11,7 @@ the function: importing a submodule ``armdyn.sweep`` would rebind that attribute
 
 from __future__ import annotations
 
+import importlib
 import inspect
 import itertools
 import json
@@ -94,16 +95,24 @@ def _takes_seed(fn: Callable) -> bool:
     return p is not None and p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)
 
 
-def _check_grid(grid: dict) -> dict[str, np.ndarray]:
+def _check_grid(grid: dict) -> dict[str, tuple[np.ndarray, list]]:
+    """Each axis as (coordinate array, the values passed to fn)."""
     if not grid:
         raise ValueError("sweep needs at least one grid axis, e.g. sweep(fn, payload=[0.0, 1.0])")
     axes = {}
     for name, values in grid.items():
-        if isinstance(values, str | bytes) or np.ndim(values) != 1:
+        try:
+            ndim = np.ndim(values)
+        except ValueError:  # ragged nesting
+            ndim = -1
+        if isinstance(values, str | bytes) or ndim != 1:
             raise ValueError(
                 f"grid axis {name!r} must be a 1-D sequence of values, got {values!r:.80}"
             )
+        values = list(values)
         arr = np.asarray(values)
+        if arr.dtype.kind in "US" and not all(isinstance(v, str | bytes) for v in values):
+            arr = np.asarray(values, dtype=object)  # mixed types: no conversion to strings
         if arr.size == 0:
             raise ValueError(f"grid axis {name!r} is empty")
         try:
@@ -112,7 +121,7 @@ def _check_grid(grid: dict) -> dict[str, np.ndarray]:
             distinct = True
         if not distinct:
             raise ValueError(f"grid axis {name!r} has repeated values: {arr.tolist()!r:.200}")
-        axes[name] = arr
+        axes[name] = (arr, values)
     return axes
 
 
@@ -187,7 +196,8 @@ def sweep(
             f"sweep: seed must be an int, a numpy SeedSequence or None, got {seed!r:.80} "
             "(a grid axis cannot be named 'seed')"
         )
-    axes = _check_grid(grid)
+    checked = _check_grid(grid)
+    axes = {k: arr for k, (arr, _) in checked.items()}
     dims = dict(dims or {})
     coords = dict(coords or {})
     takes_seed = _takes_seed(fn)
@@ -202,7 +212,9 @@ def sweep(
     shape = tuple(a.size for a in axes.values())
     n = math.prod(shape)
     # plain Python values (numpy scalars' .item()), in C order of the product
-    values = [[v.item() if isinstance(v, np.generic) else v for v in a] for a in axes.values()]
+    values = [
+        [v.item() if isinstance(v, np.generic) else v for v in vs] for _, vs in checked.values()
+    ]
     points = [dict(zip(names, combo, strict=True)) for combo in itertools.product(*values)]
     root = None
     seeds: list = [None] * n
@@ -325,7 +337,8 @@ def sweep(
             raise ValueError(f"sweep: coords[{d!r}]: no output has a dimension {d!r}")
         all_coords[d] = (d, np.asarray(values))
 
-    from armdyn import __version__
+    # the package's version without importing the package from its own submodule (no cycle)
+    __version__ = importlib.import_module("armdyn").__version__
 
     attrs = {
         "armdyn_version": __version__,

@@ -208,6 +208,12 @@ def test_output_dims_coords_and_dataarray_outputs(client):
     assert ds["map"].sel(gain=2.0, side="out", joint="b").item() == 2.0
 
 
+def test_mixed_type_axis_passes_the_values_unchanged(client):
+    ds = ad.sweep(lambda x: {"is_int": isinstance(x, int), "n": len(str(x))}, client, x=[10, "ab"])
+    assert ds["x"].dtype == object and list(ds["x"].values) == [10, "ab"]
+    np.testing.assert_array_equal(ds["is_int"].values, [True, False])
+
+
 def test_progress_bar(client, capsys):
     ad.sweep(flaky_point, client, progress=True, x=[1, 2], mode=["fine"])
     err = capsys.readouterr().err
@@ -229,6 +235,7 @@ def test_own_local_cluster_when_no_client():
         ({"x": "abc"}, "'x' must be a 1-D sequence"),
         ({"x": 3.0}, "'x' must be a 1-D sequence"),
         ({"x": []}, "'x' is empty"),
+        ({"x": [[1], [2, 3]]}, "'x' must be a 1-D sequence"),
         ({"x": [1.0, 2.0, 1.0]}, "'x' has repeated values"),
         ({"x": [1], "retries": -1}, "retries must be an integer >= 0"),
     ],
