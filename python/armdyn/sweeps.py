@@ -18,6 +18,7 @@ import json
 import logging
 import math
 import os
+import secrets
 from collections import Counter
 from collections.abc import Callable, Mapping
 from typing import Any
@@ -162,8 +163,8 @@ def sweep(
         seed: with an ``int`` (or a ``numpy.random.SeedSequence``), every point gets its own
             ``numpy.random.SeedSequence`` spawned from it in grid order (C order of the
             product), passed as ``fn(..., seed=ss)`` (``np.random.default_rng(ss)``); fn must
-            then take a ``seed`` argument. With None and an fn that takes ``seed``, fresh
-            entropy is drawn; either way the root entropy is ``attrs["seed"]`` and passing it
+            then take a ``seed`` argument. With None and an fn that takes ``seed``, a fresh
+            63-bit seed is drawn; either way the root entropy is ``attrs["seed"]`` and passing it
             back as ``seed=`` repeats the sweep.
         dims: ``{variable: (dim, ...)}`` names of the array dimensions of fn's outputs (default
             ``<variable>_dim0``, ``<variable>_dim1``, ... ; variables may share a dimension).
@@ -219,6 +220,8 @@ def sweep(
     root = None
     seeds: list = [None] * n
     if takes_seed:
+        if seed is None:  # fresh entropy, 63 bits: an int64 attribute (netCDF) repeats it
+            seed = secrets.randbits(63)
         root = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
         seeds = root.spawn(n)
 

@@ -177,6 +177,7 @@ def test_seeds_are_spawned_in_grid_order(client):
     assert ds.attrs["seed"] == 1234
     # without a seed: fresh entropy, recorded, and passing it back repeats the sweep
     first = ad.sweep(noisy, client, scale=[1.0, 2.0])
+    assert 0 <= first.attrs["seed"] < 2**63  # fits an int64 attribute
     again = ad.sweep(noisy, client, seed=first.attrs["seed"], scale=[1.0, 2.0])
     np.testing.assert_array_equal(first["draw"].values, again["draw"].values)
     assert not np.array_equal(first["draw"].values, ds["draw"].values)
