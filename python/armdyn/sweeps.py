@@ -251,17 +251,31 @@ def sweep(
             from tqdm.auto import tqdm
 
             bar = tqdm(total=n, desc="sweep", unit="point")
+        killed: list[int] = []
+
+        def collect(fut, i):
+            if fut.status == "finished":
+                results[i], errors[i] = fut.result(), None
+            else:
+                exc = fut.exception()
+                errors[i] = _message(exc) if exc is not None else f"task {fut.status}"
+                if isinstance(exc, distributed.KilledWorker):
+                    killed.append(i)
+            fut.release()
+
         try:
             for fut in distributed.as_completed(futures):
-                i = index[fut.key]
-                if fut.status == "finished":
-                    results[i] = fut.result()
-                else:
-                    exc = fut.exception()
-                    errors[i] = _message(exc) if exc is not None else f"task {fut.status}"
-                fut.release()
+                collect(fut, index[fut.key])
                 if bar is not None:
                     bar.update()
+            if len(killed) > 1:
+                # a point queued on a worker that another point crashed dies with it: each
+                # point whose worker died runs once more alone, so only the culprits stay failed
+                for i in list(killed):
+                    fut = client.submit(_call, fn, points[i], seeds[i], retries=retries, pure=False)
+                    futures.append(fut)
+                    distributed.wait(fut)
+                    collect(fut, i)
         finally:
             if bar is not None:
                 bar.close()

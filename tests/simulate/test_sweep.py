@@ -264,3 +264,27 @@ def test_clear_import_error_without_dask(monkeypatch):
     monkeypatch.setitem(sys.modules, "distributed", None)
     with pytest.raises(ImportError, match=r'pip install "armdyn\[distributed\]"'):
         ad.sweep(flaky_point, x=[1], mode=["fine"])
+
+
+def crash_at_two(x):
+    if x == 2:
+        os._exit(1)  # as a segfault in compiled code would: the worker process dies
+    return 1.5 * x
+
+
+def test_a_point_that_kills_its_worker_is_recorded():
+    """After the scheduler's allowed failures (none here: one worker death) the point is
+    recorded as KilledWorker; a point queued behind it on the dying worker (killed with it) is
+    run again alone and succeeds."""
+    import dask
+
+    with (
+        dask.config.set({"distributed.scheduler.allowed-failures": 0}),
+        distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0"
+        ) as cluster,
+        distributed.Client(cluster) as c,
+    ):
+        ds = ad.sweep(crash_at_two, c, x=[1, 2, 3, 4])
+    assert ds["status"].sel(x=2).item().startswith("KilledWorker")
+    np.testing.assert_array_equal(ds["result"].values, [1.5, np.nan, 4.5, 6.0])
