@@ -102,6 +102,8 @@ def _check_grid(grid: dict) -> dict[str, tuple[np.ndarray, list]]:
         raise ValueError("sweep needs at least one grid axis, e.g. sweep(fn, payload=[0.0, 1.0])")
     axes = {}
     for name, values in grid.items():
+        if name == "status":
+            raise ValueError("grid axis 'status' clashes with the Dataset's status variable")
         try:
             ndim = np.ndim(values)
         except ValueError:  # ragged nesting
@@ -128,6 +130,12 @@ def _check_grid(grid: dict) -> dict[str, tuple[np.ndarray, list]]:
 
 def _signature(out: dict) -> tuple:
     return tuple((k, a.shape) for k, (a, _) in out.items())
+
+
+def _entropy(root: np.random.SeedSequence):
+    """The root's entropy as an attribute: an int, or a list of ints."""
+    e = root.entropy
+    return int(e) if isinstance(e, int | np.integer) else [int(x) for x in e]
 
 
 def _message(exc: BaseException) -> str:
@@ -226,6 +234,16 @@ def sweep(
         seeds = root.spawn(n)
 
     own = client is None
+    if not own and not isinstance(client, distributed.Client):
+        raise TypeError(
+            f"sweep: client must be a distributed.Client or None, got {type(client).__name__}"
+            " (for a cluster object: distributed.Client(cluster))"
+        )
+    if progress:
+        try:
+            from tqdm.auto import tqdm
+        except ImportError as exc:
+            raise ImportError(f"sweep(progress=True) needs tqdm: {_MISSING}") from exc
     cluster = None
     if own:
         cluster = distributed.LocalCluster(
@@ -248,8 +266,6 @@ def sweep(
         index = {f.key: i for i, f in enumerate(futures)}
         bar = None
         if progress:
-            from tqdm.auto import tqdm
-
             bar = tqdm(total=n, desc="sweep", unit="point")
         killed: list[int] = []
 
@@ -360,7 +376,7 @@ def sweep(
     attrs = {
         "armdyn_version": __version__,
         "grid": json.dumps({k: v.tolist() for k, v in axes.items()}, default=str),
-        "seed": int(root.entropy) if root is not None else "none",
+        "seed": "none" if root is None else _entropy(root),
         "fn": getattr(fn, "__qualname__", type(fn).__name__),
         "retries": retries,
         "failed": int(sum(e is not None for e in errors)),

@@ -175,6 +175,11 @@ def test_seeds_are_spawned_in_grid_order(client):
         ref = noisy(s, children[i])["draw"]
         np.testing.assert_array_equal(ds["draw"].sel(scale=s).values, ref)
     assert ds.attrs["seed"] == 1234
+    # a SeedSequence as the root: the same children, its entropy recorded
+    same = ad.sweep(noisy, client, seed=np.random.SeedSequence([5, 6]), scale=[1.0])
+    ref = noisy(1.0, np.random.SeedSequence([5, 6]).spawn(1)[0])["draw"]
+    np.testing.assert_array_equal(same["draw"].values[0], ref)
+    assert same.attrs["seed"] == [5, 6]
     # without a seed: fresh entropy, recorded, and passing it back repeats the sweep
     first = ad.sweep(noisy, client, scale=[1.0, 2.0])
     assert 0 <= first.attrs["seed"] < 2**63  # fits an int64 attribute
@@ -239,6 +244,7 @@ def test_own_local_cluster_when_no_client():
         ({"x": [[1], [2, 3]]}, "'x' must be a 1-D sequence"),
         ({"x": [1.0, 2.0, 1.0]}, "'x' has repeated values"),
         ({"x": [1], "retries": -1}, "retries must be an integer >= 0"),
+        ({"status": [1, 2]}, "grid axis 'status' clashes"),
     ],
 )
 def test_bad_grids_raise_before_any_work(kwargs, match):
@@ -253,6 +259,11 @@ def test_bad_fn_and_seed_raise():
         ad.sweep(flaky_point, seed=1, x=[1], mode=["fine"])
     with pytest.raises(TypeError, match="a grid axis cannot be named 'seed'"):
         ad.sweep(noisy, seed=[1, 2], scale=[1.0])
+
+
+def test_a_cluster_instead_of_a_client_raises(client):
+    with pytest.raises(TypeError, match=r"client must be a distributed.Client or None, got Local"):
+        ad.sweep(flaky_point, client.cluster, x=[1], mode=["fine"])
 
 
 def test_output_clashing_with_a_grid_name_raises(client):
