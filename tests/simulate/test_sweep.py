@@ -132,6 +132,15 @@ def test_failing_points_are_recorded_not_raised(client):
     np.testing.assert_array_equal(ds["v"].sel(x=4, mode="raise").values, [4.0, 4.0])
 
 
+def test_an_unsupported_output_is_a_failed_point(client):
+    ds = ad.sweep(lambda x: None if x == 1 else {"a": x}, client, x=[1, 2])
+    assert ds["status"].sel(x=1).item() == (
+        "TypeError: output 'result' is NoneType of dtype object: fn must return a number, "
+        "a numeric numpy array, or a dict of those"
+    )
+    assert ds["status"].sel(x=2).item() == "ok" and ds["a"].sel(x=2).item() == 2.0
+
+
 def test_a_point_with_another_output_shape_is_failed(client):
     ds = ad.sweep(flaky_point, client, x=[1, 2, 3], mode=["shape"])
     bad = ds["status"].sel(x=3, mode="shape").item()
