@@ -46,6 +46,7 @@ from armdyn.sizing import (
     sizing_report,
     trajectory_run,
 )
+from armdyn.sweeps import sweep  # dask and xarray are imported when sweep() runs
 from armdyn.validation import LagrangeValidator
 from armdyn.workprecision import WorkPrecisionResult, work_precision
 
@@ -92,6 +93,7 @@ __all__ = [
     "simulate",
     "sizing_report",
     "state_from_joints",
+    "sweep",
     "trajectory_run",
     "urdf_builder",
     "validation",

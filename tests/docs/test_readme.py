@@ -6,6 +6,7 @@ from pathlib import Path
 
 import armdyn as ad
 import numpy as np
+import pytest
 from armdyn import verify
 
 README = Path(__file__).resolve().parents[2] / "README.md"
@@ -101,3 +102,25 @@ def test_sizing_example_runs(tmp_path, monkeypatch):
     assert (tmp_path / "sizing-report" / "motor_0.png").is_file()
     best = ns["sweep"].summary.loc["shoulder"]
     assert 20.0 <= best["ok_ratio_min"] <= 100.0 <= best["ok_ratio_max"] and bool(row["ok"])
+
+
+def test_sweep_example_runs():
+    """The README's five-line sweep (client=None: its own LocalCluster) gives a Dataset over
+    theta0 x length whose periods are the closed form 4/w0 K(sin^2(theta0/2)) of the physical
+    pendulum, w0^2 = m g L / (2/5 m r^2 + m L^2), computed here with SciPy's ellipk."""
+    pytest.importorskip("distributed")
+    from scipy.special import ellipk
+
+    blocks = re.findall(r"```python\n(.*?)```", README.read_text(), re.S)
+    block = next(b for b in blocks if "ad.sweep(" in b)
+    assert len([ln for ln in block.strip().splitlines() if ln.strip()]) <= 6
+    ns: dict = {"ad": ad, "np": np}
+    exec(compile(block, "README sweep", "exec"), ns)
+    ds = ns["ds"]
+    assert ds["period"].dims == ("theta0", "length")
+    assert (ds["status"].values == "ok").all()
+    theta0 = ds["theta0"].values[:, None]
+    length = ds["length"].values[None, :]
+    r, g = 1e-3, 9.81
+    exact = 4.0 / np.sqrt(g * length / (0.4 * r**2 + length**2)) * ellipk(np.sin(theta0 / 2) ** 2)
+    np.testing.assert_allclose(ds["period"].values, exact, rtol=1e-8)

@@ -110,3 +110,35 @@ def test_sizing_notebook_executes(tmp_path):
     rebuilt = re.search(r"rebuilt vs closed form: (\S+)", outputs)
     if rebuilt is not None:
         assert float(rebuilt.group(1)) <= 1e-9
+
+
+def test_sweep_notebook_executes(tmp_path):
+    """notebooks/sweep_ur5.ipynb runs end to end on its 2-worker LocalCluster: the UR5's payload
+    x move duration x shoulder ratio sweep (96 points, none failed) equals calling the point
+    function in the kernel, and the geared arm's motor-count sweep splits the waist's peak
+    torque between its motors (n x each motor's peak within 10 % of the single motor's)."""
+    import json
+    import re
+
+    import nbclient
+    import nbformat
+    import numpy as np
+    import pytest
+
+    pytest.importorskip("distributed")
+    nb_path = ROOT / "notebooks" / "sweep_ur5.ipynb"
+    nb = nbformat.read(nb_path, as_version=4)
+    client = nbclient.NotebookClient(
+        nb, timeout=300, kernel_name="python3", resources={"metadata": {"path": str(tmp_path)}}
+    )
+    client.execute()
+    outputs = "".join(
+        o.get("text", "") for c in nb.cells if c.cell_type == "code" for o in c.get("outputs", [])
+    )
+    assert re.findall(r"failed points: (\d+)", outputs) == ["0", "0"]
+    assert "(payload: 6, duration: 4, shoulder_ratio: 4, joint: 6)" in outputs
+    assert float(re.search(r"sweep vs serial, largest difference: (\S+)", outputs).group(1)) == 0.0
+    # each of n motors carries 1/n of the gear's load plus its own train's inertia
+    share = np.array(json.loads(re.search(r"n x peak / single peak: (.*)", outputs).group(1)))
+    assert share.shape == (4, 3) and (share[0] == 1.0).all()
+    assert (share[1:] > 1.0).all() and (share[1:] <= 1.1).all()

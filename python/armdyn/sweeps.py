@@ -1,0 +1,387 @@
+"""Parameter sweeps on Dask: :func:`sweep` runs a function over the Cartesian product of a grid
+on a ``dask.distributed`` cluster and returns an ``xarray.Dataset``.
+
+Optional dependency (``pip install "armdyn[distributed]"``): ``dask[distributed]`` and
+``xarray`` (``tqdm`` for ``progress=True``). They are imported when :func:`sweep` is called,
+never by ``import armdyn``.
+
+The module is ``armdyn.sweeps`` (plural) so that the package attribute ``armdyn.sweep`` stays
+the function: importing a submodule ``armdyn.sweep`` would rebind that attribute to the module.
+"""
+
+from __future__ import annotations
+
+import importlib
+import inspect
+import itertools
+import json
+import logging
+import math
+import os
+import secrets
+from collections import Counter
+from collections.abc import Callable, Mapping
+from typing import Any
+
+import numpy as np
+
+#: keyword names of :func:`sweep` itself: they cannot be grid names
+RESERVED = ("fn", "client", "retries", "progress", "seed", "dims", "coords")
+#: the variable name of a non-dict output
+RESULT = "result"
+
+_MISSING = (
+    'armdyn.sweep needs dask.distributed and xarray: pip install "armdyn[distributed]" '
+    '(or pip install "dask[distributed]" xarray)'
+)
+
+
+def _import_optional():
+    try:
+        import distributed
+        import xarray
+    except ImportError as exc:  # pragma: no cover - exercised in a subprocess by the tests
+        raise ImportError(f"{_MISSING} ({exc})") from exc
+    return distributed, xarray
+
+
+def _cores() -> int:
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # pragma: no cover - not Linux
+        return max(1, os.cpu_count() or 1)
+
+
+def _as_array(name: str, value) -> tuple[np.ndarray, tuple | None]:
+    """One output variable as a numeric numpy array (and the dims of a DataArray-like value)."""
+    dims = getattr(value, "dims", None)
+    arr = np.asarray(value)
+    if arr.dtype.kind not in "biufc":
+        raise TypeError(
+            f"output {name!r} is {type(value).__name__} of dtype {arr.dtype}: fn must return a "
+            "number, a numeric numpy array, or a dict of those"
+        )
+    if dims is not None:
+        dims = tuple(str(d) for d in dims)
+        if len(dims) != arr.ndim:
+            dims = None
+    return arr, dims
+
+
+def _normalise(out) -> dict[str, tuple[np.ndarray, tuple | None]]:
+    if isinstance(out, Mapping):
+        if not out:
+            raise TypeError("fn returned an empty dict")
+        bad = [k for k in out if not isinstance(k, str)]
+        if bad:
+            raise TypeError(f"fn returned a dict with non-string keys {bad!r}")
+        return {k: _as_array(k, v) for k, v in out.items()}
+    return {RESULT: _as_array(RESULT, out)}
+
+
+def _call(fn: Callable, point: dict, seed) -> dict:
+    """The task run on a worker for one grid point: fn(**point[, seed]) normalised to arrays."""
+    kwargs = dict(point)
+    if seed is not None:
+        kwargs["seed"] = seed
+    return _normalise(fn(**kwargs))
+
+
+def _takes_seed(fn: Callable) -> bool:
+    try:
+        params = inspect.signature(fn).parameters
+    except (TypeError, ValueError):
+        return False
+    p = params.get("seed")
+    return p is not None and p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)
+
+
+def _check_grid(grid: dict) -> dict[str, tuple[np.ndarray, list]]:
+    """Each axis as (coordinate array, the values passed to fn)."""
+    if not grid:
+        raise ValueError("sweep needs at least one grid axis, e.g. sweep(fn, payload=[0.0, 1.0])")
+    axes = {}
+    for name, values in grid.items():
+        if name == "status":
+            raise ValueError("grid axis 'status' clashes with the Dataset's status variable")
+        try:
+            ndim = np.ndim(values)
+        except ValueError:  # ragged nesting
+            ndim = -1
+        if isinstance(values, str | bytes) or ndim != 1:
+            raise ValueError(
+                f"grid axis {name!r} must be a 1-D sequence of values, got {values!r:.80}"
+            )
+        values = list(values)
+        arr = np.asarray(values)
+        if arr.dtype.kind in "US" and not all(isinstance(v, str | bytes) for v in values):
+            arr = np.asarray(values, dtype=object)  # mixed types: no conversion to strings
+        if arr.size == 0:
+            raise ValueError(f"grid axis {name!r} is empty")
+        try:
+            distinct = len(set(arr.tolist())) == arr.size
+        except TypeError:  # unhashable values
+            distinct = True
+        if not distinct:
+            raise ValueError(f"grid axis {name!r} has repeated values: {arr.tolist()!r:.200}")
+        axes[name] = (arr, values)
+    return axes
+
+
+def _signature(out: dict) -> tuple:
+    return tuple((k, a.shape) for k, (a, _) in out.items())
+
+
+def _entropy(root: np.random.SeedSequence):
+    """The root's entropy as an attribute: an int, or a list of ints."""
+    e = root.entropy
+    return int(e) if isinstance(e, int | np.integer) else [int(x) for x in e]
+
+
+def _message(exc: BaseException) -> str:
+    text = str(exc)
+    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
+
+
+def sweep(
+    fn: Callable,
+    client=None,
+    *,
+    retries: int = 0,
+    progress: bool = False,
+    seed: int | np.random.SeedSequence | None = None,
+    dims: Mapping[str, tuple[str, ...]] | None = None,
+    coords: Mapping[str, Any] | None = None,
+    **grid,
+):
+    """Run ``fn(**point)`` at every point of the Cartesian product of ``grid`` on Dask.
+
+    Args:
+        fn: the function of one grid point; its keyword arguments are the grid names. It
+            returns a number, a numeric numpy array, or a dict ``{name: number or array}`` (a
+            value with a ``dims`` attribute, e.g. an ``xarray.DataArray``, names its own
+            dimensions). It must be picklable (cloudpickle: lambdas and closures are) and build
+            what it needs itself, e.g. its model from a URDF path.
+        client: a ``distributed.Client``, used as it is (a LocalCluster, dask-jobqueue's SLURM or
+            PBS cluster, Kubernetes, ...); None starts a ``LocalCluster`` on this machine (worker
+            processes, one per core, one thread each) and closes it afterwards.
+        retries: Dask retries of a point whose fn raised (or whose worker died) before it is
+            recorded as failed.
+        progress: show a progress bar (tqdm) while points finish.
+        seed: with an ``int`` (or a ``numpy.random.SeedSequence``), every point gets its own
+            ``numpy.random.SeedSequence`` spawned from it in grid order (C order of the
+            product), passed as ``fn(..., seed=ss)`` (``np.random.default_rng(ss)``); fn must
+            then take a ``seed`` argument. With None and an fn that takes ``seed``, a fresh
+            63-bit seed is drawn; either way the root entropy is ``attrs["seed"]`` and passing it
+            back as ``seed=`` repeats the sweep.
+        dims: ``{variable: (dim, ...)}`` names of the array dimensions of fn's outputs (default
+            ``<variable>_dim0``, ``<variable>_dim1``, ... ; variables may share a dimension).
+        coords: ``{dim: values}`` coordinates of output dimensions.
+        **grid: ``name=values``, each a 1-D sequence of distinct values. The names ``fn``,
+            ``client``, ``retries``, ``progress``, ``seed``, ``dims`` and ``coords`` are this
+            function's own and cannot be grid names.
+
+    Returns:
+        ``xarray.Dataset`` with the grid names as its first dimensions (coordinates = the grid
+        values), each output variable (dims: the grid's, then its own), and ``status``: "ok"
+        or the point's error (``"ValueError: ..."``). A failed point's outputs are NaN;
+        integer and boolean outputs become float64 when a point failed. Points whose outputs
+        differ in names or shapes from the most common structure are failed with a status
+        saying so. ``attrs``: ``armdyn_version``, ``grid`` (JSON of the grid), ``seed``
+        (root entropy, or "none"), ``fn``, ``retries``, ``failed`` (number of failed points).
+
+    Raises:
+        ImportError: dask.distributed or xarray is not installed.
+        TypeError: fn is not callable, or a seed is given and fn takes no ``seed``.
+        ValueError: an empty or non-1-D grid axis, repeated grid values, a bad ``dims`` or
+            ``coords`` entry, or an output name that clashes with a grid name or ``status``.
+    """
+    if not callable(fn):
+        raise TypeError(f"sweep: fn must be callable, got {type(fn).__name__}")
+    if isinstance(retries, bool) or not isinstance(retries, int) or retries < 0:
+        raise ValueError(f"sweep: retries must be an integer >= 0, got {retries!r}")
+    if seed is not None and not isinstance(seed, int | np.integer | np.random.SeedSequence):
+        raise TypeError(
+            f"sweep: seed must be an int, a numpy SeedSequence or None, got {seed!r:.80} "
+            "(a grid axis cannot be named 'seed')"
+        )
+    checked = _check_grid(grid)
+    axes = {k: arr for k, (arr, _) in checked.items()}
+    dims = dict(dims or {})
+    coords = dict(coords or {})
+    takes_seed = _takes_seed(fn)
+    if seed is not None and not takes_seed:
+        raise TypeError(
+            f"sweep: seed={seed!r} given but fn {getattr(fn, '__name__', fn)!r} takes no "
+            "'seed' argument"
+        )
+    distributed, xr = _import_optional()
+
+    names = list(axes)
+    shape = tuple(a.size for a in axes.values())
+    n = math.prod(shape)
+    # plain Python values (numpy scalars' .item()), in C order of the product
+    values = [
+        [v.item() if isinstance(v, np.generic) else v for v in vs] for _, vs in checked.values()
+    ]
+    points = [dict(zip(names, combo, strict=True)) for combo in itertools.product(*values)]
+    root = None
+    seeds: list = [None] * n
+    if takes_seed:
+        if seed is None:  # fresh entropy, 63 bits: an int64 attribute (netCDF) repeats it
+            seed = secrets.randbits(63)
+        root = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
+        seeds = root.spawn(n)
+
+    own = client is None
+    if not own and not isinstance(client, distributed.Client):
+        raise TypeError(
+            f"sweep: client must be a distributed.Client or None, got {type(client).__name__}"
+            " (for a cluster object: distributed.Client(cluster))"
+        )
+    if progress:
+        try:
+            from tqdm.auto import tqdm
+        except ImportError as exc:
+            raise ImportError(f"sweep(progress=True) needs tqdm: {_MISSING}") from exc
+    cluster = None
+    if own:
+        cluster = distributed.LocalCluster(
+            n_workers=_cores(),
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=":0",
+            # a failing point is recorded in `status`: no worker traceback on the console
+            silence_logs=logging.CRITICAL,
+        )
+        client = distributed.Client(cluster)
+    results: list = [None] * n
+    errors: list[str | None] = [None] * n
+    futures: list = []
+    try:
+        futures = [
+            client.submit(_call, fn, p, s, retries=retries, pure=False)
+            for p, s in zip(points, seeds, strict=True)
+        ]
+        index = {f.key: i for i, f in enumerate(futures)}
+        bar = None
+        if progress:
+            bar = tqdm(total=n, desc="sweep", unit="point")
+        killed: list[int] = []
+
+        def collect(fut, i):
+            if fut.status == "finished":
+                results[i], errors[i] = fut.result(), None
+            else:
+                exc = fut.exception()
+                errors[i] = _message(exc) if exc is not None else f"task {fut.status}"
+                if isinstance(exc, distributed.KilledWorker):
+                    killed.append(i)
+            fut.release()
+
+        try:
+            for fut in distributed.as_completed(futures):
+                collect(fut, index[fut.key])
+                if bar is not None:
+                    bar.update()
+            if len(killed) > 1:
+                # a point queued on a worker that another point crashed dies with it: each
+                # point whose worker died runs once more alone, so only the culprits stay failed
+                for i in list(killed):
+                    fut = client.submit(_call, fn, points[i], seeds[i], retries=retries, pure=False)
+                    futures.append(fut)
+                    distributed.wait(fut)
+                    collect(fut, i)
+        finally:
+            if bar is not None:
+                bar.close()
+    except BaseException:  # Ctrl-C or a lost client: nothing left running on a given cluster
+        if not own and futures:
+            client.cancel([f for f in futures if not f.done()])
+        raise
+    finally:
+        if own:
+            client.close()
+            cluster.close()
+
+    # the structure shared by the successful points: the most common one (first in grid order
+    # on a tie); points that differ are failed
+    sigs = Counter(_signature(r) for r in results if r is not None)
+    if sigs:
+        best = max(sigs.values())
+        ref_sig = next(
+            _signature(r) for r in results if r is not None and sigs[_signature(r)] == best
+        )
+        ref_point = next(
+            i for i, r in enumerate(results) if r is not None and _signature(r) == ref_sig
+        )
+        for i, r in enumerate(results):
+            if r is not None and _signature(r) != ref_sig:
+                errors[i] = (
+                    f"output structure {dict(_signature(r))} differs from "
+                    f"{dict(ref_sig)} of point {points[ref_point]}"
+                )
+                results[i] = None
+    ok = [r for r in results if r is not None]
+
+    data_vars: dict = {}
+    if ok:
+        first = ok[0]
+        for var, (arr0, own_dims) in first.items():
+            if var in axes or var == "status":
+                raise ValueError(
+                    f"sweep: output {var!r} has the name of a grid axis or of 'status'"
+                )
+            vdims = tuple(
+                dims.get(var, own_dims or tuple(f"{var}_dim{k}" for k in range(arr0.ndim)))
+            )
+            if len(vdims) != arr0.ndim:
+                raise ValueError(
+                    f"sweep: dims[{var!r}] = {vdims!r} names {len(vdims)} dimensions but "
+                    f"{var!r} has shape {arr0.shape}"
+                )
+            clash = [d for d in vdims if d in axes]
+            if clash:
+                raise ValueError(f"sweep: output dims {clash} of {var!r} repeat grid names")
+            kinds = {r[var][0].dtype for r in ok}
+            dtype = np.result_type(*kinds)
+            if len(ok) < n and dtype.kind in "biu":
+                dtype = np.dtype(np.float64)
+            full = np.full(shape + arr0.shape, np.nan if dtype.kind in "fc" else 0, dtype=dtype)
+            flat = full.reshape((n, *arr0.shape))
+            for i, r in enumerate(results):
+                if r is not None:
+                    flat[i] = r[var][0]
+            data_vars[var] = ((*names, *vdims), full)
+    unknown = [v for v in dims if v not in data_vars]
+    if unknown and ok:
+        raise ValueError(f"sweep: dims given for {unknown}, which fn does not return")
+    status = np.array(["ok" if e is None else e for e in errors], dtype=object).reshape(shape)
+    data_vars["status"] = (tuple(names), status)
+
+    all_coords = {k: (k, v) for k, v in axes.items()}
+    used = {d for v in data_vars.values() for d in v[0]}
+    for d, values in coords.items():
+        if d in axes:
+            raise ValueError(
+                f"sweep: coords[{d!r}]: {d!r} is a grid axis (its values are the grid's)"
+            )
+        if ok and d not in used:
+            raise ValueError(f"sweep: coords[{d!r}]: no output has a dimension {d!r}")
+        all_coords[d] = (d, np.asarray(values))
+
+    # the package's version without importing the package from its own submodule (no cycle)
+    __version__ = importlib.import_module("armdyn").__version__
+
+    attrs = {
+        "armdyn_version": __version__,
+        "grid": json.dumps({k: v.tolist() for k, v in axes.items()}, default=str),
+        "seed": "none" if root is None else _entropy(root),
+        "fn": getattr(fn, "__qualname__", type(fn).__name__),
+        "retries": retries,
+        "failed": int(sum(e is not None for e in errors)),
+    }
+    try:
+        return xr.Dataset(data_vars, coords=all_coords, attrs=attrs)
+    except ValueError as exc:  # e.g. a coordinate of the wrong length
+        raise ValueError(f"sweep: cannot assemble the Dataset: {exc}") from exc
