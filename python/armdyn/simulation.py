@@ -238,7 +238,7 @@ def simulate(
         return _zero_dof_result(model, t_end, output_dt)
     if output_dt is not None:
         _check_output_bytes(model, t_end, output_dt, max_output_bytes)
-    report, close = _progress_reporter(progress, t_end)
+    report, close = _progress_reporter(progress, float(t_end), unit="s", bar_format=_BAR_FORMAT)
     try:
         raw = _core._simulate(
             model, float(t_end), u0=u0, v0=v0, q_start=q_start, progress=report, **options
@@ -290,23 +290,24 @@ def _check_output_bytes(model, t_end, output_dt, max_output_bytes) -> None:
         )
 
 
-def _progress_reporter(progress, t_end):
-    """(report(t, t_end) or None, close() or None) for simulate's ``progress`` argument; tqdm is
-    imported only here (``import armdyn`` stays light)."""
+def _progress_reporter(progress, total, who="simulate", args="(t, t_end)", **bar_options):
+    """(report(x, total) or None, close() or None) for a ``progress`` argument: True (a tqdm bar
+    of ``total``, closed by close()), a tqdm instance (its total set), a callable (called as
+    is), or False/None. tqdm is imported only here (``import armdyn`` stays light)."""
     if progress is None or progress is False:
         return None, None
     if progress is True:
         from tqdm.auto import tqdm
 
-        bar = tqdm(total=float(t_end), unit="s", desc="simulate", bar_format=_BAR_FORMAT)
+        bar = tqdm(total=total, desc=who, **bar_options)
         return _tqdm_reporter(bar), bar.close
     if hasattr(progress, "update") and hasattr(progress, "refresh") and hasattr(progress, "n"):
-        progress.total = float(t_end)
+        progress.total = total
         return _tqdm_reporter(progress), None
     if callable(progress):
         return progress, None
     raise _core.ModelError(
-        "simulate: progress must be True, False, a tqdm instance or a callable (t, t_end), "
+        f"{who}: progress must be True, False, a tqdm instance or a callable {args}, "
         f"got {type(progress).__name__}"
     )
 
@@ -315,8 +316,8 @@ _BAR_FORMAT = "{desc}: {percentage:3.0f}%|{bar}| t={n:.4g}/{total:.4g} s [{elaps
 
 
 def _tqdm_reporter(bar):
-    def report(t, t_end):
-        bar.n = t
+    def report(x, total):
+        bar.n = x
         bar.refresh()
 
     return report
@@ -443,7 +444,7 @@ def rollout(
         return []
     if model.nb == 0:  # nothing to integrate: the zero-DOF result of each run
         return [simulate(model, t_end, output_dt=options["output_dt"] or None) for _ in range(n)]
-    report, close = _run_progress(progress, n)
+    report, close = _progress_reporter(progress, n, "rollout", "(done, n_runs)", unit="run")
     try:
         raws, interrupt = _core._rollout(
             model,
@@ -471,34 +472,6 @@ def rollout(
     if len(messages) == 1 and None not in messages and all(len(r.t) == 0 for r in results):
         raise _core.ModelError(f"rollout: every run failed to start: {messages.pop()}")
     return results
-
-
-def _run_progress(progress, n):
-    """(report(done, n) or None, close() or None) for rollout's ``progress``."""
-    if progress is None or progress is False:
-        return None, None
-    if progress is True:
-        from tqdm.auto import tqdm
-
-        bar = tqdm(total=n, unit="run", desc="rollout")
-        return _count_reporter(bar), bar.close
-    if hasattr(progress, "update") and hasattr(progress, "refresh") and hasattr(progress, "n"):
-        progress.total = n
-        return _count_reporter(progress), None
-    if callable(progress):
-        return progress, None
-    raise _core.ModelError(
-        "rollout: progress must be True, False, a tqdm instance or a callable (done, n_runs), "
-        f"got {type(progress).__name__}"
-    )
-
-
-def _count_reporter(bar):
-    def report(done, n):
-        bar.n = done
-        bar.refresh()
-
-    return report
 
 
 def _core_options(
