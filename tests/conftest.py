@@ -262,3 +262,41 @@ def pendulum_factory():
 @pytest.fixture
 def double_pendulum_model():
     return double_pendulum()
+
+
+# ---------------------------------------------------------------------- runs compared bit for bit
+
+RESULT_TABLES = (
+    "t",
+    "u",
+    "v",
+    "q",
+    "qd",
+    "qdd",
+    "drive_forces",
+    "joint_torques",
+    "reaction_forces",
+    "reaction_torques",
+    "position_residual",
+    "velocity_residual",
+    "kinetic_energy",
+    "potential_energy",
+)
+
+
+def assert_same_run(a, b, stats=False):
+    """Two SimulationResults equal bit for bit: every table, the gear and limit forces, the
+    events; with stats, the step statistics too (the run time aside)."""
+    for name in RESULT_TABLES:
+        x, y = getattr(a, name), getattr(b, name)
+        assert x.shape == y.shape, name
+        assert np.array_equal(x, y), name
+    for group in ("gear_forces", "limit_forces"):
+        assert getattr(a, group)["names"] == getattr(b, group)["names"]
+        assert np.array_equal(getattr(a, group)["force"], getattr(b, group)["force"]), group
+    assert np.array_equal(a.events["t"], b.events["t"])
+    assert a.events["limits"]["joint"] == b.events["limits"]["joint"]
+    if stats:
+        sa = {k: v for k, v in a.stats.items() if k != "seconds"}
+        sb = {k: v for k, v in b.stats.items() if k != "seconds"}
+        assert sa == sb

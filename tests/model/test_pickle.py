@@ -12,49 +12,11 @@ import armdyn as ad
 import numpy as np
 import pytest
 from armdyn import profiles
+from conftest import assert_same_run
 
 from benchmarks import common
 
-TABLES = (
-    "t",
-    "u",
-    "v",
-    "q",
-    "qd",
-    "qdd",
-    "drive_forces",
-    "joint_torques",
-    "reaction_forces",
-    "reaction_torques",
-    "position_residual",
-    "velocity_residual",
-    "kinetic_energy",
-    "potential_energy",
-)
 PROTOCOLS = range(2, pickle.HIGHEST_PROTOCOL + 1)
-
-
-def assert_same_run(a, b):
-    for name in TABLES:
-        x, y = getattr(a, name), getattr(b, name)
-        assert x.shape == y.shape, name
-        assert np.array_equal(x, y), name
-    for group in ("gear_forces", "limit_forces"):
-        assert getattr(a, group)["names"] == getattr(b, group)["names"]
-        assert np.array_equal(getattr(a, group)["force"], getattr(b, group)["force"]), group
-    assert np.array_equal(a.events["t"], b.events["t"])
-    assert a.events["limits"]["joint"] == b.events["limits"]["joint"]
-    sa = {k: v for k, v in a.stats.items() if k != "seconds"}
-    sb = {k: v for k, v in b.stats.items() if k != "seconds"}
-    assert sa == sb
-    assert a.actuators.keys() == b.actuators.keys()
-    for name, side in a.actuators.items():
-        for key, x in vars(side).items():
-            y = getattr(b.actuators[name], key)
-            if isinstance(x, np.ndarray):
-                assert np.array_equal(x, y, equal_nan=True), (name, key)
-            else:
-                assert x == y, (name, key)
 
 
 DESCRIPTION = (

@@ -72,19 +72,18 @@ CHILD = textwrap.dedent(
 )
 
 
-@pytest.mark.parametrize("method", ["rk4", "dopri5", "dop853", "trbdf2", "kinematic"])
-def test_sigint_stops_within_half_a_second_with_the_partial_result(method):
-    env = dict(os.environ)
+def _interrupted_child(code, *args, delay):
+    """Run ``code`` in a child Python, send it SIGINT ``delay`` s after it prints "ready", and
+    return (its last JSON line, the time the signal was sent)."""
     proc = subprocess.Popen(
-        [sys.executable, "-c", CHILD, method],
+        [sys.executable, "-c", code, *args],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
-        env=env,
     )
     try:
         assert proc.stdout.readline().strip() == "ready"
-        time.sleep(1.0)
+        time.sleep(delay)
         sent = time.time()
         proc.send_signal(signal.SIGINT)
         out, err = proc.communicate(timeout=120)
@@ -92,7 +91,12 @@ def test_sigint_stops_within_half_a_second_with_the_partial_result(method):
         if proc.poll() is None:
             proc.kill()
     assert proc.returncode == 0, err
-    report = json.loads(out.strip().splitlines()[-1])
+    return json.loads(out.strip().splitlines()[-1]), sent
+
+
+@pytest.mark.parametrize("method", ["rk4", "dopri5", "dop853", "trbdf2", "kinematic"])
+def test_sigint_stops_within_half_a_second_with_the_partial_result(method):
+    report, sent = _interrupted_child(CHILD, method, delay=1.0)
     assert "completed" not in report, f"the run ended before the signal: {report}"
     latency = report["caught"] - sent
     print(f"{method}: SIGINT latency {latency * 1e3:.1f} ms, {report['rows']} rows kept")
@@ -159,23 +163,8 @@ ID_CHILD = textwrap.dedent(
 
 @pytest.mark.parametrize("which", ["batch", "driven"])
 def test_sigint_stops_inverse_dynamics_loops(which):
-    proc = subprocess.Popen(
-        [sys.executable, "-c", ID_CHILD, which],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    try:
-        assert proc.stdout.readline().strip() == "ready"
-        time.sleep(0.25)  # the loops take about 1 s on an idle machine (the batch 0.93 s)
-        sent = time.time()
-        proc.send_signal(signal.SIGINT)
-        out, err = proc.communicate(timeout=120)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-    assert proc.returncode == 0, err
-    report = json.loads(out.strip().splitlines()[-1])
+    # the loops take about 1 s on an idle machine (the batch 0.93 s)
+    report, sent = _interrupted_child(ID_CHILD, which, delay=0.25)
     assert "completed" not in report, f"the loop ended before the signal: {report}"
     latency = report["caught"] - sent
     print(f"{which}: SIGINT latency {latency * 1e3:.1f} ms")
@@ -440,23 +429,7 @@ URDF_CHILD = textwrap.dedent(
 def test_sigint_stops_loading_a_large_urdf():
     """The model analysis of a large URDF (quadratic in its links: plan_kkt's elimination order)
     checks for signals as it goes."""
-    proc = subprocess.Popen(
-        [sys.executable, "-c", URDF_CHILD],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    try:
-        assert proc.stdout.readline().strip() == "ready"
-        time.sleep(0.5)
-        sent = time.time()
-        proc.send_signal(signal.SIGINT)
-        out, err = proc.communicate(timeout=120)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-    assert proc.returncode == 0, err
-    report = json.loads(out.strip().splitlines()[-1])
+    report, sent = _interrupted_child(URDF_CHILD, delay=0.5)
     assert "completed" not in report, f"the load ended before the signal: {report}"
     latency = report["caught"] - sent
     print(f"load_urdf: SIGINT latency {latency * 1e3:.1f} ms")

@@ -10,39 +10,15 @@ import threading
 import armdyn as ad
 import numpy as np
 import pytest
+from conftest import assert_same_run as same_run
 from scipy.integrate import solve_ivp
 
 from benchmarks import common
 
-TABLES = (
-    "t",
-    "u",
-    "v",
-    "q",
-    "qd",
-    "qdd",
-    "drive_forces",
-    "joint_torques",
-    "reaction_forces",
-    "reaction_torques",
-    "position_residual",
-    "velocity_residual",
-    "kinetic_energy",
-    "potential_energy",
-)
-
 
 def assert_same_run(a, b):
     """Every table equal bit for bit, and the same step statistics (the run time aside)."""
-    for name in TABLES:
-        x, y = getattr(a, name), getattr(b, name)
-        assert x.shape == y.shape, name
-        assert np.array_equal(x, y), name
-    sa = {k: v for k, v in a.stats.items() if k != "seconds"}
-    sb = {k: v for k, v in b.stats.items() if k != "seconds"}
-    assert sa == sb
-    assert np.array_equal(a.limit_forces["force"], b.limit_forces["force"])
-    assert np.array_equal(a.events["t"], b.events["t"])
+    same_run(a, b, stats=True)
 
 
 def ur5():
