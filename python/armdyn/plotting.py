@@ -481,12 +481,15 @@ def sizing_torque_figure(report, joint, ax=None):
     return fig if ax is None else ax_
 
 
+def _num(value) -> float:
+    return np.nan if value is None else float(value)
+
+
 def sizing_envelope_figure(report, joint, ax=None):
     """The operating points (ω, T) of ``joint``'s motor over its continuous torque (±,
     dotted), peak torque (±, dashed), speed limit and speed–torque envelope
-    (:func:`armdyn.sizing.motor_envelope`), where the datasheet gives them."""
-    from armdyn.sizing import _num, motor_envelope
-
+    (:func:`armdyn.sizing.motor_envelope`), where the datasheet gives them. Returns the
+    Figure, or with ``ax`` that Axes."""
     if joint not in report.motors:
         _sizing_column(report, joint)  # an unknown joint
         raise _core.ModelError(
@@ -500,7 +503,7 @@ def sizing_envelope_figure(report, joint, ax=None):
         ax = fig.subplots()
     ax.plot(side.speed, side.torque, ".", ms=2.0, color="C0", label="operating points")
     w_max = float(np.max(np.abs(side.speed))) or 1.0
-    t0, w0 = motor_envelope(motor)
+    t0, w0 = report._motor_envelope(joint)  # armdyn.sizing.motor_envelope of its motor
     if np.isfinite(t0) and np.isfinite(w0) and t0 > 0 and w0 > 0:
         ws = np.array([-2.0 * w0, 0.0, 2.0 * w0])
         for sign in (1.0, -1.0):

@@ -552,6 +552,10 @@ class SizingReport:
 
         return sizing_envelope_figure(self, joint)
 
+    def _motor_envelope(self, joint) -> tuple[float, float]:
+        """(T0, ω0) of ``joint``'s motor (:func:`motor_envelope`), for its figure."""
+        return motor_envelope(self.envelopes.get(joint))
+
     def plot(self, joint=None, kind: str = "torque", ax=None, path=None):
         """The report's figures (:mod:`armdyn.plotting`; matplotlib imported here).
 
