@@ -15,12 +15,26 @@ backend is left alone, it works headless); given an ``ax``, a function draws int
 
 from __future__ import annotations
 
+import os
 import textwrap
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from armdyn import _core
+
+if TYPE_CHECKING:  # matplotlib is imported when a figure is drawn
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+    from armdyn.simulation import SimulationResult
+    from armdyn.sizing import SizingReport
+    from armdyn.workprecision import WorkPrecisionResult
+
+#: a path to save a figure to
+PathLike = str | os.PathLike[str]
 
 #: The kinds :func:`plot_result` draws, one panel each (``"reaction"`` and ``"residual"`` are
 #: two panels: force and torque, position and velocity).
@@ -69,7 +83,7 @@ _TITLES = {
 }
 
 
-def _matplotlib_figure():
+def _matplotlib_figure() -> type[Figure]:
     """``matplotlib.figure.Figure``, or an ImportError saying how to install matplotlib."""
     try:
         from matplotlib.figure import Figure
@@ -263,8 +277,11 @@ def _kinds(kind) -> list[str]:
     return panels
 
 
-_PER_JOINT = ("q", "qd", "qdd", "torque", "drive", "limit", "gear", "reaction_force")
-_PER_JOINT += ("reaction_torque",)
+# the kinds whose lines belong to joints (or gears): the ones ``joints`` selects in
+_PER_JOINT = (
+    *("q", "qd", "qdd", "torque", "drive", "limit", "gear"),
+    *("reaction_force", "reaction_torque"),
+)
 
 
 def _select(panel: _Panel, joints, model) -> _Panel:
@@ -344,16 +361,16 @@ def _axes_list(ax, n: int):
 
 
 def plot_result(
-    result,
-    kind="q",
-    joints=None,
+    result: SimulationResult,
+    kind: str | Sequence[str] = "q",
+    joints: str | int | Sequence[str | int] | None = None,
     *,
-    model=None,
-    ax=None,
-    path=None,
+    model: _core.Model | None = None,
+    ax: Axes | Sequence[Axes] | None = None,
+    path: PathLike | None = None,
     title: str | None = None,
-    **line_kw,
-):
+    **line_kw: Any,
+) -> Figure | Axes | list[Axes]:
     """Plot a run's outputs against time, one panel (axes) per kind. See
     :meth:`armdyn.SimulationResult.plot`."""
     panels = _kinds(kind)
@@ -413,16 +430,22 @@ def plot_result(
     return axes[0] if len(axes) == 1 and not isinstance(ax, (list, tuple, np.ndarray)) else axes
 
 
-def work_precision_figure(wp, path=None, title: str | None = None, ax=None):
+def work_precision_figure(
+    wp: WorkPrecisionResult,
+    path: PathLike | None = None,
+    title: str | None = None,
+    ax: Axes | None = None,
+) -> Figure | Axes:
     """Log-log error against CPU seconds, one line per integrator (and formulation) in the
     sweep's order, the references' estimated error as a dotted vertical line. See
     :meth:`armdyn.WorkPrecisionResult.plot`."""
+    fig: Any
     if ax is None:
         fig = _matplotlib_figure()(figsize=(7.5, 4.8))
         ax_ = fig.add_subplot()
     else:
         ax_, fig = ax, ax.figure
-    tab = wp.table
+    tab: Any = wp.table  # a pandas DataFrame
     ok = tab[(tab["status"] == "ok") & np.isfinite(tab["error"]) & (tab["error"] > 0)]
     for (integ, coords), rows in ok.groupby(["integrator", "coordinates"], sort=False):
         label = integ if coords == "cartesian" else f"{integ} ({coords})"
@@ -452,7 +475,7 @@ def _sizing_column(report, joint) -> int:
     return names.index(joint)
 
 
-def sizing_torque_figure(report, joint, ax=None):
+def sizing_torque_figure(report: SizingReport, joint: str, ax: Axes | None = None) -> Figure | Axes:
     """``joint``'s torque/force against time with its effort limit (±, dashed) where finite:
     the figure of :meth:`armdyn.SizingReport.save`."""
     k = _sizing_column(report, joint)
@@ -462,6 +485,7 @@ def sizing_torque_figure(report, joint, ax=None):
             f"SizingReport.plot: the run has no torque for {joint!r} (no drive, torque input "
             "or motor acts on it)"
         )
+    fig: Any
     if ax is None:
         fig = _matplotlib_figure()(figsize=(6.0, 3.0))
         ax_ = fig.subplots()
@@ -485,7 +509,9 @@ def _num(value) -> float:
     return np.nan if value is None else float(value)
 
 
-def sizing_envelope_figure(report, joint, ax=None):
+def sizing_envelope_figure(
+    report: SizingReport, joint: str, ax: Axes | None = None
+) -> Figure | Axes:
     """The operating points (ω, T) of ``joint``'s motor over its continuous torque (±,
     dotted), peak torque (±, dashed), speed limit and speed–torque envelope
     (:func:`armdyn.sizing.motor_envelope`), where the datasheet gives them. Returns the
@@ -549,7 +575,13 @@ def sizing_envelope_figure(report, joint, ax=None):
     return fig
 
 
-def sizing_figure(report, joint=None, kind: str = "torque", ax=None, path=None):
+def sizing_figure(
+    report: SizingReport,
+    joint: str | None = None,
+    kind: str = "torque",
+    ax: Axes | Sequence[Axes] | None = None,
+    path: PathLike | None = None,
+) -> Figure | Axes | list[Axes]:
     """``SizingReport.plot``: ``kind="torque"`` (the joint torque against time and its effort
     limit) or ``"motor"`` (the motor's speed–torque plane); ``joint=None``: one panel per
     joint with a torque (``"torque"``) or with a motor (``"motor"``)."""
@@ -573,7 +605,8 @@ def sizing_figure(report, joint=None, kind: str = "torque", ax=None, path=None):
     else:
         names = [joint]
     one = joint is not None
-    if ax is None and one:
+    fig: Any
+    if ax is None and joint is not None:
         if kind == "torque":
             fig = sizing_torque_figure(report, joint)
         else:
