@@ -19,7 +19,7 @@ import os
 import textwrap
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypeAlias
 
 import numpy as np
 
@@ -29,12 +29,14 @@ if TYPE_CHECKING:  # matplotlib is imported when a figure is drawn
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-    from armdyn.simulation import SimulationResult
-    from armdyn.sizing import SizingReport
-    from armdyn.workprecision import WorkPrecisionResult
+# the results drawn (armdyn.simulation.SimulationResult, armdyn.sizing.SizingReport,
+# armdyn.workprecision.WorkPrecisionResult) are not imported: those modules import this one
+_SimulationResult: TypeAlias = Any
+_SizingReport: TypeAlias = Any
+_WorkPrecisionResult: TypeAlias = Any
 
 #: a path to save a figure to
-PathLike = str | os.PathLike[str]
+_PathLike: TypeAlias = str | os.PathLike[str]
 
 #: The kinds :func:`plot_result` draws, one panel each (``"reaction"`` and ``"residual"`` are
 #: two panels: force and torque, position and velocity).
@@ -361,13 +363,13 @@ def _axes_list(ax, n: int):
 
 
 def plot_result(
-    result: SimulationResult,
+    result: _SimulationResult,
     kind: str | Sequence[str] = "q",
     joints: str | int | Sequence[str | int] | None = None,
     *,
     model: _core.Model | None = None,
     ax: Axes | Sequence[Axes] | None = None,
-    path: PathLike | None = None,
+    path: _PathLike | None = None,
     title: str | None = None,
     **line_kw: Any,
 ) -> Figure | Axes | list[Axes]:
@@ -431,8 +433,8 @@ def plot_result(
 
 
 def work_precision_figure(
-    wp: WorkPrecisionResult,
-    path: PathLike | None = None,
+    wp: _WorkPrecisionResult,
+    path: _PathLike | None = None,
     title: str | None = None,
     ax: Axes | None = None,
 ) -> Figure | Axes:
@@ -475,7 +477,9 @@ def _sizing_column(report, joint) -> int:
     return names.index(joint)
 
 
-def sizing_torque_figure(report: SizingReport, joint: str, ax: Axes | None = None) -> Figure | Axes:
+def sizing_torque_figure(
+    report: _SizingReport, joint: str, ax: Axes | None = None
+) -> Figure | Axes:
     """``joint``'s torque/force against time with its effort limit (±, dashed) where finite:
     the figure of :meth:`armdyn.SizingReport.save`."""
     k = _sizing_column(report, joint)
@@ -510,7 +514,7 @@ def _num(value) -> float:
 
 
 def sizing_envelope_figure(
-    report: SizingReport, joint: str, ax: Axes | None = None
+    report: _SizingReport, joint: str, ax: Axes | None = None
 ) -> Figure | Axes:
     """The operating points (ω, T) of ``joint``'s motor over its continuous torque (±,
     dotted), peak torque (±, dashed), speed limit and speed–torque envelope
@@ -576,11 +580,11 @@ def sizing_envelope_figure(
 
 
 def sizing_figure(
-    report: SizingReport,
+    report: _SizingReport,
     joint: str | None = None,
     kind: str = "torque",
     ax: Axes | Sequence[Axes] | None = None,
-    path: PathLike | None = None,
+    path: _PathLike | None = None,
 ) -> Figure | Axes | list[Axes]:
     """``SizingReport.plot``: ``kind="torque"`` (the joint torque against time and its effort
     limit) or ``"motor"`` (the motor's speed–torque plane); ``joint=None``: one panel per
