@@ -75,7 +75,7 @@ _TITLES = {
     "qdd": "joint accelerations qdd",
     "torque": "applied joint torques/forces",
     "drive": "drive efforts",
-    "limit": "joint-stop torques/forces",
+    "limit": "joint-stop torques/forces (×: the stops' events, impacts and releases)",
     "gear": "gear mesh forces",
     "reaction_force": "joint reaction forces (child's joint frame)",
     "reaction_torque": "joint reaction torques (child's joint frame)",
@@ -394,6 +394,8 @@ def plot_result(
         styles = {"total": dict(color="k", lw=1.4)} if panel.kind == "energy" else {}
         for label, y in zip(panel.labels, panel.ys, strict=True):
             a.plot(t, y, label=label, **{**styles.get(label, {}), **line_kw})
+        if panel.kind == "limit":
+            _stop_events(a, result, panel)
         if panel.log:
             a.set_yscale("log")
         a.set_ylabel(panel.ylabel)
@@ -430,6 +432,19 @@ def plot_result(
     if ax is None:
         return fig
     return axes[0] if len(axes) == 1 and not isinstance(ax, (list, tuple, np.ndarray)) else axes
+
+
+def _stop_events(ax: Axes, result: _SimulationResult, panel: _Panel) -> None:
+    """The located stop events of the panel's joints (``result.events["limits"]``) as ×
+    markers on the time axis, in the colour of the joint's line (the impacts are impulses,
+    not in ``limit_forces``)."""
+    events = result.events.get("limits", {}) if isinstance(result.events, dict) else {}
+    t_ev, joint_ev = np.asarray(events.get("t", []), dtype=float), list(events.get("joint", []))
+    lines = ax.get_lines()[-len(panel.labels) :] if panel.labels else []
+    for line, joint in zip(lines, panel.joints, strict=True):
+        at = t_ev[[j == joint for j in joint_ev]] if len(t_ev) else t_ev
+        if len(at):
+            ax.plot(at, np.zeros_like(at), "x", ms=6, color=line.get_color(), label="_events")
 
 
 def work_precision_figure(

@@ -61,9 +61,14 @@ def runs():
     return out
 
 
-def lines(ax):
-    """(label, x, y) of every line of ax, read back from matplotlib."""
-    return [(ln.get_label(), *ln.get_xydata().T) for ln in ax.get_lines()]
+def lines(ax, markers=False):
+    """(label, x, y) of every data line of ax (with ``markers``: of the event markers, labelled
+    "_events"), read back from matplotlib."""
+    return [
+        (ln.get_label(), *ln.get_xydata().T)
+        for ln in ax.get_lines()
+        if (ln.get_label() == "_events") == markers
+    ]
 
 
 def check_columns(ax, t, y, labels):
@@ -137,6 +142,12 @@ def test_limit_kind_draws_the_stop_torque_which_holds_m_g_l_sin_q(runs, coordina
     # resting on its lower stop the bob is held by the gravity torque (closed form)
     ((_, _, y),) = lines(ax)
     assert y[-1] == pytest.approx(MG * np.sin(L_STOP), rel=1e-9)
+    # its landing on the stop (an impulse, not in limit_forces) is marked on the time axis
+    assert list(r.events["limits"]["kind"]) == ["rest"]
+    ((label, x, y),) = lines(ax, markers=True)
+    np.testing.assert_array_equal(x, r.events["limits"]["t"])
+    np.testing.assert_array_equal(y, [0.0])
+    assert label not in [t.get_text() for t in ax.get_legend().get_texts()]
 
 
 @pytest.mark.parametrize("coordinates", COORDINATES)
