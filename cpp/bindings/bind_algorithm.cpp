@@ -203,13 +203,15 @@ void bind_algorithm(py::module_& m) {
              if (!md) throw ModelError("Data: no model");
              return std::make_unique<DataPy>(std::move(md));
            }),
-           py::arg("model"))
-      .def_property_readonly("model", [](const DataPy& d) { return d.model; });
+           py::arg("model"),
+           "A workspace for `model` (an armdyn.Model); ModelError if model is None.")
+      .def_property_readonly(
+          "model", [](const DataPy& d) { return d.model; }, "The model this workspace serves.");
 
   m.def(
       "forward_dynamics",
-      [](const ModelHolder& md, const py::object& q, const py::object& qd, const py::object& tau,
-         const py::object& t, const std::string& method, const py::object& data) {
+      [](const ModelHolder& md, const ArrayLike& q, const ArrayLike& qd, const ArrayLike& tau,
+         const FloatOrArray& t, const std::string& method, const OptData& data) {
         constexpr const char* fn = "forward_dynamics";
         Data& d = data_for(md, data, fn);
         const DynamicsMethod mth = dynamics_method(method, fn);
@@ -269,8 +271,8 @@ void bind_algorithm(py::module_& m) {
 
   m.def(
       "inverse_dynamics",
-      [](const ModelHolder& md, const py::object& q, const py::object& qd, const py::object& qdd,
-         const py::object& t, const std::string& method, const py::object& data) {
+      [](const ModelHolder& md, const ArrayLike& q, const ArrayLike& qd, const ArrayLike& qdd,
+         const FloatOrArray& t, const std::string& method, const OptData& data) {
         constexpr const char* fn = "inverse_dynamics";
         Data& d = data_for(md, data, fn);
         const DynamicsMethod mth = dynamics_method(method, fn, false);
@@ -295,7 +297,7 @@ void bind_algorithm(py::module_& m) {
 
   m.def(
       "mass_matrix",
-      [](const ModelHolder& md, const py::object& q, const py::object& data) {
+      [](const ModelHolder& md, const ArrayLike& q, const OptData& data) {
         constexpr const char* fn = "mass_matrix";
         Data& d = data_for(md, data, fn);
         const Model& mm = *md;
@@ -320,8 +322,7 @@ void bind_algorithm(py::module_& m) {
 
   m.def(
       "frame_pose",
-      [](const ModelHolder& md, const py::object& q, const py::object& frame,
-         const py::object& data) {
+      [](const ModelHolder& md, const ArrayLike& q, const FrameRef& frame, const OptData& data) {
         constexpr const char* fn = "frame_pose";
         Data& d = data_for(md, data, fn);
         const Model& mm = *md;
@@ -338,8 +339,7 @@ void bind_algorithm(py::module_& m) {
 
   m.def(
       "frame_jacobian",
-      [](const ModelHolder& md, const py::object& q, const py::object& frame,
-         const py::object& data) {
+      [](const ModelHolder& md, const ArrayLike& q, const FrameRef& frame, const OptData& data) {
         constexpr const char* fn = "frame_jacobian";
         Data& d = data_for(md, data, fn);
         const Model& mm = *md;
@@ -357,8 +357,7 @@ void bind_algorithm(py::module_& m) {
 
   m.def(
       "frame_pose_cartesian",
-      [](const ModelHolder& md, const py::object& u, const py::object& frame,
-         const py::object& data) {
+      [](const ModelHolder& md, const ArrayLike& u, const FrameRef& frame, const OptData& data) {
         constexpr const char* fn = "frame_pose_cartesian";
         Data& d = data_for(md, data, fn);
         const Model& mm = *md;
@@ -373,8 +372,7 @@ void bind_algorithm(py::module_& m) {
 
   m.def(
       "frame_jacobian_cartesian",
-      [](const ModelHolder& md, const py::object& u, const py::object& frame,
-         const py::object& data) {
+      [](const ModelHolder& md, const ArrayLike& u, const FrameRef& frame, const OptData& data) {
         constexpr const char* fn = "frame_jacobian_cartesian";
         Data& d = data_for(md, data, fn);
         const Model& mm = *md;

@@ -183,9 +183,10 @@ void bind_dynamics(py::module_& m) {
   m.def(
       "_simulate",
       [](const Model& md, double t_end, const std::string& integrator, double rtol, double atol,
-         double dt, double output_dt, py::object u0, py::object v0, const std::string& projection,
-         long max_steps, double max_step, bool merge_welded, const std::string& coordinates,
-         py::object q_start, bool limits, double restitution, py::object progress) {
+         double dt, double output_dt, const OptArrayLike& u0, const OptArrayLike& v0,
+         const std::string& projection, long max_steps, double max_step, bool merge_welded,
+         const std::string& coordinates, const OptArrayLike& q_start, bool limits,
+         double restitution, const OptProgress& progress) {
         // armdyn.simulate answers a model with no bodies itself (nothing to integrate)
         if (md.nb == 0)
           throw ModelError("_simulate: the model has no bodies (use armdyn.simulate)");
@@ -233,8 +234,8 @@ void bind_dynamics(py::module_& m) {
          double dt, double output_dt, const py::array_t<double, py::array::c_style>& u0,
          const py::array_t<double, py::array::c_style>& v0, const std::string& projection,
          long max_steps, double max_step, bool merge_welded, const std::string& coordinates,
-         py::object q_start, bool limits, double restitution, std::vector<std::string> errors,
-         int threads, py::object progress) {
+         const OptArrayLike& q_start, bool limits, double restitution,
+         std::vector<std::string> errors, int threads, const OptProgress& progress) {
         if (md.nb == 0) throw ModelError("_rollout: the model has no bodies (use armdyn.rollout)");
         const SimOptions base = sim_options(ARMDYN_SIM_OPTION_ARGS);
         if (u0.ndim() != 2 || u0.shape(1) != md.nq)
@@ -368,7 +369,7 @@ void bind_dynamics(py::module_& m) {
 
   m.def(
       "state_from_joints",
-      [](const Model& md, py::object q, py::object qd) {
+      [](const Model& md, const ArrayLike& q, const OptArrayLike& qd) {
         require_joint_space(md, "state_from_joints", true);
         const IndependentCoords& ic = md.independent;
         const long nq = ic.nq(), n = ic.nv();
@@ -385,11 +386,13 @@ void bind_dynamics(py::module_& m) {
       py::arg("model"), py::arg("q"), py::arg("qd") = py::none(),
       "Cartesian state (u, v) of a joint-space tree model from joint-space q (n_coords) and qd "
       "(n_dofs; default zero): a coupled model's independent coordinates, the followers set by "
-      "their couplings.");
+      "their couplings. Returns (u (nq,), v (nv,)) float64 arrays: per body CoM [m] and unit "
+      "Euler parameters; CoM velocity [m/s, world] and angular velocity [rad/s, body]. "
+      "ModelError on a model without a joint space or wrong shapes.");
 
   m.def(
       "joint_coordinates",
-      [](const Model& md, py::object u, py::object v) {
+      [](const Model& md, const ArrayLike& u, const ArrayLike& v) {
         VecX q, qd;
         joint_coordinates(md, to_vec(u, "u", md.nq), to_vec(v, "v", md.nv), q, qd);
         const IndependentCoords& ic = md.independent;
@@ -409,7 +412,7 @@ void bind_dynamics(py::module_& m) {
 
   m.def(
       "evaluate_constraints",
-      [](const Model& md, py::object u, py::object v, double t) {
+      [](const Model& md, const ArrayLike& u, const ArrayLike& v, double t) {
         const VecX uu = to_vec(u, "u", md.nq), vv = to_vec(v, "v", md.nv);
         check_state(md, uu, vv, "evaluate_constraints");
         std::vector<BodyKin> kin;
@@ -425,11 +428,13 @@ void bind_dynamics(py::module_& m) {
         return d;
       },
       py::arg("model"), py::arg("u"), py::arg("v"), py::arg("t") = 0.0,
-      "f (nc,), zeta (nc, nv), xi (nc,) and rhs (nc,) with zeta v = rhs and zeta v' = -xi.");
+      "The constraints at the Cartesian state u (nq,), v (nv,) and time t [s]: a dict of float64 "
+      "arrays f (nc,) (the residuals, [m or rad]), zeta (nc, nv) (the Jacobian), xi (nc,) and "
+      "rhs (nc,), with zeta v = rhs and zeta v' = -xi. ModelError on wrong shapes.");
 
   m.def(
       "body_accelerations",
-      [](const Model& md, py::object u, py::object v, double t) {
+      [](const Model& md, const ArrayLike& u, const ArrayLike& v, double t) {
         const VecX uu = to_vec(u, "u", md.nq), vv = to_vec(v, "v", md.nv);
         check_state(md, uu, vv, "body_accelerations");
         Data d(md);
@@ -438,7 +443,9 @@ void bind_dynamics(py::module_& m) {
         return py::make_tuple(to_numpy(vd), to_numpy(d.delta));
       },
       py::arg("model"), py::arg("u"), py::arg("v"), py::arg("t") = 0.0,
-      "Solve the KKT system at (u, v, t): returns (v' (nv,), multipliers delta (nc,)).");
+      "Solve the KKT system at the Cartesian state u (nq,), v (nv,) and time t [s]: returns "
+      "(v' (nv,) the bodies' accelerations [m/s^2, rad/s^2], delta (nc,) the Lagrange "
+      "multipliers [N, N m]). ModelError on wrong shapes, SolverError on a singular system.");
 
   m.def(
       "body_mass_matrix",
@@ -450,11 +457,13 @@ void bind_dynamics(py::module_& m) {
         }
         return to_numpy(g);
       },
-      py::arg("model"), "Gamma = blockdiag(m_i I3, J_i) (nv, nv), constant.");
+      py::arg("model"),
+      "The constant Cartesian mass matrix Gamma = blockdiag(m_i I3, J_i) (nv, nv) [kg, kg m^2] "
+      "of the bodies (J_i about the CoM in body axes).");
 
   m.def(
       "body_forces",
-      [](const Model& md, py::object u, py::object v, double t) {
+      [](const Model& md, const ArrayLike& u, const ArrayLike& v, double t) {
         const VecX uu = to_vec(u, "u", md.nq), vv = to_vec(v, "v", md.nv);
         check_state(md, uu, vv, "body_forces");
         Data d(md);
@@ -463,18 +472,22 @@ void bind_dynamics(py::module_& m) {
         return to_numpy(d.eta);
       },
       py::arg("model"), py::arg("u"), py::arg("v"), py::arg("t") = 0.0,
-      "eta (nv,): gravity, gyroscopic -w x Jw, loads, springs, joint forces.");
+      "The applied Cartesian forces eta (nv,) at the state u (nq,), v (nv,) and time t [s]: per "
+      "body the force [N, world] and torque [N m, body axes] of gravity, the gyroscopic -w x Jw, "
+      "loads, springs and joint forces. ModelError on wrong shapes.");
 
   m.def(
       "energy",
-      [](const Model& md, py::object u, py::object v) {
+      [](const Model& md, const ArrayLike& u, const ArrayLike& v) {
         const VecX uu = to_vec(u, "u", md.nq), vv = to_vec(v, "v", md.nv);
         Data d(md);
         double ke, pe;
         energy(md, d, uu.data(), vv.data(), ke, pe);
         return py::make_tuple(ke, pe);
       },
-      py::arg("model"), py::arg("u"), py::arg("v"), "(kinetic, potential) energy [J].");
+      py::arg("model"), py::arg("u"), py::arg("v"),
+      "(kinetic, potential) energy [J] at the Cartesian state u (nq,), v (nv,); the potential "
+      "includes gravity and springs. ModelError on wrong shapes.");
 }
 
 }  // namespace armdyn

@@ -109,7 +109,7 @@ struct ActuatorView {
   double gear_ratio = 1.0, rotor_inertia = 0.0, efficiency = 1.0;
   double friction_viscous = 0.0, friction_coulomb = 0.0, friction_smoothing = 0.0;
   bool gyroscopic = false;
-  py::object motor = py::none();
+  OptMotor motor = py::reinterpret_borrow<OptMotor>(py::none());
 };
 
 // the independent degree of freedom (into qd, model.dof_names) that moves coordinate c
@@ -134,6 +134,24 @@ double motor_field(const py::object& v, const char* name) {
 py::object motor_get(const MotorSpec& s, double MotorSpec::* p) {
   const double v = s.*p;
   return std::isnan(v) ? py::none() : py::object(py::float_(v));
+}
+
+// the docstring of a Motor field (MotorSpec::fields())
+std::string motor_field_doc(const std::string& n) {
+  static const std::pair<const char*, const char*> docs[] = {
+      {"torque_constant", "Torque constant k_t [N m/A] (motor side), or None."},
+      {"resistance", "Terminal resistance [ohm], or None."},
+      {"voltage", "Supply voltage [V], or None."},
+      {"no_load_speed", "No-load speed at the supply voltage [rad/s], or None."},
+      {"continuous_torque", "Rated continuous torque [N m] (motor side), or None."},
+      {"peak_torque", "Peak torque [N m] (motor side), or None."},
+      {"max_speed", "Maximum permissible speed [rad/s], or None."},
+      {"thermal_resistance", "Thermal resistance winding to ambient [K/W], or None."},
+      {"thermal_time_constant", "Thermal time constant of the winding [s], or None."},
+  };
+  for (const auto& [k, d] : docs)
+    if (n == k) return d;
+  return "Datasheet value '" + n + "' (SI units, motor side), or None.";
 }
 
 std::string motor_repr(const MotorSpec& s) {
@@ -165,9 +183,8 @@ void bind_model(py::module_& m) {
         "ModelBuilder.add_actuator(..., motor=armdyn.Motor(...)); it does not enter the "
         "dynamics (the rotor inertia, gear ratio and friction do), the motor-side sizing reads "
         "it. Keyword-only constructor; comparable (==) and picklable.");
-    motor.def(py::init([](const std::string& name, py::object kt, py::object r, py::object u,
-                          py::object w0, py::object tc, py::object tp, py::object wmax,
-                          py::object rth, py::object tau_th) {
+    motor.def(py::init([](const std::string& name, OptFloat kt, OptFloat r, OptFloat u, OptFloat w0,
+                          OptFloat tc, OptFloat tp, OptFloat wmax, OptFloat rth, OptFloat tau_th) {
                 MotorSpec s;
                 s.name = name;
                 const py::object given[] = {kt, r, u, w0, tc, tp, wmax, rth, tau_th};
@@ -181,11 +198,22 @@ void bind_model(py::module_& m) {
               py::arg("no_load_speed") = py::none(), py::arg("continuous_torque") = py::none(),
               py::arg("peak_torque") = py::none(), py::arg("max_speed") = py::none(),
               py::arg("thermal_resistance") = py::none(),
-              py::arg("thermal_time_constant") = py::none());
-    motor.def_readonly("name", &MotorSpec::name);
+              py::arg("thermal_time_constant") = py::none(),
+              "A motor's datasheet values (every one optional, None when not given; given ones "
+              "finite and > 0, else ModelError naming the field): torque_constant [N m/A], "
+              "resistance [ohm, terminal], voltage [V, supply], no_load_speed [rad/s], "
+              "continuous_torque [N m], peak_torque [N m], max_speed [rad/s], thermal_resistance "
+              "[K/W, winding to ambient], thermal_time_constant [s], all motor side.");
+    motor.def_readonly("name", &MotorSpec::name, "The motor's name ('' when not given).");
     for (const auto& [n, p] : MotorSpec::fields()) {
       auto ptr = p;
-      motor.def_property_readonly(n, [ptr](const MotorSpec& s) { return motor_get(s, ptr); });
+      const std::string doc = motor_field_doc(n);
+      motor.def_property_readonly(
+          n,
+          [ptr](const MotorSpec& s) {
+            return py::reinterpret_steal<OptFloat>(motor_get(s, ptr).release());
+          },
+          doc.c_str());
     }
     motor.def("__repr__", &motor_repr);
     motor.def("__eq__", [](const MotorSpec& a, py::object b) {
@@ -217,17 +245,30 @@ void bind_model(py::module_& m) {
       "rotor_inertia [kg m^2], efficiency, friction_viscous [N m s/rad, motor side], "
       "friction_coulomb [N m, motor side], friction_smoothing [rad/s, motor side], gyroscopic, "
       "motor (armdyn.Motor or None).")
-      .def_readonly("joint", &ActuatorView::joint)
-      .def_readonly("rotor_joint", &ActuatorView::rotor_joint)
-      .def_readonly("dof", &ActuatorView::dof)
-      .def_readonly("gear_ratio", &ActuatorView::gear_ratio)
-      .def_readonly("rotor_inertia", &ActuatorView::rotor_inertia)
-      .def_readonly("efficiency", &ActuatorView::efficiency)
-      .def_readonly("friction_viscous", &ActuatorView::friction_viscous)
-      .def_readonly("friction_coulomb", &ActuatorView::friction_coulomb)
-      .def_readonly("friction_smoothing", &ActuatorView::friction_smoothing)
-      .def_readonly("gyroscopic", &ActuatorView::gyroscopic)
-      .def_readonly("motor", &ActuatorView::motor)
+      .def_readonly("joint", &ActuatorView::joint, "Name of the actuated joint.")
+      .def_readonly("rotor_joint", &ActuatorView::rotor_joint,
+                    "Name of the rotor's revolute joint and body ('<joint>_rotor').")
+      .def_readonly(
+          "dof", &ActuatorView::dof,
+          "Index into the independent qd / model.dof_names of the dof the actuator moves.")
+      .def_readonly("gear_ratio", &ActuatorView::gear_ratio,
+                    "Gear ratio N = rotor speed / joint speed (negative: reversed rotor; rad/m for "
+                    "a prismatic joint).")
+      .def_readonly("rotor_inertia", &ActuatorView::rotor_inertia,
+                    "Rotor inertia J about its axis [kg m^2].")
+      .def_readonly("efficiency", &ActuatorView::efficiency,
+                    "Gearbox efficiency in (0, 1] (motor-side maths only, not in the dynamics).")
+      .def_readonly("friction_viscous", &ActuatorView::friction_viscous,
+                    "Viscous friction [N m s/rad], motor side (reflected as N^2 b).")
+      .def_readonly("friction_coulomb", &ActuatorView::friction_coulomb,
+                    "Coulomb friction [N m], motor side (reflected as |N| c).")
+      .def_readonly(
+          "friction_smoothing", &ActuatorView::friction_smoothing,
+          "Coulomb smoothing velocity [rad/s], motor side: tanh(omega / friction_smoothing).")
+      .def_readonly("gyroscopic", &ActuatorView::gyroscopic,
+                    "True: the rotor turns on the joint's parent body (full kinetic energy); "
+                    "False: the gear-reduced (armature) model.")
+      .def_readonly("motor", &ActuatorView::motor, "The attached armdyn.Motor, or None.")
       .def("__repr__", [](const ActuatorView& a) {
         auto num = [](double x) { return py::repr(py::float_(x)).cast<std::string>(); };
         return msg("<armdyn.Actuator on '", a.joint, "': gear_ratio ", num(a.gear_ratio),
@@ -238,11 +279,35 @@ void bind_model(py::module_& m) {
   py::class_<Profile>(m, "Profile", "A time profile y(t) with derivatives, evaluated in C++.")
       .def(
           "eval",
-          [](const Profile& p, double t) {
-            const ProfileValue v = p.eval(t);
-            return py::make_tuple(v.y, v.yd, v.ydd);
+          [](const Profile& p, const FloatOrArray& t) -> ProfileValues {
+            const char* who = "Profile.eval: t";
+            if (t.is_none() || py::isinstance<py::str>(t) || py::isinstance<py::bytes>(t))
+              throw ModelError(msg(who, ": expected a number or an array of numbers, got ",
+                                   py::repr(t).cast<std::string>()));
+            const bool scalar = !py::isinstance<py::array>(t) && as_array(t, who).ndim() == 0;
+            if (scalar) {
+              const ProfileValue v = p.eval(*as_array(t, who).data());
+              return py::reinterpret_steal<ProfileValues>(
+                  py::make_tuple(v.y, v.yd, v.ydd).release());
+            }
+            const py::array_t<double> ta = as_array(t, who);
+            std::vector<py::ssize_t> shape(ta.shape(), ta.shape() + ta.ndim());
+            py::array_t<double> y(shape), yd(shape), ydd(shape);
+            const double* tp = ta.data();
+            double *py_ = y.mutable_data(), *pyd = yd.mutable_data(), *pydd = ydd.mutable_data();
+            for (py::ssize_t k = 0; k < ta.size(); ++k) {
+              const ProfileValue v = p.eval(tp[k]);
+              py_[k] = v.y;
+              pyd[k] = v.yd;
+              pydd[k] = v.ydd;
+            }
+            return py::reinterpret_steal<ProfileValues>(py::make_tuple(y, yd, ydd).release());
           },
-          py::arg("t"), "Return (y, dy/dt, d2y/dt2) at time t.")
+          py::arg("t"),
+          "The profile's value y, rate dy/dt and second derivative d2y/dt2 at time t [s]: a "
+          "tuple of 3 floats for a number t; for an array t (any shape), a tuple of 3 float64 "
+          "arrays of t's shape (one evaluation per element). Units follow the profile's use "
+          "(rad, m, N m, N or a load scale, per s and s^2). ModelError if t is not numeric.")
       .def("__repr__", [](const Profile& p) { return "<armdyn.Profile " + p.describe() + ">"; })
       .def(py::pickle(
           [](const Profile& p) {
@@ -271,7 +336,8 @@ void bind_model(py::module_& m) {
           }));
 
   auto prof = m.def_submodule("profiles", "Built-in drive and load profiles (evaluated in C++).");
-  prof.def("constant", &Profile::constant, py::arg("value"));
+  prof.def("constant", &Profile::constant, py::arg("value"),
+           "The constant profile y(t) = value (zero derivatives).");
   prof.def("cubic", &Profile::cubic, py::arg("y0"), py::arg("y1"), py::arg("t0"), py::arg("t1"),
            "Cubic rest-to-rest from y0 at t0 to y1 at t1 (3s^2 - 2s^3); constant outside.");
   prof.def("quintic", &Profile::quintic, py::arg("y0"), py::arg("y1"), py::arg("t0"), py::arg("t1"),
@@ -281,22 +347,31 @@ void bind_model(py::module_& m) {
            "offset + amplitude * sin(2 pi frequency t + phase); frequency in Hz.");
   prof.def(
       "spline",
-      [](py::object t, py::object y) {
+      [](const ArrayLike& t, const ArrayLike& y) {
         const VecX tv = to_vec(t, "spline t"), yv = to_vec(y, "spline y");
         return Profile::spline(std::vector<double>(tv.data(), tv.data() + tv.size()),
                                std::vector<double>(yv.data(), yv.data() + yv.size()));
       },
       py::arg("t"), py::arg("y"),
-      "Natural cubic spline through samples; linear extrapolation outside.");
+      "Natural cubic spline through the samples (t[k], y[k]), t (n,) increasing [s], y (n,); "
+      "linear extrapolation outside [t[0], t[-1]].");
 
   py::class_<Model, std::shared_ptr<Model>>(m, "Model",
                                             "Immutable multibody model (from ModelBuilder.finalize "
                                             "or load_urdf).")
-      .def_readonly("nb", &Model::nb)
-      .def_readonly("nq", &Model::nq)
-      .def_readonly("nv", &Model::nv)
-      .def_readonly("nc", &Model::nc)
-      .def_readonly("nc_joint", &Model::nc_joint)
+      .def_readonly("nb", &Model::nb, "Number of bodies.")
+      .def_readonly(
+          "nq", &Model::nq,
+          "Length of the Cartesian position state u: 7 per body (CoM [m], unit Euler parameters).")
+      .def_readonly("nv", &Model::nv,
+                    "Length of the Cartesian velocity state v: 6 per body (CoM velocity [m/s, "
+                    "world], angular velocity [rad/s, body]).")
+      .def_readonly(
+          "nc", &Model::nc,
+          "Number of constraint rows: the joints' and ideal gears' rows, then the drives'.")
+      .def_readonly(
+          "nc_joint", &Model::nc_joint,
+          "Number of the joints' and ideal gears' constraint rows (the rows before the drives').")
       // the joint-space functions take the independent q and qd (a coupled model's followers
       // removed; all of them without couplings); simulation results report every joint's
       .def_property_readonly(
@@ -327,21 +402,25 @@ void bind_model(py::module_& m) {
             return r;
           },
           "Index of each entry of q in joint_coord_names.")
-      .def_property_readonly("couplings",
-                             [](const Model& md) {
-                               py::list r;
-                               for (const auto& g : md.gear_constraints) {
-                                 if (!g.coupling) continue;
-                                 py::dict c;
-                                 c["name"] = g.name;
-                                 c["follower"] = md.joints[md.coords[g.coord_a].joint].name;
-                                 c["leader"] = md.joints[md.coords[g.coord_b].joint].name;
-                                 c["multiplier"] = g.multiplier();
-                                 c["offset"] = g.offset;
-                                 r.append(c);
-                               }
-                               return r;
-                             })
+      .def_property_readonly(
+          "couplings",
+          [](const Model& md) {
+            py::list r;
+            for (const auto& g : md.gear_constraints) {
+              if (!g.coupling) continue;
+              py::dict c;
+              c["name"] = g.name;
+              c["follower"] = md.joints[md.coords[g.coord_a].joint].name;
+              c["leader"] = md.joints[md.coords[g.coord_b].joint].name;
+              c["multiplier"] = g.multiplier();
+              c["offset"] = g.offset;
+              r.append(c);
+            }
+            return r;
+          },
+          "The couplings (add_coupling, URDF <mimic>): a list of dicts with 'name', 'follower' and "
+          "'leader' (joint names), 'multiplier' and 'offset' [rad or m] of q_follower = multiplier "
+          "* q_leader + offset.")
       .def_property_readonly(
           "actuators",
           [](const Model& md) {
@@ -358,7 +437,8 @@ void bind_model(py::module_& m) {
               v.friction_coulomb = a.friction_coulomb;
               v.friction_smoothing = a.friction_smoothing;
               v.gyroscopic = a.gyroscopic;
-              if (a.has_motor) v.motor = py::cast(a.motor);
+              if (a.has_motor)
+                v.motor = py::reinterpret_steal<OptMotor>(py::cast(a.motor).release());
               r.push_back(v);
             }
             return r;
@@ -385,25 +465,35 @@ void bind_model(py::module_& m) {
           "actuated dof and 0 elsewhere [kg m^2, or kg for a prismatic joint]: the armature of "
           "Pinocchio's model (the gear-reduced rotor model adds exactly this to the mass "
           "matrix's diagonal).")
-      .def_property_readonly("n_drives", [](const Model& md) { return md.drives.size(); })
-      .def_property_readonly("body_names",
-                             [](const Model& md) {
-                               std::vector<std::string> r;
-                               for (const auto& b : md.bodies) r.push_back(b.name);
-                               return r;
-                             })
-      .def_property_readonly("joint_names",
-                             [](const Model& md) {
-                               std::vector<std::string> r;
-                               for (const auto& j : md.joints) r.push_back(j.name);
-                               return r;
-                             })
-      .def_property_readonly("joint_types",
-                             [](const Model& md) {
-                               std::vector<std::string> r;
-                               for (const auto& j : md.joints) r.push_back(joint_type_name(j.type));
-                               return r;
-                             })
+      .def_property_readonly(
+          "n_drives", [](const Model& md) { return md.drives.size(); },
+          "Number of drives (prescribed joint coordinates, add_drive).")
+      .def_property_readonly(
+          "body_names",
+          [](const Model& md) {
+            std::vector<std::string> r;
+            for (const auto& b : md.bodies) r.push_back(b.name);
+            return r;
+          },
+          "Names of the bodies, in the order they were added (index = body index; the URDF's links "
+          "with mass or a child joint).")
+      .def_property_readonly(
+          "joint_names",
+          [](const Model& md) {
+            std::vector<std::string> r;
+            for (const auto& j : md.joints) r.push_back(j.name);
+            return r;
+          },
+          "Names of the joints, in the order they were added (index = joint index).")
+      .def_property_readonly(
+          "joint_types",
+          [](const Model& md) {
+            std::vector<std::string> r;
+            for (const auto& j : md.joints) r.push_back(joint_type_name(j.type));
+            return r;
+          },
+          "Type of each joint of joint_names: 'revolute', 'prismatic', 'spherical', 'fixed', "
+          "'free', ...")
       .def_property_readonly(
           "coord_names",
           [](const Model& md) {
@@ -424,12 +514,14 @@ void bind_model(py::module_& m) {
           },
           "Names of the entries of qd, qdd and tau (n_dofs): a floating base's 'name:vx' .. "
           "'name:wz', then the independent joint coordinates.")
-      .def_property_readonly("frame_names",
-                             [](const Model& md) {
-                               std::vector<std::string> r;
-                               for (const auto& f : md.frames) r.push_back(f.name);
-                               return r;
-                             })
+      .def_property_readonly(
+          "frame_names",
+          [](const Model& md) {
+            std::vector<std::string> r;
+            for (const auto& f : md.frames) r.push_back(f.name);
+            return r;
+          },
+          "Names of the named frames (add_frame, URDF links), in the order they were added.")
       .def(
           "frame",
           [](const Model& md, const std::string& name) {
@@ -443,45 +535,70 @@ void bind_model(py::module_& m) {
           "A named frame's placement on its body: 'index' (into frame_names), 'body' (or "
           "'ground'), 'point' (its origin in the body's frame, relative to the centre of mass; "
           "the world for 'ground') and 'rotation' (its axes as columns in the body's axes).")
-      .def_property_readonly("drive_names",
-                             [](const Model& md) {
-                               std::vector<std::string> r;
-                               for (const auto& d : md.drives) r.push_back(d.name);
-                               return r;
-                             })
-      .def_property_readonly("drive_coords",
-                             [](const Model& md) {
-                               std::vector<int> r;
-                               for (const auto& d : md.drives)
-                                 r.push_back(md.joints[d.joint].dof0 + d.coord);
-                               return r;
-                             })
-      .def_property_readonly("gravity", [](const Model& md) { return to_numpy(VecX(md.gravity)); })
-      .def_property_readonly("masses",
-                             [](const Model& md) {
-                               VecX r(md.nb);
-                               for (int i = 0; i < md.nb; ++i) r[i] = md.bodies[i].mass;
-                               return to_numpy(r);
-                             })
-      .def_property_readonly("inertias",
-                             [](const Model& md) {
-                               py::array_t<double> a({md.nb, 3, 3});
-                               for (int i = 0; i < md.nb; ++i)
-                                 for (int r = 0; r < 3; ++r)
-                                   for (int c = 0; c < 3; ++c)
-                                     a.mutable_at(i, r, c) = md.bodies[i].inertia(r, c);
-                               return a;
-                             })
-      .def_readonly("is_tree", &Model::is_tree)
-      .def_readonly("joint_space", &Model::joint_space_ok)
+      .def_property_readonly(
+          "drive_names",
+          [](const Model& md) {
+            std::vector<std::string> r;
+            for (const auto& d : md.drives) r.push_back(d.name);
+            return r;
+          },
+          "Names of the drives, in the order they were added (columns of "
+          "SimulationResult.drive_forces).")
+      .def_property_readonly(
+          "drive_coords",
+          [](const Model& md) {
+            std::vector<int> r;
+            for (const auto& d : md.drives) r.push_back(md.joints[d.joint].dof0 + d.coord);
+            return r;
+          },
+          "Index into the joint dofs (model.joint_dof_names) of each drive's coordinate.")
+      .def_property_readonly(
+          "gravity", [](const Model& md) { return to_numpy(VecX(md.gravity)); },
+          "(3,) gravity vector in world axes [m/s^2].")
+      .def_property_readonly(
+          "masses",
+          [](const Model& md) {
+            VecX r(md.nb);
+            for (int i = 0; i < md.nb; ++i) r[i] = md.bodies[i].mass;
+            return to_numpy(r);
+          },
+          "(nb,) body masses [kg], in body_names order.")
+      .def_property_readonly(
+          "inertias",
+          [](const Model& md) {
+            py::array_t<double> a({md.nb, 3, 3});
+            for (int i = 0; i < md.nb; ++i)
+              for (int r = 0; r < 3; ++r)
+                for (int c = 0; c < 3; ++c) a.mutable_at(i, r, c) = md.bodies[i].inertia(r, c);
+            return a;
+          },
+          "(nb, 3, 3) body inertia tensors about the centre of mass in body axes [kg m^2].")
+      .def_readonly("is_tree", &Model::is_tree,
+                    "True when every body has exactly one joint path to ground (no closed loops).")
+      .def_readonly("joint_space", &Model::joint_space_ok,
+                    "True when the joint-space functions (forward_dynamics, inverse_dynamics, "
+                    "mass_matrix, state_from_joints) take the model: a tree of revolute, "
+                    "prismatic, cylindrical and fixed joints (a free joint from ground as a "
+                    "floating base) defined parent to child.")
       // why simulate(coordinates="joint") does not take the model; empty when it does
-      .def_property_readonly("joint_path_reason",
-                             [](const Model& md) { return md.joint_path_reason(); })
-      .def_readonly("mobility", &Model::mobility)
-      .def_readonly("mobility_driven", &Model::mobility_driven)
-      .def_readonly("redundant_rows", &Model::redundant_rows)
-      .def_property_readonly("u0", [](const Model& md) { return to_numpy(md.u0); })
-      .def_property_readonly("v0", [](const Model& md) { return to_numpy(md.v0); })
+      .def_property_readonly(
+          "joint_path_reason", [](const Model& md) { return md.joint_path_reason(); },
+          "Why simulate(coordinates='joint') does not take the model; '' when it does.")
+      .def_readonly("mobility", &Model::mobility,
+                    "Degrees of freedom of the mechanism without its drives.")
+      .def_readonly("mobility_driven", &Model::mobility_driven,
+                    "Degrees of freedom left with the drives (0: fully prescribed motion).")
+      .def_readonly(
+          "redundant_rows", &Model::redundant_rows,
+          "Names of the redundant constraint rows finalize() found (empty when the rows are "
+          "independent).")
+      .def_property_readonly(
+          "u0", [](const Model& md) { return to_numpy(md.u0); },
+          "(nq,) the assembled Cartesian positions u: per body CoM [m] and unit Euler parameters.")
+      .def_property_readonly(
+          "v0", [](const Model& md) { return to_numpy(md.v0); },
+          "(nv,) the initial Cartesian velocities v (zero unless set): per body CoM velocity [m/s] "
+          "and angular velocity [rad/s].")
       // URDF <limit> per joint coordinate: +-inf where none (the joints store +-1e300), effort
       // and velocity limits inf where none or 0 (unset)
       .def_property_readonly(
@@ -508,7 +625,9 @@ void bind_model(py::module_& m) {
             return py::dict(py::arg("lower") = j.lower, py::arg("upper") = j.upper,
                             py::arg("effort") = j.effort, py::arg("velocity") = j.velocity_limit);
           },
-          py::arg("joint"))
+          py::arg("joint"),
+          "A joint's limits as a dict: 'lower' and 'upper' position limits [rad or m] (+-1e300 "
+          "where none), 'effort' [N m or N] and 'velocity' [rad/s or m/s] (0 where none).")
       .def(
           "joint_frame",
           [](const Model& md, const std::string& name) {
@@ -584,11 +703,13 @@ void bind_model(py::module_& m) {
 
   py::class_<ModelBuilder>(
       m, "ModelBuilder", "Build a model: bodies, joints, drives, force elements; then finalize().")
-      .def(py::init([](py::object g, bool physical_inertia) {
+      .def(py::init([](const ArrayLike& g, bool physical_inertia) {
              return ModelBuilder(to_vec3(g, "gravity"), physical_inertia);
            }),
            py::arg("gravity") = py::make_tuple(0.0, 0.0, -9.81), py::kw_only(),
-           py::arg("physical_inertia") = true)
+           py::arg("physical_inertia") = true,
+           "An empty builder. gravity: (3,) in world axes [m/s^2]; physical_inertia: see the "
+           "property of that name. ModelError if gravity is not 3 finite numbers.")
       .def(py::pickle(
           [](const ModelBuilder& b) {
             return py::make_tuple(py::bytes(serialize_model(b.draft())), b.physical_inertia());
@@ -606,8 +727,8 @@ void bind_model(py::module_& m) {
                     "it is set.")
       .def(
           "add_body",
-          [](ModelBuilder& b, const std::string& name, double mass, py::object inertia,
-             py::object position, py::object orientation) {
+          [](ModelBuilder& b, const std::string& name, double mass, const ArrayLike& inertia,
+             const ArrayLike& position, const ArrayLike& orientation) {
             const std::string who = "body '" + name + "'";
             return b.add_body(name, mass, to_inertia(inertia, who + ": inertia"),
                               to_vec3(position, who + ": position"),
@@ -621,31 +742,46 @@ void bind_model(py::module_& m) {
       .def(
           "add_revolute",
           [](ModelBuilder& b, const std::string& n, const std::string& p, const std::string& c,
-             py::object point, py::object axis) {
+             const ArrayLike& point, const ArrayLike& axis) {
             return b.add_revolute(n, p, c, to_vec3(point, "joint '" + n + "': point"),
                                   to_vec3(axis, "joint '" + n + "': axis"));
           },
-          py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point"), py::arg("axis"))
+          py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point"), py::arg("axis"),
+          "Add a revolute (hinge) joint `name` between bodies `parent` and `child` (either may be "
+          "'ground'): rotation about `axis` (3,) (world axes, need not be unit) through `point` "
+          "(3,) [m], both in world at the assembly pose. One coordinate q [rad], positive by the "
+          "right-hand rule about axis; q = 0 at assembly. Returns the joint index. ModelError "
+          "(builder unchanged) on a duplicate name, an unknown body, a zero or non-finite axis or "
+          "point.")
       .def(
           "add_prismatic",
           [](ModelBuilder& b, const std::string& n, const std::string& p, const std::string& c,
-             py::object point, py::object axis) {
+             const ArrayLike& point, const ArrayLike& axis) {
             return b.add_prismatic(n, p, c, to_vec3(point, "joint '" + n + "': point"),
                                    to_vec3(axis, "joint '" + n + "': axis"));
           },
-          py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point"), py::arg("axis"))
+          py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point"), py::arg("axis"),
+          "Add a prismatic (slider) joint `name` between `parent` and `child` (either may be "
+          "'ground'): translation along `axis` (3,) (world axes) through `point` (3,) [m], world "
+          "at assembly. One coordinate q [m] along the unit axis; q = 0 at assembly. Returns the "
+          "joint index; ModelError on a duplicate name, an unknown body, a zero or non-finite axis "
+          "or point.")
       .def(
           "add_cylindrical",
           [](ModelBuilder& b, const std::string& n, const std::string& p, const std::string& c,
-             py::object point, py::object axis) {
+             const ArrayLike& point, const ArrayLike& axis) {
             return b.add_cylindrical(n, p, c, to_vec3(point, "joint '" + n + "': point"),
                                      to_vec3(axis, "joint '" + n + "': axis"));
           },
-          py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point"), py::arg("axis"))
+          py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point"), py::arg("axis"),
+          "Add a cylindrical joint `name` between `parent` and `child`: rotation about and "
+          "translation along `axis` (3,) through `point` (3,) [m] (world at assembly). Two "
+          "coordinates: the angle [rad], then the slide [m]. Returns the joint index; ModelError "
+          "on bad input.")
       .def(
           "add_inline",
           [](ModelBuilder& b, const std::string& n, const std::string& p, const std::string& c,
-             py::object point, py::object axis) {
+             const ArrayLike& point, const ArrayLike& axis) {
             return b.add_inline(n, p, c, to_vec3(point, "joint '" + n + "': point"),
                                 to_vec3(axis, "joint '" + n + "': axis"));
           },
@@ -654,8 +790,8 @@ void bind_model(py::module_& m) {
           "through `point` along `axis`. Closes a planar loop without redundant rows.")
       .def(
           "add_distance",
-          [](ModelBuilder& b, const std::string& n, const std::string& ba, py::object pa,
-             const std::string& bb, py::object pb) {
+          [](ModelBuilder& b, const std::string& n, const std::string& ba, const ArrayLike& pa,
+             const std::string& bb, const ArrayLike& pb) {
             const std::string who = "joint '" + n + "'";
             return b.add_distance(n, ba, to_vec3(pa, who + ": point_a"), bb,
                                   to_vec3(pb, who + ": point_b"));
@@ -667,14 +803,18 @@ void bind_model(py::module_& m) {
       .def(
           "add_spherical",
           [](ModelBuilder& b, const std::string& n, const std::string& p, const std::string& c,
-             py::object point) {
+             const ArrayLike& point) {
             return b.add_spherical(n, p, c, to_vec3(point, "joint '" + n + "': point"));
           },
-          py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point"))
+          py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point"),
+          "Add a spherical (ball) joint `name` between `parent` and `child` at `point` (3,) [m], "
+          "world at assembly: 3 constraint rows, 3 rotational dofs (joint space: a quaternion). "
+          "Returns the joint index; ModelError on a duplicate name, an unknown body, a "
+          "non-finite point.")
       .def(
           "add_fixed",
           [](ModelBuilder& b, const std::string& n, const std::string& p, const std::string& c,
-             py::object point) {
+             const OptArrayLike& point) {
             Vec3 pt;
             if (point.is_none()) {
               const int ci = c == "ground" ? -1 : b.draft().find_body(c);
@@ -684,20 +824,29 @@ void bind_model(py::module_& m) {
             }
             return b.add_fixed(n, p, c, pt);
           },
-          py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point") = py::none())
+          py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point") = py::none(),
+          "Weld `child` rigidly to `parent` (either may be 'ground'): 6 rows, no dof. `point` "
+          "(3,) [m], world at assembly, only sets where the reaction is reported (default: the "
+          "child's CoM, the world origin for 'ground'). Returns the joint index; ModelError on "
+          "a duplicate name or an unknown body.")
       .def(
           "add_universal",
           [](ModelBuilder& b, const std::string& n, const std::string& p, const std::string& c,
-             py::object point, py::object a1, py::object a2) {
+             const ArrayLike& point, const ArrayLike& a1, const ArrayLike& a2) {
             return b.add_universal(n, p, c, to_vec3(point, "joint '" + n + "': point"),
                                    to_vec3(a1, "joint '" + n + "': axis1"),
                                    to_vec3(a2, "joint '" + n + "': axis2"));
           },
           py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point"), py::arg("axis1"),
-          py::arg("axis2"))
+          py::arg("axis2"),
+          "Add a universal (Cardan) joint at `point` (3,) [m]: `axis1` (3,) fixed in the parent, "
+          "`axis2` (3,) fixed in the child, perpendicular, world at assembly. Two coordinates "
+          "[rad] (about axis1, then axis2). Returns the joint index; ModelError on bad input "
+          "(axes not perpendicular, zero, or not finite).")
       .def(
           "add_free",
-          [](ModelBuilder& b, const std::string& n, const std::string& c, py::object origin) {
+          [](ModelBuilder& b, const std::string& n, const std::string& c,
+             const OptArrayLike& origin) {
             if (origin.is_none()) return b.add_free(n, c);
             const Vec3 o = to_vec3(origin, "free joint '" + n + "': origin");
             return b.add_free(n, c, &o);
@@ -709,8 +858,8 @@ void bind_model(py::module_& m) {
           "then angular velocity, both in the frame's own axes).")
       .def(
           "add_frame",
-          [](ModelBuilder& b, const std::string& name, const std::string& body, py::object position,
-             py::object orientation) {
+          [](ModelBuilder& b, const std::string& name, const std::string& body,
+             const ArrayLike& position, const ArrayLike& orientation) {
             const std::string who = "frame '" + name + "'";
             return b.add_frame(name, body, to_vec3(position, who + ": position"),
                                to_vec4(orientation, who + ": orientation"));
@@ -722,21 +871,29 @@ void bind_model(py::module_& m) {
           "assembly pose like every builder input. Read it back with armdyn.frame_pose and "
           "armdyn.frame_jacobian.")
       .def("set_joint_limits", &ModelBuilder::set_joint_limits, py::arg("joint"), py::arg("lower"),
-           py::arg("upper"), py::arg("effort") = 0.0, py::arg("velocity") = 0.0)
+           py::arg("upper"), py::arg("effort") = 0.0, py::arg("velocity") = 0.0,
+           "Set a joint's limits (of its first coordinate): position lower <= q <= upper [rad or "
+           "m] (stops enforced by simulate(limits=True)), effort [N m or N] and velocity [rad/s "
+           "or m/s] (informative, 0 = none; read by the sizing). ModelError on an unknown "
+           "joint, lower > upper, NaN, or negative effort/velocity.")
       .def(
           "add_drive",
-          [](ModelBuilder& b, const std::string& joint, py::object profile, int coord,
-             py::object name) {
+          [](ModelBuilder& b, const std::string& joint, const ProfileLike& profile, int coord,
+             const OptStr& name) {
             return b.add_drive(joint, to_profile(profile, "add_drive '" + joint + "': profile"),
                                coord, name.is_none() ? "" : name.cast<std::string>());
           },
           py::arg("joint"), py::arg("profile"), py::arg("coord") = 0, py::arg("name") = py::none(),
-          "Prescribe a joint coordinate by a profile (armdyn.profiles.*, a number, or a Python "
-          "callable t -> (y, yd, ydd): accepted but slow, it runs Python at every evaluation).")
+          "Prescribe coordinate `coord` of `joint` by a profile [rad or m over t in s] "
+          "(armdyn.profiles.*, a number, or a Python callable t -> (y, yd, ydd): accepted but "
+          "slow, it runs Python at every evaluation): a rheonomic constraint whose multiplier is "
+          "the drive's effort (SimulationResult.drive_forces). `name` defaults to the joint's. "
+          "Returns the drive index; ModelError on an unknown joint or coordinate, or a bad "
+          "profile.")
       .def(
           "add_body_force",
-          [](ModelBuilder& b, const std::string& body, py::object force, py::object torque,
-             py::object point, py::object profile) {
+          [](ModelBuilder& b, const std::string& body, const ArrayLike& force,
+             const ArrayLike& torque, const OptArrayLike& point, const OptProfileLike& profile) {
             const std::string who = "load on body '" + body + "'";
             Vec3 pt;
             Profile pr;
@@ -753,8 +910,8 @@ void bind_model(py::module_& m) {
           "[N m], both in world axes, optionally scaled by a profile.")
       .def(
           "add_spring_damper",
-          [](ModelBuilder& b, const std::string& n, const std::string& ba, py::object pa,
-             const std::string& bb, py::object pb, double k, double c, py::object rest) {
+          [](ModelBuilder& b, const std::string& n, const std::string& ba, const ArrayLike& pa,
+             const std::string& bb, const ArrayLike& pb, double k, double c, const OptFloat& rest) {
             const std::string who = "spring-damper '" + n + "'";
             b.add_spring_damper(n, ba, to_vec3(pa, who + ": point_a"), bb,
                                 to_vec3(pb, who + ": point_b"), k, c,
@@ -762,10 +919,18 @@ void bind_model(py::module_& m) {
           },
           py::arg("name"), py::arg("body_a"), py::arg("point_a"), py::arg("body_b"),
           py::arg("point_b"), py::arg("stiffness"), py::arg("damping") = 0.0,
-          py::arg("rest_length") = py::none())
+          py::arg("rest_length") = py::none(),
+          "Point-to-point spring-damper `name` between point_a (3,) of body_a and point_b (3,) of "
+          "body_b (world coordinates at assembly [m]; a body may be 'ground'): force "
+          "stiffness [N/m] * (length - rest_length) + damping [N s/m] * length rate along the "
+          "line; rest_length [m] defaults to the assembly distance. ModelError on an unknown "
+          "body, coincident points, non-finite input, negative stiffness or damping.")
       .def("add_joint_spring_damper", &ModelBuilder::add_joint_spring_damper, py::arg("joint"),
            py::arg("stiffness") = 0.0, py::arg("damping") = 0.0, py::arg("rest") = 0.0,
-           py::arg("coord") = 0)
+           py::arg("coord") = 0,
+           "Spring-damper on coordinate `coord` of `joint`: tau = -stiffness (q - rest) - "
+           "damping qdot, stiffness [N m/rad or N/m], damping [N m s/rad or N s/m], rest [rad "
+           "or m]. ModelError on an unknown joint or coordinate, negative stiffness/damping.")
       .def(
           "add_joint_friction",
           [](ModelBuilder& b, const std::string& joint, double viscous, double coulomb,
@@ -790,8 +955,8 @@ void bind_model(py::module_& m) {
       .def(
           "add_actuator",
           [](ModelBuilder& b, const std::string& joint, double gear_ratio, double rotor_inertia,
-             double efficiency, double friction_viscous, double friction_coulomb, py::object motor,
-             bool gyroscopic, py::object friction_smoothing) {
+             double efficiency, double friction_viscous, double friction_coulomb,
+             const OptMotor& motor, bool gyroscopic, const OptFloat& friction_smoothing) {
             MotorSpec spec;
             const MotorSpec* mp = nullptr;
             if (!motor.is_none()) {
@@ -836,8 +1001,9 @@ void bind_model(py::module_& m) {
            "separation are located as events (result.events).")
       .def(
           "add_motor",
-          [](ModelBuilder& b, const std::string& joint, py::object reference, double kp, double kd,
-             double torque_limit, py::object feedforward, int coord, double ki) {
+          [](ModelBuilder& b, const std::string& joint, const ProfileLike& reference, double kp,
+             double kd, double torque_limit, const OptProfileLike& feedforward, int coord,
+             double ki) {
             const std::string who = "add_motor '" + joint + "'";
             const Profile ref = to_profile(reference, who + ": reference");
             if (feedforward.is_none()) {
@@ -857,11 +1023,16 @@ void bind_model(py::module_& m) {
           "number, or a callable).")
       .def(
           "add_joint_torque",
-          [](ModelBuilder& b, const std::string& joint, py::object profile, int coord) {
+          [](ModelBuilder& b, const std::string& joint, const ProfileLike& profile, int coord) {
             b.add_joint_torque(joint, to_profile(profile, "joint torque on '" + joint + "'"),
                                coord);
           },
-          py::arg("joint"), py::arg("profile"), py::arg("coord") = 0)
+          py::arg("joint"), py::arg("profile"), py::arg("coord") = 0,
+          "Apply a torque [N m] (revolute) or force [N] (prismatic) on coordinate `coord` of "
+          "`joint`, given by a profile of t [s] (armdyn.profiles.*, a number, or a callable t "
+          "-> (y, yd, ydd)): acts on the child about/along the joint axis and the opposite on "
+          "the parent; reported in SimulationResult.joint_torques. ModelError on an unknown "
+          "joint or coordinate, or a bad profile.")
       .def(
           "finalize",
           [cast_model](const ModelBuilder& b, bool mass_weighted) {
@@ -878,24 +1049,41 @@ void bind_model(py::module_& m) {
           },
           py::arg("mass_weighted_assembly") = true,
           "Validate, analyse topology and rank, assemble; returns an immutable Model.")
-      .def_property_readonly("body_names",
-                             [](const ModelBuilder& b) {
-                               std::vector<std::string> r;
-                               for (const auto& x : b.draft().bodies) r.push_back(x.name);
-                               return r;
-                             })
-      .def_property_readonly("frame_names", [](const ModelBuilder& b) {
-        std::vector<std::string> r;
-        for (const auto& x : b.draft().frames) r.push_back(x.name);
-        return r;
-      });
+      .def_property_readonly(
+          "body_names",
+          [](const ModelBuilder& b) {
+            std::vector<std::string> r;
+            for (const auto& x : b.draft().bodies) r.push_back(x.name);
+            return r;
+          },
+          "Names of the bodies added so far, in definition order (for urdf_builder: the "
+          "URDF's links as the loader added them).")
+      .def_property_readonly(
+          "joint_names",
+          [](const ModelBuilder& b) {
+            std::vector<std::string> r;
+            for (const auto& x : b.draft().joints) r.push_back(x.name);
+            return r;
+          },
+          "Names of the joints added so far, in definition order (for urdf_builder: the URDF's "
+          "joints as the loader added them, actuator rotors and free bases included).")
+      .def_property_readonly(
+          "frame_names",
+          [](const ModelBuilder& b) {
+            std::vector<std::string> r;
+            for (const auto& x : b.draft().frames) r.push_back(x.name);
+            return r;
+          },
+          "Names of the named frames added so far (add_frame; for urdf_builder its links), in "
+          "definition order.");
 
   m.attr("URDF_MAX_BYTES") = kUrdfMaxBytes;
   m.attr("URDF_MAX_ATTRIBUTES") = kUrdfMaxAttributes;
   m.attr("URDF_COULOMB_SMOOTHING") = kUrdfCoulombSmoothing;
   m.def(
       "urdf_builder",
-      [](const std::string& src, bool fixed_base, py::object g, bool physical_inertia, bool mimic) {
+      [](const std::string& src, bool fixed_base, const ArrayLike& g, bool physical_inertia,
+         bool mimic) {
         const Vec3 gravity = to_vec3(g, "gravity");
         try {
           return urdf_builder(src, fixed_base, gravity, physical_inertia, mimic);
@@ -909,7 +1097,11 @@ void bind_model(py::module_& m) {
       py::arg("path_or_xml"), py::arg("fixed_base") = true,
       py::arg("gravity") = py::make_tuple(0.0, 0.0, -9.81), py::kw_only(),
       py::arg("physical_inertia") = true, py::arg("mimic") = true,
-      "A ModelBuilder holding a URDF robot (add drives or loads, then finalize()).");
+      "A ModelBuilder holding a URDF robot (add drives or loads, then finalize()): "
+      "path_or_xml is a file path or the XML text; fixed_base=False adds a free joint (a "
+      "floating base) on the root link; gravity (3,) [m/s^2] in world axes; physical_inertia as "
+      "ModelBuilder's; mimic=True turns <mimic> joints into couplings. UrdfError naming the "
+      "element on a malformed or unsupported file.");
 }
 
 }  // namespace armdyn

@@ -67,7 +67,7 @@ py::dict id_result_dict(const Model& md, const InverseDynamicsResult& r) {
 void bind_validate(py::module_& m) {
   m.def(
       "_inverse_dynamics_driven",
-      [](const Model& md, py::object times) {
+      [](const Model& md, const ArrayLike& times) {
         const VecX t = to_vec(times, "t");
         std::vector<double> tv(t.data(), t.data() + t.size());
         InverseDynamicsResult r;
@@ -93,7 +93,8 @@ void bind_validate(py::module_& m) {
            py::arg("model"))
       .def(
           "__call__",
-          [](TreeDynamicsPy& self, py::object q, py::object qd, py::object tau, double t) {
+          [](TreeDynamicsPy& self, const ArrayLike& q, const ArrayLike& qd, const ArrayLike& tau,
+             double t) {
             const long n = self.td.n(), nq = self.m->nq_joint;
             const VecArg qa(q, "q", nq), qda(qd, "qd", n), ta(tau, "tau", n);
             check_joint_vector(*qa, nq, "TreeDynamics", "q");
@@ -115,7 +116,7 @@ void bind_validate(py::module_& m) {
           "forces and gear contacts are included, the ideal gears' rows are held.")
       .def(
           "mass_matrix",
-          [](TreeDynamicsPy& self, py::object q) {
+          [](TreeDynamicsPy& self, const ArrayLike& q) {
             const long n = self.td.n(), nq = self.m->nq_joint;
             const VecArg qa(q, "q", nq);
             check_joint_vector(*qa, nq, "TreeDynamics.mass_matrix", "q");
@@ -140,12 +141,15 @@ void bind_validate(py::module_& m) {
              return std::make_unique<LagrangeValidator>(std::const_pointer_cast<const Model>(md),
                                                         rot);
            }),
-           py::arg("model"), py::arg("rotational_inertia") = true)
-      .def_property_readonly("rotational_inertia", &LagrangeValidator::rotational_inertia)
+           py::arg("model"), py::arg("rotational_inertia") = true,
+           "The Euler-Lagrange equations of a tree `model` (rotational_inertia=False: the "
+           "bodies as point masses).")
+      .def_property_readonly("rotational_inertia", &LagrangeValidator::rotational_inertia,
+                             "False when the bodies count as point masses.")
       .def(
           "torques",
-          [](const LagrangeValidator& self, py::object q, py::object qd, py::object qdd,
-             py::object t) {
+          [](const LagrangeValidator& self, const ArrayLike& q, const ArrayLike& qd,
+             const ArrayLike& qdd, const OptArrayLike& t) {
             const long n = self.nv();
             const MatX Q = to_mat(q, "q", self.nq()), QD = to_mat(qd, "qd", n),
                        QDD = to_mat(qdd, "qdd", n);
@@ -172,14 +176,17 @@ void bind_validate(py::module_& m) {
           "Torques for one sample (1-D inputs) or many (rows); t a scalar or one per row.")
       .def(
           "mass_matrix",
-          [](const LagrangeValidator& self, py::object q) {
+          [](const LagrangeValidator& self, const ArrayLike& q) {
             return to_numpy(self.mass_matrix(to_vec(q, "q", self.nq())));
           },
-          py::arg("q"));
+          py::arg("q"),
+          "The joint-space mass matrix M(q) (n_dofs, n_dofs) [kg m^2, kg] of the Lagrangian at "
+          "q (n_coords,).");
 
   m.def(
       "paper_3dof_torques",
-      [](py::object L, py::object M, double g, py::object th, py::object thd) {
+      [](const ArrayLike& L, const ArrayLike& M, double g, const ArrayLike& th,
+         const ArrayLike& thd) {
         const Vec3 Lv = to_vec3(L, "L"), Mv = to_vec3(M, "M");
         const MatX T = to_mat(th, "theta", 3), TD = to_mat(thd, "thetad", 3);
         if (T.rows() != TD.rows())
@@ -195,14 +202,14 @@ void bind_validate(py::module_& m) {
 
   m.def(
       "paper_5dof_end_effector",
-      [](double h, double L1, double L2, double L34, py::object th) {
+      [](double h, double L1, double L2, double L34, const ArrayLike& th) {
         return to_numpy(VecX(paper_5dof_end_effector(h, L1, L2, L34, to_vec4(th, "theta"))));
       },
       py::arg("h"), py::arg("L1"), py::arg("L2"), py::arg("L34"), py::arg("theta"));
 
   m.def(
       "end_effector_position",
-      [](const Model& md, const std::string& body, py::object point, py::object q) {
+      [](const Model& md, const std::string& body, const ArrayLike& point, const ArrayLike& q) {
         const int b = md.find_body(body);
         const Vec3 p = to_vec3(point, "point");
         const long n = md.nq_joint;
@@ -217,7 +224,7 @@ void bind_validate(py::module_& m) {
 
   m.def(
       "torque_error_metrics",
-      [](py::object a, py::object ref) {
+      [](const ArrayLike& a, const ArrayLike& ref) {
         auto aa = as_array(a, "a");
         const long k = aa.ndim() == 2 ? aa.shape(1) : 1;
         const TorqueErrorMetrics r = torque_error_metrics(to_mat(a, "a", k), to_mat(ref, "ref", k));

@@ -122,6 +122,29 @@ class SimulateGuard {
   }
 };
 
+/// Arguments the bindings take as any Python object and check themselves (to_vec, to_profile, ...),
+/// typed for the stubs and inspect: pybind11 prints handle_type_name<T> (below) in the
+/// signatures pybind11-stubgen reads. Each accepts every object, like py::object.
+inline bool accept_any(PyObject*) { return true; }
+#define ARMDYN_HINTED_OBJECT(Name)                        \
+  class Name : public py::object {                        \
+   public:                                                \
+    PYBIND11_OBJECT_DEFAULT(Name, py::object, accept_any) \
+  };
+ARMDYN_HINTED_OBJECT(ArrayLike)       // numpy.typing.ArrayLike
+ARMDYN_HINTED_OBJECT(OptArrayLike)    // numpy.typing.ArrayLike | None
+ARMDYN_HINTED_OBJECT(ProfileLike)     // Profile | float | Callable[[float], tuple[...]]
+ARMDYN_HINTED_OBJECT(OptProfileLike)  // the same or None
+ARMDYN_HINTED_OBJECT(OptFloat)        // float | None
+ARMDYN_HINTED_OBJECT(OptStr)          // str | None
+ARMDYN_HINTED_OBJECT(FrameRef)        // str | int (a frame's name or index)
+ARMDYN_HINTED_OBJECT(OptMotor)        // Motor | None
+ARMDYN_HINTED_OBJECT(OptProgress)     // Callable[[float, float], object] | None
+ARMDYN_HINTED_OBJECT(FloatOrArray)    // float | numpy.typing.ArrayLike
+ARMDYN_HINTED_OBJECT(OptData)         // Data | None
+ARMDYN_HINTED_OBJECT(ProfileValues)   // Profile.eval's (y, yd, ydd): floats or float64 arrays
+#undef ARMDYN_HINTED_OBJECT
+
 inline py::array_t<double> as_array(const py::handle& obj, const std::string& name) {
   try {
     return py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(obj);
@@ -211,3 +234,29 @@ inline py::array_t<double> to_numpy(const MatX& m) {
 Profile to_profile(const py::handle& obj, const std::string& name);
 
 }  // namespace armdyn::py_helpers
+
+namespace pybind11::detail {
+#define ARMDYN_TYPE_HINT(Name, Hint)                  \
+  template <>                                         \
+  struct handle_type_name<armdyn::py_helpers::Name> { \
+    static constexpr auto name = const_name(Hint);    \
+  };
+ARMDYN_TYPE_HINT(ArrayLike, "numpy.typing.ArrayLike")
+ARMDYN_TYPE_HINT(OptArrayLike, "numpy.typing.ArrayLike | None")
+#define ARMDYN_PROFILE_HINT \
+  "armdyn._core.Profile | float | collections.abc.Callable[[float], tuple[float, float, float]]"
+ARMDYN_TYPE_HINT(ProfileLike, ARMDYN_PROFILE_HINT)
+ARMDYN_TYPE_HINT(OptProfileLike, ARMDYN_PROFILE_HINT " | None")
+#undef ARMDYN_PROFILE_HINT
+ARMDYN_TYPE_HINT(OptFloat, "float | None")
+ARMDYN_TYPE_HINT(OptStr, "str | None")
+ARMDYN_TYPE_HINT(FrameRef, "str | int")
+ARMDYN_TYPE_HINT(OptMotor, "armdyn._core.Motor | None")
+ARMDYN_TYPE_HINT(OptProgress, "collections.abc.Callable[[float, float], object] | None")
+ARMDYN_TYPE_HINT(FloatOrArray, "float | numpy.typing.ArrayLike")
+ARMDYN_TYPE_HINT(OptData, "armdyn._core.Data | None")
+ARMDYN_TYPE_HINT(ProfileValues,
+                 "tuple[float, float, float] | tuple[numpy.typing.NDArray[numpy.float64], "
+                 "numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]")
+#undef ARMDYN_TYPE_HINT
+}  // namespace pybind11::detail

@@ -34,8 +34,10 @@ and ``τ q̇ = P_mech + loss_friction`` (the joint-side torque's power includes 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from armdyn import _core
 from armdyn._runs import checked
@@ -45,7 +47,7 @@ from armdyn._runs import checked
 ROTOR_COULOMB_SMOOTHING = 1e-3
 
 
-def coulomb_smoothing(actuator) -> float:
+def coulomb_smoothing(actuator: _core.Actuator | Any) -> float:
     """The motor-side smoothing velocity v_s [rad/s] of an actuator's Coulomb friction
     ``c tanh(ω / v_s)``: its ``friction_smoothing`` when positive, else add_actuator's default
     ``ROTOR_COULOMB_SMOOTHING · |N|``."""
@@ -85,19 +87,19 @@ class MotorSide:
     """
 
     joint: str
-    t: np.ndarray
-    speed: np.ndarray
-    acceleration: np.ndarray
-    torque: np.ndarray
-    load_torque: np.ndarray
-    current: np.ndarray | None
-    electrical_power: np.ndarray
-    mechanical_power: np.ndarray
-    loss_copper: np.ndarray
-    loss_friction: np.ndarray
-    loss_gear: np.ndarray
-    energy: np.ndarray
-    energy_regenerated: np.ndarray
+    t: npt.NDArray[np.float64]
+    speed: npt.NDArray[np.float64]
+    acceleration: npt.NDArray[np.float64]
+    torque: npt.NDArray[np.float64]
+    load_torque: npt.NDArray[np.float64]
+    current: npt.NDArray[np.float64] | None
+    electrical_power: npt.NDArray[np.float64]
+    mechanical_power: npt.NDArray[np.float64]
+    loss_copper: npt.NDArray[np.float64]
+    loss_friction: npt.NDArray[np.float64]
+    loss_gear: npt.NDArray[np.float64]
+    energy: npt.NDArray[np.float64]
+    energy_regenerated: npt.NDArray[np.float64]
     copper_included: bool
     notes: list[str] = field(default_factory=list)
 
@@ -119,7 +121,14 @@ def _positive(value, what: str, joint: str, allow_zero: bool = False) -> float:
     return v
 
 
-def motor_side(actuator, t, qd, qdd, tau, joint: str | None = None) -> MotorSide:
+def motor_side(
+    actuator: _core.Actuator | Any,
+    t: npt.ArrayLike,
+    qd: npt.ArrayLike,
+    qdd: npt.ArrayLike,
+    tau: npt.ArrayLike,
+    joint: str | None = None,
+) -> MotorSide:
     """Motor-side values of one actuator from its joint's samples (joint side).
 
     Args:
@@ -216,7 +225,7 @@ def motor_side(actuator, t, qd, qdd, tau, joint: str | None = None) -> MotorSide
     )
 
 
-def motor_side_of_result(model, result) -> dict[str, MotorSide]:
+def motor_side_of_result(model: _core.Model, result: Any) -> dict[str, MotorSide]:
     """Motor-side values of every actuator of ``model`` along ``result``.
 
     Args:

@@ -5,10 +5,15 @@ path)."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import numpy.typing as npt
 
 from armdyn import _core
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 
 @dataclass
@@ -29,21 +34,21 @@ class InverseDynamicsResult:
             (motor-side speed, torque, current, power, energy; empty without actuators).
     """
 
-    t: np.ndarray
-    u: np.ndarray
-    v: np.ndarray
-    q: np.ndarray
-    qd: np.ndarray
-    qdd: np.ndarray
-    drive_forces: np.ndarray
-    reaction_forces: np.ndarray
-    reaction_torques: np.ndarray
-    position_residual: np.ndarray
-    velocity_residual: np.ndarray
-    stats: dict = field(default_factory=dict)
-    actuators: dict = field(default_factory=dict)
+    t: npt.NDArray[np.float64]
+    u: npt.NDArray[np.float64]
+    v: npt.NDArray[np.float64]
+    q: npt.NDArray[np.float64]
+    qd: npt.NDArray[np.float64]
+    qdd: npt.NDArray[np.float64]
+    drive_forces: npt.NDArray[np.float64]
+    reaction_forces: npt.NDArray[np.float64]
+    reaction_torques: npt.NDArray[np.float64]
+    position_residual: npt.NDArray[np.float64]
+    velocity_residual: npt.NDArray[np.float64]
+    stats: dict[str, Any] = field(default_factory=dict)
+    actuators: dict[str, Any] = field(default_factory=dict)
 
-    def limit_violations(self, model):
+    def limit_violations(self, model: _core.Model) -> pd.DataFrame:
         """Spans where this run exceeds the model's velocity and effort limits, as a DataFrame
         (joint, kind, t_start, t_end, worst, limit, samples); see
         :func:`armdyn.sizing.limit_violations`. The result does not hold its model, so the model
@@ -53,7 +58,7 @@ class InverseDynamicsResult:
         return limit_violations(model, self)
 
 
-def driven_inverse_dynamics(model: _core.Model, t) -> InverseDynamicsResult:
+def driven_inverse_dynamics(model: _core.Model, t: npt.ArrayLike) -> InverseDynamicsResult:
     """Actuator efforts and joint reactions of a *driven* model along its prescribed motion.
 
     The model's drives must leave no degree of freedom. At each time of ``t`` (increasing, s)

@@ -4,11 +4,20 @@ from __future__ import annotations
 
 import os
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import numpy.typing as npt
 
 from armdyn import _core
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+#: what the progress argument of simulate and rollout takes
+_Progress = bool | Callable[[float, float], object]
 
 
 @dataclass
@@ -56,25 +65,25 @@ class SimulationResult:
             instead; :func:`rollout` records it per run. ``status`` is ``"ok"`` or this message.
     """
 
-    t: np.ndarray
-    u: np.ndarray
-    v: np.ndarray
-    q: np.ndarray
-    qd: np.ndarray
-    qdd: np.ndarray
-    drive_forces: np.ndarray
-    joint_torques: np.ndarray
-    reaction_forces: np.ndarray
-    reaction_torques: np.ndarray
-    position_residual: np.ndarray
-    velocity_residual: np.ndarray
-    kinetic_energy: np.ndarray
-    potential_energy: np.ndarray
-    stats: dict = field(default_factory=dict)
-    events: dict = field(default_factory=dict)
-    gear_forces: dict = field(default_factory=dict)
-    limit_forces: dict = field(default_factory=dict)
-    actuators: dict = field(default_factory=dict)
+    t: npt.NDArray[np.float64]
+    u: npt.NDArray[np.float64]
+    v: npt.NDArray[np.float64]
+    q: npt.NDArray[np.float64]
+    qd: npt.NDArray[np.float64]
+    qdd: npt.NDArray[np.float64]
+    drive_forces: npt.NDArray[np.float64]
+    joint_torques: npt.NDArray[np.float64]
+    reaction_forces: npt.NDArray[np.float64]
+    reaction_torques: npt.NDArray[np.float64]
+    position_residual: npt.NDArray[np.float64]
+    velocity_residual: npt.NDArray[np.float64]
+    kinetic_energy: npt.NDArray[np.float64]
+    potential_energy: npt.NDArray[np.float64]
+    stats: dict[str, Any] = field(default_factory=dict)
+    events: dict[str, Any] = field(default_factory=dict)
+    gear_forces: dict[str, Any] = field(default_factory=dict)
+    limit_forces: dict[str, Any] = field(default_factory=dict)
+    actuators: dict[str, Any] = field(default_factory=dict)
     error: str | None = None
 
     @property
@@ -82,7 +91,7 @@ class SimulationResult:
         """``"ok"`` for a complete run, else the error that stopped it (:attr:`error`)."""
         return "ok" if self.error is None else self.error
 
-    def limit_violations(self, model):
+    def limit_violations(self, model: _core.Model) -> pd.DataFrame:
         """Spans where this run exceeds the model's velocity and effort limits, as a DataFrame
         (joint, kind, t_start, t_end, worst, limit, samples); see
         :func:`armdyn.sizing.limit_violations`. The result does not hold its model, so the model
@@ -92,10 +101,22 @@ class SimulationResult:
         return limit_violations(model, self)
 
     @property
-    def total_energy(self) -> np.ndarray:
+    def total_energy(self) -> npt.NDArray[np.float64]:
+        """(n,) kinetic + potential energy [J] at each output time (constant for a
+        conservative model: a check of the run's accuracy)."""
         return self.kinetic_energy + self.potential_energy
 
-    def plot(self, kind="q", joints=None, *, model=None, ax=None, path=None, title=None, **line_kw):
+    def plot(
+        self,
+        kind: str | list[str] | tuple[str, ...] = "q",
+        joints: list[str | int] | tuple[str | int, ...] | str | int | None = None,
+        *,
+        model: _core.Model | None = None,
+        ax: Any = None,
+        path: str | os.PathLike[str] | None = None,
+        title: str | None = None,
+        **line_kw: Any,
+    ) -> Any:
         """Plot the run against time [s], one panel per kind, joint names in the legends and
         units on the axes (:mod:`armdyn.plotting`; matplotlib is imported here, not by
         ``import armdyn``).
@@ -147,18 +168,18 @@ def simulate(
     atol: float = 1e-8,
     dt: float | None = None,
     output_dt: float | None = None,
-    q0=None,
-    qd0=None,
+    q0: npt.ArrayLike | None = None,
+    qd0: npt.ArrayLike | None = None,
     projection: str = "mass",
     max_steps: int = 10_000_000,
     max_step: float | None = None,
-    u0=None,
-    v0=None,
+    u0: npt.ArrayLike | None = None,
+    v0: npt.ArrayLike | None = None,
     merge_welded: bool = True,
     coordinates: str = "cartesian",
     limits: str = "enforce",
     restitution: float = 0.0,
-    progress=False,
+    progress: _Progress = False,
     max_output_bytes: int | None = None,
 ) -> SimulationResult:
     """Integrate the model from t = 0 to ``t_end``; the stepping loop runs in C++ without the GIL.
@@ -395,15 +416,15 @@ def _rows(name: str, x, n_cols: int, n_rows: int | None) -> np.ndarray:
 
 def rollout(
     model: _core.Model,
-    q0=None,
-    qd0=None,
+    q0: npt.ArrayLike | None = None,
+    qd0: npt.ArrayLike | None = None,
     t_end: float | None = None,
     threads: int | None = None,
     *,
-    u0=None,
-    v0=None,
-    progress=False,
-    **simulate_options,
+    u0: npt.ArrayLike | None = None,
+    v0: npt.ArrayLike | None = None,
+    progress: _Progress = False,
+    **simulate_options: Any,
 ) -> list[SimulationResult]:
     """Many runs of :func:`simulate` on C++ threads: one per row of the initial states.
 
@@ -655,9 +676,9 @@ def _urdf_source(path_or_xml) -> str:
 
 
 def load_urdf(
-    path_or_xml,
+    path_or_xml: str | bytes | os.PathLike[str],
     fixed_base: bool = True,
-    gravity=(0.0, 0.0, -9.81),
+    gravity: npt.ArrayLike = (0.0, 0.0, -9.81),
     *,
     physical_inertia: bool = True,
     mimic: bool = True,

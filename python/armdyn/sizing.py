@@ -30,15 +30,21 @@ import html
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import numpy.typing as npt
 
 from armdyn import _core
 from armdyn._runs import checked as _checked
 
 if TYPE_CHECKING:  # pandas is imported when a table is built: `import armdyn` stays light
     import pandas as pd
+    from matplotlib.figure import Figure
+
+#: the runs the sizing functions take: a SimulationResult, an InverseDynamicsResult or a
+#: TrajectoryRun (not imported here: armdyn.simulation and armdyn.dynamics import this module)
+_Run = Any
 
 _VIOLATION_COLUMNS = ["joint", "kind", "t_start", "t_end", "worst", "limit", "samples"]
 
@@ -74,7 +80,7 @@ def _spans(mask: np.ndarray) -> list[tuple[int, int]]:
     return list(zip(np.flatnonzero(d == 1), np.flatnonzero(d == -1) - 1, strict=True))
 
 
-def limit_violations(model, result) -> pd.DataFrame:
+def limit_violations(model: _core.Model, result: _Run) -> pd.DataFrame:
     """Where a run exceeds its joints' position, velocity and effort limits.
 
     Args:
@@ -174,19 +180,21 @@ class TrajectoryRun:
             (empty without actuators).
     """
 
-    t: np.ndarray
-    q: np.ndarray
-    qd: np.ndarray
-    qdd: np.ndarray
-    joint_torques: np.ndarray
-    actuators: dict = field(default_factory=dict)
+    t: npt.NDArray[np.float64]
+    q: npt.NDArray[np.float64]
+    qd: npt.NDArray[np.float64]
+    qdd: npt.NDArray[np.float64]
+    joint_torques: npt.NDArray[np.float64]
+    actuators: dict[str, Any] = field(default_factory=dict)
 
-    def limit_violations(self, model):
+    def limit_violations(self, model: _core.Model) -> pd.DataFrame:
         """See :func:`limit_violations`."""
         return limit_violations(model, self)
 
 
-def trajectory_run(model, t, q, qd, qdd) -> TrajectoryRun:
+def trajectory_run(
+    model: _core.Model, t: npt.ArrayLike, q: npt.ArrayLike, qd: npt.ArrayLike, qdd: npt.ArrayLike
+) -> TrajectoryRun:
     """The joint torques of a tree model along a planned motion: ``armdyn.inverse_dynamics``
     (recursive Newton–Euler, gravity, force elements and, with actuators, the reflected rotor
     terms included) at every sample, as a result :func:`sizing_report` takes.
@@ -496,13 +504,13 @@ class SizingReport:
     """
 
     table: pd.DataFrame
-    t: np.ndarray
-    torque: np.ndarray
-    speed: np.ndarray
-    motors: dict = field(default_factory=dict)
-    envelopes: dict = field(default_factory=dict)
+    t: npt.NDArray[np.float64]
+    torque: npt.NDArray[np.float64]
+    speed: npt.NDArray[np.float64]
+    motors: dict[str, Any] = field(default_factory=dict)
+    envelopes: dict[str, Any] = field(default_factory=dict)
 
-    def save(self, directory) -> Path:
+    def save(self, directory: str | os.PathLike[str]) -> Path:
         """Write ``table.csv``, ``report.html`` (the table, one torque-against-time figure per
         joint with a non-zero torque, and each motor's operating points on its speed–torque
         plane) and the figures ``torque_<k>.png`` / ``motor_<k>.png`` into ``directory`` (created if
@@ -543,7 +551,7 @@ class SizingReport:
         page.write_text("\n".join(parts), encoding="utf-8")
         return page
 
-    def envelope_figure(self, joint):
+    def envelope_figure(self, joint: str) -> Figure:
         """A bare matplotlib Figure: the operating points (ω, T) of ``joint``'s motor over its
         continuous torque (±, dotted), peak torque (±, dashed), speed limit and speed–torque
         envelope (:func:`motor_envelope`), where the datasheet gives them
@@ -581,7 +589,12 @@ class SizingReport:
         return sizing_figure(self, joint, kind=kind, ax=ax, path=path)
 
 
-def sizing_report(result, model, out=None, actuators=None) -> SizingReport:
+def sizing_report(
+    result: _Run,
+    model: _core.Model,
+    out: str | os.PathLike[str] | None = None,
+    actuators: dict[str, Any] | None = None,
+) -> SizingReport:
     """Peak and RMS torque and speed, power, energy, limit margins and, for actuated joints, the
     motor-side values and checks.
 
@@ -807,7 +820,12 @@ def _spec(joint: str, spec, existing):
     return SimpleNamespace(joint=joint, gear_ratio=1.0, **values)
 
 
-def gear_ratio_sweep(result, model, ratios, actuators=None) -> GearRatioSweep:
+def gear_ratio_sweep(
+    result: _Run,
+    model: _core.Model,
+    ratios: npt.ArrayLike | dict[str, npt.ArrayLike],
+    actuators: dict[str, Any] | None = None,
+) -> GearRatioSweep:
     """Per joint, the gear ratio that minimises the RMS motor torque along a run and the range
     of ratios for which every check of :func:`sizing_report` passes.
 

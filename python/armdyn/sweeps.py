@@ -21,9 +21,12 @@ import os
 import secrets
 from collections import Counter
 from collections.abc import Callable, Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:
+    import xarray as xr
 
 #: keyword names of :func:`sweep` itself: they cannot be grid names
 RESERVED = ("fn", "client", "retries", "progress", "seed", "dims", "coords")
@@ -144,16 +147,16 @@ def _message(exc: BaseException) -> str:
 
 
 def sweep(
-    fn: Callable,
-    client=None,
+    fn: Callable[..., Any],
+    client: Any = None,
     *,
     retries: int = 0,
     progress: bool = False,
     seed: int | np.random.SeedSequence | None = None,
     dims: Mapping[str, tuple[str, ...]] | None = None,
     coords: Mapping[str, Any] | None = None,
-    **grid,
-):
+    **grid: Any,
+) -> xr.Dataset:
     """Run ``fn(**point)`` at every point of the Cartesian product of ``grid`` on Dask.
 
     Args:

@@ -16,13 +16,15 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from armdyn import _core
 
 
-def torque_error_metrics(torques, reference) -> dict:
+def torque_error_metrics(torques: npt.ArrayLike, reference: npt.ArrayLike) -> dict[str, Any]:
     """Equation (26) ``|T − T_ref| / max|T_ref| × 100`` per sample and joint (columns), their
     equation (27) RMS and maximum per joint, ``ref_max`` per joint and ``average`` (the mean of
     the per-joint RMS values, as the paper's Table 2 average)."""
@@ -33,7 +35,7 @@ def torque_error_metrics(torques, reference) -> dict:
     return _core.torque_error_metrics(a, r)
 
 
-def average_of(values) -> float:
+def average_of(values: npt.ArrayLike) -> float:
     """The paper's Table 2 average: the arithmetic mean of the per-joint RMS errors."""
     v = np.asarray(values, dtype=float)
     if v.size == 0 or not np.all(np.isfinite(v)):
@@ -45,14 +47,14 @@ def average_of(values) -> float:
 class Comparison:
     """Result of :meth:`LagrangeValidator.compare`."""
 
-    t: np.ndarray
-    multibody: np.ndarray  # (n, n_coords) efforts from the result, coordinate order
-    reference: np.ndarray  # (n, n_coords) Lagrange torques
-    percent: np.ndarray  # (n, n_coords) equation (26)
-    rms: np.ndarray  # (n_coords,) equation (27)
-    max: np.ndarray
+    t: npt.NDArray[np.float64]
+    multibody: npt.NDArray[np.float64]  # (n, n_coords) efforts from the result, coordinate order
+    reference: npt.NDArray[np.float64]  # (n, n_coords) Lagrange torques
+    percent: npt.NDArray[np.float64]  # (n, n_coords) equation (26)
+    rms: npt.NDArray[np.float64]  # (n_coords,) equation (27)
+    max: npt.NDArray[np.float64]
     average: float
-    coord_names: list
+    coord_names: list[str]
 
 
 class LagrangeValidator:
@@ -64,18 +66,29 @@ class LagrangeValidator:
             (a simplified model of the paper's kind).
     """
 
-    def __init__(self, model: _core.Model, rotational_inertia: bool = True):
+    def __init__(self, model: _core.Model, rotational_inertia: bool = True) -> None:
+        """Derive the equations of ``model`` (ModelError if it is not such a tree)."""
         self.model = model
         self._v = _core.LagrangeValidator(model, rotational_inertia)
 
-    def torques(self, q, qd, qdd, t=None) -> np.ndarray:
-        """Generalised actuator forces (model joint order) for one sample or rows of samples."""
+    def torques(
+        self,
+        q: npt.ArrayLike,
+        qd: npt.ArrayLike,
+        qdd: npt.ArrayLike,
+        t: npt.ArrayLike | None = None,
+    ) -> npt.NDArray[np.float64]:
+        """Generalised actuator forces Q [N m or N] (model joint order) for one sample (1-D q
+        (n_coords,), qd and qdd (n_dofs,); returns (n_dofs,)) or rows of samples ((n, ...);
+        returns (n, n_dofs)); t [s] a scalar or one per row (default 0)."""
         return self._v.torques(q, qd, qdd, t)
 
-    def mass_matrix(self, q) -> np.ndarray:
+    def mass_matrix(self, q: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """The joint-space mass matrix M(q) (n_dofs, n_dofs) [kg m^2 or kg] of the Lagrangian at
+        q (n_coords,)."""
         return self._v.mass_matrix(q)
 
-    def compare(self, result, model=None) -> Comparison:
+    def compare(self, result: Any, model: _core.Model | None = None) -> Comparison:
         """Compare the drive efforts of a simulation/inverse-dynamics result with this model.
 
         ``model`` is the model that produced ``result`` (default: the validator's own; it must
@@ -111,7 +124,13 @@ class LagrangeValidator:
         )
 
 
-def paper_model_3dof(lengths, masses, theta, thetad, g=9.81) -> np.ndarray:
+def paper_model_3dof(
+    lengths: npt.ArrayLike,
+    masses: npt.ArrayLike,
+    theta: npt.ArrayLike,
+    thetad: npt.ArrayLike,
+    g: float = 9.81,
+) -> npt.NDArray[np.float64]:
     """The paper's printed equations (9)–(11) (the *paper model*, incomplete by design).
 
     ``theta``: absolute link angles from the horizontal [rad], one sample (3,) or rows (n, 3);
@@ -121,15 +140,22 @@ def paper_model_3dof(lengths, masses, theta, thetad, g=9.81) -> np.ndarray:
     return _core.paper_3dof_torques(lengths, masses, float(g), theta, thetad)
 
 
-def paper_end_effector_5dof(theta, h, l1, l2, l34) -> np.ndarray:
+def paper_end_effector_5dof(
+    theta: npt.ArrayLike, h: float, l1: float, l2: float, l34: float
+) -> npt.NDArray[np.float64]:
     """The paper's equations (22)–(25): ``[X, Y, Z]`` in the paper's axes (Y up) for
     ``theta = (θ1 twist, θ2, θ3, θ4)`` [rad] taken as printed."""
     return _core.paper_5dof_end_effector(float(h), float(l1), float(l2), float(l34), theta)
 
 
 def end_effector_position(
-    model: _core.Model, body: str | None = None, point=None, q=None, *, frame: str | None = None
-) -> np.ndarray:
+    model: _core.Model,
+    body: str | None = None,
+    point: npt.ArrayLike | None = None,
+    q: npt.ArrayLike | None = None,
+    *,
+    frame: str | None = None,
+) -> npt.NDArray[np.float64]:
     """World position of the end effector at joint coordinates ``q`` ((n_coords,) or rows).
 
     Either ``body`` and ``point`` (body frame, relative to the body's centre of mass), by composed

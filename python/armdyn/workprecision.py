@@ -10,14 +10,22 @@ same function on the project's standard problems and the papers' arms.
 from __future__ import annotations
 
 import math
+import os
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import numpy.typing as npt
 
 from armdyn import _core
 from armdyn.simulation import simulate
+
+if TYPE_CHECKING:
+    import pandas as pd
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
 #: integrators :func:`work_precision` sweeps, and their default settings
 TOLERANCE_INTEGRATORS = ("dopri5", "dop853", "trbdf2")
@@ -98,11 +106,11 @@ class WorkPrecisionResult:
         reference_values: ``{label: (n_out + 1, k)}`` the reference on the grid.
     """
 
-    table: object
-    t: np.ndarray
+    table: pd.DataFrame
+    t: npt.NDArray[np.float64]
     error_measure: str
-    reference: dict = field(default_factory=dict)
-    reference_values: dict = field(default_factory=dict)
+    reference: dict[str, dict[str, Any]] = field(default_factory=dict)
+    reference_values: dict[str, npt.NDArray[np.float64]] = field(default_factory=dict)
 
     def floor(self) -> float:
         """The largest estimated error of the references used (NaN when unknown)."""
@@ -110,7 +118,12 @@ class WorkPrecisionResult:
         errs = [e for e in errs if e is not None and np.isfinite(e)]
         return max(errs) if errs else math.nan
 
-    def plot(self, path=None, title: str | None = None, ax=None):
+    def plot(
+        self,
+        path: str | os.PathLike[str] | None = None,
+        title: str | None = None,
+        ax: Axes | None = None,
+    ) -> Figure | Axes:
         """Log-log plot of error against CPU seconds, one line per integrator (and
         formulation) in the order of the sweep, with the references' estimated error as a
         dotted line (:func:`armdyn.plotting.work_precision_figure`). Saved to ``path``
@@ -233,25 +246,25 @@ def _reference_on_grid(reference, t: np.ndarray, model, observe_default: bool):
 def work_precision(
     model: _core.Model,
     t_end: float,
-    q0=None,
-    qd0=None,
+    q0: npt.ArrayLike | None = None,
+    qd0: npt.ArrayLike | None = None,
     integrators: Sequence[str] | None = None,
-    rtols=None,
-    reference=None,
+    rtols: Sequence[float] | None = None,
+    reference: Any = None,
     *,
     dts: Sequence[float] | None = None,
     n_out: int = 100,
     coordinates: str = "cartesian",
     atol_factor: float = 1.0,
-    u0=None,
-    v0=None,
-    observe: Callable | None = None,
-    angular=None,
+    u0: npt.ArrayLike | None = None,
+    v0: npt.ArrayLike | None = None,
+    observe: Callable[..., Any] | None = None,
+    angular: npt.ArrayLike | None = None,
     error_measure: str | None = None,
     repeats: int = 1,
     max_steps: int = 1_000_000,
     limits: str = "enforce",
-):
+) -> WorkPrecisionResult:
     """Error against CPU time of :func:`armdyn.simulate`'s integrators on the user's model.
 
     Every run integrates from the same initial state to ``t_end`` and writes its outputs on the

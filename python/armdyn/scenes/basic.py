@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import numpy.typing as npt
 
 from armdyn import _core
 
@@ -21,7 +22,13 @@ def _rod(mass: float, length: float, radius: float, axis: int) -> list[float]:
     return d
 
 
-def simple_pendulum(length=1.0, mass=1.0, theta0=0.0, radius=1e-3, gravity=9.81):
+def simple_pendulum(
+    length: float = 1.0,
+    mass: float = 1.0,
+    theta0: float = 0.0,
+    radius: float = 1e-3,
+    gravity: float = 9.81,
+) -> _core.Model:
     """Bob (a small sphere) on a revolute joint about world y at the origin.
 
     The angle is measured from the downward vertical; the bob starts at `theta0` [rad].
@@ -34,7 +41,14 @@ def simple_pendulum(length=1.0, mass=1.0, theta0=0.0, radius=1e-3, gravity=9.81)
     return b.finalize()
 
 
-def double_pendulum(l1=1.0, l2=0.8, m1=1.0, m2=0.7, theta1=np.pi / 2, theta2=np.pi / 2):
+def double_pendulum(
+    l1: float = 1.0,
+    l2: float = 0.8,
+    m1: float = 1.0,
+    m2: float = 0.7,
+    theta1: float = np.pi / 2,
+    theta2: float = np.pi / 2,
+) -> _core.Model:
     """Planar double pendulum of slender rods in the x–z plane, both released horizontal."""
     b = _core.ModelBuilder()
     p1 = np.array([np.sin(theta1), 0, -np.cos(theta1)])
@@ -55,7 +69,7 @@ def double_pendulum(l1=1.0, l2=0.8, m1=1.0, m2=0.7, theta1=np.pi / 2, theta2=np.
     return b.finalize()
 
 
-def free_body(inertia=(1.0, 2.0, 3.0), mass=1.0):
+def free_body(inertia: npt.ArrayLike = (1.0, 2.0, 3.0), mass: float = 1.0) -> _core.Model:
     """A torque-free rigid body (no gravity) with principal inertias `inertia` in body axes."""
     b = _core.ModelBuilder(gravity=(0.0, 0.0, 0.0))
     b.add_body("body", mass, list(inertia))
@@ -63,7 +77,9 @@ def free_body(inertia=(1.0, 2.0, 3.0), mass=1.0):
     return b.finalize()
 
 
-def slider_crank(crank=0.1, rod=0.35, speed=2 * np.pi, drive=True):
+def slider_crank(
+    crank: float = 0.1, rod: float = 0.35, speed: float = 2 * np.pi, drive: bool = True
+) -> _core.Model:
     """Planar slider-crank in the x–y plane (axes along z): crank about the origin, connecting rod,
     slider on a prismatic joint along x. A closed loop: 3 bodies, 4 joints. With `drive` the
     crank angle follows `speed * t` (a linear spline, extrapolated)."""
@@ -83,16 +99,16 @@ def slider_crank(crank=0.1, rod=0.35, speed=2 * np.pi, drive=True):
 
 
 def four_bar(
-    a=0.3,
-    b_len=0.6,
-    c=0.5,
-    d=0.7,
-    five_revolutes=False,
-    crank_angle=np.pi / 3,
-    crank_drive=None,
-    gravity=9.81,
-    closure="revolute",
-):
+    a: float = 0.3,
+    b_len: float = 0.6,
+    c: float = 0.5,
+    d: float = 0.7,
+    five_revolutes: bool = False,
+    crank_angle: float = np.pi / 3,
+    crank_drive: _core.Profile | float | None = None,
+    gravity: float = 9.81,
+    closure: str = "revolute",
+) -> _core.Model:
     """Planar four-bar (crank a, coupler b, rocker c, ground d) modelled in 3-D with revolute
     joints, all axes along z, gravity along -y: 3 moving bodies, 4 revolutes = 20 rows of rank 17,
     mobility 1, so 3 rows are redundant. With `five_revolutes` the crank bearing is doubled (a
@@ -129,7 +145,13 @@ def four_bar(
     return bld.finalize()
 
 
-def spring_mass_pendulum(stiffness=1e6, damping_ratio=0.2, mass=1.0, length=1.0, theta0=0.5):
+def spring_mass_pendulum(
+    stiffness: float = 1e6,
+    damping_ratio: float = 0.2,
+    mass: float = 1.0,
+    length: float = 1.0,
+    theta0: float = 0.5,
+) -> _core.Model:
     """A stiff spring-mass pendulum: a light arm (0.5 kg rod) on a pivot about world y, and a bob
     of ``mass`` sliding along the arm on a prismatic joint held by a linear spring-damper of
     ``stiffness`` [N/m] (rest length: the arm's ``length``) with damping ``damping_ratio`` of the
@@ -156,7 +178,7 @@ def spring_mass_pendulum(stiffness=1e6, damping_ratio=0.2, mass=1.0, length=1.0,
     return b.finalize()
 
 
-def slider_driven_to_dead_centre(crank=0.1, rod=0.35):
+def slider_driven_to_dead_centre(crank: float = 0.1, rod: float = 0.35) -> _core.Model:
     """Slider-crank (axes along z, no gravity) started with the crank at 90° and its *slider*
     driven by a cubic over 1 s to x = crank + rod, the dead centre, where the driven
     constraints lose rank: the standard singular case of driven inverse dynamics."""

@@ -8,12 +8,13 @@ from __future__ import annotations
 from types import SimpleNamespace
 
 import numpy as np
+import numpy.typing as npt
 
 from armdyn import _core
 from armdyn._rotation import quat_to_rot
 
 
-def bricard(side=0.3, mass=1.0):
+def bricard(side: float = 0.3, mass: float = 1.0) -> _core.Model:
     """Orthogonal Bricard 6R linkage on the edges of a cube of edge ``side``: six equal links,
     consecutive joint axes perpendicular, one link is ground. 6 revolutes = 30 rows on 5 bodies
     (nv = 30), so Grübler's count gives 0 DOF; the linkage moves with 1, and its joint angles keep
@@ -32,7 +33,14 @@ def bricard(side=0.3, mass=1.0):
     return b.finalize()
 
 
-def heavy_top(spin=1000.0, tilt=np.pi / 6, mass=1.0, length=0.05, i1=1.5e-3, i3=2e-3):
+def heavy_top(
+    spin: float = 1000.0,
+    tilt: float = np.pi / 6,
+    mass: float = 1.0,
+    length: float = 0.05,
+    i1: float = 1.5e-3,
+    i3: float = 2e-3,
+) -> tuple[_core.Model, npt.NDArray[np.float64], npt.NDArray[np.float64], float]:
     """Symmetric top on a spherical joint at the origin, centre of mass ``length`` up its axis,
     tilted by ``tilt`` about x. Returns (model, u0, v0, omega_p): the initial state spins at
     ``spin`` about the symmetry axis and precesses at the gyroscopic rate
@@ -53,7 +61,9 @@ def heavy_top(spin=1000.0, tilt=np.pi / 6, mass=1.0, length=0.05, i1=1.5e-3, i3=
     return model, u0, v0, omega_p
 
 
-def random_chain(n, close_loop=False, seed=1, masses=None):
+def random_chain(
+    n: int, close_loop: bool = False, seed: int = 1, masses: npt.ArrayLike | None = None
+) -> _core.Model:
     """A spatial chain of n revolute links with random axes, steps of about 0.2 m along x and
     random masses (or ``masses``). ``close_loop`` ties the tip back to the first link with a
     spherical joint: one loop closure between moving bodies, mobility n − 3. (A closure to
@@ -74,19 +84,21 @@ def random_chain(n, close_loop=False, seed=1, masses=None):
     return b.finalize()
 
 
-def random_unit(rng, n: int = 3) -> np.ndarray:
+def random_unit(rng: np.random.Generator, n: int = 3) -> np.ndarray:
     """A random unit vector of length ``n``."""
     v = rng.normal(size=n)
     return v / np.linalg.norm(v)
 
 
-def random_quat(rng) -> np.ndarray:
+def random_quat(rng: np.random.Generator) -> np.ndarray:
     """Random unit Euler parameters, scalar-first, e0 >= 0."""
     e = random_unit(rng, 4)
     return e if e[0] >= 0 else -e
 
 
-def random_inertia(rng, mass: float, lo: float = 0.002, hi: float = 0.03) -> np.ndarray:
+def random_inertia(
+    rng: np.random.Generator, mass: float, lo: float = 0.002, hi: float = 0.03
+) -> np.ndarray:
     """A random FULL inertia tensor (body axes, about the CoM): R diag(principal) R^T with the
     principal moments built from second moments s_k > 0 (I1 = s2 + s3, ...), so it is symmetric,
     positive-definite and satisfies the triangle inequality strictly."""
@@ -99,7 +111,11 @@ def random_inertia(rng, mass: float, lo: float = 0.002, hi: float = 0.03) -> np.
 
 
 def random_spatial_arm(
-    rng, n: int = 6, prismatic: bool = False, gravity=(0.0, 0.0, -9.81), masses=None
+    rng: np.random.Generator,
+    n: int = 6,
+    prismatic: bool = False,
+    gravity: npt.ArrayLike = (0.0, 0.0, -9.81),
+    masses: npt.ArrayLike | None = None,
 ) -> SimpleNamespace:
     """Random spatial serial arm ground - link1 - ... - linkn, built with the builder.
 
@@ -164,7 +180,7 @@ def random_spatial_arm(
     )
 
 
-def mass_ratio_chain(ratio=1e6, n=5, seed=3) -> SimpleNamespace:
+def mass_ratio_chain(ratio: float = 1e6, n: int = 5, seed: int = 3) -> SimpleNamespace:
     """A random spatial chain of n revolute links (:func:`random_spatial_arm`: random axes,
     steps, full inertias and body orientations) whose masses alternate √ratio and 1/√ratio kg.
     Returns the arm's namespace (``model``, its geometry and ``perm``)."""
@@ -172,7 +188,7 @@ def mass_ratio_chain(ratio=1e6, n=5, seed=3) -> SimpleNamespace:
     return random_spatial_arm(np.random.default_rng(seed), n, masses=masses)
 
 
-def nan_force_pendulum(t_nan=0.31):
+def nan_force_pendulum(t_nan: float = 0.31) -> _core.Model:
     """A pendulum ('bob' on revolute 'pivot', at rest) whose user force turns NaN after
     ``t_nan``: a run must stop with a SolverError naming the body and the time."""
     b = _core.ModelBuilder()

@@ -38,6 +38,7 @@ each other (``preload``, anti-backlash).
 from __future__ import annotations
 
 import numpy as np
+import numpy.typing as npt
 
 from armdyn import _core
 
@@ -84,23 +85,23 @@ def _gear_mass(radius, scale):
 
 
 def geared_arm_6dof(
-    n_motors=1,
-    shared_joint="waist",
-    backlash=0.0,
-    control="motor",
-    targets=(0.8, 0.6, -0.9, 0.5, 0.7, 1.0),
-    t_start=0.5,
-    t_end=4.5,
-    gear_mass_scale=1.0,
-    trains=True,
-    mesh_stiffness=2e9,
-    hc_damping=0.3,
-    kp=25.0,
-    kd=0.5,
-    torque_limit=10.0,
-    preload=0.0,
-    ideal_gears=True,
-):
+    n_motors: int = 1,
+    shared_joint: str = "waist",
+    backlash: float = 0.0,
+    control: str = "motor",
+    targets: npt.ArrayLike = (0.8, 0.6, -0.9, 0.5, 0.7, 1.0),
+    t_start: float = 0.5,
+    t_end: float = 4.5,
+    gear_mass_scale: float = 1.0,
+    trains: bool = True,
+    mesh_stiffness: float = 2e9,
+    hc_damping: float = 0.3,
+    kp: float = 25.0,
+    kd: float = 0.5,
+    torque_limit: float = 10.0,
+    preload: float = 0.0,
+    ideal_gears: bool = True,
+) -> _core.Model:
     """Build the geared arm (see the module docstring for every dimension).
 
     Args:

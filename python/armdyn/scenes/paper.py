@@ -38,6 +38,7 @@ from __future__ import annotations
 from types import SimpleNamespace
 
 import numpy as np
+import numpy.typing as npt
 
 from armdyn import _core
 
@@ -134,12 +135,14 @@ def three_dof_arm(point_masses: bool = False, drives: bool = True) -> _core.Mode
     return b.finalize()
 
 
-def three_dof_absolute(q, qd):
+def three_dof_absolute(
+    q: npt.ArrayLike, qd: npt.ArrayLike
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
     """Absolute link angles and rates (from the horizontal) from relative joint angles."""
     return np.cumsum(q, axis=-1), np.cumsum(qd, axis=-1)
 
 
-def absolute_to_joint_torques(T):
+def absolute_to_joint_torques(T: npt.ArrayLike) -> npt.NDArray[np.float64]:
     """Generalised forces conjugate to absolute angles → joint torques: τ_i = Σ_{k≥i} T_k
     (θ_abs = B q with B lower-triangular ones, so τ = Bᵀ T)."""
     T = np.asarray(T, dtype=float)
@@ -149,7 +152,9 @@ def absolute_to_joint_torques(T):
 # ---------------------------------------------------------------------------------------------
 # five-DOF light-lifting arm
 # ---------------------------------------------------------------------------------------------
-def five_dof_arm(point_masses: bool = False, hold=None, drives: bool = True) -> _core.Model:
+def five_dof_arm(
+    point_masses: bool = False, hold: npt.ArrayLike | None = None, drives: bool = True
+) -> _core.Model:
     """The paper's five-DOF light-lifting arm (see the module docstring for every number).
 
     Joints in order: ``twist`` (about z), ``shoulder``, ``elbow``, ``wrist`` (pitch, positive
@@ -199,14 +204,14 @@ def five_dof_arm(point_masses: bool = False, hold=None, drives: bool = True) -> 
     return b.finalize()
 
 
-def five_dof_tip(model_is_point_mass: bool = False):
+def five_dof_tip(model_is_point_mass: bool = False) -> tuple[str, npt.NDArray[np.float64]]:
     """(body, point) of the end effector: the rod tip, in the rod's body frame (also the model's
     frame ``tip``)."""
     offset = 0.0 if model_is_point_mass else ARM5.L4 / 2
     return "rod", np.array([offset, 0.0, 0.0])
 
 
-def to_paper_axes(p):
+def to_paper_axes(p: npt.ArrayLike) -> npt.NDArray[np.float64]:
     """World (x, y, z) → the paper's (X, Y, Z) with Y up: (x, z, y)."""
     p = np.asarray(p, dtype=float)
     return p[..., [0, 2, 1]]

@@ -16,13 +16,14 @@ inline joints (2 rows) rather than revolutes, so that the rows stay independent.
 from __future__ import annotations
 
 import numpy as np
+import numpy.typing as npt
 
 from armdyn import _core
 
 G = 9.81
 
 
-def iftomm_a01_pendulum():
+def iftomm_a01_pendulum() -> _core.Model:
     """IFToMM A01: a 1 kg point mass on a massless 1 m rod, gravity 9.81 along −y, released at
     rest from the horizontal (P1 at x = +1 m), 2000 s.
 
@@ -44,7 +45,7 @@ def _bar_inertia(mass: float, length: float) -> list[float]:
     return [1e-4 * i, i, i]
 
 
-def iftomm_a02_four_bar(n: int = 40):
+def iftomm_a02_four_bar(n: int = 40) -> _core.Model:
     """IFToMM A02: ``n`` four-bar windows of 2n+1 uniform bars (1 m, 1 kg), gravity along −y.
 
     Ground pivots A_i = (i, 0), i = 0…n; vertical cranks A_i–B_i start upright (B_i = (i, 1)),
@@ -69,7 +70,7 @@ def iftomm_a02_four_bar(n: int = 40):
     return b.finalize()
 
 
-def a02_initial_velocity(model, n: int = 40, speed: float = 1.0) -> np.ndarray:
+def a02_initial_velocity(model: _core.Model, n: int = 40, speed: float = 1.0) -> np.ndarray:
     """Cartesian velocities of A02's start: every crank turning at −speed rad/s (B0 moving +x at
     ``speed`` m/s), every coupler translating at (speed, 0)."""
     v = np.zeros(model.nv)
@@ -134,7 +135,7 @@ def _rot(a: float) -> np.ndarray:
     return np.array([[np.cos(a), -np.sin(a)], [np.sin(a), np.cos(a)]])
 
 
-def squeezer_points(q) -> dict:
+def squeezer_points(q: npt.ArrayLike) -> dict:
     """Joint points and centres of mass of Andrews' mechanism at angles ``q`` (2-D, metres)."""
     p = SQUEEZER
     be, th, ga, ph, de, om, ep = q
@@ -171,7 +172,7 @@ def squeezer_points(q) -> dict:
     }
 
 
-def andrews_squeezer():
+def andrews_squeezer() -> _core.Model:
     """Andrews' squeezing mechanism (Hairer & Wanner 1996 §VII.7; Test Set "andrews"; IFToMM A03):
     seven bodies in the plane, motor torque 0.033 N m on body 1 about O, spring 4530 N/m
     (rest 0.07785 m) from the fixed point C to point D of body 3, no gravity; released at rest in
