@@ -95,6 +95,49 @@ class SimulationResult:
     def total_energy(self) -> np.ndarray:
         return self.kinetic_energy + self.potential_energy
 
+    def plot(self, kind="q", joints=None, *, model=None, ax=None, path=None, title=None, **line_kw):
+        """Plot the run against time [s], one panel per kind, joint names in the legends and
+        units on the axes (:mod:`armdyn.plotting`; matplotlib is imported here, not by
+        ``import armdyn``).
+
+        Args:
+            kind: one of, or a list of, ``"q"`` (joint coordinates [rad or m]), ``"qd"``
+                (rates), ``"qdd"`` (accelerations), ``"torque"`` (``joint_torques``),
+                ``"drive"`` (``drive_forces``), ``"limit"`` (``limit_forces``: joint-stop
+                torques/forces), ``"gear"`` (``gear_forces``), ``"reaction"`` (joint reaction
+                forces [N] and torques [N m], x/y/z in the child's joint frame; also
+                ``"reaction_force"`` / ``"reaction_torque"`` alone), ``"energy"`` (kinetic,
+                potential, total [J]), ``"residual"`` (position and velocity constraint
+                residuals, log scale; also ``"position_residual"`` / ``"velocity_residual"``).
+            joints: the joints to draw (default all): names (a joint, or a column of
+                ``model.joint_coord_names`` / ``joint_dof_names``; gear names for ``"gear"``)
+                or column indices of each panel's array. Ignored by ``"energy"`` and the
+                residuals.
+            model: the model the run was made with: joint names and per-column units (the
+                result does not hold its model); without it, columns are ``q[0]``, ... and
+                units read "rad or m".
+            ax: a matplotlib Axes to draw a single panel into (or a sequence, one per panel);
+                default: a new :class:`matplotlib.figure.Figure` (no pyplot state).
+            path: save the figure there (dpi 110) when given.
+            title: the figure's title (the first axes' with ``ax``).
+            **line_kw: passed to ``Axes.plot`` (``lw``, ``alpha``, ...).
+
+        Returns:
+            The Figure, or, with ``ax``, the Axes drawn into (a list for a sequence).
+
+        Raises:
+            ValueError: an unknown kind, a result without rows, ``ax`` not matching the panels.
+            ModelError: an unknown joint (naming it and listing the model's joints), a name
+                without ``model``, a result not from ``model``, or a kind the run did not
+                record (``"limit"`` without enforced stops, ``"drive"`` without drives,
+                ``"gear"`` without gears), saying what records it.
+        """
+        from armdyn.plotting import plot_result
+
+        return plot_result(
+            self, kind, joints, model=model, ax=ax, path=path, title=title, **line_kw
+        )
+
 
 def simulate(
     model: _core.Model,

@@ -507,8 +507,8 @@ class SizingReport:
         joint with a non-zero torque, and each motor's operating points on its speed–torque
         plane) and the figures ``torque_<k>.png`` / ``motor_<k>.png`` into ``directory`` (created if
         missing). Needs matplotlib (the ``plot`` extra). Returns the HTML page's path."""
-        # a bare Figure (Agg canvas): no pyplot state, the user's backend is left alone
-        from matplotlib.figure import Figure
+        # bare Figures (Agg canvas): no pyplot state, the user's backend is left alone
+        from armdyn.plotting import sizing_envelope_figure, sizing_torque_figure
 
         out = Path(os.fspath(directory))
         out.mkdir(parents=True, exist_ok=True)
@@ -518,24 +518,13 @@ class SizingReport:
             tau = self.torque[:, k]
             if np.all(np.isnan(tau) | (tau == 0.0)):  # no actuation on this joint
                 continue
-            fig = Figure(figsize=(6.0, 3.0))
-            ax = fig.subplots()
-            ax.plot(self.t, tau, lw=1.0, label="joint torque/force")
-            limit = self.table["effort_limit"].iloc[k]
-            if np.isfinite(limit):
-                ax.axhline(limit, color="r", ls="--", lw=0.8, label="effort limit")
-                ax.axhline(-limit, color="r", ls="--", lw=0.8)
-            ax.set_xlabel("t [s]")
-            ax.set_ylabel("torque [N m] or force [N]")
-            ax.set_title(str(name))
-            ax.legend(loc="best", fontsize="small")
-            fig.tight_layout()
+            fig = sizing_torque_figure(self, name)
             png = f"torque_{k}.png"
             fig.savefig(out / png, dpi=100)
             items = [(png, f"torque of {name}")]
             if name in self.motors:
                 png_m = f"motor_{k}.png"
-                self.envelope_figure(name).savefig(out / png_m, dpi=100)
+                sizing_envelope_figure(self, name).savefig(out / png_m, dpi=100)
                 items.append((png_m, f"speed-torque plane of the motor of {name}"))
             figures.append((name, items))
         parts = [
@@ -557,56 +546,39 @@ class SizingReport:
     def envelope_figure(self, joint):
         """A bare matplotlib Figure: the operating points (ω, T) of ``joint``'s motor over its
         continuous torque (±, dotted), peak torque (±, dashed), speed limit and speed–torque
-        envelope (:func:`motor_envelope`), where the datasheet gives them."""
-        from matplotlib.figure import Figure
+        envelope (:func:`motor_envelope`), where the datasheet gives them
+        (:func:`armdyn.plotting.sizing_envelope_figure`; ``plot(joint, kind="motor")``)."""
+        from armdyn.plotting import sizing_envelope_figure
 
-        side, motor = self.motors[joint], self.envelopes.get(joint)
-        fig = Figure(figsize=(7.5, 4.0))
-        ax = fig.subplots()
-        ax.plot(side.speed, side.torque, ".", ms=2.0, color="C0", label="operating points")
-        w_max = float(np.max(np.abs(side.speed))) or 1.0
-        t0, w0 = motor_envelope(motor)
-        if np.isfinite(t0) and np.isfinite(w0) and t0 > 0 and w0 > 0:
-            ws = np.array([-2.0 * w0, 0.0, 2.0 * w0])
-            for sign in (1.0, -1.0):
-                ax.plot(
-                    ws,
-                    sign * t0 - t0 * ws / w0,
-                    color="k",
-                    lw=1.0,
-                    label="envelope" if sign > 0 else None,
-                )
-            w_max = max(w_max, w0)
-        for attr, style, label in (
-            ("continuous_torque", ":", "continuous"),
-            ("peak_torque", "--", "peak"),
-        ):
-            value = _num(getattr(motor, attr, None))
-            if np.isfinite(value):
-                ax.axhline(value, color="r", ls=style, lw=0.9, label=label)
-                ax.axhline(-value, color="r", ls=style, lw=0.9)
-        speed_lim = _num(getattr(motor, "max_speed", None))
-        if np.isfinite(speed_lim):
-            ax.axvline(speed_lim, color="g", ls="--", lw=0.9, label="max speed")
-            ax.axvline(-speed_lim, color="g", ls="--", lw=0.9)
-            w_max = max(w_max, speed_lim)
-        ax.set_xlim(-1.1 * w_max, 1.1 * w_max)
-        t_top = float(np.max(np.abs(side.torque))) or 1.0
-        # the torque axis spans the operating points and the rated torques (the stall torque
-        # of the envelope is often far above both)
-        for v in (_num(getattr(motor, "peak_torque", None)),):
-            if np.isfinite(v):
-                t_top = max(t_top, v)
-        ax.set_ylim(-1.3 * t_top, 1.3 * t_top)
-        ax.set_xlabel("motor speed [rad/s]")
-        ax.set_ylabel("motor torque [N m]")
-        ax.set_title(
-            f"{joint}: motor speed-torque plane (N = {self.table.loc[joint, 'gear_ratio']:g})"
-        )
-        ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize="small")
-        ax.grid(lw=0.3)
-        fig.tight_layout()
-        return fig
+        return sizing_envelope_figure(self, joint)
+
+    def _motor_envelope(self, joint) -> tuple[float, float]:
+        """(T0, ω0) of ``joint``'s motor (:func:`motor_envelope`), for its figure."""
+        return motor_envelope(self.envelopes.get(joint))
+
+    def plot(self, joint=None, kind: str = "torque", ax=None, path=None):
+        """The report's figures (:mod:`armdyn.plotting`; matplotlib imported here).
+
+        Args:
+            joint: a joint (coordinate) of :attr:`table`'s index; None: one panel per joint
+                with a non-zero torque (``"torque"``) or with a motor (``"motor"``).
+            kind: ``"torque"``: the joint torque/force against time [s] with its effort limit
+                (the figures of :meth:`save`); ``"motor"``: the motor's operating points on
+                its speed–torque plane (:meth:`envelope_figure`).
+            ax: a matplotlib Axes to draw into (a sequence of them for several joints);
+                default: a new :class:`matplotlib.figure.Figure`.
+            path: save the figure there (dpi 110) when given.
+
+        Returns:
+            The Figure, or with ``ax`` the Axes drawn into.
+
+        Raises:
+            ValueError: an unknown kind. ModelError: an unknown joint (naming it and listing
+            the report's), a joint without torque, or without a motor for ``"motor"``.
+        """
+        from armdyn.plotting import sizing_figure
+
+        return sizing_figure(self, joint, kind=kind, ax=ax, path=path)
 
 
 def sizing_report(result, model, out=None, actuators=None) -> SizingReport:

@@ -10,7 +10,6 @@ same function on the project's standard problems and the papers' arms.
 from __future__ import annotations
 
 import math
-import textwrap
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -111,42 +110,19 @@ class WorkPrecisionResult:
         errs = [e for e in errs if e is not None and np.isfinite(e)]
         return max(errs) if errs else math.nan
 
-    def plot(self, path=None, title: str | None = None):
+    def plot(self, path=None, title: str | None = None, ax=None):
         """Log-log plot of error against CPU seconds, one line per integrator (and
         formulation) in the order of the sweep, with the references' estimated error as a
-        dotted line. Saved to ``path``
-        when given. Returns the :class:`matplotlib.figure.Figure`.
+        dotted line (:func:`armdyn.plotting.work_precision_figure`). Saved to ``path``
+        when given. Returns the :class:`matplotlib.figure.Figure`, or with ``ax`` (a
+        matplotlib Axes to draw into) that Axes.
 
         Raises:
             ImportError: matplotlib is missing (``pip install armdyn[plot]``).
         """
-        try:
-            from matplotlib.figure import Figure
-        except ImportError as exc:  # pragma: no cover - depends on the environment
-            raise ImportError(
-                "WorkPrecisionResult.plot needs matplotlib, the 'plot' extra of armdyn: "
-                "pip install 'armdyn[plot]' (or pip install matplotlib)"
-            ) from exc
-        fig = Figure(figsize=(7.5, 4.8))
-        ax = fig.add_subplot()
-        tab = self.table
-        ok = tab[(tab["status"] == "ok") & np.isfinite(tab["error"]) & (tab["error"] > 0)]
-        for (integ, coords), rows in ok.groupby(["integrator", "coordinates"], sort=False):
-            label = integ if coords == "cartesian" else f"{integ} ({coords})"
-            ax.loglog(rows["error"], rows["cpu_s"], "-o", ms=4, label=label)
-        floor = self.floor()
-        if np.isfinite(floor) and floor > 0:
-            ax.axvline(floor, color="grey", lw=0.8, ls=":", label="reference's estimated error")
-        ax.set_xlabel(textwrap.fill(f"error: {self.error_measure}", 90), fontsize=9)
-        ax.set_ylabel("CPU time [s]")
-        if title:
-            ax.set_title(title, fontsize=10)
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8)
-        fig.tight_layout()
-        if path is not None:
-            fig.savefig(path, dpi=110)
-        return fig
+        from armdyn.plotting import work_precision_figure
+
+        return work_precision_figure(self, path=path, title=title, ax=ax)
 
 
 def _cpu_time(fn, repeats: int):

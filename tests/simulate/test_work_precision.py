@@ -363,7 +363,8 @@ def test_plot_draws_one_line_per_integrator(sweep, tmp_path):
 def test_import_armdyn_does_not_import_pandas():
     code = (
         "import sys, armdyn; armdyn.sweep; "
-        "heavy = [m for m in ('pandas', 'dask', 'distributed', 'xarray') if m in sys.modules]; "
+        "heavy = ('pandas', 'dask', 'distributed', 'xarray', 'matplotlib'); "
+        "heavy = [m for m in heavy if m in sys.modules]; "
         "assert not heavy, f'imported: {heavy}'"
     )
     subprocess.run([sys.executable, "-c", code], check=True)
