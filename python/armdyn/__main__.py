@@ -22,16 +22,25 @@ import sys
 
 
 def main(argv: list[str] | None = None) -> int:
+    from armdyn import __version__
+
     parser = argparse.ArgumentParser(
         prog="armdyn", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
+    parser.add_argument("--version", action="version", version=f"armdyn {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     sub.add_parser("verify", help="print accuracy figures against closed forms and Lagrange")
-    rep = sub.add_parser("reproduce", help="regenerate the papers' tables and figures")
+    rep_help = (
+        "regenerate the papers' tables and figures (measured: 12 min 36 s on 2 busy cores, "
+        "366 s of CPU; 2.8 s with --no-geared)"
+    )
+    rep = sub.add_parser("reproduce", help=rep_help, description=rep_help)
     rep.add_argument("--out", default="armdyn-report", help="report folder (Markdown + PNG)")
     rep.add_argument("--no-plots", action="store_true", help="skip the figures")
     rep.add_argument(
-        "--no-geared", action="store_true", help="skip the geared-arm study (a few minutes)"
+        "--no-geared",
+        action="store_true",
+        help="skip the geared-arm study (all but 2.8 s of the run)",
     )
     size = sub.add_parser(
         "size", help="sizing report of a planned motion (exit 0: every joint ok, 1: not)"

@@ -1,13 +1,16 @@
-"""docs/api.md matches the code: every name it documents exists (package functions, builder
-methods, model properties, validation helpers), and every python block runs, in order, in one
-namespace."""
+"""docs/api.md, the guide, matches the code: every name it documents exists (package functions,
+builder methods, model properties, validation helpers), and its python blocks' results hold
+against each other and against closed forms (the blocks are run once, each as pasted, by the
+session fixture ``doc_blocks``; tests/docs/test_runnable_blocks.py checks that all of them run)."""
 
 import re
 from pathlib import Path
 
 import armdyn as ad
+import numpy as np
 import pytest
 from armdyn import validation
+from doc_blocks import namespace_with
 
 API = (Path(__file__).resolve().parents[2] / "docs" / "api.md").read_text("utf-8")
 
@@ -46,29 +49,33 @@ def test_documented_validation_helpers_exist():
     assert not missing, missing
 
 
-def test_python_blocks_run():
-    blocks = re.findall(r"```python\n(.*?)```", API, re.S)
-    assert len(blocks) >= 5
-    ns: dict = {}
-    for i, code in enumerate(blocks):
-        exec(compile(code, f"docs/api.md python block {i + 1}", "exec"), ns)
-    # the blocks' own results, against each other: inverse dynamics undoes forward dynamics,
-    # the Cartesian path equals the joint path, and the batch equals the single call
-    import numpy as np
+GUIDE = "docs/api.md"
 
+
+def test_two_link_blocks(doc_blocks):
+    """The blocks on the two-link arm of "Building", against each other: inverse dynamics undoes
+    forward dynamics, the Cartesian path equals the joint path, and the batch equals the single
+    call."""
+    ns = namespace_with(doc_blocks, GUIDE, "tau", "same", "rows", "vdot", "res", "joint")
     np.testing.assert_allclose(ns["tau"], 0.0, atol=1e-10)
     np.testing.assert_allclose(ns["same"], ns["qdd"], rtol=1e-10, atol=1e-12)
     np.testing.assert_array_equal(ns["rows"][2], ns["qdd"])
     assert ns["M"].shape == (2, 2) and ns["vdot"].shape == (12,)
     assert np.abs(ns["res"].q - ns["joint"].q).max() <= 1e-6
-    # the work-precision block: DOPRI5's error follows its tolerance; RK4's coarse step fails
-    # on the motor's damping and is a row, not an exception
-    tab = ns["wp"].table
+
+
+def test_work_precision_block(doc_blocks):
+    """DOPRI5's error follows its tolerance; RK4's coarse step fails on the motor's damping and
+    is a row, not an exception."""
+    tab = namespace_with(doc_blocks, GUIDE, "wp")["wp"].table
     assert tab["status"].tolist() == ["ok", "ok", "failed", "ok"]
     assert tab["error"].iloc[1] < 1e-8 < tab["error"].iloc[0] < 1e-5
-    # the sizing block: a rotor of 0.2 kg m² driven by q = sin(π t) needs 0.2 π² N m at
-    # t = 0.5 and 1.5 s (output samples), above its 1 N m effort limit; its peak speed π rad/s
-    # is within 4 rad/s
+
+
+def test_sizing_blocks(doc_blocks):
+    """A rotor of 0.2 kg m² driven by q = sin(π t) needs 0.2 π² N m at t = 0.5 and 1.5 s (output
+    samples), above its 1 N m effort limit; its peak speed π rad/s is within 4 rad/s."""
+    ns = namespace_with(doc_blocks, GUIDE, "sizing", "spans")
     sizing = ns["sizing"].loc["spin"]
     assert sizing["peak_torque"] == pytest.approx(0.2 * np.pi**2, rel=1e-12)
     assert sizing["torque_margin"] == pytest.approx(1.0 / (0.2 * np.pi**2), rel=1e-12)
@@ -76,3 +83,39 @@ def test_python_blocks_run():
     spans = ns["spans"]
     assert spans["kind"].tolist() == ["effort", "effort"]
     np.testing.assert_allclose(spans["worst"], 0.2 * np.pi**2 * np.array([-1.0, 1.0]), rtol=1e-12)
+
+
+def test_five_dof_dynamics_blocks(doc_blocks):
+    """The five-DOF blocks (free arm, then driven arm; their own asserts hold): the mass matrix
+    is the Lagrange validator's, and the batch equals row-by-row calls."""
+    ns = namespace_with(doc_blocks, GUIDE, "QDD", "idr", "free")
+    assert ns["QDD"].shape == (1000, 5)
+    assert ns["idr"].drive_forces.shape == (3, 5)
+    lag = ad.LagrangeValidator(ns["free"])
+    np.testing.assert_allclose(ns["M"], lag.mass_matrix(ns["q"]), rtol=1e-12, atol=1e-14)
+    Q = ns["Q"]
+    rows = np.array([ad.forward_dynamics(ns["free"], Q[i], Q[i], Q[i]) for i in (0, 999)])
+    np.testing.assert_array_equal(ns["QDD"][[0, 999]], rows)
+
+
+def test_sweep_example(doc_blocks):
+    """The pendulum sweep (client=None: its own LocalCluster) gives a Dataset over theta0 x length
+    whose periods are the closed form 4/w0 K(sin^2(theta0/2)) of the physical pendulum,
+    w0^2 = m g L / (2/5 m r^2 + m L^2), computed here with SciPy's ellipk."""
+    pytest.importorskip("distributed")
+    from scipy.special import ellipk
+
+    block = next(b for b in doc_blocks if b.file == GUIDE and "ad.sweep(period" in b.code)
+    assert not block.continues
+    assert len([ln for ln in block.code.strip().splitlines() if ln.strip()]) <= 9
+    ds = namespace_with(doc_blocks, GUIDE, "ds", "period")["ds"]
+    assert ds["period"].dims == ("theta0", "length")
+    assert (ds["status"].values == "ok").all()
+    theta0 = ds["theta0"].values[:, None]
+    length = ds["length"].values[None, :]
+    r, g = 1e-3, 9.81
+    exact = 4.0 / np.sqrt(g * length / (0.4 * r**2 + length**2)) * ellipk(np.sin(theta0 / 2) ** 2)
+    np.testing.assert_allclose(ds["period"].values, exact, rtol=1e-8)
+    # the seeded sweep on a client of one's own: its failing points are rows, not exceptions
+    study = namespace_with(doc_blocks, GUIDE, "study")["study"]
+    assert study.attrs["failed"] == 2 and study.attrs["seed"] == 7

@@ -1,0 +1,50 @@
+"""Every ```python block of README.md and docs/*.md runs, as pasted (alone, unless it says it
+continues the block before it), and all of them together take seconds; every other fenced
+block says what it is (```text, ```bash, ...), so that a reader knows what is meant to run."""
+
+from doc_blocks import doc_files, fenced_blocks
+
+# all blocks together, on the loaded 2-core machine: about 20 s (see the report of
+# test_blocks_are_quick); three times that means some block became a long computation
+TOTAL_SECONDS = 60.0
+
+
+def test_every_python_block_runs(doc_blocks):
+    assert len(doc_blocks) >= 15
+    assert {b.file for b in doc_blocks} >= {"README.md", "docs/api.md"}
+    failed = [f"{b.where}:\n{b.error}" for b in doc_blocks if b.error is not None]
+    assert not failed, "\n".join(failed)
+
+
+def test_continuing_blocks_say_so(doc_blocks):
+    """A block that says it continues follows another python block of the same file; the README
+    quick start and the first block of each file stand alone."""
+    first = {}
+    for b in doc_blocks:
+        first.setdefault(b.file, b)
+    assert all(not b.continues for b in first.values())
+
+
+def test_blocks_are_quick(doc_blocks):
+    total = sum(b.seconds for b in doc_blocks)
+    slowest = sorted(doc_blocks, key=lambda b: -b.seconds)[:3]
+    print(f"\n{len(doc_blocks)} blocks in {total:.1f} s; slowest:")
+    for b in slowest:
+        print(f"  {b.where}: {b.seconds:.1f} s")
+    assert total < TOTAL_SECONDS, [(b.where, round(b.seconds, 1)) for b in slowest]
+
+
+def test_every_fence_names_its_language():
+    untagged = [
+        f"{path.name}:{line}"
+        for path in doc_files()
+        for line, lang, _ in fenced_blocks(path.read_text("utf-8"))
+        if not lang
+    ]
+    assert not untagged, untagged
+
+
+def test_fence_parser():
+    text = "a\n```python\nx = 1\n```\n```text\n$ out\n```\n```\nbare\n```\n"
+    expected = [(2, "python", "x = 1\n"), (5, "text", "$ out\n"), (8, "", "bare\n")]
+    assert fenced_blocks(text) == expected
