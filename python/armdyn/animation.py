@@ -3,8 +3,9 @@
 The viewer is K3D-jupyter's standalone snapshot (``k3d`` on PyPI, the ``viz`` extra): its
 JavaScript is embedded in the file, so the page needs no network access. Links are drawn from the
 URDF's ``<visual>`` elements (meshes STL/OBJ/DAE through ``trimesh``, boxes, cylinders and
-spheres), or, for a model built with :class:`armdyn.ModelBuilder`, from each body's equivalent
-inertia box and rods from the joints to the centres of mass. The viewer's *Controls → Animation*
+spheres), or, for a model built with :class:`armdyn.ModelBuilder` and for bodies without any
+``<visual>``, from each body's equivalent inertia box and rods from the joints to the centres of
+mass. The viewer's *Controls → Animation*
 panel has the time slider and the play/pause toggle ("Play loop").
 """
 
@@ -39,12 +40,14 @@ def remember_urdf(model, source: str) -> None:
 
 @dataclass
 class Visual:
-    """One drawable piece of a link, in the link frame: triangles and an RGB colour in [0, 1]."""
+    """One drawable piece of a link, in the link frame (or, with ``body``, of a body in its
+    centre-of-mass frame): triangles and an RGB colour in [0, 1]."""
 
     link: str
     vertices: np.ndarray  # (n, 3) float64, link frame [m]
     faces: np.ndarray  # (m, 3) int
     colour: tuple
+    body: bool = False
 
 
 def _import_viewer():
@@ -277,10 +280,11 @@ def inertia_box(mass: float, inertia: np.ndarray) -> tuple[np.ndarray, np.ndarra
     return np.sqrt(np.clip(sq, 0.0, None)), axes
 
 
-def builder_visuals(model) -> list[Visual]:
-    """Per body its equivalent inertia box (a small sphere for point and massless bodies), in
-    the body frame (origin at the centre of mass); and the rods (body, body, point a, point b)
-    from each joint point to the child's centre of mass and from the parent's."""
+def builder_visuals(model, bodies=None) -> list[Visual]:
+    """Per body (of ``bodies``, default all) its equivalent inertia box, thickened to 6 % of
+    the model's largest joint-to-centre distance where thinner (rods, point masses, massless
+    bodies), and a rod from each of its joint points to its centre of mass; in the body frame
+    (origin at the centre of mass)."""
     import trimesh
 
     names = list(model.body_names)
@@ -300,15 +304,21 @@ def builder_visuals(model) -> list[Visual]:
     scale = max(max(reach, default=0.0), 1e-3)
     visuals = []
     for k, name in enumerate(names):
+        if bodies is not None and name not in bodies:
+            continue
         ext, axes = inertia_box(masses[k], inertias[k])
         if ext.min() < 0.02 * max(ext.max(), scale):
             # a rod or a point: keep its length, give it a visible thickness
             ext = np.maximum(ext, 0.06 * scale)
         m = trimesh.creation.box(extents=ext)
         visuals.append(
-            Visual(name, np.asarray(m.vertices) @ axes.T, np.asarray(m.faces), _DEFAULT_COLOUR)
+            Visual(
+                name, np.asarray(m.vertices) @ axes.T, np.asarray(m.faces), _DEFAULT_COLOUR, True
+            )
         )
     for body, p in rods:
+        if bodies is not None and body not in bodies:
+            continue
         length = float(np.linalg.norm(p))
         cyl = trimesh.creation.cylinder(radius=0.025 * scale, height=length, sections=16)
         z = p / length
@@ -316,7 +326,7 @@ def builder_visuals(model) -> list[Visual]:
         x /= np.linalg.norm(x)
         rot = np.column_stack([x, np.cross(z, x), z])
         verts = np.asarray(cyl.vertices) @ rot.T + 0.5 * p
-        visuals.append(Visual(body, verts, np.asarray(cyl.faces), (0.35, 0.38, 0.45)))
+        visuals.append(Visual(body, verts, np.asarray(cyl.faces), (0.35, 0.38, 0.45), True))
     return visuals
 
 
@@ -389,8 +399,9 @@ def animate(
     Link geometry comes from the URDF's ``<visual>`` elements: meshes (STL, OBJ, DAE; ``scale``
     honoured, ``package://`` resolved from the URDF's folder and its parents, then
     ``ROS_PACKAGE_PATH``), boxes, cylinders and spheres, with their material colours. A model
-    without a URDF is drawn as each body's equivalent inertia box (the uniform box of the same
-    mass and central inertia) with rods from its joints to its centre of mass.
+    without a URDF, and each body none of whose links has a ``<visual>``, is drawn as the body's
+    equivalent inertia box (the uniform box of the same mass and central inertia) with rods
+    from its joints to its centre of mass.
 
     Args:
         model: the :class:`armdyn.Model` the run was made with.
@@ -447,6 +458,7 @@ def animate(
     rows = frame_rows(t, float(fps))
     tr, ur = t[rows], u[rows]
     source = urdf if urdf is not None else _URDF_SOURCES.get(model)
+    poses = {}
     if source is not None:
         visuals = urdf_visuals(source)
         frames = set(model.frame_names)
@@ -457,12 +469,18 @@ def animate(
                 "the model was loaded from?"
             )
         poses = {
-            link: np.asarray(_core.frame_pose_cartesian(model, ur, link)).reshape(-1, 4, 4)
+            (link, False): np.asarray(_core.frame_pose_cartesian(model, ur, link)).reshape(-1, 4, 4)
             for link in dict.fromkeys(v.link for v in visuals)
         }
+        # bodies none of whose links has a <visual>: drawn as for a builder model
+        drawn = {model.frame(v.link)["body"] for v in visuals}
+        bare = [b for b in model.body_names if b not in drawn]
+        if bare:
+            visuals += builder_visuals(model, bare)
     else:
         visuals = builder_visuals(model)
-        poses = body_poses(model, ur)
+    if any(v.body for v in visuals):
+        poses.update({(b, True): t for b, t in body_poses(model, ur).items()})
 
     plot = k3d.plot(
         camera_up_axis="z",
@@ -472,7 +490,7 @@ def animate(
         name="armdyn",
     )
     for v in visuals:
-        pose = poses[v.link]
+        pose = poses[v.link, v.body]
         if np.all(pose == pose[0]):
             matrix = pose[0].astype(np.float32)
         else:

@@ -16,6 +16,7 @@ import io
 import os
 import re
 import sys
+import time
 import zlib
 from pathlib import Path
 
@@ -23,6 +24,7 @@ import armdyn as ad
 import numpy as np
 import pytest
 from armdyn import animation
+from armdyn._rotation import quat_to_rot
 from chromium import Browser, chromium_path  # tests/viz/chromium.py (pytest's rootdir import)
 
 from benchmarks import common
@@ -330,3 +332,41 @@ def test_bad_input_raises_naming_the_culprit(ur5_run, tmp_path, monkeypatch):
     monkeypatch.setitem(sys.modules, "k3d", None)
     with pytest.raises(ImportError, match=r"pip install 'armdyn\[viz\]'"):
         ad.animate(model, result, tmp_path / "x.html")
+
+
+def test_docs_block_runs_in_seconds():
+    doc = (Path(__file__).parents[2] / "docs" / "animation.md").read_text(encoding="utf-8")
+    (code,) = re.findall(r"```python\n(.*?)```", doc, re.S)
+    ns: dict = {}
+    t0 = time.perf_counter()
+    exec(compile(code, "docs/animation.md python block", "exec"), ns)
+    took = time.perf_counter() - t0
+    assert ns["page"].is_file() and took < 3.0, f"{took:.2f} s"
+
+
+def test_links_without_visual_are_drawn_as_inertia_boxes(tmp_path):
+    urdf = """<robot name="r">
+      <link name="base"><visual><geometry><box size="0.1 0.1 0.1"/></geometry></visual></link>
+      <link name="arm">
+        <inertial><origin xyz="0.25 0 0"/><mass value="2"/>
+          <inertia ixx="0.001" iyy="0.05" izz="0.05" ixy="0" ixz="0" iyz="0"/></inertial>
+      </link>
+      <joint name="j" type="revolute"><parent link="base"/><child link="arm"/>
+        <axis xyz="0 1 0"/><limit lower="-3" upper="3" effort="10" velocity="5"/></joint>
+    </robot>"""
+    model = ad.load_urdf(urdf)
+    result = ad.simulate(model, 0.3, output_dt=0.1, q0=[0.4])
+    out = animation.animate(model, result, tmp_path / "r.html")
+    objs = snapshot(out.read_text(encoding="utf-8"))["objects"]
+    assert [o["name"] for o in objs] == ["base", "arm", "arm"]  # box, then its joint rod
+    box = objs[1]
+    # the uniform box of that inertia: 0.5 m long (I_yy = m L^2 / 12 + ...), along body x
+    verts = array(box["vertices"])
+    assert np.isclose(np.ptp(verts[:, 0]), np.sqrt(6 * (0.05 + 0.05 - 0.001) / 2), rtol=1e-6)
+    for k, v in box["model_matrix"].items():
+        i = int(np.searchsorted(result.t, float(k)))
+        ref = np.eye(4)
+        ref[:3, :3] = quat_to_rot(result.u[i, 3:7])
+        ref[:3, 3] = result.u[i, :3]
+        ulp = np.spacing(np.abs(ref).astype(np.float32)).astype(float)
+        assert np.all(np.abs(array(v) - ref) <= 0.5 * ulp + 1e-9)
