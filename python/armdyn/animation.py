@@ -206,9 +206,14 @@ def _shape(geometry, link: str):
     return np.asarray(m.vertices, float), np.asarray(m.faces, np.int64)
 
 
-def urdf_visuals(urdf: str | os.PathLike) -> list[Visual]:
-    """Every ``<visual>`` of a URDF (a path or the XML text) as triangles in its link's frame."""
-    text = os.fspath(urdf)
+def urdf_visuals(urdf: str | bytes | os.PathLike) -> list[Visual]:
+    """Every ``<visual>`` of a URDF (a path, or the XML as str or UTF-8 bytes) as triangles in
+    its link's frame."""
+    if isinstance(urdf, (bytes, bytearray)):
+        text = bytes(urdf).decode("utf-8")
+    else:
+        text = os.fspath(urdf)
+        text = os.fsdecode(text) if isinstance(text, bytes) else text
     base = None
     if not text.lstrip("\ufeff").lstrip().startswith("<"):
         path = Path(text)
@@ -376,6 +381,44 @@ def time_key(t: float) -> str:
     return repr(float(t))
 
 
+def _shown_states(model, result, fps: float) -> tuple[np.ndarray, np.ndarray]:
+    """(times, Cartesian states u) of the rows shown (:func:`frame_rows`), from a result's
+    ``u`` or, for a joint-space one (``trajectory_run``: ``t``, ``q`` only), from its ``q``
+    through :func:`armdyn.state_from_joints`."""
+    name = type(result).__name__
+    t = getattr(result, "t", None)
+    u, q = getattr(result, "u", None), getattr(result, "q", None)
+    if t is None or (u is None and q is None):
+        raise _core.ModelError(
+            "animate: result needs times t (n,) and Cartesian states u (n, nq) (simulate, "
+            f"driven_inverse_dynamics) or joint coordinates q (trajectory_run); got {name}"
+        )
+    t = np.asarray(t, dtype=float)
+    if u is not None:
+        states, what, width = np.asarray(u, dtype=float), "u", model.nq
+    else:
+        states, what, width = np.asarray(q, dtype=float), "q", len(model.coord_names)
+    if t.ndim != 1 or states.ndim != 2 or states.shape != (t.size, width):
+        raise _core.ModelError(
+            f"animate: result.{what} has shape {states.shape} for {t.shape} times, the model "
+            f"needs ({t.size}, {width}): pass the model the run was made with"
+        )
+    if t.size == 0:
+        error = getattr(result, "error", None)
+        raise _core.ModelError("animate: the result has no rows" + (f" ({error})" if error else ""))
+    finite = np.all(np.isfinite(states), axis=1) & np.isfinite(t)
+    if not finite.all():
+        bad = int(np.argmin(finite))
+        raise _core.ModelError(f"animate: result has non-finite values at row {bad} (t = {t[bad]})")
+    if np.any(np.diff(t) <= 0):
+        bad = int(np.argmax(np.diff(t) <= 0)) + 1
+        raise _core.ModelError(f"animate: result.t is not increasing at row {bad} (t = {t[bad]})")
+    rows = frame_rows(t, fps)
+    if what == "u":
+        return t[rows], states[rows]
+    return t[rows], np.array([_core.state_from_joints(model, qi)[0] for qi in states[rows]])
+
+
 def _colour_int(c) -> int:
     r, g, b = (min(255, max(0, round(255 * float(x)))) for x in c[:3])
     return (r << 16) | (g << 8) | b
@@ -406,7 +449,8 @@ def animate(
     Args:
         model: the :class:`armdyn.Model` the run was made with.
         result: a :class:`SimulationResult`, :class:`InverseDynamicsResult` or anything with
-            ``t`` (n,) and the Cartesian states ``u`` (n, model.nq).
+            ``t`` (n,) and the Cartesian states ``u`` (n, model.nq); or a joint-space
+            :class:`TrajectoryRun` (``t``, ``q`` (n, len(model.coord_names))).
         path: the HTML file to write.
         urdf: the URDF (a path, or XML text) of the link geometry; default: the one
             :func:`armdyn.load_urdf` loaded ``model`` from, else inertia boxes.
@@ -421,42 +465,22 @@ def animate(
 
     Raises:
         ImportError: the ``viz`` extra (k3d, trimesh, pycollada) is not installed.
-        ModelError: ``result`` does not belong to ``model`` or has no rows.
+        ModelError: ``result`` does not belong to ``model``, has no rows, non-finite values or
+            times that do not increase.
         UrdfError: a ``<visual>`` is malformed, a mesh is missing or unreadable, or a URDF link
             is not a frame of the model.
-        ValueError: ``fps`` is not positive.
+        ValueError: ``fps`` is not positive or ``time`` not finite.
     """
     _import_viewer()
     import k3d
 
-    if not (isinstance(fps, (int, float)) and math.isfinite(fps) and fps > 0):
+    if isinstance(fps, bool) or not (
+        isinstance(fps, (int, float)) and math.isfinite(fps) and fps > 0
+    ):
         raise ValueError(f"animate: fps must be a positive number, got {fps!r}")
-    t = np.asarray(getattr(result, "t", None), dtype=float)
-    u = getattr(result, "u", None)
-    if u is None or t.ndim != 1:
-        raise _core.ModelError(
-            "animate: result needs times t (n,) and Cartesian states u (n, nq), as "
-            f"armdyn.simulate returns; got {type(result).__name__}"
-        )
-    u = np.asarray(u, dtype=float)
-    if u.ndim != 2 or u.shape[1] != model.nq or u.shape[0] != t.size:
-        raise _core.ModelError(
-            f"animate: result.u has shape {u.shape}, the model needs ({t.size}, {model.nq}): "
-            "pass the model the run was made with"
-        )
-    if t.size == 0:
-        raise _core.ModelError(
-            "animate: the result has no rows"
-            + (f" ({result.error})" if getattr(result, "error", None) else "")
-        )
-    if not np.all(np.isfinite(u)):
-        bad = int(np.argmax(~np.all(np.isfinite(u), axis=1)))
-        raise _core.ModelError(
-            f"animate: result.u has non-finite values at row {bad} (t = {t[bad]})"
-        )
-
-    rows = frame_rows(t, float(fps))
-    tr, ur = t[rows], u[rows]
+    if time is not None and not (isinstance(time, (int, float)) and math.isfinite(time)):
+        raise ValueError(f"animate: time must be a finite number [s], got {time!r}")
+    tr, ur = _shown_states(model, result, float(fps))
     source = urdf if urdf is not None else _URDF_SOURCES.get(model)
     poses = {}
     if source is not None:

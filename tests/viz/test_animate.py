@@ -19,6 +19,7 @@ import sys
 import time
 import zlib
 from pathlib import Path
+from types import SimpleNamespace
 
 import armdyn as ad
 import numpy as np
@@ -328,6 +329,18 @@ def test_bad_input_raises_naming_the_culprit(ur5_run, tmp_path, monkeypatch):
         animation.animate(other, result, tmp_path / "x.html")
     with pytest.raises(ad.UrdfError, match=r"are not frames of the model"):
         animation.animate(model, result, tmp_path / "x.html", urdf=common.robot_urdf("panda"))
+    t, u = result.t, result.u
+    for bad, match in [
+        (SimpleNamespace(t=t[::-1], u=u), r"result\.t is not increasing at row 1"),
+        (SimpleNamespace(t=t, u=np.where(t[:, None] > 0.5, np.nan, u)), r"non-finite .* row 51"),
+        (SimpleNamespace(t=t[:0], u=u[:0], error="boom"), r"no rows \(boom\)"),
+        (SimpleNamespace(t=t), r"needs times t .* got SimpleNamespace"),
+        (SimpleNamespace(t=t, q=result.q[:, :5]), r"result\.q has shape \(101, 5\)"),
+    ]:
+        with pytest.raises(ad.ModelError, match=match):
+            animation.animate(model, bad, tmp_path / "x.html")
+    with pytest.raises(ValueError, match="time must be a finite number"):
+        animation.animate(model, result, tmp_path / "x.html", time=float("nan"))
     assert not (tmp_path / "x.html").exists()
     monkeypatch.setitem(sys.modules, "k3d", None)
     with pytest.raises(ImportError, match=r"pip install 'armdyn\[viz\]'"):
@@ -368,5 +381,21 @@ def test_links_without_visual_are_drawn_as_inertia_boxes(tmp_path):
         ref = np.eye(4)
         ref[:3, :3] = quat_to_rot(result.u[i, 3:7])
         ref[:3, 3] = result.u[i, :3]
+        ulp = np.spacing(np.abs(ref).astype(np.float32)).astype(float)
+        assert np.all(np.abs(array(v) - ref) <= 0.5 * ulp + 1e-9)
+
+
+def test_joint_space_trajectory_run(tmp_path):
+    # a planned motion (trajectory_run: t and q only) is drawn from q through state_from_joints
+    model = ad.load_urdf(common.robot_urdf("ur5"))
+    t = np.linspace(0.0, 1.0, 21)
+    q = np.outer(np.sin(np.pi * t), [0.5, -0.8, 1.1, 0.3, -0.4, 0.9])
+    run = ad.trajectory_run(model, t, q, np.gradient(q, t, axis=0), np.zeros_like(q))
+    out = animation.animate(model, run, tmp_path / "plan.html", fps=10)
+    objs = snapshot(out.read_text(encoding="utf-8"))["objects"]
+    wrist = next(o for o in objs if o["name"] == "wrist_3_link")
+    assert sorted(float(k) for k in wrist["model_matrix"]) == list(t[::2])
+    for k, v in wrist["model_matrix"].items():
+        ref = ad.frame_pose(model, q[int(np.searchsorted(t, float(k)))], "wrist_3_link")
         ulp = np.spacing(np.abs(ref).astype(np.float32)).astype(float)
         assert np.all(np.abs(array(v) - ref) <= 0.5 * ulp + 1e-9)
