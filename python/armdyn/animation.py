@@ -5,8 +5,8 @@ JavaScript is embedded in the file, so the page needs no network access. Links a
 URDF's ``<visual>`` elements (meshes STL/OBJ/DAE through ``trimesh``, boxes, cylinders and
 spheres), or, for a model built with :class:`armdyn.ModelBuilder` and for bodies without any
 ``<visual>``, from each body's equivalent inertia box and rods from the joints to the centres of
-mass. The viewer's *Controls → Animation*
-panel has the time slider and the play/pause toggle ("Play loop").
+mass. The viewer's *Controls → Animation* panel has the time slider and the play/pause toggle
+("Play loop", "Stop loop" while playing).
 """
 
 from __future__ import annotations
@@ -119,7 +119,9 @@ def _package_roots(package: str, base: Path | None) -> list[Path]:
                 roots.append(parent)
     for entry in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep):
         if entry:
-            roots += [Path(entry) / package, Path(entry)]
+            roots.append(Path(entry) / package)
+            if Path(entry).name == package:
+                roots.append(Path(entry))
     return roots
 
 
@@ -169,6 +171,13 @@ def _load_mesh(path: Path, link: str) -> list[tuple[np.ndarray, np.ndarray, tupl
         loaded = trimesh.load(str(path), force="scene")
     except Exception as err:
         raise _core.UrdfError(f"animate: link '{link}': cannot read mesh '{path}': {err}") from None
+    # a COLLADA file's <unit meter=...> scales it to metres (as RViz reads it); STL and OBJ
+    # carry no unit and are taken in metres
+    factor = 1.0
+    if path.suffix.lower() == ".dae" and loaded.units:
+        from trimesh.units import unit_conversion
+
+        factor = float(unit_conversion(loaded.units, "meters"))
     pieces = []
     for geom in loaded.dump():
         if not isinstance(geom, trimesh.Trimesh) or len(geom.faces) == 0:
@@ -180,7 +189,8 @@ def _load_mesh(path: Path, link: str) -> list[tuple[np.ndarray, np.ndarray, tupl
             main = geom.visual.main_color
         if main is not None:
             colour = tuple(float(c) / 255.0 for c in np.asarray(main)[:3])
-        pieces.append((np.asarray(geom.vertices, float), np.asarray(geom.faces, np.int64), colour))
+        verts = factor * np.asarray(geom.vertices, float)
+        pieces.append((verts, np.asarray(geom.faces, np.int64), colour))
     if not pieces:
         raise _core.UrdfError(f"animate: link '{link}': mesh '{path}' holds no triangles")
     return pieces
@@ -191,16 +201,22 @@ def _shape(geometry, link: str):
     import trimesh
 
     box, cyl, sph = geometry.find("box"), geometry.find("cylinder"), geometry.find("sphere")
+
+    def size(elem, attr, n, shape):
+        vals = _floats(elem.get(attr), n, f"link '{link}' <{shape} {attr}>")
+        if np.any(vals <= 0):
+            raise _core.UrdfError(
+                f"animate: link '{link}' <{shape} {attr}> = {elem.get(attr)!r} must be positive"
+            )
+        return vals
+
     if box is not None:
-        size = _floats(box.get("size"), 3, f"link '{link}' <box size>")
-        m = trimesh.creation.box(extents=size)
+        m = trimesh.creation.box(extents=size(box, "size", 3, "box"))
     elif cyl is not None:
-        r = _floats(cyl.get("radius"), 1, f"link '{link}' <cylinder radius>")[0]
-        h = _floats(cyl.get("length"), 1, f"link '{link}' <cylinder length>")[0]
-        m = trimesh.creation.cylinder(radius=r, height=h, sections=32)
+        r = size(cyl, "radius", 1, "cylinder")[0]
+        m = trimesh.creation.cylinder(radius=r, height=size(cyl, "length", 1, "cylinder")[0])
     elif sph is not None:
-        r = _floats(sph.get("radius"), 1, f"link '{link}' <sphere radius>")[0]
-        m = trimesh.creation.icosphere(subdivisions=3, radius=r)
+        m = trimesh.creation.icosphere(subdivisions=3, radius=size(sph, "radius", 1, "sphere")[0])
     else:
         return None
     return np.asarray(m.vertices, float), np.asarray(m.faces, np.int64)
@@ -259,8 +275,10 @@ def urdf_visuals(urdf: str | bytes | os.PathLike) -> list[Visual]:
                         f"animate: {where}: geometry is none of box, cylinder, sphere, mesh"
                     )
                 scale = _floats(mesh.get("scale"), 3, f"{where} mesh scale", (1, 1, 1))
+                # a mirroring scale (odd number of negative factors) turns the triangles over
+                flip = np.prod(np.sign(scale)) < 0
                 pieces = [
-                    (v * scale, f, c)
+                    (v * scale, f[:, ::-1] if flip else f, c)
                     for v, f, c in _load_mesh(
                         resolve_mesh(mesh.get("filename"), base, lname), lname
                     )

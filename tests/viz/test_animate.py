@@ -399,3 +399,36 @@ def test_joint_space_trajectory_run(tmp_path):
         ref = ad.frame_pose(model, q[int(np.searchsorted(t, float(k)))], "wrist_3_link")
         ulp = np.spacing(np.abs(ref).astype(np.float32)).astype(float)
         assert np.all(np.abs(array(v) - ref) <= 0.5 * ulp + 1e-9)
+
+
+def test_dae_units_mirroring_scale_and_bad_sizes(tmp_path):
+    trimesh = pytest.importorskip("trimesh")
+    # the UR5 upper arm declared in millimetres: <unit meter="0.001"> scales it as RViz does
+    dae = common.robot_urdf("ur5").parents[1] / "meshes" / "ur5" / "visual" / "upperarm.dae"
+    text = dae.read_text(encoding="utf-8")
+    assert text.count('<unit name="meter" meter="1"/>') == 1
+    (tmp_path / "mm.dae").write_text(text.replace('meter="1"', 'meter="0.001"'))
+    cube = trimesh.creation.box(extents=(1.0, 2.0, 3.0))
+    cube.export(tmp_path / "cube.stl")
+    urdf = tmp_path / "r.urdf"
+    urdf.write_text(
+        """<robot name="r"><link name="a">
+        <visual><geometry><mesh filename="upperarm.dae"/></geometry></visual>
+        <visual><geometry><mesh filename="mm.dae"/></geometry></visual>
+        <visual><geometry><mesh filename="cube.stl" scale="1 -1 1"/></geometry></visual>
+        </link></robot>""".replace("upperarm.dae", str(dae))
+    )
+    visuals = animation.urdf_visuals(urdf)
+    n = (len(visuals) - 1) // 2  # the pieces (materials) of each DAE
+    assert len(visuals) == 2 * n + 1
+    for metres, mm in zip(visuals[:n], visuals[n : 2 * n], strict=True):
+        assert np.allclose(mm.vertices, 1e-3 * metres.vertices, rtol=1e-12, atol=0)
+    # the mirrored cube keeps its triangles facing out (positive enclosed volume)
+    mirrored = visuals[-1]
+    assert np.isclose(trimesh.Trimesh(mirrored.vertices, mirrored.faces).volume, 6.0)
+    for shape in ('<box size="0.1 -0.1 0.1"/>', '<sphere radius="0"/>'):
+        with pytest.raises(ad.UrdfError, match=r"link 'a' <(box size|sphere radius)>.*positive"):
+            animation.urdf_visuals(
+                f'<robot name="r"><link name="a"><visual><geometry>{shape}</geometry></visual>'
+                "</link></robot>"
+            )
