@@ -2,8 +2,10 @@
 
 Chromium's one-shot ``--screenshot`` takes its picture at an arbitrary point of the page's
 asynchronous loading, so the tests drive the browser instead: load the file, wait until the
-viewer has built its scene, then screenshot, read the DOM and list every network request the
-page made. The browser runs offline (a proxy at a closed port) and with a fresh profile.
+viewer has built its scene, then screenshot, read the DOM and list every request the page made
+(CDP's Network events). The browser runs offline with a fresh profile: its only way out is a
+proxy run here that records the request line of every connection (from any of the browser's
+processes, workers included) and then closes it.
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ import json
 import os
 import re
 import shutil
+import socket
 import subprocess
 import tempfile
 import threading
@@ -27,7 +30,6 @@ CHROMIUM_FLAGS = [
     "--disable-background-networking",
     "--disable-component-update",
     "--no-first-run",
-    "--proxy-server=127.0.0.1:9",
     "--proxy-bypass-list=<-loopback>",
     "--hide-scrollbars",
 ]
@@ -41,16 +43,54 @@ def chromium_path() -> str | None:
     return None
 
 
+class DeadProxy:
+    """An HTTP proxy on a free loopback port that answers nothing: it records the first line of
+    each connection (``CONNECT host:443 ...`` or ``GET http://...``) and closes it."""
+
+    def __init__(self):
+        self.server = socket.create_server(("127.0.0.1", 0))
+        self.port = self.server.getsockname()[1]
+        self.lines: list[str] = []
+        threading.Thread(target=self._serve, daemon=True).start()
+
+    def _serve(self):
+        while True:
+            try:
+                conn, _ = self.server.accept()
+            except OSError:
+                return
+            with conn:
+                conn.settimeout(5)
+                try:
+                    self.lines.append(conn.recv(4096).split(b"\r\n", 1)[0].decode("latin-1"))
+                except OSError:
+                    self.lines.append("(no request line)")
+
+    def hosts(self) -> list[str]:
+        """The host of each recorded request."""
+        out = []
+        for line in self.lines:
+            parts = line.split()
+            target = parts[1] if len(parts) > 1 else line
+            out.append(re.sub(r"^[a-z]+://", "", target).split("/")[0].rsplit(":", 1)[0])
+        return out
+
+    def close(self):
+        self.server.close()
+
+
 class Browser:
     """``with Browser(800, 600) as b: b.open(path); png = b.screenshot()``."""
 
     def __init__(self, width: int = 800, height: int = 600):
         self.width, self.height = width, height
         self.profile = tempfile.mkdtemp(prefix="armdyn-chromium-")
+        self.proxy = DeadProxy()
         self.proc = subprocess.Popen(
             [
                 chromium_path(),
                 *CHROMIUM_FLAGS,
+                f"--proxy-server=127.0.0.1:{self.proxy.port}",
                 f"--window-size={width},{height}",
                 f"--user-data-dir={self.profile}",
                 "--remote-debugging-port=0",
@@ -154,6 +194,7 @@ class Browser:
                 self.proc.kill()
                 self.proc.wait()
         shutil.rmtree(self.profile, ignore_errors=True)
+        self.proxy.close()
 
     def __enter__(self):
         return self

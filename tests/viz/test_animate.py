@@ -105,6 +105,15 @@ def test_page_loads_offline_with_no_request_beyond_the_file(page, ur5_html):
     schemes = {u.split(":", 1)[0] for u in urls}
     assert schemes <= {"file", "data", "blob"}, [u[:80] for u in urls if not u.startswith("data:")]
     assert page.console_errors() == []
+    # nothing left through the proxy but the browser's own services (with background
+    # networking off, Chromium still calls its Google endpoints: search, accounts, time)
+    page.evaluate(FRAME)
+    own = ("google.com", "gvt1.com")
+    others = [h for h in page.proxy.hosts() if not any(h == d or h.endswith("." + d) for d in own)]
+    assert others == [], others
+    # and the proxy does see a page's fetch (this check can fail)
+    page.evaluate("fetch('https://example.org/probe').catch(() => 0)")
+    assert "example.org" in page.proxy.hosts()
 
 
 def test_embedded_poses_equal_the_kinematics(ur5_run, ur5_html):
