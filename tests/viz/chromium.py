@@ -59,12 +59,19 @@ class DeadProxy:
                 conn, _ = self.server.accept()
             except OSError:
                 return
-            with conn:
-                conn.settimeout(5)
-                try:
-                    self.lines.append(conn.recv(4096).split(b"\r\n", 1)[0].decode("latin-1"))
-                except OSError:
-                    self.lines.append("(no request line)")
+            threading.Thread(target=self._record, args=(conn,), daemon=True).start()
+
+    def _record(self, conn):
+        with conn:
+            conn.settimeout(5)
+            try:
+                head = conn.recv(4096)
+            except OSError:
+                head = b""
+            # a connection closed before any request (Chromium preconnects to its proxy)
+            # asked for nothing
+            if head:
+                self.lines.append(head.split(b"\r\n", 1)[0].decode("latin-1"))
 
     def hosts(self) -> list[str]:
         """The host of each recorded request."""
