@@ -17,10 +17,13 @@ import weakref
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from armdyn import _core
+
+__all__ = ["animate"]
 
 #: URDF source (path or XML text) of each model made by :func:`armdyn.load_urdf`, so that
 #: :func:`animate` finds the link geometry without being told (weak: it never keeps a model alive).
@@ -443,11 +446,11 @@ def _colour_int(c) -> int:
 
 
 def animate(
-    model,
-    result,
-    path: str | os.PathLike,
+    model: _core.Model,
+    result: Any,
+    path: str | os.PathLike[str],
     *,
-    urdf: str | os.PathLike | None = None,
+    urdf: str | bytes | os.PathLike[str] | None = None,
     fps: float = 30.0,
     time: float | None = None,
     height: int = 600,
@@ -470,8 +473,9 @@ def animate(
             ``t`` (n,) and the Cartesian states ``u`` (n, model.nq); or a joint-space
             :class:`TrajectoryRun` (``t``, ``q`` (n, len(model.coord_names))).
         path: the HTML file to write.
-        urdf: the URDF (a path, or XML text) of the link geometry; default: the one
-            :func:`armdyn.load_urdf` loaded ``model`` from, else inertia boxes.
+        urdf: the URDF (a path, or the XML as str or UTF-8 bytes) of the link geometry;
+            default: the one :func:`armdyn.load_urdf` loaded ``model`` from, else inertia
+            boxes.
         fps: frames per second of simulated time kept (the output rows at least 1/fps apart,
             the first and the last; every row if the output is coarser). The viewer interpolates
             between frames when playing.
