@@ -36,6 +36,7 @@ from armdyn._core import (
     state_from_joints,
     urdf_builder,
 )
+from armdyn.animation import animate  # k3d and trimesh are imported when animate() runs
 from armdyn.dynamics import InverseDynamicsResult, driven_inverse_dynamics
 from armdyn.simulation import SimulationResult, load_urdf, rollout, simulate
 from armdyn.sizing import (
@@ -69,6 +70,7 @@ __all__ = [
     "UrdfError",
     "WorkPrecisionResult",
     "actuators",
+    "animate",
     "body_accelerations",
     "body_forces",
     "body_mass_matrix",

@@ -12,6 +12,7 @@ import numpy as np
 import numpy.typing as npt
 
 from armdyn import _core
+from armdyn.animation import remember_urdf
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -722,8 +723,9 @@ def load_urdf(
         ModelError: a joint whose motion carries no inertia (a massless leaf link, a point mass
             on its own joint axis), naming the joint and the body.
     """
+    source = _urdf_source(path_or_xml)
     model = _core.urdf_builder(
-        _urdf_source(path_or_xml),
+        source,
         fixed_base,
         gravity,
         physical_inertia=physical_inertia,
@@ -737,4 +739,6 @@ def load_urdf(
             UserWarning,
             stacklevel=2,
         )
+    # armdyn.animate draws the links from this URDF's <visual> elements
+    remember_urdf(model, source)
     return model
