@@ -357,7 +357,11 @@ arm whose driven-gear torque fluctuates with gear clearance when one motor drive
 settles when several share the work (its Fig. 3). Scene `armdyn.scenes.geared_arm_6dof`;
 study `armdyn.geared_study` (5 s runs, DOPRI5 rtol 1e-6, metrics after 0.3 s; tooth impacts
 counted on the waist gear). Preload: motors biased against each other by ±0.1 N m at the
-rotors (anti-backlash)."""
+rotors (anti-backlash). The runs here are in joint coordinates (`simulate(coordinates="joint")`,
+the tree's 13–16 independent coordinates): the same metrics as the paper's Cartesian
+formulation (peak and RMS torques to 1e-6 relative, the same tooth impacts; checked by
+`tests/papers/test_reproduce.py`) in about a fiftieth of the time.
+`python benchmarks/geared_arm_study.py` runs the Cartesian formulation (docs/geared_arm.md)."""
 
 
 def geared_section(out: Path, plots: bool = True, cases=None, t_end=None) -> tuple[str, list]:
@@ -371,6 +375,7 @@ def geared_section(out: Path, plots: bool = True, cases=None, t_end=None) -> tup
         cases=cases or geared_study.CASES,
         t_end=t_end or geared_study.T_END,
         command="armdyn reproduce",
+        coordinates="joint",
     )
     text = [
         "## Six-DOF geared arm — driven-gear torque with 1–4 motors (first paper, Fig. 3)",
@@ -387,7 +392,7 @@ def geared_section(out: Path, plots: bool = True, cases=None, t_end=None) -> tup
 
 def run(out="armdyn-report", plots=True, echo=True, geared=True):
     """Run the studies, write the report; returns (report path, studies). geared=False skips the
-    geared-arm study (a few minutes)."""
+    geared-arm study."""
     s3, s5, ee = three_dof_study(), five_dof_study(), end_effector_study()
     path = write_report(Path(out), s3, s5, ee, plots=plots)
     rows = None
