@@ -60,6 +60,9 @@ class SimulationResult:
             coordinate, positive along it (a lower stop pushes up), 0 off the stops.
         actuators: for a model with actuators (``model.actuators``), the motor-side values of
             each (:func:`armdyn.actuators.motor_side_of_result`); empty otherwise.
+        model: the :class:`armdyn.Model` the run was made with (set by :func:`simulate` and
+            :func:`rollout`; None for a result built by hand): :meth:`plot` and
+            :meth:`limit_violations` read names and limits from it.
         error: None for a complete run; else why it stopped (the ``SolverError`` message of a
             run cut short, whose tables end at the last good output, or the ``ModelError`` of a
             run that could not start, whose tables have no rows). :func:`simulate` raises
@@ -86,17 +89,24 @@ class SimulationResult:
     limit_forces: dict[str, Any] = field(default_factory=dict)
     actuators: dict[str, Any] = field(default_factory=dict)
     error: str | None = None
+    model: _core.Model | None = field(default=None, repr=False, compare=False)
 
     @property
     def status(self) -> str:
         """``"ok"`` for a complete run, else the error that stopped it (:attr:`error`)."""
         return "ok" if self.error is None else self.error
 
-    def limit_violations(self, model: _core.Model) -> pd.DataFrame:
+    def limit_violations(self, model: _core.Model | None = None) -> pd.DataFrame:
         """Spans where this run exceeds the model's velocity and effort limits, as a DataFrame
         (joint, kind, t_start, t_end, worst, limit, samples); see
-        :func:`armdyn.sizing.limit_violations`. The result does not hold its model, so the model
-        the run was made with is passed (and checked against the result's columns)."""
+        :func:`armdyn.sizing.limit_violations`. ``model``: default the one the run was made
+        with (:attr:`model`); a model passed is checked against the result's columns."""
+        model = model if model is not None else self.model
+        if model is None:
+            raise _core.ModelError(
+                "SimulationResult.limit_violations: this result holds no model; pass the model "
+                "the run was made with"
+            )
         from armdyn.sizing import limit_violations
 
         return limit_violations(model, self)
@@ -135,9 +145,9 @@ class SimulationResult:
                 ``model.joint_coord_names`` / ``joint_dof_names``; gear names for ``"gear"``)
                 or column indices of each panel's array. Ignored by ``"energy"`` and the
                 residuals.
-            model: the model the run was made with: joint names and per-column units (the
-                result does not hold its model); without it, columns are ``q[0]``, ... and
-                units read "rad or m".
+            model: the model the run was made with, for joint names and per-column units;
+                default :attr:`model` (set by :func:`simulate` and :func:`rollout`). Without
+                either, columns are ``q[0]``, ... and units read "rad or m".
             ax: a matplotlib Axes to draw a single panel into (or a sequence, one per panel);
                 default: a new :class:`matplotlib.figure.Figure` (no pyplot state).
             path: save the figure there (dpi 110) when given.
@@ -156,6 +166,7 @@ class SimulationResult:
         """
         from armdyn.plotting import plot_result
 
+        model = model if model is not None else self.model
         return plot_result(
             self, kind, joints, model=model, ax=ax, path=path, title=title, **line_kw
         )
@@ -585,6 +596,7 @@ def _result_of(model: _core.Model, raw: dict) -> SimulationResult:
     error = raw.pop("error")
     result = SimulationResult(**raw)
     result.error = error or None
+    result.model = model
     if model.actuators and len(result.t):
         _attach_motor_side(model, result)
     return result
@@ -643,6 +655,7 @@ def _zero_dof_result(model: _core.Model, t_end: float, output_dt: float | None):
         },
         gear_forces={"names": [], "force": np.zeros((n, 0))},
         limit_forces={"names": [], "force": np.zeros((n, 0))},
+        model=model,
     )
 
 
