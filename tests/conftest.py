@@ -300,3 +300,13 @@ def assert_same_run(a, b, stats=False):
         sa = {k: v for k, v in a.stats.items() if k != "seconds"}
         sb = {k: v for k, v in b.stats.items() if k != "seconds"}
         assert sa == sb
+
+
+@pytest.fixture(scope="session")
+def doc_blocks(tmp_path_factory):
+    """Every ```python block of README.md and docs/*.md, run once (tests/docs/doc_blocks.py
+    says how). It lives here, not in a tests/docs/conftest.py: two conftest modules would
+    shadow each other's ``from conftest import ...``."""
+    from doc_blocks import doc_files, run_blocks  # tests/docs, on sys.path for its tests
+
+    return run_blocks(doc_files(), tmp_path_factory.mktemp("doc-blocks"))

@@ -1,7 +1,8 @@
 """docs/api.md, the guide, matches the code: every name it documents exists (package functions,
 builder methods, model properties, validation helpers), and its python blocks' results hold
 against each other and against closed forms (the blocks are run once, each as pasted, by the
-session fixture ``doc_blocks``; tests/docs/test_runnable_blocks.py checks that all of them run)."""
+session fixture ``doc_blocks`` of tests/conftest.py; tests/docs/test_runnable_blocks.py
+checks that all of them run)."""
 
 import re
 from pathlib import Path
