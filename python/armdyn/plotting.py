@@ -97,6 +97,15 @@ def _matplotlib_figure() -> type[Figure]:
     return Figure
 
 
+def _figure_and_axes(ax: Axes | None, figsize: tuple[float, float]) -> tuple[Any, Any]:
+    """(figure, axes) to draw one panel in: a new Figure of ``figsize`` [in] with one Axes, or
+    the given ``ax`` and its figure."""
+    if ax is None:
+        fig = _matplotlib_figure()(figsize=figsize)
+        return fig, fig.add_subplot()
+    return ax.figure, ax
+
+
 @dataclass
 class _Panel:
     """One axes' worth: the lines (label, y), their joints (for selection), the y label."""
@@ -456,12 +465,7 @@ def work_precision_figure(
     """Log-log error against CPU seconds, one line per integrator (and formulation) in the
     sweep's order, the references' estimated error as a dotted vertical line. See
     :meth:`armdyn.WorkPrecisionResult.plot`."""
-    fig: Any
-    if ax is None:
-        fig = _matplotlib_figure()(figsize=(7.5, 4.8))
-        ax_ = fig.add_subplot()
-    else:
-        ax_, fig = ax, ax.figure
+    fig, ax_ = _figure_and_axes(ax, (7.5, 4.8))
     tab: Any = wp.table  # a pandas DataFrame
     ok = tab[(tab["status"] == "ok") & np.isfinite(tab["error"]) & (tab["error"] > 0)]
     for (integ, coords), rows in ok.groupby(["integrator", "coordinates"], sort=False):
@@ -504,12 +508,7 @@ def sizing_torque_figure(
             f"SizingReport.plot: the run has no torque for {joint!r} (no drive, torque input "
             "or motor acts on it)"
         )
-    fig: Any
-    if ax is None:
-        fig = _matplotlib_figure()(figsize=(6.0, 3.0))
-        ax_ = fig.subplots()
-    else:
-        ax_, fig = ax, ax.figure
+    fig, ax_ = _figure_and_axes(ax, (6.0, 3.0))
     ax_.plot(report.t, tau, lw=1.0, label="joint torque/force")
     limit = report.table["effort_limit"].iloc[k]
     if np.isfinite(limit):
