@@ -52,6 +52,15 @@ def main(argv: list[str] | None = None) -> int:
     size.add_argument("--actuators", help="TOML: per joint gear_ratio, rotor_inertia, [motor]")
     size.add_argument("--out", help="write the report (HTML, CSV, figures) into this folder")
     args = parser.parse_args(argv)
+    try:
+        return _run(args)
+    except ModuleNotFoundError as e:  # a dependency missing (e.g. pip install --no-deps)
+        fix = "reinstall armdyn" if (e.name or "").startswith("armdyn") else f"pip install {e.name}"
+        print(f"armdyn {args.command}: needs the Python module {e.name!r}: {fix}", file=sys.stderr)
+        return 2
+
+
+def _run(args: argparse.Namespace) -> int:
     if args.command == "size":
         from armdyn.size import main as size_main
 
