@@ -39,6 +39,10 @@ URDF = ROOT / "tests" / "data" / "urdf" / "sizing_pendulum.urdf"
 OPTIONAL = {
     "distributed": ("distributed", {"sweeps.py"}),
     "xarray": ("distributed", {"sweeps.py"}),
+    # armdyn.animate: K3D's viewer, the URDF meshes (pycollada's module is ``collada``)
+    "k3d": ("viz", {"animation.py"}),
+    "trimesh": ("viz", {"animation.py"}),
+    "collada": ("viz", {"animation.py"}),
 }
 
 
