@@ -31,7 +31,7 @@ def main(argv: list[str] | None = None) -> int:
     sub = parser.add_subparsers(dest="command", required=True)
     sub.add_parser("verify", help="print accuracy figures against closed forms and Lagrange")
     rep_help = (
-        "regenerate the papers' tables and figures (measured: 7.2 s on 2 cores, "
+        "regenerate the papers' tables and figures (measured: 7.0 s on 2 cores, "
         "1.7 s with --no-geared)"
     )
     rep = sub.add_parser("reproduce", help=rep_help, description=rep_help)
@@ -40,7 +40,7 @@ def main(argv: list[str] | None = None) -> int:
     rep.add_argument(
         "--no-geared",
         action="store_true",
-        help="skip the geared-arm study (7.2 s becomes 1.7 s)",
+        help="skip the geared-arm study (7.0 s becomes 1.7 s)",
     )
     size = sub.add_parser(
         "size", help="sizing report of a planned motion (exit 0: every joint ok, 1: not)"
