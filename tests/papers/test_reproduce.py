@@ -12,6 +12,22 @@ from armdyn.reproduce import run
 ROOT = Path(__file__).resolve().parents[2]
 
 
+def execute_notebook(name: str, cwd, timeout: int = 600) -> str:
+    """Run notebooks/<name> end to end (nbclient, kernel cwd ``cwd``); returns the text its code
+    cells printed."""
+    import nbclient
+    import nbformat
+
+    nb = nbformat.read(ROOT / "notebooks" / name, as_version=4)
+    client = nbclient.NotebookClient(
+        nb, timeout=timeout, kernel_name="python3", resources={"metadata": {"path": str(cwd)}}
+    )
+    client.execute()
+    return "".join(
+        o.get("text", "") for c in nb.cells if c.cell_type == "code" for o in c.get("outputs", [])
+    )
+
+
 def test_reproduce_report(tmp_path):
     path, studies = run(tmp_path / "report", plots=True, echo=False, geared=False)
     text = path.read_text(encoding="utf-8")
@@ -53,18 +69,7 @@ def test_reproduce_command_line(tmp_path):
 
 
 def test_notebook_executes(tmp_path):
-    import nbclient
-    import nbformat
-
-    nb_path = ROOT / "notebooks" / "five_dof_validation.ipynb"
-    nb = nbformat.read(nb_path, as_version=4)
-    client = nbclient.NotebookClient(
-        nb, timeout=600, kernel_name="python3", resources={"metadata": {"path": str(tmp_path)}}
-    )
-    client.execute()
-    outputs = "".join(
-        o.get("text", "") for c in nb.cells if c.cell_type == "code" for o in c.get("outputs", [])
-    )
+    outputs = execute_notebook("five_dof_validation.ipynb", tmp_path)
     assert "complete Lagrange" in outputs
 
 
@@ -108,18 +113,7 @@ def test_sizing_notebook_executes(tmp_path):
     closes and (with the actuator model) the rebuilt model's report equals the closed form."""
     import re
 
-    import nbclient
-    import nbformat
-
-    nb_path = ROOT / "notebooks" / "sizing_ur5.ipynb"
-    nb = nbformat.read(nb_path, as_version=4)
-    client = nbclient.NotebookClient(
-        nb, timeout=600, kernel_name="python3", resources={"metadata": {"path": str(tmp_path)}}
-    )
-    client.execute()
-    outputs = "".join(
-        o.get("text", "") for c in nb.cells if c.cell_type == "code" for o in c.get("outputs", [])
-    )
+    outputs = execute_notebook("sizing_ur5.ipynb", tmp_path)
     payload = float(re.search(r"max difference to J\^T m g: (\S+)", outputs).group(1))
     assert payload <= 1e-10
     balances = [float(x) for x in re.findall(r"balance error = (\S+)", outputs)]
@@ -139,21 +133,11 @@ def test_sweep_notebook_executes(tmp_path):
     import json
     import re
 
-    import nbclient
-    import nbformat
     import numpy as np
     import pytest
 
     pytest.importorskip("distributed")
-    nb_path = ROOT / "notebooks" / "sweep_ur5.ipynb"
-    nb = nbformat.read(nb_path, as_version=4)
-    client = nbclient.NotebookClient(
-        nb, timeout=300, kernel_name="python3", resources={"metadata": {"path": str(tmp_path)}}
-    )
-    client.execute()
-    outputs = "".join(
-        o.get("text", "") for c in nb.cells if c.cell_type == "code" for o in c.get("outputs", [])
-    )
+    outputs = execute_notebook("sweep_ur5.ipynb", tmp_path, timeout=300)
     assert re.findall(r"failed points: (\d+)", outputs) == ["0", "0"]
     assert "(payload: 6, duration: 4, shoulder_ratio: 4, joint: 6)" in outputs
     assert float(re.search(r"sweep vs serial, largest difference: (\S+)", outputs).group(1)) == 0.0
