@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from armdyn import _core
+from armdyn._rotation import quat_to_rot
 
 __all__ = ["animate"]
 
@@ -361,21 +362,10 @@ def body_poses(model, u: np.ndarray) -> dict[str, np.ndarray]:
     Cartesian states ``u`` (rows, nq): position and Euler parameters (scalar first)."""
     out = {}
     for k, name in enumerate(model.body_names):
-        p = u[:, 7 * k : 7 * k + 3]
         e = u[:, 7 * k + 3 : 7 * k + 7]
-        e = e / np.linalg.norm(e, axis=1, keepdims=True)
-        e0, e1, e2, e3 = e.T
         t = np.zeros((u.shape[0], 4, 4))
-        t[:, 0, 0] = 1 - 2 * (e2 * e2 + e3 * e3)
-        t[:, 0, 1] = 2 * (e1 * e2 - e0 * e3)
-        t[:, 0, 2] = 2 * (e1 * e3 + e0 * e2)
-        t[:, 1, 0] = 2 * (e1 * e2 + e0 * e3)
-        t[:, 1, 1] = 1 - 2 * (e1 * e1 + e3 * e3)
-        t[:, 1, 2] = 2 * (e2 * e3 - e0 * e1)
-        t[:, 2, 0] = 2 * (e1 * e3 - e0 * e2)
-        t[:, 2, 1] = 2 * (e2 * e3 + e0 * e1)
-        t[:, 2, 2] = 1 - 2 * (e1 * e1 + e2 * e2)
-        t[:, :3, 3] = p
+        t[:, :3, :3] = quat_to_rot(e / np.linalg.norm(e, axis=1, keepdims=True))
+        t[:, :3, 3] = u[:, 7 * k : 7 * k + 3]
         t[:, 3, 3] = 1.0
         out[name] = t
     return out

@@ -24,8 +24,8 @@ import armdyn as ad
 import numpy as np
 import pytest
 from armdyn import animation
-from armdyn._rotation import quat_to_rot
 from chromium import Browser, chromium_path  # tests/viz/chromium.py (pytest's rootdir import)
+from scipy.spatial.transform import Rotation
 
 from benchmarks import common
 
@@ -377,7 +377,8 @@ def test_links_without_visual_are_drawn_as_inertia_boxes(tmp_path):
     for k, v in box["model_matrix"].items():
         i = int(np.searchsorted(result.t, float(k)))
         ref = np.eye(4)
-        ref[:3, :3] = quat_to_rot(result.u[i, 3:7])
+        # scipy's quaternion is scalar last
+        ref[:3, :3] = Rotation.from_quat(result.u[i, [4, 5, 6, 3]]).as_matrix()
         ref[:3, 3] = result.u[i, :3]
         ulp = np.spacing(np.abs(ref).astype(np.float32)).astype(float)
         assert np.all(np.abs(array(v) - ref) <= 0.5 * ulp + 1e-9)
