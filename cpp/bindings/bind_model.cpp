@@ -284,13 +284,12 @@ void bind_model(py::module_& m) {
             if (t.is_none() || py::isinstance<py::str>(t) || py::isinstance<py::bytes>(t))
               throw ModelError(msg(who, ": expected a number or an array of numbers, got ",
                                    py::repr(t).cast<std::string>()));
-            const bool scalar = !py::isinstance<py::array>(t) && as_array(t, who).ndim() == 0;
-            if (scalar) {
-              const ProfileValue v = p.eval(*as_array(t, who).data());
+            const py::array_t<double> ta = as_array(t, who);
+            if (ta.ndim() == 0 && !py::isinstance<py::array>(t)) {  // a number: floats
+              const ProfileValue v = p.eval(*ta.data());
               return py::reinterpret_steal<ProfileValues>(
                   py::make_tuple(v.y, v.yd, v.ydd).release());
             }
-            const py::array_t<double> ta = as_array(t, who);
             std::vector<py::ssize_t> shape(ta.shape(), ta.shape() + ta.ndim());
             py::array_t<double> y(shape), yd(shape), ydd(shape);
             const double* tp = ta.data();
