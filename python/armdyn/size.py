@@ -4,8 +4,8 @@ sizing report of a planned motion from the command line.
 Trajectory CSV: a header row, then one row per sample. Columns: ``t`` (strictly increasing, s),
 one column per joint coordinate of the URDF (``model.coord_names``: positions, rad or m), and
 optionally ``<joint>.qd`` and ``<joint>.qdd`` (rates and accelerations). Joints without them
-are differentiated by a not-a-knot cubic spline through the positions (the spline of scipy's
-``CubicSpline``, computed with numpy alone: :func:`not_a_knot_spline_derivative`).
+are differentiated by a not-a-knot cubic spline through the positions (scipy's
+``CubicSpline``).
 
 Actuators TOML (optional): one table per joint with ``gear_ratio`` and ``rotor_inertia``
 (kg m², motor side) and optionally ``efficiency``, ``friction_viscous`` (N m s/rad) and
@@ -51,68 +51,15 @@ ACTUATOR_KEYS = (
 MOTOR_KEYS = MOTOR_FIELDS  # armdyn.Motor's keywords
 
 
-def not_a_knot_spline_derivative(t: np.ndarray, y: np.ndarray, order: int) -> np.ndarray:
-    """First (``order=1``) or second (``order=2``) derivative, at the samples ``t`` (strictly
-    increasing, 4 at least), of the not-a-knot cubic spline through ``(t, y)``: the spline of
-    ``scipy.interpolate.CubicSpline(t, y)`` (same equations, solved here with numpy alone).
-
-    The knot slopes s solve the tridiagonal system of C² continuity,
-    Δ_i s_{i-1} + 2 (Δ_{i-1} + Δ_i) s_i + Δ_{i-1} s_{i+1} = 3 (Δ_i m_{i-1} + Δ_{i-1} m_i)
-    (Δ_i = t_{i+1} − t_i, m_i the secant slopes), closed by the not-a-knot rows (third
-    derivative continuous at t_1 and t_{n-2}). Subtracting each end row from its neighbour
-    leaves a diagonally dominant system for s_1 … s_{n-2}, solved by the Thomas algorithm
-    (no pivoting needed); s_0 and s_{n-1} follow from the end rows."""
-    t = np.asarray(t, dtype=float)
-    y = np.asarray(y, dtype=float)
-    n = len(t)
-    dx = np.diff(t)
-    m = np.diff(y) / dx
-    # the full system's rows: sub[i] s_{i-1} + diag[i] s_i + sup[i] s_{i+1} = rhs[i]
-    sub, diag, sup, rhs = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
-    sub[1:-1], diag[1:-1], sup[1:-1] = dx[1:], 2.0 * (dx[:-1] + dx[1:]), dx[:-1]
-    rhs[1:-1] = 3.0 * (dx[1:] * m[:-1] + dx[:-1] * m[1:])
-    d0, d1 = t[2] - t[0], t[-1] - t[-3]
-    diag[0], sup[0] = dx[1], d0
-    rhs[0] = ((dx[0] + 2.0 * d0) * dx[1] * m[0] + dx[0] ** 2 * m[1]) / d0
-    sub[-1], diag[-1] = d1, dx[-2]
-    rhs[-1] = (dx[-1] ** 2 * m[-2] + (2.0 * d1 + dx[-1]) * dx[-2] * m[-1]) / d1
-    # row 1 minus row 0 and row n-2 minus row n-1 eliminate s_0 and s_{n-1}
-    # (sub[1] == diag[0] and sup[-2] == diag[-1])
-    diag[1] -= sup[0]
-    rhs[1] -= rhs[0]
-    diag[-2] -= sub[-1]
-    rhs[-2] -= rhs[-1]
-    # Thomas algorithm on rows 1 … n-2
-    c, r = np.zeros(n), np.zeros(n)
-    c[1], r[1] = sup[1] / diag[1], rhs[1] / diag[1]
-    for i in range(2, n - 1):
-        w = diag[i] - sub[i] * c[i - 1]
-        c[i], r[i] = sup[i] / w, (rhs[i] - sub[i] * r[i - 1]) / w
-    s = np.zeros(n)
-    s[n - 2] = r[n - 2]
-    for i in range(n - 3, 0, -1):
-        s[i] = r[i] - c[i] * s[i + 1]
-    s[0] = (rhs[0] - sup[0] * s[1]) / diag[0]
-    s[-1] = (rhs[-1] - sub[-1] * s[-2]) / diag[-1]
-    if order == 1:
-        return s
-    if order != 2:
-        raise ValueError(f"order must be 1 or 2, not {order!r}")
-    # second derivative of the cubic of each interval at its left end; the last sample from
-    # the last interval's right end
-    out = np.empty(n)
-    out[:-1] = 2.0 * (3.0 * m - 2.0 * s[:-1] - s[1:]) / dx
-    out[-1] = 2.0 * (2.0 * s[-1] + s[-2] - 3.0 * m[-1]) / dx[-1]
-    return out
-
-
 def _derivative(t: np.ndarray, y: np.ndarray, order: int, joint: str) -> np.ndarray:
     if len(t) < 4:
         raise _core.ModelError(
             f"trajectory: {len(t)} samples are too few for a cubic spline of {joint!r} "
             "(4 at least), or give its .qd and .qdd columns"
         )
-    return not_a_knot_spline_derivative(t, y, order)
+    from scipy.interpolate import CubicSpline
+
+    return CubicSpline(t, y)(t, order)
 
 
 def read_trajectory(path, model):

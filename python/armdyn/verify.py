@@ -12,7 +12,6 @@ the solver:
 
 from __future__ import annotations
 
-import math
 import time
 
 import numpy as np
@@ -33,23 +32,10 @@ def _crossing(t, y, k):
     return min(roots, key=lambda r: abs(r - 0.5 * (t[k] + t[k + 1])))
 
 
-def ellipk(m: float) -> float:
-    """Complete elliptic integral of the first kind K(m) = ∫₀^{π/2} dφ / √(1 − m sin²φ), for
-    0 ≤ m < 1, by the arithmetic–geometric mean: K(m) = π / (2 AGM(1, √(1 − m))) (no scipy).
-    The AGM converges quadratically; the loop stops when a and b agree to the last bit."""
-    m = float(m)
-    if not 0.0 <= m < 1.0:
-        raise ValueError(f"ellipk: m = {m!r} is outside [0, 1)")
-    a, b = 1.0, math.sqrt(1.0 - m)
-    for _ in range(64):
-        if abs(a - b) <= 2.0 * np.finfo(float).eps * a:
-            break
-        a, b = 0.5 * (a + b), math.sqrt(a * b)
-    return math.pi / (a + b)
-
-
 def pendulum_period(theta0, rtol=1e-12, length=1.0, mass=1.0, radius=1e-3, g=9.81):
     """(simulated, closed-form) period of a physical pendulum released at rest from theta0."""
+    from scipy.special import ellipk
+
     model = scenes.simple_pendulum(length, mass, theta0, radius, g)
     i_pivot = 0.4 * mass * radius**2 + mass * length**2
     omega0 = np.sqrt(mass * g * length / i_pivot)

@@ -3,9 +3,6 @@
 * Every third-party module imported anywhere in the package (module level or inside a function)
   is an ordinary dependency in pyproject.toml, except the ones of the optional features listed
   in OPTIONAL, which are in the named extra and imported only by the named modules.
-* ``armdyn verify`` and ``armdyn size`` need no scipy: K(m) by the AGM (against closed forms and
-  scipy.special.ellipk) and the not-a-knot spline (against scipy.interpolate.CubicSpline), and
-  both commands run with scipy made unimportable.
 * A missing dependency gives a one-line message naming it and exit code 2, no traceback.
 """
 
@@ -20,10 +17,7 @@ from importlib.metadata import packages_distributions
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
 import pytest
-from armdyn.size import not_a_knot_spline_derivative
-from armdyn.verify import ellipk
 
 try:
     import tomllib
@@ -82,7 +76,7 @@ def test_every_import_is_a_dependency_or_a_named_optional_feature():
     dist_of = packages_distributions()
     imports = third_party_imports()
     # the walk sees what it must: the lazily imported ones included
-    assert {"numpy", "pandas", "matplotlib", "tqdm", "tomli"} <= imports.keys()
+    assert {"numpy", "pandas", "matplotlib", "scipy", "tqdm", "tomli"} <= imports.keys()
     for module, files in sorted(imports.items()):
         dists = {d.lower().replace("_", "-") for d in dist_of.get(module, [module])}
         if module in OPTIONAL:
@@ -91,52 +85,11 @@ def test_every_import_is_a_dependency_or_a_named_optional_feature():
             assert dists & extras[extra], f"{module}: not in the {extra!r} extra"
         else:
             assert dists & deps, f"{module} (imported by {sorted(files)}) is not a dependency"
-    # scipy is gone from the CLI: no module of the package imports it
-    assert "scipy" not in imports
 
 
 def test_tomli_only_where_tomllib_is_missing():
     (req,) = [r for r in PYPROJECT["project"]["dependencies"] if r.startswith("tomli")]
     assert req.replace(" ", "").endswith(";python_version<'3.11'")
-
-
-def test_ellipk_against_closed_forms_and_scipy():
-    assert ellipk(0.0) == math.pi / 2
-    # K(1/2) = Γ(1/4)² / (4 √π)
-    assert ellipk(0.5) == pytest.approx(math.gamma(0.25) ** 2 / (4 * math.sqrt(math.pi)), 4e-16)
-    # K(m) ~ ln(4 / √(1 - m)) as m -> 1, error O((1 - m) ln(1 - m))
-    m = 1 - 1e-14
-    assert ellipk(m) == pytest.approx(math.log(4 / math.sqrt(1 - m)), abs=1e-12)
-    special = pytest.importorskip("scipy.special")
-    for m in np.concatenate([np.linspace(0, 0.999, 37), 1 - np.logspace(-3, -15, 13)]):
-        assert ellipk(m) == pytest.approx(special.ellipk(m), rel=1e-15, abs=0)
-    for bad in (-0.1, 1.0, float("nan")):
-        with pytest.raises(ValueError, match="outside"):
-            ellipk(bad)
-
-
-@pytest.mark.parametrize("n", [4, 5, 6, 9, 200])
-def test_spline_derivatives_match_scipy_cubic_spline(n):
-    interpolate = pytest.importorskip("scipy.interpolate")
-    rng = np.random.default_rng(n)
-    t = np.cumsum(rng.uniform(0.01, 1.0, n))  # uneven steps, ratios up to 100
-    y = np.sin(3 * t) + rng.normal(size=n)
-    spline = interpolate.CubicSpline(t, y)
-    for order in (1, 2):
-        ref = spline(t, order)
-        got = not_a_knot_spline_derivative(t, y, order)
-        assert np.abs(got - ref).max() <= 1e-13 * np.abs(ref).max()
-
-
-def test_spline_is_exact_on_a_cubic():
-    t = np.cumsum(np.random.default_rng(3).uniform(0.05, 0.5, 12))
-    y = 1 + 2 * t - 3 * t**2 + 0.5 * t**3
-    np.testing.assert_allclose(
-        not_a_knot_spline_derivative(t, y, 1), 2 - 6 * t + 1.5 * t**2, rtol=0, atol=1e-12
-    )
-    np.testing.assert_allclose(
-        not_a_knot_spline_derivative(t, y, 2), -6 + 3 * t, rtol=0, atol=1e-11
-    )
 
 
 def run_blocked(blocked: list[str], code: str) -> subprocess.CompletedProcess:
@@ -147,37 +100,10 @@ def run_blocked(blocked: list[str], code: str) -> subprocess.CompletedProcess:
     )
 
 
-def test_size_differentiates_positions_without_scipy(tmp_path):
-    """armdyn size on a positions-only CSV, scipy unimportable: the pendulum's torque
-    τ = I_p q̈ + m g l sin q (tests/validate/test_size_cli.py) to the spline's accuracy."""
-    i_p, mgl = 0.01 + 2.0 * 0.5**2, 2.0 * 9.81 * 0.5
-    t = np.linspace(0.0, 2.0, 801)
-    w = np.pi
-    q, qdd = 0.5 * np.sin(w * t), -0.5 * w * w * np.sin(w * t)
-    pd.DataFrame({"t": t, "pivot": q}).to_csv(
-        tmp_path / "pos.csv", index=False, float_format="%.17g"
-    )
-    proc = run_blocked(
-        ["scipy"],
-        "from armdyn.__main__ import main\n"
-        f"sys.exit(main(['size', {str(URDF)!r}, '--trajectory', {str(tmp_path / 'pos.csv')!r},"
-        f" '--out', {str(tmp_path / 'rep')!r}]))",
-    )
-    assert proc.returncode == 0, proc.stderr
-    tab = pd.read_csv(tmp_path / "rep" / "table.csv", index_col="joint")
-    tau = i_p * qdd + mgl * np.sin(q)
-    assert tab.loc["pivot", "peak_torque"] == pytest.approx(np.max(np.abs(tau)), rel=1e-5)
+def test_verify_pendulum_period_against_the_closed_form():
+    from armdyn.verify import pendulum_period
 
-
-def test_verify_pendulum_without_scipy():
-    proc = run_blocked(
-        ["scipy"],
-        "import numpy as np\nfrom armdyn.verify import pendulum_period\n"
-        "sim, exact = pendulum_period(np.radians(90.0))\n"
-        "print(repr(float(sim)), repr(float(exact)))",
-    )
-    assert proc.returncode == 0, proc.stderr
-    sim, exact = map(float, proc.stdout.split())
+    sim, exact = pendulum_period(np.radians(90.0))
     # T = 4 / ω₀ K(sin²45°), ω₀ = √(m g L / I_pivot), I_pivot = 0.4 m r² + m L² (r = 1e-3)
     omega0 = math.sqrt(9.81 / (0.4e-6 + 1.0))
     k_half = math.gamma(0.25) ** 2 / (4 * math.sqrt(math.pi))
