@@ -109,6 +109,10 @@ def test_motor_columns_against_the_closed_form(run, monkeypatch):
     row = ad.sizing_report(geared, proxy).table.loc["spin"]
     # joint side includes the reflected rotor: (I + N² J) A ω²
     assert row["peak_torque"] == pytest.approx((I_Z + N * N * J) * AMP * OMEGA**2, rel=1e-12)
+    # and its two shares on their own: the load's I A ω², the rotor's N² J A ω² (by hand:
+    # q̈ = −A ω² sin ω t, both in phase, so the peaks add)
+    assert row["peak_load_torque"] == pytest.approx(I_Z * AMP * OMEGA**2, rel=1e-12)
+    assert row["peak_rotor_torque"] == pytest.approx(N * N * J * AMP * OMEGA**2, rel=1e-12)
     assert row["gear_ratio"] == N
     assert row["motor_peak_torque"] == pytest.approx(PEAK_T, rel=1e-12)
     assert row["motor_rms_torque"] == pytest.approx(PEAK_T / np.sqrt(2.0), rel=1e-12)
@@ -146,6 +150,17 @@ def test_what_if_actuators_equal_the_stand_in_model(run, monkeypatch):
     monkeypatch.setattr(sizing, "_mass_matrix", lambda md, q: _core.mass_matrix(md, q))
     spec = {"gear_ratio": N, "rotor_inertia": J, "motor": m}
     b = ad.sizing_report(res, model, actuators={"spin": spec}).table
+    # the what-if rotor is not hidden in peak_torque: the run's own (rotor-free) peak is
+    # peak_load_torque, the rotor's N² J A ω² is peak_rotor_torque, peak_torque their sum here
+    plain = ad.sizing_report(res, model).table.loc["spin"]
+    assert "peak_load_torque" not in plain.index
+    assert b.loc["spin", "peak_load_torque"] == pytest.approx(plain["peak_torque"], rel=1e-12)
+    assert b.loc["spin", "peak_rotor_torque"] == pytest.approx(
+        N * N * J * AMP * OMEGA**2, rel=1e-12
+    )
+    assert b.loc["spin", "peak_torque"] == pytest.approx(
+        plain["peak_torque"] + b.loc["spin", "peak_rotor_torque"], rel=1e-12
+    )
     assert list(a.columns) == list(b.columns)
     num = [c for c in a.columns if c not in ("ok", "unchecked")]
     np.testing.assert_allclose(a[num].to_numpy(float), b[num].to_numpy(float), rtol=1e-12)
