@@ -865,8 +865,8 @@ def gear_ratio_sweep(
     Args:
         result: a run of ``model`` (any result :func:`sizing_report` takes).
         model: the model of the run; default the one the result holds (``result.model``).
-            ``gear_ratio_sweep(result, ratios)`` is read as ``ratios`` given, model from the
-            result.
+            ``gear_ratio_sweep(result, ratios[, actuators])`` (no model between) takes the
+            result's.
         ratios: the gear ratios to try (1-D, non-zero), or ``{joint: ratios}`` (required).
         actuators: ``{joint: spec}`` with ``rotor_inertia`` and optionally ``efficiency``,
             ``friction_viscous``, ``friction_coulomb``, ``motor`` (a dict or an object with
@@ -890,8 +890,13 @@ def gear_ratio_sweep(
 
     from armdyn.actuators import motor_side
 
-    if ratios is None and model is not None and not isinstance(model, _core.Model):
-        model, ratios = None, model  # gear_ratio_sweep(result, ratios)
+    if model is not None and not hasattr(model, "dof_names"):
+        # gear_ratio_sweep(result, ratios[, actuators]): the model is the result's
+        if actuators is not None:
+            raise _core.ModelError(
+                f"gear_ratio_sweep: model must be an armdyn.Model, got {type(model).__name__}"
+            )
+        model, ratios, actuators = None, model, ratios
     if ratios is None:
         raise _core.ModelError("gear_ratio_sweep: ratios is required (the gear ratios to try)")
     model = _model_of(result, model, "gear_ratio_sweep")

@@ -122,7 +122,7 @@ def test_sweep_example(doc_blocks):
     assert study.attrs["failed"] == 2 and study.attrs["seed"] == 7
 
 
-SHAPE = re.compile(r"`ad\.(\w+)\(([^)]*)\) -> \S+ \(([^)]*)\)`")
+SHAPE = re.compile(r"`ad\.(\w+)\(([^)]*)\) -> \S+ \(([\w, ]*)\)`")
 ROWS_SHAPE = re.compile(r"\(rows:\s+`\(rows, ([^)]*)\)`\)")
 
 

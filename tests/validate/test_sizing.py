@@ -276,7 +276,7 @@ def test_functions_of_a_result_take_its_model_by_default(two_periods):
     pd.testing.assert_frame_equal(ad.limit_violations(res), ad.limit_violations(model, res))
     spec = {"spin": {"rotor_inertia": 1e-4}}
     by_default = ad.gear_ratio_sweep(res, ratios=[10.0, 40.0], actuators=spec)
-    positional = ad.gear_ratio_sweep(res, [10.0, 40.0], actuators=spec)
+    positional = ad.gear_ratio_sweep(res, [10.0, 40.0], spec)
     old_form = ad.gear_ratio_sweep(res, model, [10.0, 40.0], spec)
     pd.testing.assert_frame_equal(by_default.table, old_form.table)
     pd.testing.assert_frame_equal(positional.table, old_form.table)
