@@ -33,14 +33,18 @@ def test_ur5_run_agrees_with_pinocchio_and_mujoco_solves_the_same_arm():
     # DOPRI5 at rtol 1e-8 stays within 1e-5 rad (measured 4.9e-6) of a DOP853 (rtol 1e-13)
     # integration of Pinocchio's ABA over all 100 outputs, and MuJoCo's import of the same URDF
     # has Pinocchio's accelerations (so its curve in the benchmark is the same problem)
+    # (the curves the benchmark's quick sweep draws, computed alone: not the whole sweep, whose
+    # other integrators and peers took 133 s of the suite on a busy machine)
     pytest.importorskip("mujoco")
     from benchmarks import workprecision as wp
 
-    r = wp.run_problem("ur5", quick=True, echo=False)
-    dopri = {p["setting"]: p["error"] for p in r["curves"]["armdyn dopri5"]}
-    assert dopri[1e-8] <= 1e-5
+    problem = wp.PROBLEMS["ur5"]
+    ref = problem.reference(common.output_times(problem))
+    curve = wp.sweep_armdyn(problem, "dopri5", [1e-6, 1e-8], ref, repeats=1)
+    dopri = {p["setting"]: p["error"] for p in curve}
+    assert dopri[1e-8] <= 1e-5  # measured 2.0e-6
     assert dopri[1e-8] < dopri[1e-6] / 10  # converges with the tolerance
-    mj = r["curves"]["MuJoCo rk4"][0]
+    (mj,) = wp.sweep_mujoco(problem, "rk4", [1e-3], ref, repeats=1)
     assert mj["error"] <= 1e-5  # RK4 at 1 ms: measured 1.7e-6
     check = wp._Ur5.get().check(None)
     assert check["armdyn_qdd_vs_pin_aba_rel"] <= 1e-9
