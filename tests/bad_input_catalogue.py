@@ -654,7 +654,23 @@ CASES = [
         ME,
         "identically zero",
     ),
+    (
+        "sizing-no-model",
+        "sizing",
+        "sizing_report of a result that holds no model, none passed",
+        lambda: ad.sizing_report(_modelless_result()),
+        ME,
+        "model is required",
+    ),
 ]
+
+
+def _modelless_result():
+    """A run's arrays without its model (a result built by hand)."""
+    from types import SimpleNamespace
+
+    r = ad.simulate(_pendulum(), 0.1, output_dt=0.05)
+    return SimpleNamespace(t=r.t, q=r.q, qd=r.qd, qdd=r.qdd, joint_torques=r.joint_torques)
 
 
 def render() -> str:

@@ -240,14 +240,17 @@ void bind_model(py::module_& m) {
       m, "Actuator",
       "A gearbox and motor rotor on a joint (ModelBuilder.add_actuator), as Model.actuators "
       "lists it: joint (the actuated joint's name), rotor_joint (the rotor's revolute joint and "
-      "body, '<joint>_rotor', a coupling follower turning at gear_ratio * qdot), dof (the "
+      "body, a coupling follower: '<joint>_armature' turning with the joint, qdot, with inertia "
+      "N^2 J by default (gyroscopic=False), '<joint>_rotor' turning at gear_ratio * qdot with "
+      "gyroscopic=True), dof (the "
       "index into the independent qd / model.dof_names the actuator moves), gear_ratio, "
       "rotor_inertia [kg m^2], efficiency, friction_viscous [N m s/rad, motor side], "
       "friction_coulomb [N m, motor side], friction_smoothing [rad/s, motor side], gyroscopic, "
       "motor (armdyn.Motor or None).")
       .def_readonly("joint", &ActuatorView::joint, "Name of the actuated joint.")
       .def_readonly("rotor_joint", &ActuatorView::rotor_joint,
-                    "Name of the rotor's revolute joint and body ('<joint>_rotor').")
+                    "Name of the rotor's revolute joint and body: '<joint>_armature' "
+                    "(gyroscopic=False, the default) or '<joint>_rotor' (gyroscopic=True).")
       .def_readonly(
           "dof", &ActuatorView::dof,
           "Index into the independent qd / model.dof_names of the dof the actuator moves.")
@@ -984,11 +987,13 @@ void bind_model(py::module_& m) {
           "friction_viscous [N m s/rad] and friction_coulomb [N m] on the motor side "
           "(reflected as N^2 b and |N| c), Coulomb smoothed by tanh(omega / friction_smoothing), "
           "friction_smoothing [rad/s, motor side] default 1e-3 |N|; motor: an armdyn.Motor or "
-          "None. Adds body, revolute joint and coupling '<joint>_rotor' (zero mass, thin-disc "
-          "inertia) along the joint axis through its origin, turning at N qdot: on ground "
-          "(gyroscopic=False: the gear-reduced model, Pinocchio's armature N^2 J exactly) or on "
-          "the joint's parent body (gyroscopic=True: the rotor's full kinetic energy, with its "
-          "carrier's rotation). ModelError, builder unchanged, on an unknown joint, a joint not "
+          "None. Adds a body, a revolute joint and a coupling (zero mass, thin-disc inertia) "
+          "along the joint axis through its origin: by default (gyroscopic=False) "
+          "'<joint>_armature' on ground, axial inertia N^2 J, turning with the joint (at qdot: "
+          "the gear-reduced model, Pinocchio's armature N^2 J exactly); with gyroscopic=True "
+          "'<joint>_rotor' on the joint's parent body, axial inertia J, turning at N qdot "
+          "relative to it (the rotor's full kinetic energy, with its carrier's rotation). "
+          "ModelError, builder unchanged, on an unknown joint, a joint not "
           "revolute or prismatic, a second actuator, gear_ratio zero or not finite, "
           "rotor_inertia < 0, efficiency outside (0, 1], negative frictions.")
       .def("add_gear_pair", &ModelBuilder::add_gear_pair, py::arg("name"), py::arg("joint_a"),

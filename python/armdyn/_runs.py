@@ -63,3 +63,18 @@ def checked(model, result, caller: str):
             )
         tau[:, col] = np.where(np.isnan(tau[:, col]), 0.0, tau[:, col]) + forces[:, d]
     return t, names, qd, tau
+
+
+def model_of(result, model, caller: str):
+    """``model`` when given, else the model the result holds (``result.model``: a
+    SimulationResult, InverseDynamicsResult or TrajectoryRun made by armdyn holds it); a result
+    without one and no model passed is a ModelError naming ``model``."""
+    if model is not None:
+        return model
+    held = getattr(result, "model", None)
+    if held is None:
+        raise _core.ModelError(
+            f"{caller}: model is required: the result holds no model (result.model is None); "
+            "pass the model the run was made with as model="
+        )
+    return held

@@ -40,7 +40,7 @@ import numpy as np
 import numpy.typing as npt
 
 from armdyn import _core
-from armdyn._runs import checked
+from armdyn._runs import checked, model_of
 
 #: add_actuator's default Coulomb smoothing velocity per unit gear ratio: v_s = 1e-3 |N| rad/s
 #: on the motor side, i.e. 1e-3 rad/s (or m/s) at the joint.
@@ -225,11 +225,15 @@ def motor_side(
     )
 
 
-def motor_side_of_result(model: _core.Model, result: Any) -> dict[str, MotorSide]:
-    """Motor-side values of every actuator of ``model`` along ``result``.
+def motor_side_of_result(
+    model: _core.Model | Any, result: Any | None = None
+) -> dict[str, MotorSide]:
+    """Motor-side values of every actuator of ``model`` along ``result``
+    (``motor_side_of_result(result)``: the model the result holds, ``result.model``).
 
     Args:
-        model: the model the run was made with (``model.actuators``).
+        model: the model the run was made with (``model.actuators``); default
+            ``result.model``.
         result: a :class:`~armdyn.SimulationResult`, :class:`~armdyn.InverseDynamicsResult`
             or :class:`~armdyn.sizing.TrajectoryRun` (``t``, ``qd``, ``qdd`` and the joint
             torques, columns ``model.joint_dof_names``).
@@ -239,8 +243,12 @@ def motor_side_of_result(model: _core.Model, result: Any) -> dict[str, MotorSide
 
     Raises:
         ModelError: the result does not match the model, or an actuated joint has no torque in
-            the result (an undriven joint of a drive-based result).
+            the result (an undriven joint of a drive-based result); no model passed and none
+            held by the result (names ``model``).
     """
+    if result is None:  # motor_side_of_result(result)
+        model, result = None, model
+    model = model_of(result, model, "motor_side_of_result")
     actuators = list(getattr(model, "actuators", None) or [])
     if not actuators:
         return {}

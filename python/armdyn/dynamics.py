@@ -32,6 +32,8 @@ class InverseDynamicsResult:
         stats: Newton iterations, factorisations, run time [s].
         actuators: ``{joint: armdyn.actuators.MotorSide}`` for every actuator of the model
             (motor-side speed, torque, current, power, energy; empty without actuators).
+        model: the model the result was computed with (the default model of
+            :func:`armdyn.sizing_report`, :func:`armdyn.limit_violations`, ...).
     """
 
     t: npt.NDArray[np.float64]
@@ -47,12 +49,14 @@ class InverseDynamicsResult:
     velocity_residual: npt.NDArray[np.float64]
     stats: dict[str, Any] = field(default_factory=dict)
     actuators: dict[str, Any] = field(default_factory=dict)
+    model: _core.Model | None = field(default=None, repr=False, compare=False)
 
-    def limit_violations(self, model: _core.Model) -> pd.DataFrame:
+    def limit_violations(self, model: _core.Model | None = None) -> pd.DataFrame:
         """Spans where this run exceeds the model's velocity and effort limits, as a DataFrame
         (joint, kind, t_start, t_end, worst, limit, samples); see
-        :func:`armdyn.sizing.limit_violations`. The result does not hold its model, so the model
-        the run was made with is passed (and checked against the result's columns)."""
+        :func:`armdyn.sizing.limit_violations`. ``model``: default the one the result was
+        computed with (:attr:`model`); a model passed is checked against the result's
+        columns."""
         from armdyn.sizing import limit_violations
 
         return limit_violations(model, self)
@@ -78,6 +82,7 @@ def driven_inverse_dynamics(model: _core.Model, t: npt.ArrayLike) -> InverseDyna
 
     times = np.atleast_1d(np.asarray(t, dtype=float))
     result = InverseDynamicsResult(**_core._inverse_dynamics_driven(model, times))
+    result.model = model
     if getattr(model, "actuators", None) and len(times) > 0:
         result.actuators = motor_side_of_result(model, result)
     return result

@@ -3,8 +3,10 @@ gear-ratio sweep.
 
 They work on a finished run (:class:`armdyn.SimulationResult`,
 :class:`armdyn.InverseDynamicsResult`, or a planned motion's :class:`TrajectoryRun` from
-:func:`trajectory_run`) and the model it came from; the results do not hold their model, so it
-is passed explicitly and checked against the result's columns.
+:func:`trajectory_run`) and the model it came from. Those results hold their model
+(``result.model``), which is the default; a model passed explicitly (the older call form
+``sizing_report(result, model)``) is checked against the result's columns. A result without a
+model (one built by hand) and no model passed is a ModelError naming ``model``.
 
 Conventions shared by these functions:
 
@@ -37,6 +39,7 @@ import numpy.typing as npt
 
 from armdyn import _core
 from armdyn._runs import checked as _checked
+from armdyn._runs import model_of as _model_of
 
 if TYPE_CHECKING:  # pandas is imported when a table is built: `import armdyn` stays light
     import pandas as pd
@@ -80,12 +83,17 @@ def _spans(mask: np.ndarray) -> list[tuple[int, int]]:
     return list(zip(np.flatnonzero(d == 1), np.flatnonzero(d == -1) - 1, strict=True))
 
 
-def limit_violations(model: _core.Model, result: _Run) -> pd.DataFrame:
+def limit_violations(model: _core.Model | _Run, result: _Run | None = None) -> pd.DataFrame:
     """Where a run exceeds its joints' position, velocity and effort limits.
 
+    ``limit_violations(result)`` takes the model the result holds (``result.model``);
+    ``limit_violations(model, result)`` checks the run against the model given.
+
     Args:
-        model: the model the run was made with.
-        result: a :class:`~armdyn.SimulationResult` or :class:`~armdyn.InverseDynamicsResult`.
+        model: the model the run was made with (default ``result.model``); or, called with one
+            argument, the result.
+        result: a :class:`~armdyn.SimulationResult`, :class:`~armdyn.InverseDynamicsResult` or
+            :class:`TrajectoryRun`.
 
     Returns:
         A DataFrame with one row per violation span, sorted by ``t_start``: ``joint`` (the
@@ -103,10 +111,14 @@ def limit_violations(model: _core.Model, result: _Run) -> pd.DataFrame:
     driven coordinates only (see the module notes).
 
     Raises:
-        ModelError: the result's columns do not match the model (names the mismatch).
+        ModelError: the result's columns do not match the model (names the mismatch); no model
+            passed and none held by the result (names ``model``).
     """
     import pandas as pd
 
+    if result is None:  # limit_violations(result)
+        model, result = None, model
+    model = _model_of(result, model, "limit_violations")
     t, names, qd, tau = _checked(model, result, "limit_violations")
     effort_limit, velocity_limit = _column_limits(model, names)
     rows = _position_rows(model, result, t)
@@ -178,6 +190,9 @@ class TrajectoryRun:
         joint_torques: (n, len(model.dof_names)) ``armdyn.inverse_dynamics`` at each sample.
         actuators: ``{joint: armdyn.actuators.MotorSide}`` for every actuator of the model
             (empty without actuators).
+        model: the model the torques were computed with (:func:`trajectory_run` sets it; the
+            default model of :func:`sizing_report`, :func:`limit_violations` and
+            :func:`gear_ratio_sweep`).
     """
 
     t: npt.NDArray[np.float64]
@@ -186,10 +201,11 @@ class TrajectoryRun:
     qdd: npt.NDArray[np.float64]
     joint_torques: npt.NDArray[np.float64]
     actuators: dict[str, Any] = field(default_factory=dict)
+    model: _core.Model | None = field(default=None, repr=False, compare=False)
 
-    def limit_violations(self, model: _core.Model) -> pd.DataFrame:
-        """See :func:`limit_violations`."""
-        return limit_violations(model, self)
+    def limit_violations(self, model: _core.Model | None = None) -> pd.DataFrame:
+        """See :func:`limit_violations`; ``model`` default :attr:`model`."""
+        return limit_violations(_model_of(self, model, "TrajectoryRun.limit_violations"), self)
 
 
 def trajectory_run(
@@ -221,7 +237,9 @@ def trajectory_run(
     from armdyn.actuators import motor_side_of_result
 
     tau = np.asarray(_core.inverse_dynamics(model, q, qd, qdd, t), dtype=float)
-    run = TrajectoryRun(t=t.copy(), q=q.copy(), qd=qd.copy(), qdd=qdd.copy(), joint_torques=tau)
+    run = TrajectoryRun(
+        t=t.copy(), q=q.copy(), qd=qd.copy(), qdd=qdd.copy(), joint_torques=tau, model=model
+    )
     if getattr(model, "actuators", None):
         run.actuators = motor_side_of_result(model, run)
     return run
@@ -287,8 +305,14 @@ def motor_values(side, actuator, t: np.ndarray) -> dict:
     T, w = side.torque, side.speed
     peak_t, peak_w = float(np.max(np.abs(T))), float(np.max(np.abs(w)))
     rms_t, rms_w = np.sqrt(_mean(T**2, t)), np.sqrt(_mean(w**2, t))
+    n = float(actuator.gear_ratio)
+    # the joint torque's two shares: the load's (what the gear output delivers to the link) and
+    # the rotor's, N T_rot (its inertia and motor-side friction reflected to the joint)
+    reflected = n * rotor_torque(actuator, side.speed / n, side.acceleration / n)
     row = {
-        "gear_ratio": float(actuator.gear_ratio),
+        "gear_ratio": n,
+        "peak_load_torque": float(np.max(np.abs(side.load_torque))),
+        "peak_rotor_torque": float(np.max(np.abs(reflected))),
         "motor_peak_torque": peak_t,
         "motor_rms_torque": rms_t,
         "motor_peak_speed": peak_w,
@@ -591,7 +615,7 @@ class SizingReport:
 
 def sizing_report(
     result: _Run,
-    model: _core.Model,
+    model: _core.Model | None = None,
     out: str | os.PathLike[str] | None = None,
     actuators: dict[str, Any] | None = None,
 ) -> SizingReport:
@@ -602,7 +626,8 @@ def sizing_report(
         result: a :class:`~armdyn.SimulationResult`, :class:`~armdyn.InverseDynamicsResult` or
             :class:`TrajectoryRun` (:func:`trajectory_run`) with at least two output samples
             spanning a positive time.
-        model: the model the run was made with.
+        model: the model the run was made with; default the one the result holds
+            (``result.model``). A model passed is checked against the result's columns.
         out: a directory: the report is also saved there (:meth:`SizingReport.save`).
         actuators: what-if actuators ``{joint: spec}`` on joints the model does not actuate
             (:func:`what_if_actuators`: ``gear_ratio``, ``rotor_inertia``, optional
@@ -616,7 +641,9 @@ def sizing_report(
         A :class:`SizingReport` whose ``.table`` is indexed by joint (coordinate) name, the
         columns of ``result.qd`` (rotor joints of actuators left out), with (joint side, SI):
 
-        - ``peak_torque`` = max |τ|, ``rms_torque`` = √(1/T ∫ τ² dt),
+        - ``peak_torque`` = max |τ|, ``rms_torque`` = √(1/T ∫ τ² dt), τ the joint torque: on
+          an actuated joint (``model.actuators`` or ``actuators=``) it includes the rotor's
+          reflected share N T_rot, which ``peak_rotor_torque`` reports on its own,
         - ``peak_speed`` = max |q̇|, ``rms_speed`` = √(1/T ∫ q̇² dt),
         - ``peak_power`` = max |τ q̇|,
         - ``energy_regenerated`` = −∫ min(τ q̇, 0) dt (the work the load does on the actuator,
@@ -628,6 +655,11 @@ def sizing_report(
         and where an actuator is attached (NaN elsewhere; motor side, see
         :mod:`armdyn.actuators`):
 
+        - ``peak_load_torque`` = max |τ − N T_rot| (joint side: the load's share, what the gear
+          delivers to the link) and ``peak_rotor_torque`` = max |N T_rot| (joint side: the
+          rotor's inertia N² J q̈ and motor friction, :func:`rotor_torque`); on these joints
+          ``peak_torque`` (and every other torque column above) is of the whole joint torque
+          τ, the rotor's share included,
         - ``gear_ratio``, ``motor_peak_torque``, ``motor_rms_torque``, ``motor_peak_speed``,
           ``motor_rms_speed``, ``peak_current``, ``rms_current`` (NaN without k_t),
         - ``continuous_torque_margin`` = continuous_torque / motor_rms_torque,
@@ -656,12 +688,13 @@ def sizing_report(
 
     Raises:
         ModelError: the result's columns do not match the model, or fewer than two samples /
-            a zero time span.
+            a zero time span; no model passed and none held by the result (names ``model``).
     """
     import pandas as pd
 
     from armdyn.actuators import actuated_column, motor_side
 
+    model = _model_of(result, model, "sizing_report")
     t, names, qd, tau = _checked(model, result, "sizing_report")
     if len(t) < 2 or not (t[-1] > t[0]):
         raise _core.ModelError(
@@ -822,8 +855,8 @@ def _spec(joint: str, spec, existing):
 
 def gear_ratio_sweep(
     result: _Run,
-    model: _core.Model,
-    ratios: npt.ArrayLike | dict[str, npt.ArrayLike],
+    model: _core.Model | None = None,
+    ratios: npt.ArrayLike | dict[str, npt.ArrayLike] | None = None,
     actuators: dict[str, Any] | None = None,
 ) -> GearRatioSweep:
     """Per joint, the gear ratio that minimises the RMS motor torque along a run and the range
@@ -831,8 +864,10 @@ def gear_ratio_sweep(
 
     Args:
         result: a run of ``model`` (any result :func:`sizing_report` takes).
-        model: the model of the run.
-        ratios: the gear ratios to try (1-D, non-zero), or ``{joint: ratios}``.
+        model: the model of the run; default the one the result holds (``result.model``).
+            ``gear_ratio_sweep(result, ratios[, actuators])`` (no model between) takes the
+            result's.
+        ratios: the gear ratios to try (1-D, non-zero), or ``{joint: ratios}`` (required).
         actuators: ``{joint: spec}`` with ``rotor_inertia`` and optionally ``efficiency``,
             ``friction_viscous``, ``friction_coulomb``, ``motor`` (a dict or an object with
             those attributes; ``gear_ratio`` is ignored). A joint the model already actuates
@@ -849,12 +884,22 @@ def gear_ratio_sweep(
 
     Raises:
         ModelError: a joint that is not a column of the result, without a torque, or without a
-            rotor inertia; a zero ratio.
+            rotor inertia; a zero ratio; no ratios; no model passed and none held by the result.
     """
     import pandas as pd
 
     from armdyn.actuators import motor_side
 
+    if model is not None and not hasattr(model, "dof_names"):
+        # gear_ratio_sweep(result, ratios[, actuators]): the model is the result's
+        if actuators is not None:
+            raise _core.ModelError(
+                f"gear_ratio_sweep: model must be an armdyn.Model, got {type(model).__name__}"
+            )
+        model, ratios, actuators = None, model, ratios
+    if ratios is None:
+        raise _core.ModelError("gear_ratio_sweep: ratios is required (the gear ratios to try)")
+    model = _model_of(result, model, "gear_ratio_sweep")
     t, names, qd, tau = _checked(model, result, "gear_ratio_sweep")
     if len(t) < 2 or not (t[-1] > t[0]):
         raise _core.ModelError(

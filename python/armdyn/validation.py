@@ -91,11 +91,13 @@ class LagrangeValidator:
     def compare(self, result: Any, model: _core.Model | None = None) -> Comparison:
         """Compare the drive efforts of a simulation/inverse-dynamics result with this model.
 
-        ``model`` is the model that produced ``result`` (default: the validator's own; it must
-        have the same joint coordinates). Every joint coordinate must be driven there; the
-        efforts are reordered to coordinate order. Returns the equation (26) errors, their
-        (27) RMS per joint and the average.
+        ``model`` is the model that produced ``result`` (default: the one the result holds,
+        ``result.model``, else the validator's own; it must have the same joint coordinates).
+        Every joint coordinate must be driven there; the efforts are reordered to coordinate
+        order. Returns the equation (26) errors, their (27) RMS per joint and the average.
         """
+        if model is None:
+            model = getattr(result, "model", None)
         m = self.model if model is None else model
         if m.n_coords != self.model.n_coords:
             raise _core.ModelError(

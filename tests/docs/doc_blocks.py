@@ -48,7 +48,7 @@ class Block:
     code: str
     continues: bool
     ns: dict = field(default_factory=dict)
-    seconds: float = 0.0
+    seconds: float = 0.0  # CPU time of this process (not wall time: load does not add to it)
     error: str | None = None
     workdir: Path | None = None
 
@@ -68,16 +68,16 @@ def run_blocks(files: list[Path], workdir: Path) -> list[Block]:
                 if lang != "python":
                     continue
                 continues = bool(CONTINUES.match(code))
-                if not continues:
-                    ns = {"__name__": "__doc_block__"}
+                if not continues:  # a script's namespace: `if __name__ == "__main__":` runs
+                    ns = {"__name__": "__main__"}
                 block = Block(str(path.relative_to(ROOT)), line, code, continues, ns)
                 block.workdir = workdir
-                start = time.perf_counter()
+                start = time.process_time()
                 try:
                     exec(compile(code, block.where, "exec"), ns)
                 except Exception as exc:  # reported by the tests
                     block.error = "".join(traceback.format_exception(exc)[-6:])
-                block.seconds = time.perf_counter() - start
+                block.seconds = time.process_time() - start
                 blocks.append(block)
     finally:
         os.chdir(cwd)

@@ -120,3 +120,62 @@ def test_sweep_example(doc_blocks):
     # the seeded sweep on a client of one's own: its failing points are rows, not exceptions
     study = namespace_with(doc_blocks, GUIDE, "study")["study"]
     assert study.attrs["failed"] == 2 and study.attrs["seed"] == 7
+
+
+SHAPE = re.compile(r"`ad\.(\w+)\(([^)]*)\) -> \S+ \(([\w, ]*)\)`")
+ROWS_SHAPE = re.compile(r"\(rows:\s+`\(rows, ([^)]*)\)`\)")
+
+
+def floating_arm():
+    """A floating base (7 coordinates, 6 rates) with two revolute links: n_coords = n_dofs + 1
+    and nq, nv differ from both, so every documented size is told apart."""
+    b = ad.ModelBuilder(gravity=(0.0, 0.0, -9.81))
+    b.add_body("base", 3.0, [0.05, 0.06, 0.07], position=(0.0, 0.0, 0.5))
+    b.add_body("upper", 1.0, [0.01, 0.01, 0.002], position=(0.2, 0.0, 0.5))
+    b.add_body("lower", 0.5, [0.005, 0.005, 0.001], position=(0.6, 0.0, 0.5))
+    b.add_free("float", "base")
+    b.add_revolute("shoulder", "base", "upper", point=(0.0, 0.0, 0.5), axis=(0, 1, 0))
+    b.add_revolute("elbow", "upper", "lower", point=(0.4, 0.0, 0.5), axis=(0, 0, 1))
+    b.add_frame("tip", "lower", position=(0.8, 0.0, 0.5))
+    return b.finalize()
+
+
+def test_documented_shapes_are_the_returned_shapes():
+    """Every ``ad.f(...) -> X (shape)`` of the guide (and its ``(rows: ...)`` batch form),
+    evaluated on a model where n_coords, n_dofs, nq and nv all differ: the returned array has
+    the documented shape (frame_jacobian was once documented as (6, n_coords))."""
+    documented = {name: shape for name, _, shape in SHAPE.findall(API)}
+    assert {"mass_matrix", "frame_pose", "frame_jacobian", "body_mass_matrix"} <= set(documented)
+    model = floating_arm()
+    sizes = {"n_coords": model.n_coords, "n_dofs": model.n_dofs, "nq": model.nq, "nv": model.nv}
+    assert len(set(sizes.values())) == 4, sizes
+    rng = np.random.default_rng(3)
+    q = np.concatenate([[0.1, -0.2, 0.5, 1.0, 0.0, 0.0, 0.0], rng.uniform(-1, 1, 2)])
+    qd = rng.uniform(-1, 1, model.n_dofs)
+    u, v = ad.state_from_joints(model, q, qd)
+    args = {"model": model, "q": q, "qd": qd, "u": u, "v": v, "frame": "tip"}
+
+    def call(name, signature, q_rows=None):
+        params = [p.strip() for p in signature.split(",") if "=" not in p]
+        values = [args[p] for p in params]
+        if q_rows is not None:
+            values[params.index("q")] = q_rows
+        return np.asarray(getattr(ad, name)(*values))
+
+    def expected(shape, rows=None):
+        dims = [d.strip() for d in shape.split(",") if d.strip()]
+        out = tuple(sizes[d] if d in sizes else int(d) for d in dims)
+        return out if rows is None else (rows, *out)
+
+    for name, signature, shape in SHAPE.findall(API):
+        assert call(name, signature).shape == expected(shape), (name, shape)
+    # the batch form, stated in the same bullet as its function
+    batched = []
+    for item in re.split(r"\n- ", API):
+        first, rows = SHAPE.search(item), ROWS_SHAPE.search(item)
+        if first and rows:
+            batched.append((first.group(1), first.group(2), rows.group(1)))
+    assert {"mass_matrix", "frame_pose", "frame_jacobian"} <= {n for n, _, _ in batched}
+    for name, signature, shape in batched:
+        out = call(name, signature, q_rows=np.tile(q, (3, 1)))
+        assert out.shape == expected(shape, rows=3), (name, shape)

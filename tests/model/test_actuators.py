@@ -615,3 +615,28 @@ def test_bad_actuator_inputs_raise_and_leave_the_builder_intact(kwargs, match):
     assert np.array_equal(after.inertias, before.inertias)
     assert np.array_equal(after.u0, before.u0)
     assert after.couplings == before.couplings
+
+
+def test_docstrings_name_the_rotor_joint_the_builder_makes():
+    """add_actuator's and Actuator.rotor_joint's docstrings say what the code does: by default
+    '<joint>_armature' turning with the joint (axial inertia N² J), '<joint>_rotor' turning at
+    N q̇ with gyroscopic=True (it once said '<joint>_rotor' at N q̇ for both)."""
+    reduced, gyro = _turntable({}), _turntable({"gyroscopic": True})
+    assert reduced.actuators[0].rotor_joint == "spin_armature"
+    assert gyro.actuators[0].rotor_joint == "spin_rotor"
+    # the armature turns with the joint, the gyroscopic rotor N times faster (relative to A)
+    (arm,) = [c for c in reduced.couplings if c["follower"] == "spin_armature"]
+    (rot,) = [c for c in gyro.couplings if c["follower"] == "spin_rotor"]
+    assert arm["multiplier"] == 1.0 and rot["multiplier"] == 40.0  # N of _turntable
+    doc = " ".join(ad.ModelBuilder.add_actuator.__doc__.split())
+    assert (
+        "by default (gyroscopic=False) '<joint>_armature' on ground, axial inertia N^2 J, "
+        "turning with the joint" in doc
+    )
+    assert (
+        "with gyroscopic=True '<joint>_rotor' on the joint's parent body, axial inertia J, "
+        "turning at N qdot" in doc
+    )
+    field = " ".join(ad.Actuator.rotor_joint.__doc__.split())
+    assert "'<joint>_armature' (gyroscopic=False, the default)" in field
+    assert "'<joint>_rotor' (gyroscopic=True)" in field

@@ -1,9 +1,14 @@
 """Interrupt, callbacks, progress and the output memory bound of simulate (issue 23).
 
-Ctrl-C is checked by the stepping loop's poll every 5 ms of wall time: SIGINT is sent to a child
-process running a long simulation, which catches the KeyboardInterrupt and reports the latency
-(signal sent to exception caught) and its partial result, checked against an uninterrupted run
-of the same length (the same steps: equal to round-off).
+Ctrl-C is checked by the compiled loops' signal poll: SIGINT is sent to a child process running
+a long simulation (or inverse-dynamics loop, or URDF load), which catches the KeyboardInterrupt
+and reports its partial result, checked against an uninterrupted run of the same length (the
+same steps: equal to round-off). That the work stopped *inside* the compiled call, by its poll,
+and not after it (Python raises a pending KeyboardInterrupt once a call returns) is seen without
+a clock: the child's SIGINT handler runs in the poll, and a profile hook tells whether a call
+into ``armdyn._core`` is in progress (CHILD_PROLOGUE). No test here asserts a time: how soon the
+work stops after the signal is measured by ``python -m benchmarks.interrupt_latency``
+(docs/benchmarks.md); the only clock is a hang guard of minutes.
 """
 
 import json
@@ -12,6 +17,7 @@ import signal
 import subprocess
 import sys
 import textwrap
+import threading
 import time
 
 import armdyn as ad
@@ -19,17 +25,46 @@ import numpy as np
 import pytest
 from conftest import simple_pendulum
 
-CHILD = textwrap.dedent(
+# the child's SIGINT handler: a KeyboardInterrupt when it runs inside a call into armdyn's compiled
+# module (the loop's poll ran it: the work stops there), else (the signal landed in Python
+# between two calls) "again" on stdout, and the parent sends another signal. Installed whatever
+# the parent's disposition (a shell's background job starts its children with SIGINT ignored).
+CHILD_PROLOGUE = textwrap.dedent(
     """
-    import json, sys, time
+    import json, signal, sys
     import numpy as np
-    import signal
     import armdyn as ad
 
-    # Ctrl-C raises KeyboardInterrupt here whatever the parent's disposition (a shell's
-    # background job starts its children with SIGINT ignored)
-    signal.signal(signal.SIGINT, signal.default_int_handler)
+    INSIDE = 0  # calls into armdyn._core in progress (their c_call/c_return profile events)
+    STOPPED_INSIDE = []
 
+
+    def _track(frame, event, arg):
+        global INSIDE
+        if getattr(arg, "__module__", None) == "armdyn._core":
+            if event == "c_call":
+                INSIDE += 1
+            elif event in ("c_return", "c_exception"):
+                INSIDE -= 1
+
+
+    def _on_sigint(signum, frame):
+        if INSIDE > 0:
+            STOPPED_INSIDE.append(True)
+            raise KeyboardInterrupt
+        print("again", flush=True)
+
+
+    sys.setprofile(_track)
+    signal.signal(signal.SIGINT, _on_sigint)
+    """
+)
+
+# a hang guard, not a latency bound: the child is killed (and the test fails) past it
+HANG_GUARD_S = 300.0
+
+CHILD = CHILD_PROLOGUE + textwrap.dedent(
+    """
     method = sys.argv[1]
     b = ad.ModelBuilder(gravity=(0.0, 0.0, -9.81))
     b.add_body("bob", 1.0, np.eye(3) * 1e-3, position=(-0.5, 0.0, -0.8))
@@ -46,19 +81,17 @@ CHILD = textwrap.dedent(
         opts.update(integrator=method, rtol=1e-13, atol=1e-13, output_dt=0.01)
     model = b.finalize()
     print("ready", flush=True)
-    start = time.time()
     try:
         ad.simulate(model, 1e4, **opts)
-        print(json.dumps({"completed": time.time() - start}), flush=True)
+        print(json.dumps({"completed": True}), flush=True)
         sys.exit(0)
     except KeyboardInterrupt as err:
-        caught = time.time()
         r = err.result
     # the partial result against an uninterrupted run to its last output time
     ref = ad.simulate(model, float(r.t[-1]), **opts)
     n = len(ref.t)
     print(json.dumps({
-        "caught": caught,
+        "inside": bool(STOPPED_INSIDE),
         "rows": len(r.t),
         "t_last": float(r.t[-1]),
         "same_rows": n == len(r.t),
@@ -73,35 +106,48 @@ CHILD = textwrap.dedent(
 
 
 def _interrupted_child(code, *args, delay):
-    """Run ``code`` in a child Python, send it SIGINT ``delay`` s after it prints "ready", and
-    return (its last JSON line, the time the signal was sent)."""
+    """Run ``code`` in a child Python, send it SIGINT ``delay`` s after it prints "ready" (again
+    each time it prints "again": the signal landed between two compiled calls), and return its
+    JSON report (the last line). The child is killed past HANG_GUARD_S."""
     proc = subprocess.Popen(
         [sys.executable, "-c", code, *args],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
     )
+    guard = threading.Timer(HANG_GUARD_S, proc.kill)
+    guard.start()
     try:
-        assert proc.stdout.readline().strip() == "ready"
+        assert proc.stdout.readline().strip() == "ready", proc.stderr.read()
         time.sleep(delay)
-        sent = time.time()
         proc.send_signal(signal.SIGINT)
-        out, err = proc.communicate(timeout=120)
+        report = None
+        for line in proc.stdout:
+            if line.strip() == "again":
+                time.sleep(delay)
+                proc.send_signal(signal.SIGINT)
+            elif line.startswith("{"):
+                report = json.loads(line)
+        err = proc.stderr.read()
+        proc.wait()
     finally:
+        guard.cancel()
         if proc.poll() is None:
             proc.kill()
-    assert proc.returncode == 0, err
-    return json.loads(out.strip().splitlines()[-1]), sent
+            proc.wait()
+    assert proc.returncode == 0, f"exit {proc.returncode} (killed past {HANG_GUARD_S} s?): {err}"
+    assert report is not None, err
+    return report
 
 
 @pytest.mark.parametrize("method", ["rk4", "dopri5", "dop853", "trbdf2", "kinematic"])
-def test_sigint_stops_within_half_a_second_with_the_partial_result(method):
-    report, sent = _interrupted_child(CHILD, method, delay=1.0)
+def test_sigint_stops_the_run_inside_its_loop_with_the_partial_result(method):
+    report = _interrupted_child(CHILD, method, delay=1.0)
     assert "completed" not in report, f"the run ended before the signal: {report}"
-    latency = report["caught"] - sent
-    print(f"{method}: SIGINT latency {latency * 1e3:.1f} ms, {report['rows']} rows kept")
-    assert latency <= 0.5, f"{method}: KeyboardInterrupt {latency:.3f} s after SIGINT"
-    assert report["rows"] > 1 and report["t_last"] > 0
+    print(f"{method}: {report['rows']} rows kept")
+    # stopped by the stepping loop's poll, inside the call, at a time short of t_end = 1e4
+    assert report["inside"]
+    assert report["rows"] > 1 and 0 < report["t_last"] < 1e4
     # the partial outputs are those of a run to the same time (the same steps), but for the
     # last output of an error-controlled run, whose final step the shorter run shortens to land
     # on its end (the fixed-step and kinematic runs agree there too)
@@ -112,17 +158,8 @@ def test_sigint_stops_within_half_a_second_with_the_partial_result(method):
         assert report["last_diff"] <= 1e-12, report
 
 
-ID_CHILD = textwrap.dedent(
+ID_CHILD = CHILD_PROLOGUE + textwrap.dedent(
     """
-    import json, sys, time
-    import numpy as np
-    import signal
-    import armdyn as ad
-
-    # Ctrl-C raises KeyboardInterrupt here whatever the parent's disposition (a shell's
-    # background job starts its children with SIGINT ignored)
-    signal.signal(signal.SIGINT, signal.default_int_handler)
-
     which = sys.argv[1]
     b = ad.ModelBuilder(gravity=(0.0, 0.0, -9.81))
     b.add_body("a", 1.0, np.eye(3) * 1e-2, position=(0.5, 0.0, 0.0))
@@ -140,22 +177,21 @@ ID_CHILD = textwrap.dedent(
     else:
         ts = np.linspace(0.0, 1e4, n)
     print("ready", flush=True)
-    start = time.time()
+    calls = 0
     try:
-        if which == "batch":
-            out = ad.inverse_dynamics(model, q, qd, qdd)
-        else:
-            out = ad.driven_inverse_dynamics(model, ts)
-        print(json.dumps({"completed": time.time() - start}), flush=True)
-        sys.exit(0)
+        while True:  # until interrupted: a fast machine cannot finish before the signal
+            if which == "batch":
+                out = ad.inverse_dynamics(model, q, qd, qdd)
+            else:
+                out = ad.driven_inverse_dynamics(model, ts)
+            calls += 1
     except KeyboardInterrupt as err:
-        caught = time.time()
         partial = getattr(err, "result", None)
-    report = {"caught": caught}
+    report = {"inside": bool(STOPPED_INSIDE), "calls": calls}
     if which == "batch":
         k = len(partial)
         ref = ad.inverse_dynamics(model, q[:k], qd[:k], qdd[:k])
-        report.update(rows=k, diff=float(np.max(np.abs(ref - partial))))
+        report.update(rows=k, n=n, diff=float(np.max(np.abs(ref - partial))) if k else 0.0)
     print(json.dumps(report), flush=True)
     """
 )
@@ -163,14 +199,11 @@ ID_CHILD = textwrap.dedent(
 
 @pytest.mark.parametrize("which", ["batch", "driven"])
 def test_sigint_stops_inverse_dynamics_loops(which):
-    # the loops take about 1 s on an idle machine (the batch 0.93 s)
-    report, sent = _interrupted_child(ID_CHILD, which, delay=0.25)
-    assert "completed" not in report, f"the loop ended before the signal: {report}"
-    latency = report["caught"] - sent
-    print(f"{which}: SIGINT latency {latency * 1e3:.1f} ms")
-    assert latency <= 0.5
+    # one call takes about 1 s on an idle machine (the batch 0.93 s)
+    report = _interrupted_child(ID_CHILD, which, delay=0.25)
+    assert report["inside"]  # stopped by the loop's poll, inside the call
     if which == "batch":  # the rows done, as a batch of those rows computes them
-        assert report["rows"] > 0 and report["diff"] == 0.0
+        assert 0 <= report["rows"] < report["n"] and report["diff"] == 0.0
 
 
 # --- callbacks --------------------------------------------------------------------------------
@@ -322,11 +355,11 @@ def test_import_armdyn_does_not_import_tqdm():
 
 
 def test_outputs_beyond_the_bound_are_refused_before_the_run():
-    p = simple_pendulum()
-    start = time.perf_counter()
+    calls = []
+    model = torque_pendulum(lambda t: calls.append(t) or (0.0, 0.0, 0.0))
     with pytest.raises(ad.ModelError, match=r"output_dt=1e-07 .* GiB"):
-        ad.simulate(p.model, 1.0, output_dt=1e-7)
-    assert time.perf_counter() - start < 1.0  # refused before anything is allocated or run
+        ad.simulate(model, 1.0, output_dt=1e-7, progress=lambda t, te: calls.append(t))
+    assert calls == []  # refused before the run: no step evaluated its torque, no progress
 
 
 def test_output_row_bytes_is_the_size_of_a_result_row():
@@ -395,12 +428,8 @@ def test_runs_on_worker_threads_equal_the_main_thread_run():
     assert seen[-1] == 5.0
 
 
-URDF_CHILD = textwrap.dedent(
+URDF_CHILD = CHILD_PROLOGUE + textwrap.dedent(
     """
-    import json, signal, sys, time
-    import armdyn as ad
-
-    signal.signal(signal.SIGINT, signal.default_int_handler)
     inertial = (
         '<inertial><origin xyz="0 0 0.05"/><mass value="1"/><inertia ixx="0.01" iyy="0.01" '
         'izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>'
@@ -416,21 +445,23 @@ URDF_CHILD = textwrap.dedent(
     parts.append("</robot>")
     xml = "\\n".join(parts)
     print("ready", flush=True)
-    start = time.time()
+    loads = 0
     try:
-        ad.load_urdf(xml)
-        print(json.dumps({"completed": time.time() - start}), flush=True)
+        while True:  # until interrupted: a fast machine cannot finish before the signal
+            ad.load_urdf(xml)
+            loads += 1
     except KeyboardInterrupt:
-        print(json.dumps({"caught": time.time()}), flush=True)
+        pass
+    # the library is intact after the interrupted load
+    small = ad.load_urdf(xml.split('<link name="l3">')[0] + "</robot>")
+    print(json.dumps({"inside": bool(STOPPED_INSIDE), "loads": loads, "nb": small.nb}), flush=True)
     """
 )
 
 
 def test_sigint_stops_loading_a_large_urdf():
-    """The model analysis of a large URDF (quadratic in its links: plan_kkt's elimination order)
-    checks for signals as it goes."""
-    report, sent = _interrupted_child(URDF_CHILD, delay=0.5)
-    assert "completed" not in report, f"the load ended before the signal: {report}"
-    latency = report["caught"] - sent
-    print(f"load_urdf: SIGINT latency {latency * 1e3:.1f} ms")
-    assert latency <= 0.5
+    """The parsing and model analysis of a large URDF check for signals as they go: the
+    KeyboardInterrupt is raised inside the load, and a load after it works."""
+    report = _interrupted_child(URDF_CHILD, delay=0.5)
+    assert report["inside"]
+    assert report["nb"] == 2  # l1 and l2 (l0 is the fixed base: ground)

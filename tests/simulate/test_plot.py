@@ -9,7 +9,6 @@ import dataclasses
 import re
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import armdyn as ad
@@ -343,7 +342,7 @@ def test_docs_plotting_block_runs(tmp_path, monkeypatch):
     doc = (Path(__file__).resolve().parents[2] / "docs" / "plotting.md").read_text("utf-8")
     (block,) = re.findall(r"```python\n(.*?)```", doc, re.S)
     monkeypatch.chdir(tmp_path)
-    start = time.perf_counter()
+    # (how long the block takes is not a test: tests/docs/test_runnable_blocks.py bounds the
+    # CPU time of all documented blocks together)
     exec(compile(block, "docs/plotting.md", "exec"), {})
-    assert time.perf_counter() - start < 2.0
     assert (tmp_path / "double_pendulum.png").read_bytes()[:4] == b"\x89PNG"

@@ -259,3 +259,45 @@ def test_result_from_another_model_is_refused(two_periods):
     one = ad.driven_inverse_dynamics(model, [0.5])
     with pytest.raises(ad.ModelError, match="at least two samples"):
         ad.sizing_report(one, model)
+
+
+def test_functions_of_a_result_take_its_model_by_default(two_periods):
+    """sizing_report, limit_violations, gear_ratio_sweep and motor_side_of_result take the model
+    the result holds (result.model): the same values as with the model passed (the older call
+    form, still accepted); a result without a model and no model is a ModelError naming model."""
+    from types import SimpleNamespace
+
+    from armdyn.actuators import motor_side_of_result
+
+    model, res = two_periods
+    assert res.model is model
+    pd = pytest.importorskip("pandas")
+    pd.testing.assert_frame_equal(ad.sizing_report(res).table, ad.sizing_report(res, model).table)
+    pd.testing.assert_frame_equal(ad.limit_violations(res), ad.limit_violations(model, res))
+    spec = {"spin": {"rotor_inertia": 1e-4}}
+    by_default = ad.gear_ratio_sweep(res, ratios=[10.0, 40.0], actuators=spec)
+    positional = ad.gear_ratio_sweep(res, [10.0, 40.0], spec)
+    old_form = ad.gear_ratio_sweep(res, model, [10.0, 40.0], spec)
+    pd.testing.assert_frame_equal(by_default.table, old_form.table)
+    pd.testing.assert_frame_equal(positional.table, old_form.table)
+    # the other results hold their model too
+    idr = ad.driven_inverse_dynamics(model, res.t[:50])
+    assert idr.model is model
+    pd.testing.assert_frame_equal(ad.sizing_report(idr).table, ad.sizing_report(idr, model).table)
+    pd.testing.assert_frame_equal(idr.limit_violations(), idr.limit_violations(model))
+    plan = ad.trajectory_run(model, res.t, res.q, res.qd, res.qdd)
+    assert plan.model is model
+    pd.testing.assert_frame_equal(ad.sizing_report(plan).table, ad.sizing_report(plan, model).table)
+    assert motor_side_of_result(res) == {}  # no actuators in this model
+    # a result with no model, and none passed
+    bare = SimpleNamespace(t=res.t, q=res.q, qd=res.qd, qdd=res.qdd, drive_forces=res.drive_forces)
+    for call in (
+        lambda: ad.sizing_report(bare),
+        lambda: ad.limit_violations(bare),
+        lambda: ad.gear_ratio_sweep(bare, ratios=[10.0], actuators=spec),
+        lambda: motor_side_of_result(bare),
+    ):
+        with pytest.raises(ad.ModelError, match=r"model is required: the result holds no model"):
+            call()
+    with pytest.raises(ad.ModelError, match="gear_ratio_sweep: ratios is required"):
+        ad.gear_ratio_sweep(res)

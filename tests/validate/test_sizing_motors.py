@@ -109,6 +109,10 @@ def test_motor_columns_against_the_closed_form(run, monkeypatch):
     row = ad.sizing_report(geared, proxy).table.loc["spin"]
     # joint side includes the reflected rotor: (I + N² J) A ω²
     assert row["peak_torque"] == pytest.approx((I_Z + N * N * J) * AMP * OMEGA**2, rel=1e-12)
+    # and its two shares on their own: the load's I A ω², the rotor's N² J A ω² (by hand:
+    # q̈ = −A ω² sin ω t, both in phase, so the peaks add)
+    assert row["peak_load_torque"] == pytest.approx(I_Z * AMP * OMEGA**2, rel=1e-12)
+    assert row["peak_rotor_torque"] == pytest.approx(N * N * J * AMP * OMEGA**2, rel=1e-12)
     assert row["gear_ratio"] == N
     assert row["motor_peak_torque"] == pytest.approx(PEAK_T, rel=1e-12)
     assert row["motor_rms_torque"] == pytest.approx(PEAK_T / np.sqrt(2.0), rel=1e-12)
@@ -146,6 +150,17 @@ def test_what_if_actuators_equal_the_stand_in_model(run, monkeypatch):
     monkeypatch.setattr(sizing, "_mass_matrix", lambda md, q: _core.mass_matrix(md, q))
     spec = {"gear_ratio": N, "rotor_inertia": J, "motor": m}
     b = ad.sizing_report(res, model, actuators={"spin": spec}).table
+    # the what-if rotor is not hidden in peak_torque: the run's own (rotor-free) peak is
+    # peak_load_torque, the rotor's N² J A ω² is peak_rotor_torque, peak_torque their sum here
+    plain = ad.sizing_report(res, model).table.loc["spin"]
+    assert "peak_load_torque" not in plain.index
+    assert b.loc["spin", "peak_load_torque"] == pytest.approx(plain["peak_torque"], rel=1e-12)
+    assert b.loc["spin", "peak_rotor_torque"] == pytest.approx(
+        N * N * J * AMP * OMEGA**2, rel=1e-12
+    )
+    assert b.loc["spin", "peak_torque"] == pytest.approx(
+        plain["peak_torque"] + b.loc["spin", "peak_rotor_torque"], rel=1e-12
+    )
     assert list(a.columns) == list(b.columns)
     num = [c for c in a.columns if c not in ("ok", "unchecked")]
     np.testing.assert_allclose(a[num].to_numpy(float), b[num].to_numpy(float), rtol=1e-12)
@@ -228,15 +243,21 @@ def test_gear_ratio_sweep_pure_inertia_optimum(run):
     m = motor(
         continuous_torque=c, peak_torque=1e3, max_speed=1e6, no_load_speed=1e6, torque_constant=0.1
     )
-    ratios = np.linspace(10.0, 100.0, 9001)  # step 0.01, holds N* = 44.72... within 0.005
+    disc = np.sqrt((c / rms_qdd) ** 2 - 4.0 * J * I_Z)
+    lo, hi = (c / rms_qdd - disc) / (2 * J), (c / rms_qdd + disc) / (2 * J)
+    # steps of 1 over [10, 100], and of 0.01 (the 0.01 lattice) within 0.5 of N*, lo and hi: the
+    # answers are resolved as by a 0.01 step everywhere (9001 ratios, 26 s of the suite), and a
+    # sweep that found them elsewhere would land on the coarse steps and fail
+    fine = [
+        np.round(np.arange(np.floor(x) - 1.0, np.ceil(x) + 1.0, 0.01), 2) for x in (n_star, lo, hi)
+    ]
+    ratios = np.unique(np.concatenate([np.linspace(10.0, 100.0, 91), *fine]))
     sweep = ad.gear_ratio_sweep(res, model, ratios, {"spin": {"rotor_inertia": J, "motor": m}})
     s = sweep.summary.loc["spin"]
     assert abs(s["best_ratio"] - n_star) <= 0.005 + 1e-12
     best = (J * s["best_ratio"] + I_Z / s["best_ratio"]) * rms_qdd
     assert s["best_rms_torque"] == pytest.approx(best, rel=1e-12)
     assert s["best_rms_torque"] >= 2.0 * np.sqrt(I_Z * J) * rms_qdd * (1 - 1e-12)
-    disc = np.sqrt((c / rms_qdd) ** 2 - 4.0 * J * I_Z)
-    lo, hi = (c / rms_qdd - disc) / (2 * J), (c / rms_qdd + disc) / (2 * J)
     assert lo - 0.01 < s["ok_ratio_min"] - 0.0 <= lo + 0.01
     assert hi - 0.01 <= s["ok_ratio_max"] < hi + 0.01
     assert bool(s["ok_contiguous"]) and bool(s["best_ok"])

@@ -2,10 +2,18 @@
 
 Chromium's one-shot ``--screenshot`` takes its picture at an arbitrary point of the page's
 asynchronous loading, so the tests drive the browser instead: load the file, wait until the
-viewer has built its scene, then screenshot, read the DOM and list every request the page made
-(CDP's Network events). The browser runs offline with a fresh profile: its only way out is a
-proxy run here that records the request line of every connection (from any of the browser's
-processes, workers included) and then closes it.
+viewer has built its scene, then screenshot, read the DOM and list every request the page made.
+
+The page's requests are told from the browser's own by who makes them: CDP's
+``Network.requestWillBeSent`` events of the page's target and of every target the page starts
+(its workers and out-of-process frames, attached automatically and paused until their Network
+domain is on: ``Target.setAutoAttach`` with ``waitForDebuggerOnStart``). Chromium's own services
+(component and update checks, which ``--disable-background-networking`` does not silence
+entirely) run in the browser process, in no target of the page, so they are never counted. The
+browser runs offline with a fresh profile: its only way out is a proxy run here that records the
+request line of every connection (from any of the browser's processes) and then closes it; the
+tests use it to show that a request the page makes does leave the browser, and that the CDP
+record sees it.
 """
 
 from __future__ import annotations
@@ -29,10 +37,20 @@ CHROMIUM_FLAGS = [
     "--enable-unsafe-swiftshader",
     "--disable-background-networking",
     "--disable-component-update",
+    "--disable-sync",
+    "--disable-default-apps",
+    "--disable-extensions",
+    "--disable-domain-reliability",
+    "--disable-client-side-phishing-detection",
+    "--no-default-browser-check",
     "--no-first-run",
     "--proxy-bypass-list=<-loopback>",
     "--hide-scrollbars",
 ]
+
+
+# attach to every target the page starts, paused until its Network domain is enabled
+AUTO_ATTACH = {"autoAttach": True, "waitForDebuggerOnStart": True, "flatten": True}
 
 
 def chromium_path() -> str | None:
@@ -130,21 +148,44 @@ class Browser:
         self.ws.__enter__()
         self._id = 0
         self.events: list[dict] = []
+        self.sessions: list[dict] = []  # the targets the page started (Target.attachedToTarget)
         self.call("Network.enable")
         self.call("Page.enable")
         self.call("Runtime.enable")
+        self.call("Target.setAutoAttach", **AUTO_ATTACH)
+
+    def _send(self, method: str, session: str | None = None, **params) -> int:
+        self._id += 1
+        msg = {"id": self._id, "method": method, "params": params}
+        if session is not None:
+            msg["sessionId"] = session
+        self.ws.send(json.dumps(msg))
+        return self._id
+
+    def _event(self, msg: dict) -> None:
+        """Record an event; a target the page started (a worker, a frame) gets its Network
+        domain and the same auto-attach before it runs (it waits for the debugger)."""
+        self.events.append(msg)
+        if msg.get("method") == "Target.attachedToTarget":
+            session = msg["params"]["sessionId"]
+            self.sessions.append(msg["params"]["targetInfo"])
+            self._send("Network.enable", session)
+            self._send("Target.setAutoAttach", session, **AUTO_ATTACH)
+            self._send("Runtime.runIfWaitingForDebugger", session)
 
     def call(self, method: str, timeout: float = 120.0, **params):
-        self._id += 1
-        self.ws.send(json.dumps({"id": self._id, "method": method, "params": params}))
+        """Send a command to the page's target and return its result (events that arrive
+        meanwhile are recorded)."""
+        own = self._send(method, **params)
         deadline = time.monotonic() + timeout
         while True:
             msg = json.loads(self.ws.recv(timeout=max(0.1, deadline - time.monotonic())))
-            if msg.get("id") == self._id:
+            if msg.get("id") == own and "sessionId" not in msg:
                 if "error" in msg:
                     raise RuntimeError(f"{method}: {msg['error']}")
                 return msg["result"]
-            self.events.append(msg)
+            if "method" in msg:
+                self._event(msg)
 
     def evaluate(self, expression: str, timeout: float = 120.0):
         """The value of a JavaScript expression (a promise is awaited)."""
@@ -169,7 +210,9 @@ class Browser:
             time.sleep(0.1)
 
     def requested_urls(self) -> list[str]:
-        """Every URL the page asked the network stack for (the document itself included)."""
+        """Every URL the page asked the network stack for: its own requests (the document
+        itself first) and those of the workers and frames it started, in order; never the
+        browser's own."""
         return [
             e["params"]["request"]["url"]
             for e in self.events

@@ -89,7 +89,7 @@ class Motor:
         """
 class Actuator:
     """
-    A gearbox and motor rotor on a joint (ModelBuilder.add_actuator), as Model.actuators lists it: joint (the actuated joint's name), rotor_joint (the rotor's revolute joint and body, '<joint>_rotor', a coupling follower turning at gear_ratio * qdot), dof (the index into the independent qd / model.dof_names the actuator moves), gear_ratio, rotor_inertia [kg m^2], efficiency, friction_viscous [N m s/rad, motor side], friction_coulomb [N m, motor side], friction_smoothing [rad/s, motor side], gyroscopic, motor (armdyn.Motor or None).
+    A gearbox and motor rotor on a joint (ModelBuilder.add_actuator), as Model.actuators lists it: joint (the actuated joint's name), rotor_joint (the rotor's revolute joint and body, a coupling follower: '<joint>_armature' turning with the joint, qdot, with inertia N^2 J by default (gyroscopic=False), '<joint>_rotor' turning at gear_ratio * qdot with gyroscopic=True), dof (the index into the independent qd / model.dof_names the actuator moves), gear_ratio, rotor_inertia [kg m^2], efficiency, friction_viscous [N m s/rad, motor side], friction_coulomb [N m, motor side], friction_smoothing [rad/s, motor side], gyroscopic, motor (armdyn.Motor or None).
     """
     def __repr__(self) -> str:
         ...
@@ -146,7 +146,7 @@ class Actuator:
     @property
     def rotor_joint(self) -> str:
         """
-        Name of the rotor's revolute joint and body ('<joint>_rotor').
+        Name of the rotor's revolute joint and body: '<joint>_armature' (gyroscopic=False, the default) or '<joint>_rotor' (gyroscopic=True).
         """
 class Profile:
     """
@@ -416,7 +416,7 @@ class ModelBuilder:
         ...
     def add_actuator(self, joint: str, gear_ratio: typing.SupportsFloat | typing.SupportsIndex, rotor_inertia: typing.SupportsFloat | typing.SupportsIndex, efficiency: typing.SupportsFloat | typing.SupportsIndex = 1.0, friction_viscous: typing.SupportsFloat | typing.SupportsIndex = 0.0, friction_coulomb: typing.SupportsFloat | typing.SupportsIndex = 0.0, motor: Motor | None = None, gyroscopic: bool = False, friction_smoothing: float | None = None) -> None:
         """
-        A gearbox and motor rotor on a revolute (continuous) or prismatic joint. gear_ratio N = rotor speed / joint speed (negative reverses the rotor; rad/m for a prismatic joint, a ball screw); rotor_inertia J [kg m^2] about the rotor axis; efficiency in (0, 1] (stored for the motor-side maths, not in the dynamics); friction_viscous [N m s/rad] and friction_coulomb [N m] on the motor side (reflected as N^2 b and |N| c), Coulomb smoothed by tanh(omega / friction_smoothing), friction_smoothing [rad/s, motor side] default 1e-3 |N|; motor: an armdyn.Motor or None. Adds body, revolute joint and coupling '<joint>_rotor' (zero mass, thin-disc inertia) along the joint axis through its origin, turning at N qdot: on ground (gyroscopic=False: the gear-reduced model, Pinocchio's armature N^2 J exactly) or on the joint's parent body (gyroscopic=True: the rotor's full kinetic energy, with its carrier's rotation). ModelError, builder unchanged, on an unknown joint, a joint not revolute or prismatic, a second actuator, gear_ratio zero or not finite, rotor_inertia < 0, efficiency outside (0, 1], negative frictions.
+        A gearbox and motor rotor on a revolute (continuous) or prismatic joint. gear_ratio N = rotor speed / joint speed (negative reverses the rotor; rad/m for a prismatic joint, a ball screw); rotor_inertia J [kg m^2] about the rotor axis; efficiency in (0, 1] (stored for the motor-side maths, not in the dynamics); friction_viscous [N m s/rad] and friction_coulomb [N m] on the motor side (reflected as N^2 b and |N| c), Coulomb smoothed by tanh(omega / friction_smoothing), friction_smoothing [rad/s, motor side] default 1e-3 |N|; motor: an armdyn.Motor or None. Adds a body, a revolute joint and a coupling (zero mass, thin-disc inertia) along the joint axis through its origin: by default (gyroscopic=False) '<joint>_armature' on ground, axial inertia N^2 J, turning with the joint (at qdot: the gear-reduced model, Pinocchio's armature N^2 J exactly); with gyroscopic=True '<joint>_rotor' on the joint's parent body, axial inertia J, turning at N qdot relative to it (the rotor's full kinetic energy, with its carrier's rotation). ModelError, builder unchanged, on an unknown joint, a joint not revolute or prismatic, a second actuator, gear_ratio zero or not finite, rotor_inertia < 0, efficiency outside (0, 1], negative frictions.
         """
     def add_body(self, name: str, mass: typing.SupportsFloat | typing.SupportsIndex, inertia: numpy.typing.ArrayLike, position: numpy.typing.ArrayLike = (0.0, 0.0, 0.0), orientation: numpy.typing.ArrayLike = (1.0, 0.0, 0.0, 0.0)) -> int:
         """
