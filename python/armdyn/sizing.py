@@ -477,17 +477,38 @@ def what_if_actuators(model, names, actuators) -> list:
                 joint=joint,
                 rotor_joint=None,
                 dof=dofs.index(joint),
-                gear_ratio=float(get("gear_ratio")),
-                rotor_inertia=float(get("rotor_inertia")),
-                efficiency=float(get("efficiency", 1.0)),
-                friction_viscous=float(get("friction_viscous", 0.0)),
-                friction_coulomb=float(get("friction_coulomb", 0.0)),
-                friction_smoothing=get("friction_smoothing"),
+                **_actuator_numbers(f"actuators: [{joint}]", get),
                 motor=motor,
                 gyroscopic=False,
             )
         )
     return out
+
+
+def _actuator_numbers(who: str, get) -> dict:
+    """The numeric actuator keys of a what-if spec, checked by the rules of
+    ``ModelBuilder.add_actuator`` (a ModelError naming the key and what it allows)."""
+    from armdyn import _checks
+
+    gear_ratio = _checks.number(who, "gear_ratio", get("gear_ratio"))
+    if gear_ratio == 0.0:
+        raise _core.ModelError(f"{who}: gear_ratio must be a finite nonzero number, got 0")
+    return dict(
+        gear_ratio=gear_ratio,
+        rotor_inertia=_checks.number(who, "rotor_inertia", get("rotor_inertia"), lo=0.0),
+        efficiency=_checks.number(
+            who, "efficiency", get("efficiency", 1.0), lo=0.0, lo_open=True, hi=1.0
+        ),
+        friction_viscous=_checks.number(
+            who, "friction_viscous", get("friction_viscous", 0.0), lo=0.0
+        ),
+        friction_coulomb=_checks.number(
+            who, "friction_coulomb", get("friction_coulomb", 0.0), lo=0.0
+        ),
+        friction_smoothing=_checks.number(
+            who, "friction_smoothing", get("friction_smoothing"), none=True
+        ),
+    )
 
 
 @dataclass
