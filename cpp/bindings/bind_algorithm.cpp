@@ -172,6 +172,17 @@ Input input(const char* name, const V& v) {
   return Input{name, v.data(), static_cast<long>(v.size())};
 }
 
+/// q with every floating base's position set to zero (kept in buf): the mass matrix does not
+/// depend on where a floating base is, and the CRBA's world-frame products lose precision
+/// with the square of its distance from the origin (1e-3 relative at 1e6 m, overflow past
+/// 1e154 m). q itself when the model has no floating base.
+Eigen::Ref<const VecX> at_origin(const Model& m, Eigen::Ref<const VecX> q, VecX& buf) {
+  if (m.n_free == 0) return q;
+  buf = q;
+  for (int k = 0; k < m.n_free; ++k) buf.segment<3>(7 * k).setZero();
+  return buf;
+}
+
 py::array_t<double> vector_out(const VecX& v) {
   py::array_t<double> a(v.size());
   std::copy(v.data(), v.data() + v.size(), a.mutable_data());
@@ -362,16 +373,17 @@ void bind_algorithm(py::module_& m) {
         Data& d = data_for(md, data, fn);
         const Model& mm = *md;
         const long n = d.ni;
+        VecX q0;  // q with the floating bases moved to the origin (at_origin)
         // M is symmetric: its column-major storage is also its row-major one
         if (is_batch(q))
           return batch(fn, d.niq, d.niq, q, q, "q", q, "q", py::float_(0.0), {n, n},
                        [&](auto qi, auto, auto, double, double* out) {
-                         const MatX& M = crba(mm, d, qi);
+                         const MatX& M = crba(mm, d, at_origin(mm, qi, q0));
                          finite_out(fn, "M (column-major)", M.data(), n * n, {input("q", qi)});
                          std::copy(M.data(), M.data() + n * n, out);
                        });
         const VecArg qa(q, "q", d.niq);
-        const MatX& M = crba(mm, d, *qa);
+        const MatX& M = crba(mm, d, at_origin(mm, *qa, q0));
         finite_out(fn, "M (column-major)", M.data(), n * n, {input("q", *qa)});
         py::array_t<double> a({n, n});
         std::copy(M.data(), M.data() + n * n, a.mutable_data());

@@ -165,7 +165,7 @@ inline py::array_t<double> as_array(const py::handle& obj, const std::string& na
     return py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(obj);
   } catch (...) {
   }
-  throw ModelError(name + ": expected an array of numbers");
+  throw ModelError(name + ": expected an array of real numbers");
 }
 
 /// The text of a str argument, or a ModelError naming it: not a str, or a str UTF-8 cannot

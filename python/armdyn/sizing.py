@@ -208,8 +208,13 @@ def trajectory_run(
         ModelError: shapes that do not match the model, non-increasing times, or a model the
             joint-space inverse dynamics does not cover.
     """
-    t = np.atleast_1d(np.asarray(t, dtype=float))
-    q, qd, qdd = (np.atleast_2d(np.asarray(x, dtype=float)) for x in (q, qd, qdd))
+    from armdyn import _checks
+
+    t = np.atleast_1d(_checks.array("trajectory_run", "t", t, finite=True))
+    q, qd, qdd = (
+        np.atleast_2d(_checks.array("trajectory_run", name, x, finite=True))
+        for name, x in (("q", q), ("qd", qd), ("qdd", qdd))
+    )
     nq, nv = len(model.coord_names), len(model.dof_names)
     if t.ndim != 1 or q.shape != (len(t), nq) or qd.shape != (len(t), nv) or qdd.shape != qd.shape:
         raise _core.ModelError(

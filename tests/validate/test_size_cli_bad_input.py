@@ -135,3 +135,11 @@ def test_devices_and_fifos_are_refused_without_reading(tmp_path):
         proc = _cli(*args)
         assert proc.returncode == 2, proc.stderr
         assert kind in proc.stderr and "Traceback" not in proc.stderr
+
+
+def test_reproduce_to_an_unwritable_folder_exits_2(tmp_path, capsys):
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    code = main(["reproduce", "--out", str(blocker / "report"), "--no-plots", "--no-geared"])
+    err = capsys.readouterr().err
+    assert_one_line_exit_2(code, err, "armdyn reproduce: cannot write the report", "report")
