@@ -191,7 +191,7 @@ py::array_t<double> vector_out(const VecX& v) {
 
 /// A frame argument: its name (str) or its index into model.frame_names (int).
 int frame_arg(const Model& md, const py::handle& frame, const char* fn) {
-  if (py::isinstance<py::str>(frame)) return md.find_frame(str_arg(frame, msg(fn, ": frame")));
+  if (py::isinstance<py::str>(frame)) return md.find_frame(str_arg(frame, fn, "frame"));
   // an int, or any integer type (numpy's too), never a bool
   if (PyIndex_Check(frame.ptr()) && !py::isinstance<py::bool_>(frame)) {
     const auto index = py::reinterpret_steal<py::int_>(PyNumber_Index(frame.ptr()));
@@ -275,7 +275,7 @@ void bind_algorithm(py::module_& m) {
          const FloatOrArray& t, const StrArg& method, const OptData& data) {
         constexpr const char* fn = "forward_dynamics";
         Data& d = data_for(md, data, fn);
-        const DynamicsMethod mth = dynamics_method(str_arg(method, msg(fn, ": method")), fn);
+        const DynamicsMethod mth = dynamics_method(str_arg(method, fn, "method"), fn);
         const Model& mm = *md;
         if (is_batch(q))
           return batch(fn, d.niq, d.ni, q, qd, "qd", tau, "tau", t, {d.ni},
@@ -341,7 +341,7 @@ void bind_algorithm(py::module_& m) {
          const FloatOrArray& t, const StrArg& method, const OptData& data) {
         constexpr const char* fn = "inverse_dynamics";
         Data& d = data_for(md, data, fn);
-        const DynamicsMethod mth = dynamics_method(str_arg(method, msg(fn, ": method")), fn, false);
+        const DynamicsMethod mth = dynamics_method(str_arg(method, fn, "method"), fn, false);
         const Model& mm = *md;
         if (is_batch(q))
           return batch(fn, d.niq, d.ni, q, qd, "qd", qdd, "qdd", t, {d.ni},

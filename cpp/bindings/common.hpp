@@ -170,15 +170,16 @@ inline py::array_t<double> as_array(const py::handle& obj, const std::string& na
 
 /// The text of a str argument, or a ModelError naming it: not a str, or a str UTF-8 cannot
 /// encode (a lone surrogate).
-inline std::string str_arg(const py::handle& obj, const std::string& name) {
+inline std::string str_arg(const py::handle& obj, const char* fn, const char* name) {
   if (!PyUnicode_Check(obj.ptr()))
-    throw ModelError(msg(name, " must be a str, got ",
+    throw ModelError(msg(fn, ": ", name, " must be a str, got ",
                          py::str(py::type::of(obj).attr("__name__")).cast<std::string>()));
   Py_ssize_t size = 0;
   const char* s = PyUnicode_AsUTF8AndSize(obj.ptr(), &size);
   if (!s) {
     PyErr_Clear();
-    throw ModelError(msg(name, " must be valid Unicode text (it holds a lone surrogate)"));
+    throw ModelError(
+        msg(fn, ": ", name, " must be valid Unicode text (it holds a lone surrogate)"));
   }
   return std::string(s, static_cast<size_t>(size));
 }
