@@ -779,6 +779,14 @@ def _urdf_source(path_or_xml) -> str:
             )
         return text
     if isinstance(path_or_xml, str):
+        try:
+            path_or_xml.encode("utf-8")
+        except UnicodeEncodeError as err:
+            raise _core.UrdfError(
+                f"load_urdf: path_or_xml holds a lone surrogate {path_or_xml[err.start]!r} at "
+                f"index {err.start}: not valid Unicode text (decode bytes with "
+                "errors='strict', or pass the XML as UTF-8 bytes)"
+            ) from None
         return path_or_xml
     if isinstance(path_or_xml, os.PathLike):
         path = os.fspath(path_or_xml)
@@ -833,16 +841,18 @@ def load_urdf(
         UrdfError: missing or irregular file, malformed XML, bad numbers or names, unsupported
             joint type, invalid inertial data (the message names the element and attribute).
         TypeError: ``path_or_xml`` is neither str, bytes nor os.PathLike.
+        ModelError: ``fixed_base``, ``physical_inertia`` or ``mimic`` not a bool, ``gravity``
+            not three finite real numbers (naming the argument).
         ModelError: a joint whose motion carries no inertia (a massless leaf link, a point mass
             on its own joint axis), naming the joint and the body.
     """
     source = _urdf_source(path_or_xml)
     model = _core.urdf_builder(
         source,
-        fixed_base,
-        gravity,
-        physical_inertia=physical_inertia,
-        mimic=mimic,
+        _checks.flag("load_urdf", "fixed_base", fixed_base),
+        _checks.array("load_urdf", "gravity", gravity, ndim=1, finite=True),
+        physical_inertia=_checks.flag("load_urdf", "physical_inertia", physical_inertia),
+        mimic=_checks.flag("load_urdf", "mimic", mimic),
     ).finalize()
     if model.nb == 0:
         warnings.warn(

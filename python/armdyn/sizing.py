@@ -688,6 +688,11 @@ def sizing_report(
 
     from armdyn.actuators import actuated_column, motor_side
 
+    if out is not None and not isinstance(out, (str, os.PathLike)):
+        raise _core.ModelError(
+            f"sizing_report: out must be a folder path (str or os.PathLike) or None, got "
+            f"{type(out).__name__}"
+        )
     t, names, qd, tau = _checked(model, result, "sizing_report")
     if len(t) < 2 or not (t[-1] > t[0]):
         raise _core.ModelError(
@@ -920,7 +925,10 @@ def gear_ratio_sweep(
                 np.max(m_diag[:, dofs.index(joint), dofs.index(joint)]) if joint in dofs else None
             )
         grid = ratios.get(joint) if isinstance(ratios, dict) else ratios
-        for n in np.atleast_1d(np.asarray(grid, dtype=float)):
+        from armdyn import _checks
+
+        name = f"ratios[{joint!r}]" if isinstance(ratios, dict) else "ratios"
+        for n in np.atleast_1d(_checks.array("gear_ratio_sweep", name, grid, finite=True)):
             act.gear_ratio = float(n)
             tau_n = tau_load + n * rotor_torque(act, qd[:, k], qdd[:, k])
             side = motor_side(act, t, qd[:, k], qdd[:, k], tau_n, joint=joint)

@@ -42,6 +42,7 @@ BAD = {
     "array2": [COMPLEX[None, :], OBJECTS[None, :], "abc"],
     "frame": [2**63, 2**70, -1, SURROGATE, 1.5, None],
     "time": ["1", 1j, None, object()],
+    "path": [2, 1j, object()],
 }
 
 # (function id, call(**options), {option: (kind, None accepted)})
@@ -67,6 +68,14 @@ ROLL_BASE = dict(q0=[[0.1]], t_end=0.05, output_dt=0.01)
 ROLL = {**{k: v for k, v in SIM.items() if k != "q0"}, "threads": ("count", True)}
 ROLL |= {"q0": ("array2", False), "qd0": ("array2", True)}
 
+WP_BASE = dict(t_end=0.05, integrators=["rk4"], dts=[0.01], n_out=5)
+URDF = """<robot name="r"><link name="base"/><link name="arm"><inertial><mass value="1"/>
+  <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
+  <joint name="j" type="continuous"><parent link="base"/><child link="arm"/><axis xyz="0 1 0"/>
+  <origin xyz="0 0 -0.5"/></joint></robot>"""
+RUN = ad.simulate(M, 0.1, q0=[0.3], output_dt=0.01, limits="ignore")
+RUN.joint_torques[:] = 1.0  # a torque to size and sweep
+GRS_BASE = dict(ratios=[10.0, 20.0], actuators={"hinge": {"rotor_inertia": 1e-5}})
 TRAJ = dict(t=[0.0, 1.0], q=[[0.0], [0.1]], qd=[[0.0], [0.0]], qdd=[[0.0], [0.0]])
 
 FUNCTIONS = [
@@ -144,6 +153,44 @@ FUNCTIONS = [
             "qd": ("array2", False),
             "qdd": ("array2", False),
         },
+    ),
+    (
+        "work_precision",
+        lambda **o: ad.work_precision(M, **{**WP_BASE, **o}),
+        {
+            "t_end": ("positive", False),
+            "n_out": ("count", False),
+            "repeats": ("count", False),
+            "max_steps": ("count", False),
+            "atol_factor": ("positive", False),
+            "coordinates": ("choice", False),
+            "limits": ("choice", False),
+        },
+    ),
+    (
+        "load_urdf",
+        lambda **o: ad.load_urdf(URDF, **o),
+        {
+            "fixed_base": ("flag", False),
+            "physical_inertia": ("flag", False),
+            "mimic": ("flag", False),
+            "gravity": ("array1", False),
+        },
+    ),
+    (
+        "LagrangeValidator",
+        lambda **o: ad.LagrangeValidator(M, **o),
+        {"rotational_inertia": ("flag", False)},
+    ),
+    (
+        "gear_ratio_sweep",
+        lambda **o: ad.gear_ratio_sweep(RUN, M, **{**GRS_BASE, **o}),
+        {"ratios": ("array1", False)},
+    ),
+    (
+        "sizing_report",
+        lambda **o: ad.sizing_report(RUN, M, **o),
+        {"out": ("path", True)},
     ),
     (
         "driven_inverse_dynamics",
