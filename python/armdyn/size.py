@@ -25,7 +25,12 @@ form of :func:`armdyn.sizing_report`'s ``actuators=`` (what the model with
 
 The command prints the report's table and, with ``--out``, writes the report there
 (``report.html``, ``table.csv``, figures). Exit code: 0 when every joint is ``ok``, 1 when
-some joint is not, 2 for bad input (a message names the file, column or key).
+some joint is not, 2 for bad input (one line names the file, column and data row, or key).
+
+Both files are read as the URDF loader reads its own: a regular file (never a FIFO or a
+device such as ``/dev/zero``) of at most ``MAX_INPUT_BYTES`` (64 MiB), UTF-8. Every value must
+be a finite number, and so must the spline derivatives and the joint torques of the motion
+(a trajectory that overflows them is bad input, named by column and data row).
 """
 
 from __future__ import annotations

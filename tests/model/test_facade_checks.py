@@ -43,6 +43,7 @@ BAD = {
     "frame": [2**63, 2**70, -1, SURROGATE, 1.5, None],
     "time": ["1", 1j, None, object()],
     "path": [2, 1j, object()],
+    "name": [SURROGATE, 5, b"tip"],
 }
 
 # (function id, call(**options), {option: (kind, None accepted)})
@@ -191,6 +192,22 @@ FUNCTIONS = [
         "sizing_report",
         lambda **o: ad.sizing_report(RUN, M, **o),
         {"out": ("path", True)},
+    ),
+    ("Model.frame", lambda **o: M.frame(**{"frame": "tip", **o}), {"frame": ("name", False)}),
+    (
+        "Model.joint_limits",
+        lambda **o: M.joint_limits(**{"joint": "hinge", **o}),
+        {"joint": ("name", False)},
+    ),
+    (
+        "Model.joint_frame",
+        lambda **o: M.joint_frame(**{"joint": "hinge", **o}),
+        {"joint": ("name", False)},
+    ),
+    (
+        "Model.with_kkt_path",
+        lambda **o: M.with_kkt_path(**{"path": "dense", **o}),
+        {"path": ("name", False)},
     ),
     (
         "driven_inverse_dynamics",
