@@ -142,6 +142,8 @@ struct Input {
 /// before the call): the output's first offending entry and the input entry of largest
 /// magnitude, the usual culprit of an overflow. A pass over the output only: no cost when
 /// it is finite beyond the scan.
+std::string largest_input(std::initializer_list<Input> inputs, double* peak_out = nullptr);
+
 void finite_out(const char* fn, const char* out_name, const double* out, long size,
                 std::initializer_list<Input> inputs) {
   long bad = -1;
@@ -151,6 +153,12 @@ void finite_out(const char* fn, const char* out_name, const double* out, long si
       break;
     }
   if (bad < 0) return;
+  throw SolverError(msg(fn, ": finite inputs overflow double precision: ", out_name, "[", bad,
+                        "] = ", out[bad], largest_input(inputs), " (scale the inputs down)"));
+}
+
+/// "; the largest input is tau[1] = 1.7e+308": the input entry of largest magnitude.
+std::string largest_input(std::initializer_list<Input> inputs, double* peak_out) {
   const Input* big = nullptr;
   long at = 0;
   double peak = -1.0;
@@ -161,10 +169,25 @@ void finite_out(const char* fn, const char* out_name, const double* out, long si
         big = &in;
         at = i;
       }
-  std::string culprit;
-  if (big) culprit = msg("; the largest input is ", big->name, "[", at, "] = ", big->data[at]);
-  throw SolverError(msg(fn, ": finite inputs overflow double precision: ", out_name, "[", bad,
-                        "] = ", out[bad], culprit, " (scale the inputs down)"));
+  if (peak_out) *peak_out = peak;
+  return big ? msg("; the largest input is ", big->name, "[", at, "] = ", big->data[at]) : "";
+}
+
+/// f(), its SolverError naming the largest input when that is beyond 1e150 (products of two
+/// such numbers overflow: the Cartesian path reports "non-finite accelerations" then).
+template <class F>
+decltype(auto) naming_huge_inputs(const char* fn, std::initializer_list<Input> inputs, F&& f) {
+  try {
+    return f();
+  } catch (const PyCallbackError&) {
+    throw;
+  } catch (const SolverError& e) {
+    double peak = 0.0;
+    const std::string culprit = largest_input(inputs, &peak);
+    if (!(peak > 1e150)) throw;
+    std::throw_with_nested(SolverError(
+        msg(fn, ": ", e.what(), culprit, " (beyond 1e150: products overflow; scale it down)")));
+  }
 }
 
 template <class V>
@@ -280,15 +303,20 @@ void bind_algorithm(py::module_& m) {
         if (is_batch(q))
           return batch(fn, d.niq, d.ni, q, qd, "qd", tau, "tau", t, {d.ni},
                        [&](auto qi, auto qdi, auto ti, double tt, double* out) {
-                         const VecX& r = forward_dynamics(mm, d, qi, qdi, ti, tt, mth);
-                         finite_out(fn, "qdd", r.data(), d.ni,
-                                    {input("q", qi), input("qd", qdi), input("tau", ti)});
+                         const auto in = {input("q", qi), input("qd", qdi), input("tau", ti)};
+                         const VecX& r = naming_huge_inputs(fn, in, [&]() -> const VecX& {
+                           return forward_dynamics(mm, d, qi, qdi, ti, tt, mth);
+                         });
+                         finite_out(fn, "qdd", r.data(), d.ni, in);
                          std::copy(r.data(), r.data() + d.ni, out);
                        });
         const VecArg qa(q, "q", d.niq), qda(qd, "qd", d.ni), ta(tau, "tau", d.ni);
-        const VecX& r = forward_dynamics(mm, d, *qa, *qda, *ta, scalar_time(t, fn), mth);
-        finite_out(fn, "qdd", r.data(), d.ni,
-                   {input("q", *qa), input("qd", *qda), input("tau", *ta)});
+        const double tt = scalar_time(t, fn);
+        const auto in = {input("q", *qa), input("qd", *qda), input("tau", *ta)};
+        const VecX& r = naming_huge_inputs(fn, in, [&]() -> const VecX& {
+          return forward_dynamics(mm, d, *qa, *qda, *ta, tt, mth);
+        });
+        finite_out(fn, "qdd", r.data(), d.ni, in);
         return vector_out(r);
       },
       py::arg("model"), py::arg("q"), py::arg("qd"), py::arg("tau"), py::arg("t") = 0.0,

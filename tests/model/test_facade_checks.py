@@ -268,8 +268,9 @@ def test_forward_dynamics_overflow_is_a_solver_error_naming_tau():
     q, z = np.array(common.UR5_Q0), np.zeros(6)
     tau = z.copy()
     tau[1] = 1.7e308
-    with pytest.raises(ad.SolverError, match=r"forward_dynamics: .*largest input is tau\[1\]"):
-        ad.forward_dynamics(model, q, z, tau)
+    for method in ("auto", "crba", "aba", "cartesian"):
+        with pytest.raises(ad.SolverError, match=r"forward_dynamics: .*largest input is tau\[1\]"):
+            ad.forward_dynamics(model, q, z, tau, method=method)
     # batch: the row is named
     qs, zs = np.tile(q, (3, 1)), np.zeros((3, 6))
     taus = zs.copy()
