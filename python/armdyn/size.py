@@ -24,8 +24,9 @@ form of :func:`armdyn.sizing_report`'s ``actuators=`` (what the model with
     peak_torque = 2.0
 
 The command prints the report's table and, with ``--out``, writes the report there
-(``report.html``, ``table.csv``, figures). Exit code: 0 when every joint is ``ok``, 1 when
-some joint is not, 2 for bad input (one line names the file, column and data row, or key).
+(``report.html``, ``table.csv``, figures), and a line for each joint whose positions leave its
+URDF ``<limit>`` (such a joint is not ok either). Exit code: 0 when every joint is ``ok``, 1
+when some joint is not, 2 for bad input (one line names the file, column and data row, or key).
 
 Both files are read as the URDF loader reads its own: a regular file (never a FIFO or a
 device such as ``/dev/zero``) of at most ``MAX_INPUT_BYTES`` (64 MiB), UTF-8. Every value must
@@ -215,7 +216,7 @@ def run(urdf, trajectory, actuators=None, out=None, echo=print) -> int:
     import pandas as pd
 
     from armdyn.simulation import load_urdf
-    from armdyn.sizing import sizing_report, trajectory_run
+    from armdyn.sizing import limit_violations, sizing_report, trajectory_run
 
     spec = read_actuators(actuators) if actuators else None
     model = load_urdf(urdf)
@@ -228,6 +229,15 @@ def run(urdf, trajectory, actuators=None, out=None, echo=print) -> int:
     with pd.option_context("display.max_columns", None, "display.width", 200):
         echo(report.table.to_string(float_format=lambda v: f"{v:.4g}"))
     bad = [str(j) for j, ok in report.table["ok"].items() if not ok]
+    # positions beyond the joints' limits (the table's "ok" covers speed and torque)
+    for row in limit_violations(model, run_).itertuples():
+        if row.kind == "position":
+            echo(
+                f"{row.joint}: position {row.worst:.6g} beyond its limit {row.limit:.6g} "
+                f"(t = {row.t_start:.6g} to {row.t_end:.6g} s)"
+            )
+            if row.joint not in bad:
+                bad.append(str(row.joint))
     if out is not None:
         echo(f"report written to {Path(out).resolve() / 'report.html'}")
     echo("all joints ok" if not bad else f"not ok: {', '.join(bad)}")

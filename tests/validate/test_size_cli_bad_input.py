@@ -143,3 +143,21 @@ def test_reproduce_to_an_unwritable_folder_exits_2(tmp_path, capsys):
     code = main(["reproduce", "--out", str(blocker / "report"), "--no-plots", "--no-geared"])
     err = capsys.readouterr().err
     assert_one_line_exit_2(code, err, "armdyn reproduce: cannot write the report", "report")
+
+
+def test_positions_beyond_the_urdf_limits_are_not_ok(tmp_path, capsys):
+    """The issue's case: positions of 1e300 rad (rates and accelerations given, zero: the
+    torques are finite) were reported as 'all joints ok'. The pivot's URDF limit is ±3 rad."""
+    t = np.linspace(0.0, 2.0, 41)
+    frame = {"t": t, "pivot": np.full_like(t, 1e300), "pivot.qd": 0.0 * t, "pivot.qdd": 0.0 * t}
+    pd.DataFrame(frame).to_csv(tmp_path / "far.csv", index=False)
+    code, out, err = run_cli(capsys, "--trajectory", tmp_path / "far.csv")
+    assert code == 1, err
+    assert "pivot: position 1e+300 beyond its limit 3 (t = 0 to 2 s)" in out
+    assert out.rstrip().endswith("not ok: pivot")
+    # just inside the limit: ok
+    frame["pivot"] = np.full_like(t, 2.9)
+    pd.DataFrame(frame).to_csv(tmp_path / "near.csv", index=False)
+    code, out, err = run_cli(capsys, "--trajectory", tmp_path / "near.csv")
+    assert code == 0, err
+    assert "beyond its limit" not in out and out.rstrip().endswith("all joints ok")
