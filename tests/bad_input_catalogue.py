@@ -43,6 +43,14 @@ def _pendulum():
     return _hinged().finalize()
 
 
+def _heavy_pendulum():
+    """10 kg at 0.5 m: I = 2.52 kg m², so I q̈ overflows for q̈ = 1.7e308."""
+    b = ad.ModelBuilder()
+    b.add_body("link", 10.0, I3, position=(0.0, 0.0, -0.5))
+    b.add_revolute("hinge", "ground", "link", (0, 0, 0), (0, 1, 0))
+    return b.finalize()
+
+
 def _driven():
     b = _hinged()
     b.add_drive("hinge", _core.profiles.cubic(0.0, 1.0, 0.0, 1.0))
@@ -572,6 +580,102 @@ CASES = [
         lambda: ad.simulate(_pendulum(), 1.0, integrator="rk4"),
         ME,
         "dt",
+    ),
+    (
+        "sim-dt-tiny",
+        "solver",
+        "dt = 1e-300 (t + dt == t)",
+        lambda: ad.simulate(_pendulum(), 1.0, integrator="rk4", dt=1e-300),
+        ME,
+        "dt=1e-300 does not advance time",
+    ),
+    (
+        "sim-rk4-memory",
+        "solver",
+        "rk4, dt = 1e-9 over 1 s without output_dt (1e9 output rows)",
+        lambda: ad.simulate(_pendulum(), 1.0, integrator="rk4", dt=1e-9),
+        ME,
+        "dt=1e-09 .* GiB of outputs",
+    ),
+    (
+        "sim-coordinates-none",
+        "solver",
+        "coordinates=None",
+        lambda: ad.simulate(_pendulum(), 1.0, coordinates=None),
+        ME,
+        "coordinates must be one of 'cartesian', 'joint', 'auto'",
+    ),
+    (
+        "sim-integrator-int",
+        "solver",
+        "integrator=123",
+        lambda: ad.simulate(_pendulum(), 1.0, integrator=123),
+        ME,
+        "integrator must be one of",
+    ),
+    (
+        "sim-max-steps-float",
+        "solver",
+        "max_steps=1.5",
+        lambda: ad.simulate(_pendulum(), 1.0, max_steps=1.5),
+        ME,
+        "max_steps must be a positive integer",
+    ),
+    (
+        "sim-t-end-str",
+        "solver",
+        "t_end='1'",
+        lambda: ad.simulate(_pendulum(), "1"),
+        ME,
+        "t_end must be a positive number",
+    ),
+    (
+        "rollout-threads-float",
+        "solver",
+        "rollout with threads=2.5",
+        lambda: ad.rollout(_pendulum(), [[0.1]], t_end=1.0, threads=2.5),
+        ME,
+        "threads must be a positive integer",
+    ),
+    (
+        "fd-complex",
+        "arrays",
+        "forward_dynamics with a complex tau array",
+        lambda: ad.forward_dynamics(_pendulum(), [0.0], [0.0], np.array([1j])),
+        ME,
+        "tau: must hold real numbers, got a complex array",
+    ),
+    (
+        "fd-overflow",
+        "arrays",
+        "forward_dynamics with tau = 1.7e308 (finite; the accelerations overflow)",
+        lambda: ad.forward_dynamics(_pendulum(), [0.0], [0.0], [1.7e308]),
+        SE,
+        r"overflow.*tau\[0\]",
+    ),
+    (
+        "id-overflow",
+        "arrays",
+        "inverse_dynamics with qdd = 1.7e308 (finite; the torques overflow)",
+        lambda: ad.inverse_dynamics(_heavy_pendulum(), [0.0], [0.0], [1.7e308]),
+        SE,
+        r"overflow.*qdd\[0\]",
+    ),
+    (
+        "frame-index-huge",
+        "arrays",
+        "frame index 2**63",
+        lambda: ad.frame_pose(_pendulum(), [0.0], 2**63),
+        ME,
+        "frame index 9223372036854775808 out of range",
+    ),
+    (
+        "frame-name-surrogate",
+        "arrays",
+        "frame name with a lone surrogate",
+        lambda: ad.frame_pose(_pendulum(), [0.0], "tip\ud800"),
+        ME,
+        "frame must be valid Unicode",
     ),
     (
         "sim-max-step",

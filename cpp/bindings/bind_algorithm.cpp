@@ -3,6 +3,8 @@
 // inverse_dynamics and mass_matrix. One state (1-D arrays) or one state per row (2-D arrays,
 // evaluated in one C++ loop without the GIL). Without data=, each thread keeps one Data per
 // model, so repeated calls allocate nothing but their output array.
+#include <cmath>
+#include <initializer_list>
 #include <memory>
 #include <vector>
 
@@ -129,6 +131,81 @@ py::array_t<double> batch(const char* fn, long nq, long n, const py::handle& q, 
   return out;
 }
 
+/// One input of a call, for finite_out's message.
+struct Input {
+  const char* name;
+  const double* data;
+  long size;
+};
+
+/// A SolverError when finite inputs gave a non-finite output (the inputs are checked finite
+/// before the call): the output's first offending entry and the input entry of largest
+/// magnitude, the usual culprit of an overflow. A pass over the output only: no cost when
+/// it is finite beyond the scan.
+std::string largest_input(std::initializer_list<Input> inputs, double* peak_out = nullptr);
+
+void finite_out(const char* fn, const char* out_name, const double* out, long size,
+                std::initializer_list<Input> inputs) {
+  long bad = -1;
+  for (long i = 0; i < size; ++i)
+    if (!std::isfinite(out[i])) {
+      bad = i;
+      break;
+    }
+  if (bad < 0) return;
+  throw SolverError(msg(fn, ": finite inputs overflow double precision: ", out_name, "[", bad,
+                        "] = ", out[bad], largest_input(inputs), " (scale the inputs down)"));
+}
+
+/// "; the largest input is tau[1] = 1.7e+308": the input entry of largest magnitude.
+std::string largest_input(std::initializer_list<Input> inputs, double* peak_out) {
+  const Input* big = nullptr;
+  long at = 0;
+  double peak = -1.0;
+  for (const Input& in : inputs)
+    for (long i = 0; i < in.size; ++i)
+      if (std::abs(in.data[i]) > peak) {
+        peak = std::abs(in.data[i]);
+        big = &in;
+        at = i;
+      }
+  if (peak_out) *peak_out = peak;
+  return big ? msg("; the largest input is ", big->name, "[", at, "] = ", big->data[at]) : "";
+}
+
+/// f(), its SolverError naming the largest input when that is beyond 1e150 (products of two
+/// such numbers overflow: the Cartesian path reports "non-finite accelerations" then).
+template <class F>
+decltype(auto) naming_huge_inputs(const char* fn, std::initializer_list<Input> inputs, F&& f) {
+  try {
+    return f();
+  } catch (const PyCallbackError&) {
+    throw;
+  } catch (const SolverError& e) {
+    double peak = 0.0;
+    const std::string culprit = largest_input(inputs, &peak);
+    if (!(peak > 1e150)) throw;
+    std::throw_with_nested(SolverError(
+        msg(fn, ": ", e.what(), culprit, " (beyond 1e150: products overflow; scale it down)")));
+  }
+}
+
+template <class V>
+Input input(const char* name, const V& v) {
+  return Input{name, v.data(), static_cast<long>(v.size())};
+}
+
+/// q with every floating base's position set to zero (kept in buf): the mass matrix does not
+/// depend on where a floating base is, and the CRBA's world-frame products lose precision
+/// with the square of its distance from the origin (1e-3 relative at 1e6 m, overflow past
+/// 1e154 m). q itself when the model has no floating base.
+Eigen::Ref<const VecX> at_origin(const Model& m, Eigen::Ref<const VecX> q, VecX& buf) {
+  if (m.n_free == 0) return q;
+  buf = q;
+  for (int k = 0; k < m.n_free; ++k) buf.segment<3>(7 * k).setZero();
+  return buf;
+}
+
 py::array_t<double> vector_out(const VecX& v) {
   py::array_t<double> a(v.size());
   std::copy(v.data(), v.data() + v.size(), a.mutable_data());
@@ -137,15 +214,17 @@ py::array_t<double> vector_out(const VecX& v) {
 
 /// A frame argument: its name (str) or its index into model.frame_names (int).
 int frame_arg(const Model& md, const py::handle& frame, const char* fn) {
-  if (py::isinstance<py::str>(frame)) return md.find_frame(frame.cast<std::string>());
+  if (py::isinstance<py::str>(frame)) return md.find_frame(str_arg(frame, fn, "frame"));
   // an int, or any integer type (numpy's too), never a bool
   if (PyIndex_Check(frame.ptr()) && !py::isinstance<py::bool_>(frame)) {
-    const long long k =
-        py::reinterpret_steal<py::int_>(PyNumber_Index(frame.ptr())).cast<long long>();
+    const auto index = py::reinterpret_steal<py::int_>(PyNumber_Index(frame.ptr()));
+    if (!index) throw py::error_already_set();
+    int overflow = 0;
+    const long long k = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
     const long long nf = static_cast<long long>(md.frames.size());
-    if (k < 0 || k >= nf)
-      throw ModelError(
-          msg(fn, ": frame index ", k, " out of range (the model has ", nf, " frames)"));
+    if (overflow != 0 || k < 0 || k >= nf)
+      throw ModelError(msg(fn, ": frame index ", py::str(index).cast<std::string>(),
+                           " out of range (the model has ", nf, " frames)"));
     return static_cast<int>(k);
   }
   throw ModelError(msg(fn, ": frame must be a frame name (str) or an index (int), got ",
@@ -166,10 +245,14 @@ py::array_t<double> per_state(const char* fn, const char* qname, long n, const p
     shape.insert(shape.begin(), rows);
     py::array_t<double> out(shape);
     for (long i = 0; i < rows; ++i) {
+      const Eigen::Map<const VecX> qi(Q.data() + i * n, n);
       try {
-        f(Eigen::Map<const VecX>(Q.data() + i * n, n), out.mutable_data() + i * size);
+        f(qi, out.mutable_data() + i * size);
+        finite_out(fn, "the result", out.data() + i * size, size, {input(qname, qi)});
       } catch (const ModelError& e) {
         throw ModelError(msg("row ", i, ": ", e.what()));
+      } catch (const SolverError& e) {
+        throw SolverError(msg("row ", i, ": ", e.what()));
       }
     }
     return out;
@@ -177,6 +260,7 @@ py::array_t<double> per_state(const char* fn, const char* qname, long n, const p
   const VecArg one(qa, msg(fn, ": ", qname).c_str(), n);
   py::array_t<double> out(shape);
   f(*one, out.mutable_data());
+  finite_out(fn, "the result", out.data(), size, {input(qname, *one)});
   return out;
 }
 
@@ -211,19 +295,29 @@ void bind_algorithm(py::module_& m) {
   m.def(
       "forward_dynamics",
       [](const ModelHolder& md, const ArrayLike& q, const ArrayLike& qd, const ArrayLike& tau,
-         const FloatOrArray& t, const std::string& method, const OptData& data) {
+         const FloatOrArray& t, const StrArg& method, const OptData& data) {
         constexpr const char* fn = "forward_dynamics";
         Data& d = data_for(md, data, fn);
-        const DynamicsMethod mth = dynamics_method(method, fn);
+        const DynamicsMethod mth = dynamics_method(str_arg(method, fn, "method"), fn);
         const Model& mm = *md;
         if (is_batch(q))
           return batch(fn, d.niq, d.ni, q, qd, "qd", tau, "tau", t, {d.ni},
                        [&](auto qi, auto qdi, auto ti, double tt, double* out) {
-                         const VecX& r = forward_dynamics(mm, d, qi, qdi, ti, tt, mth);
+                         const auto in = {input("q", qi), input("qd", qdi), input("tau", ti)};
+                         const VecX& r = naming_huge_inputs(fn, in, [&]() -> const VecX& {
+                           return forward_dynamics(mm, d, qi, qdi, ti, tt, mth);
+                         });
+                         finite_out(fn, "qdd", r.data(), d.ni, in);
                          std::copy(r.data(), r.data() + d.ni, out);
                        });
         const VecArg qa(q, "q", d.niq), qda(qd, "qd", d.ni), ta(tau, "tau", d.ni);
-        return vector_out(forward_dynamics(mm, d, *qa, *qda, *ta, scalar_time(t, fn), mth));
+        const double tt = scalar_time(t, fn);
+        const auto in = {input("q", *qa), input("qd", *qda), input("tau", *ta)};
+        const VecX& r = naming_huge_inputs(fn, in, [&]() -> const VecX& {
+          return forward_dynamics(mm, d, *qa, *qda, *ta, tt, mth);
+        });
+        finite_out(fn, "qdd", r.data(), d.ni, in);
+        return vector_out(r);
       },
       py::arg("model"), py::arg("q"), py::arg("qd"), py::arg("tau"), py::arg("t") = 0.0,
       py::arg("method") = "auto", py::arg("data") = py::none(),
@@ -272,19 +366,24 @@ void bind_algorithm(py::module_& m) {
   m.def(
       "inverse_dynamics",
       [](const ModelHolder& md, const ArrayLike& q, const ArrayLike& qd, const ArrayLike& qdd,
-         const FloatOrArray& t, const std::string& method, const OptData& data) {
+         const FloatOrArray& t, const StrArg& method, const OptData& data) {
         constexpr const char* fn = "inverse_dynamics";
         Data& d = data_for(md, data, fn);
-        const DynamicsMethod mth = dynamics_method(method, fn, false);
+        const DynamicsMethod mth = dynamics_method(str_arg(method, fn, "method"), fn, false);
         const Model& mm = *md;
         if (is_batch(q))
           return batch(fn, d.niq, d.ni, q, qd, "qd", qdd, "qdd", t, {d.ni},
                        [&](auto qi, auto qdi, auto ai, double tt, double* out) {
                          const VecX& r = inverse_dynamics(mm, d, qi, qdi, ai, tt, mth);
+                         finite_out(fn, "tau", r.data(), d.ni,
+                                    {input("q", qi), input("qd", qdi), input("qdd", ai)});
                          std::copy(r.data(), r.data() + d.ni, out);
                        });
         const VecArg qa(q, "q", d.niq), qda(qd, "qd", d.ni), aa(qdd, "qdd", d.ni);
-        return vector_out(inverse_dynamics(mm, d, *qa, *qda, *aa, scalar_time(t, fn), mth));
+        const VecX& r = inverse_dynamics(mm, d, *qa, *qda, *aa, scalar_time(t, fn), mth);
+        finite_out(fn, "tau", r.data(), d.ni,
+                   {input("q", *qa), input("qd", *qda), input("qdd", *aa)});
+        return vector_out(r);
       },
       py::arg("model"), py::arg("q"), py::arg("qd"), py::arg("qdd"), py::arg("t") = 0.0,
       py::arg("method") = "auto", py::arg("data") = py::none(),
@@ -302,15 +401,18 @@ void bind_algorithm(py::module_& m) {
         Data& d = data_for(md, data, fn);
         const Model& mm = *md;
         const long n = d.ni;
+        VecX q0;  // q with the floating bases moved to the origin (at_origin)
         // M is symmetric: its column-major storage is also its row-major one
         if (is_batch(q))
           return batch(fn, d.niq, d.niq, q, q, "q", q, "q", py::float_(0.0), {n, n},
                        [&](auto qi, auto, auto, double, double* out) {
-                         const MatX& M = crba(mm, d, qi);
+                         const MatX& M = crba(mm, d, at_origin(mm, qi, q0));
+                         finite_out(fn, "M (column-major)", M.data(), n * n, {input("q", qi)});
                          std::copy(M.data(), M.data() + n * n, out);
                        });
         const VecArg qa(q, "q", d.niq);
-        const MatX& M = crba(mm, d, *qa);
+        const MatX& M = crba(mm, d, at_origin(mm, *qa, q0));
+        finite_out(fn, "M (column-major)", M.data(), n * n, {input("q", *qa)});
         py::array_t<double> a({n, n});
         std::copy(M.data(), M.data() + n * n, a.mutable_data());
         return a;

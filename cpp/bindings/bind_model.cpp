@@ -526,8 +526,8 @@ void bind_model(py::module_& m) {
           "Names of the named frames (add_frame, URDF links), in the order they were added.")
       .def(
           "frame",
-          [](const Model& md, const std::string& name) {
-            const int k = md.find_frame(name);
+          [](const Model& md, const StrArg& frame) {
+            const int k = md.find_frame(str_arg(frame, "Model.frame", "frame"));
             const NamedFrame& f = md.frames[k];
             return py::dict(py::arg("index") = k, py::arg("body") = md.body_name(f.body),
                             py::arg("point") = to_numpy(VecX(f.point)),
@@ -622,8 +622,9 @@ void bind_model(py::module_& m) {
           "where none or 0, and on a floating base).")
       .def(
           "joint_limits",
-          [](const Model& md, const std::string& name) {
-            const Joint& j = md.joints[md.find_joint(name)];
+          [](const Model& md, const StrArg& joint) {
+            const Joint& j =
+                md.joints[md.find_joint(str_arg(joint, "Model.joint_limits", "joint"))];
             return py::dict(py::arg("lower") = j.lower, py::arg("upper") = j.upper,
                             py::arg("effort") = j.effort, py::arg("velocity") = j.velocity_limit);
           },
@@ -632,8 +633,8 @@ void bind_model(py::module_& m) {
           "where none), 'effort' [N m or N] and 'velocity' [rad/s or m/s] (0 where none).")
       .def(
           "joint_frame",
-          [](const Model& md, const std::string& name) {
-            const Joint& j = md.joints[md.find_joint(name)];
+          [](const Model& md, const StrArg& joint) {
+            const Joint& j = md.joints[md.find_joint(str_arg(joint, "Model.joint_frame", "joint"))];
             auto body = [&](int b) {
               return b == kGround ? std::string("ground") : md.bodies[b].name;
             };
@@ -659,7 +660,8 @@ void bind_model(py::module_& m) {
           "(redundant rows).")
       .def(
           "with_kkt_path",
-          [](const Model& m, const std::string& path) {
+          [](const Model& m, const StrArg& path_arg) {
+            const std::string path = str_arg(path_arg, "with_kkt_path", "path");
             if (path != "dense" && path != "auto")
               throw ModelError("with_kkt_path: path must be 'dense' or 'auto', got '" + path + "'");
             // a copy derives its plans and welded form afresh (the welded model inherits the

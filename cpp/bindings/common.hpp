@@ -137,6 +137,7 @@ ARMDYN_HINTED_OBJECT(ProfileLike)     // Profile | float | Callable[[float], tup
 ARMDYN_HINTED_OBJECT(OptProfileLike)  // the same or None
 ARMDYN_HINTED_OBJECT(OptFloat)        // float | None
 ARMDYN_HINTED_OBJECT(OptStr)          // str | None
+ARMDYN_HINTED_OBJECT(StrArg)          // str (checked by str_arg: a ModelError, never a cast error)
 ARMDYN_HINTED_OBJECT(FrameRef)        // str | int (a frame's name or index)
 ARMDYN_HINTED_OBJECT(OptMotor)        // Motor | None
 ARMDYN_HINTED_OBJECT(OptProgress)     // Callable[[float, float], object] | None
@@ -145,12 +146,42 @@ ARMDYN_HINTED_OBJECT(OptData)         // Data | None
 ARMDYN_HINTED_OBJECT(ProfileValues)   // Profile.eval's (y, yd, ydd): floats or float64 arrays
 #undef ARMDYN_HINTED_OBJECT
 
+/// Refuses values that numpy would convert to float64 with loss or by accident: complex numbers
+/// (numpy drops the imaginary part with only a warning), and arrays of objects, strings or bytes.
+inline void refuse_non_real(const py::handle& obj, const std::string& name) {
+  if (PyComplex_Check(obj.ptr()))
+    throw ModelError(name + ": must be real numbers, got a complex number");
+  if (!py::isinstance<py::array>(obj)) return;
+  const char kind = py::reinterpret_borrow<py::array>(obj).dtype().kind();
+  if (kind == 'c') throw ModelError(name + ": must hold real numbers, got a complex array");
+  if (kind == 'O' || kind == 'U' || kind == 'S' || kind == 'V')
+    throw ModelError(name + ": must hold real numbers, got an array of dtype " +
+                     py::str(py::reinterpret_borrow<py::array>(obj).dtype()).cast<std::string>());
+}
+
 inline py::array_t<double> as_array(const py::handle& obj, const std::string& name) {
+  refuse_non_real(obj, name);
   try {
     return py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(obj);
   } catch (...) {
   }
-  throw ModelError(name + ": expected an array of numbers");
+  throw ModelError(name + ": expected an array of real numbers");
+}
+
+/// The text of a str argument, or a ModelError naming it: not a str, or a str UTF-8 cannot
+/// encode (a lone surrogate).
+inline std::string str_arg(const py::handle& obj, const char* fn, const char* name) {
+  if (!PyUnicode_Check(obj.ptr()))
+    throw ModelError(msg(fn, ": ", name, " must be a str, got ",
+                         py::str(py::type::of(obj).attr("__name__")).cast<std::string>()));
+  Py_ssize_t size = 0;
+  const char* s = PyUnicode_AsUTF8AndSize(obj.ptr(), &size);
+  if (!s) {
+    PyErr_Clear();
+    throw ModelError(
+        msg(fn, ": ", name, " must be valid Unicode text (it holds a lone surrogate)"));
+  }
+  return std::string(s, static_cast<size_t>(size));
 }
 
 inline std::string shape_str(const py::array& a) {
@@ -250,6 +281,7 @@ ARMDYN_TYPE_HINT(OptProfileLike, ARMDYN_PROFILE_HINT " | None")
 #undef ARMDYN_PROFILE_HINT
 ARMDYN_TYPE_HINT(OptFloat, "float | None")
 ARMDYN_TYPE_HINT(OptStr, "str | None")
+ARMDYN_TYPE_HINT(StrArg, "str")
 ARMDYN_TYPE_HINT(FrameRef, "str | int")
 ARMDYN_TYPE_HINT(OptMotor, "armdyn._core.Motor | None")
 ARMDYN_TYPE_HINT(OptProgress, "collections.abc.Callable[[float, float], object] | None")

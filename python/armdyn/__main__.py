@@ -2,7 +2,7 @@
 
 * ``armdyn reproduce [--out DIR]`` regenerates the five-DOF validation paper's Tables 1–4 and
   Figures 5–8 beside the paper's own figures, and the six-DOF paper's geared-arm study (Fig. 3
-  style), as a Markdown + PNG report.
+  style), as a Markdown + PNG report (exit code 2 when DIR cannot be written).
 * ``armdyn size ROBOT.urdf --trajectory FILE.csv [--actuators FILE.toml] [--out DIR]`` prints
   the sizing report of a planned motion (joint side, and motor side for the actuators of the
   TOML file) and writes it to DIR; exit code 0 when every joint is ok, 1 when some joint is
@@ -72,7 +72,13 @@ def _run(args: argparse.Namespace) -> int:
     if args.command == "reproduce":
         from armdyn.reproduce import run
 
-        run(args.out, plots=not args.no_plots, geared=not args.no_geared)
+        try:
+            run(args.out, plots=not args.no_plots, geared=not args.no_geared)
+        except OSError as exc:  # --out not writable: bad input, one line
+            print(
+                f"armdyn reproduce: cannot write the report to {args.out!r}: {exc}", file=sys.stderr
+            )
+            return 2
         return 0
     return 1
 

@@ -20,6 +20,11 @@ def checked(model, result, caller: str):
     :class:`armdyn.sizing.TrajectoryRun` of a coupled model). Efforts:
     ``result.joint_torques`` when the result has them, else the drives' efforts summed per
     driven coordinate."""
+    if not (hasattr(result, "t") and hasattr(result, "qd")):
+        raise _core.ModelError(
+            f"{caller}: result must be a SimulationResult, InverseDynamicsResult or "
+            f"TrajectoryRun, got {type(result).__name__}"
+        )
     names = column_names(model)
     t = np.asarray(result.t, dtype=float)
     qd = np.asarray(result.qd, dtype=float)

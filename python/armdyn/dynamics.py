@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import numpy.typing as npt
 
-from armdyn import _core
+from armdyn import _checks, _core
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -80,7 +80,7 @@ def driven_inverse_dynamics(model: _core.Model, t: npt.ArrayLike) -> InverseDyna
     """
     from armdyn.actuators import motor_side_of_result
 
-    times = np.atleast_1d(np.asarray(t, dtype=float))
+    times = np.atleast_1d(_checks.array("driven_inverse_dynamics", "t", t))
     result = InverseDynamicsResult(**_core._inverse_dynamics_driven(model, times))
     result.model = model
     if getattr(model, "actuators", None) and len(times) > 0:

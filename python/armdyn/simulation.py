@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import numpy.typing as npt
 
-from armdyn import _core
+from armdyn import _checks, _core
 from armdyn.animation import remember_urdf
 
 if TYPE_CHECKING:
@@ -214,7 +214,9 @@ def simulate(
             give the same outputs. ``stats["integrator"]`` and ``stats["integrator_reason"]``
             say which was used and why.
         rtol, atol: error-control tolerances on every component of (u, v).
-        dt: RK4 step (required for rk4); DOPRI5/DOP853/TR-BDF2 initial step (optional).
+        dt: RK4 step (required for rk4); DOPRI5/DOP853/TR-BDF2 initial step (optional). It
+            must advance time: at least ``64 eps t_end`` (about 1.4e-14 t_end), else a
+            ModelError naming ``dt``.
         output_dt: spacing of output times (default: every accepted step). Output states are
             interpolated (the integrator's dense output) and projected onto the constraints.
         q0, qd0: initial joint-space coordinates (``model.n_coords``,) and rates
@@ -264,17 +266,23 @@ def simulate(
             run completes. Updated at most every 0.1 s of wall time, from the run's poll (the
             GIL taken briefly); an exception it raises stops the run and propagates as itself,
             with ``.result``.
-        max_output_bytes: bound on the memory of the outputs of an ``output_dt`` run (default
-            ``armdyn.simulation.MAX_OUTPUT_BYTES``, 2 GiB): a run whose tables would exceed it
-            (``t_end / output_dt + 2`` rows of every output, sized from the model) is refused
-            before it starts, with a ModelError naming ``output_dt``. Runs without
-            ``output_dt`` (an output every accepted step) are bounded by ``max_steps``.
+        max_output_bytes: bound on the memory of the run's outputs (default
+            ``armdyn.simulation.MAX_OUTPUT_BYTES``, 2 GiB), checked before the run starts
+            against its rows times the bytes of one row (every output, sized from the model).
+            With ``output_dt``: ``t_end / output_dt + 2`` rows; a run beyond the bound is
+            refused with a ModelError naming ``output_dt``. Without it (one row per accepted
+            step): an RK4 run's ``t_end / dt + 2`` rows likewise (naming ``dt``); an adaptive
+            run's rows are at most ``max_steps + 2``, and ``max_steps`` is lowered to fit the
+            bound (a run that reaches it stops with a SolverError saying so, ``.result``
+            holding the outputs so far).
 
     Returns:
         SimulationResult.
 
     Raises:
-        ModelError: invalid options or initial state; outputs beyond ``max_output_bytes``;
+        ModelError: invalid options (naming the argument and what it allows: a wrong type,
+            a value out of range, NaN, complex arrays) or initial state; a ``dt`` too small to
+            advance time; outputs beyond ``max_output_bytes``;
             ``simulate`` called from inside a running simulation (a profile or progress
             callable): re-entrant runs are refused.
         SolverError: the run failed (non-finite force, projection not converging, step-size
@@ -301,26 +309,33 @@ def simulate(
         limits,
         restitution,
     )
+    t_end = _checks.number("simulate", "t_end", t_end, lo=0.0, lo_open=True)
+    _checks_model("simulate", model)
+    q0, qd0, u0, v0 = (
+        _checks.array("simulate", name, x, ndim=1) if x is not None else None
+        for name, x in (("q0", q0), ("qd0", qd0), ("u0", u0), ("v0", v0))
+    )
     if q0 is not None or qd0 is not None:
         if u0 is not None or v0 is not None:
             raise _core.ModelError("simulate: give either q0/qd0 or u0/v0, not both")
         if q0 is None:
             raise _core.ModelError("simulate: qd0 given without q0")
         u0, v0 = _core.state_from_joints(model, q0, qd0)
-        q_start = np.asarray(q0, dtype=float)
+        q_start = q0
     else:
         q_start = None
     if model.nb == 0:
         return _zero_dof_result(model, t_end, output_dt)
-    if output_dt is not None:
-        _check_output_bytes(model, t_end, output_dt, max_output_bytes)
-    report, close = _progress_reporter(progress, float(t_end), unit="s", bar_format=_BAR_FORMAT)
+    requested = options["max_steps"]
+    options = _bound_run("simulate", model, t_end, options, max_output_bytes)
+    report, close = _progress_reporter(progress, t_end, unit="s", bar_format=_BAR_FORMAT)
     try:
         raw = _core._simulate(
-            model, float(t_end), u0=u0, v0=v0, q_start=q_start, progress=report, **options
+            model, t_end, u0=u0, v0=v0, q_start=q_start, progress=report, **options
         )
         interrupt = raw.pop("interrupt")
         cause = raw.pop("cause")
+        raw["error"] = _explain_capped(raw["error"], options, requested)
         result = _result_of(model, raw)
         if interrupt is not None:
             # Ctrl-C, or SystemExit / KeyboardInterrupt / GeneratorExit from a callable
@@ -333,7 +348,7 @@ def simulate(
                 raise exc from cause
             raise exc
         if report is not None:
-            report(float(t_end), float(t_end))
+            _final_report(report, t_end, t_end, result)
         return result
     finally:
         if close is not None:
@@ -345,24 +360,93 @@ def simulate(
 MAX_OUTPUT_BYTES = 2 * 1024**3
 
 
-def _check_output_bytes(model, t_end, output_dt, max_output_bytes) -> None:
-    """Refuse, before it starts, a run whose outputs would exceed the bound (ModelError)."""
+def _bound_run(who, model, t_end, options, max_output_bytes, n_runs=1) -> dict:
+    """The run options with the outputs' memory bounded before the run starts, and ``dt``
+    checked to advance time; ModelError naming ``dt`` / ``output_dt`` / ``max_output_bytes``.
+
+    Rows per run: ``t_end / output_dt + 2`` with ``output_dt``; without it one per step, so
+    at most ``max_steps + 2`` (RK4: ``t_end / dt + 2``). ``n_runs`` runs (rollout) share the
+    bound. A run without ``output_dt`` whose ``max_steps`` would allow more rows than the bound
+    has its ``max_steps`` lowered to fit (it then stops, keeping its outputs so far, with a
+    SolverError saying so); one that cannot fit at all is refused."""
     bound = MAX_OUTPUT_BYTES if max_output_bytes is None else max_output_bytes
-    if not (isinstance(bound, (int, float)) and bound > 0):
+    bound = _checks.number(who, "max_output_bytes", bound, lo=0.0, lo_open=True)
+    row = float(_core._output_row_bytes(model)) * n_runs
+    dt, output_dt = options["dt"], options["output_dt"]
+    if dt > 0 and not (t_end + dt > t_end and dt >= _MIN_DT_RATIO * t_end):
         raise _core.ModelError(
-            f"simulate: max_output_bytes must be a positive number, got {bound!r}"
+            f"{who}: dt={dt:g} does not advance time over t_end={t_end:g} s in floating point "
+            f"(dt must be at least {_MIN_DT_RATIO:g} t_end = {_MIN_DT_RATIO * t_end:g} s)"
         )
-    if not (np.isfinite(t_end) and t_end > 0):
-        return  # the run's own check names t_end
-    rows = float(t_end) / float(output_dt) + 2
-    need = rows * _core._output_row_bytes(model)
-    if need > bound:
+    if output_dt > 0:
+        rows = t_end / output_dt + 2
+        if rows * row > bound:
+            raise _core.ModelError(
+                f"{who}: output_dt={output_dt:g} over t_end={t_end:g} s gives {rows:.3g} output "
+                f"rows{_of_runs(n_runs)}, {rows * row / 1024**3:.3g} GiB of outputs, above the "
+                f"bound of {bound / 1024**3:.3g} GiB; raise output_dt (at least "
+                f"{t_end * row / bound:.3g} s), or raise max_output_bytes= / "
+                "armdyn.simulation.MAX_OUTPUT_BYTES"
+            )
+        return options
+    if options["integrator"] == "rk4" and dt > 0:
+        steps = np.ceil(t_end / dt)
+        if (steps + 2) * row > bound:
+            raise _core.ModelError(
+                f"{who}: dt={dt:g} over t_end={t_end:g} s without output_dt gives {steps:.3g} "
+                f"output rows (one per step){_of_runs(n_runs)}, "
+                f"{(steps + 2) * row / 1024**3:.3g} GiB of outputs, above the bound of "
+                f"{bound / 1024**3:.3g} GiB; pass output_dt, raise dt, or raise "
+                "max_output_bytes= / armdyn.simulation.MAX_OUTPUT_BYTES"
+            )
+    fit = int(bound // row) - 2
+    if fit < 1:
         raise _core.ModelError(
-            f"simulate: output_dt={output_dt:g} over t_end={t_end:g} s gives {rows:.3g} output "
-            f"rows, {need / 1024**3:.3g} GiB of outputs, above the bound of "
-            f"{bound / 1024**3:.3g} GiB; raise output_dt (at least "
-            f"{float(t_end) * _core._output_row_bytes(model) / bound:.3g} s), or raise "
-            "max_output_bytes= / armdyn.simulation.MAX_OUTPUT_BYTES"
+            f"{who}: max_output_bytes={bound:g} does not hold even one step's outputs "
+            f"({row:g} bytes{_of_runs(n_runs)})"
+        )
+    if options["max_steps"] > fit:
+        return dict(options, max_steps=fit)
+    return options
+
+
+#: the smallest dt relative to t_end (each step then moves t by at least 64 units of its last
+#: place, so that the step count stays close to t_end / dt)
+_MIN_DT_RATIO = 64 * np.finfo(float).eps
+
+
+def _of_runs(n_runs: int) -> str:
+    return "" if n_runs == 1 else f" for each of {n_runs} runs"
+
+
+def _explain_capped(error: str | None, options: dict, requested: int) -> str | None:
+    """The error of a run stopped by a max_steps that _bound_run lowered, saying so."""
+    capped = options["max_steps"]
+    if error and capped < requested and f"more than {capped} steps" in error:
+        return (
+            f"{error}: max_steps was lowered from {requested} to {capped} so that the outputs "
+            "of this run without output_dt (one row per step) fit in max_output_bytes; pass "
+            "output_dt, or raise max_output_bytes"
+        )
+    return error
+
+
+def _final_report(report, done, total, result) -> None:
+    """The progress callable's last call, at the end of a complete run: an exception it raises
+    propagates as itself with ``.result`` (the run's, complete), as during the run."""
+    try:
+        report(done, total)
+    except BaseException as exc:
+        exc.result = result
+        raise
+
+
+def _checks_model(who: str, model) -> None:
+    """A finalized armdyn.Model, or a ModelError naming the argument."""
+    if not isinstance(model, _core.Model):
+        raise _core.ModelError(
+            f"{who}: model must be a finalized armdyn.Model (ModelBuilder.finalize(), "
+            f"load_urdf), got {type(model).__name__}"
         )
 
 
@@ -417,7 +501,7 @@ _ROLLOUT_OPTIONS = (
 
 def _rows(name: str, x, n_cols: int, n_rows: int | None) -> np.ndarray:
     """x as a float (n_runs, n_cols) array, or ModelError naming it and its shape."""
-    a = np.asarray(x, dtype=float)
+    a = _checks.array("rollout", name, x)
     if a.ndim != 2 or a.shape[1] != n_cols or (n_rows is not None and a.shape[0] != n_rows):
         rows = "n_runs" if n_rows is None else str(n_rows)
         raise _core.ModelError(
@@ -436,6 +520,7 @@ def rollout(
     u0: npt.ArrayLike | None = None,
     v0: npt.ArrayLike | None = None,
     progress: _Progress = False,
+    max_output_bytes: int | None = None,
     **simulate_options: Any,
 ) -> list[SimulationResult]:
     """Many runs of :func:`simulate` on C++ threads: one per row of the initial states.
@@ -457,6 +542,9 @@ def rollout(
             instance (its ``total`` set to n_runs); or a callable ``progress(done, n_runs)``.
             Updated every 0.1 s from the waiting thread; an exception it raises stops the batch
             as Ctrl-C does (raised as itself, ``.result`` the list).
+        max_output_bytes: bound on the memory of the outputs of all the runs together
+            (default ``armdyn.simulation.MAX_OUTPUT_BYTES``), as :func:`simulate`'s for one run
+            (each run's rows times n_runs).
         **simulate_options: the options of :func:`simulate` (integrator, rtol, atol, dt,
             output_dt, projection, max_steps, max_step, merge_welded, coordinates, limits,
             restitution), the same for every run.
@@ -489,12 +577,11 @@ def rollout(
     options = _core_options(
         "rollout", *(simulate_options.get(k, defaults[k].default) for k in _ROLLOUT_OPTIONS)
     )
-    if t_end is None or not (np.isfinite(t_end) and t_end > 0):
-        raise _core.ModelError(f"rollout: t_end must be positive and finite, got {t_end}")
+    t_end = _checks.number("rollout", "t_end", t_end, lo=0.0, lo_open=True)
+    threads = _checks.integer("rollout", "threads", threads, lo=1, none=True)
     if threads is None:
         threads = os.cpu_count() or 1
-    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
-        raise _core.ModelError(f"rollout: threads must be a positive integer, got {threads!r}")
+    _checks_model("rollout", model)
     if q0 is not None or qd0 is not None:
         if u0 is not None or v0 is not None:
             raise _core.ModelError("rollout: give either q0/qd0 or u0/v0 rows, not both")
@@ -520,25 +607,29 @@ def rollout(
         return []
     if model.nb == 0:  # nothing to integrate: the zero-DOF result of each run
         return [simulate(model, t_end, output_dt=options["output_dt"] or None) for _ in range(n)]
+    requested = options["max_steps"]
+    options = _bound_run("rollout", model, t_end, options, max_output_bytes, n_runs=n)
     report, close = _progress_reporter(progress, n, "rollout", "(done, n_runs)", unit="run")
     try:
         raws, interrupt = _core._rollout(
             model,
-            float(t_end),
+            t_end,
             u0=us,
             v0=vs,
             q_start=q,
             errors=errors,
-            threads=int(threads),
+            threads=min(threads, n),
             progress=report,
             **options,
         )
+        for raw in raws:
+            raw["error"] = _explain_capped(raw["error"], options, requested)
+        results = [_result_of(model, raw) for raw in raws]
         if report is not None and interrupt is None:
-            report(n, n)
+            _final_report(report, n, n, results)
     finally:
         if close is not None:
             close()
-    results = [_result_of(model, raw) for raw in raws]
     if interrupt is not None:
         interrupt.result = results
         raise interrupt
@@ -565,30 +656,39 @@ def _core_options(
     limits,
     restitution,
 ) -> dict:
-    """The run options of :func:`simulate` checked and as ``_core._simulate`` and
-    ``_core._rollout`` take them (keyword arguments)."""
-    if dt is not None and not (dt > 0):
-        raise _core.ModelError(f"{who}: dt must be positive, got {dt}")
-    if max_step is not None and not (max_step > 0):
-        raise _core.ModelError(f"{who}: max_step must be positive, got {max_step}")
-    if output_dt is not None and not (output_dt > 0):
-        raise _core.ModelError(f"{who}: output_dt must be positive, got {output_dt}")
-    if limits not in ("enforce", "ignore"):
-        raise _core.ModelError(f"{who}: limits must be 'enforce' or 'ignore', got {limits!r}")
+    """The run options of :func:`simulate` checked (a ModelError naming the option and what
+    it allows) and as ``_core._simulate`` and ``_core._rollout`` take them (keyword
+    arguments)."""
+    integrator = _checks.choice(who, "integrator", integrator, INTEGRATORS, none=True)
+    rtol = _checks.number(who, "rtol", rtol, lo=0.0, lo_open=True)
+    atol = _checks.number(who, "atol", atol, lo=0.0, lo_open=True)
+    dt = _checks.number(who, "dt", dt, lo=0.0, lo_open=True, none=True)
+    output_dt = _checks.number(who, "output_dt", output_dt, lo=0.0, lo_open=True, none=True)
+    projection = _checks.choice(who, "projection", projection, ("mass", "unweighted"))
+    max_steps = _checks.integer(who, "max_steps", max_steps, lo=1)
+    max_step = _checks.number(who, "max_step", max_step, lo=0.0, lo_open=True, none=True)
+    merge_welded = _checks.flag(who, "merge_welded", merge_welded)
+    coordinates = _checks.choice(who, "coordinates", coordinates, ("cartesian", "joint", "auto"))
+    limits = _checks.choice(who, "limits", limits, ("enforce", "ignore"))
+    restitution = _checks.number(who, "restitution", restitution, lo=0.0, hi=1.0)
     return dict(
         integrator="default" if integrator is None else integrator,
-        rtol=float(rtol),
-        atol=float(atol),
-        dt=float(dt or 0.0),
-        output_dt=float(output_dt or 0.0),
+        rtol=rtol,
+        atol=atol,
+        dt=dt or 0.0,
+        output_dt=output_dt or 0.0,
         projection=projection,
-        max_steps=int(max_steps),
-        max_step=float(max_step or 0.0),
-        merge_welded=bool(merge_welded),
+        max_steps=max_steps,
+        max_step=max_step or 0.0,
+        merge_welded=merge_welded,
         coordinates=coordinates,
         limits=limits == "enforce",
-        restitution=float(restitution),
+        restitution=restitution,
     )
+
+
+#: the integrators simulate takes (None: the default choice)
+INTEGRATORS = ("dopri5", "dop853", "rk4", "trbdf2", "kinematic", "auto")
 
 
 def _result_of(model: _core.Model, raw: dict) -> SimulationResult:
@@ -679,6 +779,14 @@ def _urdf_source(path_or_xml) -> str:
             )
         return text
     if isinstance(path_or_xml, str):
+        try:
+            path_or_xml.encode("utf-8")
+        except UnicodeEncodeError as err:
+            raise _core.UrdfError(
+                f"load_urdf: path_or_xml holds a lone surrogate {path_or_xml[err.start]!r} at "
+                f"index {err.start}: not valid Unicode text (decode bytes with "
+                "errors='strict', or pass the XML as UTF-8 bytes)"
+            ) from None
         return path_or_xml
     if isinstance(path_or_xml, os.PathLike):
         path = os.fspath(path_or_xml)
@@ -733,16 +841,18 @@ def load_urdf(
         UrdfError: missing or irregular file, malformed XML, bad numbers or names, unsupported
             joint type, invalid inertial data (the message names the element and attribute).
         TypeError: ``path_or_xml`` is neither str, bytes nor os.PathLike.
+        ModelError: ``fixed_base``, ``physical_inertia`` or ``mimic`` not a bool, ``gravity``
+            not three finite real numbers (naming the argument).
         ModelError: a joint whose motion carries no inertia (a massless leaf link, a point mass
             on its own joint axis), naming the joint and the body.
     """
     source = _urdf_source(path_or_xml)
     model = _core.urdf_builder(
         source,
-        fixed_base,
-        gravity,
-        physical_inertia=physical_inertia,
-        mimic=mimic,
+        _checks.flag("load_urdf", "fixed_base", fixed_base),
+        _checks.array("load_urdf", "gravity", gravity, ndim=1, finite=True),
+        physical_inertia=_checks.flag("load_urdf", "physical_inertia", physical_inertia),
+        mimic=_checks.flag("load_urdf", "mimic", mimic),
     ).finalize()
     if model.nb == 0:
         warnings.warn(

@@ -24,20 +24,27 @@ form of :func:`armdyn.sizing_report`'s ``actuators=`` (what the model with
     peak_torque = 2.0
 
 The command prints the report's table and, with ``--out``, writes the report there
-(``report.html``, ``table.csv``, figures). Exit code: 0 when every joint is ``ok``, 1 when
-some joint is not, 2 for bad input (a message names the file, column or key).
+(``report.html``, ``table.csv``, figures), and a line for each joint whose positions leave its
+URDF ``<limit>`` (such a joint is not ok either). Exit code: 0 when every joint is ``ok``, 1
+when some joint is not, 2 for bad input (one line names the file, column and data row, or key).
+
+Both files are read as the URDF loader reads its own: a regular file (never a FIFO or a
+device such as ``/dev/zero``) of at most ``MAX_INPUT_BYTES`` (64 MiB), UTF-8. Every value must
+be a finite number, and so must the spline derivatives and the joint torques of the motion
+(a trajectory that overflows them is bad input, named by column and data row).
 """
 
 from __future__ import annotations
 
 import csv
+import io
 import sys
 from pathlib import Path
 
 import numpy as np
 
-from armdyn import _core
-from armdyn.sizing import MOTOR_FIELDS
+from armdyn import _checks, _core
+from armdyn.sizing import MOTOR_FIELDS, _actuator_numbers
 
 ACTUATOR_KEYS = (
     "gear_ratio",
@@ -67,8 +74,7 @@ def read_trajectory(path, model):
     ``model.coord_names`` / ``model.dof_names``. Raises ModelError naming the file and the
     missing, unknown or bad column."""
     path = Path(path)
-    with path.open(newline="", encoding="utf-8") as f:
-        rows = list(csv.reader(f))
+    rows = list(csv.reader(io.StringIO(_text(path, "trajectory"), newline="")))
     if not rows:
         raise _core.ModelError(f"{path}: empty trajectory file")
     header = [h.strip() for h in rows[0]]
@@ -90,16 +96,7 @@ def read_trajectory(path, model):
         raise _core.ModelError(f"{path}: missing column(s) {missing}")
     if len(set(header)) != len(header):
         raise _core.ModelError(f"{path}: repeated column names in {header}")
-    try:
-        data = np.array([[float(x) for x in r] for r in rows[1:] if r], dtype=float)
-    except ValueError as exc:
-        raise _core.ModelError(f"{path}: a value is not a number ({exc})") from exc
-    if data.ndim != 2 or data.shape[0] < 2 or data.shape[1] != len(header):
-        raise _core.ModelError(
-            f"{path}: need at least two rows of {len(header)} values each, got shape {data.shape}"
-        )
-    if not np.all(np.isfinite(data)):
-        raise _core.ModelError(f"{path}: non-finite values")
+    data = _numbers(path, header, [r for r in rows[1:] if r])
     col = {h: data[:, k] for k, h in enumerate(header)}
     t = col["t"]
     if not np.all(np.diff(t) > 0.0):
@@ -113,7 +110,57 @@ def read_trajectory(path, model):
         [col[f"{c}.qdd"] if f"{c}.qdd" in col else _derivative(t, col[c], 2, c) for c in coords],
         axis=1,
     )
+    with np.errstate(all="ignore"):
+        limit = np.nanmax(np.abs(data), axis=0, initial=0.0)
+    for values, suffix in ((qd, ".qd"), (qdd, ".qdd")):
+        bad = np.argwhere(~np.isfinite(values))
+        if len(bad):
+            r, c = bad[0]
+            raise _core.ModelError(
+                f"{path}: column {coords[c] + suffix!r}, data row {r + 1}: the spline derivative "
+                f"of {coords[c]!r} overflows ({values[r, c]}); the positions are too large "
+                f"(largest |{coords[c]}| = {limit[header.index(coords[c])]:.3g})"
+            )
     return t, q, qd, qdd
+
+
+#: the largest trajectory CSV or actuators TOML read [bytes] (the URDF loader's bound)
+MAX_INPUT_BYTES = _core.URDF_MAX_BYTES
+
+
+def _text(path: Path, what: str) -> str:
+    """The UTF-8 text of an input file, read through the URDF loader's rules (a regular file of
+    at most MAX_INPUT_BYTES: never a FIFO or a device)."""
+    data = _checks.regular_file(path, f"{what} file", MAX_INPUT_BYTES)
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as err:
+        raise _core.ModelError(f"{path}: not UTF-8 text (byte offset {err.start})") from None
+
+
+def _numbers(path: Path, header: list[str], rows: list[list[str]]) -> np.ndarray:
+    """The data rows as floats, or a ModelError naming the column and the data row (1 = the
+    first after the header) of a value that is not a finite number, or a short row."""
+    if len(rows) < 2:
+        raise _core.ModelError(f"{path}: need at least two data rows, got {len(rows)}")
+    data = np.empty((len(rows), len(header)))
+    for i, row in enumerate(rows):
+        if len(row) != len(header):
+            raise _core.ModelError(
+                f"{path}: data row {i + 1} has {len(row)} values, the header {len(header)}"
+            )
+        for k, text in enumerate(row):
+            try:
+                x = float(text)
+            except ValueError:
+                x = None
+            if x is None or not np.isfinite(x):
+                raise _core.ModelError(
+                    f"{path}: column {header[k]!r}, data row {i + 1}: {text.strip()!r} is not "
+                    "a finite number"
+                )
+            data[i, k] = x
+    return data
 
 
 def read_actuators(path) -> dict[str, dict]:
@@ -130,8 +177,7 @@ def read_actuators(path) -> dict[str, dict]:
             ) from exc
     path = Path(path)
     try:
-        with path.open("rb") as f:
-            doc = tomllib.load(f)
+        doc = tomllib.loads(_text(path, "actuators"))
     except tomllib.TOMLDecodeError as exc:
         raise _core.ModelError(f"{path}: not valid TOML ({exc})") from exc
     out = {}
@@ -156,6 +202,10 @@ def read_actuators(path) -> dict[str, dict]:
                 raise _core.ModelError(
                     f"{path}: [{joint}.motor] unknown key(s) {bad}; allowed {MOTOR_KEYS}"
                 )
+            for key, value in motor.items():
+                check = _checks.text if key == "name" else _checks.number
+                check(f"{path}: [{joint}.motor]", key, value)
+        _actuator_numbers(f"{path}: [{joint}]", spec.get)
         spec["motor"] = motor
         out[str(joint)] = spec
     return out
@@ -166,24 +216,53 @@ def run(urdf, trajectory, actuators=None, out=None, echo=print) -> int:
     import pandas as pd
 
     from armdyn.simulation import load_urdf
-    from armdyn.sizing import sizing_report, trajectory_run
+    from armdyn.sizing import limit_violations, sizing_report, trajectory_run
 
     spec = read_actuators(actuators) if actuators else None
     model = load_urdf(urdf)
     t, q, qd, qdd = read_trajectory(trajectory, model)
-    report = sizing_report(trajectory_run(model, t, q, qd, qdd), model, out=out, actuators=spec)
+    try:
+        run_ = trajectory_run(model, t, q, qd, qdd)
+    except _core.SolverError as exc:
+        raise _core.ModelError(f"{trajectory}: {_culprit(str(exc), model)}") from None
+    report = sizing_report(run_, model, out=out, actuators=spec)
     with pd.option_context("display.max_columns", None, "display.width", 200):
         echo(report.table.to_string(float_format=lambda v: f"{v:.4g}"))
     bad = [str(j) for j, ok in report.table["ok"].items() if not ok]
+    # positions beyond the joints' limits (the table's "ok" covers speed and torque)
+    for row in limit_violations(model, run_).itertuples():
+        if row.kind == "position":
+            echo(
+                f"{row.joint}: position {row.worst:.6g} beyond its limit {row.limit:.6g} "
+                f"(t = {row.t_start:.6g} to {row.t_end:.6g} s)"
+            )
+            if row.joint not in bad:
+                bad.append(str(row.joint))
     if out is not None:
         echo(f"report written to {Path(out).resolve() / 'report.html'}")
     echo("all joints ok" if not bad else f"not ok: {', '.join(bad)}")
     return 0 if not bad else 1
 
 
+def _culprit(message: str, model) -> str:
+    """The inverse dynamics' overflow message with its row and input entry (``row 3: ... the
+    largest input is qd[0]``) named as the CSV's data row and column."""
+    import re
+
+    m = re.search(r"row (\d+): .*the largest input is (q|qd|qdd)\[(\d+)\] = (\S+)", message)
+    if not m:
+        return message
+    row, arg, k, value = int(m[1]), m[2], int(m[3]), m[4]
+    column = model.coord_names[k] + ("" if arg == "q" else f".{arg}")
+    return (
+        f"column {column!r}, data row {row + 1}: {value} overflows the inverse dynamics "
+        "(the joint torques are not finite); the trajectory's values are too large"
+    )
+
+
 def main(args) -> int:
     try:
         return run(args.urdf, args.trajectory, args.actuators, args.out)
-    except (_core.ModelError, _core.UrdfError, OSError) as exc:
+    except (_core.ModelError, _core.UrdfError, _core.SolverError, OSError) as exc:
         print(f"armdyn size: {exc}", file=sys.stderr)
         return 2

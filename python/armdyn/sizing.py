@@ -224,8 +224,13 @@ def trajectory_run(
         ModelError: shapes that do not match the model, non-increasing times, or a model the
             joint-space inverse dynamics does not cover.
     """
-    t = np.atleast_1d(np.asarray(t, dtype=float))
-    q, qd, qdd = (np.atleast_2d(np.asarray(x, dtype=float)) for x in (q, qd, qdd))
+    from armdyn import _checks
+
+    t = np.atleast_1d(_checks.array("trajectory_run", "t", t, finite=True))
+    q, qd, qdd = (
+        np.atleast_2d(_checks.array("trajectory_run", name, x, finite=True))
+        for name, x in (("q", q), ("qd", qd), ("qdd", qdd))
+    )
     nq, nv = len(model.coord_names), len(model.dof_names)
     if t.ndim != 1 or q.shape != (len(t), nq) or qd.shape != (len(t), nv) or qdd.shape != qd.shape:
         raise _core.ModelError(
@@ -501,17 +506,38 @@ def what_if_actuators(model, names, actuators) -> list:
                 joint=joint,
                 rotor_joint=None,
                 dof=dofs.index(joint),
-                gear_ratio=float(get("gear_ratio")),
-                rotor_inertia=float(get("rotor_inertia")),
-                efficiency=float(get("efficiency", 1.0)),
-                friction_viscous=float(get("friction_viscous", 0.0)),
-                friction_coulomb=float(get("friction_coulomb", 0.0)),
-                friction_smoothing=get("friction_smoothing"),
+                **_actuator_numbers(f"actuators: [{joint}]", get),
                 motor=motor,
                 gyroscopic=False,
             )
         )
     return out
+
+
+def _actuator_numbers(who: str, get) -> dict:
+    """The numeric actuator keys of a what-if spec, checked by the rules of
+    ``ModelBuilder.add_actuator`` (a ModelError naming the key and what it allows)."""
+    from armdyn import _checks
+
+    gear_ratio = _checks.number(who, "gear_ratio", get("gear_ratio"))
+    if gear_ratio == 0.0:
+        raise _core.ModelError(f"{who}: gear_ratio must be a finite nonzero number, got 0")
+    return dict(
+        gear_ratio=gear_ratio,
+        rotor_inertia=_checks.number(who, "rotor_inertia", get("rotor_inertia"), lo=0.0),
+        efficiency=_checks.number(
+            who, "efficiency", get("efficiency", 1.0), lo=0.0, lo_open=True, hi=1.0
+        ),
+        friction_viscous=_checks.number(
+            who, "friction_viscous", get("friction_viscous", 0.0), lo=0.0
+        ),
+        friction_coulomb=_checks.number(
+            who, "friction_coulomb", get("friction_coulomb", 0.0), lo=0.0
+        ),
+        friction_smoothing=_checks.number(
+            who, "friction_smoothing", get("friction_smoothing"), none=True
+        ),
+    )
 
 
 @dataclass
@@ -695,6 +721,11 @@ def sizing_report(
     from armdyn.actuators import actuated_column, motor_side
 
     model = _model_of(result, model, "sizing_report")
+    if out is not None and not isinstance(out, (str, os.PathLike)):
+        raise _core.ModelError(
+            f"sizing_report: out must be a folder path (str or os.PathLike) or None, got "
+            f"{type(out).__name__}"
+        )
     t, names, qd, tau = _checked(model, result, "sizing_report")
     if len(t) < 2 or not (t[-1] > t[0]):
         raise _core.ModelError(
@@ -939,7 +970,10 @@ def gear_ratio_sweep(
                 np.max(m_diag[:, dofs.index(joint), dofs.index(joint)]) if joint in dofs else None
             )
         grid = ratios.get(joint) if isinstance(ratios, dict) else ratios
-        for n in np.atleast_1d(np.asarray(grid, dtype=float)):
+        from armdyn import _checks
+
+        name = f"ratios[{joint!r}]" if isinstance(ratios, dict) else "ratios"
+        for n in np.atleast_1d(_checks.array("gear_ratio_sweep", name, grid, finite=True)):
             act.gear_ratio = float(n)
             tau_n = tau_load + n * rotor_torque(act, qd[:, k], qdd[:, k])
             side = motor_side(act, t, qd[:, k], qdd[:, k], tau_n, joint=joint)

@@ -68,8 +68,15 @@ class LagrangeValidator:
 
     def __init__(self, model: _core.Model, rotational_inertia: bool = True) -> None:
         """Derive the equations of ``model`` (ModelError if it is not such a tree)."""
+        from armdyn import _checks
+
+        if not isinstance(model, _core.Model):
+            raise _core.ModelError(
+                f"LagrangeValidator: model must be an armdyn.Model, got {type(model).__name__}"
+            )
+        inertia = _checks.flag("LagrangeValidator", "rotational_inertia", rotational_inertia)
         self.model = model
-        self._v = _core.LagrangeValidator(model, rotational_inertia)
+        self._v = _core.LagrangeValidator(model, inertia)
 
     def torques(
         self,

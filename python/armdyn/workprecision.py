@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import numpy.typing as npt
 
-from armdyn import _core
+from armdyn import _checks, _core
 from armdyn.simulation import simulate
 
 if TYPE_CHECKING:
@@ -72,6 +72,10 @@ _COUNTERS = (
     "factorizations",
     "singular_evaluations",
 )
+
+
+#: the most repeats of a work_precision point (each one a full run)
+MAX_REPEATS = 1000
 
 
 def _bad(msg: str) -> _core.ModelError:
@@ -305,7 +309,7 @@ def work_precision(
             (k,) mask; default: the model's angular joint coordinates (none with ``observe``).
         error_measure: the error's description (default: the joint-coordinate error).
         repeats: CPU time of each point: 1 (default) one run; more: one warm-up run, then the
-            median of ``repeats`` runs.
+            median of ``repeats`` runs (at most ``MAX_REPEATS``, 1000).
         max_steps: step limit of each run: a run that needs more is a failed row.
         limits: :func:`armdyn.simulate`'s ``limits`` for every run (``"ignore"`` to compare with
             a reference that knows no joint stops).
@@ -336,20 +340,15 @@ def work_precision(
 
     if not isinstance(model, _core.Model):
         raise _bad(f"model must be an armdyn.Model, got {type(model).__name__}")
-    try:
-        t_end = float(t_end)
-    except (TypeError, ValueError) as exc:
-        raise _bad(f"t_end must be a number, got {t_end!r}") from exc
-    if not (np.isfinite(t_end) and t_end > 0):
-        raise _bad(f"t_end must be positive and finite, got {t_end}")
-    if isinstance(n_out, bool) or not isinstance(n_out, (int, np.integer)) or n_out < 1:
-        raise _bad(f"n_out must be a positive integer, got {n_out!r}")
-    if not (np.isfinite(atol_factor) and atol_factor > 0):
-        raise _bad(f"atol_factor must be positive and finite, got {atol_factor}")
-    if isinstance(repeats, bool) or not isinstance(repeats, (int, np.integer)) or repeats < 1:
-        raise _bad(f"repeats must be a positive integer, got {repeats!r}")
-    if coordinates not in ("cartesian", "joint"):
-        raise _bad(f"coordinates must be 'cartesian' or 'joint', got {coordinates!r}")
+    who = "work_precision"
+    t_end = _checks.number(who, "t_end", t_end, lo=0.0, lo_open=True)
+    n_out = _checks.integer(who, "n_out", n_out, lo=1)
+    atol_factor = _checks.number(who, "atol_factor", atol_factor, lo=0.0, lo_open=True)
+    repeats = _checks.integer(who, "repeats", repeats, lo=1, hi=MAX_REPEATS)
+    # the tight reference runs take 10 max_steps: keep that an int64
+    max_steps = _checks.integer(who, "max_steps", max_steps, lo=1, hi=_checks.INT_MAX // 10)
+    coordinates = _checks.choice(who, "coordinates", coordinates, ("cartesian", "joint"))
+    limits = _checks.choice(who, "limits", limits, ("enforce", "ignore"))
     joint_reason = model.joint_path_reason
     if coordinates == "joint" and joint_reason:
         raise _bad(f"coordinates='joint' does not apply to this model: {joint_reason}")

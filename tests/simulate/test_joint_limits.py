@@ -212,7 +212,7 @@ def test_limits_bad_input_is_refused_and_driven_joints_have_no_stop():
         ad.simulate(model, 1.0, q0=[0.3], qd0=[0.0])
     with pytest.raises(ad.ModelError, match="limits must be 'enforce' or 'ignore'"):
         ad.simulate(model, 1.0, limits="on")
-    with pytest.raises(ad.ModelError, match="restitution must lie in"):
+    with pytest.raises(ad.ModelError, match="restitution must be a number in \\[0, 1\\]"):
         ad.simulate(model, 1.0, restitution=1.5)
     # a run outside the limits is fine when they are ignored
     r = ad.simulate(model, 0.1, q0=[0.3], qd0=[0.0], limits="ignore")

@@ -141,7 +141,7 @@ def test_stress_many_threads_on_a_fresh_model():
         (dict(qd0=np.zeros((2, 6))), "qd0 given without q0"),
         (dict(), "give the initial states"),
         (dict(q0=np.zeros((2, 6)), threads=0), "threads must be a positive integer"),
-        (dict(q0=np.zeros((2, 6)), t_end=-1.0), "t_end must be positive"),
+        (dict(q0=np.zeros((2, 6)), t_end=-1.0), "t_end must be a positive number"),
         (dict(q0=np.zeros((2, 6)), integrator="euler"), "euler"),
         (dict(q0=np.zeros((2, 6)), limits="off"), "limits must be"),
     ],

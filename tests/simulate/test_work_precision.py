@@ -296,9 +296,9 @@ def test_a_diverging_run_is_a_row():
 @pytest.mark.parametrize(
     ("kwargs", "match"),
     [
-        ({"t_end": 0.0}, "t_end must be positive"),
-        ({"t_end": -1.0}, "t_end must be positive"),
-        ({"t_end": float("nan")}, "t_end must be positive"),
+        ({"t_end": 0.0}, "t_end must be a positive number"),
+        ({"t_end": -1.0}, "t_end must be a positive number"),
+        ({"t_end": float("nan")}, "t_end must be a positive number"),
         ({"integrators": ["euler"]}, "unknown integrator 'euler'"),
         ({"integrators": ["auto"]}, "unknown integrator 'auto'"),
         ({"integrators": ["dopri5", "dopri5"]}, "duplicates"),
