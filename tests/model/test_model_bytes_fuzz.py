@@ -4,7 +4,8 @@ extensions, swapped segments, other format versions) of three models that togeth
 field of the format, each loaded in a child interpreter with a memory limit and a timeout. Each
 either raises ModelError or loads as a model that works (forward dynamics, a short simulation,
 a pickle round trip giving the same bytes); no signal, no timeout, no other exception. Fixed
-seeds; 2,000 mutants per model, 6,000 in all, in parts of at most 1,000. Also the named errors of a few hand-made bad states."""
+seeds; 2,000 mutants per model, 6,000 in all, in parts of at most 1,000. Also the named
+errors of a few hand-made bad states."""
 
 from __future__ import annotations
 
