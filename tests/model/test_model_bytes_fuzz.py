@@ -95,3 +95,22 @@ def test_a_builder_draft_is_checked_too():
         ad.ModelBuilder.__new__(ad.ModelBuilder).__setstate__((bad, physical))
     with pytest.raises(ad.ModelError, match=r"not bytes and a bool"):
         ad.ModelBuilder.__new__(ad.ModelBuilder).__setstate__((data, 1))
+
+
+@pytest.mark.parametrize(
+    ("state", "match"),
+    [
+        ((1, 4, (0.0, 0.0, 0.0, 0.0), [0.0, 0.0], [1.0, 2.0], [], ""), "must increase strictly"),
+        ((1, 0, (float("nan"), 0.0, 0.0, 0.0), [], [], [], ""), "must be finite"),
+        ((1, 1, (0.0, 1.0, 1.0, 0.0), [], [], [], ""), "need t1 > t0"),
+        ((1, 0, (1.0, 2.0, 0.0, 0.0), [], [], [], ""), "stored parameter 1"),
+        ((1, "x", (0, 0, 0, 0), [], [], [], ""), "unknown pickled state"),
+    ],
+)
+def test_a_pickled_profile_is_made_again_by_its_factory(state, match):
+    """A Profile's pickled state goes through the factory's checks (as the profiles inside the
+    model bytes do): a spline whose samples do not increase, a NaN constant, a cubic ending
+    before it starts, a parameter the factory would not have stored, a kind that is not a
+    number."""
+    with pytest.raises(ad.ModelError, match=match):
+        ad.Profile.__new__(ad.Profile).__setstate__(state)
