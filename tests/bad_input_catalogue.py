@@ -76,6 +76,23 @@ def _nan_force_run():
     ad.simulate(b.finalize(), 1.0, integrator="rk4", dt=0.01)
 
 
+def _state_of(model):
+    return bytes(model.__getstate__()[0])
+
+
+def _load_state(data):
+    ad.Model.__new__(ad.Model).__setstate__((data,))
+
+
+def _with_body_count(data, n):
+    at = 13 + 24  # after the header (tag, format version, kind) and gravity
+    return data[:at] + int(n).to_bytes(8, "little", signed=True) + data[at + 8 :]
+
+
+def _with_format(data, version):
+    return data[:8] + int(version).to_bytes(4, "little") + data[12:]
+
+
 ME, UE, SE = ad.ModelError, ad.UrdfError, ad.SolverError
 
 CASES = [
@@ -328,6 +345,31 @@ CASES = [
         )(_b()),
         ME,
         "assembl",
+    ),
+    # ---- model bytes (pickles)
+    (
+        "bytes-truncated",
+        "pickle",
+        "a model's pickled state cut short by one byte",
+        lambda: _load_state(_state_of(_hinged().finalize())[:-1]),
+        ME,
+        r"model data: .*truncated",
+    ),
+    (
+        "bytes-count",
+        "pickle",
+        "a model's pickled state with its body count set to 2**62",
+        lambda: _load_state(_with_body_count(_state_of(_hinged().finalize()), 2**62)),
+        ME,
+        r"model data: bodies: count 4611686018427387904 exceeds",
+    ),
+    (
+        "bytes-version",
+        "pickle",
+        "a model's pickled state of another format version",
+        lambda: _load_state(_with_format(_state_of(_hinged().finalize()), 1)),
+        ME,
+        r"format version 1",
     ),
     # ---- URDF
     (

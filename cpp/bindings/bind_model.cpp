@@ -320,21 +320,25 @@ void bind_model(py::module_& m) {
                                   r.description);
           },
           [](const py::tuple& st) {
-            if (st.size() != 7 || st[0].cast<int>() != 1)
-              throw ModelError("Profile: unknown pickled state (another armdyn version?)");
+            const char* unknown = "Profile: unknown pickled state (another armdyn version?)";
+            if (st.size() != 7 || !py::isinstance<py::int_>(st[0]) || st[0].cast<int>() != 1)
+              throw ModelError(unknown);
             Profile::Raw r;
-            const int kind = st[1].cast<int>();
-            if (kind < 0 || kind >= static_cast<int>(Profile::Kind::Callback))
-              throw ModelError(msg("Profile: unknown pickled kind ", kind));
-            r.kind = static_cast<Profile::Kind>(kind);
-            const auto p = st[2].cast<py::tuple>();
-            if (p.size() != 4) throw ModelError("Profile: pickled parameters are not 4 numbers");
-            for (int i = 0; i < 4; ++i) r.p[i] = p[i].cast<double>();
-            r.t = st[3].cast<std::vector<double>>();
-            r.y = st[4].cast<std::vector<double>>();
-            r.m = st[5].cast<std::vector<double>>();
-            r.description = st[6].cast<std::string>();
-            return Profile::restore(r);
+            try {
+              const long long kind = st[1].cast<long long>();
+              if (kind < 0 || kind >= static_cast<long long>(Profile::Kind::Callback))
+                throw ModelError(msg("Profile: unknown pickled kind ", kind));
+              r.kind = static_cast<Profile::Kind>(kind);
+              const auto p = st[2].cast<py::tuple>();
+              if (p.size() != 4) throw ModelError("Profile: pickled parameters are not 4 numbers");
+              for (int i = 0; i < 4; ++i) r.p[i] = p[i].cast<double>();
+              r.t = st[3].cast<std::vector<double>>();
+              r.y = st[4].cast<std::vector<double>>();
+              r.description = st[6].cast<std::string>();
+            } catch (const py::cast_error&) {
+              throw ModelError(unknown);
+            }
+            return Profile::restore(r);  // the factory's checks (pickled second derivatives unread)
           }));
 
   auto prof = m.def_submodule("profiles", "Built-in drive and load profiles (evaluated in C++).");
@@ -699,7 +703,8 @@ void bind_model(py::module_& m) {
       .def(
           py::pickle([](const Model& md) { return py::make_tuple(py::bytes(serialize_model(md))); },
                      [](const py::tuple& st) {
-                       if (st.size() != 1) throw ModelError("Model: unknown pickled state");
+                       if (st.size() != 1 || !py::isinstance<py::bytes>(st[0]))
+                         throw ModelError("Model: unknown pickled state (not one bytes object)");
                        return std::make_shared<Model>(deserialize_model(st[0].cast<std::string>()));
                      }));
 
@@ -716,11 +721,13 @@ void bind_model(py::module_& m) {
            "property of that name. ModelError if gravity is not 3 finite numbers.")
       .def(py::pickle(
           [](const ModelBuilder& b) {
-            return py::make_tuple(py::bytes(serialize_model(b.draft())), b.physical_inertia());
+            return py::make_tuple(py::bytes(serialize_draft(b.draft())), b.physical_inertia());
           },
           [](const py::tuple& st) {
-            if (st.size() != 2) throw ModelError("ModelBuilder: unknown pickled state");
-            return ModelBuilder(deserialize_model(st[0].cast<std::string>()), st[1].cast<bool>());
+            if (st.size() != 2 || !py::isinstance<py::bytes>(st[0]) ||
+                !py::isinstance<py::bool_>(st[1]))
+              throw ModelError("ModelBuilder: unknown pickled state (not bytes and a bool)");
+            return ModelBuilder(deserialize_draft(st[0].cast<std::string>()), st[1].cast<bool>());
           }))
       .def_property("physical_inertia", &ModelBuilder::physical_inertia,
                     &ModelBuilder::set_physical_inertia,

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "armdyn/errors.hpp"
 
@@ -118,18 +119,36 @@ Profile::Raw Profile::raw() const {
 }
 
 Profile Profile::restore(const Raw& raw) {
-  if (raw.kind == Kind::Callback)
-    throw ModelError("profile: a callback profile cannot be restored from stored values");
-  if (raw.kind == Kind::Spline &&
-      (raw.t.size() < 2 || raw.y.size() != raw.t.size() || raw.m.size() != raw.t.size()))
-    throw ModelError("profile: stored spline samples are inconsistent");
+  // through the factories, which check every value; the spline's second derivatives are
+  // computed again from its samples (raw.m is not read)
   Profile p;
-  p.kind_ = raw.kind;
-  for (int i = 0; i < 4; ++i) p.p_[i] = raw.p[i];
-  p.t_ = raw.t;
-  p.y_ = raw.y;
-  p.m_ = raw.m;
-  p.description_ = raw.description;
+  switch (raw.kind) {
+    case Kind::Constant:
+      p = constant(raw.p[0]);
+      break;
+    case Kind::Cubic:
+      p = cubic(raw.p[0], raw.p[1], raw.p[2], raw.p[3]);
+      break;
+    case Kind::Quintic:
+      p = quintic(raw.p[0], raw.p[1], raw.p[2], raw.p[3]);
+      break;
+    case Kind::Sine:
+      p = sine(raw.p[0], raw.p[1], raw.p[2], raw.p[3]);
+      break;
+    case Kind::Spline:
+      p = spline(raw.t, raw.y);
+      break;
+    default:
+      throw ModelError("profile: a callback profile cannot be restored from stored values");
+  }
+  // the values a factory does not take must be its own (zeros, no samples, no description)
+  for (int i = 0; i < 4; ++i)
+    if (std::memcmp(&p.p_[i], &raw.p[i], sizeof(double)) != 0)
+      throw ModelError(msg("profile: stored parameter ", i, " (", raw.p[i], ") is not the ",
+                           p.describe(), "'s"));
+  if ((raw.kind != Kind::Spline && (!raw.t.empty() || !raw.y.empty())) || !raw.description.empty())
+    throw ModelError(
+        msg("profile: stored samples or description do not belong to a ", p.describe()));
   return p;
 }
 

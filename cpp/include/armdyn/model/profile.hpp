@@ -48,7 +48,10 @@ class Profile {
   };
   /// @throws ModelError for a callback profile (a user function cannot be stored).
   Raw raw() const;
-  /// @throws ModelError for a callback kind or inconsistent spline samples.
+  /// The profile made again by its factory (constant(), cubic(), ..., spline()), which checks
+  /// every value; the spline's second derivatives are recomputed (raw.m is not read).
+  /// @throws ModelError for a callback kind, a value the factory refuses (non-finite, t1 <= t0,
+  /// samples not increasing) or stored values the factory would not have made.
   static Profile restore(const Raw& raw);
 
  private:
