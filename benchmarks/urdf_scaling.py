@@ -10,11 +10,11 @@ temporary file and, in a fresh child process (so that each peak is its own):
 - ``builder.finalize()``: topology, assembly, rank analysis and the model checks (``finalize``);
 
 each as wall-clock and CPU seconds (``time.perf_counter`` and ``time.process_time``; on a shared
-machine the CPU time is the steadier figure), and the child's peak resident memory
-(``resource.getrusage(RUSAGE_SELF).ru_maxrss`` after the load) minus its peak after
-``import armdyn`` (``peak MiB``). The table is printed and written to
-``benchmarks/results/urdf_scaling.json``, with the ratios of the largest to the smallest size
-(linear: equal to the ratio of the sizes; quadratic: its square).
+machine the CPU time is the steadier figure), and the peak resident memory of the two beyond
+the memory before them (``peak MiB``: Linux's ``VmHWM`` of ``/proc/self/status``, reset to
+``VmRSS`` after ``import armdyn`` by writing 5 to ``/proc/self/clear_refs``). The table is
+printed and written to ``benchmarks/results/urdf_scaling.json``, with the ratios of the largest
+to the smallest size (linear: equal to the ratio of the sizes; quadratic: its square).
 
 The armdyn measured is the one ``import armdyn`` finds: the installed package, or a build
 given on ``PYTHONPATH``.
@@ -61,19 +61,25 @@ def chain_urdf(n: int, length: float = LENGTH, mass: float = MASS) -> str:
 
 # the child: one load and one finalize, its own peak memory
 CHILD = r"""
-import json, resource, sys, time
+import json, sys, time
 import armdyn
 from armdyn import _core
-base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+def status(key):  # kB
+    for line in open("/proc/self/status"):
+        if line.startswith(key + ":"):
+            return int(line.split()[1])
+with open("/proc/self/clear_refs", "w") as f:  # resets VmHWM, the peak, to VmRSS
+    f.write("5")
+before = status("VmRSS")
 w0, c0 = time.perf_counter(), time.process_time()
 b = _core.urdf_builder(sys.argv[1], True, (0.0, 0.0, -9.81), physical_inertia=True, mimic=True)
 w1, c1 = time.perf_counter(), time.process_time()
 m = b.finalize()
 w2, c2 = time.perf_counter(), time.process_time()
-peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+peak = status("VmHWM")
 assert m.n_coords == int(sys.argv[2]), m.n_coords
 print(json.dumps({"load_s": w1 - w0, "load_cpu_s": c1 - c0, "finalize_s": w2 - w1,
-                  "finalize_cpu_s": c2 - c1, "peak_mib": (peak - base) / 1024.0,
+                  "finalize_cpu_s": c2 - c1, "peak_mib": (peak - before) / 1024.0,
                   "armdyn": armdyn.__file__}))
 """
 
