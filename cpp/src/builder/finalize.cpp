@@ -193,7 +193,8 @@ void refuse_scale(const std::string& who, const std::string& what, double value,
 }
 
 // Every body's mass, inertia and position, and every joint point (at the build pose, with the
-// masses of the bodies it joins), within kMaxScale; names the first element beyond it.
+// larger mass of the bodies it joins), within kMaxScale, and a positive mass or inertia trace
+// at least kMinScale; names the first element out of bounds and the quantity.
 void check_model_scales(const Model& m) {
   auto mass_of = [&](int b) { return b == kGround ? 0.0 : m.bodies[b].mass; };
   for (const Body& b : m.bodies) {
