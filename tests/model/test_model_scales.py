@@ -19,12 +19,13 @@ def _hinge(point=(0.0, 0.0, 0.0), position=(0.5, 0.0, 0.0), mass=1.0, inertia=I3
     return b
 
 
-def _urdf(mass: str) -> str:
+def _urdf(mass: str = "1", com: str = "0.5 0 0", joint: str = "0 0 0") -> str:
     return f"""<robot name="r"><link name="base"/>
-<link name="arm"><inertial><origin xyz="0.5 0 0"/><mass value="{mass}"/>
+<link name="arm"><inertial><origin xyz="{com}"/><mass value="{mass}"/>
 <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
 <joint name="shoulder" type="revolute"><parent link="base"/><child link="arm"/>
-<axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>"""
+<origin xyz="{joint}"/><axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/>
+</joint></robot>"""
 
 
 def test_a_joint_point_of_1e100_is_refused_naming_the_joint():
@@ -35,6 +36,15 @@ def test_a_joint_point_of_1e100_is_refused_naming_the_joint():
         match=r"joint 'shoulder': squared distance of its point .* = 1e\+200 m\^2.*exceeds 1e\+150",
     ):
         b.finalize()
+
+
+def test_urdf_origins_of_1e100_and_1e300_are_refused_naming_the_link():
+    # the joint's origin places the link (its body) 1e100 m out; an inertial origin of 1e300 m
+    # places its centre of mass there
+    with pytest.raises(ad.ModelError, match=r"body 'arm': squared distance .* = 1e\+200 m\^2"):
+        ad.load_urdf(_urdf(joint="1e100 0 0"))
+    with pytest.raises(ad.ModelError, match=r"body 'arm': squared distance .* = inf m\^2"):
+        ad.load_urdf(_urdf(com="1e300 0 0"))
 
 
 def test_a_body_at_1e300_is_refused_naming_the_body():
@@ -49,7 +59,7 @@ def test_a_mass_of_1e300_is_refused_naming_the_body():
     with pytest.raises(ad.ModelError, match=r"body 'arm'.*mass = 1e\+300 kg"):
         _hinge(mass=1e300).finalize()
     with pytest.raises(ad.ModelError, match=r"body 'arm'.*mass = 1e\+300 kg.*exceeds 1e\+150"):
-        ad.load_urdf(_urdf("1e300"))
+        ad.load_urdf(_urdf(mass="1e300"))
     with pytest.raises(ad.ModelError, match=r"body 'arm'.*trace of the inertia"):
         _hinge(inertia=np.eye(3) * 1e200).finalize()
 
