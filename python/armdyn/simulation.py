@@ -734,7 +734,8 @@ def load_urdf(
             joint type, invalid inertial data (the message names the element and attribute).
         TypeError: ``path_or_xml`` is neither str, bytes nor os.PathLike.
         ModelError: a joint whose motion carries no inertia (a massless leaf link, a point mass
-            on its own joint axis), naming the joint and the body.
+            on its own joint axis), naming the joint and the body; a mass, inertia or distance
+            beyond finalize()'s scale bounds (docs/api.md), naming the body or joint.
     """
     source = _urdf_source(path_or_xml)
     model = _core.urdf_builder(
