@@ -39,6 +39,13 @@ def _massless_leaf():
     return b.finalize()
 
 
+def _hinged_with(mass=1.0, position=(0.0, 0.0, -0.5), point=(0.0, 0.0, 0.0)):
+    b = ad.ModelBuilder()
+    b.add_body("link", mass, I3, position=position)
+    b.add_revolute("hinge", "ground", "link", point, (0, 1, 0))
+    return b.finalize()
+
+
 def _pendulum():
     return _hinged().finalize()
 
@@ -107,6 +114,38 @@ CASES = [
         "hinge.*heavy",
     ),
     ("mass-nan", "body", "mass NaN", lambda: _b().add_body("heavy", np.nan, I3), ME, "heavy"),
+    (
+        "mass-overflow",
+        "model",
+        "mass 1e300 (finalize: the dynamics' products overflow)",
+        lambda: _hinged_with(mass=1e300),
+        ME,
+        "body 'link': mass = 1e\\+300",
+    ),
+    (
+        "mass-underflow",
+        "model",
+        "mass 1e-300 (finalize: its reciprocal's products overflow; massless is mass 0)",
+        lambda: _hinged_with(mass=1e-300),
+        ME,
+        "body 'link': mass = 1e-300",
+    ),
+    (
+        "position-overflow",
+        "model",
+        "a body at 1e300 m (finalize)",
+        lambda: _hinged_with(position=(1e300, 0.0, 0.0)),
+        ME,
+        "body 'link': squared distance",
+    ),
+    (
+        "joint-point-overflow",
+        "model",
+        "a joint point at 1e100 m (finalize)",
+        lambda: _hinged_with(point=(1e100, 0.0, 0.0)),
+        ME,
+        "joint 'hinge': squared distance",
+    ),
     (
         "inertia-nonsym",
         "body",
@@ -372,6 +411,20 @@ CASES = [
         r"format version 1",
     ),
     # ---- URDF
+    (
+        "urdf-mass-overflow",
+        "urdf",
+        "a link mass of 1e300 (finalize)",
+        lambda: ad.load_urdf(
+            _urdf(
+                "<joint name='j' type='continuous'><parent link='base'/><child link='arm'/>"
+                "<axis xyz='0 1 0'/></joint>",
+                URDF_LINKS.replace('<mass value="1"/>', '<mass value="1e300"/>'),
+            )
+        ),
+        ME,
+        "body 'arm': mass = 1e\\+300",
+    ),
     (
         "urdf-unterminated",
         "urdf",

@@ -1051,7 +1051,7 @@ void bind_model(py::module_& m) {
           [cast_model](const ModelBuilder& b, bool mass_weighted) {
             FinalizeOptions o;
             o.mass_weighted_assembly = mass_weighted;
-            // Ctrl-C: the quadratic parts of a large model's analysis check for signals
+            // Ctrl-C: the long parts of a large model's analysis check for signals
             Poll poll = python_poll();
             ScopedThreadPoll scope(&poll);
             ModelPtr m = b.finalize(o);
@@ -1098,6 +1098,9 @@ void bind_model(py::module_& m) {
       [](const std::string& src, bool fixed_base, const ArrayLike& g, bool physical_inertia,
          bool mimic) {
         const Vec3 gravity = to_vec3(g, "gravity");
+        // Ctrl-C: the loader's loops over the links and joints check for signals
+        Poll poll = python_poll();
+        ScopedThreadPoll scope(&poll);
         try {
           return urdf_builder(src, fixed_base, gravity, physical_inertia, mimic);
         } catch (const UrdfError& e) {

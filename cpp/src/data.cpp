@@ -24,13 +24,17 @@ Data::Data(const Model& m)
   kin.resize(m.nb);
   ce.init(m);
   light = &light_bodies(m);
+  // each joint's row block: the first block starting at its first row (linear: by row)
   joint_block.assign(m.joints.size(), -1);
-  for (size_t j = 0; j < m.joints.size(); ++j)
-    for (size_t b = 0; b < ce.blocks.size(); ++b)
-      if (joint_rows(m.joints[j].type) > 0 && ce.blocks[b].row0 == m.joints[j].row0) {
-        joint_block[j] = static_cast<int>(b);
-        break;
-      }
+  std::vector<int> block_at(static_cast<size_t>(m.nc) + 1, -1);
+  for (size_t b = ce.blocks.size(); b-- > 0;) {
+    const int r = ce.blocks[b].row0;
+    if (r >= 0 && r <= m.nc) block_at[r] = static_cast<int>(b);
+  }
+  for (size_t j = 0; j < m.joints.size(); ++j) {
+    const int r = m.joints[j].row0;
+    if (joint_rows(m.joints[j].type) > 0 && r >= 0 && r <= m.nc) joint_block[j] = block_at[r];
+  }
   jets.init(m);
   ce.coord_cache = &jets;
   ce.track_ref = &track_ref;
@@ -52,11 +56,12 @@ Data::Data(const Model& m)
   for (auto* x : {&aba.U, &aba.c}) x->assign(n, Vec6::Zero());
   aba.Dinv.assign(n, 0.0);
   aba.u.assign(n, 0.0);
-  M = MatX::Zero(n, n);
+  // M and L (n x n, dense) are allocated by their first use (ensure_mass_matrix,
+  // algorithm/crba.hpp): a Data of a long chain stays linear in its size for the Cartesian, ABA and
+  // Newton-Euler paths
   rhs = VecX::Zero(n);
   qdd = VecX::Zero(n);
   zero = VecX::Zero(n);
-  L = MatX::Zero(n, n);
   frame_jacobian = Mat6X::Zero(6, n);
   frame_jacobian_v = MatX::Zero(6, m.nv);
   niq = m.independent.source.empty() ? nq : m.independent.nq();
@@ -66,8 +71,6 @@ Data::Data(const Model& m)
     coupled.q = VecX::Zero(nq);
     for (VecX* x : {&coupled.qd, &coupled.qdd, &coupled.tau_full}) *x = VecX::Zero(n);
     for (VecX* x : {&coupled.tau, &coupled.qdd_out, &coupled.rhs}) *x = VecX::Zero(ni);
-    coupled.M = MatX::Zero(ni, ni);
-    coupled.L = MatX::Zero(ni, ni);
   }
 }
 

@@ -844,7 +844,8 @@ def load_urdf(
         ModelError: ``fixed_base``, ``physical_inertia`` or ``mimic`` not a bool, ``gravity``
             not three finite real numbers (naming the argument).
         ModelError: a joint whose motion carries no inertia (a massless leaf link, a point mass
-            on its own joint axis), naming the joint and the body.
+            on its own joint axis), naming the joint and the body; a mass, inertia or distance
+            beyond finalize()'s scale bounds (docs/api.md), naming the body or joint.
     """
     source = _urdf_source(path_or_xml)
     model = _core.urdf_builder(

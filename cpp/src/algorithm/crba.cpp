@@ -3,7 +3,18 @@
 
 namespace armdyn {
 
+void ensure_mass_matrix(Data& d) {
+  if (d.M.rows() == d.n) return;
+  d.M = MatX::Zero(d.n, d.n);
+  d.L = MatX::Zero(d.n, d.n);
+  if (d.ni != d.n) {
+    d.coupled.M = MatX::Zero(d.ni, d.ni);
+    d.coupled.L = MatX::Zero(d.ni, d.ni);
+  }
+}
+
 void crba_loaded(const Model& m, Data& d) {
+  ensure_mass_matrix(d);
   // each body's spatial inertia about the world origin: I_O = R J R^T + m (|c|^2 1 - c c^T)
   for (int i = 0; i < m.nb; ++i) {
     const Body& b = m.bodies[i];

@@ -4,6 +4,8 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <deque>
 #include <numeric>
 
@@ -13,6 +15,7 @@
 #include "armdyn/builder/builder.hpp"
 #include "armdyn/data.hpp"
 #include "armdyn/errors.hpp"
+#include "armdyn/math/quaternion.hpp"
 #include "armdyn/solver/block_sparse.hpp"
 #include "armdyn/solver/constraints.hpp"
 #include "armdyn/solver/kinematics.hpp"
@@ -131,6 +134,119 @@ void check_motions_carry_inertia(const Model& m, const VecX& u) {
                        "that motion, or make the joint fixed)"));
 }
 
+// A tree's joints in breadth-first order from ground (Model::tree_order): from each node, the
+// joints that touch it in index order, through per-node lists (linear in the joints). False,
+// with Model::joint_space_reason, when a joint points from child to parent.
+bool order_tree_from_ground(Model& m) {
+  auto node = [&](int b) { return b == kGround ? m.nb : b; };
+  std::vector<std::vector<int>> touching(m.nb + 1);
+  for (size_t ji = 0; ji < m.joints.size(); ++ji) {
+    const Joint& j = m.joints[ji];
+    touching[node(j.parent)].push_back(static_cast<int>(ji));
+    touching[node(j.child)].push_back(static_cast<int>(ji));
+  }
+  std::deque<int> queue{m.nb};
+  std::vector<char> used(m.joints.size(), 0);
+  bool ok = true;
+  while (!queue.empty()) {
+    const int n = queue.front();
+    queue.pop_front();
+    for (const int ji : touching[n]) {
+      if (used[ji]) continue;
+      const Joint& j = m.joints[ji];
+      const int p = node(j.parent), c = node(j.child);
+      used[ji] = 1;
+      if (p != n && ok) {
+        ok = false;
+        m.joint_space_reason = msg("joint '", j.name, "' points from child to parent");
+      }
+      queue.push_back(p == n ? c : p);
+      m.tree_order.push_back(ji);
+    }
+  }
+  return ok;
+}
+
+// Bounds on the model's scales: masses, squared lengths and inertias (a body's mass times the
+// square of its distance from the world origin, or of a joint point's) at most 1e150, so that
+// the products of two of them that the mass matrix, its factorisation and the energies form stay
+// finite (sqrt of the largest double: 1.3e154, with room for sums over the bodies); a positive
+// mass or inertia at least 1e-150, so that the same holds for their reciprocals (the Cartesian
+// solver's, and the accelerations of a finite force)
+constexpr double kMaxScale = 1e150;
+constexpr double kMinScale = 1e-150;
+
+// a number as messages quote it: four significant digits
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
+}
+
+void refuse_scale(const std::string& who, const std::string& what, double value, const char* unit,
+                  const std::string& from, bool small = false) {
+  throw ModelError(msg("finalize: ", who, ": ", what, " = ", num(value), " ", unit, from,
+                       small ? " is below " : " exceeds ", num(small ? kMinScale : kMaxScale),
+                       ": the dynamics multiplies such quantities, which would overflow (express "
+                       "the model in units that keep masses, lengths and inertias moderate",
+                       small ? "; a massless body has mass 0)" : ")"));
+}
+
+// Every body's mass, inertia and position, and every joint point (at the build pose, with the
+// larger mass of the bodies it joins), within kMaxScale, and a positive mass or inertia trace
+// at least kMinScale; names the first element out of bounds and the quantity.
+void check_model_scales(const Model& m) {
+  auto mass_of = [&](int b) { return b == kGround ? 0.0 : m.bodies[b].mass; };
+  for (const Body& b : m.bodies) {
+    const std::string who = msg("body '", b.name, "'");
+    const double r2 = b.position.squaredNorm();
+    const double tr = b.inertia.trace();
+    if (!(b.mass <= kMaxScale)) refuse_scale(who, "mass", b.mass, "kg", "");
+    if (b.mass > 0.0 && b.mass < kMinScale) refuse_scale(who, "mass", b.mass, "kg", "", true);
+    if (!(tr <= kMaxScale)) refuse_scale(who, "trace of the inertia", tr, "kg m^2", "");
+    if (tr > 0.0 && tr < kMinScale)
+      refuse_scale(who, "trace of the inertia", tr, "kg m^2", "", true);
+    if (!(r2 <= kMaxScale))
+      refuse_scale(who, "squared distance from the world origin", r2, "m^2",
+                   msg(" (position ", num(b.position.norm()), " m)"));
+    if (!(b.mass * r2 <= kMaxScale))
+      refuse_scale(who, "inertia about the world origin, mass x distance^2", b.mass * r2, "kg m^2",
+                   msg(" (", num(b.mass), " kg at ", num(std::sqrt(r2)), " m)"));
+  }
+  for (const Joint& j : m.joints) {
+    const std::string who = msg("joint '", j.name, "'");
+    for (const int side : {0, 1}) {
+      const int b = side == 0 ? j.parent : j.child;
+      const Vec3& local = side == 0 ? j.point_parent : j.point_child;
+      const Vec3 p =
+          b == kGround ? local
+                       : Vec3(m.bodies[b].position + quat_to_rot(m.bodies[b].orientation) * local);
+      const double r2 = p.squaredNorm(), mass = std::max(mass_of(j.parent), mass_of(j.child));
+      if (!(r2 <= kMaxScale))
+        refuse_scale(who, "squared distance of its point from the world origin", r2, "m^2",
+                     msg(" (point ", num(p.norm()), " m from the origin)"));
+      if (!(mass * r2 <= kMaxScale))
+        refuse_scale(who, "mass x squared distance of its point from the world origin", mass * r2,
+                     "kg m^2", msg(" (", num(mass), " kg, point ", num(std::sqrt(r2)), " m)"));
+    }
+  }
+}
+
+// The assembled state u0, v0 finite: else names the first non-finite entry and its body.
+void check_assembled_state(const Model& m) {
+  for (int i = 0; i < m.nq; ++i)
+    if (!std::isfinite(m.u0[i]))
+      throw ModelError(msg("finalize: the assembly produced a non-finite ",
+                           i % 7 < 3 ? "position" : "orientation", " of body '",
+                           m.bodies[i / 7].name, "' (u0[", i, "] = ", m.u0[i],
+                           ") from finite data: the joints' points and the bodies' poses are too "
+                           "far apart in scale to be assembled"));
+  for (int i = 0; i < m.nv; ++i)
+    if (!std::isfinite(m.v0[i]))
+      throw ModelError(msg("finalize: the assembly produced a non-finite velocity of body '",
+                           m.bodies[i / 6].name, "' (v0[", i, "] = ", m.v0[i], ")"));
+}
+
 }  // namespace
 
 namespace detail {
@@ -172,30 +288,7 @@ std::shared_ptr<Model> finalize_draft(const Model& draft, const FinalizeOptions&
   m.joint_space_ok = false;
   m.joint_tree = false;
   if (m.is_tree) {
-    std::vector<char> seen(m.nb + 1, 0);
-    seen[m.nb] = 1;
-    std::deque<int> queue{m.nb};
-    std::vector<char> used(m.joints.size(), 0);
-    bool ok = true;
-    while (!queue.empty()) {
-      const int n = queue.front();
-      queue.pop_front();
-      for (size_t ji = 0; ji < m.joints.size(); ++ji) {
-        if (used[ji]) continue;
-        const Joint& j = m.joints[ji];
-        const int p = node(j.parent), c = node(j.child);
-        if (p != n && c != n) continue;
-        used[ji] = 1;
-        const int other = p == n ? c : p;
-        if (p != n && ok) {
-          ok = false;
-          m.joint_space_reason = msg("joint '", j.name, "' points from child to parent");
-        }
-        seen[other] = 1;
-        queue.push_back(other);
-        m.tree_order.push_back(static_cast<int>(ji));
-      }
-    }
+    bool ok = order_tree_from_ground(m);
     for (const Joint& j : m.joints) {
       // a free joint from ground is a floating base: 7 entries of q, 6 of qd (joint_dofs)
       if (j.type == JointType::Spherical || j.type == JointType::Universal ||
@@ -315,6 +408,7 @@ std::shared_ptr<Model> finalize_draft(const Model& draft, const FinalizeOptions&
 
   m.finalize_options = options;
 
+  check_model_scales(m);
   // assembly: project the given poses onto f(u, 0) = 0, then rest velocities onto zeta v = rhs
   m.u0 = VecX(m.nq);
   for (int i = 0; i < m.nb; ++i) {
@@ -360,6 +454,7 @@ std::shared_ptr<Model> finalize_draft(const Model& draft, const FinalizeOptions&
                            "' (its child frame is turned half a revolution against the parent's); "
                            "give body poses closer to the joints' configuration"));
   }
+  check_assembled_state(m);
 
   // rank analysis at the assembled configuration: mobility and redundant rows by name
   {

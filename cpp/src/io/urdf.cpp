@@ -11,6 +11,7 @@
 //     std::map sorted by name), joint types and the tree structure, with error messages that
 //     name the culprit and quote short, escaped excerpts only;
 //  2. urdfdom (urdf::parseURDF): the full parse of poses, axes, limits and inertials.
+// Every loop over the links and joints is a poll point (Ctrl-C; the two parses are not).
 // Then every group of links joined by fixed joints is merged into one body, bodies are added
 // parent-before-child, and the moving joints are added in document order with their <limit>
 // and their <dynamics> (damping: viscous friction; friction: Coulomb friction smoothed with
@@ -51,6 +52,7 @@
 
 #include "armdyn/errors.hpp"
 #include "armdyn/math/quaternion.hpp"
+#include "armdyn/solver/poll.hpp"
 
 #ifdef ARMDYN_HAVE_CONSOLE_BRIDGE
 #include <console_bridge/console.h>
@@ -519,6 +521,7 @@ Document scan_document(const std::string& xml, const std::string& where) {
   Document out;
   std::set<std::string> links;
   for (auto* e = robot->FirstChildElement("link"); e; e = e->NextSiblingElement("link")) {
+    poll_point();
     const std::string name = attribute(e, "name");
     if (name.empty()) {
       throw UrdfError(msg(where, ": <link> without a name (line ", e->GetLineNum(), ")"));
@@ -542,6 +545,7 @@ Document scan_document(const std::string& xml, const std::string& where) {
   std::set<std::string> joint_names;
   std::map<std::string, std::string> parent_joint;  // child link -> joint
   for (auto* e = robot->FirstChildElement("joint"); e; e = e->NextSiblingElement("joint")) {
+    poll_point();
     JointDecl d;
     d.name = attribute(e, "name");
     d.type = attribute(e, "type");
@@ -730,6 +734,31 @@ class DeclaredInertials {
   std::map<std::string, std::array<double, 7>> declared_;
 };
 
+// <mimic joint= multiplier= offset=>: q_joint = multiplier q_mimicked + offset, a coupling
+// named after the mimicking joint (a fixed joint's mimic has nothing to couple: ignored)
+void add_mimic_couplings(ModelBuilder& builder, const std::vector<JointDecl>& decls,
+                         const urdf::ModelInterface& urdf_model) {
+  for (const JointDecl& d : decls) {
+    if (d.type == "fixed") continue;
+    const urdf::JointConstSharedPtr j = urdf_model.getJoint(d.name);
+    if (!j || !j->mimic) continue;
+    const std::string& leader = j->mimic->joint_name;
+    const urdf::JointConstSharedPtr lj = urdf_model.getJoint(leader);
+    if (!lj)
+      throw UrdfError(msg("URDF joint '", d.name, "': <mimic> names unknown joint '", leader, "'"));
+    if (lj->type == urdf::Joint::FIXED)
+      throw UrdfError(msg("URDF joint '", d.name, "': <mimic> names fixed joint '", leader,
+                          "', which has no coordinate to follow"));
+    try {
+      builder.add_coupling(d.name, d.name, leader, j->mimic->multiplier, j->mimic->offset);
+    } catch (const UrdfError&) {
+      throw;
+    } catch (const ModelError& e) {
+      throw UrdfError(msg("URDF joint '", d.name, "' <mimic joint='", leader, "'>: ", e.what()));
+    }
+  }
+}
+
 }  // namespace
 
 ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const Vec3& gravity,
@@ -760,6 +789,7 @@ ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const
   top_of[root_name] = root_name;
   std::vector<urdf::LinkConstSharedPtr> todo{root};
   while (!todo.empty()) {
+    poll_point();
     const urdf::LinkConstSharedPtr link = todo.back();
     todo.pop_back();
     const std::string& top = top_of.at(link->name);
@@ -820,6 +850,7 @@ ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const
     }
   }
   for (const std::string& top : group_order) {
+    poll_point();
     Group& g = groups.at(top);
     const bool merged = g.links.size() > 1;
     struct Part {
@@ -973,6 +1004,7 @@ ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const
   // then the moving joints in document order (this order defines the joint-space arrays)
   for (const JointDecl& d : decls) {
     if (d.type == "fixed") continue;
+    poll_point();
     const urdf::JointConstSharedPtr j = urdf_model->getJoint(d.name);
     if (!j) throw UrdfError(msg("URDF joint '", d.name, "': not found by urdfdom"));
     // the joint frame is the child link frame at q = 0
@@ -1018,35 +1050,13 @@ ModelBuilder urdf_builder(const std::string& path_or_xml, bool fixed_base, const
     }
   }
 
-  // <mimic joint= multiplier= offset=>: q_joint = multiplier q_mimicked + offset, a coupling
-  // named after the mimicking joint (a fixed joint's mimic has nothing to couple: ignored)
-  if (mimic) {
-    for (const JointDecl& d : decls) {
-      if (d.type == "fixed") continue;
-      const urdf::JointConstSharedPtr j = urdf_model->getJoint(d.name);
-      if (!j || !j->mimic) continue;
-      const std::string& leader = j->mimic->joint_name;
-      const urdf::JointConstSharedPtr lj = urdf_model->getJoint(leader);
-      if (!lj)
-        throw UrdfError(
-            msg("URDF joint '", d.name, "': <mimic> names unknown joint '", leader, "'"));
-      if (lj->type == urdf::Joint::FIXED)
-        throw UrdfError(msg("URDF joint '", d.name, "': <mimic> names fixed joint '", leader,
-                            "', which has no coordinate to follow"));
-      try {
-        builder.add_coupling(d.name, d.name, leader, j->mimic->multiplier, j->mimic->offset);
-      } catch (const UrdfError&) {
-        throw;
-      } catch (const ModelError& e) {
-        throw UrdfError(msg("URDF joint '", d.name, "' <mimic joint='", leader, "'>: ", e.what()));
-      }
-    }
-  }
+  if (mimic) add_mimic_couplings(builder, decls, *urdf_model);
 
   // every link stays a named frame (its link frame, not its centre of mass) on the body it was
   // merged into, or on ground: depth-first from the root (children in urdfdom's order)
   std::vector<urdf::LinkConstSharedPtr> pending{root};
   while (!pending.empty()) {
+    poll_point();
     const urdf::LinkConstSharedPtr link = pending.back();
     pending.pop_back();
     const Frame& f = frame.at(link->name);

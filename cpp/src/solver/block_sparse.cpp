@@ -3,10 +3,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <map>
+#include <queue>
 #include <set>
 #include <sstream>
 #include <type_traits>
+#include <utility>
 
 #include "armdyn/errors.hpp"
 #include "armdyn/solver/poll.hpp"
@@ -38,19 +41,23 @@ KktPlan plan_kkt(const Model& m, int nrows) {
   int remaining = 0;
   for (int g = 0; g < nblk; ++g) remaining += live[g];
   std::vector<char> done(nblk, 0);
+  // the blocks by (weighted degree, index) in a heap with lazy deletion: an entry is current
+  // while its degree equals the block's (degrees change only next to an eliminated block)
+  std::vector<long> degree(nblk, 0);
+  auto weighted_degree = [&](int g) {
+    long d = 0;
+    for (int h : nbr[g]) d += size[h];
+    return d;
+  };
+  using Entry = std::pair<long, int>;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> heap;
+  for (int g = 0; g < nblk; ++g)
+    if (live[g]) heap.emplace(degree[g] = weighted_degree(g), g);
   for (int step = 0; step < remaining; ++step) {
-    poll_point();  // O(blocks) per step: a long model's finalize stays interruptible
-    int best = -1;
-    long bestdeg = 0;
-    for (int g = 0; g < nblk; ++g) {
-      if (!live[g] || done[g]) continue;
-      long d = 0;
-      for (int h : nbr[g]) d += size[h];
-      if (best < 0 || d < bestdeg) {
-        best = g;
-        bestdeg = d;
-      }
-    }
+    poll_point();  // a long model's finalize stays interruptible
+    while (done[heap.top().second] || heap.top().first != degree[heap.top().second]) heap.pop();
+    const int best = heap.top().second;
+    heap.pop();
     done[best] = 1;
     order.push_back(best);
     const std::vector<int> nb(nbr[best].begin(), nbr[best].end());
@@ -63,6 +70,7 @@ KktPlan plan_kkt(const Model& m, int nrows) {
           fill_rows_blocks.insert(a);
           fill_rows_blocks.insert(b);
         }
+    for (int a : nb) heap.emplace(degree[a] = weighted_degree(a), a);
   }
   const int np = static_cast<int>(order.size());
   p.order = order;

@@ -9,9 +9,16 @@
 namespace armdyn {
 
 /// M(q) (n_coords x n_coords) into data.M; a coupled model's in its independent coordinates,
-/// G^T M G (Model::independent), into data.coupled.M. Allocates nothing.
+/// G^T M G (Model::independent), into data.coupled.M. Allocates nothing after its first call on
+/// a Data (ensure_mass_matrix).
 /// @throws ModelError when the model is not a joint-space tree, on a wrong size or non-finite q.
 const MatX& crba(const Model& m, Data& d, Eigen::Ref<const VecX> q);
+
+/// Allocates (zeroed) data.M and data.L, n x n, and a coupled model's data.coupled.M and L,
+/// unless they exist: a Data makes them on its first mass-matrix evaluation (never per step
+/// after it). They are quadratic in the coordinates, so a Data that never forms M (the
+/// Cartesian, ABA and Newton-Euler paths, finalize) stays linear in the model's size.
+void ensure_mass_matrix(Data& d);
 
 /// crba() without the checks, for callers that checked the model and q themselves (the
 /// joint-space simulation of a tree with ideal gears, which crba() refuses).
