@@ -315,13 +315,16 @@ class GearedArmReference:
 
         return f, np.zeros(12)
 
-    def angles(self, t, rtol=1e-12):
-        """(n_t, 6) arm joint angles on the times ``t`` (DOP853 at ``rtol``, dense output)."""
+    def angles(self, t, rtol=1e-12, method="DOP853"):
+        """(n_t, 6) arm joint angles on the times ``t`` (SciPy's ``method``, DOP853 by default,
+        at ``rtol`` = ``atol``, dense output). The rotors' damping makes the equations stiff:
+        ``"Radau"`` needs about 8x fewer evaluations at rtol 1e-10 (1.6e-12 from DOP853 at
+        1e-12 over the first second)."""
         from scipy.integrate import solve_ivp
 
         f, y0 = self.rhs()
         t = np.asarray(t, dtype=float)
-        sol = solve_ivp(f, (0.0, t[-1]), y0, method="DOP853", rtol=rtol, atol=rtol, t_eval=t)
+        sol = solve_ivp(f, (0.0, t[-1]), y0, method=method, rtol=rtol, atol=rtol, t_eval=t)
         if not sol.success:
             raise RuntimeError(f"geared-arm reference: {sol.message}")
         return sol.y[:6].T

@@ -303,10 +303,28 @@ def assert_same_run(a, b, stats=False):
 
 
 @pytest.fixture(scope="session")
-def doc_blocks(tmp_path_factory):
-    """Every ```python block of README.md and docs/*.md, run once (tests/docs/doc_blocks.py
-    says how). It lives here, not in a tests/docs/conftest.py: two conftest modules would
-    shadow each other's ``from conftest import ...``."""
-    from doc_blocks import doc_files, run_blocks  # tests/docs, on sys.path for its tests
+def doc_file_blocks(tmp_path_factory):
+    """``doc_file_blocks("README.md")``: the ```python blocks of one file (README.md or
+    docs/<name>.md), run once per session on first use (tests/docs/doc_blocks.py says how),
+    each file in its own working directory. A test needing one file's blocks waits for that file
+    only. It lives here, not in a tests/docs/conftest.py: two conftest modules would shadow each
+    other's ``from conftest import ...``."""
+    from doc_blocks import run_blocks  # tests/docs, on sys.path for its tests
 
-    return run_blocks(doc_files(), tmp_path_factory.mktemp("doc-blocks"))
+    done: dict = {}
+
+    def blocks(file: str) -> list:
+        if file not in done:
+            done[file] = run_blocks([ROOT / file], tmp_path_factory.mktemp("doc-blocks"))
+        return done[file]
+
+    return blocks
+
+
+@pytest.fixture(scope="session")
+def doc_blocks(doc_file_blocks):
+    """Every ```python block of README.md and docs/*.md (those of files already run are not run
+    again)."""
+    from doc_blocks import doc_files
+
+    return [b for path in doc_files() for b in doc_file_blocks(path.relative_to(ROOT).as_posix())]

@@ -1,7 +1,7 @@
 """docs/api.md, the guide, matches the code: every name it documents exists (package functions,
 builder methods, model properties, validation helpers), and its python blocks' results hold
 against each other and against closed forms (the blocks are run once, each as pasted, by the
-session fixture ``doc_blocks`` of tests/conftest.py; tests/docs/test_runnable_blocks.py
+session fixture ``doc_file_blocks`` of tests/conftest.py; tests/docs/test_runnable_blocks.py
 checks that all of them run)."""
 
 import re
@@ -51,6 +51,12 @@ def test_documented_validation_helpers_exist():
 
 
 GUIDE = "docs/api.md"
+
+
+@pytest.fixture(scope="module")
+def doc_blocks(doc_file_blocks):
+    """The guide's blocks (the other files' are not needed here)."""
+    return doc_file_blocks(GUIDE)
 
 
 def test_two_link_blocks(doc_blocks):

@@ -1,16 +1,24 @@
 """The README: its two commands as `.ci/run` and users read them, the quick start on the first
 screen and its results against closed forms, the reproduce tables it quotes, its sizing example
 against the motor-side closed form, and `armdyn verify` (whose output docs/benchmarks.md quotes)
-within the documented bounds. The blocks are run once by the session fixture ``doc_blocks``."""
+within the documented bounds. The README's blocks are run once, by the session fixture
+``doc_file_blocks``."""
 
 from pathlib import Path
 
 import armdyn as ad
 import numpy as np
+import pytest
 from armdyn import verify
 from doc_blocks import fenced_blocks, namespace_with
 
 README = Path(__file__).resolve().parents[2] / "README.md"
+
+
+@pytest.fixture(scope="module")
+def doc_blocks(doc_file_blocks):
+    """The README's blocks (the other files' are not needed here)."""
+    return doc_file_blocks("README.md")
 
 
 def test_the_two_commands():

@@ -4,7 +4,8 @@ continues the block before it), and all of them together are a few seconds of co
 other fenced block says what it is (```text, ```bash, ...), so that a reader knows what is
 meant to run."""
 
-from doc_blocks import doc_files, fenced_blocks
+import pytest
+from doc_blocks import ROOT, doc_files, fenced_blocks
 
 # CPU seconds of all blocks together (the report of test_blocks_are_quick prints them); three
 # times what they take means some block became a long computation. CPU time, not wall time: a
@@ -12,11 +13,20 @@ from doc_blocks import doc_files, fenced_blocks
 TOTAL_SECONDS = 60.0
 
 
-def test_every_python_block_runs(doc_blocks):
+FILES = [path.relative_to(ROOT).as_posix() for path in doc_files()]
+
+
+@pytest.mark.parametrize("file", FILES)
+def test_every_python_block_runs(doc_file_blocks, file):
+    """One file at a time (each test runs that file's blocks, once per session)."""
+    blocks = doc_file_blocks(file)
+    failed = [f"{b.where}:\n{b.error}" for b in blocks if b.error is not None]
+    assert not failed, "\n".join(failed)
+
+
+def test_the_blocks_are_found(doc_blocks):
     assert len(doc_blocks) >= 15
     assert {b.file for b in doc_blocks} >= {"README.md", "docs/api.md"}
-    failed = [f"{b.where}:\n{b.error}" for b in doc_blocks if b.error is not None]
-    assert not failed, "\n".join(failed)
 
 
 def test_continuing_blocks_say_so(doc_blocks):

@@ -213,8 +213,10 @@ def test_play_pause_and_time_slider(page, ur5_run):
     assert page.evaluate(f"(() => {{ {button}.click(); return {button}.textContent }})()") == (
         "Stop loop"
     )
-    for _ in range(10):
+    for _ in range(10):  # playing: the time moves within 10 frames (stop once it has)
         page.evaluate(FRAME)
+        if page.evaluate(time_now) != t0:
+            break
     assert page.evaluate(time_now) != t0  # playing
     assert page.evaluate(f"(() => {{ {button}.click(); return {button}.textContent }})()") == (
         "Play loop"
