@@ -10,6 +10,7 @@
 //    the full model.
 #pragma once
 
+#include <limits>
 #include <vector>
 
 #include "armdyn/algorithm/constraints.hpp"
@@ -313,6 +314,13 @@ class MbsSystem : public OdeSystem, public StopAccess {
     }
     if (stops_) stops_->events(*this, t, y, fe_, g + ng);
   }
+  bool event_rates(double /*t*/, const VecX& y, double* dg) override {
+    if (!stops_) return false;
+    const int ng = static_cast<int>(m_.gears.size());
+    for (int i = 0; i < ng; ++i) dg[i] = std::numeric_limits<double>::quiet_NaN();
+    stops_->event_rates(*this, y, dg + ng);
+    return true;
+  }
   void on_event(double t, int i, int direction) override {
     const int ng = static_cast<int>(m_.gears.size());
     if (i >= ng) return stops_->on_event(i - ng, direction);
@@ -449,6 +457,14 @@ class JointSystem : public OdeSystem, public StopAccess {
     const int ng = static_cast<int>(m_.gears.size());
     for (int i = 0; i < ng; ++i) td_.gear_mesh(i, y.data(), y.data() + nq_, s, sd, g[i]);
     if (LimitStops* st = cart_.stops()) st->events(*this, t, y, fe_, g + ng);
+  }
+  bool event_rates(double /*t*/, const VecX& y, double* dg) override {
+    LimitStops* st = cart_.stops();
+    if (!st) return false;
+    const int ng = static_cast<int>(m_.gears.size());
+    for (int i = 0; i < ng; ++i) dg[i] = std::numeric_limits<double>::quiet_NaN();
+    st->event_rates(*this, y, dg + ng);
+    return true;
   }
   void on_event(double t, int i, int direction) override { cart_.on_event(t, i, direction); }
   bool apply_events(double t, VecX& y) override {
