@@ -438,19 +438,23 @@ class LimitStops {
     for (long r = 0; r < k; ++r)
       at(r).engaged = rest_[static_cast<size_t>(r)] && !sep_[static_cast<size_t>(r)] && lam_[r] > 0;
     VecX& f = scratch_;
-    for (int round = 0; round <= k; ++round) {  // a stop the bilateral solve pulls is free
+    // a stop the bilateral solve pulls, or holds with next to nothing (below 1e-6 of the torque
+    // that stops its free acceleration: round-off of a degenerate contact), is free
+    for (int round = 0; round <= k; ++round) {
       a.stop_eval(t, y, nullptr, f, false);
-      solve(a, t, y, f);
-      int worst = -1;
-      for (int i = 0; i < size(); ++i) {
-        const Stop& s = stops_[static_cast<size_t>(i)];
-        if (s.engaged && s.lambda <= 0 &&
-            (worst < 0 || s.lambda < stops_[static_cast<size_t>(worst)].lambda))
-          worst = i;
+      solve(a, t, y, f);  // (set_: the engaged stops, a0_ and A_ theirs)
+      long worst = -1;
+      double worst_value = 0.0;
+      for (long r = 0; r < static_cast<long>(set_.size()); ++r) {
+        const double value = at(r).lambda - 1e-6 * std::abs(a0_[r]) / A_(r, r);
+        if (value <= 0 && (worst < 0 || value < worst_value)) {
+          worst = r;
+          worst_value = value;
+        }
       }
       if (worst < 0) break;
-      stops_[static_cast<size_t>(worst)].engaged = false;
-      stops_[static_cast<size_t>(worst)].lambda = 0.0;
+      at(worst).engaged = false;
+      at(worst).lambda = 0.0;
     }
     // positions of C on their limits; the engaged stops' rates to zero
     set_.clear();

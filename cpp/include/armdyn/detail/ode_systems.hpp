@@ -143,6 +143,8 @@ class MbsSystem : public OdeSystem, public StopAccess {
       // the engaged stops' joints back on their limits (the projection knows only the joints)
       body_accelerations(m_, d_, t, y.data(), y.data() + m_.nq, dy.data() + m_.nq, true);
       reuse = !stops_->hold(*this, t, y, dy);
+      // the constraints again to round-off (the hold moved along them to first order)
+      if (!reuse) project(m_, d_, t, y.data(), y.data() + m_.nq, metric_);
     }
     body_accelerations(m_, d_, t, y.data(), y.data() + m_.nq, dy.data() + m_.nq, reuse);
     udot(m_, y.data(), y.data() + m_.nq, dy.data());
@@ -163,6 +165,7 @@ class MbsSystem : public OdeSystem, public StopAccess {
       fo_.resize(yo_.size());
       fo_.segment(m_.nq, m_.nv) = vd_;
       if (stops_->hold(*this, t, yo_, fo_)) {
+        project(m_, d_, t, u, v, metric_);
         body_accelerations(m_, d_, t, u, v, vd_.data());
         fo_.segment(m_.nq, m_.nv) = vd_;
       }
@@ -328,7 +331,15 @@ class MbsSystem : public OdeSystem, public StopAccess {
     out_.event_index.push_back(i);
     out_.event_direction.push_back(direction);
   }
-  bool apply_events(double t, VecX& y) override { return stops_ && stops_->apply(*this, t, y); }
+  bool apply_events(double t, VecX& y) override {
+    if (!stops_) return false;
+    // the contact problem on the constraint manifold: the located state is the dense output's,
+    // off it by the local error, and projecting it after the stops were put on their limits
+    // would move them off again (by more than their event margin)
+    d_.aux = y.data() + m_.nq + m_.nv;
+    project(m_, d_, t, y.data(), y.data() + m_.nq, metric_);
+    return stops_->apply(*this, t, y);
+  }
 
   /// The model's Cartesian pipeline (settings, tracking, counters).
   Data& data() { return d_; }
