@@ -77,6 +77,13 @@ struct EventState {
     for (size_t i = 0; i < sgn.size(); ++i) sgn[i] = g0[static_cast<long>(i)] < 0 ? -1 : 1;
     rates = sys.event_rates(t, y, dg0.data());
   }
+  /// Values and rates at (t, y), the signs kept (a step cut at a crossing that changed nothing:
+  /// the crossed functions keep their new signs, even where round-off of the restart flips g).
+  void refresh(OdeSystem& sys, double t, const VecX& y) {
+    if (sgn.empty()) return;
+    sys.events(t, y, g0.data());
+    rates = sys.event_rates(t, y, dg0.data());
+  }
   /// The end of an accepted step without events becomes the next step's start.
   void next() {
     g0 = gend;
@@ -345,8 +352,10 @@ struct AdaptiveRun {
   /// The event functions at the start of the next step: taken afresh at the new, projected y
   /// after an event cut the step or changed the system, else those of the step's end.
   void signs_after_events(OdeSystem& sys, double tn, const VecX& y) {
-    if (resign || cut)
+    if (resign)
       ev.init(sys, tn, y);
+    else if (cut)
+      ev.refresh(sys, tn, y);
     else if (ne > 0)
       ev.next();
     resign = cut = false;
@@ -735,6 +744,7 @@ void integrate_rk4(OdeSystem& sys, VecX& y, double t0, double t1, const StepOpti
     // end already feels, e.g., a contact force is only a first guess)
     double tn = t;
     bool changed = false;  // an event changed the state or the event functions
+    bool cut = false;      // an event ended the step early
     for (int round = 0;; ++round) {
       yt = y + 0.5 * h * k1;
       sys.rhs(t + 0.5 * h, yt, k2);
@@ -764,7 +774,7 @@ void integrate_rk4(OdeSystem& sys, VecX& y, double t0, double t1, const StepOpti
       }
       take_events(sys, t, h, th, dense, ev.crossed, ev.sgn, st, tn, y1);
       changed = !ev.crossed.empty() && sys.apply_events(tn, y1);
-      changed = changed || th < 1.0;
+      cut = th < 1.0;
       creeps = 0;
       break;
     }
@@ -774,6 +784,8 @@ void integrate_rk4(OdeSystem& sys, VecX& y, double t0, double t1, const StepOpti
     ++st.rhs_evals;
     if (changed)
       ev.init(sys, t, y);
+    else if (cut)
+      ev.refresh(sys, t, y);
     else if (ne > 0)
       ev.next();
     ++st.steps;
@@ -946,22 +958,25 @@ void integrate_trbdf2(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
       yh = y1;
       auto dense = [&](double th, VecX& out) { hermite(th, h, y, K1, yh, K3, out); };
       bool changed = false;  // an event changed the state or the event functions
+      bool cut = false;      // an event ended the step early
       ev.crossed.clear();
       if (ne > 0 && ev.end(sys, tn, y1, h)) {
         const double th = ev.locate(sys, t, h, dense);
         take_events(sys, t, h, th, dense, ev.crossed, ev.sgn, st, tn, y1);
-        changed = th > 0 && th < 1.0;  // the step was cut
+        cut = th > 0 && th < 1.0;
       }
       for (; !every_step && ko < touts.size() && touts[ko] <= tn; ++ko) {
         dense((touts[ko] - t) / h, yo);
         sys.output(touts[ko], yo);
       }
-      if (ne > 0 && !ev.crossed.empty()) changed = sys.apply_events(tn, y1) || changed;
+      if (ne > 0 && !ev.crossed.empty()) changed = sys.apply_events(tn, y1);
       y = y1;
       sys.project_and_rhs(tn, y, K1);
       ++st.rhs_evals;
       if (changed)
         ev.init(sys, tn, y);
+      else if (cut)
+        ev.refresh(sys, tn, y);
       else if (ne > 0)
         ev.next();
       t = tn;
