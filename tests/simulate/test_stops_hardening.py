@@ -264,3 +264,27 @@ def test_the_joint_limited_ur5_bouncing_keeps_within_its_limits(coordinates, int
     _energy_never_rises(r, 3e-5 if integrator == "trbdf2" else 1e-6)
     if coordinates == "cartesian":
         assert r.velocity_residual.max() <= 1e-12
+
+
+@pytest.mark.parametrize(
+    "integrator, coordinates", [("dop853", "cartesian"), ("dop853", "joint"), ("dopri5", "joint")]
+)
+def test_a_joint_out_past_its_stop_and_back_within_one_step_is_caught(integrator, coordinates):
+    """Released at -0.501 rad, the pendulum swings to +0.501, 1e-3 past its stop at 0.5, for
+    about 0.04 s. At rtol 1e-4 these integrators step across the whole excursion (with the
+    limits ignored no step ends beyond 0.5: no sign change to see); the stop is still hit, at
+    the time the pendulum reaches 0.5 (a tight run without stops), and never passed."""
+    b = ad.ModelBuilder(gravity=(0, 0, -G))
+    b.add_body("bob", 1.0, np.eye(3) * 1e-4, position=(0, 0, -1.0))
+    b.add_revolute("hinge", "ground", "bob", (0.0, 0.0, 0.0), (0.0, 1.0, 0.0))
+    b.set_joint_limits("hinge", -3.0, 0.5)
+    m = b.finalize()
+    kw = dict(q0=[-0.501], integrator=integrator, coordinates=coordinates, rtol=1e-4, atol=1e-6)
+    free = ad.simulate(m, 1.2, limits="ignore", **kw)
+    assert free.q[:, 0].max() < 0.5
+    r = ad.simulate(m, 1.2, **kw)
+    assert r.events["limits"]["kind"] == ["bounce"]
+    assert r.q[:, 0].max() <= 0.5 + 1e-6
+    ref = ad.simulate(m, 1.2, q0=[-0.501], limits="ignore", rtol=1e-12, atol=1e-14, output_dt=1e-5)
+    t_ref = ref.t[np.argmax(ref.q[:, 0] >= 0.5)]
+    np.testing.assert_allclose(r.events["limits"]["t"][0], t_ref, atol=2e-3)

@@ -417,8 +417,14 @@ class LimitStops {
         for (long j = 0; j < m; ++j)
           Ms_(i, j) = A_(sub_[static_cast<size_t>(i)], sub_[static_cast<size_t>(j)]);
       }
-      if (m > 0 && !lcp_.solve(Ms_, qs_, static_cast<int>(m)))
-        throw SolverError("joint stops: no contact forces hold the resting stops");
+      if (m > 0 && !lcp_.solve(Ms_, qs_, static_cast<int>(m))) {
+        std::string names;
+        for (long i = 0; i < m; ++i)
+          names += (i ? ", '" : "'") + m_.joints[at(sub_[static_cast<size_t>(i)]).joint].name + "'";
+        throw SolverError(msg("joint stops: no contact forces hold the stops of ", names,
+                              " at rest at t=", t,
+                              "; simulate(limits='ignore') runs without the stops"));
+      }
       lam_.head(k).setZero();
       for (long r = 0; r < k; ++r) sep_[static_cast<size_t>(r)] = 0;
       for (long i = 0; i < m; ++i) {
