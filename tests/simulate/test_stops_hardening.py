@@ -240,10 +240,15 @@ def _ur5_limited():
 @pytest.mark.parametrize("integrator", INTEGRATORS)
 @pytest.mark.parametrize("coordinates", COORDINATES)
 def test_the_joint_limited_ur5_bouncing_keeps_within_its_limits(coordinates, integrator):
-    """Issue target: the joint-limited UR5 falling for 5 s at e = 0.5 (ignoring the limits, it
-    passes them by 0.28 rad; on main, enforcing them, it ended 0.10-0.14 rad beyond)."""
+    """Issue target: the joint-limited UR5 falling for 5 s at e = 0.5 stays within its limits
+    (ignoring them, it passes them by 0.28 rad). The issue reports 0.10-0.14 rad beyond on main;
+    from this start the build of 55d38f0 already held, so this case guards the impacts of a
+    6-joint arm in every integrator rather than reproducing that failure (the pendulum and the
+    URDF arm above do: 0.6 and 2.3 rad beyond before the fix)."""
     m = _ur5_limited()
     kw = dict(dt=1e-3) if integrator == "rk4" else dict(rtol=1e-9, atol=1e-11)
+    if integrator == "trbdf2":  # (the implicit method, for stiff scenes: looser, to stay quick)
+        kw = dict(rtol=1e-7, atol=1e-9)
     r = ad.simulate(
         m,
         5.0,
@@ -259,9 +264,9 @@ def test_the_joint_limited_ur5_bouncing_keeps_within_its_limits(coordinates, int
     assert "bounce" in ev["kind"]
     _one_event_per_stop_and_instant(ev)
     _events_change_the_contact(ev)
-    # TR-BDF2 (order 2) at these tolerances drifts by up to 1e-5 J with the limits ignored
-    # (4.4e-6 J joint space, 9.9e-6 J Cartesian); every impact here removes more than 1 J
-    _energy_never_rises(r, 3e-5 if integrator == "trbdf2" else 1e-6)
+    # TR-BDF2 (order 2) at rtol 1e-7 drifts by up to 2e-4 J with the limits ignored
+    # (1.9e-4 J Cartesian, 8.6e-5 J joint space); every impact here removes more than 1 J
+    _energy_never_rises(r, 5e-4 if integrator == "trbdf2" else 1e-6)
     if coordinates == "cartesian":
         assert r.velocity_residual.max() <= 1e-12
 

@@ -25,16 +25,23 @@
 //     stop (with the resting stops' forces) stays within the stop's tolerance cannot be resolved
 //     by any event location: the geometric series of ever shorter bounces that would follow is
 //     summed at once (its restitution is dropped, the joint rests on the stop), losing exactly
-//     the energy the series would lose, the rebound's kinetic energy.
+//     the energy the series would lose, the rebound's kinetic energy. (Should dropping some
+//     coupled stops' restitution but not others' raise the energy, the whole impact is plastic.)
 //  3. Resting contact: over the stops of C at rest (a rate within the same apex bound), the
 //     acceleration-level problem  w = A lambda + a0,  lambda >= 0, w >= 0, lambda' w = 0  (a0 the
 //     stops' s qdd without stop forces): a stop with w = 0 engages (degenerate ones, lambda = 0,
-//     stay free), one with w > 0 is free and leaves its limit.
+//     stay free, and so does one the bilateral solve over the engaged stops then finds pulling
+//     or holding with less than 1e-6 of the torque that stops its free acceleration: the event
+//     function of every engaged stop starts positive), one with w > 0 is free and leaves its
+//     limit.
 // Each stop whose state changed records one event ("rest", "bounce" or "release"): never a rest
 // and a release of one stop at one instant. Positions of C are put on their limits, rates of
 // the engaged stops to zero (joint space: exactly; Cartesian: along the stops' responses, which
-// keep the velocity constraints). Both formulations give the same dynamics through the same
-// primitives (StopAccess); the Cartesian path reuses the KKT factorisation for the responses.
+// keep the velocity constraints; the Cartesian system projects the located state onto the
+// constraints before, and the integrator after, so that the stops stay on their limits to
+// round-off and the velocity residual stays at round-off). Both formulations give the same dynamics
+// through the same primitives (StopAccess); the Cartesian path reuses the KKT factorisation for the
+// responses.
 #pragma once
 
 #include <algorithm>
