@@ -54,7 +54,9 @@ class SimulationResult:
         events: located events (gear contact): ``t`` (times), ``gear`` (names), ``onset``
             (True at contact onset, False at separation); ``limits``: the joint stops' events,
             ``t``, ``joint``, ``side`` ("lower"/"upper") and ``kind`` ("rest": the joint hit
-            its stop and stays on it, "bounce": it rebounded, "release": it left the stop).
+            its stop and stays on it, "bounce": it hit it and left at once, rebounding or
+            pulled off, "release": it left the stop it rested on); one event per stop whose
+            contact changed.
         limit_forces: ``names`` (the joints held by stops when limits are enforced) and
             ``force`` (n, n_limited): the stop's torque [N m] or force [N] on the joint's
             coordinate, positive along it (a lower stop pushes up), 0 off the stops.
@@ -256,8 +258,10 @@ def simulate(
             outside a limit is refused. ``"ignore"``: the limits play no part in the dynamics
             (they are still checked by :func:`armdyn.limit_violations`).
         restitution: the stops' coefficient of restitution in [0, 1]: 0 (default) a plastic
-            impact, the joint stays on its stop; e > 0 rebounds at e times the impact rate
-            (rebounds slower than 1e-6 rad/s or m/s rest on the stop).
+            impact; e > 0 rebounds at e times the impact rate. A rebound too small to rise
+            1e-9·max(1, |limit|) off its stop against the acceleration back into it ends the
+            series of ever shorter bounces that would follow: the joint rests on the stop,
+            having lost the rebound's kinetic energy, as the whole series would.
         progress: ``False`` (default): nothing shown. ``True``: a tqdm progress bar of the
             simulated time (t of ``t_end`` seconds), closed when the run ends. A ``tqdm``
             instance: that bar, its ``total`` set to ``t_end`` and ``n`` to t (left open, for

@@ -53,7 +53,10 @@ def test_pendulum_stays_within_its_limits_and_energy_never_rises(integrator, coo
     assert np.abs(q).max() <= 0.2 + 1e-6
     ev = r.events["limits"]
     assert ev["joint"][0] == "hinge" and ev["side"][0] == "upper"
-    assert ev["kind"][0] == ("rest" if e == 0 else "bounce")
+    # gravity pulls it off the upper stop: even a plastic hit leaves at once, one event (issue
+    # 31: not a "rest" and a "release" at one instant)
+    assert ev["kind"][0] == "bounce"
+    assert len(set(zip(ev["t"], ev["joint"], strict=True))) == len(ev["t"])
     E = r.kinetic_energy + r.potential_energy
     E0 = E[0]
     tol = 1e-7 * 0.5 * J * qd0**2  # the integrator's error on the energy

@@ -44,32 +44,117 @@ double err_norm(const VecX& e, const VecX& a, const VecX& b, double rtol, double
   return s;
 }
 
-// Signs of the event functions at (t, y) (a zero takes +1).
-void init_event_signs(OdeSystem& sys, double t, const VecX& y, std::vector<int>& sgn, VecX& gbuf) {
-  if (sgn.empty()) return;
-  sys.events(t, y, gbuf.data());
-  for (size_t i = 0; i < sgn.size(); ++i) sgn[i] = gbuf[i] < 0 ? -1 : 1;
-}
+// The event functions of a run: their signs and values at the start of the step (with their
+// rates, where the system knows them), their values and rates at its end, and the location of
+// the earliest crossing on the step's dense output. A crossing is a sign change between the
+// ends, or a dip: a function of one sign at both ends whose rates turn inside the step (a joint
+// out past its stop and back) and whose cubic Hermite model of g over the step comes closer to
+// zero than the depth of its turn below the nearer end; g is then evaluated on the dense output
+// at the model's turning point, and a value of the other sign brackets the crossing.
+struct EventState {
+  std::vector<int>&sgn, &crossed;
+  VecX &g0, &dg0, &gend, &dg1, &gbuf, &ybuf;
+  bool rates = false;  // the system knows some rates
 
-// Event location on a step [t, t + h] with dense output dense(theta, y_out). sgn holds the sign
-// of every event function at the start of the step; gend its values at the end. Returns the
-// theta in (0, 1] of the earliest crossing (on the side where g has its new sign), or -1.
-template <class Dense>
-double locate_events(OdeSystem& sys, double t, double h, const Dense& dense,
-                     const std::vector<int>& sgn, const VecX& gend, VecX& gbuf, VecX& ybuf,
-                     std::vector<int>& crossed) {
-  const int ne = static_cast<int>(sgn.size());
-  double best = -1.0;
-  crossed.clear();
-  for (int i = 0; i < ne; ++i) {
-    if (!(gend[i] * sgn[i] < 0)) continue;
-    // Illinois on [a, b] with g(a) of sign sgn[i], g(b) of the opposite sign
-    double a = 0.0, b = 1.0, fa = sgn[i] * 1e-300, fb = gend[i];
-    {
-      dense(0.0, ybuf);
-      sys.events(t, ybuf, gbuf.data());
-      if (gbuf[i] * sgn[i] > 0) fa = gbuf[i];
+  // buffers: the work's slots 36..38 and 40..42, its signs and crossed lists
+  EventState(OdeSystem& sys, IntegratorWork& w, long n)
+      : sgn(w.signs),
+        crossed(w.crossed),
+        g0(w.vec(40, sys.n_events())),
+        dg0(w.vec(41, sys.n_events())),
+        gend(w.vec(36, sys.n_events())),
+        dg1(w.vec(42, sys.n_events())),
+        gbuf(w.vec(37, sys.n_events())),
+        ybuf(w.vec(38, n)) {
+    sgn.assign(static_cast<size_t>(sys.n_events()), 1);
+  }
+  int size() const { return static_cast<int>(sgn.size()); }
+
+  /// Values, signs (a zero takes +1) and rates at the start of a step, (t, y).
+  void init(OdeSystem& sys, double t, const VecX& y) {
+    if (sgn.empty()) return;
+    sys.events(t, y, g0.data());
+    for (size_t i = 0; i < sgn.size(); ++i) sgn[i] = g0[static_cast<long>(i)] < 0 ? -1 : 1;
+    rates = sys.event_rates(t, y, dg0.data());
+  }
+  /// Values and rates at (t, y), the signs kept (a step cut at a crossing that changed nothing:
+  /// the crossed functions keep their new signs, even where round-off of the restart flips g).
+  void refresh(OdeSystem& sys, double t, const VecX& y) {
+    if (sgn.empty()) return;
+    sys.events(t, y, g0.data());
+    rates = sys.event_rates(t, y, dg0.data());
+  }
+  /// The end of an accepted step without events becomes the next step's start.
+  void next() {
+    g0 = gend;
+    dg0 = dg1;
+  }
+  /// Values and rates at the step's end (tn, y1); whether a crossing or a dip may lie inside.
+  bool end(OdeSystem& sys, double tn, const VecX& y1, double h) {
+    if (sgn.empty()) return false;
+    sys.events(tn, y1, gend.data());
+    if (rates) sys.event_rates(tn, y1, dg1.data());
+    for (int i = 0; i < size(); ++i)
+      if (gend[i] * sgn[i] < 0 || dip_theta(i, h) >= 0) return true;
+    return false;
+  }
+
+  /// The turning point theta in (0, 1) of a suspected dip of function i, or -1.
+  double dip_theta(int i, double h) const {
+    if (!rates) return -1.0;
+    const double s = sgn[static_cast<size_t>(i)];
+    const double a0 = s * g0[i], a1 = s * gend[i], d0 = s * h * dg0[i], d1 = s * h * dg1[i];
+    if (!(a0 >= 0 && a1 >= 0 && d0 < 0 && d1 > 0)) return -1.0;  // (NaN rates: never)
+    // the cubic Hermite p(th) of g over the step; p' = 3 c3 th^2 + 2 c2 th + d0 turns in (0, 1)
+    const double c3 = 2 * (a0 - a1) + d0 + d1, c2 = 3 * (a1 - a0) - 2 * d0 - d1;
+    double lo = 0.0, hi = 1.0;
+    for (int it = 0; it < 60; ++it) {
+      const double m = 0.5 * (lo + hi);
+      ((3 * c3 * m + 2 * c2) * m + d0 < 0 ? lo : hi) = m;
     }
+    const double th = 0.5 * (lo + hi);
+    const double pmin = ((c3 * th + c2) * th + d0) * th + a0;
+    return pmin < std::min(a0, a1) - pmin ? th : -1.0;
+  }
+
+  /// The theta in (0, 1] of the earliest crossing on the step [t, t + h] with dense output
+  /// dense(theta, y_out) (on the side where g has its new sign), or -1; crossed lists the
+  /// functions that cross there.
+  template <class Dense>
+  double locate(OdeSystem& sys, double t, double h, const Dense& dense) {
+    double best = -1.0;
+    crossed.clear();
+    for (int i = 0; i < size(); ++i) {
+      double b = 1.0, fb = gend[i];
+      if (!(gend[i] * sgn[static_cast<size_t>(i)] < 0)) {
+        const double th = dip_theta(i, h);
+        if (th < 0) continue;
+        dense(th, ybuf);
+        sys.events(t + th * h, ybuf, gbuf.data());
+        if (!(gbuf[i] * sgn[static_cast<size_t>(i)] < 0)) continue;  // no dip below zero
+        b = th;
+        fb = gbuf[i];
+      }
+      b = illinois(sys, t, h, dense, i, b, fb);
+      if (best < 0 || b < best - 1e-12) {
+        best = b;
+        crossed.assign(1, i);
+      } else if (std::abs(b - best) <= 1e-12) {
+        crossed.push_back(i);
+      }
+    }
+    return best;
+  }
+
+  // Illinois on [0, b] for function i: g(0) of sign sgn[i], g(b) = fb of the opposite sign.
+  template <class Dense>
+  double illinois(OdeSystem& sys, double t, double h, const Dense& dense, int i, double b,
+                  double fb) {
+    const int sg = sgn[static_cast<size_t>(i)];
+    double a = 0.0, fa = sg * 1e-300;
+    dense(0.0, ybuf);
+    sys.events(t, ybuf, gbuf.data());
+    if (gbuf[i] * sg > 0) fa = gbuf[i];
     int side = 0;
     for (int it = 0; it < 100 && (b - a) * h > 1e-14 * std::max(1.0, std::abs(t)); ++it) {
       const double c = (fa == fb) ? 0.5 * (a + b) : b - fb * (b - a) / (fb - fa);
@@ -77,7 +162,7 @@ double locate_events(OdeSystem& sys, double t, double h, const Dense& dense,
       dense(cc, ybuf);
       sys.events(t + cc * h, ybuf, gbuf.data());
       const double fc = gbuf[i];
-      if (fc * sgn[i] > 0) {  // still before the crossing
+      if (fc * sg > 0) {  // still before the crossing
         a = cc;
         fa = fc;
         if (side == -1) fb *= 0.5;
@@ -89,15 +174,9 @@ double locate_events(OdeSystem& sys, double t, double h, const Dense& dense,
         side = 1;
       }
     }
-    if (best < 0 || b < best - 1e-12) {
-      best = b;
-      crossed.assign(1, i);
-    } else if (std::abs(b - best) <= 1e-12) {
-      crossed.push_back(i);
-    }
+    return b;
   }
-  return best;
-}
+};
 
 // After locate_events returned th: when the crossing lies inside the step, end the step there
 // (tn and y1 from the dense output); flip the crossed functions' signs and report them.
@@ -204,11 +283,12 @@ struct AdaptiveRun {
   size_t ko = 1;
   bool last_rejected = false;
   bool resign = false;  // an event changed the system: take the signs afresh
+  bool cut = false;     // an event ended the step early
   int ne;
-  std::vector<int>&sgn, &crossed;
-  VecX &gend, &gbuf, &ybuf, &yo;
+  EventState ev;
+  VecX& yo;
 
-  // its buffers: the work's slots 36..39, output times and event signs
+  // its buffers: the work's slots 36..42, output times and event signs
   AdaptiveRun(const char* name_, OdeSystem& sys, const StepOptions& o, double t0, double t1_,
               long n, IntegratorWork& w)
       : name(name_),
@@ -219,15 +299,10 @@ struct AdaptiveRun {
         hmin(1e-14 * std::max(1.0, std::abs(t1_))),
         touts(w.times),
         ne(sys.n_events()),
-        sgn(w.signs),
-        crossed(w.crossed),
-        gend(w.vec(36, ne)),
-        gbuf(w.vec(37, ne)),
-        ybuf(w.vec(38, n)),
+        ev(sys, w, n),
         yo(w.vec(39, n)) {
     output_times(t0, t1_, o.output_dt, touts);
     every_step = touts.empty();
-    sgn.assign(static_cast<size_t>(ne), 1);
   }
 
   /// f0 = f(t0, y) at the projected y; the output at t0, the event signs and the first step
@@ -237,7 +312,7 @@ struct AdaptiveRun {
     ++st.rhs_evals;
     sys.output(t, y);
     h = initial_step(sys, t, y, f0, yt, f1, opt, hmax, hmin, order, st);
-    init_event_signs(sys, t, y, sgn, gbuf);
+    ev.init(sys, t, y);
   }
   void guard(const StepStats& st) { guard_step(name, opt, st, t, t1, hmin, h); }
   /// Rejects the step; the next attempt takes h_retry.
@@ -254,14 +329,8 @@ struct AdaptiveRun {
   bool output_inside(double tn) const {
     return !every_step && ko < touts.size() && touts[ko] <= tn;
   }
-  /// Whether an event function changed sign between t and (tn, y1) (its values kept in gend).
-  bool sign_change(OdeSystem& sys, double tn, const VecX& y1) {
-    if (ne == 0) return false;
-    sys.events(tn, y1, gend.data());
-    for (int i = 0; i < ne; ++i)
-      if (gend[i] * sgn[i] < 0) return true;
-    return false;
-  }
+  /// Whether an event function may cross zero between t and (tn, y1) (EventState::end).
+  bool sign_change(OdeSystem& sys, double tn, const VecX& y1) { return ev.end(sys, tn, y1, h); }
   /// An accepted step with its dense output: ends it at the earliest event crossing (when
   /// events), serves the output times in (t, tn] and sets y = y1. Returns whether an event cut
   /// the step (tn and y1 then moved, and f must be evaluated afresh at them).
@@ -269,20 +338,27 @@ struct AdaptiveRun {
   bool accept(OdeSystem& sys, double& tn, const Dense& dense, bool events, VecX& y, VecX& y1,
               StepStats& st) {
     const double t_end_step = tn;
+    ev.crossed.clear();
     if (events) {
-      const double th = locate_events(sys, t, h, dense, sgn, gend, gbuf, ybuf, crossed);
-      take_events(sys, t, h, th, dense, crossed, sgn, st, tn, y1);
+      const double th = ev.locate(sys, t, h, dense);
+      take_events(sys, t, h, th, dense, ev.crossed, ev.sgn, st, tn, y1);
     }
     serve_outputs(sys, touts, ko, t, h, tn, dense, yo);
-    resign = events && !crossed.empty() && sys.apply_events(tn, y1);
+    resign = !ev.crossed.empty() && sys.apply_events(tn, y1);
+    cut = tn != t_end_step;
     y = y1;
-    return tn != t_end_step || resign;
+    return cut || resign;
   }
-  /// After an event changed the system (resign), the event functions' signs at the new,
-  /// projected start of the next step.
+  /// The event functions at the start of the next step: taken afresh at the new, projected y
+  /// after an event cut the step or changed the system, else those of the step's end.
   void signs_after_events(OdeSystem& sys, double tn, const VecX& y) {
-    if (resign) init_event_signs(sys, tn, y, sgn, gbuf);
-    resign = false;
+    if (resign)
+      ev.init(sys, tn, y);
+    else if (cut)
+      ev.refresh(sys, tn, y);
+    else if (ne > 0)
+      ev.next();
+    resign = cut = false;
   }
   /// The clock moves to tn (y and the first stage there in place); the next step is hnew.
   void advance(OdeSystem& sys, double tn, const VecX& y, double hnew, StepStats& st) {
@@ -644,10 +720,8 @@ void integrate_rk4(OdeSystem& sys, VecX& y, double t0, double t1, const StepOpti
   // events: located on the cubic Hermite interpolant of (y, k1) and (y1, f(t + h, y1)), which
   // costs extra right-hand sides only on steps where an event function changes sign
   const int ne = sys.n_events();
-  std::vector<int>&sgn = w.signs, &crossed = w.crossed;
-  sgn.assign(static_cast<size_t>(ne), 1);
-  VecX &gend = w.vec(36, ne), &gbuf = w.vec(37, ne), &ybuf = w.vec(38, n);
-  init_event_signs(sys, t, y, sgn, gbuf);
+  EventState ev(sys, w, n);
+  ev.init(sys, t, y);
   const double eps = 1e-12 * std::max(1.0, std::abs(t1));
   // a step shortened to a located crossing may end just short of it (the location came from
   // the longer step's interpolant); the next step locates it again from closer by. After a few
@@ -670,6 +744,7 @@ void integrate_rk4(OdeSystem& sys, VecX& y, double t0, double t1, const StepOpti
     // end already feels, e.g., a contact force is only a first guess)
     double tn = t;
     bool changed = false;  // an event changed the state or the event functions
+    bool cut = false;      // an event ended the step early
     for (int round = 0;; ++round) {
       yt = y + 0.5 * h * k1;
       sys.rhs(t + 0.5 * h, yt, k2);
@@ -681,23 +756,25 @@ void integrate_rk4(OdeSystem& sys, VecX& y, double t0, double t1, const StepOpti
       tn = (std::abs(t + h - to) <= eps) ? to : t + h;
       st.rhs_evals += 3;
       if (ne == 0) break;
-      sys.events(tn, y1, gend.data());
-      bool any = false;
-      for (int i = 0; i < ne; ++i) any = any || gend[i] * sgn[i] < 0;
-      if (!any) {
+      if (!ev.end(sys, tn, y1, h)) {
         creeps = round > 0 ? creeps + 1 : 0;
         break;
       }
       sys.rhs(tn, y1, f1);
       ++st.rhs_evals;
       auto dense = [&](double th, VecX& out) { hermite(th, h, y, k1, y1, f1, out); };
-      const double th = locate_events(sys, t, h, dense, sgn, gend, gbuf, ybuf, crossed);
-      if (creeps < kMaxCreeps && round < 2 && th > 0 && th < 1.0 - 1e-9) {
+      const double th = ev.locate(sys, t, h, dense);
+      if (th < 0) {  // a suspected dip that does not reach zero
+        creeps = round > 0 ? creeps + 1 : 0;
+        break;
+      }
+      if (creeps < kMaxCreeps && round < 2 && th < 1.0 - 1e-9) {
         h = representable_step(t, h * th);
         continue;
       }
-      take_events(sys, t, h, th, dense, crossed, sgn, st, tn, y1);
-      changed = !crossed.empty() && sys.apply_events(tn, y1);
+      take_events(sys, t, h, th, dense, ev.crossed, ev.sgn, st, tn, y1);
+      changed = !ev.crossed.empty() && sys.apply_events(tn, y1);
+      cut = th < 1.0;
       creeps = 0;
       break;
     }
@@ -705,7 +782,12 @@ void integrate_rk4(OdeSystem& sys, VecX& y, double t0, double t1, const StepOpti
     t = tn;
     sys.project_and_rhs(t, y, k1);
     ++st.rhs_evals;
-    if (changed) init_event_signs(sys, t, y, sgn, gbuf);
+    if (changed)
+      ev.init(sys, t, y);
+    else if (cut)
+      ev.refresh(sys, t, y);
+    else if (ne > 0)
+      ev.next();
     ++st.steps;
     if (every_step) {
       sys.output(t, y);
@@ -815,10 +897,9 @@ void integrate_trbdf2(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
   };
 
   const int ne = sys.n_events();
-  std::vector<int>&sgn = wk.signs, &crossed = wk.crossed;
-  sgn.assign(static_cast<size_t>(ne), 1);
-  VecX &gend = wk.vec(36, ne), &gbuf = wk.vec(37, ne), &ybuf = wk.vec(38, n), &yh = wk.vec(39, n);
-  init_event_signs(sys, t, y, sgn, gbuf);
+  EventState ev(sys, wk, n);
+  VecX& yh = wk.vec(39, n);
+  ev.init(sys, t, y);
   weights(y);
   // initial step: a fraction of the span, limited by the first derivative
   double h = opt.dt > 0
@@ -877,20 +958,27 @@ void integrate_trbdf2(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
       yh = y1;
       auto dense = [&](double th, VecX& out) { hermite(th, h, y, K1, yh, K3, out); };
       bool changed = false;  // an event changed the state or the event functions
-      if (ne > 0) {
-        sys.events(tn, y1, gend.data());
-        const double th = locate_events(sys, t, h, dense, sgn, gend, gbuf, ybuf, crossed);
-        take_events(sys, t, h, th, dense, crossed, sgn, st, tn, y1);
+      bool cut = false;      // an event ended the step early
+      ev.crossed.clear();
+      if (ne > 0 && ev.end(sys, tn, y1, h)) {
+        const double th = ev.locate(sys, t, h, dense);
+        take_events(sys, t, h, th, dense, ev.crossed, ev.sgn, st, tn, y1);
+        cut = th > 0 && th < 1.0;
       }
       for (; !every_step && ko < touts.size() && touts[ko] <= tn; ++ko) {
         dense((touts[ko] - t) / h, yo);
         sys.output(touts[ko], yo);
       }
-      if (ne > 0 && !crossed.empty()) changed = sys.apply_events(tn, y1);
+      if (ne > 0 && !ev.crossed.empty()) changed = sys.apply_events(tn, y1);
       y = y1;
       sys.project_and_rhs(tn, y, K1);
       ++st.rhs_evals;
-      if (changed) init_event_signs(sys, tn, y, sgn, gbuf);
+      if (changed)
+        ev.init(sys, tn, y);
+      else if (cut)
+        ev.refresh(sys, tn, y);
+      else if (ne > 0)
+        ev.next();
       t = tn;
       ++st.steps;
       if (every_step) sys.output(t, y);

@@ -2,33 +2,58 @@
 // Internal to simulate(): joint position limits as unilateral constraints (SimOptions::limits).
 //
 // Every one-coordinate joint (revolute, prismatic) with a finite lower or upper limit and no
-// drive has a stop at each finite limit. A stop is free or engaged:
-//  - free: its event function is the distance to the limit, s (q - limit) (s = +1 at a lower
-//    limit, -1 at an upper; plus kMargin), located by the integrator when it turns negative: the
-//    joint hits the stop. The impact is an impulse about the joint axis that leaves the rate s qd+
-//    = -e s qd- (restitution e; engaged stops keep qd = 0), from the impulse-momentum equations of
-//    the whole mechanism: the rate response to a unit impulse at stop k is the acceleration
-//    response to a unit joint torque at k (the dynamics are affine in an added joint torque), so
-//    one more evaluation per stop gives the Delassus matrix A_ik = s_i s_k (dqdd_i / dtau_k) (the
-//    inverse mass matrix seen by the stops, positive definite for independent stops) and the
-//    impulses solve A mu = s dqd. The kinetic energy drops by 1/2 (1 - e^2) qd-^2 / A_kk: it never
-//    rises. With e = 0, or a rebound slower than kRestRate, the stop engages.
-//  - engaged: the stop holds the joint with a torque s lambda (lambda >= 0) that keeps
-//    s qdd = 0, from the same responses: A lambda = -s qdd_free. Its event function is lambda:
-//    when the load would pull the joint off the stop (lambda turns negative), it releases.
-// Both formulations give the same dynamics through the same three primitives (StopAccess):
-// the accelerations with an added joint torque, the joint coordinate at a state, and its
-// acceleration; the Cartesian path reuses the KKT factorisation for the responses.
+// drive has a stop at each finite limit; s = +1 at a lower limit, -1 at an upper, so that the
+// gap s (q - limit) >= 0 inside. A stop is free or engaged:
+//  - free: its event function is the gap plus kMargin (relative to max(1, |limit|)); the
+//    integrator locates its sign change and, through the event rates
+//    s qd, a gap that turns negative and back within one step (the joint out past the stop and
+//    back). Every contact change leaves a free stop exactly on its limit or inside it, so its
+//    event function always starts positive and the next crossing is a sign change.
+//  - engaged: the stop holds the joint with a torque s lambda, lambda >= 0, that keeps
+//    s qdd = 0 (a bilateral solve over the engaged stops between events, A lambda = -s qdd_free).
+//    Its event function is lambda: when it turns negative, the contact problem is solved again.
+// The contact problem, at every event, over the stops in contact C (engaged, or within 2 kTol of
+// their limits), through the Delassus matrix A_ik = s_i s_k dqdd_i/dtau_k (the inverse mass
+// matrix seen by the stops: the rate response to a unit impulse at k, positive semi-definite):
+//  1. Impact, when a stop of C approaches (s qd < 0): Poisson's law as linear complementarity
+//     problems (solver/lcp.hpp, exact pivoting, any number of stops, redundant ones too). The
+//     compression impulses solve  w = A mu_c + v-,  mu_c >= 0, w >= 0, mu_c' w = 0  (v- the stops'
+//     rates s qd); restitution adds e mu_c, so v+ = v- + (1 + e) A mu_c. The kinetic energy drops
+//     by 1/2 (1 - e^2) mu_c' A mu_c: it never rises (one stop: 1/2 (1 - e^2) qd-^2 / A_kk). A stop
+//     that the restitution drives into its limit (coupled stops) starts another round.
+//  2. Accumulation: a rebound whose apex v+^2 / (2 |a|) under the acceleration a back into the
+//     stop (with the resting stops' forces) stays within the stop's tolerance cannot be resolved
+//     by any event location: the geometric series of ever shorter bounces that would follow is
+//     summed at once (its restitution is dropped, the joint rests on the stop), losing exactly
+//     the energy the series would lose, the rebound's kinetic energy. (Should dropping some
+//     coupled stops' restitution but not others' raise the energy, the whole impact is plastic.)
+//  3. Resting contact: over the stops of C at rest (a rate within the same apex bound), the
+//     acceleration-level problem  w = A lambda + a0,  lambda >= 0, w >= 0, lambda' w = 0  (a0 the
+//     stops' s qdd without stop forces): a stop with w = 0 engages (degenerate ones, lambda = 0,
+//     stay free, and so does one the bilateral solve over the engaged stops then finds pulling
+//     or holding with less than 1e-6 of the torque that stops its free acceleration: the event
+//     function of every engaged stop starts positive), one with w > 0 is free and leaves its
+//     limit.
+// Each stop whose state changed records one event ("rest", "bounce" or "release"): never a rest
+// and a release of one stop at one instant. Positions of C are put on their limits, rates of
+// the engaged stops to zero (joint space: exactly; Cartesian: along the stops' responses, which
+// keep the velocity constraints; the Cartesian system projects the located state onto the
+// constraints before, and the integrator after, so that the stops stay on their limits to
+// round-off and the velocity residual stays at round-off). Both formulations give the same dynamics
+// through the same primitives (StopAccess); the Cartesian path reuses the KKT factorisation for the
+// responses.
 #pragma once
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "armdyn/errors.hpp"
 #include "armdyn/math/types.hpp"
 #include "armdyn/model/model.hpp"
+#include "armdyn/solver/lcp.hpp"
 
 namespace armdyn::detail {
 
@@ -65,11 +90,13 @@ class LimitStops {
   };
   /// Kinds of the recorded events.
   enum Kind { Hit = 0, Bounce = 1, Release = 2 };
-  /// Rebounds slower than this [rad/s or m/s] engage the stop instead of bouncing (no chatter
-  /// of ever smaller bounces).
-  static constexpr double kRestRate = 1e-6;
-  /// A free stop's event fires this far (relative to max(1, |limit|)) beyond its limit.
-  static constexpr double kMargin = 1e-9;
+  /// The stop's tolerance, relative to max(1, |limit|): a rebound whose apex stays within it
+  /// ends at rest (an accumulation); stops this close to their limits are in contact.
+  static constexpr double kTol = 1e-9;
+  /// A free stop's event fires this far (relative to max(1, |limit|)) beyond its limit: far
+  /// below kTol, so that putting a located hit back on the limit adds far less potential energy
+  /// than the smallest resolved bounce dissipates (else a chatter of bounces at that energy).
+  static constexpr double kMargin = 1e-12;
   /// Contact changes at one instant before the run is stopped as chattering.
   static constexpr int kMaxSwitches = 200;
 
@@ -87,13 +114,15 @@ class LimitStops {
       if (has_upper) stops_.push_back({j, jt.coord0, jt.dof0, -1, jt.upper});
     }
     const long k = static_cast<long>(stops_.size());
-    A_.resize(k, k);
-    L_.resize(k, k);
-    rhs_.resize(k);
-    sol_.resize(k);
-    a0_.resize(k);
+    for (MatX* M : {&A_, &L_, &Ms_}) M->resize(k, k);
+    for (VecX* v : {&rhs_, &sol_, &a0_, &vm_, &vp_, &vr_, &mu_, &ep_, &lam_, &acc_, &qs_})
+      v->resize(k);
+    for (std::vector<char>* f : {&pend_, &was_, &hit_, &rest_, &sep_}) f->assign(stops_.size(), 0);
     set_.reserve(stops_.size());
+    sub_.reserve(stops_.size());
+    cset_.reserve(stops_.size());
     pending_.reserve(stops_.size());
+    lcp_.reserve(static_cast<int>(k));
     tau_ = VecX::Zero(m.nv_joint);
   }
 
@@ -120,27 +149,27 @@ class LimitStops {
       if (s.engaged) tau_[s.dof] += s.side * s.lambda;
     return tau_;
   }
+  /// The stop's tolerance in its coordinate's unit.
+  double tolerance(const Stop& s) const { return kTol * std::max(1.0, std::abs(s.limit)); }
 
-  /// The initial state: refused outside the limits (beyond round-off); at a limit and not
-  /// moving off it, the stop is hit there. Returns whether y changed.
+  /// The initial state: refused outside the limits (beyond the tolerance); the contact problem
+  /// at the stops on their limits. Returns whether y changed.
   bool start(StopAccess& a, double t, VecX& y) {
     a.stop_load(y);
     for (int i = 0; i < size(); ++i) {
       const Stop& s = stops_[static_cast<size_t>(i)];
       double q, qd;
       a.stop_coordinate(y, s.coord, q, qd);
-      const double tol = 1e-9 * std::max(1.0, std::abs(s.limit));
       const Joint& jt = m_.joints[static_cast<size_t>(s.joint)];
-      if (s.side * (q - s.limit) < -tol)
+      if (s.side * (q - s.limit) < -tolerance(s))
         throw ModelError(msg("simulate: joint '", jt.name, "' starts at ", q, ", outside its ",
                              s.side > 0 ? "lower" : "upper", " limit ", s.limit,
                              " (limits='ignore' runs without them)"));
-      if (s.side * (q - s.limit) <= tol && s.side * qd <= 0) pending_.push_back(i);
     }
-    return apply(a, t, y);
+    return resolve(a, t, y);
   }
 
-  /// Event functions: free stops' distance to their limits, engaged stops' lambdas.
+  /// Event functions: free stops' gaps plus kMargin, engaged stops' lambdas.
   void events(StopAccess& a, double t, const VecX& y, VecX& scratch, double* g) {
     if (any_engaged()) {
       scratch.resize(y.size());
@@ -154,12 +183,20 @@ class LimitStops {
       if (s.engaged) {
         g[i] = s.lambda;
       } else {
-        // the distance to the stop, plus a margin far below any tolerance: a joint that left
-        // its stop (exactly on it) starts on the free side, so its next contact is a crossing
         double q, qd;
         a.stop_coordinate(y, s.coord, q, qd);
         g[i] = s.side * (q - s.limit) + kMargin * std::max(1.0, std::abs(s.limit));
       }
+    }
+  }
+  /// The event functions' rates where known: s qd for the free stops, NaN for the engaged.
+  void event_rates(StopAccess& a, const VecX& y, double* dg) {
+    a.stop_load(y);
+    for (size_t i = 0; i < stops_.size(); ++i) {
+      const Stop& s = stops_[i];
+      double q, qd;
+      a.stop_coordinate(y, s.coord, q, qd);
+      dg[i] = s.engaged ? std::numeric_limits<double>::quiet_NaN() : s.side * qd;
     }
   }
 
@@ -198,54 +235,18 @@ class LimitStops {
     for (int i = 0; i < size(); ++i)
       if (stops_[static_cast<size_t>(i)].engaged) set_.push_back(i);
     if (set_.empty()) return false;
-    const long k = static_cast<long>(set_.size());
     responses(a, t, y, dy);
-    const long v0 = a.stop_velocity_offset(), nv = a.stop_velocity_size();
-    bool moved = false;
-    for (int pass = 0; pass < 2; ++pass) {  // rates, then positions
-      for (long r = 0; r < k; ++r) {
-        const Stop& s = stops_[static_cast<size_t>(set_[static_cast<size_t>(r)])];
-        double q, qd;
-        a.stop_coordinate(y, s.coord, q, qd);
-        rhs_[r] = pass == 0 ? -qd : s.limit - q;
-        moved = moved || rhs_[r] != 0.0;
-        rhs_[r] *= s.side;
-      }
-      solve_delassus(k);
-      if (pass == 0) {
-        for (long c = 0; c < k; ++c) y.segment(v0, nv).noalias() += sol_[c] * R_.col(c);
-      } else {
-        dv_.setZero(nv);
-        for (long c = 0; c < k; ++c) dv_.noalias() += sol_[c] * R_.col(c);
-        a.stop_displace(y, dv_);
-      }
-    }
-    return moved;
+    return place(a, y, static_cast<long>(set_.size()), true);
   }
 
-  /// The located crossings of a step, at the end of the cut step: hits (impacts), releases.
+  /// The located crossings of a step, at the end of the cut step: the contact problem there.
   /// Returns whether anything changed.
   bool apply(StopAccess& a, double t, VecX& y) {
     if (pending_.empty()) return false;
-    bool changed = false;
-    std::vector<int> hits;  // only on events: not a hot path
-    for (int i : pending_) {
-      Stop& s = stops_[static_cast<size_t>(i)];
-      if (s.engaged) {
-        s.engaged = false;
-        s.lambda = 0.0;
-        record(t, i, Release);
-        changed = true;
-      } else {
-        hits.push_back(i);
-      }
-    }
+    std::fill(pend_.begin(), pend_.end(), 0);
+    for (int i : pending_) pend_[static_cast<size_t>(i)] = 1;
     pending_.clear();
-    if (!hits.empty()) {
-      impact(a, t, y, hits);
-      changed = true;
-    }
-    settle(a, t, y);
+    const bool changed = resolve(a, t, y);
     // never a silent hang: a mechanism whose stops keep switching at one instant is an error
     if (t - chatter_t_ > 1e-9 * std::max(1.0, std::abs(t))) {
       chatter_t_ = t;
@@ -260,50 +261,7 @@ class LimitStops {
           " contact changes at one instant; engaged: ", names.empty() ? std::string("none") : names,
           "); simulate(limits='ignore') runs without the stops"));
     }
-    return changed;
-  }
-
-  /// The contact state at (t, y) consistent with the stops' unilateral law (an active set over
-  /// the stops at their limits and at rest there): every engaged stop pushes (lambda >= 0) and
-  /// no free one at its limit accelerates into it. One change at a time, the worst first.
-  void settle(StopAccess& a, double t, VecX& y) {
-    VecX& f = scratch_;
-    f.resize(y.size());
-    a.stop_load(y);
-    std::vector<bool> at_rest(stops_.size(), false);
-    for (int i = 0; i < size(); ++i) {
-      const Stop& s = stops_[static_cast<size_t>(i)];
-      double q, qd;
-      a.stop_coordinate(y, s.coord, q, qd);
-      const double scale = std::max(1.0, std::abs(s.limit));
-      at_rest[static_cast<size_t>(i)] =
-          !s.engaged && std::abs(q - s.limit) <= 1e-9 * scale && std::abs(qd) <= kRestRate;
-    }
-    for (int round = 0; round < 4 * size() + 4; ++round) {
-      a.stop_eval(t, y, nullptr, f, false);
-      solve(a, t, y, f);
-      int worst = -1;
-      double worst_value = 0.0;
-      for (int i = 0; i < size(); ++i) {
-        const Stop& s = stops_[static_cast<size_t>(i)];
-        double value = 0.0;
-        if (s.engaged)
-          value = s.lambda;  // < 0: it would pull
-        else if (at_rest[static_cast<size_t>(i)])
-          value = s.side * a.stop_acceleration(y, f, s.coord);  // < 0: into the stop
-        if (value < worst_value) {
-          worst = i;
-          worst_value = value;
-        }
-      }
-      if (worst < 0) return;
-      Stop& s = stops_[static_cast<size_t>(worst)];
-      s.engaged = !s.engaged;
-      s.lambda = 0.0;
-      at_rest[static_cast<size_t>(worst)] = !s.engaged;
-      if (s.engaged) a.stop_place(y, s.coord, s.limit);
-      record(t, worst, s.engaged ? Hit : Release);
-    }
+    return changed || true;  // the crossed functions' signs are taken afresh either way
   }
 
   /// Located stop events: time, stop index, kind.
@@ -317,6 +275,245 @@ class LimitStops {
     event_kind.push_back(kind);
   }
 
+  Stop& at(long r) { return stops_[static_cast<size_t>(set_[static_cast<size_t>(r)])]; }
+
+  // The contact problem at (t, y) over the stops in contact (see the header). Returns whether
+  // y or the contact state changed.
+  bool resolve(StopAccess& a, double t, VecX& y) {
+    // C: the engaged stops and those within 2 kTol of their limits; their rates v-
+    a.stop_load(y);
+    set_.clear();
+    double vscale = 0.0;
+    for (int i = 0; i < size(); ++i) {
+      Stop& s = stops_[static_cast<size_t>(i)];
+      was_[static_cast<size_t>(i)] = s.engaged;
+      hit_[static_cast<size_t>(i)] = pend_[static_cast<size_t>(i)] && !s.engaged;
+      double q, qd;
+      a.stop_coordinate(y, s.coord, q, qd);
+      if (!s.engaged && s.side * (q - s.limit) > 2 * tolerance(s)) continue;
+      vm_[static_cast<long>(set_.size())] = s.side * qd;
+      vscale = std::max(vscale, std::abs(s.side * qd));
+      set_.push_back(i);
+    }
+    std::fill(pend_.begin(), pend_.end(), 0);
+    const long k = static_cast<long>(set_.size());
+    if (k == 0) return false;
+    VecX& f = scratch_;
+    f.resize(y.size());
+    a.stop_eval(t, y, nullptr, f, false);
+    responses(a, t, y, f);  // A over C (positions only: valid through the impacts), R
+    eps_v_ = 1e-12 * vscale;
+    const long v0 = a.stop_velocity_offset(), nv = a.stop_velocity_size();
+    for (long r = 0; r < k; ++r) mu_[r] = 0.0;
+    for (int round = 0; round < kMaxSwitches; ++round) {
+      bool again = false;
+      if (!impact(a, t, y, k, v0, nv, again)) break;
+      if (!again) break;
+    }
+    if (mu_.head(k).isZero(0.0)) rest_set(a, t, y, k);  // no impact: the resting contact alone
+    engage(a, t, y, k);
+    // the record: one event per stop whose state changed
+    for (long r = 0; r < k; ++r) {
+      const int i = set_[static_cast<size_t>(r)];
+      const Stop& s = stops_[static_cast<size_t>(i)];
+      const bool was = was_[static_cast<size_t>(i)] != 0;
+      if (was && !s.engaged)
+        record(t, i, Release);
+      else if (!was && s.engaged)
+        record(t, i, Hit);
+      else if (!was && (hit_[static_cast<size_t>(i)] || mu_[r] > 0))
+        record(t, i, Bounce);
+    }
+    return true;
+  }
+
+  // One impact round from the stops' current rates; mu_ accumulates the impulses of C. Sets
+  // again when the restitution drove a stop of C into its limit (another round). Returns false
+  // when no stop approaches.
+  bool impact(StopAccess& a, double t, VecX& y, long k, long v0, long nv, bool& again) {
+    a.stop_load(y);
+    bool approach = false;
+    for (long r = 0; r < k; ++r) {
+      double q, qd;
+      a.stop_coordinate(y, at(r).coord, q, qd);
+      qs_[r] = at(r).side * qd;
+      approach = approach || qs_[r] < -eps_v_;
+    }
+    if (!approach) return false;
+    for (long r = 0; r < k; ++r) vm_[r] = qs_[r];
+    // compression: w = A mu_c + v-, complementary
+    Ms_.topLeftCorner(k, k) = A_.topLeftCorner(k, k);
+    if (!lcp_.solve(Ms_, qs_, static_cast<int>(k))) {
+      std::string names;
+      for (long r = 0; r < k; ++r) names += (r ? ", '" : "'") + m_.joints[at(r).joint].name + "'";
+      throw SolverError(msg("joint stops: no impulse stops the impact at t=", t, " (stops of ",
+                            names, "); simulate(limits='ignore') runs without the stops"));
+    }
+    dv_ = y.segment(v0, nv);  // the velocities before this round
+    for (long r = 0; r < k; ++r) ep_[r] = lcp_.z()[r] > 0 ? e_ : 0.0;
+    VecX& muc = sol_;
+    muc.head(k) = lcp_.z().head(k);
+    // restitution, dropped for rebounds that accumulate (their apex within the tolerance)
+    for (int pass = 0; pass <= k; ++pass) {
+      mixed_restitution_guard(k, muc);
+      for (long r = 0; r < k; ++r) rhs_[r] = (1.0 + ep_[r]) * muc[r];
+      y.segment(v0, nv) = dv_;
+      for (long c = 0; c < k; ++c) y.segment(v0, nv).noalias() += rhs_[c] * R_.col(c);
+      vp_.head(k) = vm_.head(k) + A_.topLeftCorner(k, k) * rhs_.head(k);
+      rest_set(a, t, y, k);
+      bool dropped = false;
+      for (long r = 0; r < k; ++r) {
+        // a rebound within the apex bound (rest_set): the series of bounces it starts is
+        // summed, the stop rests
+        if (ep_[r] > 0.0 && rest_[static_cast<size_t>(r)]) {
+          ep_[r] = 0.0;
+          dropped = true;
+        }
+      }
+      if (!dropped) break;
+    }
+    for (long r = 0; r < k; ++r) mu_[r] += rhs_[r];
+    again = false;
+    for (long r = 0; r < k; ++r)
+      again = again || (!rest_[static_cast<size_t>(r)] && vp_[r] < -vr_[r] - eps_v_);
+    return true;
+  }
+
+  // Per-stop restitution (some rebounds dropped) can raise the kinetic energy of coupled stops:
+  // 1/2 ((E mu)' A (E mu) - mu' A mu) > 0. Then every stop of the impact is plastic.
+  void mixed_restitution_guard(long k, const VecX& muc) {
+    bool mixed = false;
+    for (long r = 0; r < k; ++r) mixed = mixed || (muc[r] > 0 && ep_[r] != e_);
+    if (!mixed) return;
+    for (long r = 0; r < k; ++r) qs_[r] = ep_[r] * muc[r];
+    const double gain = qs_.head(k).dot(A_.topLeftCorner(k, k) * qs_.head(k)) -
+                        muc.head(k).dot(A_.topLeftCorner(k, k) * muc.head(k));
+    if (gain > 0)
+      for (long r = 0; r < k; ++r) ep_[r] = 0.0;
+  }
+
+  // The resting contact at (t, y) over C: the stops' rates vp_, free accelerations a0_, the
+  // rest set (rates within the apex bound vr_ of the acceleration acc_ back into the stop),
+  // its LCP: lam_ (0 off the set), sep_ (separating: w > 0), acc_ = a0 + A lambda.
+  void rest_set(StopAccess& a, double t, const VecX& y, long k) {
+    VecX& f = scratch_;
+    a.stop_eval(t, y, nullptr, f, false);
+    for (long r = 0; r < k; ++r) {
+      double q, qd;
+      a.stop_coordinate(y, at(r).coord, q, qd);
+      vp_[r] = at(r).side * qd;
+      a0_[r] = at(r).side * a.stop_acceleration(y, f, at(r).coord);
+      acc_[r] = a0_[r];
+      rest_[static_cast<size_t>(r)] = 0;
+    }
+    for (int round = 0; round <= k + 1; ++round) {
+      bool changed = false;
+      for (long r = 0; r < k; ++r) {
+        vr_[r] = std::sqrt(2.0 * tolerance(at(r)) * std::max(0.0, -acc_[r]));
+        const char in = vp_[r] <= vr_[r] + eps_v_ ? 1 : 0;
+        changed = changed || in != rest_[static_cast<size_t>(r)];
+        rest_[static_cast<size_t>(r)] = in;
+      }
+      if (!changed && round > 0) break;
+      sub_.clear();
+      for (long r = 0; r < k; ++r)
+        if (rest_[static_cast<size_t>(r)]) sub_.push_back(static_cast<int>(r));
+      const long m = static_cast<long>(sub_.size());
+      for (long i = 0; i < m; ++i) {
+        qs_[i] = a0_[sub_[static_cast<size_t>(i)]];
+        for (long j = 0; j < m; ++j)
+          Ms_(i, j) = A_(sub_[static_cast<size_t>(i)], sub_[static_cast<size_t>(j)]);
+      }
+      if (m > 0 && !lcp_.solve(Ms_, qs_, static_cast<int>(m))) {
+        std::string names;
+        for (long i = 0; i < m; ++i)
+          names += (i ? ", '" : "'") + m_.joints[at(sub_[static_cast<size_t>(i)]).joint].name + "'";
+        throw SolverError(msg("joint stops: no contact forces hold the stops of ", names,
+                              " at rest at t=", t,
+                              "; simulate(limits='ignore') runs without the stops"));
+      }
+      lam_.head(k).setZero();
+      for (long r = 0; r < k; ++r) sep_[static_cast<size_t>(r)] = 0;
+      for (long i = 0; i < m; ++i) {
+        const long r = sub_[static_cast<size_t>(i)];
+        lam_[r] = lcp_.z()[i];
+        sep_[static_cast<size_t>(r)] = !lcp_.basic_z(static_cast<int>(i)) && lcp_.w()[i] > 0;
+      }
+      acc_.head(k) = a0_.head(k) + A_.topLeftCorner(k, k) * lam_.head(k);
+    }
+  }
+
+  // The new contact state over C from rest_set: the stops at rest that do not separate and
+  // push engage (lambda > 0; the bilateral solve over them confirms it), the others are free;
+  // then every stop of C on its limit, the engaged ones' rates zeroed.
+  void engage(StopAccess& a, double t, VecX& y, long k) {
+    cset_.assign(set_.begin(), set_.end());  // (solve rebuilds set_)
+    for (long r = 0; r < k; ++r)
+      at(r).engaged = rest_[static_cast<size_t>(r)] && !sep_[static_cast<size_t>(r)] && lam_[r] > 0;
+    VecX& f = scratch_;
+    // a stop the bilateral solve pulls, or holds with next to nothing (below 1e-6 of the torque
+    // that stops its free acceleration: round-off of a degenerate contact), is free
+    for (int round = 0; round <= k; ++round) {
+      a.stop_eval(t, y, nullptr, f, false);
+      solve(a, t, y, f);  // (set_: the engaged stops, a0_ and A_ theirs)
+      long worst = -1;
+      double worst_value = 0.0;
+      for (long r = 0; r < static_cast<long>(set_.size()); ++r) {
+        const double value = at(r).lambda - 1e-6 * std::abs(a0_[r]) / A_(r, r);
+        if (value <= 0 && (worst < 0 || value < worst_value)) {
+          worst = r;
+          worst_value = value;
+        }
+      }
+      if (worst < 0) break;
+      at(worst).engaged = false;
+      at(worst).lambda = 0.0;
+    }
+    // positions of C on their limits; the engaged stops' rates to zero
+    set_.clear();
+    for (int i : cset_)
+      if (stops_[static_cast<size_t>(i)].engaged) set_.push_back(i);
+    if (!set_.empty()) {
+      a.stop_eval(t, y, nullptr, f, false);
+      responses(a, t, y, f);
+      place(a, y, static_cast<long>(set_.size()), true);
+    }
+    set_.assign(cset_.begin(), cset_.end());
+    a.stop_eval(t, y, nullptr, f, false);
+    responses(a, t, y, f);
+    place(a, y, k, false);
+  }
+
+  // Rates (when rates) and offsets from the limits of the leading k stops of set_ removed along
+  // their responses R_ (A_ their Delassus matrix); the joint formulation then places them
+  // exactly. Returns whether y moved.
+  bool place(StopAccess& a, VecX& y, long k, bool rates) {
+    const long v0 = a.stop_velocity_offset(), nv = a.stop_velocity_size();
+    bool moved = false;
+    for (int pass = rates ? 0 : 1; pass < 2; ++pass) {  // rates, then positions
+      a.stop_load(y);
+      for (long r = 0; r < k; ++r) {
+        const Stop& s = at(r);
+        double q, qd;
+        a.stop_coordinate(y, s.coord, q, qd);
+        rhs_[r] = pass == 0 ? -qd : s.limit - q;
+        moved = moved || rhs_[r] != 0.0;
+        rhs_[r] *= s.side;
+      }
+      solve_delassus(k);
+      if (pass == 0) {
+        for (long c = 0; c < k; ++c) y.segment(v0, nv).noalias() += sol_[c] * R_.col(c);
+      } else {
+        dv_.setZero(nv);
+        for (long c = 0; c < k; ++c) dv_.noalias() += sol_[c] * R_.col(c);
+        a.stop_displace(y, dv_);
+        for (long r = 0; r < k; ++r) a.stop_place(y, at(r).coord, at(r).limit);
+      }
+    }
+    a.stop_load(y);
+    return moved;
+  }
+
   // R_ (velocity block x k): the responses of dy to a unit torque s_k at each stop of set_;
   // A_: their accelerations at the stops (times s_i); a0_: the stops' s_i qdd in dy.
   void responses(StopAccess& a, double t, const VecX& y, const VecX& dy) {
@@ -324,20 +521,15 @@ class LimitStops {
     const long v0 = a.stop_velocity_offset(), nv = a.stop_velocity_size();
     if (R_.rows() != nv || R_.cols() < k) R_.resize(nv, size());
     dyk_.resize(dy.size());
-    for (long r = 0; r < k; ++r) {
-      const Stop& s = stops_[static_cast<size_t>(set_[static_cast<size_t>(r)])];
-      a0_[r] = s.side * a.stop_acceleration(y, dy, s.coord);
-    }
+    for (long r = 0; r < k; ++r) a0_[r] = at(r).side * a.stop_acceleration(y, dy, at(r).coord);
     for (long c = 0; c < k; ++c) {
-      const Stop& sc = stops_[static_cast<size_t>(set_[static_cast<size_t>(c)])];
+      const Stop& sc = at(c);
       tau_.setZero();
       tau_[sc.dof] = sc.side;
       a.stop_eval(t, y, tau_.data(), dyk_, true);
       R_.col(c) = dyk_.segment(v0, nv) - dy.segment(v0, nv);
-      for (long r = 0; r < k; ++r) {
-        const Stop& sr = stops_[static_cast<size_t>(set_[static_cast<size_t>(r)])];
-        A_(r, c) = sr.side * a.stop_acceleration(y, dyk_, sr.coord) - a0_[r];
-      }
+      for (long r = 0; r < k; ++r)
+        A_(r, c) = at(r).side * a.stop_acceleration(y, dyk_, at(r).coord) - a0_[r];
     }
     tau_.setZero();
   }
@@ -371,81 +563,17 @@ class LimitStops {
     }
   }
 
-  // The impulse of the stops hit (and of the engaged ones, which keep qd = 0) at (t, y).
-  void impact(StopAccess& a, double t, VecX& y, const std::vector<int>& hits) {
-    VecX& f = scratch_;
-    f.resize(y.size());
-    a.stop_load(y);
-    std::vector<double> rate(stops_.size(), 0.0);
-    for (int i = 0; i < size(); ++i) {
-      double q, qd;
-      a.stop_coordinate(y, stops_[static_cast<size_t>(i)].coord, q, qd);
-      rate[static_cast<size_t>(i)] = qd;
-    }
-    // the post-impact rates: rebound -e qd- for the hits, 0 for the engaged
-    std::vector<double> target(stops_.size(), 0.0);
-    std::vector<bool> sticks(stops_.size(), false);
-    for (int i : hits) {
-      const Stop& s = stops_[static_cast<size_t>(i)];
-      const double into = -s.side * rate[static_cast<size_t>(i)];  // > 0 moving into the stop
-      const double out = e_ * std::max(into, 0.0);
-      sticks[static_cast<size_t>(i)] = !(out > kRestRate);
-      target[static_cast<size_t>(i)] = sticks[static_cast<size_t>(i)] ? 0.0 : s.side * out;
-    }
-    std::vector<bool> in_set(stops_.size(), false);
-    for (int i = 0; i < size(); ++i) in_set[static_cast<size_t>(i)] = stops_[i].engaged;
-    for (int i : hits) in_set[static_cast<size_t>(i)] = true;
-    // impulses must push: a stop whose impulse would pull leaves the set (it separates)
-    for (int round = 0; round <= size(); ++round) {
-      set_.clear();
-      for (int i = 0; i < size(); ++i)
-        if (in_set[static_cast<size_t>(i)]) set_.push_back(i);
-      if (set_.empty()) break;
-      const long k = static_cast<long>(set_.size());
-      a.stop_eval(t, y, nullptr, f, false);
-      responses(a, t, y, f);
-      for (long r = 0; r < k; ++r) {
-        const int i = set_[static_cast<size_t>(r)];
-        const Stop& s = stops_[static_cast<size_t>(i)];
-        rhs_[r] = s.side * (target[static_cast<size_t>(i)] - rate[static_cast<size_t>(i)]);
-      }
-      solve_delassus(k);
-      int worst = -1;
-      for (long r = 0; r < k; ++r)
-        if (sol_[r] < 0 && (worst < 0 || sol_[r] < sol_[worst])) worst = static_cast<int>(r);
-      if (worst < 0 || round == size()) {
-        const long v0 = a.stop_velocity_offset(), nv = a.stop_velocity_size();
-        for (long c = 0; c < k; ++c) y.segment(v0, nv).noalias() += sol_[c] * R_.col(c);
-        break;
-      }
-      in_set[static_cast<size_t>(set_[static_cast<size_t>(worst)])] = false;
-    }
-    for (int i : hits) {
-      Stop& s = stops_[static_cast<size_t>(i)];
-      const bool engage = sticks[static_cast<size_t>(i)] && in_set[static_cast<size_t>(i)];
-      if (engage) {
-        s.engaged = true;
-        a.stop_place(y, s.coord, s.limit);
-      }
-      record(t, i, engage ? Hit : Bounce);
-    }
-    for (int i = 0; i < size(); ++i) {
-      Stop& s = stops_[static_cast<size_t>(i)];
-      if (s.engaged && !in_set[static_cast<size_t>(i)]) {
-        s.engaged = false;
-        record(t, i, Release);
-      }
-    }
-  }
-
   const Model& m_;
   double e_;
+  double eps_v_ = 0.0;  // the round-off of the stops' rates at this event
   double chatter_t_ = -1e300;
   int chatter_n_ = 0;
   std::vector<Stop> stops_;
-  std::vector<int> limited_, set_, pending_;
-  MatX A_, L_, R_;
-  VecX rhs_, sol_, a0_, tau_, dyk_, scratch_, dv_;
+  std::vector<int> limited_, set_, sub_, cset_, pending_;
+  std::vector<char> pend_, was_, hit_, rest_, sep_;
+  LcpSolver lcp_;
+  MatX A_, L_, R_, Ms_;
+  VecX rhs_, sol_, a0_, vm_, vp_, vr_, mu_, ep_, lam_, acc_, qs_, tau_, dyk_, scratch_, dv_;
 };
 
 }  // namespace armdyn::detail

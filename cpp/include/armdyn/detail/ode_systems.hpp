@@ -10,6 +10,7 @@
 //    the full model.
 #pragma once
 
+#include <limits>
 #include <vector>
 
 #include "armdyn/algorithm/constraints.hpp"
@@ -142,6 +143,8 @@ class MbsSystem : public OdeSystem, public StopAccess {
       // the engaged stops' joints back on their limits (the projection knows only the joints)
       body_accelerations(m_, d_, t, y.data(), y.data() + m_.nq, dy.data() + m_.nq, true);
       reuse = !stops_->hold(*this, t, y, dy);
+      // the constraints again to round-off (the hold moved along them to first order)
+      if (!reuse) project(m_, d_, t, y.data(), y.data() + m_.nq, metric_);
     }
     body_accelerations(m_, d_, t, y.data(), y.data() + m_.nq, dy.data() + m_.nq, reuse);
     udot(m_, y.data(), y.data() + m_.nq, dy.data());
@@ -162,6 +165,7 @@ class MbsSystem : public OdeSystem, public StopAccess {
       fo_.resize(yo_.size());
       fo_.segment(m_.nq, m_.nv) = vd_;
       if (stops_->hold(*this, t, yo_, fo_)) {
+        project(m_, d_, t, u, v, metric_);
         body_accelerations(m_, d_, t, u, v, vd_.data());
         fo_.segment(m_.nq, m_.nv) = vd_;
       }
@@ -313,6 +317,13 @@ class MbsSystem : public OdeSystem, public StopAccess {
     }
     if (stops_) stops_->events(*this, t, y, fe_, g + ng);
   }
+  bool event_rates(double /*t*/, const VecX& y, double* dg) override {
+    if (!stops_) return false;
+    const int ng = static_cast<int>(m_.gears.size());
+    for (int i = 0; i < ng; ++i) dg[i] = std::numeric_limits<double>::quiet_NaN();
+    stops_->event_rates(*this, y, dg + ng);
+    return true;
+  }
   void on_event(double t, int i, int direction) override {
     const int ng = static_cast<int>(m_.gears.size());
     if (i >= ng) return stops_->on_event(i - ng, direction);
@@ -320,7 +331,15 @@ class MbsSystem : public OdeSystem, public StopAccess {
     out_.event_index.push_back(i);
     out_.event_direction.push_back(direction);
   }
-  bool apply_events(double t, VecX& y) override { return stops_ && stops_->apply(*this, t, y); }
+  bool apply_events(double t, VecX& y) override {
+    if (!stops_) return false;
+    // the contact problem on the constraint manifold: the located state is the dense output's,
+    // off it by the local error, and projecting it after the stops were put on their limits
+    // would move them off again (by more than their event margin)
+    d_.aux = y.data() + m_.nq + m_.nv;
+    project(m_, d_, t, y.data(), y.data() + m_.nq, metric_);
+    return stops_->apply(*this, t, y);
+  }
 
   /// The model's Cartesian pipeline (settings, tracking, counters).
   Data& data() { return d_; }
@@ -449,6 +468,14 @@ class JointSystem : public OdeSystem, public StopAccess {
     const int ng = static_cast<int>(m_.gears.size());
     for (int i = 0; i < ng; ++i) td_.gear_mesh(i, y.data(), y.data() + nq_, s, sd, g[i]);
     if (LimitStops* st = cart_.stops()) st->events(*this, t, y, fe_, g + ng);
+  }
+  bool event_rates(double /*t*/, const VecX& y, double* dg) override {
+    LimitStops* st = cart_.stops();
+    if (!st) return false;
+    const int ng = static_cast<int>(m_.gears.size());
+    for (int i = 0; i < ng; ++i) dg[i] = std::numeric_limits<double>::quiet_NaN();
+    st->event_rates(*this, y, dg + ng);
+    return true;
   }
   void on_event(double t, int i, int direction) override { cart_.on_event(t, i, direction); }
   bool apply_events(double t, VecX& y) override {

@@ -48,6 +48,10 @@ class OdeSystem {
   /// (DOPRI5: its 4th-order dense output; TR-BDF2 and RK4: cubic Hermite).
   virtual int n_events() const { return 0; }
   virtual void events(double /*t*/, const VecX& /*y*/, double* /*g*/) {}
+  /// The rates dg_i/dt of the event functions at (t, y) where the system knows them (NaN
+  /// elsewhere); false when it knows none. With them, a function that turns and comes back
+  /// within one step (of one sign at both ends, of the other between) is located too.
+  virtual bool event_rates(double /*t*/, const VecX& /*y*/, double* /*dg*/) { return false; }
   /// Called for each located crossing; direction +1 when g goes from negative to positive.
   virtual void on_event(double /*t*/, int /*i*/, int /*direction*/) {}
   /// Called once after the on_event calls of a step's crossings, at the end of the cut step
@@ -105,7 +109,7 @@ struct IntegratorWork {
   std::vector<int> signs, crossed;
 
  private:
-  std::array<VecX, 40> v_;
+  std::array<VecX, 44> v_;
   std::array<MatX, 2> m_;
 };
 
