@@ -271,6 +271,32 @@ def test_the_joint_limited_ur5_bouncing_keeps_within_its_limits(coordinates, int
         assert r.velocity_residual.max() <= 1e-12
 
 
+@pytest.mark.parametrize("integrator", ["dopri5", "dop853", "rk4"])
+@pytest.mark.parametrize("coordinates", COORDINATES)
+def test_the_joint_limited_ur5_at_default_tolerances_keeps_within_its_limits(
+    coordinates, integrator
+):
+    """The same fall at the default tolerances (rk4 at dt = 1e-3): on 55d38f0 the Cartesian
+    DOP853 run ended 0.012 rad beyond a limit; every run now stays within 1e-6 of its stops."""
+    m = _ur5_limited()
+    kw = dict(dt=1e-3) if integrator == "rk4" else {}
+    r = ad.simulate(
+        m,
+        5.0,
+        restitution=0.5,
+        coordinates=coordinates,
+        integrator=integrator,
+        output_dt=1e-3,
+        **kw,
+    )
+    assert r.error is None
+    assert np.maximum(r.q - m.coord_upper, m.coord_lower - r.q).max() <= 1e-6
+    ev = r.events["limits"]
+    assert "bounce" in ev["kind"]
+    _one_event_per_stop_and_instant(ev)
+    _events_change_the_contact(ev)
+
+
 @pytest.mark.parametrize(
     "integrator, coordinates", [("dop853", "cartesian"), ("dop853", "joint"), ("dopri5", "joint")]
 )
