@@ -143,6 +143,7 @@ ARMDYN_HINTED_OBJECT(StrArg)          // str (checked by str_arg: a ModelError, 
 ARMDYN_HINTED_OBJECT(FloatArg)        // a real number (checked by float_arg)
 ARMDYN_HINTED_OBJECT(IntArg)          // an integer (checked by int_arg)
 ARMDYN_HINTED_OBJECT(BoolArg)         // bool (checked by bool_arg)
+ARMDYN_HINTED_OBJECT(ModelArg)        // armdyn._core.Model (checked where it is taken)
 ARMDYN_HINTED_OBJECT(FrameRef)        // str | int (a frame's name or index)
 ARMDYN_HINTED_OBJECT(OptMotor)        // Motor | None
 ARMDYN_HINTED_OBJECT(OptProgress)     // Callable[[float, float], object] | None
@@ -388,6 +389,7 @@ ARMDYN_TYPE_HINT(StrArg, "str")
 ARMDYN_TYPE_HINT(FloatArg, "typing.SupportsFloat | typing.SupportsIndex")
 ARMDYN_TYPE_HINT(IntArg, "typing.SupportsInt | typing.SupportsIndex")
 ARMDYN_TYPE_HINT(BoolArg, "bool")
+ARMDYN_TYPE_HINT(ModelArg, "armdyn._core.Model")
 ARMDYN_TYPE_HINT(FrameRef, "str | int")
 ARMDYN_TYPE_HINT(OptMotor, "armdyn._core.Motor | None")
 ARMDYN_TYPE_HINT(OptProgress, "collections.abc.Callable[[float, float], object] | None")

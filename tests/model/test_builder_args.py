@@ -1,7 +1,7 @@
 """Every argument of every ModelBuilder method (and its constructor, finalize and the
-physical_inertia setter), of armdyn.Motor, of urdf_builder and of the armdyn.profiles factories
-fed a wrong type, None, NaN, an infinity, a complex number or array, a lone-surrogate string or
-a huge integer: a ModelError naming the argument, never pybind11's "incompatible function
+physical_inertia setter), of armdyn.Motor and armdyn.Data, of urdf_builder and of the
+armdyn.profiles factories fed a wrong type, None, NaN, an infinity, a complex number or array, a
+lone-surrogate string or a huge integer: a ModelError naming the argument, never pybind11's "incompatible function
 arguments" signature dump nor "Unable to cast" (common.hpp's float_arg, int_arg, bool_arg,
 str_arg in the bindings), and the builder unchanged. The baselines succeed, so each failure is
 the bad argument's."""
@@ -29,6 +29,7 @@ BAD = {
     "inertia": [[[1j, 0, 0], [0, 1, 0], [0, 0, 1]], "abc", [1.0, 2.0]],
     "profile": ["abc", 1j, b"x"],
     "motor": [5, "maxon"],
+    "model": [5, "model", ad.ModelBuilder()],
 }
 
 
@@ -277,6 +278,13 @@ METHODS = [
     ),
 ]
 
+
+def _builder_model():
+    b = _builder()
+    b.add_free("fd", "d")
+    return b.finalize()
+
+
 URDF = """<robot name="r"><link name="base"/><link name="arm"><inertial><mass value="1"/>
   <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
   <joint name="j" type="continuous"><parent link="base"/><child link="arm"/><axis xyz="0 1 0"/>
@@ -318,6 +326,11 @@ FUNCTIONS = [
                 "thermal_time_constant",
             )
         },
+    ),
+    (
+        "Data",
+        lambda **o: ad.Data(**{"model": _builder_model(), **o}),
+        {"model": ("model", False)},
     ),
     ("profiles.constant", lambda **o: ad.profiles.constant(**{"value": 1.0, **o}), {"value": 0}),
     (
