@@ -1,10 +1,10 @@
 """Every argument of every ModelBuilder method (and its constructor, finalize and the
 physical_inertia setter), of armdyn.Motor and armdyn.Data, of urdf_builder and of the
 armdyn.profiles factories fed a wrong type, None, NaN, an infinity, a complex number or array, a
-lone-surrogate string or a huge integer: a ModelError naming the argument, never pybind11's "incompatible function
-arguments" signature dump nor "Unable to cast" (common.hpp's float_arg, int_arg, bool_arg,
-str_arg in the bindings), and the builder unchanged. The baselines succeed, so each failure is
-the bad argument's."""
+lone-surrogate string or a huge integer: a ModelError naming the argument, never pybind11's
+"incompatible function arguments" signature dump nor "Unable to cast" (common.hpp's float_arg,
+int_arg, bool_arg, str_arg in the bindings), and the builder unchanged. The baselines succeed, so
+each failure is the bad argument's."""
 
 from __future__ import annotations
 
