@@ -1232,6 +1232,8 @@ void bind_model(py::module_& m) {
          const BoolArg& physical_inertia_, const BoolArg& mimic_) {
         const char* fn = "urdf_builder";
         // bytes pass as they are (the loader checks names are UTF-8)
+        if (!py::isinstance<py::bytes>(src_) && !py::isinstance<py::str>(src_))
+          throw ModelError(msg(fn, ": path_or_xml must be a str or bytes, got ", shown(src_)));
         const std::string src = py::isinstance<py::bytes>(src_) ? src_.cast<std::string>()
                                                                 : str_arg(src_, fn, "path_or_xml");
         const bool fixed_base = bool_arg(fixed_base_, fn, "fixed_base");
