@@ -106,6 +106,22 @@ CASES = [
     # ---- bodies
     ("mass-negative", "body", "mass −1", lambda: _b().add_body("heavy", -1.0, I3), ME, "heavy"),
     (
+        "mass-str",
+        "body",
+        "mass '1' (a str, not a number)",
+        lambda: _b().add_body("heavy", "1", I3),
+        ME,
+        r"ModelBuilder\.add_body: mass must be a real number, got '1'",
+    ),
+    (
+        "body-name-surrogate",
+        "body",
+        "a name holding a lone surrogate",
+        lambda: _b().add_body("\ud800", 1.0, I3),
+        ME,
+        "add_body: name must be valid Unicode text",
+    ),
+    (
         "mass-zero-leaf",
         "model",
         "a massless leaf body on a hinge (its motion carries no inertia)",
@@ -227,6 +243,14 @@ CASES = [
         "ground",
     ),
     # ---- joints
+    (
+        "coord-huge",
+        "joint",
+        "coord 2**70 (beyond a C int)",
+        lambda: _hinged().add_joint_torque("hinge", 1.0, coord=2**70),
+        ME,
+        r"add_joint_torque: coord must be an integer in \[",
+    ),
     (
         "axis-zero-revolute",
         "joint",

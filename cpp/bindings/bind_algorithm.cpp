@@ -283,9 +283,10 @@ void bind_algorithm(py::module_& m) {
                      "Workspace of one model's evaluations: every buffer forward_dynamics, "
                      "inverse_dynamics and mass_matrix write. One per thread; pass it as data= "
                      "to choose it explicitly (otherwise each thread keeps one per model).")
-      .def(py::init([](ModelHolder md) {
-             if (!md) throw ModelError("Data: no model");
-             return std::make_unique<DataPy>(std::move(md));
+      .def(py::init([](const ModelArg& model) {
+             if (!py::isinstance<Model>(model))
+               throw ModelError(msg("Data: model must be an armdyn.Model, got ", shown(model)));
+             return std::make_unique<DataPy>(model.cast<ModelHolder>());
            }),
            py::arg("model"),
            "A workspace for `model` (an armdyn.Model); ModelError if model is None.")

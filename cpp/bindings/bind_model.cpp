@@ -102,6 +102,22 @@ py::array_t<double> coord_limit(const Model& md, CoordLimit which) {
   return to_numpy(r);
 }
 
+// a joint's name, bodies, point and axis from Python, checked: a ModelError naming the argument
+// (point or axis null: the method takes none)
+struct JointArgs {
+  std::string name, parent, child;
+  Vec3 point = Vec3::Zero(), axis = Vec3::Zero();
+  JointArgs(const py::handle& n, const py::handle& p, const py::handle& c, const py::handle* pt,
+            const py::handle* ax, const char* fn)
+      : name(str_arg(n, fn, "name")),
+        parent(str_arg(p, fn, "parent")),
+        child(str_arg(c, fn, "child")) {
+    const std::string who = "joint '" + name + "'";
+    if (pt) point = to_vec3(*pt, who + ": point");
+    if (ax) axis = to_vec3(*ax, who + ": axis");
+  }
+};
+
 // what Model.actuators lists: an Actuator with its joints named and its degree of freedom
 struct ActuatorView {
   std::string joint, rotor_joint;
@@ -118,17 +134,10 @@ int independent_dof(const Model& md, int c) {
   return ic.lead_v + ic.source[c];
 }
 
-// a Motor field from Python: None (not given) or a number, NaN refused
+// a Motor field from Python: None (not given) or a finite number
 double motor_field(const py::object& v, const char* name) {
   if (v.is_none()) return MotorSpec::kUnset;
-  double x;
-  try {
-    x = v.cast<double>();
-  } catch (const py::cast_error&) {
-    throw ModelError(msg("Motor: ", name, " must be a number or None"));
-  }
-  if (std::isnan(x)) throw ModelError(msg("Motor: ", name, " must be finite and > 0, got nan"));
-  return x;
+  return opt_float_arg(v, "Motor", name, MotorSpec::kUnset, true);  // > 0: MotorSpec::validate
 }
 
 py::object motor_get(const MotorSpec& s, double MotorSpec::* p) {
@@ -183,10 +192,10 @@ void bind_model(py::module_& m) {
         "ModelBuilder.add_actuator(..., motor=armdyn.Motor(...)); it does not enter the "
         "dynamics (the rotor inertia, gear ratio and friction do), the motor-side sizing reads "
         "it. Keyword-only constructor; comparable (==) and picklable.");
-    motor.def(py::init([](const std::string& name, OptFloat kt, OptFloat r, OptFloat u, OptFloat w0,
+    motor.def(py::init([](const StrArg& name, OptFloat kt, OptFloat r, OptFloat u, OptFloat w0,
                           OptFloat tc, OptFloat tp, OptFloat wmax, OptFloat rth, OptFloat tau_th) {
                 MotorSpec s;
-                s.name = name;
+                s.name = str_arg(name, "Motor", "name");
                 const py::object given[] = {kt, r, u, w0, tc, tp, wmax, rth, tau_th};
                 int k = 0;
                 for (const auto& [n, p] : MotorSpec::fields()) s.*p = motor_field(given[k++], n);
@@ -342,19 +351,45 @@ void bind_model(py::module_& m) {
           }));
 
   auto prof = m.def_submodule("profiles", "Built-in drive and load profiles (evaluated in C++).");
-  prof.def("constant", &Profile::constant, py::arg("value"),
-           "The constant profile y(t) = value (zero derivatives).");
-  prof.def("cubic", &Profile::cubic, py::arg("y0"), py::arg("y1"), py::arg("t0"), py::arg("t1"),
-           "Cubic rest-to-rest from y0 at t0 to y1 at t1 (3s^2 - 2s^3); constant outside.");
-  prof.def("quintic", &Profile::quintic, py::arg("y0"), py::arg("y1"), py::arg("t0"), py::arg("t1"),
-           "Quintic rest-to-rest (zero velocity and acceleration at both ends).");
-  prof.def("sine", &Profile::sine, py::arg("amplitude"), py::arg("frequency"),
-           py::arg("phase") = 0.0, py::arg("offset") = 0.0,
-           "offset + amplitude * sin(2 pi frequency t + phase); frequency in Hz.");
+  prof.def(
+      "constant",
+      [](const FloatArg& value) {
+        return Profile::constant(float_arg(value, "profiles.constant", "value"));
+      },
+      py::arg("value"), "The constant profile y(t) = value (zero derivatives).");
+  prof.def(
+      "cubic",
+      [](const FloatArg& y0, const FloatArg& y1, const FloatArg& t0, const FloatArg& t1) {
+        const char* fn = "profiles.cubic";
+        return Profile::cubic(float_arg(y0, fn, "y0"), float_arg(y1, fn, "y1"),
+                              float_arg(t0, fn, "t0"), float_arg(t1, fn, "t1"));
+      },
+      py::arg("y0"), py::arg("y1"), py::arg("t0"), py::arg("t1"),
+      "Cubic rest-to-rest from y0 at t0 to y1 at t1 (3s^2 - 2s^3); constant outside.");
+  prof.def(
+      "quintic",
+      [](const FloatArg& y0, const FloatArg& y1, const FloatArg& t0, const FloatArg& t1) {
+        const char* fn = "profiles.quintic";
+        return Profile::quintic(float_arg(y0, fn, "y0"), float_arg(y1, fn, "y1"),
+                                float_arg(t0, fn, "t0"), float_arg(t1, fn, "t1"));
+      },
+      py::arg("y0"), py::arg("y1"), py::arg("t0"), py::arg("t1"),
+      "Quintic rest-to-rest (zero velocity and acceleration at both ends).");
+  prof.def(
+      "sine",
+      [](const FloatArg& amplitude, const FloatArg& frequency, const FloatArg& phase,
+         const FloatArg& offset) {
+        const char* fn = "profiles.sine";
+        return Profile::sine(float_arg(amplitude, fn, "amplitude"),
+                             float_arg(frequency, fn, "frequency"), float_arg(phase, fn, "phase"),
+                             float_arg(offset, fn, "offset"));
+      },
+      py::arg("amplitude"), py::arg("frequency"), py::arg("phase") = 0.0, py::arg("offset") = 0.0,
+      "offset + amplitude * sin(2 pi frequency t + phase); frequency in Hz.");
   prof.def(
       "spline",
       [](const ArrayLike& t, const ArrayLike& y) {
-        const VecX tv = to_vec(t, "spline t"), yv = to_vec(y, "spline y");
+        const VecX tv = to_vec(t, "profiles.spline: t"), yv = to_vec(y, "profiles.spline: y");
         return Profile::spline(std::vector<double>(tv.data(), tv.data() + tv.size()),
                                std::vector<double>(yv.data(), yv.data() + yv.size()));
       },
@@ -712,8 +747,9 @@ void bind_model(py::module_& m) {
 
   py::class_<ModelBuilder>(
       m, "ModelBuilder", "Build a model: bodies, joints, drives, force elements; then finalize().")
-      .def(py::init([](const ArrayLike& g, bool physical_inertia) {
-             return ModelBuilder(to_vec3(g, "gravity"), physical_inertia);
+      .def(py::init([](const ArrayLike& g, const BoolArg& physical_inertia) {
+             const bool pi = bool_arg(physical_inertia, "ModelBuilder", "physical_inertia");
+             return ModelBuilder(to_vec3(g, "gravity"), pi);
            }),
            py::arg("gravity") = py::make_tuple(0.0, 0.0, -9.81), py::kw_only(),
            py::arg("physical_inertia") = true,
@@ -729,19 +765,25 @@ void bind_model(py::module_& m) {
               throw ModelError("ModelBuilder: unknown pickled state (not bytes and a bool)");
             return ModelBuilder(deserialize_draft(st[0].cast<std::string>()), st[1].cast<bool>());
           }))
-      .def_property("physical_inertia", &ModelBuilder::physical_inertia,
-                    &ModelBuilder::set_physical_inertia,
-                    "True (default): add_body accepts physically consistent inertias only "
-                    "(positive semidefinite, triangle inequality). False: any positive "
-                    "semidefinite tensor; negative round-off moments down to -1e-12 of the "
-                    "largest are clamped to zero with a warning. Applies to bodies added after "
-                    "it is set.")
+      .def_property(
+          "physical_inertia", &ModelBuilder::physical_inertia,
+          [](ModelBuilder& b, const BoolArg& v) {
+            b.set_physical_inertia(bool_arg(v, "ModelBuilder", "physical_inertia"));
+          },
+          "True (default): add_body accepts physically consistent inertias only "
+          "(positive semidefinite, triangle inequality). False: any positive "
+          "semidefinite tensor; negative round-off moments down to -1e-12 of the "
+          "largest are clamped to zero with a warning. Applies to bodies added after "
+          "it is set.")
       .def(
           "add_body",
-          [](ModelBuilder& b, const std::string& name, double mass, const ArrayLike& inertia,
+          [](ModelBuilder& b, const StrArg& name_, const FloatArg& mass, const ArrayLike& inertia,
              const ArrayLike& position, const ArrayLike& orientation) {
+            const char* fn = "ModelBuilder.add_body";
+            const std::string name = str_arg(name_, fn, "name");
+            const double m = float_arg(mass, fn, "mass");
             const std::string who = "body '" + name + "'";
-            return b.add_body(name, mass, to_inertia(inertia, who + ": inertia"),
+            return b.add_body(name, m, to_inertia(inertia, who + ": inertia"),
                               to_vec3(position, who + ": position"),
                               to_vec4(orientation, who + ": orientation"));
           },
@@ -752,10 +794,10 @@ void bind_model(py::module_& m) {
           "diagonal), CoM position [m], orientation as unit Euler parameters [e0, e1, e2, e3].")
       .def(
           "add_revolute",
-          [](ModelBuilder& b, const std::string& n, const std::string& p, const std::string& c,
+          [](ModelBuilder& b, const StrArg& n, const StrArg& p, const StrArg& c,
              const ArrayLike& point, const ArrayLike& axis) {
-            return b.add_revolute(n, p, c, to_vec3(point, "joint '" + n + "': point"),
-                                  to_vec3(axis, "joint '" + n + "': axis"));
+            const JointArgs a(n, p, c, &point, &axis, "ModelBuilder.add_revolute");
+            return b.add_revolute(a.name, a.parent, a.child, a.point, a.axis);
           },
           py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point"), py::arg("axis"),
           "Add a revolute (hinge) joint `name` between bodies `parent` and `child` (either may be "
@@ -766,10 +808,10 @@ void bind_model(py::module_& m) {
           "point.")
       .def(
           "add_prismatic",
-          [](ModelBuilder& b, const std::string& n, const std::string& p, const std::string& c,
+          [](ModelBuilder& b, const StrArg& n, const StrArg& p, const StrArg& c,
              const ArrayLike& point, const ArrayLike& axis) {
-            return b.add_prismatic(n, p, c, to_vec3(point, "joint '" + n + "': point"),
-                                   to_vec3(axis, "joint '" + n + "': axis"));
+            const JointArgs a(n, p, c, &point, &axis, "ModelBuilder.add_prismatic");
+            return b.add_prismatic(a.name, a.parent, a.child, a.point, a.axis);
           },
           py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point"), py::arg("axis"),
           "Add a prismatic (slider) joint `name` between `parent` and `child` (either may be "
@@ -779,10 +821,10 @@ void bind_model(py::module_& m) {
           "or point.")
       .def(
           "add_cylindrical",
-          [](ModelBuilder& b, const std::string& n, const std::string& p, const std::string& c,
+          [](ModelBuilder& b, const StrArg& n, const StrArg& p, const StrArg& c,
              const ArrayLike& point, const ArrayLike& axis) {
-            return b.add_cylindrical(n, p, c, to_vec3(point, "joint '" + n + "': point"),
-                                     to_vec3(axis, "joint '" + n + "': axis"));
+            const JointArgs a(n, p, c, &point, &axis, "ModelBuilder.add_cylindrical");
+            return b.add_cylindrical(a.name, a.parent, a.child, a.point, a.axis);
           },
           py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point"), py::arg("axis"),
           "Add a cylindrical joint `name` between `parent` and `child`: rotation about and "
@@ -791,18 +833,21 @@ void bind_model(py::module_& m) {
           "on bad input.")
       .def(
           "add_inline",
-          [](ModelBuilder& b, const std::string& n, const std::string& p, const std::string& c,
+          [](ModelBuilder& b, const StrArg& n, const StrArg& p, const StrArg& c,
              const ArrayLike& point, const ArrayLike& axis) {
-            return b.add_inline(n, p, c, to_vec3(point, "joint '" + n + "': point"),
-                                to_vec3(axis, "joint '" + n + "': axis"));
+            const JointArgs a(n, p, c, &point, &axis, "ModelBuilder.add_inline");
+            return b.add_inline(a.name, a.parent, a.child, a.point, a.axis);
           },
           py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point"), py::arg("axis"),
           "Inline (point-on-line) joint, 2 rows: the child's point stays on the parent's line "
           "through `point` along `axis`. Closes a planar loop without redundant rows.")
       .def(
           "add_distance",
-          [](ModelBuilder& b, const std::string& n, const std::string& ba, const ArrayLike& pa,
-             const std::string& bb, const ArrayLike& pb) {
+          [](ModelBuilder& b, const StrArg& n_, const StrArg& ba_, const ArrayLike& pa,
+             const StrArg& bb_, const ArrayLike& pb) {
+            const char* fn = "ModelBuilder.add_distance";
+            const std::string n = str_arg(n_, fn, "name"), ba = str_arg(ba_, fn, "body_a"),
+                              bb = str_arg(bb_, fn, "body_b");
             const std::string who = "joint '" + n + "'";
             return b.add_distance(n, ba, to_vec3(pa, who + ": point_a"), bb,
                                   to_vec3(pb, who + ": point_b"));
@@ -813,9 +858,10 @@ void bind_model(py::module_& m) {
           "point_b of body_b (world coordinates at assembly); it holds their assembly distance.")
       .def(
           "add_spherical",
-          [](ModelBuilder& b, const std::string& n, const std::string& p, const std::string& c,
+          [](ModelBuilder& b, const StrArg& n, const StrArg& p, const StrArg& c,
              const ArrayLike& point) {
-            return b.add_spherical(n, p, c, to_vec3(point, "joint '" + n + "': point"));
+            const JointArgs a(n, p, c, &point, nullptr, "ModelBuilder.add_spherical");
+            return b.add_spherical(a.name, a.parent, a.child, a.point);
           },
           py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point"),
           "Add a spherical (ball) joint `name` between `parent` and `child` at `point` (3,) [m], "
@@ -824,16 +870,17 @@ void bind_model(py::module_& m) {
           "non-finite point.")
       .def(
           "add_fixed",
-          [](ModelBuilder& b, const std::string& n, const std::string& p, const std::string& c,
+          [](ModelBuilder& b, const StrArg& n, const StrArg& p, const StrArg& c,
              const OptArrayLike& point) {
+            const JointArgs a(n, p, c, nullptr, nullptr, "ModelBuilder.add_fixed");
             Vec3 pt;
             if (point.is_none()) {
-              const int ci = c == "ground" ? -1 : b.draft().find_body(c);
+              const int ci = a.child == "ground" ? -1 : b.draft().find_body(a.child);
               pt = ci < 0 ? Vec3::Zero() : b.draft().bodies[ci].position;
             } else {
-              pt = to_vec3(point, "joint '" + n + "': point");
+              pt = to_vec3(point, "joint '" + a.name + "': point");
             }
-            return b.add_fixed(n, p, c, pt);
+            return b.add_fixed(a.name, a.parent, a.child, pt);
           },
           py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point") = py::none(),
           "Weld `child` rigidly to `parent` (either may be 'ground'): 6 rows, no dof. `point` "
@@ -842,11 +889,12 @@ void bind_model(py::module_& m) {
           "a duplicate name or an unknown body.")
       .def(
           "add_universal",
-          [](ModelBuilder& b, const std::string& n, const std::string& p, const std::string& c,
+          [](ModelBuilder& b, const StrArg& n, const StrArg& p, const StrArg& c,
              const ArrayLike& point, const ArrayLike& a1, const ArrayLike& a2) {
-            return b.add_universal(n, p, c, to_vec3(point, "joint '" + n + "': point"),
-                                   to_vec3(a1, "joint '" + n + "': axis1"),
-                                   to_vec3(a2, "joint '" + n + "': axis2"));
+            const JointArgs a(n, p, c, &point, nullptr, "ModelBuilder.add_universal");
+            return b.add_universal(a.name, a.parent, a.child, a.point,
+                                   to_vec3(a1, "joint '" + a.name + "': axis1"),
+                                   to_vec3(a2, "joint '" + a.name + "': axis2"));
           },
           py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("point"), py::arg("axis1"),
           py::arg("axis2"),
@@ -856,8 +904,9 @@ void bind_model(py::module_& m) {
           "(axes not perpendicular, zero, or not finite).")
       .def(
           "add_free",
-          [](ModelBuilder& b, const std::string& n, const std::string& c,
-             const OptArrayLike& origin) {
+          [](ModelBuilder& b, const StrArg& n_, const StrArg& c_, const OptArrayLike& origin) {
+            const char* fn = "ModelBuilder.add_free";
+            const std::string n = str_arg(n_, fn, "name"), c = str_arg(c_, fn, "child");
             if (origin.is_none()) return b.add_free(n, c);
             const Vec3 o = to_vec3(origin, "free joint '" + n + "': origin");
             return b.add_free(n, c, &o);
@@ -869,8 +918,10 @@ void bind_model(py::module_& m) {
           "then angular velocity, both in the frame's own axes).")
       .def(
           "add_frame",
-          [](ModelBuilder& b, const std::string& name, const std::string& body,
-             const ArrayLike& position, const ArrayLike& orientation) {
+          [](ModelBuilder& b, const StrArg& name_, const StrArg& body_, const ArrayLike& position,
+             const ArrayLike& orientation) {
+            const char* fn = "ModelBuilder.add_frame";
+            const std::string name = str_arg(name_, fn, "name"), body = str_arg(body_, fn, "body");
             const std::string who = "frame '" + name + "'";
             return b.add_frame(name, body, to_vec3(position, who + ": position"),
                                to_vec4(orientation, who + ": orientation"));
@@ -881,18 +932,40 @@ void bind_model(py::module_& m) {
           "(unit Euler parameters [e0, e1, e2, e3], frame -> world), both in world at the "
           "assembly pose like every builder input. Read it back with armdyn.frame_pose and "
           "armdyn.frame_jacobian.")
-      .def("set_joint_limits", &ModelBuilder::set_joint_limits, py::arg("joint"), py::arg("lower"),
-           py::arg("upper"), py::arg("effort") = 0.0, py::arg("velocity") = 0.0,
-           "Set a joint's limits (of its first coordinate): position lower <= q <= upper [rad or "
-           "m] (stops enforced by simulate(limits=True)), effort [N m or N] and velocity [rad/s "
-           "or m/s] (informative, 0 = none; read by the sizing). ModelError on an unknown "
-           "joint, lower > upper, NaN, or negative effort/velocity.")
+      .def(
+          "set_joint_limits",
+          [](ModelBuilder& b, const StrArg& joint, const FloatArg& lower, const FloatArg& upper,
+             const FloatArg& effort, const FloatArg& velocity) {
+            const char* fn = "ModelBuilder.set_joint_limits";
+            // infinities: no limit; NaN refused naming the argument
+            auto limit = [fn](const py::handle& v, const char* name) {
+              const double x = float_arg(v, fn, name);
+              if (std::isnan(x))
+                throw ModelError(msg(fn, ": ", name,
+                                     " must be a real number (inf: no limit), "
+                                     "got nan"));
+              return x;
+            };
+            b.set_joint_limits(str_arg(joint, fn, "joint"), limit(lower, "lower"),
+                               limit(upper, "upper"), limit(effort, "effort"),
+                               limit(velocity, "velocity"));
+          },
+          py::arg("joint"), py::arg("lower"), py::arg("upper"), py::arg("effort") = 0.0,
+          py::arg("velocity") = 0.0,
+          "Set a joint's limits (of its first coordinate): position lower <= q <= upper [rad or "
+          "m] (stops enforced by simulate(limits=True)), effort [N m or N] and velocity [rad/s "
+          "or m/s] (informative, 0 = none; read by the sizing). ModelError on an unknown "
+          "joint, lower > upper, NaN, or negative effort/velocity.")
       .def(
           "add_drive",
-          [](ModelBuilder& b, const std::string& joint, const ProfileLike& profile, int coord,
+          [](ModelBuilder& b, const StrArg& joint_, const ProfileLike& profile, const IntArg& coord,
              const OptStr& name) {
-            return b.add_drive(joint, to_profile(profile, "add_drive '" + joint + "': profile"),
-                               coord, name.is_none() ? "" : name.cast<std::string>());
+            const char* fn = "ModelBuilder.add_drive";
+            const std::string joint = str_arg(joint_, fn, "joint");
+            const int k = int_arg(coord, fn, "coord");
+            const std::string nm = opt_str_arg(name, fn, "name");
+            return b.add_drive(joint, to_profile(profile, "add_drive '" + joint + "': profile"), k,
+                               nm);
           },
           py::arg("joint"), py::arg("profile"), py::arg("coord") = 0, py::arg("name") = py::none(),
           "Prescribe coordinate `coord` of `joint` by a profile [rad or m over t in s] "
@@ -903,8 +976,9 @@ void bind_model(py::module_& m) {
           "profile.")
       .def(
           "add_body_force",
-          [](ModelBuilder& b, const std::string& body, const ArrayLike& force,
-             const ArrayLike& torque, const OptArrayLike& point, const OptProfileLike& profile) {
+          [](ModelBuilder& b, const StrArg& body_, const ArrayLike& force, const ArrayLike& torque,
+             const OptArrayLike& point, const OptProfileLike& profile) {
+            const std::string body = str_arg(body_, "ModelBuilder.add_body_force", "body");
             const std::string who = "load on body '" + body + "'";
             Vec3 pt;
             Profile pr;
@@ -921,12 +995,19 @@ void bind_model(py::module_& m) {
           "[N m], both in world axes, optionally scaled by a profile.")
       .def(
           "add_spring_damper",
-          [](ModelBuilder& b, const std::string& n, const std::string& ba, const ArrayLike& pa,
-             const std::string& bb, const ArrayLike& pb, double k, double c, const OptFloat& rest) {
+          [](ModelBuilder& b, const StrArg& n_, const StrArg& ba_, const ArrayLike& pa,
+             const StrArg& bb_, const ArrayLike& pb, const FloatArg& k, const FloatArg& c,
+             const OptFloat& rest) {
+            const char* fn = "ModelBuilder.add_spring_damper";
+            const std::string n = str_arg(n_, fn, "name"), ba = str_arg(ba_, fn, "body_a"),
+                              bb = str_arg(bb_, fn, "body_b");
+            const double kv = float_arg(k, fn, "stiffness"), cv = float_arg(c, fn, "damping");
+            const double rv = opt_float_arg(rest, fn, "rest_length", -1.0);
+            if (!rest.is_none() && rv < 0.0)
+              throw ModelError(msg(fn, ": rest_length must be >= 0 or None, got ", rv));
             const std::string who = "spring-damper '" + n + "'";
             b.add_spring_damper(n, ba, to_vec3(pa, who + ": point_a"), bb,
-                                to_vec3(pb, who + ": point_b"), k, c,
-                                rest.is_none() ? -1.0 : rest.cast<double>());
+                                to_vec3(pb, who + ": point_b"), kv, cv, rv);
           },
           py::arg("name"), py::arg("body_a"), py::arg("point_a"), py::arg("body_b"),
           py::arg("point_b"), py::arg("stiffness"), py::arg("damping") = 0.0,
@@ -936,54 +1017,91 @@ void bind_model(py::module_& m) {
           "stiffness [N/m] * (length - rest_length) + damping [N s/m] * length rate along the "
           "line; rest_length [m] defaults to the assembly distance. ModelError on an unknown "
           "body, coincident points, non-finite input, negative stiffness or damping.")
-      .def("add_joint_spring_damper", &ModelBuilder::add_joint_spring_damper, py::arg("joint"),
-           py::arg("stiffness") = 0.0, py::arg("damping") = 0.0, py::arg("rest") = 0.0,
-           py::arg("coord") = 0,
-           "Spring-damper on coordinate `coord` of `joint`: tau = -stiffness (q - rest) - "
-           "damping qdot, stiffness [N m/rad or N/m], damping [N m s/rad or N s/m], rest [rad "
-           "or m]. ModelError on an unknown joint or coordinate, negative stiffness/damping.")
+      .def(
+          "add_joint_spring_damper",
+          [](ModelBuilder& b, const StrArg& joint, const FloatArg& k, const FloatArg& c,
+             const FloatArg& rest, const IntArg& coord) {
+            const char* fn = "ModelBuilder.add_joint_spring_damper";
+            b.add_joint_spring_damper(str_arg(joint, fn, "joint"), float_arg(k, fn, "stiffness"),
+                                      float_arg(c, fn, "damping"), float_arg(rest, fn, "rest"),
+                                      int_arg(coord, fn, "coord"));
+          },
+          py::arg("joint"), py::arg("stiffness") = 0.0, py::arg("damping") = 0.0,
+          py::arg("rest") = 0.0, py::arg("coord") = 0,
+          "Spring-damper on coordinate `coord` of `joint`: tau = -stiffness (q - rest) - "
+          "damping qdot, stiffness [N m/rad or N/m], damping [N m s/rad or N s/m], rest [rad "
+          "or m]. ModelError on an unknown joint or coordinate, negative stiffness/damping.")
       .def(
           "add_joint_friction",
-          [](ModelBuilder& b, const std::string& joint, double viscous, double coulomb,
-             double smoothing_velocity, int coord) {
-            b.add_joint_friction(joint, viscous, coulomb, smoothing_velocity, coord);
+          [](ModelBuilder& b, const StrArg& joint, const FloatArg& viscous, const FloatArg& coulomb,
+             const FloatArg& smoothing_velocity, const IntArg& coord) {
+            const char* fn = "ModelBuilder.add_joint_friction";
+            b.add_joint_friction(str_arg(joint, fn, "joint"), float_arg(viscous, fn, "viscous"),
+                                 float_arg(coulomb, fn, "coulomb"),
+                                 float_arg(smoothing_velocity, fn, "smoothing_velocity"),
+                                 int_arg(coord, fn, "coord"));
           },
           py::arg("joint"), py::arg("viscous") = 0.0, py::arg("coulomb") = 0.0,
           py::arg("smoothing_velocity") = 1e-3, py::arg("coord") = 0,
           "Joint friction: tau = -viscous * qdot - coulomb * tanh(qdot / smoothing_velocity).")
-      .def("add_gear", &ModelBuilder::add_gear, py::arg("name"), py::arg("joint_a"),
-           py::arg("joint_b"), py::arg("r_a"), py::arg("r_b"),
-           "Ideal gear (no backlash) between two revolute joints: the rolling constraint "
-           "r_a q_a + r_b q_b = 0 (external mesh, multi-turn angles).")
-      .def("add_coupling", &ModelBuilder::add_coupling, py::arg("name"), py::arg("follower"),
-           py::arg("leader"), py::arg("multiplier"), py::arg("offset") = 0.0,
-           "Coupling q_follower = multiplier * q_leader + offset [rad or m] between two revolute "
-           "(continuous) or two prismatic joints (URDF <mimic>): one constraint row; the "
-           "follower becomes a dependent coordinate, and forward_dynamics, inverse_dynamics, "
-           "mass_matrix, state_from_joints and simulate(q0=...) take the independent ones "
-           "(model.coord_names). Chains allowed; cycles, a follower coupled twice, joints of "
-           "different types and a zero or non-finite multiplier are refused (ModelError).")
+      .def(
+          "add_gear",
+          [](ModelBuilder& b, const StrArg& name, const StrArg& ja, const StrArg& jb,
+             const FloatArg& ra, const FloatArg& rb) {
+            const char* fn = "ModelBuilder.add_gear";
+            b.add_gear(str_arg(name, fn, "name"), str_arg(ja, fn, "joint_a"),
+                       str_arg(jb, fn, "joint_b"), float_arg(ra, fn, "r_a"),
+                       float_arg(rb, fn, "r_b"));
+          },
+          py::arg("name"), py::arg("joint_a"), py::arg("joint_b"), py::arg("r_a"), py::arg("r_b"),
+          "Ideal gear (no backlash) between two revolute joints: the rolling constraint "
+          "r_a q_a + r_b q_b = 0 (external mesh, multi-turn angles).")
+      .def(
+          "add_coupling",
+          [](ModelBuilder& b, const StrArg& name, const StrArg& follower, const StrArg& leader,
+             const FloatArg& multiplier, const FloatArg& offset) {
+            const char* fn = "ModelBuilder.add_coupling";
+            b.add_coupling(str_arg(name, fn, "name"), str_arg(follower, fn, "follower"),
+                           str_arg(leader, fn, "leader"), float_arg(multiplier, fn, "multiplier"),
+                           float_arg(offset, fn, "offset"));
+          },
+          py::arg("name"), py::arg("follower"), py::arg("leader"), py::arg("multiplier"),
+          py::arg("offset") = 0.0,
+          "Coupling q_follower = multiplier * q_leader + offset [rad or m] between two revolute "
+          "(continuous) or two prismatic joints (URDF <mimic>): one constraint row; the "
+          "follower becomes a dependent coordinate, and forward_dynamics, inverse_dynamics, "
+          "mass_matrix, state_from_joints and simulate(q0=...) take the independent ones "
+          "(model.coord_names). Chains allowed; cycles, a follower coupled twice, joints of "
+          "different types and a zero or non-finite multiplier are refused (ModelError).")
       .def(
           "add_actuator",
-          [](ModelBuilder& b, const std::string& joint, double gear_ratio, double rotor_inertia,
-             double efficiency, double friction_viscous, double friction_coulomb,
-             const OptMotor& motor, bool gyroscopic, const OptFloat& friction_smoothing) {
+          [](ModelBuilder& b, const StrArg& joint_, const FloatArg& gear_ratio,
+             const FloatArg& rotor_inertia, const FloatArg& efficiency,
+             const FloatArg& friction_viscous, const FloatArg& friction_coulomb,
+             const OptMotor& motor, const BoolArg& gyroscopic, const OptFloat& friction_smoothing) {
+            const char* fn = "ModelBuilder.add_actuator";
+            const std::string joint = str_arg(joint_, fn, "joint");
+            const double n = float_arg(gear_ratio, fn, "gear_ratio");
+            const double j = float_arg(rotor_inertia, fn, "rotor_inertia");
+            const double eff = float_arg(efficiency, fn, "efficiency");
+            const double fv = float_arg(friction_viscous, fn, "friction_viscous");
+            const double fc = float_arg(friction_coulomb, fn, "friction_coulomb");
+            const bool gyro = bool_arg(gyroscopic, fn, "gyroscopic");
             MotorSpec spec;
             const MotorSpec* mp = nullptr;
             if (!motor.is_none()) {
               if (!py::isinstance<MotorSpec>(motor))
-                throw ModelError(msg("add_actuator on joint '", joint,
-                                     "': motor must be an armdyn.Motor or None"));
+                throw ModelError(msg(fn, " on joint '", joint,
+                                     "': motor must be an armdyn.Motor or None, got ",
+                                     shown(motor)));
               spec = motor.cast<MotorSpec>();
               mp = &spec;
             }
-            const double vs =
-                friction_smoothing.is_none() ? 0.0 : friction_smoothing.cast<double>();
+            const double vs = opt_float_arg(friction_smoothing, fn, "friction_smoothing", 0.0);
             if (!friction_smoothing.is_none() && !(vs > 0.0))
               throw ModelError(msg("add_actuator on joint '", joint,
                                    "': friction_smoothing must be positive, got ", vs));
-            b.add_actuator(joint, gear_ratio, rotor_inertia, efficiency, friction_viscous,
-                           friction_coulomb, mp, gyroscopic, vs);
+            b.add_actuator(joint, n, j, eff, fv, fc, mp, gyro, vs);
           },
           py::arg("joint"), py::arg("gear_ratio"), py::arg("rotor_inertia"),
           py::arg("efficiency") = 1.0, py::arg("friction_viscous") = 0.0,
@@ -1005,18 +1123,36 @@ void bind_model(py::module_& m) {
           "ModelError, builder unchanged, on an unknown joint, a joint not "
           "revolute or prismatic, a second actuator, gear_ratio zero or not finite, "
           "rotor_inertia < 0, efficiency outside (0, 1], negative frictions.")
-      .def("add_gear_pair", &ModelBuilder::add_gear_pair, py::arg("name"), py::arg("joint_a"),
-           py::arg("joint_b"), py::arg("r_a"), py::arg("r_b"), py::arg("backlash") = 0.0,
-           py::arg("stiffness") = 1e8, py::arg("exponent") = 1.5, py::arg("hc_damping") = 0.0,
-           "Gear pair with backlash between two revolute joints (external mesh): mesh "
-           "displacement s = r_a q_a + r_b q_b, dead zone |s| <= backlash/2, Hunt-Crossley "
-           "contact force F = k d^n (1 + hc_damping d') >= 0 beyond it. Contact onset and "
-           "separation are located as events (result.events).")
+      .def(
+          "add_gear_pair",
+          [](ModelBuilder& b, const StrArg& name, const StrArg& ja, const StrArg& jb,
+             const FloatArg& ra, const FloatArg& rb, const FloatArg& backlash,
+             const FloatArg& stiffness, const FloatArg& exponent, const FloatArg& hc_damping) {
+            const char* fn = "ModelBuilder.add_gear_pair";
+            b.add_gear_pair(
+                str_arg(name, fn, "name"), str_arg(ja, fn, "joint_a"), str_arg(jb, fn, "joint_b"),
+                float_arg(ra, fn, "r_a"), float_arg(rb, fn, "r_b"),
+                float_arg(backlash, fn, "backlash"), float_arg(stiffness, fn, "stiffness"),
+                float_arg(exponent, fn, "exponent"), float_arg(hc_damping, fn, "hc_damping"));
+          },
+          py::arg("name"), py::arg("joint_a"), py::arg("joint_b"), py::arg("r_a"), py::arg("r_b"),
+          py::arg("backlash") = 0.0, py::arg("stiffness") = 1e8, py::arg("exponent") = 1.5,
+          py::arg("hc_damping") = 0.0,
+          "Gear pair with backlash between two revolute joints (external mesh): mesh "
+          "displacement s = r_a q_a + r_b q_b, dead zone |s| <= backlash/2, Hunt-Crossley "
+          "contact force F = k d^n (1 + hc_damping d') >= 0 beyond it. Contact onset and "
+          "separation are located as events (result.events).")
       .def(
           "add_motor",
-          [](ModelBuilder& b, const std::string& joint, const ProfileLike& reference, double kp,
-             double kd, double torque_limit, const OptProfileLike& feedforward, int coord,
-             double ki) {
+          [](ModelBuilder& b, const StrArg& joint_, const ProfileLike& reference,
+             const FloatArg& kp_, const FloatArg& kd_, const FloatArg& torque_limit_,
+             const OptProfileLike& feedforward, const IntArg& coord_, const FloatArg& ki_) {
+            const char* fn = "ModelBuilder.add_motor";
+            const std::string joint = str_arg(joint_, fn, "joint");
+            const double kp = float_arg(kp_, fn, "kp"), kd = float_arg(kd_, fn, "kd");
+            const double torque_limit = float_arg(torque_limit_, fn, "torque_limit");
+            const int coord = int_arg(coord_, fn, "coord");
+            const double ki = float_arg(ki_, fn, "ki");
             const std::string who = "add_motor '" + joint + "'";
             const Profile ref = to_profile(reference, who + ": reference");
             if (feedforward.is_none()) {
@@ -1036,9 +1172,12 @@ void bind_model(py::module_& m) {
           "number, or a callable).")
       .def(
           "add_joint_torque",
-          [](ModelBuilder& b, const std::string& joint, const ProfileLike& profile, int coord) {
-            b.add_joint_torque(joint, to_profile(profile, "joint torque on '" + joint + "'"),
-                               coord);
+          [](ModelBuilder& b, const StrArg& joint_, const ProfileLike& profile,
+             const IntArg& coord) {
+            const char* fn = "ModelBuilder.add_joint_torque";
+            const std::string joint = str_arg(joint_, fn, "joint");
+            const int k = int_arg(coord, fn, "coord");
+            b.add_joint_torque(joint, to_profile(profile, "joint torque on '" + joint + "'"), k);
           },
           py::arg("joint"), py::arg("profile"), py::arg("coord") = 0,
           "Apply a torque [N m] (revolute) or force [N] (prismatic) on coordinate `coord` of "
@@ -1048,9 +1187,10 @@ void bind_model(py::module_& m) {
           "joint or coordinate, or a bad profile.")
       .def(
           "finalize",
-          [cast_model](const ModelBuilder& b, bool mass_weighted) {
+          [cast_model](const ModelBuilder& b, const BoolArg& mass_weighted) {
             FinalizeOptions o;
-            o.mass_weighted_assembly = mass_weighted;
+            o.mass_weighted_assembly =
+                bool_arg(mass_weighted, "ModelBuilder.finalize", "mass_weighted_assembly");
             // Ctrl-C: the long parts of a large model's analysis check for signals
             Poll poll = python_poll();
             ScopedThreadPoll scope(&poll);
@@ -1095,8 +1235,17 @@ void bind_model(py::module_& m) {
   m.attr("URDF_COULOMB_SMOOTHING") = kUrdfCoulombSmoothing;
   m.def(
       "urdf_builder",
-      [](const std::string& src, bool fixed_base, const ArrayLike& g, bool physical_inertia,
-         bool mimic) {
+      [](const StrArg& src_, const BoolArg& fixed_base_, const ArrayLike& g,
+         const BoolArg& physical_inertia_, const BoolArg& mimic_) {
+        const char* fn = "urdf_builder";
+        // bytes pass as they are (the loader checks names are UTF-8)
+        if (!py::isinstance<py::bytes>(src_) && !py::isinstance<py::str>(src_))
+          throw ModelError(msg(fn, ": path_or_xml must be a str or bytes, got ", shown(src_)));
+        const std::string src = py::isinstance<py::bytes>(src_) ? src_.cast<std::string>()
+                                                                : str_arg(src_, fn, "path_or_xml");
+        const bool fixed_base = bool_arg(fixed_base_, fn, "fixed_base");
+        const bool physical_inertia = bool_arg(physical_inertia_, fn, "physical_inertia");
+        const bool mimic = bool_arg(mimic_, fn, "mimic");
         const Vec3 gravity = to_vec3(g, "gravity");
         // Ctrl-C: the loader's loops over the links and joints check for signals
         Poll poll = python_poll();

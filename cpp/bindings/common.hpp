@@ -7,7 +7,9 @@
 #include <pybind11/pybind11.h>
 
 #include <chrono>
+#include <cmath>
 #include <exception>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -138,6 +140,10 @@ ARMDYN_HINTED_OBJECT(OptProfileLike)  // the same or None
 ARMDYN_HINTED_OBJECT(OptFloat)        // float | None
 ARMDYN_HINTED_OBJECT(OptStr)          // str | None
 ARMDYN_HINTED_OBJECT(StrArg)          // str (checked by str_arg: a ModelError, never a cast error)
+ARMDYN_HINTED_OBJECT(FloatArg)        // a real number (checked by float_arg)
+ARMDYN_HINTED_OBJECT(IntArg)          // an integer (checked by int_arg)
+ARMDYN_HINTED_OBJECT(BoolArg)         // bool (checked by bool_arg)
+ARMDYN_HINTED_OBJECT(ModelArg)        // armdyn._core.Model (checked where it is taken)
 ARMDYN_HINTED_OBJECT(FrameRef)        // str | int (a frame's name or index)
 ARMDYN_HINTED_OBJECT(OptMotor)        // Motor | None
 ARMDYN_HINTED_OBJECT(OptProgress)     // Callable[[float, float], object] | None
@@ -182,6 +188,103 @@ inline std::string str_arg(const py::handle& obj, const char* fn, const char* na
         msg(fn, ": ", name, " must be valid Unicode text (it holds a lone surrogate)"));
   }
   return std::string(s, static_cast<size_t>(size));
+}
+
+/// A short repr of a rejected argument (at most 60 characters), for messages.
+inline std::string shown(const py::handle& obj) {
+  std::string r;
+  try {
+    r = py::repr(obj).cast<std::string>();
+  } catch (const py::error_already_set&) {
+    r = "<" + py::str(py::type::of(obj).attr("__name__")).cast<std::string>() + ">";
+  }
+  return r.size() <= 60 ? r : r.substr(0, 57) + "...";
+}
+
+/// Whether obj is a bool (Python's or numpy's).
+inline bool is_bool_like(const py::handle& obj) {
+  if (PyBool_Check(obj.ptr())) return true;
+  const std::string tn = Py_TYPE(obj.ptr())->tp_name;
+  return tn == "numpy.bool_" || tn == "numpy.bool";
+}
+
+/// Whether obj is an instance of numbers.<abc> (numpy's real and integer scalars register).
+inline bool is_number_abc(const py::handle& obj, const char* abc) {
+  const py::object cls = py::module_::import("numbers").attr(abc);
+  const int r = PyObject_IsInstance(obj.ptr(), cls.ptr());
+  if (r < 0) PyErr_Clear();
+  return r == 1;
+}
+
+/// A real number argument (int, float, a numpy real scalar; not bool, str, None or complex) as a
+/// double, or a ModelError naming the function and the argument. `finite`: NaN and infinities
+/// refused here too (otherwise the callee's own checks, which name the element, judge the
+/// value). Fast for a Python float (one type check).
+inline double float_arg(const py::handle& obj, const char* fn, const char* name,
+                        bool finite = false) {
+  double x = 0.0;
+  bool ok = false;
+  if (PyFloat_Check(obj.ptr())) {
+    x = PyFloat_AS_DOUBLE(obj.ptr());
+    ok = true;
+  } else if (!is_bool_like(obj) && !PyComplex_Check(obj.ptr()) &&
+             (PyLong_Check(obj.ptr()) || is_number_abc(obj, "Real"))) {
+    x = PyFloat_AsDouble(obj.ptr());  // an int beyond double's range: OverflowError
+    ok = !(x == -1.0 && PyErr_Occurred());
+    if (!ok) PyErr_Clear();
+  }
+  if (!ok || (finite && !std::isfinite(x)))
+    throw ModelError(msg(fn, ": ", name, " must be a ", finite ? "finite " : "",
+                         "real number, got ", shown(obj)));
+  return x;
+}
+
+/// float_arg, or `none_value` for None (an optional number).
+inline double opt_float_arg(const py::handle& obj, const char* fn, const char* name,
+                            double none_value, bool finite = false) {
+  if (obj.is_none()) return none_value;
+  try {
+    return float_arg(obj, fn, name, finite);
+  } catch (const ModelError&) {
+    throw ModelError(msg(fn, ": ", name, " must be a ", finite ? "finite " : "",
+                         "real number or None, got ", shown(obj)));
+  }
+}
+
+/// An integer argument (int or a numpy integer; not bool, not a float such as 1.0) that fits a C++
+/// int, or a ModelError naming the function and the argument.
+inline int int_arg(const py::handle& obj, const char* fn, const char* name) {
+  long long k = 0;
+  bool ok = false;
+  if (!is_bool_like(obj) && (PyLong_Check(obj.ptr()) || is_number_abc(obj, "Integral"))) {
+    const py::object idx = py::reinterpret_steal<py::object>(PyNumber_Index(obj.ptr()));
+    int overflow = 0;
+    if (idx) k = PyLong_AsLongLongAndOverflow(idx.ptr(), &overflow);
+    ok = idx && overflow == 0 && !(k == -1 && PyErr_Occurred());
+    if (!ok) PyErr_Clear();
+    ok = ok && k >= std::numeric_limits<int>::min() && k <= std::numeric_limits<int>::max();
+  }
+  if (!ok)
+    throw ModelError(msg(fn, ": ", name, " must be an integer in [",
+                         std::numeric_limits<int>::min(), ", ", std::numeric_limits<int>::max(),
+                         "], got ", shown(obj)));
+  return static_cast<int>(k);
+}
+
+/// True or False (Python's or numpy's bool), or a ModelError naming the function and argument.
+inline bool bool_arg(const py::handle& obj, const char* fn, const char* name) {
+  if (!is_bool_like(obj))
+    throw ModelError(msg(fn, ": ", name, " must be True or False, got ", shown(obj)));
+  return PyObject_IsTrue(obj.ptr()) == 1;
+}
+
+/// str_arg, or `none_value` for None.
+inline std::string opt_str_arg(const py::handle& obj, const char* fn, const char* name,
+                               const std::string& none_value = "") {
+  if (obj.is_none()) return none_value;
+  if (!PyUnicode_Check(obj.ptr()))
+    throw ModelError(msg(fn, ": ", name, " must be a str or None, got ", shown(obj)));
+  return str_arg(obj, fn, name);
 }
 
 inline std::string shape_str(const py::array& a) {
@@ -282,6 +385,11 @@ ARMDYN_TYPE_HINT(OptProfileLike, ARMDYN_PROFILE_HINT " | None")
 ARMDYN_TYPE_HINT(OptFloat, "float | None")
 ARMDYN_TYPE_HINT(OptStr, "str | None")
 ARMDYN_TYPE_HINT(StrArg, "str")
+// the hints pybind11 prints for double and int arguments (the stubs unchanged)
+ARMDYN_TYPE_HINT(FloatArg, "typing.SupportsFloat | typing.SupportsIndex")
+ARMDYN_TYPE_HINT(IntArg, "typing.SupportsInt | typing.SupportsIndex")
+ARMDYN_TYPE_HINT(BoolArg, "bool")
+ARMDYN_TYPE_HINT(ModelArg, "armdyn._core.Model")
 ARMDYN_TYPE_HINT(FrameRef, "str | int")
 ARMDYN_TYPE_HINT(OptMotor, "armdyn._core.Motor | None")
 ARMDYN_TYPE_HINT(OptProgress, "collections.abc.Callable[[float, float], object] | None")
