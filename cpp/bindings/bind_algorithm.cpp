@@ -31,6 +31,13 @@ struct DataPy {
 };
 
 /// This thread's workspace for md: the last few models used, the most recent first.
+/// The model argument of a dynamics function: an armdyn.Model, else a ModelError naming it.
+ModelHolder model_of(const ModelArg& model, const char* fn) {
+  if (!py::isinstance<Model>(model))
+    throw ModelError(msg(fn, ": model must be an armdyn.Model, got ", shown(model)));
+  return model.cast<ModelHolder>();
+}
+
 Data& cached_data(const ModelHolder& md) {
   struct Entry {
     const Model* key;
@@ -284,9 +291,7 @@ void bind_algorithm(py::module_& m) {
                      "inverse_dynamics and mass_matrix write. One per thread; pass it as data= "
                      "to choose it explicitly (otherwise each thread keeps one per model).")
       .def(py::init([](const ModelArg& model) {
-             if (!py::isinstance<Model>(model))
-               throw ModelError(msg("Data: model must be an armdyn.Model, got ", shown(model)));
-             return std::make_unique<DataPy>(model.cast<ModelHolder>());
+             return std::make_unique<DataPy>(model_of(model, "Data"));
            }),
            py::arg("model"),
            "A workspace for `model` (an armdyn.Model); ModelError if model is None.")
@@ -295,9 +300,10 @@ void bind_algorithm(py::module_& m) {
 
   m.def(
       "forward_dynamics",
-      [](const ModelHolder& md, const ArrayLike& q, const ArrayLike& qd, const ArrayLike& tau,
+      [](const ModelArg& model_, const ArrayLike& q, const ArrayLike& qd, const ArrayLike& tau,
          const FloatOrArray& t, const StrArg& method, const OptData& data) {
         constexpr const char* fn = "forward_dynamics";
+        const ModelHolder md = model_of(model_, fn);
         Data& d = data_for(md, data, fn);
         const DynamicsMethod mth = dynamics_method(str_arg(method, fn, "method"), fn);
         const Model& mm = *md;
@@ -334,8 +340,8 @@ void bind_algorithm(py::module_& m) {
 
   m.def(
       "dynamics_cost",
-      [](const ModelHolder& md) {
-        if (!md) throw ModelError("dynamics_cost: no model");
+      [](const ModelArg& model_) {
+        const ModelHolder md = model_of(model_, "dynamics_cost");
         const DynamicsCost& c = dynamics_cost(*md);
         auto lower = [](DynamicsMethod x) {
           return x == DynamicsMethod::Aba    ? "aba"
@@ -366,9 +372,10 @@ void bind_algorithm(py::module_& m) {
 
   m.def(
       "inverse_dynamics",
-      [](const ModelHolder& md, const ArrayLike& q, const ArrayLike& qd, const ArrayLike& qdd,
+      [](const ModelArg& model_, const ArrayLike& q, const ArrayLike& qd, const ArrayLike& qdd,
          const FloatOrArray& t, const StrArg& method, const OptData& data) {
         constexpr const char* fn = "inverse_dynamics";
+        const ModelHolder md = model_of(model_, fn);
         Data& d = data_for(md, data, fn);
         const DynamicsMethod mth = dynamics_method(str_arg(method, fn, "method"), fn, false);
         const Model& mm = *md;
@@ -397,8 +404,9 @@ void bind_algorithm(py::module_& m) {
 
   m.def(
       "mass_matrix",
-      [](const ModelHolder& md, const ArrayLike& q, const OptData& data) {
+      [](const ModelArg& model_, const ArrayLike& q, const OptData& data) {
         constexpr const char* fn = "mass_matrix";
+        const ModelHolder md = model_of(model_, fn);
         Data& d = data_for(md, data, fn);
         const Model& mm = *md;
         const long n = d.ni;
@@ -425,8 +433,9 @@ void bind_algorithm(py::module_& m) {
 
   m.def(
       "frame_pose",
-      [](const ModelHolder& md, const ArrayLike& q, const FrameRef& frame, const OptData& data) {
+      [](const ModelArg& model_, const ArrayLike& q, const FrameRef& frame, const OptData& data) {
         constexpr const char* fn = "frame_pose";
+        const ModelHolder md = model_of(model_, fn);
         Data& d = data_for(md, data, fn);
         const Model& mm = *md;
         require_joint_space(mm, fn, true);
@@ -442,8 +451,9 @@ void bind_algorithm(py::module_& m) {
 
   m.def(
       "frame_jacobian",
-      [](const ModelHolder& md, const ArrayLike& q, const FrameRef& frame, const OptData& data) {
+      [](const ModelArg& model_, const ArrayLike& q, const FrameRef& frame, const OptData& data) {
         constexpr const char* fn = "frame_jacobian";
+        const ModelHolder md = model_of(model_, fn);
         Data& d = data_for(md, data, fn);
         const Model& mm = *md;
         require_joint_space(mm, fn, true);
@@ -460,8 +470,9 @@ void bind_algorithm(py::module_& m) {
 
   m.def(
       "frame_pose_cartesian",
-      [](const ModelHolder& md, const ArrayLike& u, const FrameRef& frame, const OptData& data) {
+      [](const ModelArg& model_, const ArrayLike& u, const FrameRef& frame, const OptData& data) {
         constexpr const char* fn = "frame_pose_cartesian";
+        const ModelHolder md = model_of(model_, fn);
         Data& d = data_for(md, data, fn);
         const Model& mm = *md;
         const int f = frame_arg(mm, frame, fn);
@@ -475,8 +486,9 @@ void bind_algorithm(py::module_& m) {
 
   m.def(
       "frame_jacobian_cartesian",
-      [](const ModelHolder& md, const ArrayLike& u, const FrameRef& frame, const OptData& data) {
+      [](const ModelArg& model_, const ArrayLike& u, const FrameRef& frame, const OptData& data) {
         constexpr const char* fn = "frame_jacobian_cartesian";
+        const ModelHolder md = model_of(model_, fn);
         Data& d = data_for(md, data, fn);
         const Model& mm = *md;
         const int f = frame_arg(mm, frame, fn);

@@ -241,6 +241,26 @@ def test_a_bad_option_is_a_model_error_naming_it(call, name, value):
     assert not any(leak in message for leak in LEAKS), message
 
 
+@pytest.mark.parametrize("not_a_model", [None, 5, "ur5.urdf", ad.ModelBuilder()])
+@pytest.mark.parametrize(
+    "name, call",
+    [
+        ("forward_dynamics", lambda m: ad.forward_dynamics(m, [0.1], [0.0], [0.0])),
+        ("inverse_dynamics", lambda m: ad.inverse_dynamics(m, [0.1], [0.0], [0.0])),
+        ("mass_matrix", lambda m: ad.mass_matrix(m, [0.1])),
+        ("frame_pose", lambda m: ad.frame_pose(m, [0.1], 0)),
+        ("frame_jacobian", lambda m: ad.frame_jacobian(m, [0.1], 0)),
+        ("dynamics_cost", lambda m: ad.dynamics_cost(m)),
+        ("Data", lambda m: ad.Data(m)),
+    ],
+)
+def test_a_model_argument_that_is_not_a_model_is_named(name, call, not_a_model):
+    with pytest.raises(ad.ModelError, match=rf"{name}: model must be an armdyn.Model") as err:
+        call(not_a_model)
+    assert not any(leak in str(err.value) for leak in LEAKS)
+    call(M)  # the same call with the model runs
+
+
 def test_no_complex_warning_leaks(recwarn):
     with pytest.raises(ad.ModelError, match=r"q: .*real numbers"):
         ad.forward_dynamics(M, [0.1 + 0j], [0.0], [0.0])
