@@ -19,6 +19,12 @@ from armdyn import _core
 INT_MAX = 2**63 - 1
 
 
+class ArgumentTypeError(_core.ModelError, TypeError):
+    """A bad argument of the wrong type: a ``ModelError`` naming it that is also a ``TypeError``
+    (where a function documented ``TypeError`` before its options were checked as ModelErrors,
+    ``except TypeError`` keeps working)."""
+
+
 def _shown(value) -> str:
     text = repr(value)
     return text if len(text) <= 60 else text[:57] + "..."

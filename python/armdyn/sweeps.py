@@ -25,6 +25,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from armdyn._checks import ArgumentTypeError
+from armdyn._core import ModelError
+
 if TYPE_CHECKING:
     import xarray as xr
 
@@ -102,17 +105,17 @@ def _takes_seed(fn: Callable) -> bool:
 def _check_grid(grid: dict) -> dict[str, tuple[np.ndarray, list]]:
     """Each axis as (coordinate array, the values passed to fn)."""
     if not grid:
-        raise ValueError("sweep needs at least one grid axis, e.g. sweep(fn, payload=[0.0, 1.0])")
+        raise ModelError("sweep needs at least one grid axis, e.g. sweep(fn, payload=[0.0, 1.0])")
     axes = {}
     for name, values in grid.items():
         if name == "status":
-            raise ValueError("grid axis 'status' clashes with the Dataset's status variable")
+            raise ModelError("grid axis 'status' clashes with the Dataset's status variable")
         try:
             ndim = np.ndim(values)
         except ValueError:  # ragged nesting
             ndim = -1
         if isinstance(values, str | bytes) or ndim != 1:
-            raise ValueError(
+            raise ModelError(
                 f"grid axis {name!r} must be a 1-D sequence of values, got {values!r:.80}"
             )
         values = list(values)
@@ -120,13 +123,13 @@ def _check_grid(grid: dict) -> dict[str, tuple[np.ndarray, list]]:
         if arr.dtype.kind in "US" and not all(isinstance(v, str | bytes) for v in values):
             arr = np.asarray(values, dtype=object)  # mixed types: no conversion to strings
         if arr.size == 0:
-            raise ValueError(f"grid axis {name!r} is empty")
+            raise ModelError(f"grid axis {name!r} is empty")
         try:
             distinct = len(set(arr.tolist())) == arr.size
         except TypeError:  # unhashable values
             distinct = True
         if not distinct:
-            raise ValueError(f"grid axis {name!r} has repeated values: {arr.tolist()!r:.200}")
+            raise ModelError(f"grid axis {name!r} has repeated values: {arr.tolist()!r:.200}")
         axes[name] = (arr, values)
     return axes
 
@@ -195,16 +198,19 @@ def sweep(
 
     Raises:
         ImportError: dask.distributed or xarray is not installed.
-        TypeError: fn is not callable, or a seed is given and fn takes no ``seed``.
-        ValueError: an empty or non-1-D grid axis, repeated grid values, a bad ``dims`` or
-            ``coords`` entry, or an output name that clashes with a grid name or ``status``.
+        armdyn.ModelError (also a TypeError): fn is not callable, a seed that is not an int
+            or SeedSequence or that fn cannot take, or a client that is not a
+            ``distributed.Client``.
+        armdyn.ModelError (a ValueError): an empty or non-1-D grid axis, repeated grid
+            values, a bad ``retries``, ``dims`` or ``coords`` entry, or an output name that
+            clashes with a grid name or ``status``.
     """
     if not callable(fn):
-        raise TypeError(f"sweep: fn must be callable, got {type(fn).__name__}")
+        raise ArgumentTypeError(f"sweep: fn must be callable, got {type(fn).__name__}")
     if isinstance(retries, bool) or not isinstance(retries, int) or retries < 0:
-        raise ValueError(f"sweep: retries must be an integer >= 0, got {retries!r}")
+        raise ModelError(f"sweep: retries must be an integer >= 0, got {retries!r}")
     if seed is not None and not isinstance(seed, int | np.integer | np.random.SeedSequence):
-        raise TypeError(
+        raise ArgumentTypeError(
             f"sweep: seed must be an int, a numpy SeedSequence or None, got {seed!r:.80} "
             "(a grid axis cannot be named 'seed')"
         )
@@ -214,7 +220,7 @@ def sweep(
     coords = dict(coords or {})
     takes_seed = _takes_seed(fn)
     if seed is not None and not takes_seed:
-        raise TypeError(
+        raise ArgumentTypeError(
             f"sweep: seed={seed!r} given but fn {getattr(fn, '__name__', fn)!r} takes no "
             "'seed' argument"
         )
@@ -238,7 +244,7 @@ def sweep(
 
     own = client is None
     if not own and not isinstance(client, distributed.Client):
-        raise TypeError(
+        raise ArgumentTypeError(
             f"sweep: client must be a distributed.Client or None, got {type(client).__name__}"
             " (for a cluster object: distributed.Client(cluster))"
         )
@@ -332,20 +338,20 @@ def sweep(
         first = ok[0]
         for var, (arr0, own_dims) in first.items():
             if var in axes or var == "status":
-                raise ValueError(
+                raise ModelError(
                     f"sweep: output {var!r} has the name of a grid axis or of 'status'"
                 )
             vdims = tuple(
                 dims.get(var, own_dims or tuple(f"{var}_dim{k}" for k in range(arr0.ndim)))
             )
             if len(vdims) != arr0.ndim:
-                raise ValueError(
+                raise ModelError(
                     f"sweep: dims[{var!r}] = {vdims!r} names {len(vdims)} dimensions but "
                     f"{var!r} has shape {arr0.shape}"
                 )
             clash = [d for d in vdims if d in axes]
             if clash:
-                raise ValueError(f"sweep: output dims {clash} of {var!r} repeat grid names")
+                raise ModelError(f"sweep: output dims {clash} of {var!r} repeat grid names")
             kinds = {r[var][0].dtype for r in ok}
             dtype = np.result_type(*kinds)
             if len(ok) < n and dtype.kind in "biu":
@@ -358,7 +364,7 @@ def sweep(
             data_vars[var] = ((*names, *vdims), full)
     unknown = [v for v in dims if v not in data_vars]
     if unknown and ok:
-        raise ValueError(f"sweep: dims given for {unknown}, which fn does not return")
+        raise ModelError(f"sweep: dims given for {unknown}, which fn does not return")
     status = np.array(["ok" if e is None else e for e in errors], dtype=object).reshape(shape)
     data_vars["status"] = (tuple(names), status)
 
@@ -366,11 +372,11 @@ def sweep(
     used = {d for v in data_vars.values() for d in v[0]}
     for d, values in coords.items():
         if d in axes:
-            raise ValueError(
+            raise ModelError(
                 f"sweep: coords[{d!r}]: {d!r} is a grid axis (its values are the grid's)"
             )
         if ok and d not in used:
-            raise ValueError(f"sweep: coords[{d!r}]: no output has a dimension {d!r}")
+            raise ModelError(f"sweep: coords[{d!r}]: no output has a dimension {d!r}")
         all_coords[d] = (d, np.asarray(values))
 
     # the package's version without importing the package from its own submodule (no cycle)

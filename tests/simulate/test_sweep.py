@@ -257,26 +257,33 @@ def test_own_local_cluster_when_no_client():
     ],
 )
 def test_bad_grids_raise_before_any_work(kwargs, match):
-    with pytest.raises(ValueError, match=match):
+    # a ModelError naming the argument, still a ValueError for code written before
+    with pytest.raises(ad.ModelError, match=match) as err:
         ad.sweep(flaky_point, **kwargs)
+    assert isinstance(err.value, ValueError)
 
 
 def test_bad_fn_and_seed_raise():
-    with pytest.raises(TypeError, match="fn must be callable"):
-        ad.sweep(3, x=[1])
-    with pytest.raises(TypeError, match="takes no 'seed' argument"):
-        ad.sweep(flaky_point, seed=1, x=[1], mode=["fine"])
-    with pytest.raises(TypeError, match="a grid axis cannot be named 'seed'"):
-        ad.sweep(noisy, seed=[1, 2], scale=[1.0])
+    # ModelErrors naming the argument that are also TypeErrors (as documented before)
+    for call, match in [
+        (lambda: ad.sweep(3, x=[1]), "fn must be callable"),
+        (lambda: ad.sweep(flaky_point, seed=1, x=[1], mode=["fine"]), "takes no 'seed' argument"),
+        (lambda: ad.sweep(noisy, seed=[1, 2], scale=[1.0]), "a grid axis cannot be named 'seed'"),
+    ]:
+        with pytest.raises(ad.ModelError, match=match) as err:
+            call()
+        assert isinstance(err.value, TypeError)
 
 
 def test_a_cluster_instead_of_a_client_raises(client):
-    with pytest.raises(TypeError, match=r"client must be a distributed.Client or None, got Local"):
+    with pytest.raises(
+        ad.ModelError, match=r"client must be a distributed.Client or None, got Loc"
+    ):
         ad.sweep(flaky_point, client.cluster, x=[1], mode=["fine"])
 
 
 def test_output_clashing_with_a_grid_name_raises(client):
-    with pytest.raises(ValueError, match="output 'a' has the name of a grid axis"):
+    with pytest.raises(ad.ModelError, match="output 'a' has the name of a grid axis"):
         ad.sweep(lambda a: {"a": a}, client, a=[1])
 
 
