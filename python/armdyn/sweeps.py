@@ -25,8 +25,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from armdyn import _core
 from armdyn._checks import ArgumentTypeError
-from armdyn._core import ModelError
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -105,17 +105,19 @@ def _takes_seed(fn: Callable) -> bool:
 def _check_grid(grid: dict) -> dict[str, tuple[np.ndarray, list]]:
     """Each axis as (coordinate array, the values passed to fn)."""
     if not grid:
-        raise ModelError("sweep needs at least one grid axis, e.g. sweep(fn, payload=[0.0, 1.0])")
+        raise _core.ModelError(
+            "sweep needs at least one grid axis, e.g. sweep(fn, payload=[0.0, 1.0])"
+        )
     axes = {}
     for name, values in grid.items():
         if name == "status":
-            raise ModelError("grid axis 'status' clashes with the Dataset's status variable")
+            raise _core.ModelError("grid axis 'status' clashes with the Dataset's status variable")
         try:
             ndim = np.ndim(values)
         except ValueError:  # ragged nesting
             ndim = -1
         if isinstance(values, str | bytes) or ndim != 1:
-            raise ModelError(
+            raise _core.ModelError(
                 f"grid axis {name!r} must be a 1-D sequence of values, got {values!r:.80}"
             )
         values = list(values)
@@ -123,13 +125,13 @@ def _check_grid(grid: dict) -> dict[str, tuple[np.ndarray, list]]:
         if arr.dtype.kind in "US" and not all(isinstance(v, str | bytes) for v in values):
             arr = np.asarray(values, dtype=object)  # mixed types: no conversion to strings
         if arr.size == 0:
-            raise ModelError(f"grid axis {name!r} is empty")
+            raise _core.ModelError(f"grid axis {name!r} is empty")
         try:
             distinct = len(set(arr.tolist())) == arr.size
         except TypeError:  # unhashable values
             distinct = True
         if not distinct:
-            raise ModelError(f"grid axis {name!r} has repeated values: {arr.tolist()!r:.200}")
+            raise _core.ModelError(f"grid axis {name!r} has repeated values: {arr.tolist()!r:.200}")
         axes[name] = (arr, values)
     return axes
 
@@ -208,7 +210,7 @@ def sweep(
     if not callable(fn):
         raise ArgumentTypeError(f"sweep: fn must be callable, got {type(fn).__name__}")
     if isinstance(retries, bool) or not isinstance(retries, int) or retries < 0:
-        raise ModelError(f"sweep: retries must be an integer >= 0, got {retries!r}")
+        raise _core.ModelError(f"sweep: retries must be an integer >= 0, got {retries!r}")
     if seed is not None and not isinstance(seed, int | np.integer | np.random.SeedSequence):
         raise ArgumentTypeError(
             f"sweep: seed must be an int, a numpy SeedSequence or None, got {seed!r:.80} "
@@ -338,20 +340,20 @@ def sweep(
         first = ok[0]
         for var, (arr0, own_dims) in first.items():
             if var in axes or var == "status":
-                raise ModelError(
+                raise _core.ModelError(
                     f"sweep: output {var!r} has the name of a grid axis or of 'status'"
                 )
             vdims = tuple(
                 dims.get(var, own_dims or tuple(f"{var}_dim{k}" for k in range(arr0.ndim)))
             )
             if len(vdims) != arr0.ndim:
-                raise ModelError(
+                raise _core.ModelError(
                     f"sweep: dims[{var!r}] = {vdims!r} names {len(vdims)} dimensions but "
                     f"{var!r} has shape {arr0.shape}"
                 )
             clash = [d for d in vdims if d in axes]
             if clash:
-                raise ModelError(f"sweep: output dims {clash} of {var!r} repeat grid names")
+                raise _core.ModelError(f"sweep: output dims {clash} of {var!r} repeat grid names")
             kinds = {r[var][0].dtype for r in ok}
             dtype = np.result_type(*kinds)
             if len(ok) < n and dtype.kind in "biu":
@@ -364,7 +366,7 @@ def sweep(
             data_vars[var] = ((*names, *vdims), full)
     unknown = [v for v in dims if v not in data_vars]
     if unknown and ok:
-        raise ModelError(f"sweep: dims given for {unknown}, which fn does not return")
+        raise _core.ModelError(f"sweep: dims given for {unknown}, which fn does not return")
     status = np.array(["ok" if e is None else e for e in errors], dtype=object).reshape(shape)
     data_vars["status"] = (tuple(names), status)
 
@@ -372,11 +374,11 @@ def sweep(
     used = {d for v in data_vars.values() for d in v[0]}
     for d, values in coords.items():
         if d in axes:
-            raise ModelError(
+            raise _core.ModelError(
                 f"sweep: coords[{d!r}]: {d!r} is a grid axis (its values are the grid's)"
             )
         if ok and d not in used:
-            raise ModelError(f"sweep: coords[{d!r}]: no output has a dimension {d!r}")
+            raise _core.ModelError(f"sweep: coords[{d!r}]: no output has a dimension {d!r}")
         all_coords[d] = (d, np.asarray(values))
 
     # the package's version without importing the package from its own submodule (no cycle)
