@@ -15,6 +15,7 @@
 
 #include "armdyn/builder/builder.hpp"
 #include "armdyn/errors.hpp"
+#include "utf8.hpp"
 
 namespace armdyn {
 
@@ -257,36 +258,7 @@ std::string write(const Model& m, std::uint8_t kind) {
 // reading: every value checked where it is read, the message naming its field
 
 // well-formed UTF-8 (no overlong forms, surrogates or code points above U+10FFFF)
-bool valid_utf8(const std::string& s) {
-  const auto* p = reinterpret_cast<const unsigned char*>(s.data());
-  const std::size_t n = s.size();
-  for (std::size_t i = 0; i < n;) {
-    const unsigned c = p[i];
-    std::size_t len = 0;
-    unsigned lo = 0x80, hi = 0xBF;  // the range of the second byte
-    if (c < 0x80) {
-      ++i;
-      continue;
-    } else if (c >= 0xC2 && c <= 0xDF) {
-      len = 2;
-    } else if (c >= 0xE0 && c <= 0xEF) {
-      len = 3;
-      if (c == 0xE0) lo = 0xA0;
-      if (c == 0xED) hi = 0x9F;
-    } else if (c >= 0xF0 && c <= 0xF4) {
-      len = 4;
-      if (c == 0xF0) lo = 0x90;
-      if (c == 0xF4) hi = 0x8F;
-    } else {
-      return false;
-    }
-    if (n - i < len || p[i + 1] < lo || p[i + 1] > hi) return false;
-    for (std::size_t k = 2; k < len; ++k)
-      if (p[i + k] < 0x80 || p[i + k] > 0xBF) return false;
-    i += len;
-  }
-  return true;
-}
+bool valid_utf8(const std::string& s) { return utf8_error(s) == std::string::npos; }
 
 class Reader {
  public:
