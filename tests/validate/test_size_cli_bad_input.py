@@ -7,6 +7,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import armdyn
 import numpy as np
 import pandas as pd
 import pytest
@@ -114,7 +115,8 @@ def _cli(*args):
         capture_output=True,
         text=True,
         timeout=120,
-        env={**os.environ, "PYTHONPATH": str(ROOT / "python")},
+        # the armdyn this test imported (installed, or a source tree on PYTHONPATH)
+        env={**os.environ, "PYTHONPATH": str(Path(armdyn.__file__).resolve().parents[1])},
     )
 
 
