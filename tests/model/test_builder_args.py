@@ -11,6 +11,7 @@ from __future__ import annotations
 import armdyn as ad
 import numpy as np
 import pytest
+from armdyn.sizing import MOTOR_FIELDS
 
 LEAKS = ("incompatible function arguments", "Unable to cast", "TypeError", "ComplexWarning")
 SURROGATE = "bad\ud800name"
@@ -311,21 +312,7 @@ FUNCTIONS = [
     (
         "Motor",
         lambda **o: ad.Motor(**o),
-        {"name": ("name", False)}
-        | {
-            f: ("float", True)
-            for f in (
-                "torque_constant",
-                "resistance",
-                "voltage",
-                "no_load_speed",
-                "continuous_torque",
-                "peak_torque",
-                "max_speed",
-                "thermal_resistance",
-                "thermal_time_constant",
-            )
-        },
+        {"name": ("name", False)} | {f: ("float", True) for f in MOTOR_FIELDS if f != "name"},
     ),
     (
         "Data",
