@@ -13,19 +13,34 @@ void ensure_mass_matrix(Data& d) {
   }
 }
 
+namespace {
+// The point the spatial quantities below are taken about. M does not depend on it; about the
+// world origin the products m |c|^2 lose precision with the square of a floating base's distance
+// from it (1e-3 relative at 1e6 m, overflow past 1e154 m), so with a floating base they are
+// taken about the first base's centre of mass. Without one, about the world origin.
+Vec3 reference_point(const Model& m, const Data& d) {
+  if (m.n_free == 0) return Vec3::Zero();
+  for (int ji : m.tree_order)
+    if (m.joints[ji].type == JointType::Free) return d.kin[m.joints[ji].child].x;
+  return Vec3::Zero();
+}
+}  // namespace
+
 void crba_loaded(const Model& m, Data& d) {
   ensure_mass_matrix(d);
-  // each body's spatial inertia about the world origin: I_O = R J R^T + m (|c|^2 1 - c c^T)
+  const Vec3 o = reference_point(m, d);
+  // each body's spatial inertia about o: I_o = R J R^T + m (|c|^2 1 - c c^T), c = x - o
   for (int i = 0; i < m.nb; ++i) {
     const Body& b = m.bodies[i];
     const BodyKin& k = d.kin[i];
     Data::Composite& I = d.ic[i];
+    const Vec3 c = k.x - o;
     I.m = b.mass;
-    I.h = b.mass * k.x;
+    I.h = b.mass * c;
     const Mat3 RJ = k.R * b.inertia;
     I.I.noalias() = RJ * k.R.transpose();
-    I.I.noalias() -= I.h * k.x.transpose();
-    I.I.diagonal().array() += I.h.dot(k.x);
+    I.I.noalias() -= I.h * c.transpose();
+    I.I.diagonal().array() += I.h.dot(c);
   }
   // composites, children first
   for (auto it = m.tree_order.rbegin(); it != m.tree_order.rend(); ++it) {
@@ -43,7 +58,7 @@ void crba_loaded(const Model& m, Data& d) {
     const Joint& j = m.joints[ji];
     if (j.dof0 < 0) continue;
     const Vec3& z = d.rne.axis[ji];
-    const Vec3& p = d.rne.point[ji];
+    const Vec3 p = d.rne.point[ji] - o;
     if (j.type == JointType::Free) {
       // a floating base: slides along, then turns about, its frame's axes through its origin
       const Mat3 B = free_frame(j, d.kin[j.child]);
@@ -65,7 +80,7 @@ void crba_loaded(const Model& m, Data& d) {
   // M_jk for j among the degrees of freedom of k's joint and of the joints towards ground
   for (int k = 0; k < d.n; ++k) {
     const int jk = m.dof_joint[k];
-    // the subtree's momentum for the motion s = (w, v_O)
+    // the subtree's momentum for the motion s = (w, v_o)
     const Data::Composite& I = d.ic[m.joints[jk].child];
     const Vec3 w = d.s[k].head<3>(), v = d.s[k].tail<3>();
     Vec6 f;
