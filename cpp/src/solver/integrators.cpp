@@ -89,6 +89,17 @@ struct EventState {
     g0 = gend;
     dg0 = dg1;
   }
+  /// The event functions at the start of the next step, at the new, projected (t, y): taken
+  /// afresh after an event changed the system, refreshed with their signs kept after an event
+  /// cut the step, else those of the step's end.
+  void after_step(OdeSystem& sys, double t, const VecX& y, bool changed, bool cut) {
+    if (changed)
+      init(sys, t, y);
+    else if (cut)
+      refresh(sys, t, y);
+    else if (!sgn.empty())
+      next();
+  }
   /// Values and rates at the step's end (tn, y1); whether a crossing or a dip may lie inside.
   bool end(OdeSystem& sys, double tn, const VecX& y1, double h) {
     if (sgn.empty()) return false;
@@ -284,7 +295,6 @@ struct AdaptiveRun {
   bool last_rejected = false;
   bool resign = false;  // an event changed the system: take the signs afresh
   bool cut = false;     // an event ended the step early
-  int ne;
   EventState ev;
   VecX& yo;
 
@@ -298,7 +308,6 @@ struct AdaptiveRun {
         hmax(o.max_step > 0 ? o.max_step : t1_ - t0),
         hmin(1e-14 * std::max(1.0, std::abs(t1_))),
         touts(w.times),
-        ne(sys.n_events()),
         ev(sys, w, n),
         yo(w.vec(39, n)) {
     output_times(t0, t1_, o.output_dt, touts);
@@ -352,12 +361,7 @@ struct AdaptiveRun {
   /// The event functions at the start of the next step: taken afresh at the new, projected y
   /// after an event cut the step or changed the system, else those of the step's end.
   void signs_after_events(OdeSystem& sys, double tn, const VecX& y) {
-    if (resign)
-      ev.init(sys, tn, y);
-    else if (cut)
-      ev.refresh(sys, tn, y);
-    else if (ne > 0)
-      ev.next();
+    ev.after_step(sys, tn, y, resign, cut);
     resign = cut = false;
   }
   /// The clock moves to tn (y and the first stage there in place); the next step is hnew.
@@ -782,12 +786,7 @@ void integrate_rk4(OdeSystem& sys, VecX& y, double t0, double t1, const StepOpti
     t = tn;
     sys.project_and_rhs(t, y, k1);
     ++st.rhs_evals;
-    if (changed)
-      ev.init(sys, t, y);
-    else if (cut)
-      ev.refresh(sys, t, y);
-    else if (ne > 0)
-      ev.next();
+    ev.after_step(sys, t, y, changed, cut);
     ++st.steps;
     if (every_step) {
       sys.output(t, y);
@@ -973,12 +972,7 @@ void integrate_trbdf2(OdeSystem& sys, VecX& y, double t0, double t1, const StepO
       y = y1;
       sys.project_and_rhs(tn, y, K1);
       ++st.rhs_evals;
-      if (changed)
-        ev.init(sys, tn, y);
-      else if (cut)
-        ev.refresh(sys, tn, y);
-      else if (ne > 0)
-        ev.next();
+      ev.after_step(sys, tn, y, changed, cut);
       t = tn;
       ++st.steps;
       if (every_step) sys.output(t, y);
