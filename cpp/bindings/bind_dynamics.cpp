@@ -13,9 +13,9 @@
 #include "armdyn/algorithm/forces.hpp"
 #include "armdyn/algorithm/kinematics.hpp"
 #include "armdyn/algorithm/kkt.hpp"
-#include "armdyn/analysis/joint_space.hpp"
-#include "armdyn/analysis/simulate.hpp"
 #include "armdyn/data.hpp"
+#include "armdyn/kernels/joint_space.hpp"
+#include "armdyn/simulate/simulate.hpp"
 #include "common.hpp"
 
 namespace armdyn {

@@ -7,7 +7,7 @@
 #include "armdyn/builder/summary.hpp"
 #include "armdyn/io/serialize.hpp"
 #include "armdyn/io/urdf.hpp"
-#include "armdyn/solver/block_sparse.hpp"
+#include "armdyn/kernels/block_sparse.hpp"
 #include "common.hpp"
 
 namespace armdyn::py_helpers {

@@ -2,8 +2,8 @@
 // Bindings of inverse dynamics and the Lagrange and geometric validators.
 #include <pybind11/stl.h>
 
-#include "armdyn/analysis/inverse_dynamics.hpp"
-#include "armdyn/analysis/tree_dynamics.hpp"
+#include "armdyn/algorithm/driven_inverse_dynamics.hpp"
+#include "armdyn/algorithm/tree_dynamics.hpp"
 #include "armdyn/validate/validators.hpp"
 #include "common.hpp"
 

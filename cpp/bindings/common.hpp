@@ -17,7 +17,7 @@
 #include "armdyn/errors.hpp"
 #include "armdyn/math/types.hpp"
 #include "armdyn/model/profile.hpp"
-#include "armdyn/solver/poll.hpp"
+#include "armdyn/poll.hpp"
 
 namespace armdyn::py_helpers {
 
@@ -70,7 +70,7 @@ inline bool propagates_as_itself(const py::error_already_set& e) {
          e.matches(PyExc_GeneratorExit);
 }
 
-/// The poll of a run started from Python (solver/poll.hpp): every 5 ms of wall time it takes
+/// The poll of a run started from Python (poll.hpp): every 5 ms of wall time it takes
 /// the GIL briefly (on the main thread, or with a progress callable) to run the signal handlers
 /// (PyErr_CheckSignals: Ctrl-C raises KeyboardInterrupt there) and, every 0.1 s and when not None,
 /// calls progress(t, t_end). A Python exception from either stops the run as a PyInterrupted

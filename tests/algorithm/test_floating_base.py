@@ -100,7 +100,7 @@ def test_free_flyer_dynamics_equal_pinocchio(robot):
 @pytest.mark.parametrize("robot", ["ur5", "solo12"])
 def test_lagrange_validator_takes_floating_bases(robot):
     # an independent derivation: Euler-Lagrange by automatic differentiation of the composed
-    # joint transforms, the base in a local chart (validate/joint_fk.hpp)
+    # joint transforms, the base in a local chart (cpp/src/validate/joint_fk.hpp)
     m = armdyn.load_urdf(_robot_path(ROBOTS[robot]), fixed_base=False)
     lv = armdyn.LagrangeValidator(m)
     rng = np.random.default_rng(8)

@@ -121,7 +121,7 @@ def test_human_urdf_simulates_in_joint_and_cartesian_coordinates():
     assert "joint space" in joint.stats["formulation"]
     assert cart.stats["formulation"].startswith("cartesian")
     # massless bodies: the floored range-space factor refined against the exact system, no
-    # augmented LU (solver/kkt.hpp accelerations_refined)
+    # augmented LU (kernels/kkt_factor.hpp accelerations_refined)
     assert cart.stats["augmented_solves"] == 0 and cart.stats["kkt_solves"] > 0
     np.testing.assert_allclose(joint.q[0], q0, atol=1e-12)
     # the two formulations of the same motion (measured 2.3e-13 rad, 8.1e-12 rad/s), energy
@@ -143,7 +143,7 @@ def test_human_urdf_simulates_in_joint_and_cartesian_coordinates():
 
 def test_falling_human_cartesian_run_follows_the_joint_space_run():
     # from rest under gravity at the default tolerances: the Cartesian run's projections use a
-    # metric floored for the massless bodies (solver/kkt.cpp; with the light-body floors, 1e-9
+    # metric floored for the massless bodies (kernels/kkt_factor.cpp; with the light-body floors, 1e-9
     # of the heaviest mass, a 1 s fall stalled at t = 0.13 s with |f| = 1.4e-9)
     model = ad.load_urdf(str(_human()))
     # (the stops' contact sequence is tested in tests/simulate/test_joint_limits.py)

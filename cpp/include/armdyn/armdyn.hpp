@@ -10,30 +10,38 @@
 //   armdyn::SimResult r = armdyn::simulate(*model, t_end, options, model->u0, model->v0);
 #pragma once
 
-// errors and math
+// In layer order (docs/development.md, "Layers"): each folder includes only those above it.
+
+// errors, interruption and math
 #include "armdyn/errors.hpp"
 #include "armdyn/math/angles.hpp"
 #include "armdyn/math/quaternion.hpp"
 #include "armdyn/math/types.hpp"
+#include "armdyn/poll.hpp"
 
-// the model description and its per-evaluation workspace
-#include "armdyn/data.hpp"
+// the integrators (ODE interface, DOPRI5, DOP853, RK4, TR-BDF2; the Integrator enum)
+#include "armdyn/integrate/integrators.hpp"
+
+// the model description
 #include "armdyn/model/model.hpp"
 #include "armdyn/model/profile.hpp"
 
-// building a model: the builder (finalize: topology, assembly, rank analysis), its summary,
-// and the welded form simulate() integrates
-#include "armdyn/builder/builder.hpp"
-#include "armdyn/builder/summary.hpp"
-#include "armdyn/builder/weld.hpp"
+// the kernels under the algorithms: jets, constraint rows, KKT factor, block-sparse Schur,
+// tree sweep, and the joint-space kinematics and Newton-Euler sweep
+#include "armdyn/kernels/joint_space.hpp"
 
-// joint-space algorithms: forces, recursive Newton-Euler, CRBA, forward/inverse dynamics, frame
-// poses and Jacobians
+// the per-evaluation workspace
+#include "armdyn/data.hpp"
+
+// joint-space algorithms: forces, recursive Newton-Euler, CRBA, forward/inverse dynamics, tree
+// dynamics with gears, driven inverse dynamics, frame poses and Jacobians
 #include "armdyn/algorithm/crba.hpp"
+#include "armdyn/algorithm/driven_inverse_dynamics.hpp"
 #include "armdyn/algorithm/dynamics.hpp"
 #include "armdyn/algorithm/forces.hpp"
 #include "armdyn/algorithm/frames.hpp"
 #include "armdyn/algorithm/rnea.hpp"
+#include "armdyn/algorithm/tree_dynamics.hpp"
 
 // the Cartesian pipeline on the bodies' state (u, v): kinematics, constraints, forces
 // (cartesian_forces), KKT (body_accelerations), projection, reactions, energy
@@ -44,18 +52,18 @@
 #include "armdyn/algorithm/projection.hpp"
 #include "armdyn/algorithm/reactions.hpp"
 
-// URDF import
-#include "armdyn/io/urdf.hpp"
+// building a model: the builder (finalize: topology, assembly, rank analysis), its summary,
+// and the welded form simulate() integrates
+#include "armdyn/builder/builder.hpp"
+#include "armdyn/builder/summary.hpp"
+#include "armdyn/builder/weld.hpp"
 
-// the integrators (the kernels under the pipeline -- jets, constraint rows, KKT factor, tree
-// sweep -- are in armdyn/solver/)
-#include "armdyn/solver/integrators.hpp"
-
-// driven inverse dynamics, joint-space state, tree dynamics with gears, whole runs
-#include "armdyn/analysis/inverse_dynamics.hpp"
-#include "armdyn/analysis/joint_space.hpp"
-#include "armdyn/analysis/simulate.hpp"
-#include "armdyn/analysis/tree_dynamics.hpp"
+// whole runs
+#include "armdyn/simulate/simulate.hpp"
 
 // validators independent of the Cartesian path
 #include "armdyn/validate/validators.hpp"
+
+// URDF import and model bytes
+#include "armdyn/io/serialize.hpp"
+#include "armdyn/io/urdf.hpp"

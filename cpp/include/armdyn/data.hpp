@@ -8,13 +8,13 @@
 #include <string>
 #include <vector>
 
-#include "armdyn/analysis/joint_space.hpp"
+#include "armdyn/integrate/integrators.hpp"
+#include "armdyn/kernels/constraint_rows.hpp"
+#include "armdyn/kernels/jets.hpp"
+#include "armdyn/kernels/joint_space.hpp"
+#include "armdyn/kernels/kkt_factor.hpp"
+#include "armdyn/kernels/tree_sweep.hpp"
 #include "armdyn/model/model.hpp"
-#include "armdyn/solver/constraints.hpp"
-#include "armdyn/solver/integrators.hpp"
-#include "armdyn/solver/kinematics.hpp"
-#include "armdyn/solver/kkt.hpp"
-#include "armdyn/solver/tree_sweep.hpp"
 
 namespace armdyn {
 
@@ -123,7 +123,7 @@ class Data {
   double tol_f = 1e-13;              ///< position residual accepted by project without a correction
   PipelineStats stats;
 
-  // --- whole runs (analysis/simulate) and driven solves (analysis/inverse_dynamics) ---
+  // --- whole runs (simulate/simulate) and driven solves (algorithm/driven_inverse_dynamics) ---
   IntegratorWork integrator;  ///< the integrators' stages and scratch
   /// a run's output: the state y, (u, v), the accelerations vd and joint accelerations qdd
   struct RunScratch {

@@ -5,9 +5,9 @@
 #include <cmath>
 #include <cstdio>
 
-#include "armdyn/analysis/tree_dynamics.hpp"
+#include "armdyn/algorithm/tree_dynamics.hpp"
 #include "armdyn/errors.hpp"
-#include "armdyn/solver/kkt.hpp"
+#include "armdyn/kernels/kkt_factor.hpp"
 
 namespace armdyn {
 
@@ -83,7 +83,7 @@ const DynamicsCost& dynamics_cost(const Model& m) {
     c.joint = c.aba < c.crba ? DynamicsMethod::Aba : DynamicsMethod::Crba;
     const double jc = std::min(c.crba, c.aba);
     c.best = c.cartesian < jc ? DynamicsMethod::Cartesian : c.joint;
-    // light bodies (solver/kkt.hpp): ABA, about each body's centre of mass, keeps their
+    // light bodies (kernels/kkt_factor.hpp): ABA, about each body's centre of mass, keeps their
     // accelerations; CRBA's composites about the world origin lose a light leaf link's (UR5
     // wrist_3_link inertia x 1e-12: 6.6e-4), and the Cartesian path turns to a dense LU
     // (actuator rotors, massless coupling followers, are exact in CRBA: LightBodies)

@@ -10,7 +10,7 @@
 #include "armdyn/algorithm/kinematics.hpp"
 #include "armdyn/algorithm/kkt.hpp"
 #include "armdyn/algorithm/rnea.hpp"
-#include "armdyn/analysis/tree_dynamics.hpp"
+#include "armdyn/algorithm/tree_dynamics.hpp"
 #include "armdyn/errors.hpp"
 #include "armdyn/math/cholesky.hpp"
 

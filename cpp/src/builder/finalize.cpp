@@ -11,14 +11,14 @@
 
 #include "armdyn/algorithm/kinematics.hpp"
 #include "armdyn/algorithm/projection.hpp"
-#include "armdyn/analysis/joint_space.hpp"
 #include "armdyn/builder/builder.hpp"
 #include "armdyn/data.hpp"
 #include "armdyn/errors.hpp"
+#include "armdyn/kernels/block_sparse.hpp"
+#include "armdyn/kernels/constraint_rows.hpp"
+#include "armdyn/kernels/jets.hpp"
+#include "armdyn/kernels/joint_space.hpp"
 #include "armdyn/math/quaternion.hpp"
-#include "armdyn/solver/block_sparse.hpp"
-#include "armdyn/solver/constraints.hpp"
-#include "armdyn/solver/kinematics.hpp"
 
 namespace armdyn {
 

@@ -4,8 +4,8 @@
 #include <sstream>
 
 #include "armdyn/builder/weld.hpp"
-#include "armdyn/solver/block_sparse.hpp"
-#include "armdyn/solver/kkt.hpp"
+#include "armdyn/kernels/block_sparse.hpp"
+#include "armdyn/kernels/kkt_factor.hpp"
 
 namespace armdyn {
 

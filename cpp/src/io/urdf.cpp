@@ -52,7 +52,7 @@
 
 #include "armdyn/errors.hpp"
 #include "armdyn/math/quaternion.hpp"
-#include "armdyn/solver/poll.hpp"
+#include "armdyn/poll.hpp"
 #include "utf8.hpp"
 
 #ifdef ARMDYN_HAVE_CONSOLE_BRIDGE

@@ -4,7 +4,7 @@
 #include <unsupported/Eigen/AutoDiff>
 
 #include "armdyn/errors.hpp"
-#include "armdyn/validate/joint_fk.hpp"
+#include "joint_fk.hpp"
 
 namespace armdyn {
 

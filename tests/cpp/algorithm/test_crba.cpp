@@ -5,8 +5,8 @@
 #include <cmath>
 
 #include "armdyn/algorithm/crba.hpp"
-#include "armdyn/analysis/joint_space.hpp"
 #include "armdyn/errors.hpp"
+#include "armdyn/kernels/joint_space.hpp"
 #include "check.hpp"
 #include "models.hpp"
 

@@ -7,7 +7,7 @@
 
 #include "armdyn/algorithm/dynamics.hpp"
 #include "armdyn/algorithm/kkt.hpp"
-#include "armdyn/analysis/joint_space.hpp"
+#include "armdyn/kernels/joint_space.hpp"
 #include "armdyn/math/quaternion.hpp"
 #include "check.hpp"
 #include "models.hpp"

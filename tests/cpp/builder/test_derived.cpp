@@ -6,7 +6,7 @@
 #include "armdyn/builder/builder.hpp"
 #include "armdyn/builder/summary.hpp"
 #include "armdyn/builder/weld.hpp"
-#include "armdyn/solver/block_sparse.hpp"
+#include "armdyn/kernels/block_sparse.hpp"
 #include "check.hpp"
 #include "models.hpp"
 

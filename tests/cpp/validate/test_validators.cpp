@@ -6,7 +6,7 @@
 
 #include "armdyn/algorithm/crba.hpp"
 #include "armdyn/algorithm/rnea.hpp"
-#include "armdyn/analysis/joint_space.hpp"
+#include "armdyn/kernels/joint_space.hpp"
 #include "armdyn/math/quaternion.hpp"
 #include "armdyn/validate/validators.hpp"
 #include "check.hpp"

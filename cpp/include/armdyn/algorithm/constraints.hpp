@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Constraints stage of the Cartesian pipeline: the residuals f(u, t), the velocity-space
 // Jacobian zeta, rhs (zeta v = rhs) and xi (zeta v' = -xi) of every row, at the kinematics
-// loaded in data.kin, into data.ce (assembled by armdyn/solver/constraints.hpp, the ideal gear
+// loaded in data.kin, into data.ce (assembled by armdyn/kernels/constraint_rows.hpp, the ideal gear
 // rows reading the coordinate jets and the tracked angles of data).
 #pragma once
 

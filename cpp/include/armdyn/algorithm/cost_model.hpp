@@ -43,7 +43,7 @@ struct DynamicsCost {
   DynamicsMethod joint = DynamicsMethod::Crba;  ///< the cheaper joint-space algorithm
   DynamicsMethod best = DynamicsMethod::Crba;   ///< the cheapest of crba, aba, cartesian
   bool joint_rhs_cheaper = true;                ///< simulate: joint space is predicted cheaper
-  /// the model has light bodies (solver/kkt.hpp light_bodies): joint, best and an explicit
+  /// the model has light bodies (kernels/kkt_factor.hpp light_bodies): joint, best and an explicit
   /// "crba" take ABA, the algorithm that keeps their accelerations
   bool light = false;
   /// e.g. "predicted 41 us (ABA) vs 95 us (CRBA) vs 120 us (Cartesian) per evaluation"

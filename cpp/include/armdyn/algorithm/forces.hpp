@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "armdyn/data.hpp"
+#include "armdyn/kernels/jets.hpp"
 #include "armdyn/model/model.hpp"
-#include "armdyn/solver/kinematics.hpp"
 
 namespace armdyn {
 

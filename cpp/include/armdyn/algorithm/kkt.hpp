@@ -3,10 +3,10 @@
 // Newton-Euler equations
 //   Gamma v' + zeta^T delta = eta,   zeta v' = -xi
 // over the rows taking part (data.nrows), solved for the accelerations v' and the multipliers
-// data.delta by the Schur complement of the KKT system (armdyn/solver/kkt.hpp), or, for the
-// square zeta of a fully driven tree, by two O(n) sweeps (armdyn/solver/tree_sweep.hpp). A
+// data.delta by the Schur complement of the KKT system (armdyn/kernels/kkt_factor.hpp), or, for the
+// square zeta of a fully driven tree, by two O(n) sweeps (armdyn/kernels/tree_sweep.hpp). A
 // configuration where the Jacobian has lost rank against assembly is counted and described in
-// data.stats. Never silently inaccurate: a model with light bodies (solver/kkt.hpp
+// data.stats. Never silently inaccurate: a model with light bodies (kernels/kkt_factor.hpp
 // light_bodies) is solved in augmented form without Gamma^-1, and a range-space solve whose
 // constraint residual shows lost accuracy is redone in that form (data.stats.augmented_*).
 #pragma once

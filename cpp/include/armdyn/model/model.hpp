@@ -351,7 +351,7 @@ class Model {
   /// (IndependentCoords); the others refuse such a model (joint_space_reason names the coupling)
   bool coupled_joint_space = false;
   /// a tree of joint-coordinate joints defined parent -> child, ideal gears allowed (the
-  /// joint-space path of simulate, armdyn/analysis/tree_dynamics.hpp)
+  /// joint-space path of simulate, armdyn/algorithm/tree_dynamics.hpp)
   bool joint_tree = false;
   /// Why the joint-space path (TreeDynamics) does not apply to this model -- not a joint tree,
   /// or (unless ignore_drives) a drive prescribes a coordinate -- or empty when it does.
@@ -390,7 +390,7 @@ class Model {
   std::string body_name(int b) const { return b == kGround ? "ground" : bodies[b].name; }
 
   /// What the solver and analysis layers derive from this model on first use (KKT plans, the
-  /// welded model): see armdyn/solver/block_sparse.hpp kkt_plans(), armdyn/builder/weld.hpp.
+  /// welded model): see armdyn/kernels/block_sparse.hpp kkt_plans(), armdyn/builder/weld.hpp.
   detail::DerivedCache derived;
 };
 

@@ -30,7 +30,7 @@ class LagrangeValidator {
   /// @throws ModelError when the model is not a joint-space tree.
   explicit LagrangeValidator(std::shared_ptr<const Model> m, bool rotational_inertia = true);
   /// Generalised actuator forces (n_dofs) for q (n_coords), qd, qdd (n_dofs) at time t; a
-  /// floating base by a local chart about its pose in q (validate/joint_fk.hpp); a coupled
+  /// floating base by a local chart about its pose in q (cpp/src/validate/joint_fk.hpp); a coupled
   /// model's in its independent coordinates (G^T tau_full at the expanded state).
   VecX torques(const VecX& q, const VecX& qd, const VecX& qdd, double t = 0.0) const;
   /// Joint-space mass matrix M(q) (a coupled model's G^T M G).
