@@ -5,10 +5,11 @@ import sys
 
 import armdyn as ad
 from armdyn import scenes
+from armdyn.papers.geared_arm import geared_arm_6dof
 
 kind, n = sys.argv[1], int(sys.argv[2])
 if kind == "sparse":
-    m = scenes.geared_arm_6dof(backlash=0.0)
+    m = geared_arm_6dof(backlash=0.0)
     ad.simulate(m, n * 1e-5, integrator="rk4", dt=1e-5, output_dt=n * 1e-5 / 10)
 else:
     m = scenes.double_pendulum() if kind == "tree" else scenes.four_bar()

@@ -38,8 +38,8 @@ from pathlib import Path
 import armdyn as ad
 import numpy as np
 from armdyn import ModelError
+from armdyn.papers.geared_arm import geared_arm_6dof
 from armdyn.scenes.extreme import random_chain
-from armdyn.scenes.geared_arm import geared_arm_6dof
 
 from benchmarks import common
 from benchmarks.common import median_time
@@ -232,7 +232,7 @@ def bench_five_dof() -> dict:
     the constraints (no integration). The DOPRI5 run at rtol 1e-8 (which only feeds starting
     guesses to the same problems) is timed beside it, with the largest difference of the drive
     efforts between the two."""
-    from armdyn.scenes.paper import five_dof_arm
+    from armdyn.papers.five_dof import five_dof_arm
 
     model = five_dof_arm()
 

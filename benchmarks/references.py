@@ -247,7 +247,7 @@ class GearedArmReference:
         import inspect
 
         import pinocchio as pin
-        from armdyn.scenes.geared_arm import JOINTS, geared_arm_6dof
+        from armdyn.papers.geared_arm import JOINTS, geared_arm_6dof
 
         defaults = {k: v.default for k, v in inspect.signature(geared_arm_6dof).parameters.items()}
         self.scene = dict(defaults, **scene, backlash=0.0, n_motors=1, control="motor")

@@ -2,10 +2,10 @@
 target: >= 1.6x the serial throughput on a grid of >= 16 points).
 
 Each point is a real armdyn computation of 0.2-0.5 s CPU: the first paper's geared arm
-(:func:`armdyn.scenes.geared_arm_6dof`, 0.1 mm backlash) with 1-4 motors on its waist and a
-move ending at 1.5-3 s, simulated in joint coordinates, and the waist motors' peak and RMS
-torques from ``armdyn.sizing_report``. The function builds its model itself, so nothing but the
-grid values travels to the workers.
+(:func:`armdyn.papers.geared_arm.geared_arm_6dof`, 0.1 mm backlash) with 1-4 motors on its waist and
+a move ending at 1.5-3 s, simulated in joint coordinates, and the waist motors' peak and RMS torques
+from ``armdyn.sizing_report``. The function builds its model itself, so nothing but the grid values
+travels to the workers.
 
 A control runs the same points on a ``multiprocessing`` pool of 2 processes: on a machine
 shared with other sessions, it shows how much parallelism the machine gave at that moment.
@@ -41,7 +41,7 @@ def geared_point(n_motors, move_end):
     """The geared arm with ``n_motors`` on the waist (0.1 mm backlash), a move from 0.1 s to
     ``move_end``, run to ``move_end + 0.5`` s: the waist motors' largest peak and RMS torque
     [N m], the steps, and the CPU time of the point (not compared)."""
-    from armdyn.scenes.geared_arm import geared_arm_6dof
+    from armdyn.papers.geared_arm import geared_arm_6dof
 
     c0 = time.process_time()
     arm = geared_arm_6dof(n_motors=n_motors, backlash=BACKLASH, t_start=0.1, t_end=move_end)

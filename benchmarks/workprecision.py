@@ -40,9 +40,10 @@ from pathlib import Path
 
 import numpy as np
 from armdyn import _core, work_precision
-from armdyn.reproduce import efforts_in_coord_order
-from armdyn.scenes import paper, standard
-from armdyn.scenes.geared_arm import geared_arm_6dof
+from armdyn.papers import five_dof
+from armdyn.papers.geared_arm import geared_arm_6dof
+from armdyn.papers.reproduce import efforts_in_coord_order
+from armdyn.scenes import standard
 
 from benchmarks import common, references
 from benchmarks.common import error, output_times, sweep_scipy
@@ -128,9 +129,9 @@ def _five_dof_reference(t):
     rest-to-rest cubics q(t) = q1 (3 s² − 2 s³), s = t / T."""
     from armdyn.validation import LagrangeValidator
 
-    a = paper.ARM5
+    a = five_dof.ARM5
     t = np.asarray(t, dtype=float)
-    ends = np.array([a.target_deg * paper.DEG] * 4 + [a.stroke])
+    ends = np.array([a.target_deg * five_dof.DEG] * 4 + [a.stroke])
     s = t / a.duration
     q = np.outer(3 * s**2 - 2 * s**3, ends)
     qd = np.outer((6 * s - 6 * s**2) / a.duration, ends)
@@ -138,7 +139,7 @@ def _five_dof_reference(t):
     # the acceleration jumps at the start and at the end; armdyn's profiles take the value of
     # the rest outside (0, T) there
     qdd[(s <= 0.0) | (s >= 1.0)] = 0.0
-    return LagrangeValidator(paper.five_dof_arm()).torques(q, qd, qdd, t)
+    return LagrangeValidator(five_dof.five_dof_arm()).torques(q, qd, qdd, t)
 
 
 def _a01_check(ref):
@@ -353,7 +354,7 @@ PROBLEMS: dict[str, Problem] = {
         t_end=5.0,
         n_out=500,
         quantity="max |tau - tau_Lagrange| of the 5 drive efforts over 500 outputs [N m, N]",
-        build=paper.five_dof_arm,
+        build=five_dof.five_dof_arm,
         observe=efforts_in_coord_order,
         reference=_five_dof_reference,
         # every joint is driven: the kinematic path (simulate's default here) solves each
@@ -401,9 +402,9 @@ PROBLEMS: dict[str, Problem] = {
     "geared_arm": Problem(
         name="geared_arm",
         title="Geared arm (six-DOF paper; 44 bodies, no backlash) on its PD motors, 5 s",
-        source="six-dof-arm-topological-projection (armdyn.scenes.geared_arm_6dof, backlash 0); "
-        "reference: Pinocchio's CRBA and RNEA on the open tree of the same bodies, reduced by the "
-        "gear ratios, SciPy DOP853 at rtol 1e-12",
+        source="six-dof-arm-topological-projection (armdyn.papers.geared_arm.geared_arm_6dof, "
+        "backlash 0); reference: Pinocchio's CRBA and RNEA on the open tree of the same bodies, "
+        "reduced by the gear ratios, SciPy DOP853 at rtol 1e-12",
         t_end=5.0,
         n_out=100,
         quantity="max |q - q_ref| of the 6 arm joint angles over 100 outputs [rad]",

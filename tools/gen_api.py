@@ -5,7 +5,7 @@ docstrings and signatures.
     python tools/gen_api.py --check    # exit 1 with a diff when docs/reference.md is stale
 
 What it walks: every name of ``armdyn.__all__`` (functions, classes, the ``profiles`` module),
-then every public submodule (``armdyn.simulation``, ``armdyn.sizing``, ``armdyn.scenes.paper``,
+then every public submodule (``armdyn.simulation``, ``armdyn.sizing``, ``armdyn.papers.five_dof``,
 ...: module names without a leading underscore, ``__main__`` excepted) for the public functions,
 classes and numeric constants it defines that were not already listed. A class lists its
 constructor and the public methods and properties it defines itself.

@@ -8,7 +8,7 @@ intermediate shafts, six rotors) of the Pinocchio model
 :func:`benchmarks.peers.pinocchio.pinocchio_tree`
 builds from the scene's bodies, each Pinocchio joint carrying the composite inertia of the bodies
 welded to it. The twelve gear meshes are constraints between joint coordinates, from the scene's
-pitch radii (:data:`armdyn.scenes.geared_arm.JOINTS`): q_motor = -(R1/r1) q_shaft and
+pitch radii (:data:`armdyn.papers.geared_arm.JOINTS`): q_motor = -(R1/r1) q_shaft and
 q_shaft = -(R2/r2) q_joint. The motors are the scene's PD law on the rotor angles,
 clamp(kp (N ref(t) - q_m) + kd (N ref'(t) - q_m'), +-limit), with the quintic references.
 
@@ -64,7 +64,7 @@ from __future__ import annotations
 import contextlib
 
 import numpy as np
-from armdyn.scenes.geared_arm import JOINTS
+from armdyn.papers.geared_arm import JOINTS
 
 from benchmarks import common
 from benchmarks.peers.closed_loops import (

@@ -70,7 +70,7 @@ def _run(args: argparse.Namespace) -> int:
 
         return verify_main()
     if args.command == "reproduce":
-        from armdyn.reproduce import run
+        from armdyn.papers.reproduce import run
 
         try:
             run(args.out, plots=not args.no_plots, geared=not args.no_geared)

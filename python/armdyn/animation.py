@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import math
 import os
-import weakref
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
@@ -23,23 +22,12 @@ import numpy as np
 
 from armdyn import _core
 from armdyn._rotation import quat_to_rot
+from armdyn.urdf import urdf_source
 
 __all__ = ["animate"]
 
-#: URDF source (path or XML text) of each model made by :func:`armdyn.load_urdf`, so that
-#: :func:`animate` finds the link geometry without being told (weak: it never keeps a model alive).
-_URDF_SOURCES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
-
 _DEFAULT_COLOUR = (0.72, 0.74, 0.78)
 _MESH_SUFFIXES = (".stl", ".obj", ".dae")
-
-
-def remember_urdf(model, source: str) -> None:
-    """Record the URDF ``source`` (a path or the XML text) that ``model`` was loaded from."""
-    if source.lstrip("\ufeff").lstrip().startswith("<"):
-        _URDF_SOURCES[model] = source
-    else:
-        _URDF_SOURCES[model] = os.path.abspath(source)
 
 
 @dataclass
@@ -464,8 +452,8 @@ def animate(
             :class:`TrajectoryRun` (``t``, ``q`` (n, len(model.coord_names))).
         path: the HTML file to write.
         urdf: the URDF (a path, or the XML as str or UTF-8 bytes) of the link geometry;
-            default: the one :func:`armdyn.load_urdf` loaded ``model`` from, else inertia
-            boxes.
+            default: the one :func:`armdyn.load_urdf` loaded ``model`` from
+            (:func:`armdyn.urdf.urdf_source`), else inertia boxes.
         fps: frames per second of simulated time kept (the output rows at least 1/fps apart,
             the first and the last; every row if the output is coarser). The viewer interpolates
             between frames when playing.
@@ -493,7 +481,7 @@ def animate(
     if time is not None and not (isinstance(time, (int, float)) and math.isfinite(time)):
         raise ValueError(f"animate: time must be a finite number [s], got {time!r}")
     tr, ur = _shown_states(model, result, float(fps))
-    source = urdf if urdf is not None else _URDF_SOURCES.get(model)
+    source = urdf if urdf is not None else urdf_source(model)  # asked of the loader
     poses = {}
     if source is not None:
         visuals = urdf_visuals(source)

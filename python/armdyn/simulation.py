@@ -1,9 +1,10 @@
-"""Whole runs and URDF loading: the Python face of the C++ stepping loops."""
+"""Whole runs: :func:`simulate` and :func:`rollout`, the Python face of the C++ stepping loops.
+
+``load_urdf`` lives in :mod:`armdyn.urdf` (re-exported here, its old path)."""
 
 from __future__ import annotations
 
 import os
-import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -11,8 +12,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import numpy.typing as npt
 
-from armdyn import _checks, _core
-from armdyn.animation import remember_urdf
+from armdyn import _checks, _core, _run_options
+from armdyn._run_options import INTEGRATORS  # noqa: F401  (armdyn.simulation.INTEGRATORS)
+from armdyn.urdf import load_urdf  # noqa: F401  (the old path armdyn.simulation.load_urdf)
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -201,26 +203,6 @@ def simulate(
     Args:
         model: a finalized :class:`armdyn.Model`.
         t_end: end time [s] (> 0).
-        integrator: ``"dopri5"`` (Dormand–Prince 5(4), error control, dense output),
-            ``"dop853"`` (Dormand–Prince 8(5,3), error control, 7th-order dense output: for
-            tight tolerances), ``"rk4"`` (classical fixed step ``dt``), ``"trbdf2"``
-            (L-stable implicit TR-BDF2 with error control, for stiff scenes), ``"kinematic"``
-            (a fully driven model: each output state is solved from the constraints, nothing is
-            integrated), or ``"auto"``: kinematic when the drives leave no degree of freedom
-            (and outputs are on an ``output_dt`` grid), else TR-BDF2 when the stiffness
-            estimate of the force elements says an explicit method would need more than 5000
-            steps for stability alone, else DOP853 for ``rtol <= 1e-7`` and DOPRI5 above.
-            Default (``None``): kinematic for a fully driven model with ``output_dt``, else
-            DOPRI5. A fully driven model has nothing to integrate: its DOPRI5 run only supplies
-            starting guesses to the same position, velocity and acceleration problems, so both
-            give the same outputs. ``stats["integrator"]`` and ``stats["integrator_reason"]``
-            say which was used and why.
-        rtol, atol: error-control tolerances on every component of (u, v).
-        dt: RK4 step (required for rk4); DOPRI5/DOP853/TR-BDF2 initial step (optional). It
-            must advance time: at least ``64 eps t_end`` (about 1.4e-14 t_end), else a
-            ModelError naming ``dt``.
-        output_dt: spacing of output times (default: every accepted step). Output states are
-            interpolated (the integrator's dense output) and projected onto the constraints.
         q0, qd0: initial joint-space coordinates (``model.n_coords``,) and rates
             (``model.n_dofs``,) for tree models; default: the model's assembled state at rest.
             Angles are multi-turn: the run starts from q0's turns (3.5 rad stays 3.5, not
@@ -232,36 +214,7 @@ def simulate(
             followers are set by their couplings.
         u0, v0: initial Cartesian state (nq,), (nv,) instead of q0/qd0 (projected onto the
             constraints first); default: the model's assembled state.
-        projection: metric of the minimum-norm projection: ``"mass"`` (kinetic-energy metric,
-            reuses the KKT factorisation) or ``"unweighted"`` (the paper's form).
-        max_steps: limit on steps.
-        max_step: largest step of DOPRI5/DOP853/TR-BDF2 (default: no limit).
-        merge_welded: integrate bodies joined by fixed joints as one composite body (fewer
-            bodies and rows: the same motion at lower cost); the outputs still cover every body
-            and joint, the fixed joints' reactions from their bodies' Newton–Euler balances.
-            ``stats["solver_bodies"]`` / ``stats["solver_rows"]`` give the size integrated.
-        coordinates: ``"cartesian"`` (default): the bodies' Cartesian state with the
-            constrained Newton–Euler equations and the topological projection (the paper's
-            method; any mechanism). ``"joint"``: the joint coordinates and rates of a tree
-            without drives, ideal gears allowed: the mass matrix by the composite-rigid-body
-            algorithm, the bias and applied forces by recursive Newton–Euler, the gears
-            eliminated by their null space (far fewer states and a cheaper right-hand side;
-            the error control then acts on (q, qd)). Outputs are the same tables, built from
-            (q, qd). ``"auto"``: joint space wherever it applies, else Cartesian.
-            ``stats["formulation"]`` names the path taken (and for ``"auto"`` why).
-        limits: ``"enforce"`` (default): every joint with one coordinate (revolute,
-            prismatic), a finite position limit (``set_joint_limits``, the URDF ``<limit>``;
-            ``model.coord_lower``/``coord_upper``) and no drive is held within it by a
-            unilateral stop: the contact is located as an event, the impact is an impulse of the
-            whole mechanism (kinetic energy never rises), and the joint then rests on its stop,
-            held by a torque in ``limit_forces``, until the load pulls it off. A run that starts
-            outside a limit is refused. ``"ignore"``: the limits play no part in the dynamics
-            (they are still checked by :func:`armdyn.limit_violations`).
-        restitution: the stops' coefficient of restitution in [0, 1]: 0 (default) a plastic
-            impact; e > 0 rebounds at e times the impact rate. A rebound too small to rise
-            1e-9·max(1, |limit|) off its stop against the acceleration back into it ends the
-            series of ever shorter bounces that would follow: the joint rests on the stop,
-            having lost the rebound's kinetic energy, as the whole series would.
+        {run options}
         progress: ``False`` (default): nothing shown. ``True``: a tqdm progress bar of the
             simulated time (t of ``t_end`` seconds), closed when the run ends. A ``tqdm``
             instance: that bar, its ``total`` set to ``t_end`` and ``n`` to t (left open, for
@@ -298,21 +251,8 @@ def simulate(
             ``KeyboardInterrupt`` and ``GeneratorExit`` raised by a profile or progress
             callable propagate as themselves in the same way (``.result`` set).
     """
-    options = _core_options(
-        "simulate",
-        integrator,
-        rtol,
-        atol,
-        dt,
-        output_dt,
-        projection,
-        max_steps,
-        max_step,
-        merge_welded,
-        coordinates,
-        limits,
-        restitution,
-    )
+    # first, before any other name is bound: the arguments, of which the run options
+    options = _run_options.core_options("simulate", locals())
     t_end = _checks.number("simulate", "t_end", t_end, lo=0.0, lo_open=True)
     _checks_model("simulate", model)
     q0, qd0, u0, v0 = (
@@ -487,22 +427,6 @@ def _tqdm_reporter(bar):
     return report
 
 
-_ROLLOUT_OPTIONS = (
-    "integrator",
-    "rtol",
-    "atol",
-    "dt",
-    "output_dt",
-    "projection",
-    "max_steps",
-    "max_step",
-    "merge_welded",
-    "coordinates",
-    "limits",
-    "restitution",
-)
-
-
 def _rows(name: str, x, n_cols: int, n_rows: int | None) -> np.ndarray:
     """x as a float (n_runs, n_cols) array, or ModelError naming it and its shape."""
     a = _checks.array("rollout", name, x)
@@ -549,9 +473,8 @@ def rollout(
         max_output_bytes: bound on the memory of the outputs of all the runs together
             (default ``armdyn.simulation.MAX_OUTPUT_BYTES``), as :func:`simulate`'s for one run
             (each run's rows times n_runs).
-        **simulate_options: the options of :func:`simulate` (integrator, rtol, atol, dt,
-            output_dt, projection, max_steps, max_step, merge_welded, coordinates, limits,
-            restitution), the same for every run.
+        **simulate_options: the options of :func:`simulate`, the same for every run:
+            {run option names}.
 
     Returns:
         A list of :class:`SimulationResult` in input order. A run that fails does not stop the
@@ -569,23 +492,45 @@ def rollout(
             ``err.result`` holds the list (runs not started have ``error`` "interrupted before
             the run started").
     """
-    unknown = sorted(set(simulate_options) - set(_ROLLOUT_OPTIONS))
-    if unknown:
-        raise TypeError(
-            f"rollout: unknown option(s) {', '.join(unknown)} (per-run initial states are q0/qd0"
-            f" or u0/v0 rows; the options are simulate's: {', '.join(_ROLLOUT_OPTIONS)})"
-        )
-    import inspect
-
-    defaults = inspect.signature(simulate).parameters
-    options = _core_options(
-        "rollout", *(simulate_options.get(k, defaults[k].default) for k in _ROLLOUT_OPTIONS)
-    )
+    options = _rollout_options(simulate_options)
     t_end = _checks.number("rollout", "t_end", t_end, lo=0.0, lo_open=True)
     threads = _checks.integer("rollout", "threads", threads, lo=1, none=True)
     if threads is None:
         threads = os.cpu_count() or 1
     _checks_model("rollout", model)
+    us, vs, q, errors = _initial_rows(model, q0, qd0, u0, v0)
+    n = us.shape[0]
+    if n == 0:
+        return []
+    if model.nb == 0:  # nothing to integrate: the zero-DOF result of each run
+        return [simulate(model, t_end, output_dt=options["output_dt"] or None) for _ in range(n)]
+    results = _run_batch(
+        model, t_end, (us, vs, q, errors), min(threads, n), progress, options, max_output_bytes
+    )
+    _refuse_if_none_started(results)
+    return results
+
+
+simulate.__doc__ = _run_options.document(simulate.__doc__)
+rollout.__doc__ = _run_options.document(rollout.__doc__)
+
+
+def _rollout_options(simulate_options: dict) -> dict:
+    """rollout's ``**simulate_options``: only run options (a TypeError naming the others), the
+    rest at their defaults, checked and as ``_core._rollout`` takes them."""
+    unknown = sorted(set(simulate_options) - set(_run_options.NAMES))
+    if unknown:
+        raise TypeError(
+            f"rollout: unknown option(s) {', '.join(unknown)} (per-run initial states are q0/qd0"
+            f" or u0/v0 rows; the options are simulate's: {', '.join(_run_options.NAMES)})"
+        )
+    return _run_options.core_options("rollout", {**_run_options.DEFAULTS, **simulate_options})
+
+
+def _initial_rows(model, q0, qd0, u0, v0):
+    """(u0 rows, v0 rows, q0 rows or None, errors): the initial Cartesian state of each run,
+    from q0/qd0 rows (a run whose joint state does not assemble gets the model's state and its
+    error, so that it fails alone) or u0/v0 rows; ModelError for shapes or a mix of both."""
     if q0 is not None or qd0 is not None:
         if u0 is not None or v0 is not None:
             raise _core.ModelError("rollout: give either q0/qd0 or u0/v0 rows, not both")
@@ -600,17 +545,21 @@ def rollout(
                 us[k], vs[k] = _core.state_from_joints(model, q[k], qd[k])
             except _core.ModelError as err:  # this run cannot start; the others can
                 us[k], vs[k], errors[k] = model.u0, model.v0, str(err)
-    elif u0 is not None:
+        return us, vs, q, errors
+    if u0 is not None:
         us = _rows("u0", u0, model.nq, None)
-        n, q = us.shape[0], None
+        n = us.shape[0]
         vs = np.tile(model.v0, (n, 1)) if v0 is None else _rows("v0", v0, model.nv, n)
-        errors = [""] * n
-    else:
-        raise _core.ModelError("rollout: give the initial states, q0 (and qd0) or u0 (and v0)")
-    if n == 0:
-        return []
-    if model.nb == 0:  # nothing to integrate: the zero-DOF result of each run
-        return [simulate(model, t_end, output_dt=options["output_dt"] or None) for _ in range(n)]
+        return us, vs, None, [""] * n
+    raise _core.ModelError("rollout: give the initial states, q0 (and qd0) or u0 (and v0)")
+
+
+def _run_batch(model, t_end, starts, threads, progress, options, max_output_bytes):
+    """The runs on C++ threads, with the outputs' memory bounded and progress reported; the
+    results in input order. Ctrl-C (or an exception of the progress callable) is raised with
+    ``.result`` the list."""
+    us, vs, q, errors = starts
+    n = us.shape[0]
     requested = options["max_steps"]
     options = _bound_run("rollout", model, t_end, options, max_output_bytes, n_runs=n)
     report, close = _progress_reporter(progress, n, "rollout", "(done, n_runs)", unit="run")
@@ -622,7 +571,7 @@ def rollout(
             v0=vs,
             q_start=q,
             errors=errors,
-            threads=min(threads, n),
+            threads=threads,
             progress=report,
             **options,
         )
@@ -637,62 +586,15 @@ def rollout(
     if interrupt is not None:
         interrupt.result = results
         raise interrupt
-    # the same error on every run and none started: the options or the model are at fault
-    # (rk4 without dt, a model without joint coordinates), not the runs
-    messages = {r.error for r in results}
-    if len(messages) == 1 and None not in messages and all(len(r.t) == 0 for r in results):
-        raise _core.ModelError(f"rollout: every run failed to start: {messages.pop()}")
     return results
 
 
-def _core_options(
-    who,
-    integrator,
-    rtol,
-    atol,
-    dt,
-    output_dt,
-    projection,
-    max_steps,
-    max_step,
-    merge_welded,
-    coordinates,
-    limits,
-    restitution,
-) -> dict:
-    """The run options of :func:`simulate` checked (a ModelError naming the option and what
-    it allows) and as ``_core._simulate`` and ``_core._rollout`` take them (keyword
-    arguments)."""
-    integrator = _checks.choice(who, "integrator", integrator, INTEGRATORS, none=True)
-    rtol = _checks.number(who, "rtol", rtol, lo=0.0, lo_open=True)
-    atol = _checks.number(who, "atol", atol, lo=0.0, lo_open=True)
-    dt = _checks.number(who, "dt", dt, lo=0.0, lo_open=True, none=True)
-    output_dt = _checks.number(who, "output_dt", output_dt, lo=0.0, lo_open=True, none=True)
-    projection = _checks.choice(who, "projection", projection, ("mass", "unweighted"))
-    max_steps = _checks.integer(who, "max_steps", max_steps, lo=1)
-    max_step = _checks.number(who, "max_step", max_step, lo=0.0, lo_open=True, none=True)
-    merge_welded = _checks.flag(who, "merge_welded", merge_welded)
-    coordinates = _checks.choice(who, "coordinates", coordinates, ("cartesian", "joint", "auto"))
-    limits = _checks.choice(who, "limits", limits, ("enforce", "ignore"))
-    restitution = _checks.number(who, "restitution", restitution, lo=0.0, hi=1.0)
-    return dict(
-        integrator="default" if integrator is None else integrator,
-        rtol=rtol,
-        atol=atol,
-        dt=dt or 0.0,
-        output_dt=output_dt or 0.0,
-        projection=projection,
-        max_steps=max_steps,
-        max_step=max_step or 0.0,
-        merge_welded=merge_welded,
-        coordinates=coordinates,
-        limits=limits == "enforce",
-        restitution=restitution,
-    )
-
-
-#: the integrators simulate takes (None: the default choice)
-INTEGRATORS = ("dopri5", "dop853", "rk4", "trbdf2", "kinematic", "auto")
+def _refuse_if_none_started(results: list[SimulationResult]) -> None:
+    """The same error on every run and none started: the options or the model are at fault
+    (rk4 without dt, a model without joint coordinates), not the runs: one ModelError."""
+    messages = {r.error for r in results}
+    if len(messages) == 1 and None not in messages and all(len(r.t) == 0 for r in results):
+        raise _core.ModelError(f"rollout: every run failed to start: {messages.pop()}")
 
 
 def _result_of(model: _core.Model, raw: dict) -> SimulationResult:
@@ -761,112 +663,3 @@ def _zero_dof_result(model: _core.Model, t_end: float, output_dt: float | None):
         limit_forces={"names": [], "force": np.zeros((n, 0))},
         model=model,
     )
-
-
-def _urdf_source(path_or_xml) -> str:
-    """The text handed to the C++ loader: a str (XML or path), an os.PathLike, or bytes holding
-    UTF-8 XML; anything else is a TypeError."""
-    if isinstance(path_or_xml, (bytes, bytearray, memoryview)):
-        data = bytes(path_or_xml)
-        try:
-            text = data.decode("utf-8")
-        except UnicodeDecodeError as err:
-            raise _core.UrdfError(
-                f"URDF bytes are not valid UTF-8 (byte offset {err.start}); pass XML as UTF-8 "
-                "bytes or str, or a path as str"
-            ) from None
-        if not text.lstrip("\ufeff").lstrip().startswith("<"):
-            raise _core.UrdfError(
-                f"URDF bytes must hold XML (starting with '<'), got {data[:40]!r}"
-                + ("..." if len(data) > 40 else "")
-                + "; pass a path as str or os.PathLike"
-            )
-        return text
-    if isinstance(path_or_xml, str):
-        try:
-            path_or_xml.encode("utf-8")
-        except UnicodeEncodeError as err:
-            raise _core.UrdfError(
-                f"load_urdf: path_or_xml holds a lone surrogate {path_or_xml[err.start]!r} at "
-                f"index {err.start}: not valid Unicode text (decode bytes with "
-                "errors='strict', or pass the XML as UTF-8 bytes)"
-            ) from None
-        return path_or_xml
-    if isinstance(path_or_xml, os.PathLike):
-        path = os.fspath(path_or_xml)
-        return path if isinstance(path, str) else _urdf_source(path)
-    raise TypeError(
-        "load_urdf: expected a path (str or os.PathLike) or URDF XML (str or bytes), got "
-        f"{type(path_or_xml).__name__}"
-    )
-
-
-def load_urdf(
-    path_or_xml: str | bytes | os.PathLike[str],
-    fixed_base: bool = True,
-    gravity: npt.ArrayLike = (0.0, 0.0, -9.81),
-    *,
-    physical_inertia: bool = True,
-    mimic: bool = True,
-) -> _core.Model:
-    """Load a URDF file (or XML string) through urdfdom into a finalized Model.
-
-    Links joined by fixed joints are merged into one body; joint-space arrays follow the URDF's
-    document order of its moving joints. With ``fixed_base`` the root link is welded to ground.
-    Massless links (no ``<inertial>``, e.g. the "virtual" links between the joints of a 3-DOF
-    hip) are massless bodies, accepted wherever every joint motion still carries inertia.
-
-    With ``mimic`` (default), each ``<mimic joint= multiplier= offset=>`` becomes a coupling
-    ``q = multiplier * q_joint + offset`` (:meth:`ModelBuilder.add_coupling`, named after the
-    mimicking joint): the joint-space functions then take the independent coordinates
-    (``model.coord_names``, followers removed), as Pinocchio's ``mimic=True`` models do, while
-    simulation results report every joint (``model.joint_coord_names``). ``mimic=False`` gives
-    every mimicking joint its own coordinate (Pinocchio's default).
-
-    ``<dynamics damping friction>`` becomes joint friction (viscous, and Coulomb smoothed with
-    ``armdyn._core.URDF_COULOMB_SMOOTHING``); ``<limit>`` gives ``model.coord_lower`` /
-    ``coord_upper`` / ``coord_effort_limit`` / ``coord_velocity_limit``. See docs/urdf.md.
-
-    ``path_or_xml``: a path (str or os.PathLike) to a regular file of at most
-    ``armdyn._core.URDF_MAX_BYTES`` bytes, or the XML itself as str or UTF-8 bytes.
-
-    A URDF with no moving joint loaded with ``fixed_base=True`` is a zero-DOF model (a structure
-    that only carries loads): it loads with a ``UserWarning`` suggesting ``fixed_base=False``
-    for a robot meant to move freely.
-
-    Args:
-        physical_inertia: True (default) refuses a link inertia that is not positive
-            semi-definite or violates the triangle inequality, listing every such link with its
-            principal moments. False accepts any positive semi-definite tensor (published or
-            identified parameter sets, point masses); negative round-off moments down to
-            -1e-12 of the largest are clamped to zero with a warning.
-
-    Raises:
-        UrdfError: missing or irregular file, malformed XML, bad numbers or names, unsupported
-            joint type, invalid inertial data (the message names the element and attribute).
-        TypeError: ``path_or_xml`` is neither str, bytes nor os.PathLike.
-        ModelError: ``fixed_base``, ``physical_inertia`` or ``mimic`` not a bool, ``gravity``
-            not three finite real numbers (naming the argument).
-        ModelError: a joint whose motion carries no inertia (a massless leaf link, a point mass
-            on its own joint axis), naming the joint and the body; a mass, inertia or distance
-            beyond finalize()'s scale bounds (docs/api.md), naming the body or joint.
-    """
-    source = _urdf_source(path_or_xml)
-    model = _core.urdf_builder(
-        source,
-        _checks.flag("load_urdf", "fixed_base", fixed_base),
-        _checks.array("load_urdf", "gravity", gravity, ndim=1, finite=True),
-        physical_inertia=_checks.flag("load_urdf", "physical_inertia", physical_inertia),
-        mimic=_checks.flag("load_urdf", "mimic", mimic),
-    ).finalize()
-    if model.nb == 0:
-        warnings.warn(
-            "armdyn: the URDF has no moving joint: with fixed_base=True it loads as a model with "
-            "no degrees of freedom (nb = 0, n_coords = 0); pass fixed_base=False if the robot "
-            "is meant to move freely",
-            UserWarning,
-            stacklevel=2,
-        )
-    # armdyn.animate draws the links from this URDF's <visual> elements
-    remember_urdf(model, source)
-    return model

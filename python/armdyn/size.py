@@ -215,8 +215,8 @@ def run(urdf, trajectory, actuators=None, out=None, echo=print) -> int:
     """The ``armdyn size`` command: returns the exit code (0 all ok, 1 some joint not ok)."""
     import pandas as pd
 
-    from armdyn.simulation import load_urdf
     from armdyn.sizing import limit_violations, sizing_report, trajectory_run
+    from armdyn.urdf import load_urdf
 
     spec = read_actuators(actuators) if actuators else None
     model = load_urdf(urdf)

@@ -14,7 +14,7 @@ import re
 import armdyn as ad
 import numpy as np
 import pytest
-from armdyn.scenes import paper
+from armdyn.papers import five_dof
 from armdyn.validation import end_effector_position
 from conftest import quat_to_rot, random_quat, random_unit
 
@@ -261,9 +261,9 @@ def test_cartesian_frames_on_a_closed_loop():
 
 
 def test_geometric_validator_by_frame(rng):
-    model = paper.five_dof_arm(hold=np.zeros(5))
-    body, point = paper.five_dof_tip()
-    Q = np.column_stack([rng.uniform(-1.2, 1.2, (6, 4)), rng.uniform(0, paper.ARM5.stroke, 6)])
+    model = five_dof.five_dof_arm(hold=np.zeros(5))
+    body, point = five_dof.five_dof_tip()
+    Q = np.column_stack([rng.uniform(-1.2, 1.2, (6, 4)), rng.uniform(0, five_dof.ARM5.stroke, 6)])
     by_body = end_effector_position(model, body, point, Q)
     by_frame = end_effector_position(model, q=Q, frame="tip")
     assert by_frame.shape == (6, 3)

@@ -17,7 +17,7 @@ import armdyn as ad
 import numpy as np
 import pytest
 from armdyn import _core
-from armdyn.scenes import paper
+from armdyn.papers import five_dof
 from conftest import G, rel_err, spatial_arm, to_armdyn, tol
 
 
@@ -89,13 +89,13 @@ def test_driven_inverse_dynamics_matches_simulation_and_lagrange(rng):
 def test_forward_replay_tracks_the_drives():
     """Torques from inverse dynamics, applied as joint torque inputs to the undriven 3-DOF
     arm, reproduce the prescribed cubic trajectories when integrated forward."""
-    driven = paper.three_dof_arm()
-    free = paper.three_dof_arm(drives=False)
+    driven = five_dof.three_dof_arm()
+    free = five_dof.three_dof_arm(drives=False)
 
     def solver(q, qd, qdd, t):
         return ad.inverse_dynamics(free, q, qd, qdd, t)
 
-    targets, T = paper.ARM3.targets, paper.ARM3.duration
+    targets, T = five_dof.ARM3.targets, five_dof.ARM3.duration
     profiles = [_core.profiles.cubic(0.0, float(x), 0.0, T) for x in targets]
 
     def reference(t):
@@ -105,11 +105,13 @@ def test_forward_replay_tracks_the_drives():
     b = _core.ModelBuilder(gravity=(0.0, 0.0, -G))
     # the same arm, with torque inputs computed by inverse dynamics along the reference
     x = 0.0
-    for i, (length, mass) in enumerate(zip(paper.ARM3.lengths, paper.ARM3.masses, strict=True)):
-        inertia = paper._box(mass, length, paper.ARM3.thickness, paper.ARM3.width)
+    for i, (length, mass) in enumerate(
+        zip(five_dof.ARM3.lengths, five_dof.ARM3.masses, strict=True)
+    ):
+        inertia = five_dof._box(mass, length, five_dof.ARM3.thickness, five_dof.ARM3.width)
         b.add_body(f"link{i + 1}", mass, inertia, position=(x + 0.5 * length, 0, 0))
         parent = "ground" if i == 0 else f"link{i}"
-        b.add_revolute(f"j{i + 1}", parent, f"link{i + 1}", point=(x, 0, 0), axis=paper.PITCH)
+        b.add_revolute(f"j{i + 1}", parent, f"link{i + 1}", point=(x, 0, 0), axis=five_dof.PITCH)
         x += length
     for i in range(3):
 
@@ -149,7 +151,7 @@ def test_sign_convention_static_link():
 
 
 def test_under_driven_model_names_coordinates():
-    model = paper.five_dof_arm(drives=False)
+    model = five_dof.five_dof_arm(drives=False)
     with pytest.raises(ad.ModelError, match=r"5 degree.*'twist'.*'extend'"):
         ad.driven_inverse_dynamics(model, [0.0, 1.0])
 
@@ -167,7 +169,7 @@ def test_singular_driven_slider_crank_names_the_drive():
 
 
 def test_inverse_dynamics_bad_input():
-    arm_model = paper.three_dof_arm()
+    arm_model = five_dof.three_dof_arm()
     with pytest.raises(ad.ModelError, match="qdd"):
         ad.inverse_dynamics(arm_model, [0, 0, 0], [0, 0, 0], [0, np.nan, 0])
     with pytest.raises(ad.ModelError, match=r"q.*length|shape"):
@@ -272,4 +274,4 @@ def test_recursive_and_kkt_paths_agree(rng):
     with pytest.raises(_core.ModelError, match=r"data must be an armdyn\.Data"):
         ad.inverse_dynamics(model, q[0], qd[0], qdd[0], data=model)
     with pytest.raises(_core.ModelError, match="data was made for another model"):
-        ad.inverse_dynamics(paper.three_dof_arm(), [0.0] * 3, [0.0] * 3, [0.0] * 3, data=data)
+        ad.inverse_dynamics(five_dof.three_dof_arm(), [0.0] * 3, [0.0] * 3, [0.0] * 3, data=data)

@@ -6,6 +6,8 @@ linearly with the number of bodies."""
 import armdyn as ad
 import numpy as np
 import pytest
+from armdyn.papers.five_dof import five_dof_arm
+from armdyn.papers.geared_arm import geared_arm_6dof
 
 chain = ad.scenes.random_chain
 
@@ -52,17 +54,17 @@ def test_loop_path_matches_dense_on_a_closed_chain():
 def test_geared_arm_is_a_tree_of_row_blocks_and_matches_dense():
     # the ideal gears couple bodies already sharing a link, so they add no fill (ideal gears
     # in both stages here: the stiff backlash mesh wants steps far below RK4's 0.1 ms)
-    model = ad.scenes.geared_arm_6dof(n_motors=1, backlash=0.0)
+    model = geared_arm_6dof(n_motors=1, backlash=0.0)
     assert model.kkt_path == "tree" and model.nb == 44
     assert_same_run(model, t_end=0.02, dt=1e-4)
 
 
 def test_driven_model_and_joint_only_solves_match_dense():
     # drives: the all-rows plan (forward runs) and the joint-rows plan (inverse dynamics)
-    model = ad.scenes.geared_arm_6dof(n_motors=2, backlash=0.0, control="drive")
+    model = geared_arm_6dof(n_motors=2, backlash=0.0, control="drive")
     assert model.kkt_path in ("tree", "tree+loops")
     assert_same_run(model, t_end=0.02, dt=1e-4)
-    arm = ad.scenes.geared_arm_6dof(trains=False)
+    arm = geared_arm_6dof(trains=False)
     t = np.linspace(0.0, 5.0, 11)
     a = ad.driven_inverse_dynamics(arm, t)
     b = ad.driven_inverse_dynamics(arm.with_kkt_path("dense"), t)
@@ -72,7 +74,7 @@ def test_driven_model_and_joint_only_solves_match_dense():
 def test_small_models_take_the_block_path_and_redundant_ones_stay_dense():
     # the block elimination is faster than the dense Cholesky down to 15 rows
     # (benchmarks/kkt_paths.py), so even the 5-link paper arm takes it, with the dense answers
-    five = ad.scenes.five_dof_arm()
+    five = five_dof_arm()
     assert five.kkt_path == "tree"
     assert_same_run(five, t_end=0.5, dt=1e-3)
     four_bar = ad.scenes.four_bar()

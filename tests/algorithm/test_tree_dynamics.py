@@ -9,7 +9,7 @@ import armdyn as ad
 import numpy as np
 import pytest
 from armdyn import _core
-from armdyn.scenes.geared_arm import geared_arm_6dof
+from armdyn.papers.geared_arm import geared_arm_6dof
 
 from benchmarks import common
 from benchmarks.peers.pinocchio import PinPair

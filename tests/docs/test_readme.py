@@ -73,7 +73,7 @@ def test_cli_verify_entry_point(capsys):
 
 def test_readme_quotes_the_reproduce_tables():
     """The tables quoted in the README are what `armdyn reproduce` prints now."""
-    from armdyn.reproduce import five_dof_study, table2
+    from armdyn.papers.reproduce import five_dof_study, table2
 
     text = README.read_text()
     assert "armdyn reproduce" in text

@@ -54,6 +54,8 @@ def test_reference_lists_every_public_name():
     for name in ad.scenes.__all__:
         assert any(h.startswith("armdyn.scenes.") and h.endswith("." + name) for h in headings)
     assert "armdyn.validation.paper_model_3dof" in headings
+    for name in ("five_dof.five_dof_arm", "five_dof.three_dof_arm", "geared_arm.geared_arm_6dof"):
+        assert f"armdyn.papers.{name}" in headings, name
     assert "armdyn.sizing.make_motor" in headings
 
 

@@ -12,6 +12,7 @@ import armdyn as ad
 import numpy as np
 import pytest
 from armdyn import profiles
+from armdyn.papers.geared_arm import geared_arm_6dof
 from conftest import assert_same_run
 
 from benchmarks import common
@@ -128,7 +129,7 @@ def test_rich_model_and_builder_pickle_bit_for_bit(coordinates):
 
 
 def test_geared_model_with_backlash_pickles():
-    model = ad.scenes.geared_arm_6dof(backlash=2e-4, t_end=0.03, t_start=0.0)
+    model = geared_arm_6dof(backlash=2e-4, t_end=0.03, t_start=0.0)
     ref = ad.simulate(model, 0.02, output_dt=0.002)
     c = pickle.loads(pickle.dumps(model))
     assert_same_model(model, c)

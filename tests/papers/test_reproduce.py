@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from armdyn.reproduce import run
+from armdyn.papers.reproduce import run
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -87,8 +87,8 @@ def test_geared_section_of_the_report(tmp_path):
     """The geared-arm study as `armdyn reproduce` runs it, cut to two cases and 0.8 s: the
     table, JSON and figure are written, and the backlash adds a tooth impact at the start of
     the motion that the backlash-free gear does not have."""
-    from armdyn import geared_study
-    from armdyn.reproduce import geared_section
+    from armdyn.papers import geared_study
+    from armdyn.papers.reproduce import geared_section
 
     cases = [geared_study.CASES[0], geared_study.CASES[1]]
     text, rows = geared_section(tmp_path, plots=True, cases=cases, t_end=0.8)
@@ -104,7 +104,7 @@ def test_geared_study_joint_coordinates_match_the_cartesian_formulation():
     formulation gives the same metrics (two motors on a backlash gear, 0.8 s: the tooth
     impacts of the start of the motion, peak and RMS driven-gear torque, and the torque
     history itself)."""
-    from armdyn import geared_study
+    from armdyn.papers import geared_study
 
     case = geared_study.CASES[2]
     cart, t_c, tau_c = geared_study.run_case(case, t_end=0.8, coordinates="cartesian")

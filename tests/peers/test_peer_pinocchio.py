@@ -21,7 +21,7 @@ from benchmarks import common
 
 pin = pytest.importorskip("pinocchio")
 
-from armdyn.scenes.geared_arm import geared_arm_6dof  # noqa: E402
+from armdyn.papers.geared_arm import geared_arm_6dof  # noqa: E402
 
 from benchmarks.peers.pinocchio import PinPair, mass_matrix, pinocchio_tree  # noqa: E402
 from benchmarks.references import GearedArmReference  # noqa: E402

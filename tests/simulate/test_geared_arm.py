@@ -5,7 +5,7 @@ short run with backlash that shows tooth impacts while the motors hold the arm."
 import armdyn as ad
 import numpy as np
 import pytest
-from armdyn.scenes.geared_arm import RATIOS, geared_arm_6dof
+from armdyn.papers.geared_arm import RATIOS, geared_arm_6dof
 
 
 def test_structure():

@@ -8,7 +8,7 @@ import armdyn as ad
 import numpy as np
 import pytest
 from armdyn import _core
-from armdyn.scenes import paper
+from armdyn.papers import five_dof
 from conftest import rel_err
 
 FIELDS = ("q", "qd", "qdd", "drive_forces", "reaction_forces", "reaction_torques")
@@ -22,7 +22,7 @@ def _compare(a, b, rel=1e-11):
 
 
 def test_five_dof_run_is_kinematic_and_equals_the_integrated_run():
-    model = paper.five_dof_arm()
+    model = five_dof.five_dof_arm()
     kin = ad.simulate(model, 5.0, output_dt=0.01)
     assert kin.stats["integrator"] == "kinematic"
     assert "no degree of freedom" in kin.stats["integrator_reason"]
@@ -59,13 +59,13 @@ def test_driven_four_bar_loop_kinematic_equals_integrated():
 
 
 def test_models_with_freedom_are_integrated_and_kinematic_says_why_not():
-    model = paper.three_dof_arm(drives=False)
+    model = five_dof.three_dof_arm(drives=False)
     assert model.mobility_driven > 0
     res = ad.simulate(model, 0.1, output_dt=0.05)
     assert res.stats["integrator"] == "dopri5"
     with pytest.raises(ad.ModelError, match="degree"):
         ad.simulate(model, 0.1, integrator="kinematic", output_dt=0.05)
-    driven = paper.five_dof_arm()
+    driven = five_dof.five_dof_arm()
     with pytest.raises(ad.ModelError, match="output_dt"):
         ad.simulate(driven, 0.1, integrator="kinematic")
     # without an output grid the default integrates (outputs at its accepted steps)

@@ -23,7 +23,8 @@ import sys
 import armdyn as ad
 import numpy as np
 import pytest
-from armdyn.scenes import paper, standard
+from armdyn.papers import five_dof
+from armdyn.scenes import standard
 
 T_END = 1.0
 N_OUT = 50
@@ -250,7 +251,7 @@ def test_closed_loop_uses_the_cartesian_formulation_with_another_integrator():
 
 def test_fully_driven_model_against_the_kinematic_path():
     r = ad.work_precision(
-        paper.five_dof_arm(), 5.0, integrators=["kinematic", "dopri5"], rtols=[1e-6], n_out=20
+        five_dof.five_dof_arm(), 5.0, integrators=["kinematic", "dopri5"], rtols=[1e-6], n_out=20
     )
     assert list(r.reference) == ["kinematic (cartesian)"]
     assert r.table["integrator"].tolist() == ["kinematic", "dopri5"]

@@ -1,10 +1,12 @@
 """The public API of armdyn as the typing tests walk it: every name of ``armdyn.__all__``, the
 public names of its public submodules (``actuators``, ``scenes`` and its modules,
-``validation``, ``profiles``), and the public methods and properties of every public class."""
+``validation``, ``profiles``), the papers' scenes (``papers.five_dof``, ``papers.geared_arm``),
+and the public methods and properties of every public class."""
 
 from __future__ import annotations
 
 import dataclasses
+import importlib
 import inspect
 import re
 import types
@@ -60,6 +62,9 @@ def public_api() -> list[tuple[str, Any]]:
         for sub_name, sub in vars(mod).items():
             if isinstance(sub, types.ModuleType) and sub.__name__.startswith(mod.__name__ + "."):
                 modules.append((f"{name}.{sub_name}", sub))
+    # the papers' scenes (armdyn.papers: not imported by armdyn itself)
+    for sub in ("five_dof", "geared_arm"):
+        modules.append((f"papers.{sub}", importlib.import_module(f"armdyn.papers.{sub}")))
     for name, mod in modules:
         out.append((name, mod))
         for n in _module_names(mod):

@@ -9,7 +9,7 @@ import armdyn as ad
 import numpy as np
 import pytest
 import sympy as sp
-from armdyn.scenes import paper
+from armdyn.papers import five_dof
 from armdyn.validation import (
     average_of,
     end_effector_position,
@@ -42,8 +42,8 @@ def test_lagrange_validator_vs_rnea_random_arms(rng, prismatic):
 def test_complete_lagrange_equals_multibody_on_paper_scenes(scene):
     """The paper's acceptance metric (RMS of eq. (26)) between our multibody torques and the
     complete Lagrange equations: ≤ 1e-6 % on every joint (the paper accepts 10 %)."""
-    model = paper.three_dof_arm() if scene == "three" else paper.five_dof_arm()
-    t_end = paper.ARM3.duration if scene == "three" else paper.ARM5.duration
+    model = five_dof.three_dof_arm() if scene == "three" else five_dof.five_dof_arm()
+    t_end = five_dof.ARM3.duration if scene == "three" else five_dof.ARM5.duration
     res = ad.simulate(model, t_end, rtol=1e-10, atol=1e-12, output_dt=0.01)
     assert len(res.t) == round(t_end / 0.01) + 1
     cmp = ad.LagrangeValidator(model).compare(res)
@@ -55,8 +55,8 @@ def test_complete_lagrange_equals_multibody_on_paper_scenes(scene):
 
 def test_compare_requires_every_coordinate_driven():
     # the validator's model need not be the one that ran (here: the same arm without drives)
-    model = paper.five_dof_arm()
-    lag = ad.LagrangeValidator(paper.five_dof_arm(drives=False))
+    model = five_dof.five_dof_arm()
+    lag = ad.LagrangeValidator(five_dof.five_dof_arm(drives=False))
     res = ad.simulate(model, 0.5, rtol=1e-10, atol=1e-12, output_dt=0.01)
     assert np.all(lag.compare(res, model=model).rms <= 1e-6)
     b = ad.ModelBuilder()
@@ -74,7 +74,7 @@ def test_compare_requires_every_coordinate_driven():
 def test_lagrange_validator_rejects_loops_and_bad_input():
     with pytest.raises(ad.ModelError, match="LagrangeValidator"):
         ad.LagrangeValidator(ad.scenes.four_bar())
-    lag = ad.LagrangeValidator(paper.three_dof_arm())
+    lag = ad.LagrangeValidator(five_dof.three_dof_arm())
     with pytest.raises(ad.ModelError, match="qd"):
         lag.torques([0, 0, 0], [0, np.inf, 0], [0, 0, 0])
     with pytest.raises(ad.ModelError, match="shape"):
@@ -130,15 +130,15 @@ def test_complete_equations_of_the_point_mass_arm_match_the_validator(rng):
         ddt = sum(sp.diff(p, th[k]) * thd[k] + sp.diff(p, thd[k]) * thdd[k] for k in range(3))
         full.append(ddt - sp.diff(lag, th[i]))
     f_full = sp.lambdify((th, thd, thdd, L, M, g), full, "numpy")
-    model = paper.three_dof_arm(point_masses=True, drives=False)
+    model = five_dof.three_dof_arm(point_masses=True, drives=False)
     lagv = ad.LagrangeValidator(model, rotational_inertia=False)
-    lengths, masses = paper.ARM3.lengths, paper.ARM3.masses
+    lengths, masses = five_dof.ARM3.lengths, five_dof.ARM3.masses
     for _ in range(10):
         q, qd, qdd = rng.normal(size=(3, 3))
-        theta, thetad = paper.three_dof_absolute(q, qd)
+        theta, thetad = five_dof.three_dof_absolute(q, qd)
         thetadd = np.cumsum(qdd)
         t_abs = np.array(f_full(theta, thetad, thetadd, lengths, masses, 9.81))
-        assert rel_err(lagv.torques(q, qd, qdd), paper.absolute_to_joint_torques(t_abs)) <= 1e-12
+        assert rel_err(lagv.torques(q, qd, qdd), five_dof.absolute_to_joint_torques(t_abs)) <= 1e-12
         printed = paper_model_3dof(lengths, masses, theta, thetad)
         assert np.max(np.abs(printed - t_abs)) > 1e-3  # the missing terms are not small
 
@@ -149,8 +149,8 @@ def test_complete_equations_of_the_point_mass_arm_match_the_validator(rng):
 
 
 def test_metric_reproduces_the_papers_arithmetic():
-    assert average_of(paper.PAPER.table2_rmse) == pytest.approx(7.6, abs=1e-12)
-    assert average_of([24, 3, 4, 6, 1]) == pytest.approx(paper.PAPER.table2_average, abs=1e-12)
+    assert average_of(five_dof.PAPER.table2_rmse) == pytest.approx(7.6, abs=1e-12)
+    assert average_of([24, 3, 4, 6, 1]) == pytest.approx(five_dof.PAPER.table2_average, abs=1e-12)
 
 
 def test_torque_error_metrics_by_hand():
@@ -174,41 +174,41 @@ def test_torque_error_metrics_by_hand():
 
 
 def test_paper_equations_at_position_1():
-    a = paper.ARM5
+    a = five_dof.ARM5
     p = paper_end_effector_5dof([0, 0, 0, 0], a.h, a.L1, a.L2, a.L3 + a.L4)
     assert p == pytest.approx([0.66, 0.16, 0.0], abs=1e-15)
 
 
 def simulated_tip(q):
     """End effector from the Cartesian state the constraint solver gives for held joints."""
-    model = paper.five_dof_arm(hold=q)
+    model = five_dof.five_dof_arm(hold=q)
     res = ad.simulate(model, 0.02, rtol=1e-10, atol=1e-12, output_dt=0.01)
-    body, point = paper.five_dof_tip()
+    body, point = five_dof.five_dof_tip()
     b = model.body_names.index(body)
     u = res.u[-1, 7 * b : 7 * b + 7]
     return model, res, u[:3] + quat_to_rot(u[3:]) @ point
 
 
 def joint_sets(rng):
-    sets = [np.append(d * paper.DEG, 0.0) for d in paper.PAPER.table3_deg]
+    sets = [np.append(d * five_dof.DEG, 0.0) for d in five_dof.PAPER.table3_deg]
     for _ in range(4):
-        sets.append(np.append(rng.uniform(-1.2, 1.2, 4), rng.uniform(0, paper.ARM5.stroke)))
+        sets.append(np.append(rng.uniform(-1.2, 1.2, 4), rng.uniform(0, five_dof.ARM5.stroke)))
     return sets
 
 
 def test_geometric_validator_vs_simulated_end_effector(rng):
-    a = paper.ARM5
+    a = five_dof.ARM5
     for q in joint_sets(rng):
         model, res, tip = simulated_tip(q)
         assert np.max(np.abs(res.q[-1] - q)) <= 1e-12
-        body, point = paper.five_dof_tip()
+        body, point = five_dof.five_dof_tip()
         geo = end_effector_position(model, body, point, q)
         assert np.max(np.abs(geo - tip)) <= 1e-9
         # the paper's equations with our joint angles made absolute (prismatic retracted)
         th = q[:4]
         absolute = [th[0], th[1], th[1] + th[2], th[1] + th[2] + th[3]]
         eq = paper_end_effector_5dof(absolute, a.h, a.L1, a.L2, a.L3 + a.L4 + q[4])
-        assert np.max(np.abs(eq - paper.to_paper_axes(tip))) <= 1e-9
+        assert np.max(np.abs(eq - five_dof.to_paper_axes(tip))) <= 1e-9
 
 
 def test_geometric_validator_on_random_arms(rng):
@@ -226,18 +226,18 @@ def test_geometric_validator_on_random_arms(rng):
 
 def test_paper_table4_is_inconsistent_with_its_equations():
     """Position 3 has θ1 = 45°, so eqs (24)–(25) force X = Z; the paper's row does not."""
-    a = paper.ARM5
-    th = paper.PAPER.table3_deg[2] * paper.DEG
+    a = five_dof.ARM5
+    th = five_dof.PAPER.table3_deg[2] * five_dof.DEG
     p = paper_end_effector_5dof(th, a.h, a.L1, a.L2, a.L3 + a.L4)
     assert p[0] == pytest.approx(p[2], abs=1e-15)
-    row = paper.PAPER.table4_geometric[2]
+    row = five_dof.PAPER.table4_geometric[2]
     assert abs(row[0] - row[2]) > 0.1
 
 
 # ----------------------------------------------------------------------------------------------
 # simplified-model gaps, pinned (regression values)
 # ----------------------------------------------------------------------------------------------
-# Source: `armdyn reproduce` with the scenes of armdyn/scenes/paper.py (the reconstructed arms
+# Source: `armdyn reproduce` with the scenes of armdyn/papers/five_dof.py (the reconstructed arms
 # documented there), DOPRI5 rtol 1e-10, outputs every 0.01 s. The values are the eq. (27) RMS of
 # eq. (26) between our multibody torques and the simplified models. They depend only on the
 # scene parameters (the motion is fully prescribed), so they change only if those do.
@@ -247,7 +247,7 @@ PINNED_5DOF_POINT_MASS = [13.441714, 16.533158, 18.656142, 26.956566, 0.190235]
 
 
 def test_simplified_model_gaps_pinned():
-    from armdyn.reproduce import five_dof_study, three_dof_study
+    from armdyn.papers.reproduce import five_dof_study, three_dof_study
 
     s3, s5 = three_dof_study(), five_dof_study()
     assert s3.metrics["printed"]["rms"] == pytest.approx(PINNED_3DOF_PRINTED, abs=5e-6)
