@@ -37,7 +37,6 @@ EXCEPTIONS = {
     ("python/armdyn/plotting.py", "_panel"): (103, 48),
     ("python/armdyn/plotting.py", "_select"): (57, 32),
     ("python/armdyn/simulation.py", "rollout"): (84, 31),
-    ("python/armdyn/workprecision.py", "work_precision"): (205, 62),
 }
 
 
