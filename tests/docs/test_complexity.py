@@ -34,8 +34,6 @@ EXCEPTIONS = {
     ("cpp/src/solver/block_sparse.cpp", "armdyn::plan_kkt"): (92, 33),
     ("cpp/src/solver/constraints.cpp", "armdyn::eval_constraints"): (121, 35),
     ("cpp/src/solver/integrators.cpp", "armdyn::integrate_trbdf2"): (179, 46),
-    ("python/armdyn/plotting.py", "_panel"): (103, 48),
-    ("python/armdyn/plotting.py", "_select"): (57, 32),
     ("python/armdyn/simulation.py", "rollout"): (84, 31),
 }
 
