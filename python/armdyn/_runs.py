@@ -1,5 +1,5 @@
-"""Reading a run's joint-rate columns and joint torques, shared by :mod:`armdyn.sizing` and
-:mod:`armdyn.actuators`."""
+"""Reading a run's joint-rate columns and joint torques, and the trapezoid rule over its
+samples, shared by :mod:`armdyn.sizing` and :mod:`armdyn.actuators`."""
 
 from __future__ import annotations
 
@@ -83,3 +83,22 @@ def model_of(result, model, caller: str):
             "pass the model the run was made with as model="
         )
     return held
+
+
+def trapezoid_steps(y, t) -> np.ndarray:
+    """The trapezoid rule's area of each sample interval, ½ (y[k] + y[k+1]) (t[k+1] − t[k]),
+    per column when ``y`` is 2-D: the one place the rule is written (:func:`trapezoid`,
+    :func:`armdyn.actuators.cumulative_trapezoid`)."""
+    y = np.asarray(y, dtype=float)
+    dt = np.diff(t)
+    return 0.5 * (y[1:] + y[:-1]) * (dt[:, None] if y.ndim == 2 else dt)
+
+
+def trapezoid(y, t) -> np.ndarray:
+    """∫ y dt over the samples, per column of a 2-D ``y`` (trapezoid rule)."""
+    return np.sum(trapezoid_steps(y, t), axis=0)
+
+
+def time_mean(y, t) -> float:
+    """(1 / (t[-1] − t[0])) ∫ y dt of a 1-D ``y`` (trapezoid rule)."""
+    return float(trapezoid(np.asarray(y)[:, None], t)[0] / (t[-1] - t[0]))

@@ -9,7 +9,8 @@ The rotor is in the dynamics, so the joint-side torque ``τ`` of a run (``result
 or the drives' efforts) already includes the reflected rotor terms
 ``N² J q̈ + N² b q̇ + N c tanh(N q̇ / v_s)``. Splitting it:
 
-- ``T_rot = J ω̇ + b ω + c tanh(ω / v_s)``: the motor-side torque that spins the rotor itself;
+- ``T_rot = J ω̇ + b ω + c tanh(ω / v_s)``: the motor-side torque that spins the rotor itself
+  (:func:`rotor_torque`);
 - ``τ_gear = τ − N T_rot``: the load's share, the torque the gear output delivers to the link;
 - the motor (air-gap) torque ``T = T_rot + τ_gear / (N η)`` while the gear transmits power from
   the motor to the load (``τ_gear q̇ ≥ 0``), else ``T = T_rot + τ_gear η / N`` (the load drives
@@ -40,7 +41,7 @@ import numpy as np
 import numpy.typing as npt
 
 from armdyn import _core
-from armdyn._runs import checked, model_of
+from armdyn._runs import checked, model_of, trapezoid_steps
 
 #: add_actuator's default Coulomb smoothing velocity per unit gear ratio: v_s = 1e-3 |N| rad/s
 #: on the motor side, i.e. 1e-3 rad/s (or m/s) at the joint.
@@ -61,8 +62,32 @@ def cumulative_trapezoid(y: np.ndarray, t: np.ndarray) -> np.ndarray:
     """∫_{t0}^{t_k} y dt at every sample (trapezoid rule), starting at 0."""
     y = np.asarray(y, dtype=float)
     out = np.zeros_like(y)
-    out[1:] = np.cumsum(0.5 * (y[1:] + y[:-1]) * np.diff(t))
+    out[1:] = np.cumsum(trapezoid_steps(y, t))
     return out
+
+
+def rotor_torque(
+    actuator: _core.Actuator | Any, qd: npt.ArrayLike, qdd: npt.ArrayLike
+) -> npt.NDArray[np.float64]:
+    """T_rot = J ω̇ + b ω + c tanh(ω / v_s), ω = N q̇, ω̇ = N q̈: the motor-side torque that
+    spins the rotor itself (its inertia and motor-side friction; v_s:
+    :func:`coulomb_smoothing`). The joint carries N T_rot of it. ``qd``, ``qdd``: the joint's
+    rates and accelerations (arrays of one shape); the actuator's values are taken as they
+    are (:func:`motor_side` checks them)."""
+    qd, qdd = np.asarray(qd, dtype=float), np.asarray(qdd, dtype=float)
+    n, j = float(actuator.gear_ratio), float(actuator.rotor_inertia)
+    b, c = float(actuator.friction_viscous), float(actuator.friction_coulomb)
+    return _rotor(actuator, n, j, b, c, qd, qdd)[3]
+
+
+def _rotor(actuator, n: float, j: float, b: float, c: float, qd, qdd):
+    """(ω, ω̇, the Coulomb term c tanh(ω / v_s), T_rot) of gear ratio ``n``, rotor inertia
+    ``j``, viscous ``b`` and Coulomb ``c`` friction: the one place the rotor torque is written
+    (:func:`rotor_torque`, :func:`motor_side`, and through them armdyn.sizing)."""
+    w = n * qd
+    wd = n * qdd
+    coulomb = c * np.tanh(w / coulomb_smoothing(actuator))
+    return w, wd, coulomb, j * wd + b * w + coulomb
 
 
 @dataclass
@@ -174,10 +199,7 @@ def motor_side(
     b = _positive(actuator.friction_viscous, "friction_viscous", name, allow_zero=True)
     c = _positive(actuator.friction_coulomb, "friction_coulomb", name, allow_zero=True)
 
-    w = n_ratio * qd
-    wd = n_ratio * qdd
-    coulomb = c * np.tanh(w / coulomb_smoothing(actuator))
-    t_rot = j_rot * wd + b * w + coulomb
+    w, wd, coulomb, t_rot = _rotor(actuator, n_ratio, j_rot, b, c, qd, qdd)
     tau_gear = tau - n_ratio * t_rot
     p_load = tau_gear * qd
     motoring = p_load >= 0.0

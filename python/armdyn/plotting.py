@@ -171,93 +171,13 @@ def _panel(result, kind: str, model) -> _Panel:
     """The lines of one panel (every column; selection comes after)."""
     layout = _joint_columns(model) if model is not None else None
     if kind in ("q", "qd", "qdd", "torque"):
-        field = "joint_torques" if kind == "torque" else kind
-        if model is not None:
-            cols = model.joint_coord_names if kind == "q" else model.joint_dof_names
-            what = "joint coordinates" if kind == "q" else "joint dofs"
-            y = _check_shape(result, field, len(cols), what, model)
-            names = list(cols)
-            if layout is not None:
-                per = layout[0] if kind == "q" else layout[1]
-                joints, kinds = [j for j, _ in per], [k for _, k in per]
-            else:
-                joints, kinds = names, [None] * len(names)
-        else:
-            y = np.asarray(getattr(result, field), dtype=float)
-            names = [f"{kind}[{k}]" for k in range(y.shape[1])]
-            joints, kinds = [None] * len(names), [None] * len(names)
-        quantity = "effort" if kind == "torque" else kind
-        symbol = {"torque": "τ"}.get(kind, kind)
-        return _column_panel(kind, quantity, y, names, joints, kinds, symbol)
+        return _coordinate_panel(result, kind, model, layout)
     if kind == "drive":
-        y = np.asarray(result.drive_forces, dtype=float)
-        if y.ndim != 2 or y.shape[1] == 0:
-            raise _core.ModelError(
-                "result.plot('drive'): the run has no drives (result.drive_forces has no "
-                "columns): add_drive on the model prescribes a motion and records its effort; "
-                "the applied torques of torque inputs and motors are kind 'torque'"
-            )
-        if model is not None:
-            names = list(model.drive_names)
-            y = _check_shape(result, "drive_forces", len(names), "drives", model)
-            dof_kinds = layout[1] if layout is not None else None
-            kinds = [
-                dof_kinds[c][1] if dof_kinds is not None and 0 <= c < len(dof_kinds) else None
-                for c in model.drive_coords
-            ]
-            dof_joints = list(model.joint_dof_names)
-            joints = [
-                (dof_kinds[c][0] if dof_kinds is not None else dof_joints[c])
-                if 0 <= c < len(dof_joints)
-                else None
-                for c in model.drive_coords
-            ]
-            joints = [j if j is not None else n for j, n in zip(joints, names, strict=True)]
-        else:
-            names = [f"drive[{k}]" for k in range(y.shape[1])]
-            joints, kinds = [None] * len(names), [None] * len(names)
-        return _column_panel(kind, "effort", y, names, joints, kinds, "effort")
+        return _drive_panel(result, model, layout)
     if kind in ("limit", "gear"):
-        store = result.limit_forces if kind == "limit" else result.gear_forces
-        names = list(store.get("names", []))
-        if not names:
-            if kind == "limit":
-                raise _core.ModelError(
-                    "result.plot('limit'): the run recorded no joint-stop forces "
-                    "(result.limit_forces is empty): they are recorded for the joints with a "
-                    "finite position limit (set_joint_limits, the URDF <limit>) when the run "
-                    "enforces them, simulate(..., limits='enforce') (the default)"
-                )
-            raise _core.ModelError(
-                "result.plot('gear'): the run has no gears (result.gear_forces is empty): "
-                "gear mesh forces are recorded for the model's gear pairs and ideal gears"
-            )
-        y = np.asarray(store["force"], dtype=float)
-        if kind == "gear":
-            return _Panel(kind, names, names, list(range(len(names))), list(y.T), "mesh force [N]")
-        kinds = [None] * len(names)
-        if layout is not None:
-            by_joint = {j: k for j, k in layout[1]}
-            kinds = [by_joint.get(n) for n in names]
-        return _column_panel(kind, "effort", y, names, names, kinds, "stop effort")
+        return _stop_or_gear_panel(result, kind, layout)
     if kind in ("reaction_force", "reaction_torque"):
-        field = "reaction_forces" if kind == "reaction_force" else "reaction_torques"
-        if model is not None:
-            jnames = list(model.joint_names)
-            y = _check_shape(result, field, len(jnames), "joints", model)
-        else:
-            y = np.asarray(getattr(result, field), dtype=float)
-            jnames = [f"joint[{k}]" for k in range(y.shape[1])]
-        sym = "F" if kind == "reaction_force" else "M"
-        labels, joints, columns, ys = [], [], [], []
-        for k, name in enumerate(jnames):
-            for c, axis in enumerate("xyz"):
-                labels.append(f"{name} {sym}{axis}")
-                joints.append(name if model is not None else None)
-                columns.append(k)
-                ys.append(y[:, k, c])
-        unit = "N" if kind == "reaction_force" else "N m"
-        return _Panel(kind, labels, joints, columns, ys, f"{sym} [{unit}]")
+        return _reaction_panel(result, kind, model)
     if kind == "energy":
         ke = np.asarray(result.kinetic_energy, dtype=float)
         pe = np.asarray(result.potential_energy, dtype=float)
@@ -271,6 +191,108 @@ def _panel(result, kind: str, model) -> _Panel:
         log = bool(np.any(y > 0))
         return _Panel(kind, [label], [None], [0], [y], f"residual [{unit}]", log=log)
     raise AssertionError(kind)  # pragma: no cover - kinds are checked before
+
+
+def _coordinate_panel(result, kind: str, model, layout) -> _Panel:
+    """``q``, ``qd``, ``qdd`` or ``torque`` (``result.joint_torques``): one line per
+    joint-space column, named by the model (``q[k]`` ... without it)."""
+    field = "joint_torques" if kind == "torque" else kind
+    if model is not None:
+        cols = model.joint_coord_names if kind == "q" else model.joint_dof_names
+        what = "joint coordinates" if kind == "q" else "joint dofs"
+        y = _check_shape(result, field, len(cols), what, model)
+        names = list(cols)
+        if layout is not None:
+            per = layout[0] if kind == "q" else layout[1]
+            joints, kinds = [j for j, _ in per], [k for _, k in per]
+        else:
+            joints, kinds = names, [None] * len(names)
+    else:
+        y = np.asarray(getattr(result, field), dtype=float)
+        names = [f"{kind}[{k}]" for k in range(y.shape[1])]
+        joints, kinds = [None] * len(names), [None] * len(names)
+    quantity = "effort" if kind == "torque" else kind
+    symbol = {"torque": "τ"}.get(kind, kind)
+    return _column_panel(kind, quantity, y, names, joints, kinds, symbol)
+
+
+def _drive_panel(result, model, layout) -> _Panel:
+    """One line per drive (``result.drive_forces``), belonging to its driven joint."""
+    y = np.asarray(result.drive_forces, dtype=float)
+    if y.ndim != 2 or y.shape[1] == 0:
+        raise _core.ModelError(
+            "result.plot('drive'): the run has no drives (result.drive_forces has no "
+            "columns): add_drive on the model prescribes a motion and records its effort; "
+            "the applied torques of torque inputs and motors are kind 'torque'"
+        )
+    if model is None:
+        names = [f"drive[{k}]" for k in range(y.shape[1])]
+        joints, kinds = [None] * len(names), [None] * len(names)
+        return _column_panel("drive", "effort", y, names, joints, kinds, "effort")
+    names = list(model.drive_names)
+    y = _check_shape(result, "drive_forces", len(names), "drives", model)
+    dof_kinds = layout[1] if layout is not None else None
+    kinds = [
+        dof_kinds[c][1] if dof_kinds is not None and 0 <= c < len(dof_kinds) else None
+        for c in model.drive_coords
+    ]
+    dof_joints = list(model.joint_dof_names)
+    joints = [
+        (dof_kinds[c][0] if dof_kinds is not None else dof_joints[c])
+        if 0 <= c < len(dof_joints)
+        else None
+        for c in model.drive_coords
+    ]
+    joints = [j if j is not None else n for j, n in zip(joints, names, strict=True)]
+    return _column_panel("drive", "effort", y, names, joints, kinds, "effort")
+
+
+def _stop_or_gear_panel(result, kind: str, layout) -> _Panel:
+    """``limit``: one line per joint with a stop (``result.limit_forces``); ``gear``: one per
+    gear pair (``result.gear_forces``)."""
+    store = result.limit_forces if kind == "limit" else result.gear_forces
+    names = list(store.get("names", []))
+    if not names:
+        if kind == "limit":
+            raise _core.ModelError(
+                "result.plot('limit'): the run recorded no joint-stop forces "
+                "(result.limit_forces is empty): they are recorded for the joints with a "
+                "finite position limit (set_joint_limits, the URDF <limit>) when the run "
+                "enforces them, simulate(..., limits='enforce') (the default)"
+            )
+        raise _core.ModelError(
+            "result.plot('gear'): the run has no gears (result.gear_forces is empty): "
+            "gear mesh forces are recorded for the model's gear pairs and ideal gears"
+        )
+    y = np.asarray(store["force"], dtype=float)
+    if kind == "gear":
+        return _Panel(kind, names, names, list(range(len(names))), list(y.T), "mesh force [N]")
+    kinds = [None] * len(names)
+    if layout is not None:
+        by_joint = {j: k for j, k in layout[1]}
+        kinds = [by_joint.get(n) for n in names]
+    return _column_panel(kind, "effort", y, names, names, kinds, "stop effort")
+
+
+def _reaction_panel(result, kind: str, model) -> _Panel:
+    """``reaction_force`` / ``reaction_torque``: three lines (x, y, z) per joint."""
+    field = "reaction_forces" if kind == "reaction_force" else "reaction_torques"
+    if model is not None:
+        jnames = list(model.joint_names)
+        y = _check_shape(result, field, len(jnames), "joints", model)
+    else:
+        y = np.asarray(getattr(result, field), dtype=float)
+        jnames = [f"joint[{k}]" for k in range(y.shape[1])]
+    sym = "F" if kind == "reaction_force" else "M"
+    labels, joints, columns, ys = [], [], [], []
+    for k, name in enumerate(jnames):
+        for c, axis in enumerate("xyz"):
+            labels.append(f"{name} {sym}{axis}")
+            joints.append(name if model is not None else None)
+            columns.append(k)
+            ys.append(y[:, k, c])
+    unit = "N" if kind == "reaction_force" else "N m"
+    return _Panel(kind, labels, joints, columns, ys, f"{sym} [{unit}]")
 
 
 def _kinds(kind) -> list[str]:
@@ -299,46 +321,12 @@ def _select(panel: _Panel, joints, model) -> _Panel:
     """The lines of ``panel`` for ``joints`` (names or column indices, in the order given)."""
     if joints is None or panel.kind not in _PER_JOINT:
         return panel
-    what = "gear" if panel.kind == "gear" else "joint"
-    n_cols = max(panel.columns) + 1 if panel.columns else 0
-    keep = []
+    keep: list[int] = []
     for sel in joints:
         if isinstance(sel, (int, np.integer)) and not isinstance(sel, bool):
-            if not -n_cols <= sel < n_cols:
-                raise _core.ModelError(
-                    f"result.plot({panel.kind!r}): {what} index {sel} out of range: the panel "
-                    f"has {n_cols} columns"
-                )
-            col = int(sel) % n_cols
-            hit = [i for i, c in enumerate(panel.columns) if c == col]
+            hit = _lines_of_column(panel, sel)
         elif isinstance(sel, str):
-            if panel.kind != "gear" and model is None and panel.kind != "limit":
-                raise _core.ModelError(
-                    f"result.plot: selecting joint {sel!r} by name needs the model the run was "
-                    "made with: result.plot(..., model=model) (or select by column index)"
-                )
-            hit = [
-                i
-                for i, (j, lab) in enumerate(zip(panel.joints, panel.labels, strict=True))
-                if sel == j or sel == lab.split(" [")[0]
-            ]
-            if not hit:
-                known = _known_names(model)
-                if panel.kind == "gear" or (model is not None and sel in known):
-                    present = list(dict.fromkeys(j for j in panel.joints if j is not None))
-                    raise _core.ModelError(
-                        f"result.plot({panel.kind!r}): {what} {sel!r} has no line in this "
-                        f"panel; its {what}s are {present}"
-                    )
-                raise _core.ModelError(
-                    f"result.plot: unknown joint {sel!r}; the model's joints are "
-                    f"{list(model.joint_names) if model is not None else []}"
-                    + (
-                        f" and its joint-space columns {list(model.joint_coord_names)}"
-                        if model is not None
-                        else ""
-                    )
-                )
+            hit = _lines_of_name(panel, sel, model)
         else:
             raise TypeError(
                 f"result.plot: joints must be names (str) or column indices (int), got {sel!r}"
@@ -352,6 +340,55 @@ def _select(panel: _Panel, joints, model) -> _Panel:
         [panel.ys[i] for i in keep],
         panel.ylabel,
         panel.log,
+    )
+
+
+def _what(panel: _Panel) -> str:
+    return "gear" if panel.kind == "gear" else "joint"
+
+
+def _lines_of_column(panel: _Panel, sel) -> list[int]:
+    """The lines of column index ``sel`` (negative from the end), or a ModelError."""
+    n_cols = max(panel.columns) + 1 if panel.columns else 0
+    if not -n_cols <= sel < n_cols:
+        raise _core.ModelError(
+            f"result.plot({panel.kind!r}): {_what(panel)} index {sel} out of range: the panel "
+            f"has {n_cols} columns"
+        )
+    col = int(sel) % n_cols
+    return [i for i, c in enumerate(panel.columns) if c == col]
+
+
+def _lines_of_name(panel: _Panel, sel: str, model) -> list[int]:
+    """The lines of joint (or gear) ``sel``, or of the line labelled so; a ModelError naming
+    what the panel or the model has when there is none."""
+    what = _what(panel)
+    if panel.kind != "gear" and model is None and panel.kind != "limit":
+        raise _core.ModelError(
+            f"result.plot: selecting joint {sel!r} by name needs the model the run was "
+            "made with: result.plot(..., model=model) (or select by column index)"
+        )
+    hit = [
+        i
+        for i, (j, lab) in enumerate(zip(panel.joints, panel.labels, strict=True))
+        if sel == j or sel == lab.split(" [")[0]
+    ]
+    if hit:
+        return hit
+    if panel.kind == "gear" or (model is not None and sel in _known_names(model)):
+        present = list(dict.fromkeys(j for j in panel.joints if j is not None))
+        raise _core.ModelError(
+            f"result.plot({panel.kind!r}): {what} {sel!r} has no line in this "
+            f"panel; its {what}s are {present}"
+        )
+    raise _core.ModelError(
+        f"result.plot: unknown joint {sel!r}; the model's joints are "
+        f"{list(model.joint_names) if model is not None else []}"
+        + (
+            f" and its joint-space columns {list(model.joint_coord_names)}"
+            if model is not None
+            else ""
+        )
     )
 
 

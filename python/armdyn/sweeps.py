@@ -16,7 +16,6 @@ import inspect
 import itertools
 import json
 import logging
-import math
 import os
 import secrets
 from collections import Counter
@@ -207,6 +206,34 @@ def sweep(
             values, a bad ``retries``, ``dims`` or ``coords`` entry, or an output name that
             clashes with a grid name or ``status``.
     """
+    _check_arguments(fn, retries, seed)
+    checked = _check_grid(grid)
+    axes = {k: arr for k, (arr, _) in checked.items()}
+    dims = dict(dims or {})
+    coords = dict(coords or {})
+    takes_seed = _check_seed_use(fn, seed)
+    distributed, xr = _import_optional()
+    names, shape, points = _points(checked)
+    root, seeds = _seeds(seed, takes_seed, len(points))
+    _check_client(client, distributed)
+    bar = _progress_bar(progress)
+    results, errors = _run_points(fn, client, distributed, points, seeds, retries, bar)
+    _fail_odd_structures(results, errors, points)
+    data_vars = _data_vars(results, errors, names, shape, axes, dims)
+    ok = any(r is not None for r in results)
+    all_coords = _coords(axes, coords, data_vars, ok)
+    attrs = _attrs(axes, root, fn, retries, errors)
+    try:
+        return xr.Dataset(data_vars, coords=all_coords, attrs=attrs)
+    except ValueError as exc:  # e.g. a coordinate of the wrong length
+        raise ValueError(f"sweep: cannot assemble the Dataset: {exc}") from exc
+
+
+# --- the stages of sweep, in order ------------------------------------------------------------
+
+
+def _check_arguments(fn, retries, seed) -> None:
+    """fn callable, retries an integer >= 0, seed an int, a SeedSequence or None."""
     if not callable(fn):
         raise ArgumentTypeError(f"sweep: fn must be callable, got {type(fn).__name__}")
     if isinstance(retries, bool) or not isinstance(retries, int) or retries < 0:
@@ -216,45 +243,67 @@ def sweep(
             f"sweep: seed must be an int, a numpy SeedSequence or None, got {seed!r:.80} "
             "(a grid axis cannot be named 'seed')"
         )
-    checked = _check_grid(grid)
-    axes = {k: arr for k, (arr, _) in checked.items()}
-    dims = dict(dims or {})
-    coords = dict(coords or {})
+
+
+def _check_seed_use(fn, seed) -> bool:
+    """Whether fn takes a ``seed`` argument; a seed given to an fn without one is an error."""
     takes_seed = _takes_seed(fn)
     if seed is not None and not takes_seed:
         raise ArgumentTypeError(
             f"sweep: seed={seed!r} given but fn {getattr(fn, '__name__', fn)!r} takes no "
             "'seed' argument"
         )
-    distributed, xr = _import_optional()
+    return takes_seed
 
-    names = list(axes)
-    shape = tuple(a.size for a in axes.values())
-    n = math.prod(shape)
-    # plain Python values (numpy scalars' .item()), in C order of the product
+
+def _points(checked: dict) -> tuple[list[str], tuple[int, ...], list[dict]]:
+    """``(names, shape, points)``: the grid's axis names and shape, and one ``{name: value}``
+    per point in C order of the product, the values plain Python (numpy scalars' .item())."""
+    names = list(checked)
+    shape = tuple(arr.size for arr, _ in checked.values())
     values = [
         [v.item() if isinstance(v, np.generic) else v for v in vs] for _, vs in checked.values()
     ]
     points = [dict(zip(names, combo, strict=True)) for combo in itertools.product(*values)]
-    root = None
-    seeds: list = [None] * n
-    if takes_seed:
-        if seed is None:  # fresh entropy, 63 bits: an int64 attribute (netCDF) repeats it
-            seed = secrets.randbits(63)
-        root = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
-        seeds = root.spawn(n)
+    return names, shape, points
 
-    own = client is None
-    if not own and not isinstance(client, distributed.Client):
+
+def _seeds(seed, takes_seed: bool, n: int):
+    """``(root, seeds)``: the root SeedSequence (None when fn takes no seed) and one spawned
+    SeedSequence per point (None each when fn takes no seed)."""
+    if not takes_seed:
+        return None, [None] * n
+    if seed is None:  # fresh entropy, 63 bits: an int64 attribute (netCDF) repeats it
+        seed = secrets.randbits(63)
+    root = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
+    return root, root.spawn(n)
+
+
+def _check_client(client, distributed) -> None:
+    if client is not None and not isinstance(client, distributed.Client):
         raise ArgumentTypeError(
             f"sweep: client must be a distributed.Client or None, got {type(client).__name__}"
             " (for a cluster object: distributed.Client(cluster))"
         )
-    if progress:
-        try:
-            from tqdm.auto import tqdm
-        except ImportError as exc:
-            raise ImportError(f"sweep(progress=True) needs tqdm: {_MISSING}") from exc
+
+
+def _progress_bar(progress: bool):
+    """tqdm's progress bar class when asked for (an ImportError without tqdm), else None."""
+    if not progress:
+        return None
+    try:
+        from tqdm.auto import tqdm
+    except ImportError as exc:
+        raise ImportError(f"sweep(progress=True) needs tqdm: {_MISSING}") from exc
+    return tqdm
+
+
+def _run_points(fn, client, distributed, points, seeds, retries, bar):
+    """``(results, errors)`` per point: fn's normalised outputs (None for a failed point) and
+    the failure's message (None for a point that ran). Without a client, on a LocalCluster
+    started and closed here; on a given client, whatever is still running when this is
+    interrupted is cancelled."""
+    own = client is None
     cluster = None
     if own:
         cluster = distributed.LocalCluster(
@@ -266,46 +315,9 @@ def sweep(
             silence_logs=logging.CRITICAL,
         )
         client = distributed.Client(cluster)
-    results: list = [None] * n
-    errors: list[str | None] = [None] * n
     futures: list = []
     try:
-        futures = [
-            client.submit(_call, fn, p, s, retries=retries, pure=False)
-            for p, s in zip(points, seeds, strict=True)
-        ]
-        index = {f.key: i for i, f in enumerate(futures)}
-        bar = None
-        if progress:
-            bar = tqdm(total=n, desc="sweep", unit="point")
-        killed: list[int] = []
-
-        def collect(fut, i):
-            if fut.status == "finished":
-                results[i], errors[i] = fut.result(), None
-            else:
-                exc = fut.exception()
-                errors[i] = _message(exc) if exc is not None else f"task {fut.status}"
-                if isinstance(exc, distributed.KilledWorker):
-                    killed.append(i)
-            fut.release()
-
-        try:
-            for fut in distributed.as_completed(futures):
-                collect(fut, index[fut.key])
-                if bar is not None:
-                    bar.update()
-            if len(killed) > 1:
-                # a point queued on a worker that another point crashed dies with it: each
-                # point whose worker died runs once more alone, so only the culprits stay failed
-                for i in list(killed):
-                    fut = client.submit(_call, fn, points[i], seeds[i], retries=retries, pure=False)
-                    futures.append(fut)
-                    distributed.wait(fut)
-                    collect(fut, i)
-        finally:
-            if bar is not None:
-                bar.close()
+        return _submit_and_collect(fn, client, distributed, points, seeds, retries, bar, futures)
     except BaseException:  # Ctrl-C or a lost client: nothing left running on a given cluster
         if not own and futures:
             client.cancel([f for f in futures if not f.done()])
@@ -315,61 +327,121 @@ def sweep(
             client.close()
             cluster.close()
 
-    # the structure shared by the successful points: the most common one (first in grid order
-    # on a tie); points that differ are failed
-    sigs = Counter(_signature(r) for r in results if r is not None)
-    if sigs:
-        best = max(sigs.values())
-        ref_sig = next(
-            _signature(r) for r in results if r is not None and sigs[_signature(r)] == best
-        )
-        ref_point = next(
-            i for i, r in enumerate(results) if r is not None and _signature(r) == ref_sig
-        )
-        for i, r in enumerate(results):
-            if r is not None and _signature(r) != ref_sig:
-                errors[i] = (
-                    f"output structure {dict(_signature(r))} differs from "
-                    f"{dict(ref_sig)} of point {points[ref_point]}"
-                )
-                results[i] = None
-    ok = [r for r in results if r is not None]
 
+def _submit_and_collect(fn, client, distributed, points, seeds, retries, bar, futures):
+    """Submit one task per point (appended to ``futures``) and collect them as they finish;
+    when workers died under several points, each of those runs once more alone, so that only
+    the culprits stay failed (a point queued on a worker another point crashed dies with it)."""
+    n = len(points)
+    results: list = [None] * n
+    errors: list[str | None] = [None] * n
+    futures.extend(
+        [
+            client.submit(_call, fn, p, s, retries=retries, pure=False)
+            for p, s in zip(points, seeds, strict=True)
+        ]
+    )
+    index = {f.key: i for i, f in enumerate(futures)}
+    progress = bar(total=n, desc="sweep", unit="point") if bar is not None else None
+    killed: list[int] = []
+    try:
+        for fut in distributed.as_completed(futures):
+            _collect(fut, index[fut.key], results, errors, killed, distributed)
+            if progress is not None:
+                progress.update()
+        if len(killed) > 1:
+            for i in list(killed):
+                fut = client.submit(_call, fn, points[i], seeds[i], retries=retries, pure=False)
+                futures.append(fut)
+                distributed.wait(fut)
+                _collect(fut, i, results, errors, killed, distributed)
+    finally:
+        if progress is not None:
+            progress.close()
+    return results, errors
+
+
+def _collect(fut, i: int, results: list, errors: list, killed: list, distributed) -> None:
+    """Point ``i``'s outcome from its finished future (a KilledWorker adds it to ``killed``)."""
+    if fut.status == "finished":
+        results[i], errors[i] = fut.result(), None
+    else:
+        exc = fut.exception()
+        errors[i] = _message(exc) if exc is not None else f"task {fut.status}"
+        if isinstance(exc, distributed.KilledWorker):
+            killed.append(i)
+    fut.release()
+
+
+def _fail_odd_structures(results: list, errors: list, points: list[dict]) -> None:
+    """The structure shared by the successful points is the most common one (first in grid
+    order on a tie); points whose outputs differ from it are failed (in place)."""
+    sigs = Counter(_signature(r) for r in results if r is not None)
+    if not sigs:
+        return
+    best = max(sigs.values())
+    ref_sig = next(_signature(r) for r in results if r is not None and sigs[_signature(r)] == best)
+    ref_point = next(i for i, r in enumerate(results) if r is not None and _signature(r) == ref_sig)
+    for i, r in enumerate(results):
+        if r is not None and _signature(r) != ref_sig:
+            errors[i] = (
+                f"output structure {dict(_signature(r))} differs from "
+                f"{dict(ref_sig)} of point {points[ref_point]}"
+            )
+            results[i] = None
+
+
+def _data_vars(results, errors, names, shape, axes, dims) -> dict:
+    """The Dataset's variables: each output over the grid (NaN, or 0, at failed points) and
+    ``status``."""
+    ok = [r for r in results if r is not None]
     data_vars: dict = {}
     if ok:
-        first = ok[0]
-        for var, (arr0, own_dims) in first.items():
-            if var in axes or var == "status":
-                raise _core.ModelError(
-                    f"sweep: output {var!r} has the name of a grid axis or of 'status'"
-                )
-            vdims = tuple(
-                dims.get(var, own_dims or tuple(f"{var}_dim{k}" for k in range(arr0.ndim)))
-            )
-            if len(vdims) != arr0.ndim:
-                raise _core.ModelError(
-                    f"sweep: dims[{var!r}] = {vdims!r} names {len(vdims)} dimensions but "
-                    f"{var!r} has shape {arr0.shape}"
-                )
-            clash = [d for d in vdims if d in axes]
-            if clash:
-                raise _core.ModelError(f"sweep: output dims {clash} of {var!r} repeat grid names")
-            kinds = {r[var][0].dtype for r in ok}
-            dtype = np.result_type(*kinds)
-            if len(ok) < n and dtype.kind in "biu":
-                dtype = np.dtype(np.float64)
-            full = np.full(shape + arr0.shape, np.nan if dtype.kind in "fc" else 0, dtype=dtype)
-            flat = full.reshape((n, *arr0.shape))
-            for i, r in enumerate(results):
-                if r is not None:
-                    flat[i] = r[var][0]
-            data_vars[var] = ((*names, *vdims), full)
+        for var, (arr0, own_dims) in ok[0].items():
+            vdims = _output_dims(var, arr0, own_dims, axes, dims)
+            data_vars[var] = ((*names, *vdims), _gridded(var, arr0, results, ok, shape))
     unknown = [v for v in dims if v not in data_vars]
     if unknown and ok:
         raise _core.ModelError(f"sweep: dims given for {unknown}, which fn does not return")
     status = np.array(["ok" if e is None else e for e in errors], dtype=object).reshape(shape)
     data_vars["status"] = (tuple(names), status)
+    return data_vars
 
+
+def _output_dims(var: str, arr0: np.ndarray, own_dims, axes, dims) -> tuple:
+    """The names of an output's own dimensions: ``dims[var]``, else the ones it carries, else
+    ``<var>_dim0``, ...; checked against its shape and the grid's names."""
+    if var in axes or var == "status":
+        raise _core.ModelError(f"sweep: output {var!r} has the name of a grid axis or of 'status'")
+    vdims = tuple(dims.get(var, own_dims or tuple(f"{var}_dim{k}" for k in range(arr0.ndim))))
+    if len(vdims) != arr0.ndim:
+        raise _core.ModelError(
+            f"sweep: dims[{var!r}] = {vdims!r} names {len(vdims)} dimensions but "
+            f"{var!r} has shape {arr0.shape}"
+        )
+    clash = [d for d in vdims if d in axes]
+    if clash:
+        raise _core.ModelError(f"sweep: output dims {clash} of {var!r} repeat grid names")
+    return vdims
+
+
+def _gridded(var: str, arr0: np.ndarray, results, ok, shape) -> np.ndarray:
+    """One output over the grid, in the common dtype of the points' values (float64 for an
+    integer output when some point failed: its entries are NaN)."""
+    n = len(results)
+    dtype = np.result_type(*{r[var][0].dtype for r in ok})
+    if len(ok) < n and dtype.kind in "biu":
+        dtype = np.dtype(np.float64)
+    full = np.full(shape + arr0.shape, np.nan if dtype.kind in "fc" else 0, dtype=dtype)
+    flat = full.reshape((n, *arr0.shape))
+    for i, r in enumerate(results):
+        if r is not None:
+            flat[i] = r[var][0]
+    return full
+
+
+def _coords(axes, coords, data_vars, ok: bool) -> dict:
+    """The grid's coordinates and the given ones of output dimensions (checked)."""
     all_coords = {k: (k, v) for k, v in axes.items()}
     used = {d for v in data_vars.values() for d in v[0]}
     for d, values in coords.items():
@@ -380,11 +452,15 @@ def sweep(
         if ok and d not in used:
             raise _core.ModelError(f"sweep: coords[{d!r}]: no output has a dimension {d!r}")
         all_coords[d] = (d, np.asarray(values))
+    return all_coords
 
+
+def _attrs(axes, root, fn, retries, errors) -> dict:
+    """The Dataset's attributes: the armdyn version, the grid, the seed, fn, retries and the
+    number of failed points."""
     # the package's version without importing the package from its own submodule (no cycle)
     __version__ = importlib.import_module("armdyn").__version__
-
-    attrs = {
+    return {
         "armdyn_version": __version__,
         "grid": json.dumps({k: v.tolist() for k, v in axes.items()}, default=str),
         "seed": "none" if root is None else _entropy(root),
@@ -392,7 +468,3 @@ def sweep(
         "retries": retries,
         "failed": int(sum(e is not None for e in errors)),
     }
-    try:
-        return xr.Dataset(data_vars, coords=all_coords, attrs=attrs)
-    except ValueError as exc:  # e.g. a coordinate of the wrong length
-        raise ValueError(f"sweep: cannot assemble the Dataset: {exc}") from exc

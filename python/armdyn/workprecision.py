@@ -336,8 +336,77 @@ def work_precision(
             ``coordinates`` the model cannot take, a reference of the wrong shape).
         SolverError: the default reference run failed (pass ``reference=``).
     """
-    import pandas as pd
+    plan = _check_arguments(
+        model,
+        t_end,
+        integrators,
+        n_out=n_out,
+        coordinates=coordinates,
+        atol_factor=atol_factor,
+        repeats=repeats,
+        max_steps=max_steps,
+        limits=limits,
+    )
+    plan.start = _check_start(model, q0, qd0, u0, v0, observe, reference)
+    settings = _settings(plan, rtols, dts)
+    seen = _observation(model, plan.n_out, observe, angular, error_measure)
+    refs, ref_values, row_reference = _references(plan, reference, seen.mask, observe is None)
+    rows = [
+        _measure(plan, integ, s, row_reference[integ], ref_values[row_reference[integ]], seen)
+        for integ in plan.integrators
+        for s in settings[integ]
+    ]
+    return WorkPrecisionResult(
+        table=_table(rows),
+        t=plan.t,
+        error_measure=seen.measure,
+        reference=refs,
+        reference_values=ref_values,
+    )
 
+
+# --- the stages of work_precision, in order ---------------------------------------------------
+
+
+@dataclass
+class _Plan:
+    """The checked arguments every run of the sweep shares, and the output grid."""
+
+    model: _core.Model
+    t_end: float
+    n_out: int
+    coordinates: str
+    atol_factor: float
+    repeats: int
+    max_steps: int
+    limits: str
+    integrators: list[str]
+    t: np.ndarray
+    start: dict[str, Any] = field(default_factory=dict)
+
+    def run(self, integ: str, coords: str, rtol=None, dt=None, max_steps=None):
+        """:func:`armdyn.simulate` from the start state on the output grid: ``integ`` in
+        formulation ``coords`` at ``rtol`` (``atol = atol_factor * rtol``) or, for RK4, step
+        ``dt``; ``max_steps`` default the sweep's."""
+        opts = dict(
+            self.start,
+            output_dt=self.t_end / self.n_out,
+            coordinates=coords,
+            max_steps=int(self.max_steps if max_steps is None else max_steps),
+            limits=self.limits,
+        )
+        if integ == "rk4":
+            opts["dt"] = dt
+        elif integ != "kinematic":
+            opts.update(rtol=rtol, atol=self.atol_factor * rtol)
+        return simulate(self.model, self.t_end, integrator=integ, **opts)
+
+
+def _check_arguments(
+    model, t_end, integrators, *, n_out, coordinates, atol_factor, repeats, max_steps, limits
+) -> _Plan:
+    """The model, the numbers and choices, and the integrators, checked (a ModelError naming
+    the argument)."""
     if not isinstance(model, _core.Model):
         raise _bad(f"model must be an armdyn.Model, got {type(model).__name__}")
     who = "work_precision"
@@ -349,9 +418,23 @@ def work_precision(
     max_steps = _checks.integer(who, "max_steps", max_steps, lo=1, hi=_checks.INT_MAX // 10)
     coordinates = _checks.choice(who, "coordinates", coordinates, ("cartesian", "joint"))
     limits = _checks.choice(who, "limits", limits, ("enforce", "ignore"))
-    joint_reason = model.joint_path_reason
-    if coordinates == "joint" and joint_reason:
-        raise _bad(f"coordinates='joint' does not apply to this model: {joint_reason}")
+    if coordinates == "joint" and model.joint_path_reason:
+        raise _bad(f"coordinates='joint' does not apply to this model: {model.joint_path_reason}")
+    return _Plan(
+        model=model,
+        t_end=t_end,
+        n_out=n_out,
+        coordinates=coordinates,
+        atol_factor=atol_factor,
+        repeats=repeats,
+        max_steps=max_steps,
+        limits=limits,
+        integrators=_check_integrators(model, integrators),
+        t=np.linspace(0.0, t_end, n_out + 1),
+    )
+
+
+def _check_integrators(model, integrators) -> list[str]:
     if isinstance(integrators, str):
         integrators = [integrators]
     integrators = list(DEFAULT_INTEGRATORS if integrators is None else integrators)
@@ -364,6 +447,12 @@ def work_precision(
         raise _bad(f"integrators has duplicates: {integrators}")
     if "kinematic" in integrators and model.mobility_driven != 0:
         raise _bad("integrator 'kinematic' needs a fully driven model (mobility_driven == 0)")
+    return integrators
+
+
+def _check_start(model, q0, qd0, u0, v0, observe, reference) -> dict[str, Any]:
+    """The start state as simulate's keywords (empty: the model's assembled state at rest),
+    and what is compared checked to exist."""
     q0 = _check_vector("q0", q0, model.n_coords)
     qd0 = _check_vector("qd0", qd0, model.n_coords)
     if qd0 is not None and q0 is None:
@@ -377,11 +466,20 @@ def work_precision(
         )
     if observe is not None and reference is None:
         raise _bad("observe needs reference= (the default reference compares joint coordinates)")
+    if q0 is not None:
+        return {"q0": q0, "qd0": qd0}
+    if u0 is not None or v0 is not None:
+        return {"u0": u0, "v0": v0}
+    return {}
 
+
+def _settings(plan: _Plan, rtols, dts) -> dict[str, tuple]:
+    """Per integrator, the settings swept: RK4's steps, the others' tolerances (the kinematic
+    path: one NaN)."""
     settings: dict[str, tuple] = {}
-    for integ in integrators:
+    for integ in plan.integrators:
         if integ == "rk4":
-            spacing = t_end / n_out
+            spacing = plan.t_end / plan.n_out
             settings[integ] = (
                 _check_settings("dts", dts)
                 if dts is not None
@@ -390,43 +488,35 @@ def work_precision(
         elif integ == "kinematic":
             settings[integ] = (math.nan,)
         else:
-            if rtols is None:
-                vals = DEFAULT_RTOLS[integ]
-            elif isinstance(rtols, dict):
-                unknown = sorted(set(rtols) - set(TOLERANCE_INTEGRATORS))
-                if unknown:
-                    raise _bad(
-                        f"rtols names {unknown}, which take no tolerance; choose from "
-                        f"{list(TOLERANCE_INTEGRATORS)} (RK4's steps: dts=)"
-                    )
-                vals = rtols.get(integ, DEFAULT_RTOLS[integ])
-            else:
-                vals = rtols
-            settings[integ] = _check_settings(f"rtols of {integ}", vals)
+            settings[integ] = _check_settings(f"rtols of {integ}", _rtols_of(integ, rtols))
+    return settings
 
-    t = np.linspace(0.0, t_end, n_out + 1)
-    output_dt = t_end / n_out
-    start = {}
-    if q0 is not None:
-        start = {"q0": q0, "qd0": qd0}
-    elif u0 is not None or v0 is not None:
-        start = {"u0": u0, "v0": v0}
 
-    def run(integ, coords, rtol=None, dt=None, max_steps=max_steps):
-        opts = dict(
-            start,
-            output_dt=output_dt,
-            coordinates=coords,
-            max_steps=int(max_steps),
-            limits=limits,
-        )
-        if integ == "rk4":
-            opts["dt"] = dt
-        elif integ != "kinematic":
-            opts.update(rtol=rtol, atol=atol_factor * rtol)
-        return simulate(model, t_end, integrator=integ, **opts)
+def _rtols_of(integ: str, rtols):
+    if rtols is None:
+        return DEFAULT_RTOLS[integ]
+    if isinstance(rtols, dict):
+        unknown = sorted(set(rtols) - set(TOLERANCE_INTEGRATORS))
+        if unknown:
+            raise _bad(
+                f"rtols names {unknown}, which take no tolerance; choose from "
+                f"{list(TOLERANCE_INTEGRATORS)} (RK4's steps: dts=)"
+            )
+        return rtols.get(integ, DEFAULT_RTOLS[integ])
+    return rtols
 
-    # --- references -------------------------------------------------------------------------
+
+@dataclass
+class _Observation:
+    """What each run's error compares: ``observe(result)``, its angular columns (wrapped) and
+    the description of the error."""
+
+    observe: Callable[[Any], Any]
+    mask: Any
+    measure: str
+
+
+def _observation(model, n_out: int, observe, angular, error_measure) -> _Observation:
     if observe is None:
         mask = _angular_mask(model) if angular is None else angular
         observe_fn = lambda res: res.q  # noqa: E731
@@ -440,130 +530,158 @@ def work_precision(
         measure = error_measure or f"max |observed - reference| over {n_out + 1} outputs"
     if np.ndim(mask) == 1:
         mask = np.asarray(mask, dtype=bool)
+    return _Observation(observe_fn, mask, measure)
 
+
+def _references(plan: _Plan, reference, mask, observe_default: bool):
+    """``(refs, ref_values, row_reference)``: how each reference was obtained, its values on
+    the grid, and which one each integrator's rows are measured against (the user's; else the
+    kinematic path of a fully driven model; else DOP853 at REFERENCE_RTOL on the other
+    formulation; else, without a joint formulation, the Cartesian one with another
+    integrator)."""
+    model, integrators = plan.model, plan.integrators
+    if reference is not None:
+        vals = _reference_on_grid(reference, plan.t, model, observe_default)
+        refs = {
+            "user": {
+                "method": "given by the user",
+                "formulation": None,
+                "rtol": None,
+                "estimated_error": math.nan,
+                "why": "reference= given",
+            }
+        }
+        return refs, {"user": vals}, dict.fromkeys(integrators, "user")
     refs: dict[str, dict] = {}
     ref_values: dict[str, np.ndarray] = {}
-    row_reference: dict[str, str] = {}
 
-    def default_reference(label, integ, coords, rtol, why):
-        try:
-            tight = run(integ, coords, rtol=rtol, max_steps=10 * max_steps)
-            loose = (
-                run(integ, coords, rtol=10 * rtol, max_steps=10 * max_steps)
-                if integ != "kinematic"
-                else None
-            )
-        except _core.SolverError as exc:
-            raise _core.SolverError(
-                f"work_precision: the reference run ({label}) failed: {exc}; pass reference="
-            ) from exc
-        vals = np.asarray(tight.q, dtype=float)
-        if loose is not None:
-            est = _max_error(loose.q, vals, mask)
-        else:
-            est = float(np.max(tight.position_residual))
-        refs[label] = {
-            "method": integ,
-            "formulation": coords,
-            "rtol": rtol if integ != "kinematic" else None,
-            "atol": atol_factor * rtol if integ != "kinematic" else None,
-            "estimated_error": est,
-            "estimated_error_how": (
-                f"max over the grid of |{integ} at rtol {rtol:g} - {integ} at rtol {10 * rtol:g}|"
-                if integ != "kinematic"
-                else "largest position residual of the constraints over the outputs"
-            ),
-            "why": why,
-        }
-        ref_values[label] = vals
+    def default(label, integ, coords, rtol, why):
+        refs[label], ref_values[label] = _default_reference(
+            plan, label, integ, coords, rtol, why, mask
+        )
 
-    if reference is not None:
-        vals = _reference_on_grid(reference, t, model, observe is None)
-        refs["user"] = {
-            "method": "given by the user",
-            "formulation": None,
-            "rtol": None,
-            "estimated_error": math.nan,
-            "why": "reference= given",
-        }
-        ref_values["user"] = vals
-        row_reference = dict.fromkeys(integrators, "user")
-    elif model.mobility_driven == 0 and model.n_drives > 0:
+    if model.mobility_driven == 0 and model.n_drives > 0:
         label = "kinematic (cartesian)"
-        default_reference(
+        default(
             label, "kinematic", "cartesian", 0.0, "fully driven: every output is solved exactly"
         )
-        row_reference = dict.fromkeys(integrators, label)
-    elif not joint_reason:
-        other = "joint" if coordinates == "cartesian" else "cartesian"
+        return refs, ref_values, dict.fromkeys(integrators, label)
+    if not model.joint_path_reason:
+        other = "joint" if plan.coordinates == "cartesian" else "cartesian"
         label = f"dop853 rtol {REFERENCE_RTOL:g} ({other})"
-        why = f"the other formulation than the sweep's ({coordinates})"
-        default_reference(label, "dop853", other, REFERENCE_RTOL, why)
-        row_reference = dict.fromkeys(integrators, label)
-    else:
-        why = (
-            f"the joint formulation does not apply to this model ({joint_reason}): the "
-            "Cartesian one with a different integrator"
-        )
-        label = f"dop853 rtol {REFERENCE_RTOL:g} (cartesian)"
-        if any(i != "dop853" for i in integrators):
-            default_reference(label, "dop853", "cartesian", REFERENCE_RTOL, why)
-        row_reference = dict.fromkeys(integrators, label)
-        if "dop853" in integrators:
-            label2 = "dopri5 rtol 1e-12 (cartesian)"
-            default_reference(label2, "dopri5", "cartesian", 1e-12, why)
-            row_reference["dop853"] = label2
+        why = f"the other formulation than the sweep's ({plan.coordinates})"
+        default(label, "dop853", other, REFERENCE_RTOL, why)
+        return refs, ref_values, dict.fromkeys(integrators, label)
+    why = (
+        f"the joint formulation does not apply to this model ({model.joint_path_reason}): the "
+        "Cartesian one with a different integrator"
+    )
+    label = f"dop853 rtol {REFERENCE_RTOL:g} (cartesian)"
+    if any(i != "dop853" for i in integrators):
+        default(label, "dop853", "cartesian", REFERENCE_RTOL, why)
+    row_reference = dict.fromkeys(integrators, label)
+    if "dop853" in integrators:
+        label2 = "dopri5 rtol 1e-12 (cartesian)"
+        default(label2, "dopri5", "cartesian", 1e-12, why)
+        row_reference["dop853"] = label2
+    return refs, ref_values, row_reference
 
-    # --- the sweep ----------------------------------------------------------------------------
-    rows = []
-    for integ in integrators:
-        ref_label = row_reference[integ]
-        ref = ref_values[ref_label]
-        for s in settings[integ]:
-            row = dict.fromkeys(COLUMNS, math.nan)
-            row.update(
-                integrator=integ,
-                coordinates=coordinates,
-                rtol=s if integ in TOLERANCE_INTEGRATORS else math.nan,
-                atol=atol_factor * s if integ in TOLERANCE_INTEGRATORS else math.nan,
-                dt=s if integ == "rk4" else math.nan,
-                status="ok",
-                message="",
-                reference=ref_label,
-                error_measure=measure,
-                repeats=repeats,
-            )
-            for k in _COUNTERS:
-                row[k] = None
-            res = None
-            t0 = time.process_time()
-            try:
-                sec, reps, res = _cpu_time(
-                    lambda integ=integ, s=s: run(integ, coordinates, rtol=s, dt=s), repeats
-                )
-                row.update(cpu_s=sec, repeats=reps)
-                obs = observe_fn(res)
-                row["error"] = _max_error(obs, ref, mask)
-                if not np.isfinite(row["error"]):
-                    row.update(status="non-finite", message="outputs are not finite")
-            except _core.SolverError as exc:
-                row.update(
-                    cpu_s=time.process_time() - t0,
-                    repeats=1,
-                    status="failed",
-                    message=str(exc).split(";")[0][:300],
-                    error=math.nan,
-                )
-                res = getattr(exc, "result", None)
-            if res is not None:
-                for k in _COUNTERS:
-                    if k in res.stats:
-                        row[k] = int(res.stats[k])
-                if "seconds" in res.stats:
-                    row["integration_s"] = float(res.stats["seconds"])
-                if len(res.position_residual):
-                    row["max_position_residual"] = float(np.max(res.position_residual))
-            rows.append(row)
+
+def _default_reference(plan: _Plan, label: str, integ, coords, rtol, why, mask):
+    """``(info, values)`` of a reference run at ``rtol`` (10 times the sweep's step limit),
+    its own error estimated against the same method one decade looser (the kinematic path: its
+    largest position residual)."""
+    try:
+        tight = plan.run(integ, coords, rtol=rtol, max_steps=10 * plan.max_steps)
+        loose = (
+            plan.run(integ, coords, rtol=10 * rtol, max_steps=10 * plan.max_steps)
+            if integ != "kinematic"
+            else None
+        )
+    except _core.SolverError as exc:
+        raise _core.SolverError(
+            f"work_precision: the reference run ({label}) failed: {exc}; pass reference="
+        ) from exc
+    vals = np.asarray(tight.q, dtype=float)
+    if loose is not None:
+        est = _max_error(loose.q, vals, mask)
+    else:
+        est = float(np.max(tight.position_residual))
+    info = {
+        "method": integ,
+        "formulation": coords,
+        "rtol": rtol if integ != "kinematic" else None,
+        "atol": plan.atol_factor * rtol if integ != "kinematic" else None,
+        "estimated_error": est,
+        "estimated_error_how": (
+            f"max over the grid of |{integ} at rtol {rtol:g} - {integ} at rtol {10 * rtol:g}|"
+            if integ != "kinematic"
+            else "largest position residual of the constraints over the outputs"
+        ),
+        "why": why,
+    }
+    return info, vals
+
+
+def _measure(plan: _Plan, integ: str, s: float, ref_label: str, ref, seen: _Observation) -> dict:
+    """One row of the table: the run of ``integ`` at setting ``s`` (its tolerance or RK4's
+    step), its CPU time, error against ``ref`` and counters; a run that fails is a row with
+    its reason."""
+    row = dict.fromkeys(COLUMNS, math.nan)
+    tolerance = integ in TOLERANCE_INTEGRATORS
+    row.update(
+        integrator=integ,
+        coordinates=plan.coordinates,
+        rtol=s if tolerance else math.nan,
+        atol=plan.atol_factor * s if tolerance else math.nan,
+        dt=s if integ == "rk4" else math.nan,
+        status="ok",
+        message="",
+        reference=ref_label,
+        error_measure=seen.measure,
+        repeats=plan.repeats,
+    )
+    for k in _COUNTERS:
+        row[k] = None
+    res = None
+    t0 = time.process_time()
+    try:
+        sec, reps, res = _cpu_time(
+            lambda: plan.run(integ, plan.coordinates, rtol=s, dt=s), plan.repeats
+        )
+        row.update(cpu_s=sec, repeats=reps)
+        row["error"] = _max_error(seen.observe(res), ref, seen.mask)
+        if not np.isfinite(row["error"]):
+            row.update(status="non-finite", message="outputs are not finite")
+    except _core.SolverError as exc:
+        row.update(
+            cpu_s=time.process_time() - t0,
+            repeats=1,
+            status="failed",
+            message=str(exc).split(";")[0][:300],
+            error=math.nan,
+        )
+        res = getattr(exc, "result", None)
+    if res is not None:
+        _add_stats(row, res)
+    return row
+
+
+def _add_stats(row: dict, res) -> None:
+    """The run's counters, integration time and largest position residual into ``row``."""
+    for k in _COUNTERS:
+        if k in res.stats:
+            row[k] = int(res.stats[k])
+    if "seconds" in res.stats:
+        row["integration_s"] = float(res.stats["seconds"])
+    if len(res.position_residual):
+        row["max_position_residual"] = float(np.max(res.position_residual))
+
+
+def _table(rows: list[dict]) -> pd.DataFrame:
+    """The rows as a DataFrame with :data:`COLUMNS` and their dtypes (nullable integer
+    counters)."""
+    import pandas as pd
 
     table = pd.DataFrame(rows, columns=list(COLUMNS))
     for k in _COUNTERS:
@@ -571,6 +689,4 @@ def work_precision(
     table["repeats"] = table["repeats"].astype("int64")
     for k in ("rtol", "atol", "dt", "error", "cpu_s", "integration_s", "max_position_residual"):
         table[k] = table[k].astype("float64")
-    return WorkPrecisionResult(
-        table=table, t=t, error_measure=measure, reference=refs, reference_values=ref_values
-    )
+    return table

@@ -34,11 +34,6 @@ EXCEPTIONS = {
     ("cpp/src/kernels/block_sparse.cpp", "armdyn::plan_kkt"): (92, 33),
     ("cpp/src/kernels/constraint_rows.cpp", "armdyn::eval_constraints"): (121, 35),
     ("cpp/src/integrate/integrators.cpp", "armdyn::integrate_trbdf2"): (179, 46),
-    ("python/armdyn/plotting.py", "_panel"): (103, 48),
-    ("python/armdyn/plotting.py", "_select"): (57, 32),
-    ("python/armdyn/sizing.py", "gear_ratio_sweep"): (98, 35),
-    ("python/armdyn/sweeps.py", "sweep"): (176, 88),
-    ("python/armdyn/workprecision.py", "work_precision"): (205, 62),
 }
 
 

@@ -143,8 +143,8 @@ def test_human_urdf_simulates_in_joint_and_cartesian_coordinates():
 
 def test_falling_human_cartesian_run_follows_the_joint_space_run():
     # from rest under gravity at the default tolerances: the Cartesian run's projections use a
-    # metric floored for the massless bodies (kernels/kkt_factor.cpp; with the light-body floors, 1e-9
-    # of the heaviest mass, a 1 s fall stalled at t = 0.13 s with |f| = 1.4e-9)
+    # metric floored for the massless bodies (kernels/kkt_factor.cpp; with the light-body
+    # floors, 1e-9 of the heaviest mass, a 1 s fall stalled at t = 0.13 s with |f| = 1.4e-9)
     model = ad.load_urdf(str(_human()))
     # (the stops' contact sequence is tested in tests/simulate/test_joint_limits.py)
     runs = {

@@ -13,7 +13,12 @@ from types import SimpleNamespace
 import armdyn as ad
 import numpy as np
 import pytest
-from armdyn.actuators import ROTOR_COULOMB_SMOOTHING, motor_side, motor_side_of_result
+from armdyn.actuators import (
+    ROTOR_COULOMB_SMOOTHING,
+    motor_side,
+    motor_side_of_result,
+    rotor_torque,
+)
 
 
 def actuator(n=50.0, j=2e-5, eta=1.0, b=0.0, c=0.0, motor=None, joint="j1"):
@@ -156,6 +161,28 @@ def test_negative_gear_ratio_mirrors_the_motor():
     np.testing.assert_allclose(neg.speed, -pos.speed, rtol=1e-15)
     np.testing.assert_allclose(neg.torque, -pos.torque, rtol=1e-14)
     np.testing.assert_allclose(neg.electrical_power, pos.electrical_power, rtol=1e-14)
+
+
+@pytest.mark.parametrize("n", [35.0, -35.0])
+def test_rotor_torque_is_the_one_motor_side_splits_off(n):
+    """T_rot = J N q̈ + b N q̇ + c tanh(N q̇ / v_s) (v_s = 1e-3 |N|, add_actuator's default) is
+    written once: motor_side's load share is τ − N T_rot bit for bit with rotor_torque's T_rot,
+    which the sizing report, its what-if actuators and the gear-ratio sweep use
+    (armdyn.sizing.rotor_torque is the same function)."""
+    rng = np.random.default_rng(5)
+    t = np.cumsum(rng.uniform(1e-3, 1e-2, 200))
+    qd, qdd, tau = 0.05 * rng.normal(size=200), rng.normal(size=200), rng.normal(size=200)
+    j, b, c = 3e-5, 2e-4, 0.03
+    act = actuator(n=n, j=j, eta=0.8, b=b, c=c)
+    t_rot = rotor_torque(act, qd, qdd)
+    smoothing = 1e-3 * abs(n)
+    closed = j * n * qdd + b * n * qd + c * np.tanh(n * qd / smoothing)
+    np.testing.assert_allclose(t_rot, closed, rtol=1e-13, atol=1e-13 * np.max(np.abs(closed)))
+    # the Coulomb term is in its smooth range for some samples and saturated for others
+    assert np.any(np.abs(n * qd) < smoothing) and np.any(np.abs(n * qd) > 3 * smoothing)
+    s = motor_side(act, t, qd, qdd, tau)
+    assert np.array_equal(s.load_torque, tau - n * t_rot)
+    assert ad.sizing.rotor_torque is rotor_torque
 
 
 @pytest.mark.parametrize("with_motor", [True, False])

@@ -14,6 +14,7 @@ import armdyn as ad
 import numpy as np
 import pytest
 from armdyn import _core, sizing
+from armdyn.sizing import motor as sizing_motor  # the home of _mass_matrix, patched below
 
 I_Z, AMP, FREQ, H = 0.2, 1.0, 0.5, 1e-3
 OMEGA = 2.0 * np.pi * FREQ
@@ -104,7 +105,7 @@ def test_motor_columns_against_the_closed_form(run, monkeypatch):
     proxy = WithActuators(model, [stand_in(m)])
     # the mass matrix of a model with the actuator: the rotor-free one plus N² J (contract)
     monkeypatch.setattr(
-        sizing, "_mass_matrix", lambda md, q: _core.mass_matrix(md._model, q) + N * N * J
+        sizing_motor, "_mass_matrix", lambda md, q: _core.mass_matrix(md._model, q) + N * N * J
     )
     row = ad.sizing_report(geared, proxy).table.loc["spin"]
     # joint side includes the reflected rotor: (I + N² J) A ω²
@@ -144,10 +145,10 @@ def test_what_if_actuators_equal_the_stand_in_model(run, monkeypatch):
     model, res, geared = run
     m = full_motor()
     monkeypatch.setattr(
-        sizing, "_mass_matrix", lambda md, q: _core.mass_matrix(md._model, q) + N * N * J
+        sizing_motor, "_mass_matrix", lambda md, q: _core.mass_matrix(md._model, q) + N * N * J
     )
     a = ad.sizing_report(geared, WithActuators(model, [stand_in(m)])).table
-    monkeypatch.setattr(sizing, "_mass_matrix", lambda md, q: _core.mass_matrix(md, q))
+    monkeypatch.setattr(sizing_motor, "_mass_matrix", lambda md, q: _core.mass_matrix(md, q))
     spec = {"gear_ratio": N, "rotor_inertia": J, "motor": m}
     b = ad.sizing_report(res, model, actuators={"spin": spec}).table
     # the what-if rotor is not hidden in peak_torque: the run's own (rotor-free) peak is
@@ -179,7 +180,7 @@ def test_what_if_actuators_equal_the_stand_in_model(run, monkeypatch):
 
 def test_a_failing_or_missing_check_is_not_ok(run, monkeypatch):
     model, _, geared = run
-    monkeypatch.setattr(sizing, "_mass_matrix", lambda md, q: _core.mass_matrix(md._model, q))
+    monkeypatch.setattr(sizing_motor, "_mass_matrix", lambda md, q: _core.mass_matrix(md._model, q))
     tight = WithActuators(model, [stand_in(full_motor(peak_torque=0.9 * PEAK_T))])
     row = ad.sizing_report(geared, tight).table.loc["spin"]
     assert row["peak_torque_margin"] == pytest.approx(0.9, rel=1e-12) and not row["ok"]
@@ -220,7 +221,7 @@ def test_thermal_model_closed_forms():
 def test_save_draws_the_speed_torque_plane(run, tmp_path, monkeypatch):
     pytest.importorskip("matplotlib")
     model, _, geared = run
-    monkeypatch.setattr(sizing, "_mass_matrix", lambda md, q: _core.mass_matrix(md._model, q))
+    monkeypatch.setattr(sizing_motor, "_mass_matrix", lambda md, q: _core.mass_matrix(md._model, q))
     report = ad.sizing_report(geared, WithActuators(model, [stand_in(full_motor())]), out=tmp_path)
     html = (tmp_path / "report.html").read_text("utf-8")
     assert 'src="motor_0.png"' in html and 'src="torque_0.png"' in html
@@ -278,11 +279,11 @@ def test_gear_ratio_sweep_strips_the_models_own_rotor(run, monkeypatch):
     m = full_motor()
     proxy = WithActuators(model, [stand_in(m)])
     monkeypatch.setattr(
-        sizing, "_mass_matrix", lambda md, q: _core.mass_matrix(md._model, q) + N * N * J
+        sizing_motor, "_mass_matrix", lambda md, q: _core.mass_matrix(md._model, q) + N * N * J
     )
     ratios = [5.0, 25.0, 60.0]
     a = ad.gear_ratio_sweep(geared, proxy, ratios).table
-    monkeypatch.setattr(sizing, "_mass_matrix", lambda md, q: _core.mass_matrix(md, q))
+    monkeypatch.setattr(sizing_motor, "_mass_matrix", lambda md, q: _core.mass_matrix(md, q))
     b = ad.gear_ratio_sweep(res, model, ratios, {"spin": stand_in(m)}).table
     cols = ["motor_rms_torque", "motor_peak_torque", "peak_torque", "inertia_ratio"]
     np.testing.assert_allclose(a[cols].to_numpy(), b[cols].to_numpy(), rtol=1e-12)
