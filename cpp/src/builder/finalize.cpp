@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // ModelBuilder::finalize(): sizes and rows, connectivity and topology, the assembly of the
-// initial state and the rank analysis at it.
+// initial state and the rank analysis at it. detail::finalize_draft (at the end) calls the
+// stages in order, each a function of this file above it.
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 #include <algorithm>
@@ -586,6 +587,14 @@ void analyse_rank(Model& m) {
   m.redundant = m.rank_joint < m.nc_joint || m.rank_all < m.nc;
 }
 
+// A model with redundant rows takes the dense pivoted factorisation (minimum-norm multipliers)
+// throughout (KktSolver and kkt_path() read m.redundant): its assembly is projected again on it
+void reassemble_if_redundant(Model& m, Metric metric) {
+  if (!m.redundant) return;
+  Data d(m);
+  project(m, d, 0.0, m.u0.data(), m.v0.data(), metric);
+}
+
 // A tree's joint coordinates at a spread-out configuration (each 0.6 sin(phase (index + 1)),
 // the free joints at the identity) as a state u
 VecX spread_configuration(const Model& m, double phase) {
@@ -648,12 +657,7 @@ std::shared_ptr<Model> finalize_draft(const Model& draft, const FinalizeOptions&
   assemble(m, metric);
   check_assembled_state(m);
   analyse_rank(m);
-  if (m.redundant) {
-    // redundant rows: the dense pivoted factorisation (minimum-norm multipliers) throughout
-    // (KktSolver and kkt_path() read m.redundant)
-    Data d(m);
-    project(m, d, 0.0, m.u0.data(), m.v0.data(), metric);
-  }
+  reassemble_if_redundant(m, metric);
   check_inertia_of_motions(m);
   return mp;
 }
