@@ -694,7 +694,7 @@ void bind_model(py::module_& m) {
           "summary", [](const Model& m) { return summary(m); },
           "Readable description: sizes, topology, solver path.")
       .def_property_readonly(
-          "kkt_path", [](const Model& m) { return kkt_path(m); },
+          "kkt_path", [](const Model& m) { return kkt_path_name(kkt_path(m)); },
           "KKT solver path chosen at finalize(): 'tree', 'tree+loops', 'sparse', or 'dense' "
           "(redundant rows).")
       .def(
@@ -717,7 +717,7 @@ void bind_model(py::module_& m) {
           [](const Model& m) {
             py::dict d;
             const KktPlan& p = kkt_plans(m).all;
-            d["path"] = kkt_path(m);
+            d["path"] = kkt_path_name(kkt_path(m));
             d["description"] = kkt_path_description(m);
             d["blocks"] = p.order.size();
             d["factor_entries"] = p.factor_entries;

@@ -41,6 +41,18 @@ void require_pose(const std::string& who, const Vec3& position, const Vec4& orie
                          orientation.norm()));
 }
 
+const char* inertia_problem_words(InertiaProblem kind) {
+  switch (kind) {
+    case InertiaProblem::NotPositiveSemidefinite:
+      return "is not positive semidefinite";
+    case InertiaProblem::TriangleInequality:
+      return "violates the triangle inequality";
+    case InertiaProblem::None:
+      break;
+  }
+  return "";
+}
+
 }  // namespace
 
 InertiaCheck check_inertia(const Mat3& inertia, bool physical, double scale) {
@@ -55,16 +67,18 @@ InertiaCheck check_inertia(const Mat3& inertia, bool physical, double scale) {
     // simulates while the joint-space mass matrix stays positive definite (finalize checks)
     const double scale = inertia.cwiseAbs().maxCoeff();
     if (!(p[0] >= -1e-12 * std::max(scale, 1e-300)))
-      c.problem = "is not positive semidefinite";
+      c.kind = InertiaProblem::NotPositiveSemidefinite;
     else if (p[0] + p[1] < p[2] * (1.0 - 1e-9))
-      c.problem = "violates the triangle inequality";
+      c.kind = InertiaProblem::TriangleInequality;
+    c.problem = inertia_problem_words(c.kind);
     return c;
   }
   // any positive semidefinite tensor; negatives down to -1e-12 of the largest moment are
   // round-off, clamped to zero (a warning unless they are the round-off of a rotation)
   const double largest = std::max(p[2], 0.0);
   if (!(p[0] >= -1e-12 * std::max(largest, scale))) {
-    c.problem = "is not positive semidefinite";
+    c.kind = InertiaProblem::NotPositiveSemidefinite;
+    c.problem = inertia_problem_words(c.kind);
     return c;
   }
   if (p[0] < 0.0) {
@@ -103,7 +117,7 @@ int ModelBuilder::add_body(const std::string& name, double mass, const Mat3& ine
   const InertiaCheck ic = check_inertia(0.5 * (inertia + inertia.transpose()), physical_inertia_);
   const Vec3& p = ic.moments;
   if (!ic.problem.empty()) {
-    if (ic.problem == "violates the triangle inequality")
+    if (ic.kind == InertiaProblem::TriangleInequality)
       throw ModelError(msg(who, ": inertia violates the triangle inequality (principal moments ",
                            p[0], " + ", p[1], " < ", p[2],
                            "); physical_inertia=False accepts any positive semidefinite tensor"));
@@ -525,22 +539,28 @@ void ModelBuilder::add_coupling_impl(const std::string& name, const std::string&
   m_.gear_constraints.push_back(g);
 }
 
-void ModelBuilder::add_actuator(const std::string& joint, double gear_ratio, double rotor_inertia,
-                                double efficiency, double friction_viscous, double friction_coulomb,
-                                const MotorSpec* motor, bool gyroscopic,
-                                double friction_smoothing) {
-  const std::string who = msg("add_actuator on joint '", joint, "'");
-  auto it = m_.joint_index.find(joint);
-  if (it == m_.joint_index.end()) throw ModelError(msg(who, ": unknown joint"));
+namespace {
+
+// the joint an actuator drives: known, revolute or prismatic, without an actuator yet
+int actuated_joint(const Model& m, const std::string& who, const std::string& joint) {
+  auto it = m.joint_index.find(joint);
+  if (it == m.joint_index.end()) throw ModelError(msg(who, ": unknown joint"));
   const int ji = it->second;
-  const Joint& j = m_.joints[ji];
+  const Joint& j = m.joints[ji];
   if (j.type != JointType::Revolute && j.type != JointType::Prismatic)
     throw ModelError(msg(who, ": the joint is ", joint_type_name(j.type),
                          "; an actuator needs a revolute (continuous) or prismatic joint"));
-  for (const Actuator& a : m_.actuators)
+  for (const Actuator& a : m.actuators)
     if (a.joint == ji)
       throw ModelError(msg(who, ": the joint already has an actuator (rotor '",
-                           m_.joints[a.rotor_joint].name, "')"));
+                           m.joints[a.rotor_joint].name, "')"));
+  return ji;
+}
+
+// an actuator's numbers and motor, in the order add_actuator takes them
+void check_actuator_numbers(const std::string& who, double gear_ratio, double rotor_inertia,
+                            double efficiency, double friction_viscous, double friction_coulomb,
+                            const MotorSpec* motor, double friction_smoothing) {
   if (!std::isfinite(gear_ratio) || gear_ratio == 0.0)
     throw ModelError(msg(who, ": gear_ratio must be finite and nonzero, got ", gear_ratio));
   if (!std::isfinite(rotor_inertia) || rotor_inertia < 0.0)
@@ -554,6 +574,38 @@ void ModelBuilder::add_actuator(const std::string& joint, double gear_ratio, dou
   if (!std::isfinite(friction_smoothing))
     throw ModelError(msg(who, ": friction_smoothing must be finite, got ", friction_smoothing));
   if (motor) motor->validate(who + ": motor");
+}
+
+// the rotor's name taken by no body, joint, coupling or gear
+void check_rotor_name_free(const Model& m, const std::string& who, const std::string& rotor) {
+  if (m.body_index.count(rotor) || rotor == "ground")
+    throw ModelError(msg(who, ": a body named '", rotor, "' exists (the rotor's name)"));
+  if (m.joint_index.count(rotor))
+    throw ModelError(msg(who, ": a joint named '", rotor, "' exists (the rotor's name)"));
+  for (const GearConstraint& g : m.gear_constraints)
+    if (g.name == rotor)
+      throw ModelError(msg(who, ": a coupling or gear named '", rotor, "' exists (the rotor's)"));
+}
+
+// the joint's origin and axis in world at the build pose
+std::pair<Vec3, Vec3> joint_axis_in_world(const Model& m, const Joint& j) {
+  if (j.parent == kGround) return {j.point_parent, j.frame_parent.col(2)};
+  const Body& p = m.bodies[j.parent];
+  const Mat3 R = quat_to_rot(p.orientation);
+  return {p.position + R * j.point_parent, R * j.frame_parent.col(2)};
+}
+
+}  // namespace
+
+void ModelBuilder::add_actuator(const std::string& joint, double gear_ratio, double rotor_inertia,
+                                double efficiency, double friction_viscous, double friction_coulomb,
+                                const MotorSpec* motor, bool gyroscopic,
+                                double friction_smoothing) {
+  const std::string who = msg("add_actuator on joint '", joint, "'");
+  const int ji = actuated_joint(m_, who, joint);
+  const Joint& j = m_.joints[ji];
+  check_actuator_numbers(who, gear_ratio, rotor_inertia, efficiency, friction_viscous,
+                         friction_coulomb, motor, friction_smoothing);
   // the gear-reduced rotor (on ground) is the joint's reflected inertia N^2 J turning with the
   // joint ("<joint>_armature": the same dynamics as a rotor at N qdot, without a body spinning N
   // times faster for the Cartesian error control to follow); the gyroscopic one is the rotor
@@ -561,21 +613,8 @@ void ModelBuilder::add_actuator(const std::string& joint, double gear_ratio, dou
   const bool reduced = !gyroscopic;
   const std::string rotor = joint + (reduced ? "_armature" : "_rotor");
   const double n_abs = std::abs(gear_ratio);
-  if (m_.body_index.count(rotor) || rotor == "ground")
-    throw ModelError(msg(who, ": a body named '", rotor, "' exists (the rotor's name)"));
-  if (m_.joint_index.count(rotor))
-    throw ModelError(msg(who, ": a joint named '", rotor, "' exists (the rotor's name)"));
-  for (const GearConstraint& g : m_.gear_constraints)
-    if (g.name == rotor)
-      throw ModelError(msg(who, ": a coupling or gear named '", rotor, "' exists (the rotor's)"));
-  // the joint's origin and axis in world at the build pose
-  Vec3 point = j.point_parent, axis = j.frame_parent.col(2);
-  if (j.parent != kGround) {
-    const Body& p = m_.bodies[j.parent];
-    const Mat3 R = quat_to_rot(p.orientation);
-    point = p.position + R * j.point_parent;
-    axis = R * j.frame_parent.col(2);
-  }
+  check_rotor_name_free(m_, who, rotor);
+  const auto [point, axis] = joint_axis_in_world(m_, j);
   const std::string carrier =
       gyroscopic && j.parent != kGround ? m_.bodies[j.parent].name : std::string("ground");
   // thin disc: axial J, transverse J / 2 (the rotor's mass belongs to the link's inertia)

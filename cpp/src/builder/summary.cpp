@@ -24,7 +24,7 @@ std::string summary(const Model& m) {
     for (const auto& r : m.redundant_rows) os << "\n    " << r;
     os << "\n  multipliers: minimum-norm (reactions of redundant joints are not unique)\n";
   }
-  os << "  KKT path: " << kkt_path(m) << " -- " << kkt_path_description(m) << "\n";
+  os << "  KKT path: " << kkt_path_name(kkt_path(m)) << " -- " << kkt_path_description(m) << "\n";
   if (const LightBodies& light = light_bodies(m); !light.bodies.empty())
     os << "  " << light.note << "\n";
   const Welding* w = welding(m);
@@ -33,9 +33,9 @@ std::string summary(const Model& m) {
     for (int jw : w->weld_joint) merged += jw < 0;
     const Model& wm = *w->model;
     os << "  welded: " << merged << " fixed joints merged into composite bodies; simulate() "
-       << "integrates " << wm.nb << " bodies and " << wm.nc << " rows (KKT path " << kkt_path(wm)
-       << ", ~" << kkt_plans(wm).all.flops << " flops per factorisation) and reports all " << m.nb
-       << " bodies\n";
+       << "integrates " << wm.nb << " bodies and " << wm.nc << " rows (KKT path "
+       << kkt_path_name(kkt_path(wm)) << ", ~" << kkt_plans(wm).all.flops
+       << " flops per factorisation) and reports all " << m.nb << " bodies\n";
   }
   {
     // simulate(coordinates="joint"): the integrated model (welded, when fixed joints merge)

@@ -16,28 +16,35 @@
 
 namespace armdyn {
 
-KktPlan plan_kkt(const Model& m, int nrows) {
-  ConstraintEval ce;
-  ce.init(m);
-  KktPlan p;
-  p.nrows = nrows;
-  const int nblk = static_cast<int>(ce.blocks.size());
-  std::vector<char> live(nblk, 0);
-  std::vector<int> size(nblk, 0);
-  for (int g = 0; g < nblk; ++g) {
-    live[g] = ce.blocks[g].row0 < nrows;
-    size[g] = ce.blocks[g].nrows;
-  }
-  std::vector<std::set<int>> nbr(nblk);
+namespace {
+
+// The row blocks' adjacency in A: blocks g and h (both live) touch a common body
+std::vector<std::set<int>> block_neighbours(const ConstraintEval& ce,
+                                            const std::vector<char>& live) {
+  std::vector<std::set<int>> nbr(ce.blocks.size());
   for (const auto& list : ce.body_blocks)
     for (const auto& [g, sg] : list)
       for (const auto& [h, sh] : list)
         if (g != h && live[g] && live[h]) nbr[g].insert(h);
-  const std::vector<std::set<int>> original = nbr;
-  // greedy minimum degree, the degree weighted by the neighbours' row counts; ties by index
+  return nbr;
+}
+
+// The elimination of the live blocks by greedy minimum degree, the degree weighted by the
+// neighbours' row counts, ties by index: the order, each step's neighbours (the blocks of its
+// column of L), and the fill (blocks of L absent from A, and the blocks that receive it)
+struct Elimination {
   std::vector<int> order;
   std::vector<std::vector<int>> cols_blk;
   std::set<int> fill_rows_blocks;
+  long fill_blocks = 0;
+};
+
+Elimination eliminate_by_minimum_degree(std::vector<std::set<int>> nbr,
+                                        const std::vector<char>& live,
+                                        const std::vector<int>& size) {
+  const int nblk = static_cast<int>(nbr.size());
+  const std::vector<std::set<int>> original = nbr;
+  Elimination e;
   int remaining = 0;
   for (int g = 0; g < nblk; ++g) remaining += live[g];
   std::vector<char> done(nblk, 0);
@@ -59,56 +66,81 @@ KktPlan plan_kkt(const Model& m, int nrows) {
     const int best = heap.top().second;
     heap.pop();
     done[best] = 1;
-    order.push_back(best);
+    e.order.push_back(best);
     const std::vector<int> nb(nbr[best].begin(), nbr[best].end());
-    cols_blk.push_back(nb);
+    e.cols_blk.push_back(nb);
     for (int a : nb) nbr[a].erase(best);
     for (int a : nb)
       for (int b : nb)
         if (a != b && nbr[a].insert(b).second && a < b && !original[a].count(b)) {
-          ++p.fill_blocks;
-          fill_rows_blocks.insert(a);
-          fill_rows_blocks.insert(b);
+          ++e.fill_blocks;
+          e.fill_rows_blocks.insert(a);
+          e.fill_rows_blocks.insert(b);
         }
     for (int a : nb) heap.emplace(degree[a] = weighted_degree(a), a);
   }
-  const int np = static_cast<int>(order.size());
-  p.order = order;
+  return e;
+}
+
+// the plan's path from its fill, and its one-line description
+void describe_plan(KktPlan& p, int np) {
+  std::ostringstream os;
+  if (p.nrows == 0) {
+    p.path = KktPath::Dense;
+    os << "no constraint rows";
+    p.description = os.str();
+    return;
+  }
+  if (p.fill_blocks == 0)
+    p.path = KktPath::Tree;
+  else if (p.fill_blocks <= np)
+    p.path = KktPath::TreeLoops;  // loop closures: fill along the loops, still linear in size
+  else
+    p.path = KktPath::Sparse;
+  if (p.path == KktPath::Tree)
+    os << "tree: block elimination leaves first, no fill (O(n))";
+  else if (p.path == KktPath::TreeLoops)
+    os << "tree + loops: block elimination leaves first, fill of " << p.fill_blocks
+       << " blocks along the loops (" << p.loop_rows << " rows)";
+  else
+    os << "general sparse: minimum-degree block elimination, fill " << p.fill_blocks << " blocks";
+  os << "; " << np << " row blocks, " << p.factor_entries << " factor entries, ~" << p.flops
+     << " flops per factorisation";
+  p.description = os.str();
+}
+
+}  // namespace
+
+KktPlan plan_kkt(const Model& m, int nrows) {
+  ConstraintEval ce;
+  ce.init(m);
+  KktPlan p;
+  p.nrows = nrows;
+  const int nblk = static_cast<int>(ce.blocks.size());
+  std::vector<char> live(nblk, 0);
+  std::vector<int> size(nblk, 0);
+  for (int g = 0; g < nblk; ++g) {
+    live[g] = ce.blocks[g].row0 < nrows;
+    size[g] = ce.blocks[g].nrows;
+  }
+  const Elimination e = eliminate_by_minimum_degree(block_neighbours(ce, live), live, size);
+  p.fill_blocks = e.fill_blocks;
+  const int np = static_cast<int>(e.order.size());
+  p.order = e.order;
   p.pos.assign(nblk, -1);
-  for (int k = 0; k < np; ++k) p.pos[order[k]] = k;
+  for (int k = 0; k < np; ++k) p.pos[e.order[k]] = k;
   p.cols.resize(np);
   for (int k = 0; k < np; ++k) {
-    for (int g : cols_blk[k]) p.cols[k].push_back(p.pos[g]);
+    for (int g : e.cols_blk[k]) p.cols[k].push_back(p.pos[g]);
     std::sort(p.cols[k].begin(), p.cols[k].end());
-    const long s = size[order[k]];
+    const long s = size[e.order[k]];
     long r = 0;
-    for (int i : p.cols[k]) r += size[order[i]];
+    for (int i : p.cols[k]) r += size[e.order[i]];
     p.factor_entries += s * (s + 1) / 2 + s * r;
     p.flops += s * s * s / 3 + s * s * r + s * r * r;
   }
-  for (int g : fill_rows_blocks) p.loop_rows += size[g];
-  std::ostringstream os;
-  if (nrows == 0) {
-    p.path = "dense";
-    os << "no constraint rows";
-  } else {
-    if (p.fill_blocks == 0)
-      p.path = "tree";
-    else if (p.fill_blocks <= np)
-      p.path = "tree+loops";  // loop closures: fill along the loops, still linear in size
-    else
-      p.path = "sparse";
-    if (p.path == "tree")
-      os << "tree: block elimination leaves first, no fill (O(n))";
-    else if (p.path == "tree+loops")
-      os << "tree + loops: block elimination leaves first, fill of " << p.fill_blocks
-         << " blocks along the loops (" << p.loop_rows << " rows)";
-    else
-      os << "general sparse: minimum-degree block elimination, fill " << p.fill_blocks << " blocks";
-    os << "; " << np << " row blocks, " << p.factor_entries << " factor entries, ~" << p.flops
-       << " flops per factorisation";
-  }
-  p.description = os.str();
+  for (int g : e.fill_rows_blocks) p.loop_rows += size[g];
+  describe_plan(p, np);
   return p;
 }
 
@@ -121,9 +153,25 @@ const KktPlans& kkt_plans(const Model& m) {
   });
 }
 
-std::string kkt_path(const Model& m) {
-  if (m.nc == 0) return "";
-  if (m.redundant || m.force_dense_kkt) return "dense";
+const char* kkt_path_name(KktPath path) {
+  switch (path) {
+    case KktPath::Tree:
+      return "tree";
+    case KktPath::TreeLoops:
+      return "tree+loops";
+    case KktPath::Sparse:
+      return "sparse";
+    case KktPath::Dense:
+      return "dense";
+    case KktPath::None:
+      break;
+  }
+  return "";
+}
+
+KktPath kkt_path(const Model& m) {
+  if (m.nc == 0) return KktPath::None;
+  if (m.redundant || m.force_dense_kkt) return KktPath::Dense;
   return kkt_plans(m).all.path;
 }
 

@@ -87,140 +87,155 @@ std::vector<int> gear_bodies(const Model& m, const GearConstraint& g) {
   return bodies;
 }
 
+namespace {
+
+// The rows of joint j into its block b (kinematics ka of the parent, kb of the child): the
+// coincident points of a spherical, revolute, universal or fixed joint, then the axis rows of
+// its type
+inline void eval_joint_rows(const Joint& j, const BodyKin& ka, const BodyKin& kb, bool with_xi,
+                            ConstraintEval& ce, ConstraintBlock& b) {
+  // separation of the joint points, and the joint frames' axes in world
+  auto sep = [&] { return sep_jet(ka, j.point_parent, kb, j.point_child); };
+  auto pa = [&](int k) { return axis_jet(ka, j.frame_parent.col(k)); };
+  auto pb = [&](int k) { return axis_jet(kb, j.frame_child.col(k)); };
+  // a parent axis dotted with a child axis, or with the separation
+  auto axes_row = [&](int r, const AxisJet& p, const AxisJet& q) {
+    put_row(ce, b, r, dot_axes(p, ka.R, q, kb.R), with_xi);
+  };
+  // the child's joint point on the parent's joint axis line: no separation along the
+  // parent's x and y axes (2 rows from row r)
+  auto on_axis_rows = [&](int r) {
+    const SepJet d = sep();
+    put_row(ce, b, r, dot_axis_sep(pa(0), ka.R, d, kb.R), with_xi);
+    put_row(ce, b, r + 1, dot_axis_sep(pa(1), ka.R, d, kb.R), with_xi);
+    return r + 2;
+  };
+  int r = 0;
+  switch (j.type) {
+    case JointType::Spherical:
+    case JointType::Revolute:
+    case JointType::Universal:
+    case JointType::Fixed:
+      // coincident joint points: 3 rows
+      put_point_rows(ce, b, ka, kb, sep(), with_xi);
+      r = 3;
+      break;
+    default:
+      break;
+  }
+  switch (j.type) {
+    case JointType::Revolute:
+    case JointType::Cylindrical: {
+      // child x and y axes perpendicular to the parent's z axis
+      const AxisJet za = pa(2);
+      axes_row(r++, za, pb(0));
+      axes_row(r++, za, pb(1));
+      if (j.type == JointType::Cylindrical) r = on_axis_rows(r);
+      break;
+    }
+    case JointType::Universal:
+      axes_row(r++, pa(2), pb(2));
+      break;
+    case JointType::Fixed:
+    case JointType::Prismatic: {
+      // relative rotation locked: z_a.x_b = z_a.y_b = x_a.y_b = 0
+      const AxisJet za = pa(2), yb = pb(1);
+      axes_row(r++, za, pb(0));
+      axes_row(r++, za, yb);
+      axes_row(r++, pa(0), yb);
+      if (j.type == JointType::Prismatic) r = on_axis_rows(r);  // sliding along z_a only
+      break;
+    }
+    case JointType::Distance: {
+      // (|d|^2 - L^2) / (2 L): zero on the sphere, gradient the unit direction there
+      const VecJet d =
+          difference(point_jet(kb, j.point_child, 1), point_jet(ka, j.point_parent, 0));
+      ScalarJet s = dot(d, d);
+      const double k = 0.5 / j.length;
+      s.val = k * (s.val - j.length * j.length);
+      s.rate *= k;
+      s.J *= k;
+      s.bias *= k;
+      put_row(ce, b, r++, s, with_xi);
+      break;
+    }
+    case JointType::Inline:
+      r = on_axis_rows(r);
+      break;
+    default:
+      break;
+  }
+}
+
+// An ideal gear's or coupling's row r_a q_a + r_b q_b = offset (multi-turn angles), over up to
+// four bodies, into its block b
+inline void eval_gear_row(const Model& m, const std::vector<BodyKin>& kin, const GearConstraint& g,
+                          bool with_xi, ConstraintEval& ce, ConstraintBlock& b) {
+  double f = -g.offset, xi = 0.0;
+  b.J.setZero();
+  const bool angular = m.coords[g.coord_a].angular;
+  for (int k = 0; k < 2; ++k) {
+    const int c = k == 0 ? g.coord_a : g.coord_b;
+    const double r = k == 0 ? g.r_a : g.r_b;
+    const ScalarJet& q = ce.coord_cache ? ce.coord_cache->get(m, kin, c) : coord_jet(m, kin, c);
+    // per coordinate: an actuator's revolute rotor may follow a prismatic joint
+    const bool ang_c = m.coords[c].angular;
+    const double ref = ce.track_ref && ang_c ? (*ce.track_ref)[c] : 0.0;
+    f += r * (ang_c ? ref + wrap_angle(q.val - ref) : q.val);
+    xi += r * q.bias;
+    const Joint& j = m.joints[m.coords[c].joint];
+    const int ends[2] = {j.parent, j.child};
+    for (int e = 0; e < 2; ++e) {
+      if (ends[e] == kGround) continue;
+      int slot = 0;
+      while (b.body[slot] != ends[e]) ++slot;
+      b.J.block<1, 6>(0, 6 * slot) += r * q.J.segment<6>(6 * e);
+    }
+  }
+  // a revolute follower's pose gives its angle only modulo a turn (r_a = 1): the row is
+  // the follower's angle error, wrapped
+  ce.f[b.row0] = g.coupling && angular ? wrap_angle(f) : f;
+  ce.rhs[b.row0] = 0.0;
+  if (with_xi) ce.xi[b.row0] = xi;
+}
+
+// Drive di's row q_c(u) - q_ref(t) = 0 into its block b; zeta v = q_ref', xi = bias - q_ref''
+inline void eval_drive_row(const Model& m, const std::vector<BodyKin>& kin, size_t di, double t,
+                           bool with_xi, ConstraintEval& ce, ConstraintBlock& b) {
+  const Drive& dr = m.drives[di];
+  const ScalarJet q = coord_jet(m, kin, m.joints[dr.joint].coord0 + dr.coord, ce.drive_values);
+  ProfileValue p;
+  if (ce.drive_ref) {
+    p.y = ce.drive_ref[3 * di];
+    p.yd = ce.drive_ref[3 * di + 1];
+    p.ydd = ce.drive_ref[3 * di + 2];
+  } else {
+    p = dr.profile.eval(t);
+  }
+  const bool angular = m.coords[m.joints[dr.joint].coord0 + dr.coord].angular;
+  if (!ce.drive_values)
+    ce.f[b.row0] = 0.0;
+  else
+    ce.f[b.row0] = angular ? wrap_angle(q.val - p.y) : q.val - p.y;
+  ce.rhs[b.row0] = p.yd;
+  b.J.row(0).head<12>() = q.J;
+  if (with_xi) ce.xi[b.row0] = q.bias - p.ydd;
+}
+
+}  // namespace
+
+// The rows in block order: the joints', the ideal gears' and couplings', the drives'
 void eval_constraints(const Model& m, const std::vector<BodyKin>& kin, double t, bool with_xi,
                       ConstraintEval& ce) {
   int bi = 0;
-  for (int ji = 0; ji < static_cast<int>(m.joints.size()); ++ji) {
-    const Joint& j = m.joints[ji];
+  for (const Joint& j : m.joints) {
     if (joint_rows(j.type) == 0) continue;
-    ConstraintBlock& b = ce.blocks[bi++];
-    const BodyKin& ka = kin_of(kin, j.parent);
-    const BodyKin& kb = kin_of(kin, j.child);
-    // separation of the joint points, and the joint frames' axes in world
-    auto sep = [&] { return sep_jet(ka, j.point_parent, kb, j.point_child); };
-    auto pa = [&](int k) { return axis_jet(ka, j.frame_parent.col(k)); };
-    auto pb = [&](int k) { return axis_jet(kb, j.frame_child.col(k)); };
-    // a parent axis dotted with a child axis, or with the separation
-    auto axes_row = [&](int r, const AxisJet& p, const AxisJet& q) {
-      put_row(ce, b, r, dot_axes(p, ka.R, q, kb.R), with_xi);
-    };
-    // the child's joint point on the parent's joint axis line: no separation along the
-    // parent's x and y axes (2 rows from row r)
-    auto on_axis_rows = [&](int r) {
-      const SepJet d = sep();
-      put_row(ce, b, r, dot_axis_sep(pa(0), ka.R, d, kb.R), with_xi);
-      put_row(ce, b, r + 1, dot_axis_sep(pa(1), ka.R, d, kb.R), with_xi);
-      return r + 2;
-    };
-    int r = 0;
-    switch (j.type) {
-      case JointType::Spherical:
-      case JointType::Revolute:
-      case JointType::Universal:
-      case JointType::Fixed:
-        // coincident joint points: 3 rows
-        put_point_rows(ce, b, ka, kb, sep(), with_xi);
-        r = 3;
-        break;
-      default:
-        break;
-    }
-    switch (j.type) {
-      case JointType::Revolute:
-      case JointType::Cylindrical: {
-        // child x and y axes perpendicular to the parent's z axis
-        const AxisJet za = pa(2);
-        axes_row(r++, za, pb(0));
-        axes_row(r++, za, pb(1));
-        if (j.type == JointType::Cylindrical) r = on_axis_rows(r);
-        break;
-      }
-      case JointType::Universal:
-        axes_row(r++, pa(2), pb(2));
-        break;
-      case JointType::Fixed:
-      case JointType::Prismatic: {
-        // relative rotation locked: z_a.x_b = z_a.y_b = x_a.y_b = 0
-        const AxisJet za = pa(2), yb = pb(1);
-        axes_row(r++, za, pb(0));
-        axes_row(r++, za, yb);
-        axes_row(r++, pa(0), yb);
-        if (j.type == JointType::Prismatic) r = on_axis_rows(r);  // sliding along z_a only
-        break;
-      }
-      case JointType::Distance: {
-        // (|d|^2 - L^2) / (2 L): zero on the sphere, gradient the unit direction there
-        const VecJet d =
-            difference(point_jet(kb, j.point_child, 1), point_jet(ka, j.point_parent, 0));
-        ScalarJet s = dot(d, d);
-        const double k = 0.5 / j.length;
-        s.val = k * (s.val - j.length * j.length);
-        s.rate *= k;
-        s.J *= k;
-        s.bias *= k;
-        put_row(ce, b, r++, s, with_xi);
-        break;
-      }
-      case JointType::Inline:
-        r = on_axis_rows(r);
-        break;
-      default:
-        break;
-    }
+    eval_joint_rows(j, kin_of(kin, j.parent), kin_of(kin, j.child), with_xi, ce, ce.blocks[bi++]);
   }
-  // ideal gears and couplings: r_a q_a + r_b q_b = offset (multi-turn angles), over up to four
-  // bodies
-  for (const GearConstraint& g : m.gear_constraints) {
-    ConstraintBlock& b = ce.blocks[bi++];
-    double f = -g.offset, xi = 0.0;
-    b.J.setZero();
-    const bool angular = m.coords[g.coord_a].angular;
-    for (int k = 0; k < 2; ++k) {
-      const int c = k == 0 ? g.coord_a : g.coord_b;
-      const double r = k == 0 ? g.r_a : g.r_b;
-      const ScalarJet& q = ce.coord_cache ? ce.coord_cache->get(m, kin, c) : coord_jet(m, kin, c);
-      // per coordinate: an actuator's revolute rotor may follow a prismatic joint
-      const bool ang_c = m.coords[c].angular;
-      const double ref = ce.track_ref && ang_c ? (*ce.track_ref)[c] : 0.0;
-      f += r * (ang_c ? ref + wrap_angle(q.val - ref) : q.val);
-      xi += r * q.bias;
-      const Joint& j = m.joints[m.coords[c].joint];
-      const int ends[2] = {j.parent, j.child};
-      for (int e = 0; e < 2; ++e) {
-        if (ends[e] == kGround) continue;
-        int slot = 0;
-        while (b.body[slot] != ends[e]) ++slot;
-        b.J.block<1, 6>(0, 6 * slot) += r * q.J.segment<6>(6 * e);
-      }
-    }
-    // a revolute follower's pose gives its angle only modulo a turn (r_a = 1): the row is
-    // the follower's angle error, wrapped
-    ce.f[b.row0] = g.coupling && angular ? wrap_angle(f) : f;
-    ce.rhs[b.row0] = 0.0;
-    if (with_xi) ce.xi[b.row0] = xi;
-  }
-  // drives: q_c(u) - q_ref(t) = 0; zeta v = q_ref', xi = bias - q_ref''
-  for (size_t di = 0; di < m.drives.size(); ++di) {
-    const Drive& dr = m.drives[di];
-    ConstraintBlock& b = ce.blocks[bi++];
-    const ScalarJet q = coord_jet(m, kin, m.joints[dr.joint].coord0 + dr.coord, ce.drive_values);
-    ProfileValue p;
-    if (ce.drive_ref) {
-      p.y = ce.drive_ref[3 * di];
-      p.yd = ce.drive_ref[3 * di + 1];
-      p.ydd = ce.drive_ref[3 * di + 2];
-    } else {
-      p = dr.profile.eval(t);
-    }
-    const bool angular = m.coords[m.joints[dr.joint].coord0 + dr.coord].angular;
-    if (!ce.drive_values)
-      ce.f[b.row0] = 0.0;
-    else
-      ce.f[b.row0] = angular ? wrap_angle(q.val - p.y) : q.val - p.y;
-    ce.rhs[b.row0] = p.yd;
-    b.J.row(0).head<12>() = q.J;
-    if (with_xi) ce.xi[b.row0] = q.bias - p.ydd;
-  }
+  for (const GearConstraint& g : m.gear_constraints)
+    eval_gear_row(m, kin, g, with_xi, ce, ce.blocks[bi++]);
+  for (size_t di = 0; di < m.drives.size(); ++di)
+    eval_drive_row(m, kin, di, t, with_xi, ce, ce.blocks[bi++]);
 }
 
 namespace {

@@ -100,9 +100,10 @@ KktSolver::KktSolver(const Model& m)
   // the block-sparse plans unless the model is redundant or forced onto the dense path
   const bool sparse = !m.redundant && !m.force_dense_kkt && m.nc > 0;
   const KktPlans* plans = sparse ? &kkt_plans(m) : nullptr;
-  const bool sparse_all = plans && plans->all.path != "dense";
+  const bool sparse_all = plans && plans->all.path != KktPath::Dense;
   if (sparse_all) sp_all_ = std::make_unique<BlockSparseSchur>(m, plans->all);
-  if (plans && m.nc_joint != m.nc && !plans->joint.path.empty() && plans->joint.path != "dense")
+  if (plans && m.nc_joint != m.nc && plans->joint.path != KktPath::None &&
+      plans->joint.path != KktPath::Dense)
     sp_joint_ = std::make_unique<BlockSparseSchur>(m, plans->joint);
   if (!sparse_all) ensure_dense();
 }

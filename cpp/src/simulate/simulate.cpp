@@ -407,7 +407,7 @@ SimResult simulate(const Model& m, Data& d, double t_end, const SimOptions& opt,
     out.formulation = jsys->dynamics().description();
   } else {
     out.formulation = msg("cartesian: ", ms.nb, " bodies, ", ms.nc, " constraint rows, KKT path '",
-                          kkt_path(ms), "'");
+                          kkt_path_name(kkt_path(ms)), "'");
   }
   if (opt.coordinates == Coordinates::Auto) out.formulation += msg(" [", plan.why_coordinates, "]");
   // the joint position limits' stops (none on a fully driven model)

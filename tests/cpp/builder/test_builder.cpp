@@ -117,4 +117,26 @@ TEST_CASE(invalid_input_throws_and_leaves_the_builder_unchanged) {
   CHECK(empty->coords.empty() && empty->mobility == 0);
 }
 
+TEST_CASE(check_inertia_names_its_verdict) {
+  // the kind decides add_body's message; the words are what the URDF reader quotes
+  const InertiaCheck ok = check_inertia(Vec3(0.1, 0.2, 0.25).asDiagonal(), true);
+  CHECK(ok.kind == InertiaProblem::None && ok.problem.empty());
+  const InertiaCheck tri = check_inertia(Vec3(0.5, 0.1, 0.1).asDiagonal(), true);
+  CHECK(tri.kind == InertiaProblem::TriangleInequality);
+  CHECK(tri.problem == "violates the triangle inequality");
+  const InertiaCheck neg = check_inertia(Vec3(-0.1, 0.1, 0.1).asDiagonal(), true);
+  CHECK(neg.kind == InertiaProblem::NotPositiveSemidefinite);
+  CHECK(neg.problem == "is not positive semidefinite");
+  // physical = false accepts the triangle violation, not a negative moment
+  CHECK(check_inertia(Vec3(0.5, 0.1, 0.1).asDiagonal(), false).kind == InertiaProblem::None);
+  CHECK(check_inertia(Vec3(-0.1, 0.1, 0.1).asDiagonal(), false).kind ==
+        InertiaProblem::NotPositiveSemidefinite);
+  ModelBuilder b;
+  const std::string why = THROWN_MESSAGE(
+      b.add_body("b", 1.0, Vec3(0.5, 0.1, 0.1).asDiagonal(), Vec3::Zero(), kIdentityQuat),
+      ModelError);
+  CHECK(why.find("body 'b': inertia violates the triangle inequality (principal moments ") == 0);
+  CHECK(why.find(" < 0.5); physical_inertia=False accepts") != std::string::npos);
+}
+
 ARMDYN_TEST_MAIN()

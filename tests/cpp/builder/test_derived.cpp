@@ -31,12 +31,12 @@ TEST_CASE(kkt_plans_are_made_once_per_model) {
   const ModelPtr m = armdyn_test::TwoLink().model();
   const KktPlans& p = kkt_plans(*m);
   CHECK(&kkt_plans(*m) == &p);
-  CHECK(p.all.path == "tree" && kkt_path(*m) == "tree");
-  CHECK(p.joint.path.empty());  // no drives: no separate plan of the joint rows
+  CHECK(p.all.path == KktPath::Tree && kkt_path(*m) == KktPath::Tree);
+  CHECK(p.joint.path == KktPath::None);  // no drives: no separate plan of the joint rows
   // a copy forced onto the dense reference path
   Model c(*m);
   c.force_dense_kkt = true;
-  CHECK(kkt_path(c) == "dense" && kkt_path(*m) == "tree");
+  CHECK(kkt_path(c) == KktPath::Dense && kkt_path(*m) == KktPath::Tree);
   CHECK(kkt_path_description(c).find("forced") != std::string::npos);
 }
 

@@ -40,7 +40,7 @@ ModelPtr four_bar() { return armdyn_test::four_bar_builder().finalize(); }
 
 void check_against_dense(const ModelPtr& m, bool expect_fill) {
   const KktPlan plan = plan_kkt(*m, m->nc);
-  CHECK(plan.path != "dense");
+  CHECK(plan.path != KktPath::Dense);
   CHECK(plan.nrows == m->nc);
   CHECK((plan.fill_blocks > 0) == expect_fill);
   // order and pos are inverse permutations
@@ -89,5 +89,26 @@ TEST_CASE(tree_factor_has_no_fill) { check_against_dense(branched_tree(false), f
 TEST_CASE(loop_through_ground_has_no_fill) { check_against_dense(four_bar(), false); }
 
 TEST_CASE(loop_through_a_body_makes_fill) { check_against_dense(branched_tree(true), true); }
+
+TEST_CASE(kkt_path_names_are_the_python_strings) {
+  // the names Model.kkt_path returns in Python (the enum stays in C++)
+  CHECK(std::string(kkt_path_name(KktPath::Tree)) == "tree");
+  CHECK(std::string(kkt_path_name(KktPath::TreeLoops)) == "tree+loops");
+  CHECK(std::string(kkt_path_name(KktPath::Sparse)) == "sparse");
+  CHECK(std::string(kkt_path_name(KktPath::Dense)) == "dense");
+  CHECK(std::string(kkt_path_name(KktPath::None)).empty());
+  // a plan of no rows is dense; a model without rows has no path
+  ModelBuilder b;
+  b.add_body("free", 1.0, Vec3(0.1, 0.1, 0.1).asDiagonal(), Vec3::Zero(),
+             armdyn_test::kIdentityQuat);
+  b.add_free("float", "free");
+  const ModelPtr m = b.finalize();
+  CHECK(m->nc == 0 && kkt_path(*m) == KktPath::None);
+  CHECK(plan_kkt(*m, 0).path == KktPath::Dense);
+  // the closed loop's fill makes it tree+loops; the branched tree's none makes it tree
+  const ModelPtr loop = branched_tree(true);
+  CHECK(plan_kkt(*loop, loop->nc).path == KktPath::TreeLoops);
+  CHECK(kkt_path(*branched_tree(false)) == KktPath::Tree);
+}
 
 ARMDYN_TEST_MAIN()

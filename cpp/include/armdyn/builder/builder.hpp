@@ -16,14 +16,18 @@
 
 namespace armdyn {
 
+/// Why check_inertia refuses a tensor.
+enum class InertiaProblem { None, NotPositiveSemidefinite, TriangleInequality };
+
 /// The verdict on a (symmetric) inertia tensor under ModelBuilder::set_physical_inertia.
 struct InertiaCheck {
-  Vec3 moments = Vec3::Zero();  ///< principal moments, ascending [kg m^2]
-  std::string problem;          ///< why it is refused ("violates the triangle inequality"), or ""
-  Mat3 tensor = Mat3::Zero();   ///< the tensor to use: the input, or its clamped version
-  bool clamped = false;         ///< negative round-off moments were set to zero
-  bool warn = false;            ///< ... and they exceed the round-off of rotating a tensor
-  double smallest = 0.0;        ///< the smallest principal moment before clamping
+  Vec3 moments = Vec3::Zero();                 ///< principal moments, ascending [kg m^2]
+  InertiaProblem kind = InertiaProblem::None;  ///< why it is refused
+  std::string problem;         ///< ... in words ("violates the triangle inequality"), or ""
+  Mat3 tensor = Mat3::Zero();  ///< the tensor to use: the input, or its clamped version
+  bool clamped = false;        ///< negative round-off moments were set to zero
+  bool warn = false;           ///< ... and they exceed the round-off of rotating a tensor
+  double smallest = 0.0;       ///< the smallest principal moment before clamping
 };
 /// physical = false: negative moments down to -1e-12 max(largest moment, scale) are round-off,
 /// clamped (the URDF reader passes the robot's largest link moment as scale: CAD exports write

@@ -26,12 +26,21 @@
 
 namespace armdyn {
 
+/// The path of a model's KKT solves: the block-sparse factor of a tree (no fill), of a tree with
+/// loops (fill along the loops) or of a general pattern, or the dense pivoted Schur complement
+/// (redundant rows, force_dense_kkt, a plan without rows). None: no constraint rows (a model's
+/// kkt_path()), or no plan made (KktPlans::joint of a model without drives).
+enum class KktPath { None, Tree, TreeLoops, Sparse, Dense };
+/// The path's name in messages, summaries and Python (Model.kkt_path): "tree", "tree+loops",
+/// "sparse", "dense", and "" for None.
+const char* kkt_path_name(KktPath path);
+
 /// Symbolic plan of the block-sparse Schur factorisation (armdyn/kernels/block_sparse.hpp).
 struct KktPlan {
-  std::string path;         ///< "tree", "tree+loops", "sparse", or "dense" (redundant rows)
-  std::string description;  ///< one line for summary() (armdyn/builder/summary.hpp)
-  std::vector<int> order;   ///< elimination position -> block index
-  std::vector<int> pos;     ///< block index -> elimination position
+  KktPath path = KktPath::None;  ///< Tree, TreeLoops, Sparse, or Dense (no rows)
+  std::string description;       ///< one line for summary() (armdyn/builder/summary.hpp)
+  std::vector<int> order;        ///< elimination position -> block index
+  std::vector<int> pos;          ///< block index -> elimination position
   /// per position: the later positions with a nonzero block in its column of L (sorted)
   std::vector<std::vector<int>> cols;
   int nrows = 0;  ///< the plan covers the blocks with rows < nrows
@@ -48,9 +57,9 @@ struct KktPlans {
 /// structure only; a redundant model or one with force_dense_kkt takes the dense path whatever
 /// the plan (kkt_path()).
 const KktPlans& kkt_plans(const Model& m);
-/// The path the KKT solves of m take: "dense" for a redundant model or force_dense_kkt, else
-/// kkt_plans(m).all.path ("tree", "tree+loops" or "sparse"); "" without rows.
-std::string kkt_path(const Model& m);
+/// The path the KKT solves of m take: Dense for a redundant model or force_dense_kkt, else
+/// kkt_plans(m).all.path (Tree, TreeLoops or Sparse); None without rows.
+KktPath kkt_path(const Model& m);
 /// One line on that path for summaries.
 std::string kkt_path_description(const Model& m);
 

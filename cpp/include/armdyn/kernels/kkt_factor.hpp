@@ -15,7 +15,7 @@
 // 4.2.9). vdot and zeta^T delta are unique either way. All storage is sized once in the
 // constructor, so neither path allocates per step.
 //
-// Models whose plan (kkt_plans(), made on first use) is not "dense" factor A with
+// Models whose plan (kkt_plans(), made on first use) is not KktPath::Dense factor A with
 // the block-sparse Cholesky of block_sparse.hpp instead (linear in the bodies on trees). A
 // singular configuration ahead (a pivot below 1e-4 of its diagonal, in a non-redundant model,
 // confirmed on the unweighted A so that mass ratios alone do not count) switches the solver,
