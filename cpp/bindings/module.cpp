@@ -13,9 +13,12 @@ namespace py = pybind11;
 
 namespace armdyn {
 void bind_model(py::module_& m);
+void bind_simulate(py::module_& m);
 void bind_dynamics(py::module_& m);
+void bind_inverse_dynamics(py::module_& m);
 void bind_validate(py::module_& m);
 void bind_algorithm(py::module_& m);
+void bind_frames(py::module_& m);
 }  // namespace armdyn
 
 namespace {
@@ -202,8 +205,11 @@ PYBIND11_MODULE(_core, m) {
     }
   });
   armdyn::bind_model(m);
+  armdyn::bind_simulate(m);
   armdyn::bind_dynamics(m);
+  armdyn::bind_inverse_dynamics(m);
   armdyn::bind_validate(m);
   armdyn::bind_algorithm(m);
+  armdyn::bind_frames(m);
   add_text_signatures(m, py::module_::import("ast").attr("literal_eval"));
 }

@@ -20,10 +20,7 @@ MAX_CCN = 30
 
 #: (file, function): (lines of code, cyclomatic complexity) when the function was named here
 EXCEPTIONS = {
-    ("cpp/bindings/bind_algorithm.cpp", "armdyn::bind_algorithm"): (207, 7),
-    ("cpp/bindings/bind_dynamics.cpp", "armdyn::bind_dynamics"): (291, 48),
     ("cpp/bindings/bind_model.cpp", "armdyn::bind_model"): (1062, 75),
-    ("cpp/bindings/bind_validate.cpp", "armdyn::bind_validate"): (168, 16),
     ("cpp/src/simulate/simulate.cpp", "armdyn::simulate"): (107, 34),
     ("cpp/src/io/urdf.cpp", "armdyn::scan_document"): (105, 36),
     ("cpp/src/io/urdf.cpp", "armdyn::urdf_builder"): (268, 84),

@@ -59,6 +59,7 @@
 #include "armdyn/builder/weld.hpp"
 
 // whole runs
+#include "armdyn/simulate/batch.hpp"
 #include "armdyn/simulate/simulate.hpp"
 
 // validators independent of the Cartesian path

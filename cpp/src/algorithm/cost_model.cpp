@@ -121,4 +121,20 @@ DynamicsMethod resolve_method(const Model& m, DynamicsMethod method) {
   }
 }
 
+const char* method_key(DynamicsMethod method) {
+  switch (method) {
+    case DynamicsMethod::Auto:
+      return "auto";
+    case DynamicsMethod::Joint:
+      return "joint";
+    case DynamicsMethod::Crba:
+      return "crba";
+    case DynamicsMethod::Aba:
+      return "aba";
+    case DynamicsMethod::Cartesian:
+      return "cartesian";
+  }
+  return "cartesian";
+}
+
 }  // namespace armdyn

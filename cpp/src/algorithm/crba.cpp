@@ -114,4 +114,11 @@ const MatX& mass_matrix_at(const Model& m, Data& d, Eigen::Ref<const VecX> q) {
   return d.M;
 }
 
+Eigen::Ref<const VecX> bases_at_origin(const Model& m, Eigen::Ref<const VecX> q, VecX& buf) {
+  if (m.n_free == 0) return q;
+  buf = q;
+  for (int k = 0; k < m.n_free; ++k) buf.segment<3>(7 * k).setZero();
+  return buf;
+}
+
 }  // namespace armdyn

@@ -189,7 +189,7 @@ InverseDynamicsResult inverse_dynamics_driven(const Model& m, const std::vector<
   out.q.reserve(nt * nco);
   out.qd.reserve(nt * nco);
   out.qdd.reserve(nt * nco);
-  out.efforts.reserve(nt * m.drives.size());
+  out.drive_forces.reserve(nt * m.drives.size());
   out.reaction_forces.reserve(nt * 3 * m.joints.size());
   out.reaction_torques.reserve(nt * 3 * m.joints.size());
   out.position_residual.reserve(nt);
@@ -215,7 +215,7 @@ InverseDynamicsResult inverse_dynamics_driven(const Model& m, const std::vector<
       out.qd.push_back(s.rate);
       out.qdd.push_back(coord_acceleration(m, s, c, vd));
     }
-    for (const Drive& dr : m.drives) out.efforts.push_back(-d.delta[dr.row]);
+    for (const Drive& dr : m.drives) out.drive_forces.push_back(-d.delta[dr.row]);
     for (size_t j = 0; j < m.joints.size(); ++j) {
       Vec3 f, tq;
       joint_reaction(m, d, static_cast<int>(j), f, tq);

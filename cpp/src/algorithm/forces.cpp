@@ -174,4 +174,11 @@ void gear_mesh(const Model& m, Data& d, int gi, double& s, double& sd, double& p
   gear_mesh(m, gi, d.cq.data(), d.cqd.data(), s, sd, penetration);
 }
 
+const VecX& cartesian_forces_at(const Model& m, Data& d, const double* u, const double* v,
+                                double t) {
+  load_kinematics(m, d, u, v);
+  cartesian_forces(m, d, t);
+  return d.eta;
+}
+
 }  // namespace armdyn

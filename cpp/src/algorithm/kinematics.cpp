@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "armdyn/algorithm/kinematics.hpp"
 
+#include "armdyn/errors.hpp"
 #include "armdyn/math/quaternion.hpp"
 
 namespace armdyn {
@@ -36,6 +37,14 @@ void commit_tracking(const Model& m, Data& d) {
   // every angle coordinate is followed over turns (gears need it; outputs use it)
   for (int c = 0; c < static_cast<int>(m.coords.size()); ++c)
     if (m.coords[c].angular) d.track_ref[c] = tracked(d, c, coord_value(m, d.kin, c));
+}
+
+void check_cartesian_state(const Model& m, const VecX& u, const VecX& v, const char* fn) {
+  if (!u.allFinite()) throw ModelError(msg(fn, ": u contains NaN or inf"));
+  if (!v.allFinite()) throw ModelError(msg(fn, ": v contains NaN or inf"));
+  for (int i = 0; i < m.nb; ++i)
+    if (!(u.segment<4>(7 * i + 3).norm() > 0))
+      throw ModelError(msg(fn, ": zero Euler parameters for body '", m.bodies[i].name, "'"));
 }
 
 }  // namespace armdyn

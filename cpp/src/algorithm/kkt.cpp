@@ -155,4 +155,13 @@ void body_accelerations_loaded(const Model& m, Data& d, double t, double* vdot, 
   vd = d.vd_work;
 }
 
+MatX cartesian_mass_matrix(const Model& m) {
+  MatX g = MatX::Zero(m.nv, m.nv);
+  for (int i = 0; i < m.nb; ++i) {
+    g.block<3, 3>(6 * i, 6 * i) = m.bodies[i].mass * Mat3::Identity();
+    g.block<3, 3>(6 * i + 3, 6 * i + 3) = m.bodies[i].inertia;
+  }
+  return g;
+}
+
 }  // namespace armdyn

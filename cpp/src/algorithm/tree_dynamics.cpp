@@ -10,6 +10,7 @@
 #include "armdyn/algorithm/dynamics.hpp"
 #include "armdyn/algorithm/forces.hpp"
 #include "armdyn/errors.hpp"
+#include "armdyn/kernels/joint_space.hpp"
 #include "armdyn/kernels/kkt_factor.hpp"
 #include "armdyn/math/cholesky.hpp"
 
@@ -184,6 +185,28 @@ void TreeDynamics::project(double* q, double* qd) {
     if (x == qc) w -= gs_.range_value;
     xv.noalias() -= gs_.range.bottomRows(nc) * w;
   }
+}
+
+void checked_accelerations(TreeDynamics& td, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
+                           Eigen::Ref<const VecX> tau, double t, double* qdd) {
+  const Model& m = td.model();
+  const long n = td.n(), nq = m.nq_joint;
+  check_joint_vector(q, nq, "TreeDynamics", "q");
+  check_base_quaternions(m, q, "TreeDynamics");
+  check_joint_vector(qd, n, "TreeDynamics", "qd");
+  check_joint_vector(tau, n, "TreeDynamics", "tau");
+  if (!std::isfinite(t)) throw ModelError("TreeDynamics: t is not finite");
+  if (m.n_aux)
+    throw ModelError(
+        "TreeDynamics: the model's PI motors have integral states; simulate() integrates them");
+  td.accelerations(t, q.data(), qd.data(), nullptr, tau.data(), qdd);
+}
+
+const MatX& checked_mass_matrix(TreeDynamics& td, Eigen::Ref<const VecX> q) {
+  const Model& m = td.model();
+  check_joint_vector(q, m.nq_joint, "TreeDynamics.mass_matrix", "q");
+  check_base_quaternions(m, q, "TreeDynamics.mass_matrix");
+  return td.mass_matrix(q.data());
 }
 
 }  // namespace armdyn

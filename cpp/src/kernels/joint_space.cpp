@@ -333,4 +333,31 @@ void joint_coordinates(const Model& m, const VecX& u, const VecX& v, VecX& q, Ve
   base_coordinates(m, kin, u.data(), q.data(), qd.data());
 }
 
+void state_from_independent(const Model& m, const VecX& q, const VecX& qd, VecX& u, VecX& v,
+                            const char* fn) {
+  require_joint_space(m, fn, true);
+  const IndependentCoords& ic = m.independent;
+  check_joint_vector(q, ic.nq(), fn, "q");
+  check_joint_vector(qd, ic.nv(), fn, "qd");
+  VecX qf(m.nq_joint), qdf(m.nv_joint);
+  ic.expand_q(q.data(), qf.data());
+  ic.expand_v(qd.data(), qdf.data());
+  state_from_joints(m, qf, qdf, u, v);
+}
+
+void independent_joint_coordinates(const Model& m, const VecX& u, const VecX& v, VecX& q,
+                                   VecX& qd) {
+  VecX qf, qdf;
+  joint_coordinates(m, u, v, qf, qdf);
+  const IndependentCoords& ic = m.independent;
+  q.resize(ic.nq());
+  qd.resize(ic.nv());
+  q.head(ic.lead_q) = qf.head(ic.lead_q);
+  qd.head(ic.lead_v) = qdf.head(ic.lead_v);
+  for (int k = 0; k < ic.n; ++k) {
+    q[ic.lead_q + k] = qf[ic.lead_q + ic.full[k]];
+    qd[ic.lead_v + k] = qdf[ic.lead_v + ic.full[k]];
+  }
+}
+
 }  // namespace armdyn

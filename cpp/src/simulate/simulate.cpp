@@ -356,6 +356,20 @@ Coordinates coordinates_from_name(const std::string& name) {
       msg("simulate: unknown coordinates '", name, "' (expected 'cartesian', 'joint' or 'auto')"));
 }
 
+Metric projection_from_name(const std::string& name) {
+  if (name == "mass") return Metric::Mass;
+  if (name == "unweighted") return Metric::Identity;
+  throw ModelError(msg("projection must be 'mass' or 'unweighted', got '", name, "'"));
+}
+
+VecX q_start_from_independent(const Model& m, const VecX& qi) {
+  if (qi.size() != m.independent.nq())
+    throw ModelError(msg("q0 must have ", m.independent.nq(), " entries, got ", qi.size()));
+  VecX q(m.nq_joint);
+  m.independent.expand_q(qi.data(), q.data());
+  return q;
+}
+
 SimResult simulate(const Model& m, double t_end, const SimOptions& opt, const VecX& u0,
                    const VecX& v0) {
   Data d(m);

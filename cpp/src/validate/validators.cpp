@@ -265,4 +265,35 @@ TorqueErrorMetrics torque_error_metrics(const MatX& a, const MatX& ref) {
   return r;
 }
 
+MatX LagrangeValidator::torques(const MatX& Q, const MatX& QD, const MatX& QDD,
+                                const VecX& t) const {
+  if (QD.rows() != Q.rows() || QDD.rows() != Q.rows())
+    throw ModelError("LagrangeValidator.torques: q, qd, qdd need the same number of rows");
+  MatX out(Q.rows(), nv());
+  for (long i = 0; i < Q.rows(); ++i)
+    out.row(i) = torques(VecX(Q.row(i).transpose()), VecX(QD.row(i).transpose()),
+                         VecX(QDD.row(i).transpose()), t[i])
+                     .transpose();
+  return out;
+}
+
+MatX paper_3dof_torques(const Vec3& L, const Vec3& M, double g, const MatX& theta,
+                        const MatX& thetad) {
+  if (theta.rows() != thetad.rows())
+    throw ModelError("paper_3dof_torques: theta and thetad need the same number of rows");
+  MatX out(theta.rows(), 3);
+  for (long i = 0; i < theta.rows(); ++i)
+    out.row(i) =
+        paper_3dof_torques(L, M, g, Vec3(theta.row(i).transpose()), Vec3(thetad.row(i).transpose()))
+            .transpose();
+  return out;
+}
+
+MatX end_effector_positions(const Model& m, int body, const Vec3& point, const MatX& q) {
+  MatX out(q.rows(), 3);
+  for (long i = 0; i < q.rows(); ++i)
+    out.row(i) = end_effector_position(m, body, point, VecX(q.row(i).transpose())).transpose();
+  return out;
+}
+
 }  // namespace armdyn

@@ -29,7 +29,7 @@ TEST_CASE(driven_pendulum_efforts) {
     CHECK_NEAR(r.q[k], v.y, 1e-10);
     CHECK_NEAR(r.qd[k], v.yd, 1e-10);
     CHECK_NEAR(r.qdd[k], v.ydd, 1e-9);
-    CHECK_NEAR(r.efforts[k], p.io() * v.ydd + p.m * p.g * p.L * std::sin(phi), 1e-9);
+    CHECK_NEAR(r.drive_forces[k], p.io() * v.ydd + p.m * p.g * p.L * std::sin(phi), 1e-9);
     CHECK(r.position_residual[k] < 1e-12);
   }
 }
@@ -54,7 +54,7 @@ TEST_CASE(fully_driven_arm_matches_rnea) {
       qdd[c] = v.ydd;
     }
     const VecX tau = rnea(*free_model, d, q, qd, qdd);
-    const Eigen::Map<const VecX> eff(r.efforts.data() + 4 * k, 4);
+    const Eigen::Map<const VecX> eff(r.drive_forces.data() + 4 * k, 4);
     CHECK_MAT_NEAR(eff, tau, 1e-9);
   }
 }

@@ -6,6 +6,7 @@
 #pragma once
 
 #include "armdyn/data.hpp"
+#include "armdyn/kernels/constraint_rows.hpp"
 
 namespace armdyn {
 
@@ -13,5 +14,17 @@ namespace armdyn {
 inline void evaluate_constraints(const Model& m, Data& d, double t, bool with_xi) {
   eval_constraints(m, d.kin, t, with_xi, d.ce);
 }
+
+/// Every constraint row at a Cartesian state: residuals f (nc), the dense Jacobian zeta (nc, nv),
+/// xi and rhs (nc), with zeta v = rhs and zeta v' = -xi.
+struct ConstraintValues {
+  VecX f, xi, rhs;
+  MatX zeta;
+};
+
+/// The constraints at the Cartesian state (u: nq, v: nv) and time t (a Data of its own; the state
+/// checked by check_cartesian_state, messages naming fn).
+ConstraintValues constraint_values(const Model& m, const VecX& u, const VecX& v, double t,
+                                   const char* fn);
 
 }  // namespace armdyn

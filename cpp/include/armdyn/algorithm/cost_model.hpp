@@ -59,5 +59,7 @@ const DynamicsCost& dynamics_cost(const Model& m);
 /// Crba on a model with light bodies runs ABA).
 DynamicsMethod resolve_method(const Model& m, DynamicsMethod method);
 const char* method_name(DynamicsMethod method);
+/// The method's name as dynamics_method takes it: "auto", "joint", "crba", "aba", "cartesian".
+const char* method_key(DynamicsMethod method);
 
 }  // namespace armdyn

@@ -29,4 +29,10 @@ const MatX& mass_matrix_at(const Model& m, Data& d, Eigen::Ref<const VecX> q);
 /// forward dynamics.
 void crba_loaded(const Model& m, Data& d);
 
+/// q with every floating base's position set to zero (kept in buf): the mass matrix does not
+/// depend on where a floating base is, and the CRBA's world-frame products lose precision
+/// with the square of its distance from the origin (1e-3 relative at 1e6 m, overflow past
+/// 1e154 m). q itself when the model has no floating base.
+Eigen::Ref<const VecX> bases_at_origin(const Model& m, Eigen::Ref<const VecX> q, VecX& buf);
+
 }  // namespace armdyn

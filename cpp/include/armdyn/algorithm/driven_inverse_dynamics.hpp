@@ -57,13 +57,40 @@ class DrivenSolver {
   std::string singular_rows() const;  ///< a sentence when the factor lost rank, else empty
 };
 
+/// The tables of driven inverse dynamics, row-major, one row per time: X(name, columns, doc).
+/// The one list of them: InverseDynamicsResult's members, the bindings' result dict and the
+/// Python InverseDynamicsResult's fields (tests/docs/test_schema.py) follow it.
+#define ARMDYN_DRIVEN_ID_TABLES(X)                                                          \
+  X(t, None, "(n,) times [s]")                                                              \
+  X(u, Nq, "(n, nq) Cartesian positions solving the driven constraints")                    \
+  X(v, Nv, "(n, nv) Cartesian velocities solving the driven constraints")                   \
+  X(q, Coords, "(n, n_coords) joint coordinates")                                           \
+  X(qd, Coords, "(n, n_coords) joint rates")                                                \
+  X(qdd, Coords, "(n, n_coords) joint accelerations")                                       \
+  X(drive_forces, Drives,                                                                   \
+    "(n, n_drives) actuator torque/force of each drive, tau = -delta_drive [N m or N]")     \
+  X(reaction_forces, Joints3, "(n, n_joints, 3) joint reaction force on the child [N]")     \
+  X(reaction_torques, Joints3, "(n, n_joints, 3) joint reaction torque on the child [N m]") \
+  X(position_residual, None, "(n,) max |f| of the constraints [m or rad]")                  \
+  X(velocity_residual, None, "(n,) max |zeta v - rhs|")
+
+/// The rest of the result as Python sees it: X(name, doc).
+#define ARMDYN_DRIVEN_ID_RECORDS(X) X(stats, "counters and CPU time (ARMDYN_DRIVEN_ID_STATS)")
+
+/// The statistics, in the order of Python's result.stats: X(key, type, member, doc).
+#define ARMDYN_DRIVEN_ID_STATS(X)                                                             \
+  X(newton_iterations, long, newton_iterations, "Newton iterations of the position problems") \
+  X(factorizations, long, factorizations, "KKT factorizations")                               \
+  X(seconds, double, cpu_seconds, "CPU time [s]")
+
 struct InverseDynamicsResult {
   long n = 0;
-  /// row-major tables, one row per time
-  std::vector<double> t, u, v, q, qd, qdd, efforts, reaction_forces, reaction_torques;
-  std::vector<double> position_residual, velocity_residual;
-  long newton_iterations = 0, factorizations = 0;
-  double cpu_seconds = 0.0;
+#define ARMDYN_DECLARE_TABLE(name, columns, doc) std::vector<double> name;
+  ARMDYN_DRIVEN_ID_TABLES(ARMDYN_DECLARE_TABLE)
+#undef ARMDYN_DECLARE_TABLE
+#define ARMDYN_DECLARE_STAT(key, type, member, doc) type member{};
+  ARMDYN_DRIVEN_ID_STATS(ARMDYN_DECLARE_STAT)
+#undef ARMDYN_DECLARE_STAT
 };
 
 /// Inverse dynamics of a driven model at the given (increasing) times.

@@ -48,4 +48,9 @@ void aux_rates(const Model& m, Data& d, double t, double* zdot);
 /// gear_mesh at the loaded kinematics, the angles tracked over turns (data.track_ref).
 void gear_mesh(const Model& m, Data& d, int g, double& s, double& sd, double& penetration);
 
+/// data.eta (nv) at the Cartesian state (u, v) and time t: loads the kinematics, then
+/// cartesian_forces.
+const VecX& cartesian_forces_at(const Model& m, Data& d, const double* u, const double* v,
+                                double t);
+
 }  // namespace armdyn

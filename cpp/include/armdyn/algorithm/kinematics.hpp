@@ -32,4 +32,8 @@ inline double tracked(const Data& d, int coord, double raw) {
 /// by project after each projection).
 void commit_tracking(const Model& m, Data& d);
 
+/// Check a Cartesian state (u: nq, v: nv) before evaluating at it: finite, and every body's Euler
+/// parameters non-zero; throws ModelError "fn: ..." naming the body.
+void check_cartesian_state(const Model& m, const VecX& u, const VecX& v, const char* fn);
+
 }  // namespace armdyn

@@ -38,4 +38,8 @@ void body_accelerations_loaded(const Model& m, Data& d, double t, double* vdot,
 /// (Model::row_name), for messages about singular configurations.
 std::string dependent_row_names(const Model& m, const Data& d);
 
+/// The constant Cartesian mass matrix Gamma = blockdiag(m_i I3, J_i) (nv, nv) of the bodies (J_i
+/// about the centre of mass, body axes): the matrix of the KKT system.
+MatX cartesian_mass_matrix(const Model& m);
+
 }  // namespace armdyn

@@ -102,4 +102,12 @@ class TreeDynamics {
   bool aba_ = false;  // accelerations by the articulated-body algorithm (no ideal gears)
 };
 
+/// td.accelerations for a caller outside a run (the Python binding): q (model.nq_joint), qd and
+/// tau (td.n()) checked finite, the floating bases' quaternions unit, t finite and the model
+/// without integral states; ModelError "TreeDynamics: ..." otherwise.
+void checked_accelerations(TreeDynamics& td, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
+                           Eigen::Ref<const VecX> tau, double t, double* qdd);
+/// td.mass_matrix at q (model.nq_joint) checked as checked_accelerations checks it.
+const MatX& checked_mass_matrix(TreeDynamics& td, Eigen::Ref<const VecX> q);
+
 }  // namespace armdyn

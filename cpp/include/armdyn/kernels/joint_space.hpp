@@ -120,4 +120,13 @@ void require_joint_space(const Model& m, const char* what, bool coupled_ok = fal
 /// Check a joint-space vector's length (n) and values; throws ModelError "fn: name ...".
 void check_joint_vector(Eigen::Ref<const VecX> x, long n, const char* fn, const char* name);
 
+/// Cartesian (u, v) of a joint-space tree from its independent joint-space q
+/// (model.independent.nq()) and qd (nv()): a coupled model's followers set by their couplings.
+/// @throws ModelError "fn: ..." on a model without a joint space or non-finite values.
+void state_from_independent(const Model& m, const VecX& q, const VecX& qd, VecX& u, VecX& v,
+                            const char* fn);
+/// joint_coordinates reduced to the independent coordinates (Model::independent): q
+/// (independent.nq()) and qd (independent.nv()).
+void independent_joint_coordinates(const Model& m, const VecX& u, const VecX& v, VecX& q, VecX& qd);
+
 }  // namespace armdyn

@@ -12,6 +12,7 @@
 #include "armdyn/integrate/integrators.hpp"
 #include "armdyn/kernels/kkt_factor.hpp"
 #include "armdyn/model/model.hpp"
+#include "armdyn/simulate/result.hpp"
 
 namespace armdyn {
 
@@ -45,48 +46,13 @@ struct SimOptions {
   double restitution = 0.0;
 };
 
-/// Row-major output tables: one row per output time.
-struct SimResult {
-  long n = 0;
-  std::vector<double> t, u, v, q, qd, qdd, drive_forces, reaction_forces, reaction_torques;
-  std::vector<double> position_residual, velocity_residual, kinetic_energy, potential_energy;
-  /// mesh force along the line of action of every gear pair, then every ideal gear [N]
-  /// (positive when s > 0: pushes q_a and q_b back), one row per output
-  std::vector<double> gear_forces;
-  /// the joints held by stops (limits enforced), and the stops' torque/force on each joint's
-  /// coordinate (positive along the coordinate: a lower stop pushes up), one row per output
-  std::vector<std::string> limit_joints;
-  std::vector<double> limit_forces;
-  /// located stop events: time, joint, side (+1 lower, -1 upper), kind (0 the joint came to
-  /// rest on the stop, 1 it bounced, 2 it left the stop)
-  std::vector<double> limit_event_t;
-  std::vector<std::string> limit_event_joint;
-  std::vector<int> limit_event_side, limit_event_kind;
-  /// applied generalised force on every joint dof (Model::dof_names; floating bases' zero),
-  /// joint side: drive efforts + torque inputs + motor torques (after their torque limits);
-  /// springs, dampers and friction excluded. One row per output.
-  std::vector<double> joint_torques;
-  StepStats stats;
-  long kkt_solves = 0, factorizations = 0, position_projections = 0, newton_iterations = 0;
-  long singular_evaluations = 0;
-  std::string singular_note;
-  /// accelerations solved in augmented form (light bodies, or lost accuracy), and why
-  long augmented_solves = 0;
-  std::string augmented_note;
-  /// located events: gear contact onset (+1) and separation (-1), by gear index
-  std::vector<double> event_t;
-  std::vector<int> event_index, event_direction;
-  double cpu_seconds = 0.0;
-  std::string error;  ///< non-empty when the run stopped early (SolverError message)
-  /// The exception that stopped the run early, when one did: an Interrupted (`error` then
-  /// holds its message) or the SolverError. Callers that carry their own exception types
-  /// (derived from these) through the run -- the Python bindings -- rethrow it.
-  std::exception_ptr exception;
-  bool interrupted = false;  ///< stopped by an Interrupted (opt.step.poll), not a SolverError
-  std::string integrator, integrator_reason;  ///< the method used, and why (for "auto")
-  int solver_bodies = 0, solver_rows = 0;     ///< bodies and rows of the model integrated
-  std::string formulation;  ///< the coordinates integrated and the solver path, one line
-};
+/// The projection metric by its name: "mass" or "unweighted"; throws ModelError otherwise.
+Metric projection_from_name(const std::string& name);
+
+/// The full joint-space q (model.nq_joint) a run starts its multi-turn tracking from
+/// (SimOptions::q_start), of the independent coordinates qi (a coupled model's followers set by
+/// their couplings). @throws ModelError when qi has not model.independent.nq() entries.
+VecX q_start_from_independent(const Model& m, const VecX& qi);
 
 /// Stiffness estimate for integrator="auto": the fastest rate |lambda| [1/s] of the force
 /// elements (springs: sqrt(k / m_eff), dampers: c / m_eff, with m_eff the effective mass of the

@@ -33,6 +33,9 @@ class LagrangeValidator {
   /// floating base by a local chart about its pose in q (cpp/src/validate/joint_fk.hpp); a coupled
   /// model's in its independent coordinates (G^T tau_full at the expanded state).
   VecX torques(const VecX& q, const VecX& qd, const VecX& qdd, double t = 0.0) const;
+  /// torques() of every row of Q (rows, nq()), QD and QDD (rows, nv()) at t[row]: (rows, nv()).
+  /// @throws ModelError when the row counts differ.
+  MatX torques(const MatX& Q, const MatX& QD, const MatX& QDD, const VecX& t) const;
   /// Joint-space mass matrix M(q) (a coupled model's G^T M G).
   MatX mass_matrix(const VecX& q) const;
   const Model& model() const { return *m_; }
@@ -53,6 +56,10 @@ class LagrangeValidator {
 /// horizontal), rates thetad, link lengths L, point masses M at the link ends, gravity g > 0.
 Vec3 paper_3dof_torques(const Vec3& L, const Vec3& M, double g, const Vec3& theta,
                         const Vec3& thetad);
+/// The same for every row of theta and thetad (rows, 3): (rows, 3).
+/// @throws ModelError when the row counts differ.
+MatX paper_3dof_torques(const Vec3& L, const Vec3& M, double g, const MatX& theta,
+                        const MatX& thetad);
 
 /// The paper's equations (22)-(25): end effector [X, Y, Z] (paper axes, Y up) from
 /// theta = (theta1 twist, theta2, theta3, theta4 as printed), h and L1, L2, L3 + L4.
@@ -61,6 +68,8 @@ Vec3 paper_5dof_end_effector(double h, double L1, double L2, double L34, const V
 /// World position of `point` (body frame, relative to the CoM) on body `body` at joint
 /// coordinates q, by composed joint transforms (no Cartesian state involved).
 Vec3 end_effector_position(const Model& m, int body, const Vec3& point, const VecX& q);
+/// The same for every row of q (rows, model.nq_joint): (rows, 3).
+MatX end_effector_positions(const Model& m, int body, const Vec3& point, const MatX& q);
 
 /// Equation (26) percentage errors |a - ref| / max|ref| * 100 per sample and joint, and their
 /// equation (27) RMS and maximum per joint (columns). ref_max may override max|ref| per column.
