@@ -29,8 +29,6 @@ EXCEPTIONS = {
     ("cpp/src/builder/finalize.cpp", "armdyn::check_motions_carry_inertia"): (92, 39),
     ("cpp/src/builder/finalize.cpp", "armdyn::detail::finalize_draft"): (278, 86),
     ("cpp/src/builder/weld.cpp", "armdyn::build_welding"): (181, 47),
-    ("cpp/src/io/urdf.cpp", "armdyn::scan_document"): (105, 36),
-    ("cpp/src/io/urdf.cpp", "armdyn::urdf_builder"): (268, 84),
     ("cpp/src/kernels/block_sparse.cpp", "armdyn::plan_kkt"): (92, 33),
     ("cpp/src/kernels/constraint_rows.cpp", "armdyn::eval_constraints"): (121, 35),
     ("cpp/src/integrate/integrators.cpp", "armdyn::integrate_trbdf2"): (179, 46),
