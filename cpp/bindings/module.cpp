@@ -12,7 +12,13 @@
 namespace py = pybind11;
 
 namespace armdyn {
+void bind_motor(py::module_& m);
+void bind_profile(py::module_& m);
 void bind_model(py::module_& m);
+void bind_builder(py::module_& m);
+void bind_builder_forces(py::module_& m);
+void bind_urdf(py::module_& m);
+void bind_pickle(py::module_& m);
 void bind_simulate(py::module_& m);
 void bind_dynamics(py::module_& m);
 void bind_inverse_dynamics(py::module_& m);
@@ -204,7 +210,13 @@ PYBIND11_MODULE(_core, m) {
       PyErr_SetString(PyExc_KeyboardInterrupt, e.what());
     }
   });
+  armdyn::bind_motor(m);
+  armdyn::bind_profile(m);
   armdyn::bind_model(m);
+  armdyn::bind_builder(m);
+  armdyn::bind_builder_forces(m);
+  armdyn::bind_urdf(m);
+  armdyn::bind_pickle(m);
   armdyn::bind_simulate(m);
   armdyn::bind_dynamics(m);
   armdyn::bind_inverse_dynamics(m);

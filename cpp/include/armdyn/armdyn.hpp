@@ -25,6 +25,7 @@
 // the model description
 #include "armdyn/model/model.hpp"
 #include "armdyn/model/profile.hpp"
+#include "armdyn/model/properties.hpp"
 
 // the kernels under the algorithms: jets, constraint rows, KKT factor, block-sparse Schur,
 // tree sweep, and the joint-space kinematics and Newton-Euler sweep

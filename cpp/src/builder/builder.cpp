@@ -259,6 +259,12 @@ int ModelBuilder::add_fixed(const std::string& name, const std::string& parent,
                             const std::string& child, const Vec3& point) {
   return add_joint(name, JointType::Fixed, parent, child, point, Vec3::UnitZ(), nullptr);
 }
+int ModelBuilder::add_fixed(const std::string& name, const std::string& parent,
+                            const std::string& child, const Vec3* point) {
+  if (point) return add_fixed(name, parent, child, *point);
+  const int c = m_.find_body(child);
+  return add_fixed(name, parent, child, c == kGround ? Vec3::Zero() : m_.bodies[c].position);
+}
 int ModelBuilder::add_universal(const std::string& name, const std::string& parent,
                                 const std::string& child, const Vec3& point, const Vec3& axis1,
                                 const Vec3& axis2) {

@@ -152,6 +152,15 @@ Profile Profile::restore(const Raw& raw) {
   return p;
 }
 
+void Profile::eval(const double* t, long n, double* y, double* yd, double* ydd) const {
+  for (long k = 0; k < n; ++k) {
+    const ProfileValue v = eval(t[k]);
+    y[k] = v.y;
+    yd[k] = v.yd;
+    ydd[k] = v.ydd;
+  }
+}
+
 ProfileValue Profile::eval(double t) const {
   ProfileValue v;
   switch (kind_) {

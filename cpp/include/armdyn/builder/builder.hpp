@@ -74,6 +74,10 @@ class ModelBuilder {
   /// Rigid connection; `point` only sets where reactions are reported.
   int add_fixed(const std::string& name, const std::string& parent, const std::string& child,
                 const Vec3& point);
+  /// add_fixed with `point` null: the reactions reported at the child's centre of mass (the
+  /// world origin for "ground"). @throws ModelError on an unknown child, as add_fixed.
+  int add_fixed(const std::string& name, const std::string& parent, const std::string& child,
+                const Vec3* point);
   /// Universal (Cardan) joint: axis1 fixed in parent, axis2 fixed in child, perpendicular.
   int add_universal(const std::string& name, const std::string& parent, const std::string& child,
                     const Vec3& point, const Vec3& axis1, const Vec3& axis2);

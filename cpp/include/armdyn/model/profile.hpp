@@ -35,6 +35,8 @@ class Profile {
   static Profile callback(Callback fn, std::string description);
 
   ProfileValue eval(double t) const;
+  /// eval at each of the n times t[k]: y[k], yd[k], ydd[k] (Python's Profile.eval of an array).
+  void eval(const double* t, long n, double* y, double* yd, double* ydd) const;
   Kind kind() const { return kind_; }
   std::string describe() const;
 
