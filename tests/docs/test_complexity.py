@@ -33,7 +33,6 @@ EXCEPTIONS = {
     ("cpp/src/io/urdf.cpp", "armdyn::urdf_builder"): (268, 84),
     ("cpp/src/kernels/block_sparse.cpp", "armdyn::plan_kkt"): (92, 33),
     ("cpp/src/kernels/constraint_rows.cpp", "armdyn::eval_constraints"): (121, 35),
-    ("cpp/src/integrate/integrators.cpp", "armdyn::integrate_trbdf2"): (179, 46),
     ("python/armdyn/plotting.py", "_panel"): (103, 48),
     ("python/armdyn/plotting.py", "_select"): (57, 32),
     ("python/armdyn/simulation.py", "rollout"): (84, 31),
