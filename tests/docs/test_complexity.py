@@ -24,7 +24,6 @@ EXCEPTIONS = {
     ("cpp/bindings/bind_dynamics.cpp", "armdyn::bind_dynamics"): (291, 48),
     ("cpp/bindings/bind_model.cpp", "armdyn::bind_model"): (1062, 75),
     ("cpp/bindings/bind_validate.cpp", "armdyn::bind_validate"): (168, 16),
-    ("cpp/src/simulate/simulate.cpp", "armdyn::simulate"): (107, 34),
     ("cpp/src/builder/builder.cpp", "armdyn::ModelBuilder::add_actuator"): (83, 35),
     ("cpp/src/builder/finalize.cpp", "armdyn::check_motions_carry_inertia"): (92, 39),
     ("cpp/src/builder/finalize.cpp", "armdyn::detail::finalize_draft"): (278, 86),
