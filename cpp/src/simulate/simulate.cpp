@@ -10,6 +10,7 @@
 #include "armdyn/algorithm/constraints.hpp"
 #include "armdyn/algorithm/cost_model.hpp"
 #include "armdyn/algorithm/driven_inverse_dynamics.hpp"
+#include "armdyn/algorithm/forces.hpp"
 #include "armdyn/algorithm/kinematics.hpp"
 #include "armdyn/algorithm/projection.hpp"
 #include "armdyn/builder/weld.hpp"
@@ -86,7 +87,7 @@ double stiffness_estimate(const Model& m, std::string& culprit) {
     const double im = std::max(0.0, eta.dot(vd));
     // linearised contact stiffness at a penetration of 1 % of the backlash (or 1 um)
     const double d = std::max(0.01 * g.backlash, 1e-6);
-    const double k = g.stiffness * g.exponent * std::pow(d, g.exponent - 1.0);
+    const double k = gear_contact_stiffness(g, d);
     consider(std::sqrt(k * im), msg("gear pair '", g.name, "' mesh"));
   }
   return lam;
