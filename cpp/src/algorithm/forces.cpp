@@ -1,11 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "armdyn/algorithm/forces.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <exception>
 
 #include "armdyn/algorithm/kinematics.hpp"
 #include "armdyn/errors.hpp"
+#include "armdyn/math/angles.hpp"
 
 namespace armdyn {
 
@@ -32,6 +34,65 @@ void load_gear_coordinates(const Model& m, Data& d, const GearPair& g) {
   }
 }
 }  // namespace
+
+double gear_force(const GearPair& g, double s, double sd, double& penetration) {
+  penetration = std::abs(s) - 0.5 * g.backlash;
+  if (penetration <= 0.0) return 0.0;
+  const double rate = s >= 0 ? sd : -sd;  // penetration rate
+  const double f = g.stiffness * std::pow(penetration, g.exponent) * (1.0 + g.hc_damping * rate);
+  return std::max(f, 0.0);
+}
+
+namespace {
+// the PD/PI motor's torque after its limit (0 without a motor), and the rate of its integral
+double motor_value(const CoordForce& cf, bool angular, double q, double qdot, double t, double z,
+                   double* zdot) {
+  if (!cf.motor) {
+    if (zdot) *zdot = 0.0;
+    return 0.0;
+  }
+  const ProfileValue r = cf.reference.eval(t);
+  const double e = angular ? wrap_angle(r.y - q) : r.y - q;
+  const double u = cf.kp * e + cf.kd * (r.yd - qdot) + cf.ki * z;
+  const double uc = std::clamp(u, -cf.torque_limit, cf.torque_limit);
+  if (zdot) *zdot = (uc != u && e * u > 0) ? 0.0 : e;  // stop integrating into saturation
+  return uc;
+}
+}  // namespace
+
+double coord_actuation_value(const CoordForce& cf, bool angular, double q, double qdot, double t,
+                             double z, double* zdot) {
+  double tau = 0.0;
+  if (cf.has_input) tau += cf.input.eval(t).y;
+  if (cf.motor)
+    tau += motor_value(cf, angular, q, qdot, t, z, zdot);
+  else if (zdot)
+    *zdot = 0.0;
+  return tau;
+}
+
+double coord_force_value(const CoordForce& cf, bool angular, double q, double qdot, double t,
+                         double z, double* zdot) {
+  const double dq = angular ? wrap_angle(q - cf.rest) : q - cf.rest;
+  double tau = -cf.stiffness * dq - cf.damping * qdot;
+  if (cf.coulomb > 0) tau -= cf.coulomb * std::tanh(qdot / cf.v_smooth);
+  if (cf.has_input) tau += cf.input.eval(t).y;
+  if (cf.motor)
+    tau += motor_value(cf, angular, q, qdot, t, z, zdot);
+  else if (zdot)
+    *zdot = 0.0;
+  return tau;
+}
+
+double gear_mesh_force(const GearPair& g, double s, double sd) {
+  double pen;
+  const double f = gear_force(g, s, sd, pen);
+  return s >= 0 ? f : -f;
+}
+
+double gear_contact_stiffness(const GearPair& g, double penetration) {
+  return g.stiffness * g.exponent * std::pow(penetration, g.exponent - 1.0);
+}
 
 void body_forces(const Model& m, const std::vector<BodyKin>& kin, double t, Eigen::Ref<VecX> eta) {
   // gravity and gyroscopic terms, per body
@@ -102,11 +163,8 @@ void coordinate_forces(const Model& m, const double* q, const double* qd, const 
     const GearPair& g = m.gears[gi];
     double s, sd, pen;
     gear_mesh(m, gi, q, qd, s, sd, pen);
-    const double f = gear_force(g, s, sd, pen);
-    if (f == 0.0) continue;
-    const double fs = s >= 0 ? f : -f;
-    out[g.coord_a] -= g.r_a * fs;
-    out[g.coord_b] -= g.r_b * fs;
+    const double f = gear_mesh_force(g, s, sd);
+    if (f != 0.0) add_gear_torques(g, f, out.data());
   }
 }
 

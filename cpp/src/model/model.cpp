@@ -142,55 +142,6 @@ void IndependentCoords::align(const std::vector<Coord>& coords, double* coord_q)
   }
 }
 
-double gear_force(const GearPair& g, double s, double sd, double& penetration) {
-  penetration = std::abs(s) - 0.5 * g.backlash;
-  if (penetration <= 0.0) return 0.0;
-  const double rate = s >= 0 ? sd : -sd;  // penetration rate
-  const double f = g.stiffness * std::pow(penetration, g.exponent) * (1.0 + g.hc_damping * rate);
-  return std::max(f, 0.0);
-}
-
-namespace {
-// the PD/PI motor's torque after its limit (0 without a motor), and the rate of its integral
-double motor_value(const CoordForce& cf, bool angular, double q, double qdot, double t, double z,
-                   double* zdot) {
-  if (!cf.motor) {
-    if (zdot) *zdot = 0.0;
-    return 0.0;
-  }
-  const ProfileValue r = cf.reference.eval(t);
-  const double e = angular ? wrap_angle(r.y - q) : r.y - q;
-  const double u = cf.kp * e + cf.kd * (r.yd - qdot) + cf.ki * z;
-  const double uc = std::clamp(u, -cf.torque_limit, cf.torque_limit);
-  if (zdot) *zdot = (uc != u && e * u > 0) ? 0.0 : e;  // stop integrating into saturation
-  return uc;
-}
-}  // namespace
-
-double coord_actuation_value(const CoordForce& cf, bool angular, double q, double qdot, double t,
-                             double z, double* zdot) {
-  double tau = 0.0;
-  if (cf.has_input) tau += cf.input.eval(t).y;
-  if (cf.motor)
-    tau += motor_value(cf, angular, q, qdot, t, z, zdot);
-  else if (zdot)
-    *zdot = 0.0;
-  return tau;
-}
-
-double coord_force_value(const CoordForce& cf, bool angular, double q, double qdot, double t,
-                         double z, double* zdot) {
-  const double dq = angular ? wrap_angle(q - cf.rest) : q - cf.rest;
-  double tau = -cf.stiffness * dq - cf.damping * qdot;
-  if (cf.coulomb > 0) tau -= cf.coulomb * std::tanh(qdot / cf.v_smooth);
-  if (cf.has_input) tau += cf.input.eval(t).y;
-  if (cf.motor)
-    tau += motor_value(cf, angular, q, qdot, t, z, zdot);
-  else if (zdot)
-    *zdot = 0.0;
-  return tau;
-}
-
 const std::vector<std::pair<const char*, double MotorSpec::*>>& MotorSpec::fields() {
   static const std::vector<std::pair<const char*, double MotorSpec::*>> f = {
       {"torque_constant", &MotorSpec::torque_constant},

@@ -248,8 +248,7 @@ class MbsSystem : public OdeSystem, public StopAccess {
     for (int gi = 0; gi < static_cast<int>(m_.gears.size()); ++gi) {
       double sm, sd, pen;
       gear_mesh(m_, d_, gi, sm, sd, pen);
-      const double f = gear_force(m_.gears[gi], sm, sd, pen);
-      out_.gear_forces.push_back(sm >= 0 ? f : -f);
+      out_.gear_forces.push_back(gear_mesh_force(m_.gears[gi], sm, sd));
     }
     for (const GearConstraint& g : m_.gear_constraints) out_.gear_forces.push_back(d_.delta[g.row]);
     // actuator efforts: tau = -delta of the drive rows

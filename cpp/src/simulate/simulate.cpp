@@ -10,6 +10,7 @@
 #include "armdyn/algorithm/constraints.hpp"
 #include "armdyn/algorithm/cost_model.hpp"
 #include "armdyn/algorithm/driven_inverse_dynamics.hpp"
+#include "armdyn/algorithm/forces.hpp"
 #include "armdyn/algorithm/kinematics.hpp"
 #include "armdyn/algorithm/projection.hpp"
 #include "armdyn/builder/weld.hpp"
@@ -86,7 +87,7 @@ double stiffness_estimate(const Model& m, std::string& culprit) {
     const double im = std::max(0.0, eta.dot(vd));
     // linearised contact stiffness at a penetration of 1 % of the backlash (or 1 um)
     const double d = std::max(0.01 * g.backlash, 1e-6);
-    const double k = g.stiffness * g.exponent * std::pow(d, g.exponent - 1.0);
+    const double k = gear_contact_stiffness(g, d);
     consider(std::sqrt(k * im), msg("gear pair '", g.name, "' mesh"));
   }
   return lam;
@@ -346,6 +347,151 @@ void record_stop_events(const Model& ms, const detail::LimitStops& stops, SimRes
   }
 }
 
+/// The Data the run evaluates on: d, or for a welded run d.welded_data (made for the welded
+/// model when it holds none), both with fresh pipelines; the initial angles' turns from the q
+/// the initial state was made from (multi-turn).
+Data& run_data(const Model& m, Data& d, const RunPlan& plan, const SimOptions& opt) {
+  const Model& ms = *plan.ms;
+  if (plan.welded && (!d.welded_data || d.welded_data->model != &ms))
+    d.welded_data = std::make_unique<Data>(ms);
+  Data& ds = plan.welded ? *d.welded_data : d;
+  reset_pipeline(ds);
+  if (plan.welded) reset_pipeline(d);
+  if (opt.q_start.size() == m.nq_joint) {
+    const int off = 7 * m.n_free;
+    for (size_t c = 0; c < m.coords.size(); ++c) {
+      if (!m.coords[c].angular) continue;
+      const double q = opt.q_start[off + static_cast<long>(c)];
+      const int cs = plan.welded ? plan.welding->coord_map[c] : static_cast<int>(c);
+      if (cs >= 0) ds.track_ref[cs] = q;
+      if (plan.welded) d.track_ref[static_cast<long>(c)] = q;
+    }
+  }
+  return ds;
+}
+
+/// An empty result naming the integrator, its tables reserved for the output times.
+SimResult new_result(const Model& m, const RunPlan& plan, double t_end, const StepOptions& s) {
+  SimResult out;
+  out.integrator = integrator_name(plan.integrator);
+  out.integrator_reason = plan.reason;
+  if (s.output_dt > 0) {
+    const size_t n = static_cast<size_t>(t_end / s.output_dt) + 2;
+    out.t.reserve(n);
+    out.u.reserve(n * m.nq);
+    out.v.reserve(n * m.nv);
+  }
+  return out;
+}
+
+/// The joint-space system of a joint-coordinates run (null for a Cartesian one), and the
+/// formulation's description in out.
+std::unique_ptr<detail::JointSystem> formulation(const Model& ms, const RunPlan& plan,
+                                                 const SimOptions& opt, detail::MbsSystem& sys,
+                                                 SimResult& out) {
+  std::unique_ptr<detail::JointSystem> jsys;
+  if (plan.joint) {
+    try {
+      jsys = std::make_unique<detail::JointSystem>(ms, sys);
+    } catch (const ModelError& err) {
+      throw ModelError(msg("simulate: coordinates 'joint': ", err.what()));
+    }
+    out.formulation = jsys->dynamics().description();
+  } else {
+    out.formulation = msg("cartesian: ", ms.nb, " bodies, ", ms.nc, " constraint rows, KKT path '",
+                          kkt_path_name(kkt_path(ms)), "'");
+  }
+  if (opt.coordinates == Coordinates::Auto) out.formulation += msg(" [", plan.why_coordinates, "]");
+  return jsys;
+}
+
+/// The joint position limits' stops, given to sys (null when none: no limited joint, limits
+/// off, or a fully driven model); their joints' names and force table in out.
+std::unique_ptr<detail::LimitStops> joint_stops(const Model& ms, const RunPlan& plan, double t_end,
+                                                const SimOptions& opt, detail::MbsSystem& sys,
+                                                SimResult& out) {
+  if (!opt.limits || plan.integrator == Integrator::Kinematic) return nullptr;
+  auto stops = std::make_unique<detail::LimitStops>(ms, opt.restitution);
+  if (stops->size() == 0) return nullptr;
+  sys.set_stops(stops.get());
+  for (int j : stops->limited_joints())
+    out.limit_joints.push_back(ms.joints[static_cast<size_t>(j)].name);
+  if (opt.step.output_dt > 0)
+    out.limit_forces.reserve((static_cast<size_t>(t_end / opt.step.output_dt) + 2) *
+                             out.limit_joints.size());
+  return stops;
+}
+
+/// The initial Cartesian state y = (u, v, z = 0) of the model integrated: (u0, v0), or in a
+/// welded run the composites' state contracted from it by the expander made here (given to sys).
+VecX initial_state(const Model& m, Data& d, const RunPlan& plan, const VecX& u0, const VecX& v0,
+                   detail::MbsSystem& sys, std::unique_ptr<detail::WeldExpander>& expander) {
+  const Model& ms = *plan.ms;
+  VecX y = VecX::Zero(ms.nq + ms.nv + ms.n_aux);
+  if (plan.welded) {
+    expander = std::make_unique<detail::WeldExpander>(m, *plan.welding, d);
+    sys.set_expander(expander.get());
+    VecX uw(ms.nq), vw(ms.nv);
+    expander->contract(u0, v0, uw, vw);
+    y.head(ms.nq) = uw;
+    y.segment(ms.nq, ms.nv) = vw;
+  } else {
+    y.head(m.nq) = u0;
+    y.segment(m.nq, m.nv) = v0;
+  }
+  return y;
+}
+
+/// The run itself on the plan's path (kinematic, joint-space or Cartesian), from y; on return
+/// y is the last good state and t_last its time (a failure: the kinematic path's last state).
+void run_path(const RunPlan& plan, const SimOptions& opt, double t_end, detail::MbsSystem& sys,
+              detail::JointSystem* jsys, detail::LimitStops* stops, VecX& y, double& t_last,
+              SimResult& out, IntegratorWork& work) {
+  const Model& ms = *plan.ms;
+  const StepOptions& s = opt.step;
+  if (plan.integrator == Integrator::Kinematic) {
+    run_kinematic(ms, sys, y, t_end, s.output_dt, s.poll, out, t_last);
+  } else if (plan.joint) {
+    VecX yj = joint_state(ms, sys, y, opt.projection);
+    if (stops) stops->start(*jsys, 0.0, yj);
+    integrate(plan.integrator, *jsys, yj, t_end, s, out.stats, work);
+  } else {
+    if (stops) {
+      sys.data().aux = y.data() + ms.nq + ms.nv;
+      project(ms, sys.data(), 0.0, y.data(), y.data() + ms.nq, opt.projection);
+      stops->start(sys, 0.0, y);
+    }
+    integrate(plan.integrator, sys, y, t_end, s, out.stats, work);
+  }
+}
+
+/// run_path, its failure (a SolverError: explained where the constraints are singular) or
+/// interruption (Interrupted) kept in out with the outputs so far; the CPU time in out.
+void run_and_catch(const RunPlan& plan, const SimOptions& opt, double t_end, detail::MbsSystem& sys,
+                   detail::JointSystem* jsys, detail::LimitStops* stops, VecX& y, SimResult& out,
+                   IntegratorWork& work) {
+  const auto start = std::chrono::steady_clock::now();
+  double t_last = 0.0;  // the time of the last good state y
+  if (opt.step.poll) opt.step.poll->start();
+  try {
+    run_path(plan, opt, t_end, sys, jsys, stops, y, t_last, out, work);
+  } catch (const SolverError& err) {
+    out.error = err.what();
+    out.exception = std::current_exception();
+    const bool kinematic = plan.integrator == Integrator::Kinematic;
+    if (!kinematic) t_last = out.t.empty() ? 0.0 : out.t.back();
+    // (the joint-space path has no constraint Jacobian to diagnose but the gears' constant one)
+    if (!plan.joint) explain_failure(*plan.ms, sys, y, t_last, kinematic, out.error);
+  } catch (const Interrupted& err) {
+    // stopped from outside (opt.step.poll; a profile callback's binding): the outputs so far
+    out.error = err.what();
+    if (out.error.empty()) out.error = "interrupted";
+    out.exception = std::current_exception();
+    out.interrupted = true;
+  }
+  out.cpu_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 }  // namespace
 
 Coordinates coordinates_from_name(const std::string& name) {
@@ -382,110 +528,15 @@ SimResult simulate(const Model& m, Data& d, double t_end, const SimOptions& opt,
   check_options(m, t_end, opt, u0, v0);
   const RunPlan plan = plan_run(m, t_end, opt);
   const Model& ms = *plan.ms;  // the model integrated
-  // the Data the run evaluates on (of the welded model: d.welded_data), as a new one would be
-  if (plan.welded && (!d.welded_data || d.welded_data->model != &ms))
-    d.welded_data = std::make_unique<Data>(ms);
-  Data& ds = plan.welded ? *d.welded_data : d;
-  reset_pipeline(ds);
-  if (plan.welded) reset_pipeline(d);
-  // the initial angles' turns, from the q the initial state was made from (multi-turn)
-  if (opt.q_start.size() == m.nq_joint) {
-    const int off = 7 * m.n_free;
-    for (size_t c = 0; c < m.coords.size(); ++c) {
-      if (!m.coords[c].angular) continue;
-      const double q = opt.q_start[off + static_cast<long>(c)];
-      const int cs = plan.welded ? plan.welding->coord_map[c] : static_cast<int>(c);
-      if (cs >= 0) ds.track_ref[cs] = q;
-      if (plan.welded) d.track_ref[static_cast<long>(c)] = q;
-    }
-  }
-  const StepOptions& s = opt.step;
-  SimResult out;
-  out.integrator = integrator_name(plan.integrator);
-  out.integrator_reason = plan.reason;
-  if (s.output_dt > 0) {
-    const size_t n = static_cast<size_t>(t_end / s.output_dt) + 2;
-    out.t.reserve(n);
-    out.u.reserve(n * m.nq);
-    out.v.reserve(n * m.nv);
-  }
+  Data& ds = run_data(m, d, plan, opt);
+  SimResult out = new_result(m, plan, t_end, opt.step);
   // the formulation's ODE system; outputs are recorded by the Cartesian one
   detail::MbsSystem sys(ms, ds, opt.projection, out);
-  std::unique_ptr<detail::JointSystem> jsys;
-  if (plan.joint) {
-    try {
-      jsys = std::make_unique<detail::JointSystem>(ms, sys);
-    } catch (const ModelError& err) {
-      throw ModelError(msg("simulate: coordinates 'joint': ", err.what()));
-    }
-    out.formulation = jsys->dynamics().description();
-  } else {
-    out.formulation = msg("cartesian: ", ms.nb, " bodies, ", ms.nc, " constraint rows, KKT path '",
-                          kkt_path_name(kkt_path(ms)), "'");
-  }
-  if (opt.coordinates == Coordinates::Auto) out.formulation += msg(" [", plan.why_coordinates, "]");
-  // the joint position limits' stops (none on a fully driven model)
-  std::unique_ptr<detail::LimitStops> stops;
-  if (opt.limits && plan.integrator != Integrator::Kinematic) {
-    stops = std::make_unique<detail::LimitStops>(ms, opt.restitution);
-    if (stops->size() == 0) {
-      stops.reset();
-    } else {
-      sys.set_stops(stops.get());
-      for (int j : stops->limited_joints())
-        out.limit_joints.push_back(ms.joints[static_cast<size_t>(j)].name);
-      if (s.output_dt > 0)
-        out.limit_forces.reserve((static_cast<size_t>(t_end / s.output_dt) + 2) *
-                                 out.limit_joints.size());
-    }
-  }
-  // the initial state (of the composites, in a welded run)
+  const std::unique_ptr<detail::JointSystem> jsys = formulation(ms, plan, opt, sys, out);
+  const std::unique_ptr<detail::LimitStops> stops = joint_stops(ms, plan, t_end, opt, sys, out);
   std::unique_ptr<detail::WeldExpander> expander;
-  VecX y = VecX::Zero(ms.nq + ms.nv + ms.n_aux);
-  if (plan.welded) {
-    expander = std::make_unique<detail::WeldExpander>(m, *plan.welding, d);
-    sys.set_expander(expander.get());
-    VecX uw(ms.nq), vw(ms.nv);
-    expander->contract(u0, v0, uw, vw);
-    y.head(ms.nq) = uw;
-    y.segment(ms.nq, ms.nv) = vw;
-  } else {
-    y.head(m.nq) = u0;
-    y.segment(m.nq, m.nv) = v0;
-  }
-  const auto start = std::chrono::steady_clock::now();
-  double t_last = 0.0;  // the time of the last good state y
-  if (s.poll) s.poll->start();
-  try {
-    if (plan.integrator == Integrator::Kinematic) {
-      run_kinematic(ms, sys, y, t_end, s.output_dt, s.poll, out, t_last);
-    } else if (plan.joint) {
-      VecX yj = joint_state(ms, sys, y, opt.projection);
-      if (stops) stops->start(*jsys, 0.0, yj);
-      integrate(plan.integrator, *jsys, yj, t_end, s, out.stats, d.integrator);
-    } else {
-      if (stops) {
-        sys.data().aux = y.data() + ms.nq + ms.nv;
-        project(ms, sys.data(), 0.0, y.data(), y.data() + ms.nq, opt.projection);
-        stops->start(sys, 0.0, y);
-      }
-      integrate(plan.integrator, sys, y, t_end, s, out.stats, d.integrator);
-    }
-  } catch (const SolverError& err) {
-    out.error = err.what();
-    out.exception = std::current_exception();
-    const bool kinematic = plan.integrator == Integrator::Kinematic;
-    if (!kinematic) t_last = out.t.empty() ? 0.0 : out.t.back();
-    // (the joint-space path has no constraint Jacobian to diagnose but the gears' constant one)
-    if (!plan.joint) explain_failure(ms, sys, y, t_last, kinematic, out.error);
-  } catch (const Interrupted& err) {
-    // stopped from outside (opt.step.poll; a profile callback's binding): the outputs so far
-    out.error = err.what();
-    if (out.error.empty()) out.error = "interrupted";
-    out.exception = std::current_exception();
-    out.interrupted = true;
-  }
-  out.cpu_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  VecX y = initial_state(m, d, plan, u0, v0, sys, expander);
+  run_and_catch(plan, opt, t_end, sys, jsys.get(), stops.get(), y, out, d.integrator);
   if (stops) record_stop_events(ms, *stops, out);
   finish(m, ms, sys.data().stats, out);
   return out;

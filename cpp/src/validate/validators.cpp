@@ -3,6 +3,7 @@
 
 #include <unsupported/Eigen/AutoDiff>
 
+#include "armdyn/algorithm/forces.hpp"
 #include "armdyn/errors.hpp"
 #include "joint_fk.hpp"
 
@@ -157,14 +158,10 @@ VecX LagrangeValidator::full_torques(const VecX& q, const VecX& qd, const VecX& 
     Qc[cf.coord] +=
         coord_force_value(cf, m.coords[cf.coord].angular, qc[cf.coord], qdc[cf.coord], t);
   // gear pairs (q are unwrapped here)
-  for (const GearPair& g : m.gears) {
-    const double s = g.r_a * qc[g.coord_a] + g.r_b * qc[g.coord_b];
-    const double sd = g.r_a * qdc[g.coord_a] + g.r_b * qdc[g.coord_b];
-    double pen;
-    const double f = gear_force(g, s, sd, pen);
-    const double fs = s >= 0 ? f : -f;
-    Qc[g.coord_a] -= g.r_a * fs;
-    Qc[g.coord_b] -= g.r_b * fs;
+  for (int gi = 0; gi < static_cast<int>(m.gears.size()); ++gi) {
+    double s, sd, pen;
+    gear_mesh(m, gi, qc, qdc, s, sd, pen);
+    add_gear_torques(m.gears[gi], gear_mesh_force(m.gears[gi], s, sd), Qc);
   }
   // body loads: world force at a body point and world torque
   for (const BodyLoad& l : m.body_loads) {

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "armdyn/algorithm/crba.hpp"
+#include "armdyn/algorithm/forces.hpp"
 #include "armdyn/builder/builder.hpp"
 #include "armdyn/data.hpp"
 #include "armdyn/errors.hpp"

@@ -15,6 +15,32 @@
 
 namespace armdyn {
 
+/// Generalised force of a coordinate force element at (q, qdot, t), angle differences wrapped;
+/// z is the element's integral state (PI motors), 0 otherwise. When `zdot` is given it receives
+/// the rate of z (the tracking error, or 0 while saturated).
+double coord_force_value(const CoordForce& cf, bool angular, double q, double qdot, double t,
+                         double z = 0.0, double* zdot = nullptr);
+/// The actuation part of coord_force_value: input(t) + motor (after its torque limit), without
+/// the spring, damper and friction terms (the applied joint torque a run reports).
+double coord_actuation_value(const CoordForce& cf, bool angular, double q, double qdot, double t,
+                             double z = 0.0, double* zdot = nullptr);
+
+/// Mesh force F >= 0 of a gear pair for mesh displacement s and rate sd; also returns the
+/// penetration (negative inside the gap).
+double gear_force(const GearPair& g, double s, double sd, double& penetration);
+/// Gear pair g's mesh force along the line of action, signed as the mesh displacement s:
+/// sign(s) F, F = gear_force(g, s, sd) (positive when s > 0: it pushes q_a and q_b back).
+double gear_mesh_force(const GearPair& g, double s, double sd);
+/// The generalised forces of gear pair g's signed mesh force f (gear_mesh_force) on its two
+/// coordinates, -r_a f and -r_b f, added to tau (indexed by coordinate).
+inline void add_gear_torques(const GearPair& g, double f, double* tau) {
+  tau[g.coord_a] -= g.r_a * f;
+  tau[g.coord_b] -= g.r_b * f;
+}
+/// The contact stiffness dF/dd of gear pair g at penetration d > 0, without damping:
+/// n k d^(n-1).
+double gear_contact_stiffness(const GearPair& g, double penetration);
+
 /// eta (nv) at the kinematics kin and time t: per body (force in world axes, torque in body
 /// axes). Overwrites eta.
 /// @throws SolverError naming the element (a profile that fails, a spring of zero length) or the

@@ -143,7 +143,7 @@ struct SpringDamper {
 /// z the integral of (q_ref - q): an auxiliary state of the simulation (PI(D) motors), integrated
 /// only while the motor is not saturated (conditional integration, no wind-up).
 /// Covers rotational/linear spring-dampers, viscous and smoothed Coulomb friction, torque/force
-/// inputs and PD motors with a torque limit.
+/// inputs and PD motors with a torque limit. The law: coord_force_value (algorithm/forces.hpp).
 struct CoordForce {
   int coord = 0;
   double stiffness = 0.0, damping = 0.0, rest = 0.0;
@@ -157,23 +157,13 @@ struct CoordForce {
   std::string name;  ///< for messages
 };
 
-/// Generalised force of a coordinate force element at (q, qdot, t), angle differences wrapped;
-/// z is the element's integral state (PI motors), 0 otherwise. When `zdot` is given it receives
-/// the rate of z (the tracking error, or 0 while saturated).
-double coord_force_value(const CoordForce& cf, bool angular, double q, double qdot, double t,
-                         double z = 0.0, double* zdot = nullptr);
-/// The actuation part of coord_force_value: input(t) + motor (after its torque limit), without
-/// the spring, damper and friction terms (the applied joint torque a run reports).
-double coord_actuation_value(const CoordForce& cf, bool angular, double q, double qdot, double t,
-                             double z = 0.0, double* zdot = nullptr);
-
 /// Gear pair with backlash between the angle coordinates of two revolute joints (external
 /// mesh): the mesh displacement along the line of action is s = r_a q_a + r_b q_b (zero when
 /// both gears are at their assembly angles; rolling without slip keeps it constant). Inside the
 /// gap |s| <= backlash/2 no force acts; beyond it the penetration d = |s| - backlash/2 gives the
 /// Hunt-Crossley contact force F = k d^n (1 + alpha d'), clamped at F >= 0 (never pulling), and
 /// the generalised forces tau_a = -r_a sign(s) F, tau_b = -r_b sign(s) F. q_a, q_b are tracked
-/// over several turns (unwrapped).
+/// over several turns (unwrapped). The law: gear_force (algorithm/forces.hpp).
 struct GearPair {
   std::string name;
   int coord_a = 0, coord_b = 0;
@@ -200,10 +190,6 @@ struct GearConstraint {
   int row = 0;
   double multiplier() const { return -r_b / r_a; }
 };
-
-/// Mesh force F >= 0 of a gear pair for mesh displacement s and rate sd; also returns the
-/// penetration (negative inside the gap).
-double gear_force(const GearPair& g, double s, double sd, double& penetration);
 
 /// One joint coordinate (revolute angle, prismatic displacement, ...).
 struct Coord {
