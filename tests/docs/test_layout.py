@@ -219,7 +219,13 @@ def test_importing_the_library_loads_no_papers_module():
         "assert armdyn.scenes.geared_arm_6dof is importlib.import_module("
         "'armdyn.papers.geared_arm').geared_arm_6dof\n"
     )
-    env = {**__import__("os").environ, "PYTHONPATH": str(ROOT / "python")}
+    import armdyn
+
+    # the armdyn this test imported (installed, as in CI, or a source tree on PYTHONPATH)
+    env = {
+        **__import__("os").environ,
+        "PYTHONPATH": str(Path(armdyn.__file__).resolve().parents[1]),
+    }
     out = subprocess.run(
         [sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True
     )
