@@ -37,17 +37,7 @@ def actuator(n=50.0, j=2e-5, eta=1.0, b=0.0, c=0.0, motor=None, joint="j1"):
 
 
 def motor(**kw):
-    fields = (
-        "torque_constant",
-        "resistance",
-        "voltage",
-        "no_load_speed",
-        "continuous_torque",
-        "peak_torque",
-        "max_speed",
-        "thermal_resistance",
-        "thermal_time_constant",
-    )
+    fields = [f for f in ad.sizing.MOTOR_FIELDS if f != "name"]
     return SimpleNamespace(name="m", **{f: kw.get(f) for f in fields})
 
 

@@ -40,17 +40,7 @@ class WithActuators:
 
 
 def motor(**kw):
-    fields = (
-        "torque_constant",
-        "resistance",
-        "voltage",
-        "no_load_speed",
-        "continuous_torque",
-        "peak_torque",
-        "max_speed",
-        "thermal_resistance",
-        "thermal_time_constant",
-    )
+    fields = [f for f in ad.sizing.MOTOR_FIELDS if f != "name"]
     return SimpleNamespace(name="m", **{f: kw.get(f) for f in fields})
 
 
