@@ -132,8 +132,8 @@ def figure(path: Path, curves: dict) -> None:
         ax.grid(alpha=0.3)
     for ax in axes[1]:
         ax.set_xlabel("t [s]")
-    for ax in axes[:, 0]:
-        ax.set_ylabel(f"torque on the {JOINT} driven gear [N m]")
+    # one label for the shared y axis (one per row overlapped the other at this height)
+    fig.supylabel(f"torque on the {JOINT} driven gear [N m]", fontsize="medium")
     fig.suptitle(
         f"Geared 6-DOF arm (44+ bodies): {JOINT} driven-gear torque, 1–4 motors sharing it"
     )
