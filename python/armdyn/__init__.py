@@ -47,6 +47,7 @@ from armdyn.sizing import (
     sizing_report,
     trajectory_run,
 )
+from armdyn.sizing.select import DrivetrainSelection, select_drivetrain
 from armdyn.sweeps import sweep  # dask and xarray are imported when sweep() runs
 from armdyn.validation import LagrangeValidator
 from armdyn.workprecision import WorkPrecisionResult, work_precision
@@ -56,6 +57,7 @@ __version__ = "0.1.0"
 __all__ = [
     "Actuator",
     "Data",
+    "DrivetrainSelection",
     "InverseDynamicsResult",
     "LagrangeValidator",
     "Model",
@@ -92,6 +94,7 @@ __all__ = [
     "profiles",
     "rollout",
     "scenes",
+    "select_drivetrain",
     "simulate",
     "sizing_report",
     "state_from_joints",
