@@ -1,0 +1,410 @@
+"""armdyn.select_drivetrain: the coupled selection equals an independent exhaustive search of
+every combination of every joint's parts (the actuators' masses carried, the checks evaluated
+candidate by candidate in a plain loop), infeasible cases explained, hostile inputs refused."""
+
+from __future__ import annotations
+
+import itertools
+import sys
+import types
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import armdyn as ad
+from armdyn.sizing import checks as checks_module
+from armdyn.sizing.checks import CHECKS, margin
+
+# ---------------------------------------------------------------------------------------------
+# the arm: a planar 3-link arm (x-z plane, joints about y) built with ModelBuilder; an actuator
+# mass is a body welded at its joint's point on the parent link (what the selection places
+# with model.with_payload)
+
+LINKS = (("upper", 3.0, 0.5), ("fore", 2.0, 0.4), ("hand", 1.0, 0.2))  # name, mass, length
+JOINTS = ("shoulder", "elbow", "wrist")
+
+
+def planar_arm(payloads=()):
+    """The arm with point masses ``[(body, mass, com in the body frame from its centre)]``."""
+    b = ad.ModelBuilder(gravity=(0, 0, -9.81))
+    x, centres, parent = 0.0, {}, "ground"
+    for (name, mass, length), joint in zip(LINKS, JOINTS, strict=True):
+        centres[name] = np.array([x + length / 2, 0.0, 0.0])
+        inertia = mass * length**2 / 12
+        b.add_body(name, mass, [1e-4, inertia, inertia], position=tuple(centres[name]))
+        b.add_revolute(joint, parent, name, point=(x, 0, 0), axis=(0, 1, 0))
+        x, parent = x + length, name
+    for k, (body, mass, com) in enumerate(payloads):
+        p = tuple(centres[body] + np.asarray(com, float))
+        b.add_body(f"payload{k}", float(mass), [0.0, 0.0, 0.0], position=p)
+        b.add_fixed(f"weld{k}", body, f"payload{k}", point=p)
+    return b.finalize()
+
+
+def motion(model, n=121):
+    """A rest-to-rest move of every joint (quintic), sampled: (t, q, qd, qdd)."""
+    t = np.linspace(0.0, 1.0, n)
+    q0, q1 = np.array([-0.3, 0.4, -0.2]), np.array([0.6, -0.5, 0.5])
+    cols = [ad.profiles.quintic(a, b, 0.0, 1.0).eval(t) for a, b in zip(q0, q1, strict=True)]
+    q, qd, qdd = (np.stack([c[i] for c in cols], axis=1) for i in range(3))
+    return t, q, qd, qdd
+
+
+# ---------------------------------------------------------------------------------------------
+# private stand-ins of parts 2, 4 and 5 (installed only where the real one is missing)
+
+
+@dataclass(frozen=True)
+class _Load:
+    joint: str
+    t: np.ndarray
+    speed: np.ndarray
+    acceleration: np.ndarray
+    torque: np.ndarray
+    period: float
+
+
+class _Cycle:
+    def __init__(self, model, t, q, qd, qdd):
+        self.model, self.t, self.q, self.qd, self.qdd = model, t, q, qd, qdd
+        self.names = list(model.dof_names)
+        self.torque = ad.trajectory_run(model, t, q, qd, qdd).joint_torques
+
+    def with_model(self, model):
+        return _Cycle(model, self.t, self.q, self.qd, self.qdd)
+
+    def joint_load(self, joint):
+        k = self.names.index(joint)
+        span = float(self.t[-1] - self.t[0])
+        return _Load(joint, self.t, self.qd[:, k], self.qdd[:, k], self.torque[:, k], span)
+
+
+def _duty_cycle(model, run, dwell=0.0, repeat=None):
+    return _Cycle(model, run.t, run.q, run.qd, run.qdd)
+
+
+def _rms(x, t, period):
+    return np.sqrt(np.trapezoid(x**2, t, axis=-1) / period)
+
+
+def _motor_cycle_values(load, ratio, efficiency, rotor_inertia, motors, options):
+    n = np.asarray(ratio, float)[:, None]
+    torque = (
+        load.torque[None] / (n * np.asarray(efficiency)[:, None])
+        + np.asarray(rotor_inertia)[:, None] * n * load.acceleration[None]
+    )
+    speed = n * load.speed[None]
+    rms, peak = _rms(torque, load.t, load.period), np.max(np.abs(torque), axis=1)
+    w = np.max(np.abs(speed), axis=1)
+    kt, r = motors["torque_constant"], motors["resistance"]
+    power = torque * speed + r[:, None] * (torque / kt[:, None]) ** 2
+    return {
+        "motor_rms_torque": rms,
+        "motor_peak_torque": peak,
+        "motor_peak_speed": w,
+        "peak_current": peak / kt,
+        "rms_current": rms / kt,
+        "peak_electrical_power": np.max(power, axis=1),
+        "continuous_torque": margin(rms, motors["continuous_torque"]),
+        "peak_torque": margin(peak, motors["peak_torque"]),
+        "speed": margin(w, motors["max_speed"]),
+    }
+
+
+def _motor_cycle_series(load, ratio, efficiency, rotor_inertia, motor, options):
+    torque = load.torque / (ratio * efficiency) + rotor_inertia * ratio * load.acceleration
+    speed = ratio * load.speed
+    power = torque * speed + motor["resistance"] * (torque / motor["torque_constant"]) ** 2
+    return {"torque": torque, "speed": speed, "electrical_power": power}
+
+
+def _gearbox_cycle_values(load, ratio, gearboxes, options):
+    peak = np.full(len(ratio), np.max(np.abs(load.torque)))
+    speed = np.asarray(ratio) * np.max(np.abs(load.speed))
+    return {
+        "gear_repeated_peak_torque": peak,
+        "gear_repeated_peak_margin": margin(peak, gearboxes["repeated_peak_torque"]),
+        "gear_peak_input_speed": speed,
+        "gear_input_speed_margin": margin(speed, gearboxes["max_input_speed"]),
+    }
+
+
+def _none(*args, **kwargs):
+    return {}
+
+
+def _drive_values(motor_values, drives):
+    return {
+        "drive_peak_current_margin": margin(motor_values["peak_current"], drives["peak_current"])
+    }
+
+
+def _bus_values(t, power, period, drives):
+    return {"bus_peak_power": float(np.max(power.sum(axis=0)))}
+
+
+#: the stand-in functions per module (only the names a module lacks are installed)
+_STANDINS = {
+    "armdyn.sizing.cycle": {"duty_cycle": _duty_cycle},
+    "armdyn.sizing.motor": {
+        "motor_cycle_values": _motor_cycle_values,
+        "motor_cycle_series": _motor_cycle_series,
+    },
+    "armdyn.sizing.gearbox": {
+        "gearbox_cycle_values": _gearbox_cycle_values,
+        "bearing_cycle_values": lambda load, gearboxes, options: {},
+        "emergency_stop_values": _none,
+    },
+    "armdyn.sizing.drive": {
+        "drive_values": _drive_values,
+        "brake_values": _none,
+        "bus_values": _bus_values,
+    },
+}
+
+_RECIPES: dict = {}
+
+
+def _with_payload(self, at, mass, com=(0.0, 0.0, 0.0), inertia=None, name="payload"):
+    base = _RECIPES.get(id(self), (self, ()))[1]
+    out = planar_arm((*base, (at, mass, tuple(com))))
+    _RECIPES[id(out)] = (out, (*base, (at, mass, tuple(com))))
+    return out
+
+
+@pytest.fixture
+def parts(monkeypatch):
+    """The parts' functions: the real ones where they exist, else the stand-ins above."""
+    import importlib
+
+    for module_name, functions in _STANDINS.items():
+        try:
+            module = importlib.import_module(module_name)
+        except ImportError:
+            module = types.ModuleType(module_name)
+            monkeypatch.setitem(sys.modules, module_name, module)
+            monkeypatch.setattr(ad.sizing, module_name.rsplit(".", 1)[1], module, raising=False)
+        for name, fn in functions.items():
+            if not hasattr(module, name):
+                monkeypatch.setattr(module, name, fn, raising=False)
+    if not hasattr(ad.Model, "with_payload"):
+        monkeypatch.setattr(ad.Model, "with_payload", _with_payload, raising=False)
+    return {name: sys.modules[name] for name in _STANDINS}
+
+
+# ---------------------------------------------------------------------------------------------
+# the catalog (SI), written here
+
+MOTORS = pd.DataFrame(
+    {
+        "torque_constant": [0.05, 0.08, 0.12, 0.2],
+        "resistance": [1.2, 0.8, 0.5, 0.3],
+        "rotor_inertia": [2e-6, 5e-6, 1.2e-5, 3e-5],
+        "mass": [0.31, 0.52, 0.83, 1.37],
+        "continuous_torque": [0.08, 0.16, 0.45, 0.62],
+        "peak_torque": [0.25, 0.5, 1.3, 1.9],
+        "max_speed": [900.0, 700.0, 600.0, 450.0],
+        "cost": [100.0, 160.0, 230.0, 390.0],
+    },
+    index=pd.Index(["M1", "M2", "M3", "M4"], name="name"),
+)
+GEARBOXES = pd.DataFrame(
+    {
+        "ratio": [50.0, 100.0, 160.0],
+        "efficiency": [0.8, 0.75, 0.7],
+        "input_inertia": [1e-6, 2e-6, 3e-6],
+        "mass": [0.41, 0.67, 1.12],
+        "repeated_peak_torque": [30.0, 60.0, 120.0],
+        "max_input_speed": [800.0, 700.0, 600.0],
+        "cost": [300.0, 420.0, 610.0],
+    },
+    index=pd.Index(["G50", "G100", "G160"], name="name"),
+)
+DRIVES = pd.DataFrame(
+    {"peak_current": [6.0, 15.0], "continuous_current": [2.0, 5.0], "cost": [80.0, 150.0]},
+    index=pd.Index(["D6", "D15"], name="name"),
+)
+
+
+@dataclass
+class _Catalog:
+    motors: pd.DataFrame
+    gearboxes: pd.DataFrame
+    drives: pd.DataFrame | None = None
+
+
+def catalog(drives=False, motors=MOTORS, gearboxes=GEARBOXES):
+    return _Catalog(motors.copy(), gearboxes.copy(), DRIVES.copy() if drives else None)
+
+
+# ---------------------------------------------------------------------------------------------
+# the independent exhaustive search
+
+
+def _margins_of(out: dict) -> dict:
+    found = {}
+    for check in CHECKS:
+        if check.margin_column in out:
+            found[check.name] = float(np.asarray(out[check.margin_column]).reshape(-1)[0])
+        elif check.name in out and check.name != check.value:
+            found[check.name] = float(np.asarray(out[check.name]).reshape(-1)[0])
+    return found
+
+
+def _one(table: pd.DataFrame, name: str) -> dict:
+    """One part's numeric columns as (1,) arrays."""
+    row = table.loc[name]
+    return {c: np.array([float(row[c])]) for c in table.columns if table[c].dtype.kind in "fiu"}
+
+
+def candidate_margins(fns, load, motor, gearbox, drive, cat, options) -> dict:
+    """Every check's margin of one candidate, calling the parts' functions for it alone."""
+    m, g = _one(cat.motors, motor), _one(cat.gearboxes, gearbox)
+    rotor = m["rotor_inertia"] + g["input_inertia"]
+    gm = fns["armdyn.sizing.gearbox"]
+    dm = fns["armdyn.sizing.drive"]
+    mv = fns["armdyn.sizing.motor"].motor_cycle_values(
+        load, g["ratio"], g["efficiency"], rotor, m, options
+    )
+    brake = m.get("brake_torque", np.array([np.nan]))
+    stop = np.fmax(m["peak_torque"], brake)
+    outs = [
+        mv,
+        gm.gearbox_cycle_values(load, g["ratio"], g, options),
+        gm.bearing_cycle_values(load, g, options),
+        gm.emergency_stop_values(load, g["ratio"], g["efficiency"], rotor, stop, g, options),
+        dm.brake_values(load, g["ratio"], brake, options),
+    ]
+    if drive is not None:
+        outs.append(dm.drive_values(mv, _one(cat.drives, drive)))
+    found = {}
+    for out in outs:
+        found.update(_margins_of(out))
+    return found
+
+
+def _cycle_on(fns, payloads, run):
+    model = planar_arm(payloads)
+    return fns["armdyn.sizing.cycle"].duty_cycle(model, ad.trajectory_run(model, *run))
+
+
+def exhaustive(fns, run, joints, cat, options, objective="mass"):
+    """Every combination of every joint's (motor, gearbox[, drive]) on the model carrying that
+    combination's actuator masses at each joint's point on its parent link (built here with
+    ModelBuilder); the feasible one of least total objective: ``(total, combination, margins
+    per joint)``, None when no combination is feasible."""
+    drives = [None] if cat.drives is None else list(cat.drives.index)
+    per_joint = list(itertools.product(cat.motors.index, cat.gearboxes.index, drives))
+    parents = {"shoulder": None, "elbow": "upper", "wrist": "fore"}
+    half = {"upper": 0.25, "fore": 0.2}
+    cycles, seen, best = {}, {}, None
+    for combo in itertools.product(per_joint, repeat=len(joints)):
+        masses = tuple(
+            float(cat.motors.loc[mo, "mass"] + cat.gearboxes.loc[ge, "mass"]) for mo, ge, _ in combo
+        )
+        payloads = tuple(
+            (parents[j], m, (half[parents[j]], 0.0, 0.0))
+            for j, m in zip(joints, masses, strict=True)
+            if parents[j] is not None
+        )
+        if payloads not in cycles:
+            cycles[payloads] = _cycle_on(fns, payloads, run)
+        margins, feasible, total = {}, True, 0.0
+        for j, (mo, ge, dr) in zip(joints, combo, strict=True):
+            key = (payloads, j, mo, ge, dr)
+            if key not in seen:
+                load = cycles[payloads].joint_load(j)
+                seen[key] = candidate_margins(fns, load, mo, ge, dr, cat, options)
+            margins[j] = seen[key]
+            feasible = feasible and all(np.isnan(v) or v >= 1.0 for v in margins[j].values())
+            if objective == "mass":
+                total += float(cat.motors.loc[mo, "mass"] + cat.gearboxes.loc[ge, "mass"])
+            else:
+                total += float(cat.motors.loc[mo, "cost"] + cat.gearboxes.loc[ge, "cost"])
+                total += 0.0 if dr is None else float(cat.drives.loc[dr, "cost"])
+            if not feasible:
+                break
+        if feasible and (best is None or total < best[0]):
+            best = (total, combo, margins)
+    return best
+
+
+@pytest.fixture
+def run():
+    return motion(planar_arm())
+
+
+OPTIONS = ad.sizing.options.SizingOptions() if hasattr(ad.sizing, "options") else None
+
+
+def _options():
+    from armdyn.sizing.options import SizingOptions
+
+    return SizingOptions()
+
+
+def _chosen(sel, joints):
+    return tuple(
+        (sel.table.loc[j, "motor"], sel.table.loc[j, "gearbox"], sel.table.loc[j, "drive"])
+        for j in joints
+    )
+
+
+def _assert_margins(sel, ref_margins, joints):
+    for j in joints:
+        for name, value in ref_margins[j].items():
+            got = sel.table.loc[j, checks_module.CHECKS_BY_NAME[name].margin_column]
+            np.testing.assert_allclose(got, value, rtol=1e-12, err_msg=f"{j} {name}")
+
+
+def test_equals_exhaustive_search_mass(parts, run):
+    model = planar_arm()
+    cat = catalog(gearboxes=GEARBOXES.iloc[:2])
+    sel = ad.select_drivetrain(model, ad.trajectory_run(model, *run), cat, drives=False)
+    total, combo, ref_margins = exhaustive(parts, run, JOINTS, cat, _options())
+    assert _chosen(sel, JOINTS) == combo
+    np.testing.assert_allclose(sel.table["mass"].sum(), total, rtol=1e-12)
+    _assert_margins(sel, ref_margins, JOINTS)
+    assert sel.converged and sel.ok and sel.passes == 2
+    assert list(sel.table.index) == list(JOINTS)
+    assert sel.table["ok"].all() and len(sel.infeasible) == 0
+
+
+def test_the_coupling_changes_the_shoulder(parts, run):
+    """Without the carried masses (every mount None) the shoulder would take a lighter motor
+    that the elbow's and wrist's actuators overload: the coupled search must not."""
+    model = planar_arm()
+    cat = catalog(gearboxes=GEARBOXES.iloc[:2])
+    traj = ad.trajectory_run(model, *run)
+    free = ad.select_drivetrain(
+        model, traj, cat, drives=False, mounts={"elbow": None, "wrist": None}
+    )
+    coupled = ad.select_drivetrain(model, traj, cat, drives=False)
+    assert free.passes == 2 and coupled.passes == 2
+    assert coupled.table.loc["shoulder", "mass"] > free.table.loc["shoulder", "mass"]
+    # the free choice fails on the loaded arm: its margin there (from the candidates of the
+    # coupled run) is below 1
+    cand = coupled.candidates("shoulder")
+    fm, fg = free.table.loc["shoulder", ["motor", "gearbox"]]
+    row = cand[(cand["motor"] == fm) & (cand["gearbox"] == fg)].iloc[0]
+    assert not row["ok"] and row["margin"] < 1.0
+    # the wrist carries no actuator beyond it: the same values; the elbow carries the wrist's
+    cols = ["motor", "gearbox", "margin", "motor_rms_torque"]
+    assert free.table.loc["wrist", cols].tolist() == coupled.table.loc["wrist", cols].tolist()
+    assert coupled.table.loc["elbow", "motor_rms_torque"] > free.table.loc["elbow", "motor_rms_torque"]
+
+
+def test_equals_exhaustive_search_cost_with_drives(parts, run):
+    model = planar_arm()
+    cat = catalog(drives=True, gearboxes=GEARBOXES.iloc[1:])
+    joints = ["elbow", "wrist"]
+    sel = ad.select_drivetrain(
+        model, ad.trajectory_run(model, *run), cat, objective="cost", joints=joints
+    )
+    total, combo, ref_margins = exhaustive(parts, run, joints, cat, _options(), "cost")
+    assert _chosen(sel, joints) == combo
+    np.testing.assert_allclose(sel.table["cost"].sum(), total, rtol=1e-12)
+    _assert_margins(sel, ref_margins, joints)
+    assert sel.bus is not None
