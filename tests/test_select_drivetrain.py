@@ -9,11 +9,10 @@ import sys
 import types
 from dataclasses import dataclass
 
+import armdyn as ad
 import numpy as np
 import pandas as pd
 import pytest
-
-import armdyn as ad
 from armdyn.sizing import checks as checks_module
 from armdyn.sizing.checks import CHECKS, margin
 
@@ -336,9 +335,6 @@ def run():
     return motion(planar_arm())
 
 
-OPTIONS = ad.sizing.options.SizingOptions() if hasattr(ad.sizing, "options") else None
-
-
 def _options():
     from armdyn.sizing.options import SizingOptions
 
@@ -393,7 +389,9 @@ def test_the_coupling_changes_the_shoulder(parts, run):
     # the wrist carries no actuator beyond it: the same values; the elbow carries the wrist's
     cols = ["motor", "gearbox", "margin", "motor_rms_torque"]
     assert free.table.loc["wrist", cols].tolist() == coupled.table.loc["wrist", cols].tolist()
-    assert coupled.table.loc["elbow", "motor_rms_torque"] > free.table.loc["elbow", "motor_rms_torque"]
+    assert (
+        coupled.table.loc["elbow", "motor_rms_torque"] > free.table.loc["elbow", "motor_rms_torque"]
+    )
 
 
 def test_equals_exhaustive_search_cost_with_drives(parts, run):
@@ -408,3 +406,158 @@ def test_equals_exhaustive_search_cost_with_drives(parts, run):
     np.testing.assert_allclose(sel.table["cost"].sum(), total, rtol=1e-12)
     _assert_margins(sel, ref_margins, joints)
     assert sel.bus is not None
+
+
+def _select(run, cat, **kw):
+    model = planar_arm()
+    return ad.select_drivetrain(model, ad.trajectory_run(model, *run), cat, **kw)
+
+
+def test_margin_and_bus_power_objectives_rank_by_their_value(parts, run):
+    cat = catalog()
+    by_margin = _select(run, cat, drives=False, objective="margin")
+    by_power = _select(run, cat, drives=False, objective="bus_power")
+    for sel, column, best in ((by_margin, "margin", np.max), (by_power, "objective", np.min)):
+        for joint in JOINTS:
+            cand = sel.candidates(joint)
+            feasible = cand[cand["ok"]]
+            assert cand.iloc[0]["motor"] == sel.table.loc[joint, "motor"]
+            assert cand.iloc[0]["gearbox"] == sel.table.loc[joint, "gearbox"]
+            assert feasible.iloc[0][column] == best(feasible[column])
+            # feasible first, then the infeasible ones closest first
+            assert list(cand["ok"]) == sorted(cand["ok"], reverse=True)
+            rest = cand[~cand["ok"]]["margin"].to_numpy()
+            assert np.all(np.diff(rest) <= 0)
+    np.testing.assert_array_equal(
+        by_power.candidates("wrist")["objective"],
+        by_power.candidates("wrist")["peak_electrical_power"],
+    )
+
+
+def test_candidates_are_every_combination_ranked(parts, run):
+    cat = catalog(drives=True)
+    sel = _select(run, cat, objective="cost")
+    cand = sel.candidates("elbow")
+    assert len(cand) == len(MOTORS) * len(GEARBOXES) * len(DRIVES)
+    assert len(set(zip(cand["motor"], cand["gearbox"], cand["drive"], strict=True))) == len(cand)
+    feasible = cand[cand["ok"]]
+    assert np.all(np.diff(feasible["cost"].to_numpy()) >= 0)
+    expected = (
+        MOTORS.loc[cand["motor"], "cost"].to_numpy()
+        + GEARBOXES.loc[cand["gearbox"], "cost"].to_numpy()
+        + DRIVES.loc[cand["drive"], "cost"].to_numpy()
+    )
+    np.testing.assert_array_equal(cand["cost"].to_numpy(), expected)
+    assert len(sel.candidates("elbow", n=3)) == 3
+    assert sel.table.loc["elbow", "candidates"] == len(cand)
+    assert sel.table.loc["elbow", "feasible"] == int(cand["ok"].sum())
+
+
+def test_no_feasible_candidate_names_the_check_and_best_margin(parts, run):
+    weak = MOTORS.copy()
+    weak["continuous_torque"] = weak["continuous_torque"] * 0.2
+    cat = catalog(motors=weak)
+    sel = _select(run, cat, drives=False)
+    assert not sel.ok
+    failing = sel.table.index[~sel.table["ok"]].tolist()
+    assert "shoulder" in failing
+    why = sel.infeasible[sel.infeasible["joint"] == "shoulder"]
+    assert "continuous_torque" in why["check"].tolist()
+    row = why[why["check"] == "continuous_torque"].iloc[0]
+    # the best margin any candidate reaches on it, and by which one: a plain loop over the
+    # candidates on the model the table is of
+    cand = sel.candidates("shoulder")
+    k = int(np.argmax(cand["continuous_torque_margin"].to_numpy()))
+    assert row["best_margin"] == cand["continuous_torque_margin"].iloc[k] < 1.0
+    assert (row["motor"], row["gearbox"]) == (cand["motor"].iloc[k], cand["gearbox"].iloc[k])
+    assert row["part"] == "motor"
+    # the table shows the closest candidate
+    assert sel.table.loc["shoulder", "margin"] == cand["margin"].max()
+    assert "no candidate passes continuous_torque" in sel.explain()
+
+
+def test_checks_in_conflict_are_explained(parts, run):
+    """One motor and two gearboxes: the small ratio overloads the motor, the large one exceeds
+    the gearbox's input speed; each check is passed by some candidate, none passes both."""
+    motors = MOTORS.loc[["M2"]].copy()
+    gearboxes = GEARBOXES.loc[["G50", "G160"]].copy()
+    gearboxes["max_input_speed"] = [800.0, 100.0]
+    sel = _select(run, catalog(motors=motors, gearboxes=gearboxes), drives=False, joints=["elbow"])
+    assert not sel.table.loc["elbow", "ok"]
+    why = sel.infeasible
+    assert len(why) >= 1
+    assert why["reason"].str.contains("none passes all").all()
+    cand = sel.candidates("elbow")
+    assert (why["motor"].iloc[0], why["gearbox"].iloc[0]) == (
+        cand["motor"].iloc[0],
+        cand["gearbox"].iloc[0],
+    )
+
+
+def test_not_converged_is_flagged(parts, run):
+    with pytest.warns(UserWarning, match="not converged"):
+        sel = _select(run, catalog(), drives=False, max_passes=1)
+    assert sel.passes == 1 and not sel.converged and not sel.ok
+
+
+def test_mount_on_a_frame_and_the_model_carries_the_actuators(parts, run):
+    """mounts places the mass where told; the result's model carries every chosen actuator:
+    the shoulder's static torque there equals the arm's plus the carried masses' m g x."""
+    sel = _select(run, catalog(), drives=False, mounts={"wrist": ("upper", (0.25, 0.0, 0.0))})
+    masses = sel.table["mass"]
+    ref = planar_arm(
+        [("upper", masses["elbow"], (0.25, 0, 0)), ("upper", masses["wrist"], (0.25, 0, 0))]
+    )
+    q = np.zeros(3)
+    tau = ad.inverse_dynamics(sel.model, q, q, q)
+    np.testing.assert_allclose(tau, ad.inverse_dynamics(ref, q, q, q), rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"objective": "weight"}, "objective must be one of"),
+        ({"joints": ["knee"]}, "'knee' is not a revolute or prismatic joint"),
+        ({"joints": []}, "joints is empty"),
+        ({"joints": ["elbow", "elbow"]}, "listed twice"),
+        ({"mounts": {"knee": "upper"}}, "'knee' is not a selected joint"),
+        ({"mounts": {"elbow": "nowhere"}}, "'nowhere' is not a body or frame"),
+        ({"mounts": {"elbow": ("upper", (0, 0))}}, "com must be 3 numbers"),
+        ({"mounts": {"elbow": ("upper", (0, 0, np.nan))}}, "is not finite"),
+        ({"mounts": ["elbow"]}, "mounts must be a dict"),
+        ({"max_passes": 0}, "max_passes"),
+        ({"max_passes": True}, "max_passes"),
+        ({"drives": "yes"}, "drives must be True or False"),
+        ({"drives": True}, "drives=True but the catalog has no drives"),
+        ({"objective": "cost", "motors": MOTORS.drop(columns="cost")}, "no 'cost' column"),
+        ({"motors": MOTORS.iloc[:0]}, "the catalog has no motors"),
+        ({"gearboxes": GEARBOXES.iloc[:0]}, "the catalog has no gearboxes"),
+        ({"motors": MOTORS.assign(mass=[0.3, np.nan, 0.8, 1.3])}, "motor 'M2' has mass = nan"),
+        ({"gearboxes": GEARBOXES.assign(ratio=[50.0, 0.0, 160.0])}, "'G100' has ratio = 0.0"),
+        ({"gearboxes": GEARBOXES.drop(columns="input_inertia")}, "no 'input_inertia'"),
+        ({"required_lif": 1.0}, "unknown option"),
+    ],
+)
+def test_hostile_inputs(parts, run, kwargs, match):
+    kwargs = dict(kwargs)
+    cat = catalog(motors=kwargs.pop("motors", MOTORS), gearboxes=kwargs.pop("gearboxes", GEARBOXES))
+    kwargs.setdefault("drives", False)
+    with pytest.raises(ad.ModelError, match=match):
+        _select(run, cat, **kwargs)
+
+
+def test_hostile_model_catalog_and_candidates(parts, run):
+    model = planar_arm()
+    traj = ad.trajectory_run(model, *run)
+    with pytest.raises(ad.ModelError, match=r"model must be an armdyn\.Model"):
+        ad.select_drivetrain("arm.urdf", traj, catalog(), drives=False)
+    with pytest.raises(ad.ModelError, match=r"catalog\.motors must be a pandas DataFrame"):
+        ad.select_drivetrain(model, traj, _Catalog([1, 2], GEARBOXES), drives=False)
+    with pytest.raises(ad.ModelError, match="the catalog has no motors"):
+        ad.select_drivetrain(model, traj, object(), drives=False)
+    sel = ad.select_drivetrain(model, traj, catalog(), drives=False, joints=["wrist"])
+    with pytest.raises(ad.ModelError, match="'elbow' was not selected"):
+        sel.candidates("elbow")
+    with pytest.raises(ad.ModelError, match="n must be"):
+        sel.candidates("wrist", n=0)
+    assert list(sel.table.index) == ["wrist"]

@@ -117,7 +117,7 @@ def _required(kind: str, names: np.ndarray, cols: dict, column: str, why: str) -
     if np.any(bad):
         row = int(np.flatnonzero(bad)[0])
         raise _core.ModelError(
-            f"{_WHO}: catalog {kind} {names[row]!r} has {column} = {values[row]!r} "
+            f"{_WHO}: catalog {kind} {names[row]!r} has {column} = {float(values[row])!r} "
             f"({why}: a finite number >= 0 is needed)"
         )
     return values
@@ -169,7 +169,7 @@ def catalog_parts(catalog, drives: bool, objective: str) -> CatalogParts:
     if np.any(ratio <= 0):
         row = int(np.flatnonzero(ratio <= 0)[0])
         raise _core.ModelError(
-            f"{_WHO}: catalog gearbox {names['gearbox'][row]!r} has ratio = {ratio[row]!r} "
+            f"{_WHO}: catalog gearbox {names['gearbox'][row]!r} has ratio = {float(ratio[row])!r} "
             "(must be > 0)"
         )
     if objective == "cost":
