@@ -47,7 +47,7 @@ OBJECTIVES: tuple[str, ...] = ("mass", "cost", "bus_power", "margin")
 
 #: candidates × samples per chunk of the motor-side evaluation (bounds the memory of the
 #: (k, n) arrays the vectorised functions build)
-CHUNK_ELEMENTS = 2_000_000
+CHUNK_ELEMENTS = 1_000_000
 
 _WHO = "select_drivetrain"
 

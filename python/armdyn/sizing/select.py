@@ -353,7 +353,9 @@ class _Search:
     def cycle_now(self):
         """The cycle on the model carrying the actuators chosen so far (re-run only when a
         carried mass changed)."""
-        key = tuple(sorted((j, float(m)) for j, m in self.carried.items()))
+        key = tuple(
+            sorted((j, float(m)) for j, m in self.carried.items() if self.mounts[j] is not None)
+        )
         if self.current_cycle is None or key != self.current:
             self.current_model = _with_actuators(self.model, self.carried, self.mounts)
             self.current_cycle = (
