@@ -289,24 +289,28 @@ def _cycle_on(fns, payloads, run):
     return fns["armdyn.sizing.cycle"].duty_cycle(model, ad.trajectory_run(model, *run))
 
 
-def exhaustive(fns, run, joints, cat, options, objective="mass"):
+def exhaustive(fns, run, joints, cat, options, objective="mass", mounts=None):
     """Every combination of every joint's (motor, gearbox[, drive]) on the model carrying that
     combination's actuator masses at each joint's point on its parent link (built here with
     ModelBuilder); the feasible one of least total objective: ``(total, combination, margins
     per joint)``, None when no combination is feasible."""
     drives = [None] if cat.drives is None else list(cat.drives.index)
     per_joint = list(itertools.product(cat.motors.index, cat.gearboxes.index, drives))
-    parents = {"shoulder": None, "elbow": "upper", "wrist": "fore"}
-    half = {"upper": 0.25, "fore": 0.2}
+    places = {
+        "shoulder": None,
+        "elbow": ("upper", (0.25, 0.0, 0.0)),
+        "wrist": ("fore", (0.2, 0, 0)),
+    }
+    places.update(mounts or {})
     cycles, seen, best = {}, {}, None
     for combo in itertools.product(per_joint, repeat=len(joints)):
         masses = tuple(
             float(cat.motors.loc[mo, "mass"] + cat.gearboxes.loc[ge, "mass"]) for mo, ge, _ in combo
         )
         payloads = tuple(
-            (parents[j], m, (half[parents[j]], 0.0, 0.0))
+            (places[j][0], m, places[j][1])
             for j, m in zip(joints, masses, strict=True)
-            if parents[j] is not None
+            if places[j] is not None
         )
         if payloads not in cycles:
             cycles[payloads] = _cycle_on(fns, payloads, run)
@@ -561,3 +565,32 @@ def test_hostile_model_catalog_and_candidates(parts, run):
     with pytest.raises(ad.ModelError, match="n must be"):
         sel.candidates("wrist", n=0)
     assert list(sel.table.index) == ["wrist"]
+
+
+def test_an_actuator_on_its_own_link_takes_passes_and_equals_the_exhaustive_search(parts, run):
+    """The wrist's actuator mounted at the hand's tip (on the link it drives) loads its own
+    joint: the choice must hold with its own mass (a fixed point reached over passes)."""
+    tip = {"wrist": ("hand", (0.1, 0.0, 0.0))}
+    tiny = pd.DataFrame(
+        {c: [v] for c, v in zip(MOTORS.columns, [0.03, 3.0, 1e-6, 0.2, 0.03, 0.1, 900.0, 60.0])},
+        index=pd.Index(["M0"], name="name"),
+    )
+    cat = catalog(motors=pd.concat([tiny, MOTORS]), gearboxes=GEARBOXES.iloc[:2])
+    sel = _select(run, cat, drives=False, mounts=tip)
+    total, combo, ref_margins = exhaustive(parts, run, JOINTS, cat, _options(), mounts=tip)
+    assert _chosen(sel, JOINTS) == combo
+    _assert_margins(sel, ref_margins, JOINTS)
+    assert sel.converged and sel.passes >= 2
+    # the wrist's first-pass choice (without its own mass) differs from the final one
+    assert sel.history[0]["wrist"] != sel.history[-1]["wrist"]
+
+
+def test_chunks_give_the_same_screening(parts, run, monkeypatch):
+    from armdyn.sizing import drivetrain
+
+    cat = catalog(drives=True)
+    whole = _select(run, cat, objective="cost")
+    monkeypatch.setattr(drivetrain, "CHUNK_ELEMENTS", 3 * len(run[0]))  # 3 pairs per chunk
+    chunked = _select(run, cat, objective="cost")
+    for joint in JOINTS:
+        pd.testing.assert_frame_equal(whole.candidates(joint), chunked.candidates(joint))
