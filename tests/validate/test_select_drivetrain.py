@@ -572,12 +572,15 @@ def test_an_actuator_on_its_own_link_takes_passes_and_equals_the_exhaustive_sear
     joint: the choice must hold with its own mass (a fixed point reached over passes)."""
     tip = {"wrist": ("hand", (0.1, 0.0, 0.0))}
     tiny = pd.DataFrame(
-        {c: [v] for c, v in zip(MOTORS.columns, [0.03, 3.0, 1e-6, 0.2, 0.03, 0.1, 900.0, 60.0])},
+        {
+            c: [v]
+            for c, v in zip(MOTORS.columns, [0.03, 3.0, 1e-6, 0.2, 0.03, 0.1, 900, 60], strict=True)
+        },
         index=pd.Index(["M0"], name="name"),
     )
     cat = catalog(motors=pd.concat([tiny, MOTORS]), gearboxes=GEARBOXES.iloc[:2])
     sel = _select(run, cat, drives=False, mounts=tip)
-    total, combo, ref_margins = exhaustive(parts, run, JOINTS, cat, _options(), mounts=tip)
+    _, combo, ref_margins = exhaustive(parts, run, JOINTS, cat, _options(), mounts=tip)
     assert _chosen(sel, JOINTS) == combo
     _assert_margins(sel, ref_margins, JOINTS)
     assert sel.converged and sel.passes >= 2
