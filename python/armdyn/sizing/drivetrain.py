@@ -220,18 +220,17 @@ class JointEvaluation:
 
 
 def _split(out: dict) -> tuple[dict, dict]:
-    """``(values, margins)`` of a check function's output: margins under the check's
-    ``<name>_margin`` key, or under its name where that is not also a value column."""
-    margins, values = {}, {}
-    keys = set(out)
+    """``(values, margins)`` of a check function's output: a check's margin is under its
+    ``<name>_margin`` key, or under its name where that is not also its value column (the
+    motor side's keys); every other numeric (k,) entry is a value."""
+    margins, taken = {}, set()
     for check in CHECKS:
-        if check.margin_column in keys:
-            margins[check.name] = out[check.margin_column]
-        elif check.name in keys and check.name != check.value:
-            margins[check.name] = out[check.name]
-    taken = {CHECKS_BY_NAME[n].margin_column for n in margins} | {
-        n for n in margins if CHECKS_BY_NAME[n].name != CHECKS_BY_NAME[n].value
-    }
+        for key in (check.margin_column, check.name):
+            if key in out and (key != check.name or check.name != check.value):
+                margins[check.name] = out[key]
+                taken.add(key)
+                break
+    values = {}
     for key, val in out.items():
         if key not in taken and not key.endswith("_margin"):
             arr = np.asarray(val)

@@ -510,9 +510,29 @@ def _infeasible(search: _Search, joints: list[str]):
     return pd.DataFrame(rows, columns=columns)
 
 
+def _bus_parameters(drives: dict[str, np.ndarray]) -> dict[str, float]:
+    """The common DC bus of the chosen drives (one per axis): the capacitances, braking
+    resistors' continuous and peak powers add up (those given; NaN when none is), the nominal
+    voltage is the largest and the maximum voltage the smallest of the drives' (the capacitors
+    absorb the least energy)."""
+    out = {}
+    for key, reduce in (
+        ("bus_voltage", np.max),
+        ("bus_voltage_max", np.min),
+        ("bus_capacitance", np.sum),
+        ("braking_resistor_power", np.sum),
+        ("braking_resistor_peak_power", np.sum),
+    ):
+        if key in drives:
+            given = drives[key][~np.isnan(drives[key])]
+            out[key] = float(reduce(given)) if len(given) else np.nan
+    return out
+
+
 def _bus(search: _Search, joints: list[str]) -> dict | None:
-    """The DC bus of the chosen set: every axis's electrical power over the cycle summed
-    (``armdyn.sizing.drive.bus_values``) with the chosen drives' bus parameters."""
+    """The DC bus of the chosen set: every axis's electrical power over the cycle
+    (``motor_cycle_series``) summed by ``armdyn.sizing.drive.bus_values`` with the chosen
+    drives' common bus (:func:`_bus_parameters`); None without drives."""
     if not search.parts.with_drives:
         return None
     from armdyn.sizing import drive as drive_module
@@ -523,18 +543,18 @@ def _bus(search: _Search, joints: list[str]) -> dict | None:
     for joint in joints:
         ev, c = search.evaluations[joint], search.choice[joint]
         mi, gi, di = int(ev.motor[c]), int(ev.gearbox[c]), int(ev.drive[c])
-        gb = {k: v[gi] for k, v in parts.gearboxes.items()}
-        motor = {k: v[mi] for k, v in parts.motors.items()}
+        gb = {k: float(v[gi]) for k, v in parts.gearboxes.items()}
+        motor = {k: float(v[mi]) for k, v in parts.motors.items()}
         rotor = motor["rotor_inertia"] + gb["input_inertia"]
         series = motor_module.motor_cycle_series(
             search.loads[joint], gb["ratio"], gb["efficiency"], rotor, motor, search.options
         )
         power.append(np.asarray(series["electrical_power"], dtype=float))
         drive_rows.append(di)
-    drives = {k: v[np.asarray(drive_rows)] for k, v in parts.drives.items()}
+    bus = _bus_parameters({k: v[np.asarray(drive_rows)] for k, v in parts.drives.items()})
     load = search.loads[joints[0]]
-    t = np.asarray(load.t, dtype=float)
-    return dict(drive_module.bus_values(t, np.stack(power), load.period, drives))
+    out = drive_module.bus_values(load.t, np.stack(power), load.period, bus)
+    return {k: float(np.asarray(v).reshape(-1)[0]) for k, v in out.items()}
 
 
 def select_drivetrain(
