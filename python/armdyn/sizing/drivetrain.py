@@ -40,7 +40,7 @@ import numpy as np
 
 from armdyn import _core
 from armdyn.sizing import motor as _motor_module
-from armdyn.sizing.checks import CHECKS, CHECKS_BY_NAME, verdict
+from armdyn.sizing.checks import CHECKS, verdict
 
 #: the objectives of the selection
 OBJECTIVES: tuple[str, ...] = ("mass", "cost", "bus_power", "margin")
