@@ -516,15 +516,16 @@ def _bus_parameters(drives: dict[str, np.ndarray]) -> dict[str, float]:
     voltage is the largest and the maximum voltage the smallest of the drives' (the capacitors
     absorb the least energy)."""
     out = {}
-    for key, reduce in (
-        ("bus_voltage", np.max),
-        ("bus_voltage_max", np.min),
-        ("bus_capacitance", np.sum),
-        ("braking_resistor_power", np.sum),
-        ("braking_resistor_peak_power", np.sum),
+    for key, column, reduce in (
+        ("bus_voltage", "bus_voltage", np.max),
+        ("bus_voltage_max", "max_bus_voltage", np.min),  # the catalog's column name
+        ("bus_capacitance", "bus_capacitance", np.sum),
+        ("braking_resistor_power", "braking_resistor_power", np.sum),
+        ("braking_resistor_peak_power", "braking_resistor_peak_power", np.sum),
     ):
-        if key in drives:
-            given = drives[key][~np.isnan(drives[key])]
+        values = drives.get(column, drives.get(key))
+        if values is not None:
+            given = values[~np.isnan(values)]
             out[key] = float(reduce(given)) if len(given) else np.nan
     return out
 
