@@ -62,22 +62,45 @@ class _Load:
     speed: np.ndarray
     acceleration: np.ndarray
     torque: np.ndarray
+    gravity_torque: np.ndarray
+    inertia: np.ndarray
+    force: np.ndarray
+    moment: np.ndarray
+    axis: np.ndarray
     period: float
+    repeat: int | None = None
 
 
 class _Cycle:
+    """Stand-in of armdyn.sizing.cycle.DutyCycle: the motion alone (no dwell), no reactions."""
+
     def __init__(self, model, t, q, qd, qdd):
         self.model, self.t, self.q, self.qd, self.qdd = model, t, q, qd, qdd
         self.names = list(model.dof_names)
         self.torque = ad.trajectory_run(model, t, q, qd, qdd).joint_torques
+        zero = np.zeros(len(self.names))
+        self.gravity = np.stack([ad.inverse_dynamics(model, x, zero, zero) for x in q])
+        self.inertia = np.stack([np.diag(ad.mass_matrix(model, x)) for x in q])
 
     def with_model(self, model):
         return _Cycle(model, self.t, self.q, self.qd, self.qdd)
 
     def joint_load(self, joint):
         k = self.names.index(joint)
-        span = float(self.t[-1] - self.t[0])
-        return _Load(joint, self.t, self.qd[:, k], self.qdd[:, k], self.torque[:, k], span)
+        n = len(self.t)
+        return _Load(
+            joint,
+            self.t,
+            self.qd[:, k],
+            self.qdd[:, k],
+            self.torque[:, k],
+            self.gravity[:, k],
+            self.inertia[:, k],
+            np.zeros((n, 3)),
+            np.zeros((n, 3)),
+            np.array([0.0, 0.0, 1.0]),
+            float(self.t[-1] - self.t[0]),
+        )
 
 
 def _duty_cycle(model, run, dwell=0.0, repeat=None):
@@ -376,7 +399,22 @@ def test_the_coupling_changes_the_shoulder(parts, run):
     """Without the carried masses (every mount None) the shoulder would take a lighter motor
     that the elbow's and wrist's actuators overload: the coupled search must not."""
     model = planar_arm()
-    cat = catalog(gearboxes=GEARBOXES.iloc[:2])
+    # a ladder of motors 20 % apart in torque: the carried masses raise the shoulder's torques
+    # by more than that, so its lightest feasible motor must change
+    c = 0.05 * 1.2 ** np.arange(16)
+    ladder = pd.DataFrame(
+        {
+            "torque_constant": 0.05 + 0.2 * c,
+            "resistance": 0.3 / c**0.5,
+            "rotor_inertia": 2e-5 * c,
+            "mass": 0.2 + 2.0 * c,
+            "continuous_torque": c,
+            "peak_torque": 3.0 * c,
+            "max_speed": np.full(len(c), 900.0),
+        },
+        index=pd.Index([f"L{i:02d}" for i in range(len(c))], name="name"),
+    )
+    cat = catalog(motors=ladder, gearboxes=GEARBOXES.iloc[1:])
     traj = ad.trajectory_run(model, *run)
     free = ad.select_drivetrain(
         model, traj, cat, drives=False, mounts={"elbow": None, "wrist": None}
