@@ -613,9 +613,9 @@ def select_drivetrain(
     options = sizing_options(options, **option_overrides)
     if not isinstance(model, _core.Model):
         raise _core.ModelError(f"{_WHO}: model must be an armdyn.Model, got {type(model).__name__}")
+    parts = catalog_parts(catalog, drives, objective)
     cycle = _cycle_of(model, cycle)
     joints = _joints(model, cycle, joints)
-    parts = catalog_parts(catalog, drives, objective)
     mounts = _mounts(model, joints, mounts)
     search = _Search(model, cycle, _distal_first(model, joints), parts, mounts, options, objective)
     passes, converged, history = _run_passes(search, max_passes)
