@@ -305,34 +305,40 @@ def _append(store: dict, new: dict) -> None:
         store.setdefault(key, []).append(np.asarray(val, dtype=float))
 
 
+def _chunk_stage(load, parts: CatalogParts, options, sl: slice, gear: tuple[dict, dict]):
+    """The candidates of the (motor, gearbox) pairs ``sl`` (pair p = motor p // g with gearbox
+    p % g), each with every drive (pair-major, drive-minor): ``(values, margins, rows)``."""
+    g, d = len(parts.gearbox_names), len(parts.drive_names)
+    pair = np.arange(sl.start, sl.stop)
+    mi, gi = pair // g, pair % g
+    pv, pm = _pair_stage(load, parts, mi, gi, options)
+    pv.update({k: v[gi] for k, v in gear[0].items()})
+    pm.update({k: v[gi] for k, v in gear[1].items()})
+    di = np.full(len(pair), -1)
+    if d:
+        mi, gi, di = np.repeat(mi, d), np.repeat(gi, d), np.tile(np.arange(d), len(pair))
+        pv = {k: np.repeat(v, d) for k, v in pv.items()}
+        pm = {k: np.repeat(v, d) for k, v in pm.items()}
+        dv, dm = _drive_stage(pv, parts, di)
+        pv.update(dv)
+        pm.update(dm)
+    return pv, pm, np.stack([mi, gi, di])
+
+
 def _screen(load, parts: CatalogParts, options) -> tuple[dict, dict, np.ndarray]:
-    """Every candidate's values and margins (lists of chunks joined) and the candidate ->
+    """Every candidate's values and margins (the chunks joined) and the candidate ->
     (motor, gearbox, drive) rows."""
-    m, g = len(parts.motor_names), len(parts.gearbox_names)
-    d = len(parts.drive_names)
-    gear_values, gear_margins = _gearbox_stage(load, parts, options)
+    pairs = len(parts.motor_names) * len(parts.gearbox_names)
+    gear = _gearbox_stage(load, parts, options)
     n_samples = len(np.atleast_1d(load.t))
     values: dict = {}
     margins: dict = {}
     rows = []
-    for sl in _chunks(m * g, n_samples):
-        pair = np.arange(sl.start, sl.stop)
-        mi, gi = pair // g, pair % g
-        pv, pm = _pair_stage(load, parts, mi, gi, options)
-        pv.update({k: v[gi] for k, v in gear_values.items()})
-        pm.update({k: v[gi] for k, v in gear_margins.items()})
-        di = np.full(len(pair), -1)
-        if d:
-            # every pair with every drive: pair-major, drive-minor
-            mi, gi, di = np.repeat(mi, d), np.repeat(gi, d), np.tile(np.arange(d), len(pair))
-            pv = {k: np.repeat(v, d) for k, v in pv.items()}
-            pm = {k: np.repeat(v, d) for k, v in pm.items()}
-            dv, dm = _drive_stage(pv, parts, di)
-            pv.update(dv)
-            pm.update(dm)
+    for sl in _chunks(pairs, n_samples):
+        pv, pm, r = _chunk_stage(load, parts, options, sl, gear)
         _append(values, pv)
         _append(margins, pm)
-        rows.append(np.stack([mi, gi, di]))
+        rows.append(r)
     join = {k: np.concatenate(v) for k, v in values.items()}
     return join, {k: np.concatenate(v) for k, v in margins.items()}, np.concatenate(rows, 1)
 
