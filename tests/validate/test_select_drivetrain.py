@@ -646,3 +646,46 @@ def test_chunks_give_the_same_screening(parts, run, monkeypatch):
     chunked = _select(run, cat, objective="cost")
     for joint in JOINTS:
         pd.testing.assert_frame_equal(whole.candidates(joint), chunked.candidates(joint))
+
+
+def _ur5_pick_and_place():
+    """The UR5 with a 3 kg payload 5 cm beyond its tool flange, moving every joint from a pick
+    pose to a place pose (quintic, 1.5 s), holding there 0.5 s, repeated forever."""
+    from benchmarks import common
+
+    path = common.robot_urdf("ur5")
+    if path is None:
+        pytest.skip("example-robot-data is not installed")
+    if not hasattr(ad, "duty_cycle") or not hasattr(ad.Model, "with_payload"):
+        pytest.skip("needs armdyn.duty_cycle and Model.with_payload (issue 33 parts 2 and 4)")
+    arm = ad.load_urdf(str(path))
+    model = arm.with_payload("tool0", 3.0, com=(0.0, 0.0, 0.05))
+    t = np.linspace(0.0, 1.5, 151)
+    pick = np.array([0.0, -1.2, 1.5, -1.9, -1.57, 0.0])
+    place = np.array([1.4, -1.6, 1.2, -1.2, -1.57, 0.8])
+    cols = [ad.profiles.quintic(a, b, 0.0, 1.5).eval(t) for a, b in zip(pick, place, strict=True)]
+    q, qd, qdd = (np.stack([c[i] for c in cols], axis=1) for i in range(3))
+    return model, ad.duty_cycle(model, ad.trajectory_run(model, t, q, qd, qdd), dwell=0.5)
+
+
+def test_ur5_pick_and_place_from_the_example_catalog():
+    model, cycle = _ur5_pick_and_place()
+    catalog = ad.load_catalog(ad.sizing.EXAMPLE_CATALOG)
+    sel = ad.select_drivetrain(model, cycle, catalog)
+    assert sel.converged and sel.passes >= 2
+    assert sel.ok, sel.explain()
+    assert list(sel.table.index) == list(model.dof_names)
+    # a non-trivial choice: every joint has candidates that fail
+    assert (sel.table["feasible"] < sel.table["candidates"]).all()
+    # the model carries every actuator but the base joint's (its housing sits on the ground)
+    carried = sel.table["mass"].drop(model.dof_names[0]).sum()
+    np.testing.assert_allclose(np.sum(sel.model.masses), np.sum(model.masses) + carried, rtol=1e-12)
+    # a fixed point: selecting again on the model that already carries the chosen actuators,
+    # carrying nothing more, gives the same choice and the same margins
+    again = ad.select_drivetrain(
+        sel.model, cycle, catalog, mounts={j: None for j in model.dof_names}
+    )
+    cols = ["motor", "gearbox", "drive", "ok", "binding_check"]
+    pd.testing.assert_frame_equal(again.table[cols], sel.table[cols])
+    np.testing.assert_allclose(again.table["margin"], sel.table["margin"], rtol=1e-12)
+    assert again.passes == 2
