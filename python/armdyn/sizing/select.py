@@ -232,11 +232,24 @@ def _joints(model, cycle, joints) -> list[str]:
 
 def _default_mount(model, joint: str):
     """``(at, com)``: the joint's point on its parent body; None on the ground (a housing
-    fixed to the world loads nothing)."""
+    fixed to the world loads nothing). ``with_payload`` takes a name that is also a frame's
+    (a URDF link's) as that frame: the point is then given in the frame's axes from its
+    origin."""
     jf = model.joint_frame(joint)
-    if jf["parent"] == "ground":
+    body = str(jf["parent"])
+    if body == "ground":
         return None
-    return str(jf["parent"]), np.asarray(jf["point_parent"], dtype=float)
+    point = np.asarray(jf["point_parent"], dtype=float)  # body axes, from its centre of mass
+    if body in model.frame_names:
+        frame = model.frame(body)
+        if frame["body"] != body:
+            raise _core.ModelError(
+                f"{_WHO}: joint {joint!r}: its parent body {body!r} shares its name with a "
+                f"frame on body {frame['body']!r}; pass mounts={{{joint!r}: (at, com)}}"
+            )
+        rotation = np.asarray(frame["rotation"], dtype=float)
+        point = rotation.T @ (point - np.asarray(frame["point"], dtype=float))
+    return body, point
 
 
 def _mount(model, joint: str, spec):
@@ -307,13 +320,23 @@ def _distal_first(model, joints: list[str]) -> list[str]:
 def _with_actuators(model, carried: dict, mounts: dict):
     """``model`` carrying each joint's actuator mass ``carried[joint]`` at its mount (a point
     mass)."""
+    payloads = [
+        {
+            "at": mounts[joint][0],
+            "mass": float(mass),
+            "com": tuple(float(x) for x in mounts[joint][1]),
+            "name": f"{joint}_actuator",
+        }
+        for joint, mass in carried.items()
+        if mounts[joint] is not None and mass > 0.0
+    ]
+    if not payloads:
+        return model
+    if hasattr(model, "with_payloads"):
+        return model.with_payloads(payloads)
     out = model
-    for joint, mass in carried.items():
-        mount = mounts[joint]
-        if mount is None or not mass > 0.0:
-            continue
-        at, com = mount
-        out = out.with_payload(at, float(mass), com=tuple(com), name=f"{joint}_actuator")
+    for p in payloads:
+        out = out.with_payload(p["at"], p["mass"], com=p["com"], name=p["name"])
     return out
 
 
