@@ -1,0 +1,746 @@
+"""Catalogs of motors, gearboxes and drives (:func:`load_catalog`, :class:`Catalog`).
+
+A catalog is a folder holding ``motors.csv`` and ``gearboxes.csv`` (and, for the drive checks,
+``drives.csv``), or single CSV files, one part per row, SI units (speeds in rad/s, inertias in
+kg m², temperatures in °C, lives in hours). Every column is declared once, here, with its unit,
+whether it is required, its bounds and its meaning: :data:`MOTOR_COLUMNS`,
+:data:`GEARBOX_COLUMNS`, :data:`DRIVE_COLUMNS` (docs/api.md's tables are generated from them by
+:func:`column_table`).
+
+Reading rules (every row is checked before anything is returned):
+
+- A file is read as the URDF loader reads its own: a regular file (never a FIFO, a directory or a
+  device such as ``/dev/zero``) of at most :data:`MAX_CATALOG_BYTES` bytes (64 MiB), UTF-8 text
+  (a UTF-8 byte-order mark is skipped; CRLF, LF and CR line ends are all accepted).
+- The first non-blank row is the header; blank rows (also rows of empty cells, as spreadsheets
+  export them) are skipped. Cells are stripped of surrounding blanks. Every row has as many
+  cells as the header.
+- A numeric cell is a decimal number (``12``, ``-0.5``, ``1.2e-4``); ``nan``, ``inf`` and a
+  number that overflows (``1e400``) are refused. A blank cell of an optional column is NaN (or
+  the column's default: ``life_exponent`` 3); of a required column, an error. A value outside
+  the column's bounds is an error. Columns given together (the two-node thermal model's four,
+  the gear life's rated speed and life, the bearing rating's load and pitch diameter) are
+  checked as a group, and a bearing allowable or rating needs ``bearing_offset``. Ordered
+  columns (continuous ≤ peak torque and current, rated ≤ repeated peak ≤ momentary peak torque,
+  bus voltage ≤ maximum bus voltage) are checked on every row.
+- Columns not declared here are kept as they are: as floats when every cell is a number or
+  blank (blank: NaN), else as text.
+- Part names are unique per kind, across all the paths merged.
+
+Every error is an :class:`armdyn.ModelError` naming the file, the line (1-based, as an editor
+counts it), and the column; a missing or unreadable path is the ``OSError`` that names it.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+import os
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass, field, make_dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from armdyn import _checks, _core
+
+if TYPE_CHECKING:
+    pass
+
+#: the largest catalog file read [bytes] (the URDF loader's bound, 64 MiB)
+MAX_CATALOG_BYTES = _core.URDF_MAX_BYTES
+#: the folder of the example catalog shipped with armdyn (motors.csv, gearboxes.csv, drives.csv)
+EXAMPLE_CATALOG = Path(__file__).resolve().parent / "example_catalog"
+#: the part kinds, and the file name of each in a catalog folder
+KINDS = ("motors", "gearboxes", "drives")
+FILE_NAMES = {kind: f"{kind}.csv" for kind in KINDS}
+
+
+@dataclass(frozen=True)
+class Column:
+    """One catalog column.
+
+    Attributes:
+        name: the CSV header name (and the DataFrame column, the dataclass field).
+        unit: its unit ("" for text, "1" for a pure number).
+        required: a missing column, or a blank cell in it, is an error.
+        doc: what it is.
+        lo, hi: bounds (None: unbounded); ``lo_open``: the value must be > lo (else >= lo).
+        default: an optional column's value when blank or absent (None: NaN).
+        text: a text column (name, source).
+    """
+
+    name: str
+    unit: str
+    required: bool
+    doc: str
+    lo: float | None = 0.0
+    lo_open: bool = True
+    hi: float | None = None
+    default: float | None = None
+    text: bool = False
+
+    @property
+    def allowed(self) -> str:
+        """The bounds in words ("> 0", "in (0, 1]", "any finite number")."""
+        if self.text:
+            return "text"
+        if self.lo is not None and self.hi is not None:
+            return f"in {'(' if self.lo_open else '['}{self.lo:g}, {self.hi:g}]"
+        if self.lo is not None:
+            return f"{'>' if self.lo_open else '>='} {self.lo:g}"
+        if self.hi is not None:
+            return f"<= {self.hi:g}"
+        return "any finite number"
+
+    def out_of_bounds(self, x: np.ndarray) -> np.ndarray:
+        """Where the (non-NaN) values ``x`` break the bounds."""
+        bad = np.zeros(x.shape, dtype=bool)
+        with np.errstate(invalid="ignore"):
+            if self.lo is not None:
+                bad |= (x <= self.lo) if self.lo_open else (x < self.lo)
+            if self.hi is not None:
+                bad |= x > self.hi
+        return bad & ~np.isnan(x)
+
+
+def _name(doc: str) -> Column:
+    return Column("name", "", True, doc, text=True)
+
+
+_SOURCE = Column(
+    "source",
+    "",
+    False,
+    'where the values come from: "illustrative", or the public datasheet they are taken from',
+    text=True,
+)
+_COST = Column(
+    "cost", "any", False, "price (any currency, the same in one catalog)", lo=0.0, lo_open=False
+)
+
+MOTOR_COLUMNS: tuple[Column, ...] = (
+    _name("the motor's part name (unique among the motors)"),
+    Column("torque_constant", "N m/A", True, "torque per ampere, k_t"),
+    Column("resistance", "ohm", True, "terminal resistance at the resistance temperature"),
+    Column("rotor_inertia", "kg m^2", True, "the rotor's moment of inertia (motor side)"),
+    Column("mass", "kg", True, "the motor's mass (carried by the arm)"),
+    Column("continuous_torque", "N m", True, "continuous (rated) torque"),
+    Column("peak_torque", "N m", True, "peak torque (at least the continuous torque)"),
+    Column("no_load_speed", "rad/s", False, "no-load speed at the rated voltage"),
+    Column("max_speed", "rad/s", False, "maximum (mechanical or rated) speed"),
+    Column("voltage", "V", False, "rated supply voltage of the speed-torque envelope"),
+    Column(
+        "thermal_resistance_winding",
+        "K/W",
+        False,
+        "two-node thermal model: winding to housing (the four two-node columns go together)",
+    ),
+    Column("thermal_resistance_housing", "K/W", False, "two-node model: housing to ambient"),
+    Column("thermal_time_constant_winding", "s", False, "two-node model: the winding's"),
+    Column("thermal_time_constant_housing", "s", False, "two-node model: the housing's"),
+    Column("max_winding_temperature", "degC", False, "the winding's largest allowed temperature"),
+    Column("thermal_resistance", "K/W", False, "one-node model: winding to ambient"),
+    Column("thermal_time_constant", "s", False, "one-node model: the winding's"),
+    Column("brake_torque", "N m", False, "holding brake torque (motor side); blank: no brake"),
+    _COST,
+    _SOURCE,
+)
+
+GEARBOX_COLUMNS: tuple[Column, ...] = (
+    _name("the gearbox's part name (unique; a series in several ratios is several rows)"),
+    Column("ratio", "1", True, "reduction ratio N (input speed / output speed)"),
+    Column("efficiency", "1", True, "efficiency, constant per row", hi=1.0),
+    Column("input_inertia", "kg m^2", True, "moment of inertia at the input", lo_open=False),
+    Column("mass", "kg", True, "the gearbox's mass (carried by the arm)"),
+    Column("rated_torque", "N m", True, "rated output torque T_N (at the rated input speed)"),
+    Column("rated_input_speed", "rad/s", False, "input speed n_N of the rated life"),
+    Column("rated_life", "h", False, "rated life L_N at T_N and n_N (L10 or L50, as given)"),
+    Column(
+        "life_exponent",
+        "1",
+        False,
+        "exponent p of L = L_N (T_N/T_av)^p (n_N/n_av): 3 (strain wave), 10/3 (RV)",
+        hi=20.0,
+        default=3.0,
+    ),
+    Column("average_torque_limit", "N m", False, "limit for the cubic-mean output torque"),
+    Column("average_input_speed_limit", "rad/s", False, "limit for the average input speed"),
+    Column("repeated_peak_torque", "N m", True, "limit for repeated peak (start/stop) torque"),
+    Column("momentary_peak_torque", "N m", False, "limit for momentary (emergency stop) torque"),
+    Column("momentary_peak_count", "1", False, "allowed number of momentary peaks over the life"),
+    Column("max_input_speed", "rad/s", False, "maximum input speed"),
+    Column("bearing_moment_allowable", "N m", False, "output bearing: allowable tilting moment"),
+    Column("bearing_axial_allowable", "N", False, "output bearing: allowable axial force"),
+    Column("bearing_radial_allowable", "N", False, "output bearing: allowable radial force"),
+    Column(
+        "bearing_offset",
+        "m",
+        False,
+        "output bearing: its reference point's distance from the joint point along the joint "
+        "axis (signed)",
+        lo=None,
+    ),
+    Column("bearing_dynamic_load_rating", "N", False, "output bearing: dynamic load rating C"),
+    Column("bearing_pitch_diameter", "m", False, "output bearing: roller pitch diameter d_p"),
+    _COST,
+    _SOURCE,
+)
+
+DRIVE_COLUMNS: tuple[Column, ...] = (
+    _name("the drive's part name (unique among the drives)"),
+    Column("continuous_current", "A", True, "continuous output current (RMS over the cycle)"),
+    Column("peak_current", "A", True, "peak output current"),
+    Column("bus_voltage", "V", True, "nominal DC bus voltage"),
+    Column(
+        "max_bus_voltage",
+        "V",
+        False,
+        "bus voltage at which the braking resistor switches in (the capacitance absorbs "
+        "regenerated energy up to it)",
+    ),
+    Column("bus_capacitance", "F", False, "DC bus capacitance"),
+    Column("braking_resistor_power", "W", False, "braking resistor: continuous power"),
+    Column("braking_resistor_peak_power", "W", False, "braking resistor: peak power"),
+    Column("mass", "kg", False, "the drive's mass (not carried by the arm)"),
+    _COST,
+    _SOURCE,
+)
+
+#: the columns of each kind
+COLUMNS: dict[str, tuple[Column, ...]] = {
+    "motors": MOTOR_COLUMNS,
+    "gearboxes": GEARBOX_COLUMNS,
+    "drives": DRIVE_COLUMNS,
+}
+_BY_NAME = {kind: {c.name: c for c in cols} for kind, cols in COLUMNS.items()}
+
+#: columns given together or not at all
+_GROUPS = {
+    "motors": (
+        (
+            "thermal_resistance_winding",
+            "thermal_resistance_housing",
+            "thermal_time_constant_winding",
+            "thermal_time_constant_housing",
+        ),
+    ),
+    "gearboxes": (
+        ("rated_input_speed", "rated_life"),
+        ("bearing_dynamic_load_rating", "bearing_pitch_diameter"),
+    ),
+    "drives": (),
+}
+#: (column, the column it needs): a bearing allowable or rating needs the bearing's offset
+_NEEDS = {
+    "motors": (),
+    "gearboxes": tuple(
+        (c, "bearing_offset")
+        for c in (
+            "bearing_moment_allowable",
+            "bearing_axial_allowable",
+            "bearing_radial_allowable",
+            "bearing_dynamic_load_rating",
+        )
+    ),
+    "drives": (),
+}
+#: (smaller, larger) pairs checked on every row where both are given
+_ORDERED = {
+    "motors": (("continuous_torque", "peak_torque"),),
+    "gearboxes": (
+        ("rated_torque", "repeated_peak_torque"),
+        ("repeated_peak_torque", "momentary_peak_torque"),
+    ),
+    "drives": (("continuous_current", "peak_current"), ("bus_voltage", "max_bus_voltage")),
+}
+
+_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
+
+
+def _dataclass(cls_name: str, kind: str, what: str):
+    cols = COLUMNS[kind]
+    fields_ = [(c.name, str if c.text else float) for c in cols]
+    fields_.append(("extra", Mapping[str, Any], field(default_factory=dict)))
+    cls = make_dataclass(cls_name, fields_, frozen=True)
+    cls.__module__ = __name__  # (make_dataclass takes module= from Python 3.12)
+    lines = [
+        f"One {what} of a :class:`Catalog` (frozen; fields in SI units, NaN when not given).",
+        "",
+    ]
+    lines.append("Attributes:")
+    for c in cols:
+        unit = f" [{c.unit}]" if c.unit not in ("", "1") else ""
+        lines.append(f"    {c.name}: {c.doc}{unit}.")
+    lines.append("    extra: the row's other (undeclared) columns, by name.")
+    cls.__doc__ = "\n".join(lines)
+    return cls
+
+
+Gearbox = _dataclass("Gearbox", "gearboxes", "gearbox")
+Drive = _dataclass("Drive", "drives", "drive")
+
+
+class Catalog:
+    """Motors, gearboxes and drives (from :func:`load_catalog` or :meth:`from_frames`).
+
+    Attributes:
+        motors, gearboxes, drives: pandas DataFrames indexed by part name (``name``): the
+            declared columns (:data:`MOTOR_COLUMNS`, ...) in their declared order as floats in
+            SI units (text for ``source``), NaN where an optional value is not given, then any
+            undeclared columns. A kind the catalog has no file for has no rows.
+        paths: the files read, in order.
+    """
+
+    def __init__(self, motors, gearboxes, drives, paths=(), origins=None) -> None:
+        self.motors = motors
+        self.gearboxes = gearboxes
+        self.drives = drives
+        self.paths = tuple(paths)
+        self._origins = dict(origins or {})
+
+    def __repr__(self) -> str:
+        return (
+            f"Catalog({len(self.motors)} motors, {len(self.gearboxes)} gearboxes, "
+            f"{len(self.drives)} drives)"
+        )
+
+    @classmethod
+    def from_frames(cls, motors=None, gearboxes=None, drives=None) -> Catalog:
+        """A catalog from DataFrames (or mappings of columns), checked by the rules of the CSV
+        files: each indexed by part name, or with a ``name`` column. A bad value is a
+        ModelError naming the table, the part and the column."""
+        tables, origins = {}, {}
+        for kind, frame in zip(KINDS, (motors, gearboxes, drives), strict=True):
+            tables[kind], where = _frame_table(kind, frame)
+            origins.update({(kind, n): w for n, w in zip(tables[kind].index, where, strict=True)})
+        return cls(tables["motors"], tables["gearboxes"], tables["drives"], (), origins)
+
+    def _row(self, kind: str, name: str):
+        table = getattr(self, kind)
+        if not isinstance(name, str) or name not in table.index:
+            shown = list(table.index[:10]) + (["..."] if len(table) > 10 else [])
+            raise _core.ModelError(f"catalog: no {kind[:-1]} named {name!r} (the {kind}: {shown})")
+        return table.loc[name]
+
+    def motor(self, name: str):
+        """The motor ``name`` as an :class:`armdyn.Motor` (its MOTOR_FIELDS from the row)."""
+        return _motor_from_row(self._row("motors", name), name)
+
+    def gearbox(self, name: str) -> Any:
+        """The gearbox ``name`` as a frozen :class:`Gearbox`."""
+        return _part(Gearbox, "gearboxes", self._row("gearboxes", name), name)
+
+    def drive(self, name: str) -> Any:
+        """The drive ``name`` as a frozen :class:`Drive`."""
+        return _part(Drive, "drives", self._row("drives", name), name)
+
+    def origin(self, kind: str, name: str) -> str:
+        """Where the part was read (``file:line``, or the table and part for a DataFrame)."""
+        self._row(kind, name)
+        return self._origins[(kind, name)]
+
+
+def _motor_from_row(row, name: str):
+    from_row = getattr(_core.Motor, "from_row", None)
+    if from_row is not None:
+        row = row.copy()
+        row.name = name
+        return from_row(row)
+    from armdyn.sizing import what_if
+
+    kw = {}
+    for key in what_if.MOTOR_FIELDS:
+        if key == "name" or key not in row.index:
+            continue
+        value = row[key]
+        if isinstance(value, float) and math.isnan(value):
+            continue
+        kw[key] = float(value)
+    return _core.Motor(name=name, **kw)
+
+
+def _part(cls, kind: str, row, name: str):
+    declared = _BY_NAME[kind]
+    values = {"name": name}
+    for c in COLUMNS[kind][1:]:
+        value = row[c.name]
+        values[c.name] = str(value) if c.text else float(value)
+    extra = {k: row[k] for k in row.index if k not in declared}
+    return cls(**values, extra=extra)
+
+
+# --- reading -----------------------------------------------------------------------------------
+
+
+def load_catalog(path, *more) -> Catalog:
+    """The catalog at ``path`` (and ``more`` paths, merged): each a folder holding
+    ``motors.csv`` and ``gearboxes.csv`` (and optionally ``drives.csv``), or a single CSV file
+    whose kind is told by its name (``motors.csv``, ``my_motors.csv``, ``gearboxes.csv``,
+    ``drives.csv``...) or else by its header (the kind whose required columns it has). Every
+    row is checked (the module notes give the rules); a part name met twice (in one file or
+    across the paths) is a ModelError naming both places. ``armdyn.sizing.EXAMPLE_CATALOG`` is
+    the example shipped with armdyn."""
+    files: list[tuple[str | None, Path]] = []
+    for k, p in enumerate((path, *more)):
+        if not isinstance(p, (str, os.PathLike)):
+            raise _core.ModelError(
+                f"load_catalog: path {k + 1} must be a str or a path, got {type(p).__name__}"
+            )
+        files.extend(_files_of(Path(os.fspath(p))))
+    parsed: dict[str, list] = {kind: [] for kind in KINDS}
+    for kind, file in files:
+        header, rows, lines = _read_csv(file)
+        kind = kind or _kind_of(file, header)
+        parsed[kind].append(_csv_table(kind, file, header, rows, lines))
+    tables, origins = {}, {}
+    for kind in KINDS:
+        tables[kind], where = _merge(kind, parsed[kind])
+        origins.update({(kind, n): w for n, w in zip(tables[kind].index, where, strict=True)})
+    return Catalog(
+        tables["motors"], tables["gearboxes"], tables["drives"], [f for _, f in files], origins
+    )
+
+
+def _files_of(path: Path) -> list[tuple[str | None, Path]]:
+    """The CSV files of a catalog path (kind None: told by the file later)."""
+    if not path.exists():
+        raise FileNotFoundError(2, "catalog path not found", str(path))
+    if not path.is_dir():
+        return [(None, path)]
+    out = [(kind, path / FILE_NAMES[kind]) for kind in KINDS if (path / FILE_NAMES[kind]).exists()]
+    missing = [
+        FILE_NAMES[k] for k in ("motors", "gearboxes") if not (path / FILE_NAMES[k]).exists()
+    ]
+    if missing:
+        raise _core.ModelError(
+            f"catalog folder {str(path)!r} has no {' and no '.join(missing)} (a catalog folder "
+            "holds motors.csv, gearboxes.csv and optionally drives.csv)"
+        )
+    others = sorted(
+        p.name
+        for p in path.iterdir()
+        if p.suffix.lower() == ".csv" and p.name not in FILE_NAMES.values()
+    )
+    if others:
+        raise _core.ModelError(
+            f"catalog folder {str(path)!r}: unrecognised CSV file(s) {others} (a catalog folder "
+            "holds motors.csv, gearboxes.csv and drives.csv; pass other files as paths of "
+            "their own)"
+        )
+    return out
+
+
+def _text_of(path: Path) -> str:
+    data = _checks.regular_file(path, "catalog file", MAX_CATALOG_BYTES)
+    if data.startswith(b"\xef\xbb\xbf"):
+        data = data[3:]
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as err:
+        line = data[: err.start].count(b"\n") + 1
+        raise _core.ModelError(
+            f"{path}:{line}: not UTF-8 text (byte {data[err.start : err.start + 1]!r} at offset "
+            f"{err.start}); save the catalog as UTF-8"
+        ) from None
+
+
+def _read_csv(path: Path) -> tuple[list[str], list[list[str]], list[int]]:
+    """(header, data rows, each data row's first line): blank rows skipped, cells stripped."""
+    text = _text_of(path)
+    reader = csv.reader(io.StringIO(text, newline=""), strict=True)
+    header, rows, lines = None, [], []
+    while True:
+        line = reader.line_num + 1
+        try:
+            row = next(reader)
+        except StopIteration:
+            break
+        except csv.Error as err:
+            raise _core.ModelError(f"{path}:{line}: malformed CSV ({err})") from None
+        cells = [c.strip() for c in row]
+        if not any(cells):
+            continue
+        if header is None:
+            header = _header(path, line, cells)
+            continue
+        if len(cells) != len(header):
+            raise _core.ModelError(
+                f"{path}:{line}: the row has {len(cells)} cells, the header {len(header)}"
+            )
+        rows.append(cells)
+        lines.append(line)
+    if header is None:
+        raise _core.ModelError(f"{path}: empty catalog file (no header row)")
+    if not rows:
+        raise _core.ModelError(f"{path}: no parts (a header row and no data rows)")
+    return header, rows, lines
+
+
+def _header(path: Path, line: int, cells: list[str]) -> list[str]:
+    for k, name in enumerate(cells):
+        if not name:
+            raise _core.ModelError(f"{path}:{line}: header cell {k + 1} is empty")
+    seen = set()
+    for name in cells:
+        if name in seen:
+            raise _core.ModelError(f"{path}:{line}: column {name!r} appears twice in the header")
+        seen.add(name)
+    return cells
+
+
+def _kind_of(path: Path, header: list[str]) -> str:
+    stem = path.stem.lower()
+    for kind in KINDS:
+        if stem == kind or re.search(rf"[_\-. ]{kind}$", stem):
+            return kind
+    fits = [k for k in KINDS if {c.name for c in COLUMNS[k] if c.required} <= set(header)]
+    if len(fits) == 1:
+        return fits[0]
+    names = ", ".join(FILE_NAMES.values())
+    if not fits:
+        raise _core.ModelError(
+            f"{path}: which kind of part? The file name is none of {names} and its header has "
+            "the required columns of no kind ("
+            + "; ".join(f"{k}: missing {_missing(k, header)}" for k in KINDS)
+            + ")"
+        )
+    raise _core.ModelError(f"{path}: which kind of part? Its header fits {fits}: name it {names}")
+
+
+def _missing(kind: str, header) -> list[str]:
+    return [c.name for c in COLUMNS[kind] if c.required and c.name not in header]
+
+
+@dataclass
+class _Table:
+    """One file's (or frame's) parts before merging: the columns as arrays, and where each row
+    came from (for messages)."""
+
+    kind: str
+    names: list[str]
+    values: dict[str, Any]  # column -> float array, or list of str (text columns)
+    where: list[str]  # "file:line" per row
+    extras: list[str]
+
+
+def _csv_table(kind: str, path: Path, header, rows, lines) -> _Table:
+    missing = _missing(kind, header)
+    if missing:
+        raise _core.ModelError(f"{path}: missing required column(s) {missing} of {kind}")
+    where = [f"{path}:{line}" for line in lines]
+    by_name = _BY_NAME[kind]
+    values: dict[str, Any] = {}
+    for k, col in enumerate(header):
+        cells = [r[k] for r in rows]
+        c = by_name.get(col)
+        if c is None:
+            values[col] = _extra_values(cells)
+        elif c.text:
+            values[col] = cells
+        else:
+            values[col] = _numbers(cells, col, where)
+    extras = [h for h in header if h not in by_name]
+    return _check_table(_Table(kind, values["name"], values, where, extras))
+
+
+def _numbers(cells: list[str], col: str, where: list[str]) -> np.ndarray:
+    out = np.empty(len(cells))
+    for i, text in enumerate(cells):
+        if not text:
+            out[i] = np.nan
+            continue
+        x = float(text) if _NUMBER.fullmatch(text) else math.nan
+        if not math.isfinite(x):
+            why = "overflows a float" if _NUMBER.fullmatch(text) else "is not a finite number"
+            raise _core.ModelError(f"{where[i]}: column {col!r}: {text[:40]!r} {why}")
+        out[i] = x
+    return out
+
+
+def _extra_values(cells: list[str]):
+    """An undeclared column: floats when every non-blank cell is a finite number, else text."""
+    if all(not t or _NUMBER.fullmatch(t) for t in cells):
+        x = np.array([float(t) if t else np.nan for t in cells])
+        if np.all(np.isfinite(x) | np.array([not t for t in cells])):
+            return x
+    return list(cells)
+
+
+def _check_table(t: _Table) -> _Table:
+    """Every rule of the module notes on one table (names, required, bounds, groups, order);
+    the first offence is a ModelError naming the row's place and the column."""
+    names = [str(n) for n in t.names]
+    for i, n in enumerate(names):
+        if not n:
+            raise _core.ModelError(f"{t.where[i]}: column 'name': empty part name")
+        if any(ord(ch) < 32 for ch in n):
+            raise _core.ModelError(f"{t.where[i]}: column 'name': {n!r} has control characters")
+    t.names = names
+    _duplicates(t.kind, names, t.where)
+    for c in COLUMNS[t.kind][1:]:
+        if c.text:
+            t.values[c.name] = [str(v) for v in t.values.get(c.name, [""] * len(names))]
+            continue
+        x = t.values.get(c.name)
+        x = np.full(len(names), np.nan) if x is None else np.asarray(x, dtype=float)
+        bad = np.flatnonzero(np.isnan(x)) if c.required else []
+        if len(bad):
+            raise _core.ModelError(
+                f"{t.where[bad[0]]}: column {c.name!r}: a value is required ({c.unit}, {c.allowed})"
+            )
+        bad = np.flatnonzero(c.out_of_bounds(x) | np.isinf(x))
+        if len(bad):
+            i = bad[0]
+            raise _core.ModelError(
+                f"{t.where[i]}: column {c.name!r}: {x[i]!r} must be {c.allowed} [{c.unit}]"
+            )
+        if c.default is not None:
+            x = np.where(np.isnan(x), c.default, x)
+        t.values[c.name] = x
+    _relations(t)
+    return t
+
+
+def _relations(t: _Table) -> None:
+    v = t.values
+    for group in _GROUPS[t.kind]:
+        given = np.stack([~np.isnan(v[c]) for c in group])
+        partial = np.flatnonzero(given.any(axis=0) & ~given.all(axis=0))
+        if len(partial):
+            i = partial[0]
+            lacking = [c for k, c in enumerate(group) if not given[k, i]]
+            raise _core.ModelError(
+                f"{t.where[i]}: column(s) {lacking}: {list(group)} are given together or not at all"
+            )
+    for col, needed in _NEEDS[t.kind]:
+        bad = np.flatnonzero(~np.isnan(v[col]) & np.isnan(v[needed]))
+        if len(bad):
+            raise _core.ModelError(f"{t.where[bad[0]]}: column {needed!r}: {col} needs it")
+    for small, large in _ORDERED[t.kind]:
+        with np.errstate(invalid="ignore"):
+            bad = np.flatnonzero(v[small] > v[large])
+        if len(bad):
+            i = bad[0]
+            raise _core.ModelError(
+                f"{t.where[i]}: column {large!r}: {v[large][i]!r} is less than {small} "
+                f"{v[small][i]!r}"
+            )
+
+
+def _duplicates(kind: str, names: list[str], where: list[str]) -> None:
+    first: dict[str, int] = {}
+    for i, n in enumerate(names):
+        if n in first:
+            raise _core.ModelError(
+                f"{where[i]}: column 'name': {kind[:-1]} {n!r} is already at {where[first[n]]}"
+            )
+        first[n] = i
+
+
+def _merge(kind: str, tables: list[_Table]):
+    """One DataFrame per kind (declared columns, then the extras in order of appearance)."""
+    import pandas as pd
+
+    names = [n for t in tables for n in t.names]
+    where = [w for t in tables for w in t.where]
+    _duplicates(kind, names, where)
+    data: dict[str, Any] = {}
+    for c in COLUMNS[kind][1:]:
+        if c.text:
+            data[c.name] = [s for t in tables for s in t.values[c.name]]
+        else:
+            data[c.name] = np.concatenate([t.values[c.name] for t in tables] or [np.empty(0)])
+    extras = list(dict.fromkeys(e for t in tables for e in t.extras))
+    for e in extras:
+        parts = [_extra_or_blank(t, e) for t in tables]
+        if all(isinstance(p, np.ndarray) for p in parts):
+            data[e] = np.concatenate(parts)
+        else:
+            data[e] = [
+                str(x) if not (isinstance(x, float) and np.isnan(x)) else ""
+                for p in parts
+                for x in p
+            ]
+    frame = pd.DataFrame(data, index=pd.Index(names, name="name", dtype=object))
+    return frame, where
+
+
+def _extra_or_blank(t: _Table, col: str):
+    if col in t.values:
+        return t.values[col]
+    return np.full(len(t.names), np.nan)
+
+
+def _frame_table(kind: str, frame):
+    """A DataFrame (or mapping of columns, or None) checked as a table of ``kind``."""
+    import pandas as pd
+
+    if frame is None:
+        frame = pd.DataFrame({c.name: [] for c in COLUMNS[kind]})
+    if isinstance(frame, Mapping):
+        frame = pd.DataFrame(dict(frame))
+    if not isinstance(frame, pd.DataFrame):
+        raise _core.ModelError(
+            f"Catalog.from_frames: {kind} must be a DataFrame, a mapping of columns or None, "
+            f"got {type(frame).__name__}"
+        )
+    if "name" not in frame.columns:
+        frame = frame.reset_index().rename(columns={frame.index.name or "index": "name"})
+    header = [str(c) for c in frame.columns]
+    missing = _missing(kind, header)
+    if missing:
+        raise _core.ModelError(f"Catalog.from_frames: {kind} lacks required column(s) {missing}")
+    names = [str(n) for n in frame["name"]]
+    where = [f"{kind} table, part {n!r}" for n in names]
+    by_name = _BY_NAME[kind]
+    values: dict[str, Any] = {}
+    for col in header:
+        c = by_name.get(col)
+        series = frame[col]
+        if c is not None and not c.text:
+            values[col] = _frame_numbers(series, col, where)
+        elif c is not None:
+            values[col] = ["" if _blank(v) else str(v) for v in series]
+        else:
+            values[col] = series.to_numpy()
+    extras = [h for h in header if h not in by_name]
+    t = _check_table(_Table(kind, names, values, where, extras))
+    return _merge(kind, [t])
+
+
+def _blank(v) -> bool:
+    return v is None or (isinstance(v, float) and math.isnan(v))
+
+
+def _frame_numbers(series, col: str, where: list[str]) -> np.ndarray:
+    out = np.empty(len(series))
+    for i, v in enumerate(series.tolist()):
+        if _blank(v):
+            out[i] = np.nan
+            continue
+        if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, float, np.number)):
+            raise _core.ModelError(f"{where[i]}: column {col!r}: {v!r} is not a number")
+        out[i] = float(v)
+        if not math.isfinite(out[i]):
+            raise _core.ModelError(f"{where[i]}: column {col!r}: {v!r} is not a finite number")
+    return out
+
+
+# --- docs ---------------------------------------------------------------------------------------
+
+
+def column_table(kind: str) -> str:
+    """The Markdown table of a kind's columns (docs/api.md's "Catalogs" tables)."""
+    _checks.choice("column_table", "kind", kind, KINDS)
+    lines = ["| column | unit | required | allowed | meaning |", "|---|---|---|---|---|"]
+    for c in COLUMNS[kind]:
+        allowed = c.allowed + (f", default {c.default:g}" if c.default is not None else "")
+        unit = c.unit or "text"
+        lines.append(
+            f"| `{c.name}` | {unit} | {'yes' if c.required else ''} | {allowed} | {c.doc} |"
+        )
+    return "\n".join(lines)
