@@ -57,6 +57,7 @@ EXAMPLE_CATALOG = Path(__file__).resolve().parent / "example_catalog"
 #: the part kinds, and the file name of each in a catalog folder
 KINDS = ("motors", "gearboxes", "drives")
 FILE_NAMES = {kind: f"{kind}.csv" for kind in KINDS}
+_ONE = {"motors": "motor", "gearboxes": "gearbox", "drives": "drive"}
 
 
 @dataclass(frozen=True)
@@ -323,7 +324,7 @@ class Catalog:
         table = getattr(self, kind)
         if not isinstance(name, str) or name not in table.index:
             shown = list(table.index[:10]) + (["..."] if len(table) > 10 else [])
-            raise _core.ModelError(f"catalog: no {kind[:-1]} named {name!r} (the {kind}: {shown})")
+            raise _core.ModelError(f"catalog: no {_ONE[kind]} named {name!r} (the {kind}: {shown})")
         return table.loc[name]
 
     def motor(self, name: str):
@@ -438,6 +439,12 @@ def _text_of(path: Path) -> str:
     data = _checks.regular_file(path, "catalog file", MAX_CATALOG_BYTES)
     if data.startswith(b"\xef\xbb\xbf"):
         data = data[3:]
+    nul = data.find(b"\x00")
+    if nul >= 0:
+        line = data[:nul].count(b"\n") + 1
+        raise _core.ModelError(
+            f"{path}:{line}: a NUL byte (offset {nul}): not UTF-8 text (a binary or UTF-16 file?)"
+        )
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as err:
@@ -596,7 +603,7 @@ def _check_table(t: _Table) -> _Table:
         if len(bad):
             i = bad[0]
             raise _core.ModelError(
-                f"{t.where[i]}: column {c.name!r}: {x[i]!r} must be {c.allowed} [{c.unit}]"
+                f"{t.where[i]}: column {c.name!r}: {float(x[i])!r} must be {c.allowed} [{c.unit}]"
             )
         if c.default is not None:
             x = np.where(np.isnan(x), c.default, x)
@@ -626,8 +633,8 @@ def _relations(t: _Table) -> None:
         if len(bad):
             i = bad[0]
             raise _core.ModelError(
-                f"{t.where[i]}: column {large!r}: {v[large][i]!r} is less than {small} "
-                f"{v[small][i]!r}"
+                f"{t.where[i]}: column {large!r}: {float(v[large][i])!r} is less than {small} "
+                f"{float(v[small][i])!r}"
             )
 
 
@@ -636,7 +643,7 @@ def _duplicates(kind: str, names: list[str], where: list[str]) -> None:
     for i, n in enumerate(names):
         if n in first:
             raise _core.ModelError(
-                f"{where[i]}: column 'name': {kind[:-1]} {n!r} is already at {where[first[n]]}"
+                f"{where[i]}: column 'name': {_ONE[kind]} {n!r} is already at {where[first[n]]}"
             )
         first[n] = i
 
@@ -689,7 +696,11 @@ def _frame_table(kind: str, frame):
             f"got {type(frame).__name__}"
         )
     if "name" not in frame.columns:
-        frame = frame.reset_index().rename(columns={frame.index.name or "index": "name"})
+        if isinstance(frame.index, pd.RangeIndex) and len(frame):
+            raise _core.ModelError(
+                f"Catalog.from_frames: {kind} needs a 'name' column or an index of part names"
+            )
+        frame = frame.rename_axis("name").reset_index()
     header = [str(c) for c in frame.columns]
     missing = _missing(kind, header)
     if missing:
@@ -728,6 +739,127 @@ def _frame_numbers(series, col: str, where: list[str]) -> np.ndarray:
         if not math.isfinite(out[i]):
             raise _core.ModelError(f"{where[i]}: column {col!r}: {v!r} is not a finite number")
     return out
+
+
+# --- a synthetic catalog (benchmarks, tests) ----------------------------------------------------
+
+_RATIOS = (50.0, 80.0, 100.0, 120.0, 160.0)
+#: strain-wave rated torque per ratio, relative to ratio 100 (the example catalog's pattern)
+_RATIO_TORQUE = {50.0: 0.6, 80.0: 0.94, 100.0: 1.0, 120.0: 1.0, 160.0: 1.0}
+_RATIO_EFFICIENCY = {50.0: 0.80, 80.0: 0.78, 100.0: 0.75, 120.0: 0.72, 160.0: 0.68}
+
+
+def synthetic_catalog(n_motors: int = 100, n_gearboxes: int = 100, n_drives: int = 4, seed=0):
+    """A large catalog of made-up, self-consistent parts for benchmarks and tests (every value
+    ``source`` "synthetic"): ``n_motors`` 48 V motors with continuous torques log-uniform in
+    0.02-5 N m and the other columns from scaling laws of the example catalog's motors;
+    ``n_gearboxes`` strain-wave units of sizes log-uniform in 8-40 in the ratios 50, 80, 100,
+    120, 160 (in turn), scaled from the example's size 25; ``n_drives`` drives of continuous
+    currents log-uniform in 3-60 A. Values jittered by up to +-10 % (``seed``: numpy's
+    default_rng). ``n_motors * n_gearboxes`` combinations per joint (100 x 100 = 10,000)."""
+    import pandas as pd
+
+    who = "synthetic_catalog"
+    n_motors = _checks.integer(who, "n_motors", n_motors, lo=1, hi=10**6)
+    n_gearboxes = _checks.integer(who, "n_gearboxes", n_gearboxes, lo=1, hi=10**6)
+    n_drives = _checks.integer(who, "n_drives", n_drives, lo=0, hi=10**6)
+    rng = np.random.default_rng(seed)
+    motors = _synthetic_motors(rng, n_motors)
+    gearboxes = _synthetic_gearboxes(rng, n_gearboxes)
+    current = np.exp(rng.uniform(np.log(3.0), np.log(60.0), n_drives))
+    drives = pd.DataFrame(
+        {
+            "name": [f"SD-{k:05d}" for k in range(n_drives)],
+            "continuous_current": current,
+            "peak_current": 3.0 * current,
+            "bus_voltage": 48.0,
+            "max_bus_voltage": 58.0,
+            "bus_capacitance": 1e-4 * current,
+            "braking_resistor_power": 5.0 * current,
+            "braking_resistor_peak_power": 60.0 * current,
+            "mass": 0.015 * current,
+            "cost": 60.0 * current**0.6,
+            "source": "synthetic",
+        }
+    )
+    return Catalog.from_frames(motors, gearboxes, drives)
+
+
+def _synthetic_motors(rng, n: int):
+    import pandas as pd
+
+    def jitter():
+        return rng.uniform(0.9, 1.1, n)
+
+    tc = np.exp(rng.uniform(np.log(0.02), np.log(5.0), n))
+    kt = 0.14 * np.sqrt(tc) * jitter()
+    loss = 15.0 * tc**0.8 * jitter()  # copper loss at the continuous torque, 25 degC [W]
+    resistance = loss * kt**2 / tc**2
+    t_max = 155.0
+    r_total = (t_max - 25.0) / (loss * (1.0 + 0.00393 * (t_max - 25.0)))
+    no_load = 48.0 / kt
+    return pd.DataFrame(
+        {
+            "name": [f"SM-{k:05d}" for k in range(n)],
+            "torque_constant": kt,
+            "resistance": resistance,
+            "rotor_inertia": 1.1e-4 * tc**1.6 * jitter(),
+            "mass": 0.5 * tc**0.75 * jitter(),
+            "continuous_torque": tc,
+            "peak_torque": 3.1 * tc * jitter(),
+            "no_load_speed": no_load,
+            "max_speed": np.minimum(no_load, 1500.0),
+            "voltage": 48.0,
+            "thermal_resistance_winding": 0.3 * r_total,
+            "thermal_resistance_housing": 0.7 * r_total,
+            "thermal_time_constant_winding": 60.0 * tc**0.3 * jitter(),
+            "thermal_time_constant_housing": 1500.0 * tc**0.3 * jitter(),
+            "max_winding_temperature": t_max,
+            "brake_torque": np.where(np.arange(n) % 3 == 2, 1.1 * tc, np.nan),
+            "cost": 250.0 * tc**0.6 * jitter(),
+            "source": "synthetic",
+        }
+    )
+
+
+def _synthetic_gearboxes(rng, n: int):
+    import pandas as pd
+
+    def jitter():
+        return rng.uniform(0.9, 1.1, n)
+
+    s = np.exp(rng.uniform(np.log(8.0), np.log(40.0), n)) / 25.0  # size relative to 25
+    ratio = np.array([_RATIOS[k % len(_RATIOS)] for k in range(n)])
+    rated = 67.0 * s**3 * np.array([_RATIO_TORQUE[r] for r in ratio]) * jitter()
+    rpm = 2.0 * np.pi / 60.0
+    return pd.DataFrame(
+        {
+            "name": [f"SG-{k:05d}-{int(r)}" for k, r in enumerate(ratio)],
+            "ratio": ratio,
+            "efficiency": np.array([_RATIO_EFFICIENCY[r] for r in ratio])
+            * rng.uniform(0.97, 1.03, n),
+            "input_inertia": 4.13e-5 * s**5 * jitter(),
+            "mass": 1.5 * s**2.3 * jitter(),
+            "rated_torque": rated,
+            "rated_input_speed": 2000.0 * rpm,
+            "rated_life": 7000.0,
+            "life_exponent": 3.0,
+            "average_torque_limit": 1.6 * rated,
+            "average_input_speed_limit": 3500.0 * rpm,
+            "repeated_peak_torque": 2.35 * rated,
+            "momentary_peak_torque": 4.3 * rated,
+            "momentary_peak_count": 10000.0,
+            "max_input_speed": 5600.0 * rpm * s**-0.6,
+            "bearing_moment_allowable": 156.0 * s**3 * jitter(),
+            "bearing_axial_allowable": 7200.0 * s**2 * jitter(),
+            "bearing_radial_allowable": 4800.0 * s**2 * jitter(),
+            "bearing_offset": 0.0145 * s,
+            "bearing_dynamic_load_rating": 10400.0 * s**2 * jitter(),
+            "bearing_pitch_diameter": 0.068 * s,
+            "cost": 850.0 * s**1.5 * jitter(),
+            "source": "synthetic",
+        }
+    )
 
 
 # --- docs ---------------------------------------------------------------------------------------
