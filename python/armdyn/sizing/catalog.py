@@ -296,12 +296,30 @@ class Catalog:
         paths: the files read, in order.
     """
 
-    def __init__(self, motors, gearboxes, drives, paths=(), origins=None) -> None:
-        self.motors = motors
-        self.gearboxes = gearboxes
-        self.drives = drives
+    def __init__(self, motors=None, gearboxes=None, drives=None) -> None:
+        """A catalog from DataFrames (or mappings of columns, or None for no parts), each
+        indexed by part name or with a ``name`` column, checked by the rules of the CSV files
+        (a bad value is a ModelError naming the table, the part and the column); the same as
+        :meth:`from_frames`. :func:`load_catalog` reads files."""
+        tables, origins = {}, {}
+        for kind, frame in zip(KINDS, (motors, gearboxes, drives), strict=True):
+            tables[kind], where = _frame_table(kind, frame)
+            origins.update({(kind, n): w for n, w in zip(tables[kind].index, where, strict=True)})
+        self._set(tables, (), origins)
+
+    def _set(self, tables: dict, paths, origins: dict) -> None:
+        self.motors = tables["motors"]
+        self.gearboxes = tables["gearboxes"]
+        self.drives = tables["drives"]
         self.paths = tuple(paths)
-        self._origins = dict(origins or {})
+        self._origins = dict(origins)
+
+    @classmethod
+    def _checked(cls, tables: dict, paths, origins: dict) -> Catalog:
+        """A catalog of tables already checked (load_catalog's)."""
+        self = cls.__new__(cls)
+        self._set(tables, paths, origins)
+        return self
 
     def __repr__(self) -> str:
         return (
@@ -311,14 +329,10 @@ class Catalog:
 
     @classmethod
     def from_frames(cls, motors=None, gearboxes=None, drives=None) -> Catalog:
-        """A catalog from DataFrames (or mappings of columns), checked by the rules of the CSV
-        files: each indexed by part name, or with a ``name`` column. A bad value is a
+        """A catalog from DataFrames (or mappings of columns, or None), checked by the rules of
+        the CSV files: each indexed by part name, or with a ``name`` column. A bad value is a
         ModelError naming the table, the part and the column."""
-        tables, origins = {}, {}
-        for kind, frame in zip(KINDS, (motors, gearboxes, drives), strict=True):
-            tables[kind], where = _frame_table(kind, frame)
-            origins.update({(kind, n): w for n, w in zip(tables[kind].index, where, strict=True)})
-        return cls(tables["motors"], tables["gearboxes"], tables["drives"], (), origins)
+        return cls(motors, gearboxes, drives)
 
     def _row(self, kind: str, name: str):
         table = getattr(self, kind)
@@ -401,9 +415,7 @@ def load_catalog(path, *more) -> Catalog:
     for kind in KINDS:
         tables[kind], where = _merge(kind, parsed[kind])
         origins.update({(kind, n): w for n, w in zip(tables[kind].index, where, strict=True)})
-    return Catalog(
-        tables["motors"], tables["gearboxes"], tables["drives"], [f for _, f in files], origins
-    )
+    return Catalog._checked(tables, [f for _, f in files], origins)
 
 
 def _files_of(path: Path) -> list[tuple[str | None, Path]]:
