@@ -619,7 +619,7 @@ def test_from_frames_checks_every_value():
     good = synthetic_catalog(3, 3, 1, seed=0)
     motors = good.motors.copy()
     motors.loc["SM-00001", "peak_torque"] = -2.0
-    with raises(r"motors table, part 'SM-00001': column 'peak_torque': -2.0 must be > 0"):
+    with raises(r"motors table, row 2, part 'SM-00001': column 'peak_torque': -2.0 must be > 0"):
         Catalog.from_frames(motors, good.gearboxes)
     motors = good.motors.copy()
     motors["mass"] = motors["mass"].astype(object)

@@ -718,7 +718,7 @@ def _frame_table(kind: str, frame):
     if missing:
         raise _core.ModelError(f"Catalog.from_frames: {kind} lacks required column(s) {missing}")
     names = [str(n) for n in frame["name"]]
-    where = [f"{kind} table, part {n!r}" for n in names]
+    where = [f"{kind} table, row {i + 1}, part {n!r}" for i, n in enumerate(names)]
     by_name = _BY_NAME[kind]
     values: dict[str, Any] = {}
     for col in header:
