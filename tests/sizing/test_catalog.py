@@ -453,6 +453,10 @@ def test_bad_paths(tmp_path):
         load_catalog(tmp_path / "nowhere")
     with raises(r"load_catalog: path 2 must be a str or a path, got int"):
         load_catalog(EXAMPLE_CATALOG, 3)
+    with raises(r"load_catalog: path 1 must be a str or a path, got bytes"):
+        load_catalog(b"x")
+    with raises(r"path 1 must be a str path without NUL characters, got 'a\\x00b'"):
+        load_catalog("a\x00b")
 
 
 # --- hostile files ------------------------------------------------------------------------------

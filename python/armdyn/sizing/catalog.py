@@ -405,7 +405,13 @@ def load_catalog(path, *more) -> Catalog:
             raise _core.ModelError(
                 f"load_catalog: path {k + 1} must be a str or a path, got {type(p).__name__}"
             )
-        files.extend(_files_of(Path(os.fspath(p))))
+        text = os.fspath(p)
+        if not isinstance(text, str) or "\x00" in text:
+            raise _core.ModelError(
+                f"load_catalog: path {k + 1} must be a str path without NUL characters, got "
+                f"{text!r:.60}"
+            )
+        files.extend(_files_of(Path(text)))
     parsed: dict[str, list] = {kind: [] for kind in KINDS}
     for kind, file in files:
         header, rows, lines = _read_csv(file)
