@@ -258,6 +258,16 @@ def test_unknown_columns_are_kept_numbers_as_floats_text_as_text(tmp_path):
     assert c.motors.loc["M1", "vendor"] == "Acme" and c.motors.loc["M2", "vendor"] == ""
 
 
+def test_a_misspelt_column_is_kept_with_a_warning(tmp_path):
+    d = folder(tmp_path, f"{MOTORS_HEADER},max_winding_temp\n{MOTOR_ROW},155\n")
+    with pytest.warns(
+        UserWarning, match="'max_winding_temp' is not a motor column .*'max_winding_temperature'"
+    ):
+        c = load_catalog(d)
+    assert c.motors.loc["M1", "max_winding_temp"] == 155.0
+    assert math.isnan(c.motors.loc["M1", "max_winding_temperature"])
+
+
 def test_bom_crlf_and_blank_rows_read_as_plain_csv(tmp_path):
     text = f"{MOTORS_HEADER}\n\n{MOTOR_ROW}\n,,,,,,\nM2,0.2,0.4,2e-5,0.5,1,3\n"
     plain = load_catalog(folder(tmp_path / "a", text))
@@ -479,6 +489,10 @@ def test_bad_paths(tmp_path):
             rf"motors.csv:2: a NUL byte \(offset {len(MOTORS_HEADER) + 2}\)",
         ),
         (f"{MOTORS_HEADER},\n{MOTOR_ROW},\n", r"motors.csv:1: header cell 8 is empty"),
+        (
+            f"{MOTORS_HEADER}\n{MOTOR_ROW}\n{'M' * 200_000},0.1,0.5,1e-5,0.3,0.5,1.5\n",
+            r"motors.csv:3: malformed CSV \(field larger than field limit",
+        ),
         (f"{MOTORS_HEADER},mass\n{MOTOR_ROW},1\n", r"motors.csv:1: column 'mass' appears twice"),
         (
             f"{MOTORS_HEADER}\n\x01M,0.1,0.5,1e-5,0.3,0.5,1.5\n",

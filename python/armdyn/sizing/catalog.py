@@ -24,7 +24,8 @@ Reading rules (every row is checked before anything is returned):
   columns (continuous ≤ peak torque and current, rated ≤ repeated peak ≤ momentary peak torque,
   bus voltage ≤ maximum bus voltage) are checked on every row.
 - Columns not declared here are kept as they are: as floats when every cell is a number or
-  blank (blank: NaN), else as text.
+  blank (blank: NaN), else as text. One that looks like a misspelt declared column
+  (``max_winding_temp``) gives a UserWarning naming the column it resembles.
 - Part names are unique per kind, across all the paths merged.
 
 Every error is an :class:`armdyn.ModelError` naming the file, the line (1-based, as an editor
@@ -569,7 +570,25 @@ def _csv_table(kind: str, path: Path, header, rows, lines) -> _Table:
         else:
             values[col] = _numbers(cells, col, where)
     extras = [h for h in header if h not in by_name]
+    _near_misses(kind, str(path), extras)
     return _check_table(_Table(kind, values["name"], values, where, extras))
+
+
+def _near_misses(kind: str, where: str, extras: list[str]) -> None:
+    """A UserWarning for each undeclared column that looks like a misspelt declared one (kept,
+    but its check would go unchecked)."""
+    import difflib
+    import warnings
+
+    for e in extras:
+        close = difflib.get_close_matches(e, list(_BY_NAME[kind]), n=1, cutoff=0.8)
+        if close:
+            warnings.warn(
+                f"{where}: column {e!r} is not a {_ONE[kind]} column (kept as an extra); "
+                f"did you mean {close[0]!r}?",
+                UserWarning,
+                stacklevel=4,
+            )
 
 
 def _numbers(cells: list[str], col: str, where: list[str]) -> np.ndarray:
@@ -737,6 +756,7 @@ def _frame_table(kind: str, frame):
         else:
             values[col] = series.to_numpy()
     extras = [h for h in header if h not in by_name]
+    _near_misses(kind, f"{kind} table", extras)
     t = _check_table(_Table(kind, names, values, where, extras))
     return _merge(kind, [t])
 
