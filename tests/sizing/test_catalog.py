@@ -277,6 +277,13 @@ def test_bom_crlf_and_blank_rows_read_as_plain_csv(tmp_path):
     other = load_catalog(odd)
     pd.testing.assert_frame_equal(plain.motors, other.motors)
     assert other.origin("motors", "M2") == f"{odd / 'motors.csv'}:5"  # blank lines counted
+    write(odd / "motors.csv", text.replace("\n", "\r"))  # old Mac line ends
+    other = load_catalog(odd)
+    pd.testing.assert_frame_equal(plain.motors, other.motors)
+    assert other.origin("motors", "M2") == f"{odd / 'motors.csv'}:5"
+    (odd / "motors.csv").write_bytes(text.replace("\n", "\r").encode() + b"M3,\xff\r")
+    with raises(re.escape(f"{odd / 'motors.csv'}:6: not UTF-8 text (byte b'\\xff'")):
+        load_catalog(odd)
 
 
 @pytest.mark.parametrize(

@@ -460,18 +460,23 @@ def _text_of(path: Path) -> str:
         data = data[3:]
     nul = data.find(b"\x00")
     if nul >= 0:
-        line = data[:nul].count(b"\n") + 1
+        line = _line_of(data, nul)
         raise _core.ModelError(
             f"{path}:{line}: a NUL byte (offset {nul}): not UTF-8 text (a binary or UTF-16 file?)"
         )
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as err:
-        line = data[: err.start].count(b"\n") + 1
+        line = _line_of(data, err.start)
         raise _core.ModelError(
             f"{path}:{line}: not UTF-8 text (byte {data[err.start : err.start + 1]!r} at offset "
             f"{err.start}); save the catalog as UTF-8"
         ) from None
+
+
+def _line_of(data: bytes, offset: int) -> int:
+    """The 1-based line of a byte offset (CRLF, LF and CR line ends, as the CSV reader)."""
+    return len(re.split(rb"\r\n|\r|\n", data[:offset]))
 
 
 def _read_csv(path: Path) -> tuple[list[str], list[list[str]], list[int]]:
