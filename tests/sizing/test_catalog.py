@@ -622,7 +622,20 @@ def test_gearbox_and_drive_are_frozen_dataclasses_of_the_declared_columns(exampl
 def test_extra_columns_reach_the_dataclass(tmp_path):
     gears = f"{GEARBOX_HEADER},vendor,backlash\n{GEARBOX_ROW},Acme,0.5\n"
     c = load_catalog(folder(tmp_path, f"{MOTORS_HEADER}\n{MOTOR_ROW}\n", gears))
-    assert dict(c.gearbox("G1").extra) == {"vendor": "Acme", "backlash": 0.5}
+    g = c.gearbox("G1")
+    assert dict(g.extra) == {"vendor": "Acme", "backlash": 0.5}
+    assert isinstance(hash(g), int)  # hashable, extra left out
+
+
+def test_catalogs_and_parts_pickle(example):
+    import pickle
+
+    back = pickle.loads(pickle.dumps(example))
+    for kind in cat.KINDS:
+        pd.testing.assert_frame_equal(getattr(back, kind), getattr(example, kind))
+    assert back.origin("motors", "FL-70x18") == example.origin("motors", "FL-70x18")
+    g = example.gearbox("SW-25-100")
+    assert repr(pickle.loads(pickle.dumps(g))) == repr(g)  # (NaN fields: == is False)
 
 
 # --- frames and the synthetic catalog -----------------------------------------------------------

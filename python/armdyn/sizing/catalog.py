@@ -266,7 +266,8 @@ _NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
 def _dataclass(cls_name: str, kind: str, what: str):
     cols = COLUMNS[kind]
     fields_ = [(c.name, str if c.text else float) for c in cols]
-    fields_.append(("extra", Mapping[str, Any], field(default_factory=dict)))
+    # the other columns, left out of the hash (a dict is not hashable)
+    fields_.append(("extra", Mapping[str, Any], field(default_factory=dict, hash=False)))
     cls = make_dataclass(cls_name, fields_, frozen=True)
     cls.__module__ = __name__  # (make_dataclass takes module= from Python 3.12)
     lines = [
@@ -277,7 +278,7 @@ def _dataclass(cls_name: str, kind: str, what: str):
     for c in cols:
         unit = f" [{c.unit}]" if c.unit not in ("", "1") else ""
         lines.append(f"    {c.name}: {c.doc}{unit}.")
-    lines.append("    extra: the row's other (undeclared) columns, by name.")
+    lines.append("    extra: the row's other (undeclared) columns, by name (a dict).")
     cls.__doc__ = "\n".join(lines)
     return cls
 
