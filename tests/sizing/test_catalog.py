@@ -606,6 +606,22 @@ def test_motor_carries_every_motor_field_of_its_row(example):
         example.motor("nope")
 
 
+def test_motor_goes_through_motor_from_row_when_there_is_one(example, monkeypatch):
+    """With armdyn.Motor.from_row (issue 33's motor part), Catalog.motor hands it the row: a
+    pandas Series named after the part, holding every column of the row."""
+    seen = []
+
+    def from_row(row):
+        seen.append(row)
+        return "from_row"
+
+    monkeypatch.setattr(ad.Motor, "from_row", staticmethod(from_row), raising=False)
+    assert example.motor("FL-85x23-B") == "from_row"
+    (row,) = seen
+    assert row.name == "FL-85x23-B" and row["brake_torque"] == 2.5
+    assert list(row.index) == list(example.motors.columns)
+
+
 def test_gearbox_and_drive_are_frozen_dataclasses_of_the_declared_columns(example):
     g = example.gearbox("SW-25-100")
     assert [f.name for f in dataclasses.fields(g)] == [c.name for c in GEARBOX_COLUMNS] + ["extra"]
