@@ -182,8 +182,8 @@ GEARBOX_COLUMNS: tuple[Column, ...] = (
         "bearing_offset",
         "m",
         False,
-        "output bearing: its reference point's distance from the joint point along the joint "
-        "axis (signed)",
+        "output bearing: the signed distance of its reference point from the joint point "
+        "along the joint axis (the bearing checks document the sign)",
         lo=None,
     ),
     Column("bearing_dynamic_load_rating", "N", False, "output bearing: dynamic load rating C"),
