@@ -101,6 +101,33 @@ def test_the_wheel_takes_the_example_catalog():
         assert ignored.returncode == 1 and ignored.stdout == "", ignored.stdout  # none ignored
 
 
+def test_the_built_wheel_holds_the_example_catalog(tmp_path, example):
+    """The wheel's Python part, built by scikit-build-core from this checkout (CMake skipped:
+    wheel.cmake=false, the same package file selection as the full build), holds the example
+    catalog, and the files installed from it load to the same tables."""
+    pytest.importorskip("scikit_build_core")
+    build = ["--no-deps", "--no-build-isolation", "-C", "wheel.cmake=false", "-q"]
+    proc = subprocess.run(
+        [sys.executable, "-m", "pip", "wheel", str(ROOT), *build, "-w", str(tmp_path / "dist")],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert proc.returncode == 0, proc.stderr
+    (wheel,) = (tmp_path / "dist").glob("armdyn-*.whl")
+    import zipfile
+
+    with zipfile.ZipFile(wheel) as z:
+        members = [n for n in z.namelist() if n.startswith("armdyn/sizing/example_catalog/")]
+        assert sorted(members) == [
+            f"armdyn/sizing/example_catalog/{f}" for f in sorted(cat.FILE_NAMES.values())
+        ]
+        z.extractall(tmp_path / "site", members)
+    installed = load_catalog(tmp_path / "site" / "armdyn" / "sizing" / "example_catalog")
+    for kind in cat.KINDS:
+        pd.testing.assert_frame_equal(getattr(installed, kind), getattr(example, kind))
+
+
 def test_every_example_part_says_where_its_values_come_from(example):
     for kind in cat.KINDS:
         for name, source in getattr(example, kind)["source"].items():
