@@ -696,6 +696,26 @@ def test_frames_and_csv_give_the_same_catalog(tmp_path):
         pd.testing.assert_frame_equal(getattr(a, kind), getattr(b, kind))
 
 
+def test_from_frames_blank_cells_none_nan_and_na():
+    motors = {
+        "name": ["A", "B", "C"],
+        "torque_constant": [0.1, 0.1, 0.1],
+        "resistance": [0.5, 0.5, 0.5],
+        "rotor_inertia": [1e-5, 1e-5, 1e-5],
+        "mass": [0.3, 0.3, 0.3],
+        "continuous_torque": [0.5, 0.5, 0.5],
+        "peak_torque": [1.5, 1.5, 1.5],
+        "voltage": pd.array([48, None, pd.NA], dtype=object),
+        "brake_torque": np.array([np.float32("nan"), 1.0, np.nan], dtype=object),
+        "ratio_pinned": [1, 2, 3],  # undeclared: kept
+    }
+    c = Catalog(motors)
+    assert c.motors.loc["A", "voltage"] == 48.0
+    assert c.motors[["voltage", "brake_torque"]].isna().sum().tolist() == [2, 2]
+    assert c.motors["ratio_pinned"].tolist() == [1, 2, 3]
+    assert c.origin("motors", "B") == "motors table, row 2, part 'B'"
+
+
 def test_from_frames_checks_every_value():
     good = synthetic_catalog(3, 3, 1, seed=0)
     motors = good.motors.copy()

@@ -768,7 +768,10 @@ def _frame_table(kind: str, frame):
 
 
 def _blank(v) -> bool:
-    return v is None or (isinstance(v, float) and math.isnan(v))
+    """None, a NaN (Python's or numpy's) or pandas' NA: a cell not given."""
+    if v is None or type(v).__name__ == "NAType":
+        return True
+    return isinstance(v, (float, np.floating)) and math.isnan(v)
 
 
 def _frame_numbers(series, col: str, where: list[str]) -> np.ndarray:
