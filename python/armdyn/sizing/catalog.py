@@ -30,6 +30,10 @@ Reading rules (every row is checked before anything is returned):
 
 Every error is an :class:`armdyn.ModelError` naming the file, the line (1-based, as an editor
 counts it), and the column; a missing or unreadable path is the ``OSError`` that names it.
+
+DataFrames are checked by the same rules (:class:`Catalog` / :meth:`Catalog.from_frames`; a bad
+value is named by table, row and part). :func:`synthetic_catalog` makes large catalogs of
+made-up parts for benchmarks.
 """
 
 from __future__ import annotations
