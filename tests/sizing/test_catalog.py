@@ -733,6 +733,18 @@ def test_from_frames_checks_every_value():
         Catalog.from_frames(good.motors.reset_index(drop=True))
     with raises(r"gearboxes must be a DataFrame, a mapping of columns or None, got int"):
         Catalog.from_frames(good.motors, 5)
+    with raises(r"Catalog.from_frames: motors is not a table of columns"):
+        Catalog({"name": "A", "mass": 1.0})
+    twice = pd.concat([good.motors, good.motors[["mass"]]], axis=1)
+    with raises(r"motors has column\(s\) \['mass'\] twice"):
+        Catalog(twice)
+    motors = good.motors.reset_index()
+    motors.loc[1, "name"] = np.nan
+    with raises(r"motors table, row 2, part '': column 'name': empty part name"):
+        Catalog(motors)
+    motors = good.motors.astype({"mass": complex})
+    with raises(r"part 'SM-00000': column 'mass': .*j\) is not a number"):
+        Catalog(motors)
 
 
 def test_the_synthetic_catalog():

@@ -736,7 +736,12 @@ def _frame_table(kind: str, frame):
     if frame is None:
         frame = pd.DataFrame({c.name: [] for c in COLUMNS[kind]})
     if isinstance(frame, Mapping):
-        frame = pd.DataFrame(dict(frame))
+        try:
+            frame = pd.DataFrame(dict(frame))
+        except (ValueError, TypeError) as err:
+            raise _core.ModelError(
+                f"Catalog.from_frames: {kind} is not a table of columns ({err})"
+            ) from None
     if not isinstance(frame, pd.DataFrame):
         raise _core.ModelError(
             f"Catalog.from_frames: {kind} must be a DataFrame, a mapping of columns or None, "
@@ -749,10 +754,13 @@ def _frame_table(kind: str, frame):
             )
         frame = frame.rename_axis("name").reset_index()
     header = [str(c) for c in frame.columns]
+    if len(set(header)) != len(header):
+        twice = sorted({h for h in header if header.count(h) > 1})
+        raise _core.ModelError(f"Catalog.from_frames: {kind} has column(s) {twice} twice")
     missing = _missing(kind, header)
     if missing:
         raise _core.ModelError(f"Catalog.from_frames: {kind} lacks required column(s) {missing}")
-    names = [str(n) for n in frame["name"]]
+    names = ["" if _blank(n) else str(n) for n in frame["name"]]
     where = [f"{kind} table, row {i + 1}, part {n!r}" for i, n in enumerate(names)]
     by_name = _BY_NAME[kind]
     values: dict[str, Any] = {}
@@ -784,7 +792,9 @@ def _frame_numbers(series, col: str, where: list[str]) -> np.ndarray:
         if _blank(v):
             out[i] = np.nan
             continue
-        if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, float, np.number)):
+        if isinstance(v, (bool, np.bool_, complex, np.complexfloating)) or not isinstance(
+            v, (int, float, np.number)
+        ):
             raise _core.ModelError(f"{where[i]}: column {col!r}: {v!r} is not a number")
         out[i] = float(v)
         if not math.isfinite(out[i]):
