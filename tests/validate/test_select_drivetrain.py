@@ -238,6 +238,7 @@ GEARBOXES = pd.DataFrame(
         "efficiency": [0.8, 0.75, 0.7],
         "input_inertia": [1e-6, 2e-6, 3e-6],
         "mass": [0.41, 0.67, 1.12],
+        "rated_torque": [12.0, 25.0, 50.0],
         "repeated_peak_torque": [30.0, 60.0, 120.0],
         "max_input_speed": [800.0, 700.0, 600.0],
         "cost": [300.0, 420.0, 610.0],
@@ -263,6 +264,12 @@ class _Catalog:
 
 
 def catalog(drives=False, motors=MOTORS, gearboxes=GEARBOXES):
+    """The test's catalog: an armdyn Catalog (checked by the catalog's rules)."""
+    return ad.Catalog(motors.copy(), gearboxes.copy(), DRIVES.copy() if drives else None)
+
+
+def raw_catalog(drives=False, motors=MOTORS, gearboxes=GEARBOXES):
+    """The same tables unchecked (what a hand-made catalog object may hold)."""
     return _Catalog(motors.copy(), gearboxes.copy(), DRIVES.copy() if drives else None)
 
 
@@ -332,7 +339,7 @@ def exhaustive(fns, run, joints, cat, options, objective="mass", mounts=None):
     here with ModelBuilder) until the first that passes every check of every joint: every
     lighter (cheaper) combination was checked and failed. ``(total, combination, margins per
     joint)``, None when no combination is feasible."""
-    drives = [None] if cat.drives is None else list(cat.drives.index)
+    drives = [None] if cat.drives is None or len(cat.drives) == 0 else list(cat.drives.index)
     per_joint = list(itertools.product(cat.motors.index, cat.gearboxes.index, drives))
     places = {
         "shoulder": None,
@@ -592,7 +599,9 @@ def test_mount_on_a_frame_and_the_model_carries_the_actuators(parts, run):
 )
 def test_hostile_inputs(parts, run, kwargs, match):
     kwargs = dict(kwargs)
-    cat = catalog(motors=kwargs.pop("motors", MOTORS), gearboxes=kwargs.pop("gearboxes", GEARBOXES))
+    cat = raw_catalog(
+        motors=kwargs.pop("motors", MOTORS), gearboxes=kwargs.pop("gearboxes", GEARBOXES)
+    )
     kwargs.setdefault("drives", False)
     with pytest.raises(ad.ModelError, match=match):
         _select(run, cat, **kwargs)
@@ -607,6 +616,8 @@ def test_hostile_model_catalog_and_candidates(parts, run):
         ad.select_drivetrain(model, traj, _Catalog([1, 2], GEARBOXES), drives=False)
     with pytest.raises(ad.ModelError, match="the catalog has no motors"):
         ad.select_drivetrain(model, traj, object(), drives=False)
+    with pytest.raises(ad.ModelError, match="drives=True but the catalog has no drives"):
+        ad.select_drivetrain(model, traj, catalog())  # a Catalog without drives.csv
     sel = ad.select_drivetrain(model, traj, catalog(), drives=False, joints=["wrist"])
     with pytest.raises(ad.ModelError, match="'elbow' was not selected"):
         sel.candidates("elbow")
