@@ -4,14 +4,14 @@ per joint in ≤ 10 s on the 2-core machine), through the public API.
     python -m benchmarks.select_drivetrain [--motors 100] [--gearboxes 100] [--drives 0]
         [--samples 201] [--repeats 3]
 
-The UR5 (example-robot-data) moves every joint rest to rest (a quintic, 1.2 s) and holds the end
-pose for a 0.5 s dwell, repeated forever (``armdyn.duty_cycle``); a synthetic catalog of
-``--motors`` motors and ``--gearboxes`` gearboxes (``--drives`` drives; default none, i.e.
-motor × gearbox combinations) spanning small to large parts
-(``armdyn.sizing.catalog.synthetic_catalog``); ``armdyn.select_drivetrain`` screens every combination for every joint
-with the coupled passes (the actuators' masses carried). Reported: the wall-clock and CPU time
-of the selection (median of ``--repeats`` runs after one warm-up), the passes, the joint
-screenings made and the choice. Written to ``benchmarks/results/select_drivetrain.json``.
+The UR5 (example-robot-data) with a 3 kg payload moves every joint rest to rest (a quintic,
+1.2 s) and holds the end pose for a 0.5 s dwell, repeated forever (``armdyn.duty_cycle``); a
+synthetic catalog of ``--motors`` motors and ``--gearboxes`` gearboxes (``--drives`` drives;
+default none: motor × gearbox combinations) spanning small to large parts
+(``armdyn.sizing.catalog.synthetic_catalog``); ``armdyn.select_drivetrain`` screens every
+combination for every joint with the coupled passes (the actuators' masses carried). Reported:
+the wall-clock and CPU time of the selection (median of ``--repeats`` runs after one warm-up),
+the passes and the choice. Written to ``benchmarks/results/select_drivetrain.json``.
 """
 
 from __future__ import annotations
