@@ -103,3 +103,105 @@ def test_one_state_and_scalar_or_default_time():
     f0, n0 = ad.joint_reactions(model, q[1], qd[1], qdd[1])
     np.testing.assert_array_equal(f0, f1)
     np.testing.assert_array_equal(n0, n1)
+
+
+def _quat(axis, angle):
+    axis = np.asarray(axis, float) / np.linalg.norm(axis)
+    return np.concatenate([[np.cos(angle / 2)], np.sin(angle / 2) * axis])
+
+
+def welded_pendulums():
+    """Two links on revolutes with parts welded at odd angles (a bracket welded to ground, a
+    weight and a sensor welded in a chain to link 1, a tip to link 2), a spring and a load on
+    welded members and a PI motor on the second joint (an integral state): fixed joints, force
+    elements and a motor whose torque joint_reactions does not know (its integral state is the
+    run's), which the reactions do not depend on."""
+    b = ad.ModelBuilder(gravity=(0.0, 0.0, -9.81))
+    b.add_body(
+        "bracket", 2.0, [0.02, 0.03, 0.04], position=(0, 0, 0.1), orientation=_quat((1, 1, 0), 0.4)
+    )
+    b.add_fixed("bracket_mount", "ground", "bracket", point=(0, 0, 0))
+    b.add_body("link1", 1.0, [0.001, 0.02, 0.02], position=(0.2, 0, 0.2))
+    b.add_revolute("pivot1", "bracket", "link1", point=(0, 0, 0.2), axis=(0, 1, 0))
+    b.add_body(
+        "weight", 0.5, [1e-3, 2e-3, 3e-3], position=(0.4, 0.05, 0.2), orientation=_quat((0, 0.3, 1), 1.1)
+    )
+    b.add_fixed("weight_mount", "link1", "weight", point=(0.4, 0, 0.2))
+    b.add_body(
+        "sensor", 0.1, [1e-4, 1e-4, 2e-4], position=(0.45, 0.1, 0.25), orientation=_quat((1, 0, 0), -0.7)
+    )
+    b.add_fixed("sensor_mount", "weight", "sensor", point=(0.45, 0.1, 0.2))
+    b.add_body("link2", 0.8, [0.001, 0.015, 0.015], position=(0.55, 0, 0.2))
+    b.add_revolute("pivot2", "link1", "link2", point=(0.4, 0, 0.2), axis=(0, 0, 1))
+    b.add_body("tip", 0.2, [1e-4, 1e-4, 1e-4], position=(0.7, 0, 0.2))
+    b.add_fixed("tip_mount", "link2", "tip", point=(0.7, 0, 0.2))
+    b.add_spring_damper("spring", "ground", (0.5, 0.3, 0.6), "sensor", (0.45, 0.1, 0.25), 40.0, 0.5)
+    b.add_body_force("tip", force=(0.0, 1.5, 0.0), point=(0.72, 0.0, 0.21))
+    b.add_motor("pivot2", ad.profiles.sine(0.5, 1.0, 0.0, 0.0), 20.0, 1.0, ki=5.0)
+    return b.finalize()
+
+
+def independent(model, res):
+    """The run's independent coordinates (model.coord_names) and rates, the floating bases'
+    entries first, from its columns over every joint."""
+    cols = list(model.joint_coord_names)
+    k = [cols.index(c) for c in model.coord_names]
+    nb_q, nb_v = res.q.shape[1] - len(cols), res.qd.shape[1] - len(cols)
+    iq = list(range(nb_q)) + [nb_q + i for i in k]
+    iv = list(range(nb_v)) + [nb_v + i for i in k]
+    return res.q[:, iq], res.qd[:, iv], res.qdd[:, iv]
+
+
+def assert_equal_to_run(model, res, rel):
+    q, qd, qdd = independent(model, res)
+    forces, torques = ad.joint_reactions(model, q, qd, qdd, res.t)
+    assert forces.shape == res.reaction_forces.shape
+    assert rel_err(forces, res.reaction_forces) <= rel
+    assert rel_err(torques, res.reaction_torques) <= rel
+    return forces, torques
+
+
+@pytest.mark.parametrize("merge_welded", [True, False])
+def test_fixed_joints_equal_a_joint_space_run(merge_welded):
+    # measured: 1.1e-15 (merged) and 1.2e-15 (full) relative
+    model = welded_pendulums()
+    res = ad.simulate(
+        model, 0.6, coordinates="joint", merge_welded=merge_welded, rtol=1e-10, output_dt=0.05
+    )
+    forces, torques = assert_equal_to_run(model, res, 1e-12)
+    # the welds carry loads: the tip's weld its weight and inertia, never zero
+    tip = list(model.joint_names).index("tip_mount")
+    assert np.abs(forces[:, tip]).max() >= 0.2 * 9.81 * 0.9
+
+
+def test_ur5_equal_to_a_joint_space_run():
+    # measured 2.4e-15 relative
+    _, model = ur5()
+    qd0 = np.array([0.4, -0.3, 0.5, 0.2, -0.6, 0.3])
+    res = ad.simulate(
+        model, 1.0, q0=common.UR5_Q0, qd0=qd0, coordinates="joint", limits="ignore", output_dt=0.1
+    )
+    assert_equal_to_run(model, res, 1e-12)
+
+
+def test_fixed_joint_reaction_of_a_hanging_weight_is_its_weight():
+    # at rest: the weld carries the weight's gravity (m g up on it, no torque about the weld
+    # point above its centre of mass), the pivot both bodies'
+    b = ad.ModelBuilder(gravity=(0.0, 0.0, -9.81))
+    b.add_body("rod", 1.0, [0.01, 0.01, 1e-4], position=(0, 0, -0.5))
+    b.add_revolute("pivot", "ground", "rod", point=(0, 0, 0), axis=(0, 1, 0))
+    b.add_body("weight", 2.5, [1e-3, 1e-3, 1e-3], position=(0, 0, -1.1))
+    b.add_fixed("weld", "rod", "weight", point=(0, 0, -1.0))
+    model = b.finalize()
+    f, n = ad.joint_reactions(model, [0.0], [0.0], [0.0])
+    j = list(model.joint_names).index("weld")
+    np.testing.assert_allclose(f[j], [0.0, 0.0, 2.5 * 9.81], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(n[j], 0.0, atol=1e-12)
+    # swinging through the bottom at rate w and no angular acceleration: the centripetal
+    # force m w^2 r adds to the weight, still along the rod
+    w = 1.7
+    f, n = ad.joint_reactions(model, [0.0], [w], [0.0])
+    np.testing.assert_allclose(f[j], [0.0, 0.0, 2.5 * (9.81 + w**2 * 1.1)], rtol=1e-13, atol=1e-12)
+    np.testing.assert_allclose(n[j], 0.0, atol=1e-12)
+    p = list(model.joint_names).index("pivot")
+    assert np.linalg.norm(f[p]) == pytest.approx(3.5 * 9.81 + (0.5 + 2.5 * 1.1) * w**2, rel=1e-13)
