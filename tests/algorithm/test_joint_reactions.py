@@ -205,3 +205,72 @@ def test_fixed_joint_reaction_of_a_hanging_weight_is_its_weight():
     np.testing.assert_allclose(n[j], 0.0, atol=1e-12)
     p = list(model.joint_names).index("pivot")
     assert np.linalg.norm(f[p]) == pytest.approx(3.5 * 9.81 + (0.5 + 2.5 * 1.1) * w**2, rel=1e-13)
+
+
+def expand(model, q, qd, qdd, follower, leader, multiplier, offset):
+    """A coupled motion over every coordinate of the uncoupled model."""
+    names = list(model.coord_names)
+    i, k = names.index(leader), [n for n in names if n != follower]
+    full = []
+    for x, shift in ((q, offset), (qd, 0.0), (qdd, 0.0)):
+        y = np.empty((len(x), len(names)))
+        y[:, [names.index(n) for n in k]] = x
+        y[:, names.index(follower)] = multiplier * y[:, i] + shift
+        full.append(y)
+    return full
+
+
+def test_coupling_gives_the_reactions_of_the_coupled_motion():
+    # a coupling (URDF <mimic>) only ties the coordinates' axis torques: every joint's reaction
+    # is the uncoupled arm's along the same motion, and a joint-space run's (measured 3.4e-16)
+    path, plain = ur5()
+    b = ad.urdf_builder(str(path))
+    b.add_coupling("wrist_link", "wrist_3_joint", "wrist_2_joint", -1.5, 0.2)
+    coupled = b.finalize()
+    assert len(coupled.coord_names) == 5
+    t, q, qd, qdd = motion(5, q0=np.delete(common.UR5_Q0, 5))
+    forces, torques = ad.joint_reactions(coupled, q, qd, qdd, t)
+    qf, qdf, qddf = expand(plain, q, qd, qdd, "wrist_3_joint", "wrist_2_joint", -1.5, 0.2)
+    ref_f, ref_t = ad.joint_reactions(plain, qf, qdf, qddf, t)
+    assert list(coupled.joint_names) == list(plain.joint_names)
+    assert rel_err(forces, ref_f) <= 1e-12
+    assert rel_err(torques, ref_t) <= 1e-12
+    res = ad.simulate(
+        coupled, 0.5, q0=q[0], qd0=qd[0], coordinates="joint", limits="ignore", output_dt=0.05
+    )
+    assert_equal_to_run(coupled, res, 1e-12)
+
+
+@pytest.mark.parametrize("gyroscopic", [False, True])
+def test_actuators(gyroscopic):
+    # an armature on ground (gyroscopic=False) turns with its joint and loads no arm body: the
+    # arm's reactions are the bare arm's; a rotor on the joint's parent body (gyroscopic=True)
+    # adds its gyroscopic moments there: checked against a joint-space run (measured 1.5e-15)
+    path, plain = ur5()
+    b = ad.urdf_builder(str(path))
+    for k, name in enumerate(plain.coord_names):
+        b.add_actuator(name, 50.0 + 10 * k, 2e-5 * (k + 1), gyroscopic=gyroscopic)
+    model = b.finalize()
+    t, q, qd, qdd = motion(6, q0=common.UR5_Q0)
+    forces, torques = ad.joint_reactions(model, q, qd, qdd, t)
+    names = list(model.joint_names)
+    arm = [names.index(n) for n in plain.joint_names]
+    ref_f, ref_t = ad.joint_reactions(plain, q, qd, qdd, t)
+    if gyroscopic:
+        assert rel_err(torques[:, arm], ref_t) >= 1e-6  # the rotors' moments are there
+        res = ad.simulate(
+            model, 0.3, q0=q[0], qd0=qd[0], coordinates="joint", limits="ignore", output_dt=0.05
+        )
+        assert_equal_to_run(model, res, 1e-12)
+        return
+    assert rel_err(forces[:, arm], ref_f) <= 1e-12
+    assert rel_err(torques[:, arm], ref_t) <= 1e-12
+    rotors = [i for i in range(len(names)) if i not in arm]
+    assert len(rotors) == 6
+    assert np.abs(forces[:, rotors]).max() <= 1e-12
+    assert np.abs(torques[:, rotors]).max() <= 1e-12 * np.abs(ref_t).max()
+    # the joint torques are the inverse dynamics': the bare arm's and the reflected inertia
+    tau = ad.inverse_dynamics(model, q, qd, qdd, t)
+    reflected = np.array([(50.0 + 10 * k) ** 2 * 2e-5 * (k + 1) for k in range(6)]) * qdd
+    tau_plain = ad.inverse_dynamics(plain, q, qd, qdd, t)
+    assert rel_err(tau, tau_plain + reflected) <= 1e-12
