@@ -40,19 +40,32 @@ def rel_err(a, b):
     return float(np.abs(a - b).max() / np.abs(b).max())
 
 
-def test_ur5_reactions_equal_pinocchio_rnea_joint_forces():
+@pytest.mark.parametrize("fixed_base", [True, False])
+def test_ur5_reactions_equal_pinocchio_rnea_joint_forces(fixed_base):
     pin = pytest.importorskip("pinocchio")
-    path, model = ur5()
-    pm = pin.buildModelFromUrdf(str(path))
+    path, model = ur5(fixed_base=fixed_base)
+    root = () if fixed_base else (pin.JointModelFreeFlyer(),)
+    pm = pin.buildModelFromUrdf(str(path), *root)
     pd = pm.createData()
-    names = list(model.joint_names)
+    names = [n for n in model.joint_names if n != "root_free"]
+    base = 0 if fixed_base else 6  # the floating base's rates lead qd (7 entries of q)
     pin_joints = [pm.getJointId(n) for n in names]
     perm = [pm.joints[j].idx_q for j in pin_joints]  # armdyn coordinate k -> Pinocchio q index
-    assert sorted(perm) == list(range(pm.nq))
-    t, q, qd, qdd = motion(model.n_coords, q0=common.UR5_Q0)
+    assert sorted(perm) == list(range(pm.nq - len(names), pm.nq))
+    t, q, qd, qdd = motion(len(names), q0=common.UR5_Q0)
+    if not fixed_base:
+        # the base: a position, a unit quaternion (scalar first) and its rates in its own frame
+        _, qb, qdb, qddb = motion(6, seed=5)
+        quat = np.stack([np.cos(qb[:, 3]), *(np.sin(qb[:, 3]) * np.c_[0.6, 0.0, 0.8].T)], axis=1)
+        q = np.hstack([qb[:, :3], quat, q])
+        qd, qdd = np.hstack([qdb, qd]), np.hstack([qddb, qdd])
     forces, torques = ad.joint_reactions(model, q, qd, qdd, t)
-    assert forces.shape == torques.shape == (len(t), len(names), 3)
+    assert forces.shape == torques.shape == (len(t), len(model.joint_names), 3)
     tau = ad.inverse_dynamics(model, q, qd, qdd, t)
+    if not fixed_base:
+        # a free joint has no rows: no reaction (its wrench is the inverse dynamics' base entries)
+        assert not forces[:, 0].any() and not torques[:, 0].any()
+        forces, torques = forces[:, 1:], torques[:, 1:]
     # armdyn's joint frame (z the axis) in the URDF child link's frame, Pinocchio's joint frame
     place = []
     for name in names:
@@ -65,7 +78,11 @@ def test_ur5_reactions_equal_pinocchio_rnea_joint_forces():
     fmax = tmax = taumax = 0.0
     for i in range(len(t)):
         qp, vp, ap = (np.empty(pm.nq) for _ in range(3))
-        qp[perm], vp[perm], ap[perm] = q[i], qd[i], qdd[i]
+        qp[perm], vp[perm], ap[perm] = q[i, base + base // 6 :], qd[i, base:], qdd[i, base:]
+        if not fixed_base:
+            qp[:3], qp[3:6], qp[6] = q[i, :3], q[i, 4:7], q[i, 3]  # Pinocchio: scalar last
+        vp, ap = vp[pm.nq - pm.nv :], ap[pm.nq - pm.nv :]
+        vp[:base], ap[:base] = qd[i, :base], qdd[i, :base]
         tau_pin = pin.rnea(pm, pd, qp, vp, ap)
         friction = -pm.damping * vp - pm.friction * np.tanh(vp / ad._core.URDF_COULOMB_SMOOTHING)
         for k, jid in enumerate(pin_joints):
@@ -81,11 +98,16 @@ def test_ur5_reactions_equal_pinocchio_rnea_joint_forces():
             worst_t = max(worst_t, np.abs(n + (axis @ n_pin) * axis - n_pin).max())
             worst_tau = max(worst_tau, abs(axis @ n_pin - tau_pin[pm.joints[jid].idx_v]))
             fmax, tmax = max(fmax, np.abs(f_pin).max()), max(tmax, np.abs(n_pin).max())
-        # armdyn's inverse dynamics is Pinocchio's joint torque with the URDF's friction
+        # armdyn's inverse dynamics is Pinocchio's joint torque with the URDF's friction (and
+        # the floating base's wrench, Pinocchio's first six)
         tau_ref = tau_pin - friction
-        worst_tau = max(worst_tau, np.abs(tau[i] - tau_ref[perm]).max())
+        vperm = [pm.joints[j].idx_v for j in pin_joints]
+        worst_tau = max(worst_tau, np.abs(tau[i, base:] - tau_ref[vperm]).max())
+        if base:
+            worst_tau = max(worst_tau, np.abs(tau[i, :base] - tau_ref[:base]).max())
         taumax = max(taumax, np.abs(tau_ref).max())
-    # measured: forces 7.9e-16, torques 6.5e-16, joint torques 3.8e-16 relative
+    # measured: forces 7.9e-16 (5.5e-16 floating), torques 6.5e-16 (7.3e-16), joint torques
+    # 3.8e-16 (4.0e-16) relative
     assert worst_f <= 1e-9 * fmax
     assert worst_t <= 1e-9 * tmax
     assert worst_tau <= 1e-9 * taumax
@@ -124,11 +146,19 @@ def welded_pendulums():
     b.add_body("link1", 1.0, [0.001, 0.02, 0.02], position=(0.2, 0, 0.2))
     b.add_revolute("pivot1", "bracket", "link1", point=(0, 0, 0.2), axis=(0, 1, 0))
     b.add_body(
-        "weight", 0.5, [1e-3, 2e-3, 3e-3], position=(0.4, 0.05, 0.2), orientation=_quat((0, 0.3, 1), 1.1)
+        "weight",
+        0.5,
+        [1e-3, 2e-3, 3e-3],
+        position=(0.4, 0.05, 0.2),
+        orientation=_quat((0, 0.3, 1), 1.1),
     )
     b.add_fixed("weight_mount", "link1", "weight", point=(0.4, 0, 0.2))
     b.add_body(
-        "sensor", 0.1, [1e-4, 1e-4, 2e-4], position=(0.45, 0.1, 0.25), orientation=_quat((1, 0, 0), -0.7)
+        "sensor",
+        0.1,
+        [1e-4, 1e-4, 2e-4],
+        position=(0.45, 0.1, 0.25),
+        orientation=_quat((1, 0, 0), -0.7),
     )
     b.add_fixed("sensor_mount", "weight", "sensor", point=(0.45, 0.1, 0.2))
     b.add_body("link2", 0.8, [0.001, 0.015, 0.015], position=(0.55, 0, 0.2))
@@ -144,11 +174,11 @@ def welded_pendulums():
 def independent(model, res):
     """The run's independent coordinates (model.coord_names) and rates, the floating bases'
     entries first, from its columns over every joint."""
-    cols = list(model.joint_coord_names)
-    k = [cols.index(c) for c in model.coord_names]
-    nb_q, nb_v = res.q.shape[1] - len(cols), res.qd.shape[1] - len(cols)
-    iq = list(range(nb_q)) + [nb_q + i for i in k]
-    iv = list(range(nb_v)) + [nb_v + i for i in k]
+    nf = len(model.coord_names) - model.n_dofs  # floating bases: 7 entries of q, 6 of qd
+    cols = list(model.joint_coord_names)[7 * nf :]
+    k = [cols.index(c) for c in list(model.coord_names)[7 * nf :]]
+    iq = list(range(7 * nf)) + [7 * nf + i for i in k]
+    iv = list(range(6 * nf)) + [6 * nf + i for i in k]
     return res.q[:, iq], res.qd[:, iv], res.qdd[:, iv]
 
 
@@ -168,20 +198,26 @@ def test_fixed_joints_equal_a_joint_space_run(merge_welded):
     res = ad.simulate(
         model, 0.6, coordinates="joint", merge_welded=merge_welded, rtol=1e-10, output_dt=0.05
     )
-    forces, torques = assert_equal_to_run(model, res, 1e-12)
+    forces, _ = assert_equal_to_run(model, res, 1e-12)
     # the welds carry loads: the tip's weld its weight and inertia, never zero
     tip = list(model.joint_names).index("tip_mount")
     assert np.abs(forces[:, tip]).max() >= 0.2 * 9.81 * 0.9
 
 
-def test_ur5_equal_to_a_joint_space_run():
+@pytest.mark.parametrize("fixed_base", [True, False])
+def test_ur5_equal_to_a_joint_space_run(fixed_base):
     # measured 2.4e-15 relative
-    _, model = ur5()
-    qd0 = np.array([0.4, -0.3, 0.5, 0.2, -0.6, 0.3])
+    _, model = ur5(fixed_base=fixed_base)
+    q0, qd0 = np.array(common.UR5_Q0), np.array([0.4, -0.3, 0.5, 0.2, -0.6, 0.3])
+    if not fixed_base:  # a base thrown spinning
+        q0 = np.r_[0.1, -0.2, 0.3, _quat((1, 2, 3), 0.5), q0]
+        qd0 = np.r_[0.5, 0.0, 1.0, 0.3, -0.2, 0.4, qd0]
     res = ad.simulate(
-        model, 1.0, q0=common.UR5_Q0, qd0=qd0, coordinates="joint", limits="ignore", output_dt=0.1
+        model, 1.0, q0=q0, qd0=qd0, coordinates="joint", limits="ignore", output_dt=0.1
     )
-    assert_equal_to_run(model, res, 1e-12)
+    forces, _ = assert_equal_to_run(model, res, 1e-12)
+    if not fixed_base:
+        assert not forces[:, 0].any()
 
 
 def test_fixed_joint_reaction_of_a_hanging_weight_is_its_weight():
