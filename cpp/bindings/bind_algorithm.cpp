@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Bindings of the joint-space algorithms (armdyn/algorithm/): armdyn.Data, forward_dynamics,
-// inverse_dynamics, joint_reactions, mass_matrix and dynamics_cost. One state (1-D arrays) or one state per row
-// (2-D arrays, evaluated in one C++ loop without the GIL). Without data=, each thread keeps one
-// Data per model, so repeated calls allocate nothing but their output array (rows.hpp).
+// inverse_dynamics, joint_reactions, mass_matrix and dynamics_cost. One state (1-D arrays) or one
+// state per row (2-D arrays, evaluated in one C++ loop without the GIL). Without data=, each thread
+// keeps one Data per model, so repeated calls allocate nothing but their output array (rows.hpp).
 #include <pybind11/stl.h>
 
 #include "armdyn/algorithm/cost_model.hpp"
@@ -74,8 +74,26 @@ py::array_t<double> inverse_dynamics_py(const ModelArg& model, const ArrayLike& 
   return vector_out(one(*qa, *qda, *aa, scalar_time(t, fn)));
 }
 
+// (forces, torques) from the reactions of one state (2, n_joints, 3) or of each row (rows, 2,
+// n_joints, 3), batch: the latter
+py::tuple split_reactions(const py::array_t<double>& both, bool batch) {
+  const long rows = batch ? static_cast<long>(both.shape(0)) : 1;
+  const auto nj = static_cast<py::ssize_t>(both.shape(batch ? 2 : 1));
+  std::vector<py::ssize_t> shape{nj, 3};
+  if (batch) shape.insert(shape.begin(), rows);
+  py::array_t<double> forces(shape), torques(shape);
+  const long block = 3 * static_cast<long>(nj);
+  const double* src = both.data();
+  double *fo = forces.mutable_data(), *to = torques.mutable_data();
+  for (long i = 0; i < rows; ++i) {
+    std::copy(src + 2 * i * block, src + (2 * i + 1) * block, fo + i * block);
+    std::copy(src + (2 * i + 1) * block, src + (2 * i + 2) * block, to + i * block);
+  }
+  return py::make_tuple(forces, torques);
+}
+
 py::tuple joint_reactions_py(const ModelArg& model, const ArrayLike& q, const ArrayLike& qd,
-                             const ArrayLike& qdd, const OptFloatOrArray& t, const OptData& data) {
+                             const ArrayLike& qdd, const OptTimes& t, const OptData& data) {
   constexpr const char* fn = "joint_reactions";
   const CallArgs a = call_args(model, data, fn);
   Data& d = a.data;
@@ -83,32 +101,28 @@ py::tuple joint_reactions_py(const ModelArg& model, const ArrayLike& q, const Ar
   const py::object tt = t.is_none() ? py::object(py::float_(0.0)) : py::object(t);
   // forces then torques of one state, each (n_joints, 3) row-major
   auto one = [&](const auto& qi, const auto& qdi, const auto& ai, double ti, double* out) {
-    joint_reactions(a.model(), d, qi, qdi, ai, ti, out, out + 3 * nj);
-    check_finite_output(fn, "the reactions", out, 6 * nj,
-                        {named_input("q", qi), named_input("qd", qdi), named_input("qdd", ai)});
+    const auto in = {named_input("q", qi), named_input("qd", qdi), named_input("qdd", ai)};
+    naming_huge_inputs(fn, in, [&]() {
+      joint_reactions(a.model(), d, qi, qdi, ai, ti, out, out + 3 * nj);
+      return 0;
+    });
+    check_finite_output(fn, "the reactions", out, 6 * nj, in);
   };
-  py::array_t<double> both;
-  long rows = 0;
   if (is_batch(q)) {
-    both = batch(fn, d.niq, d.ni, q, qd, "qd", qdd, "qdd", tt, {2, nj, 3}, one);
-    rows = static_cast<long>(both.shape(0));
-  } else {
-    const VecArg qa(q, "q", d.niq), qda(qd, "qd", d.ni), aa(qdd, "qdd", d.ni);
-    both = py::array_t<double>(std::vector<py::ssize_t>{2, nj, 3});
-    one(*qa, *qda, *aa, scalar_time(tt, fn), both.mutable_data());
+    try {
+      return split_reactions(batch(fn, d.niq, d.ni, q, qd, "qd", qdd, "qdd", tt, {2, nj, 3}, one),
+                             true);
+    } catch (PyInterrupted& e) {
+      // Ctrl-C: the rows done, as (forces, torques) too
+      const py::object err = e.err.value();
+      err.attr("result") = split_reactions(err.attr("result").cast<py::array_t<double>>(), true);
+      throw;
+    }
   }
-  // the two halves of each row as two arrays
-  std::vector<py::ssize_t> shape{nj, 3};
-  if (is_batch(q)) shape.insert(shape.begin(), rows);
-  py::array_t<double> forces(shape), torques(shape);
-  const long block = 3 * static_cast<long>(nj);
-  const double* src = both.data();
-  double *fo = forces.mutable_data(), *to = torques.mutable_data();
-  for (long i = 0; i < std::max(rows, 1L); ++i) {
-    std::copy(src + 2 * i * block, src + (2 * i + 1) * block, fo + i * block);
-    std::copy(src + (2 * i + 1) * block, src + (2 * i + 2) * block, to + i * block);
-  }
-  return py::make_tuple(forces, torques);
+  const VecArg qa(q, "q", d.niq), qda(qd, "qd", d.ni), aa(qdd, "qdd", d.ni);
+  py::array_t<double> both(std::vector<py::ssize_t>{2, nj, 3});
+  one(*qa, *qda, *aa, scalar_time(tt, fn), both.mutable_data());
+  return split_reactions(both, false);
 }
 
 py::array_t<double> mass_matrix_py(const ModelArg& model, const ArrayLike& q, const OptData& data) {

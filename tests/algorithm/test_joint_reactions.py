@@ -310,3 +310,45 @@ def test_actuators(gyroscopic):
     reflected = np.array([(50.0 + 10 * k) ** 2 * 2e-5 * (k + 1) for k in range(6)]) * qdd
     tau_plain = ad.inverse_dynamics(plain, q, qd, qdd, t)
     assert rel_err(tau, tau_plain + reflected) <= 1e-12
+
+
+def test_hostile_inputs_name_their_culprit():
+    _, model = ur5()
+    z, rows = np.zeros(6), np.zeros((3, 6))
+    cases = [
+        ((None, z, z, z), "model must be an armdyn.Model"),
+        ((model, np.r_[np.nan, z[1:]], z, z), r"\bq contains NaN"),
+        ((model, z, z, np.r_[z[1:], np.inf]), r"\bqdd contains NaN"),
+        ((model, rows, rows, np.full((3, 6), np.nan)), r"row 0: .*\bqdd contains NaN"),
+        ((model, z, z[:5], z), r"\bqd: expected shape \(6,\)"),
+        ((model, rows, np.zeros((2, 6)), rows), r"\bqd must have shape \(3, 6\)"),
+        ((model, rows, z, rows), r"\bqd must have shape \(3, 6\)"),
+        ((model, z + 1j, z, z), r"\bq: must hold real numbers"),
+        ((model, "abc", z, z), r"\bq: expected an array"),
+        ((model, z, z, z, np.nan), r"\bt is not finite"),
+        ((model, z, z, z, "x"), r"\bt must be a number"),
+        ((model, rows, rows, rows, [0.0, 1.0]), r"\bt: expected shape \(3,\)"),
+        ((ad.scenes.four_bar(), np.zeros(4), np.zeros(4), np.zeros(4)), "closed loops"),
+    ]
+    for args, pattern in cases:
+        with pytest.raises(ad.ModelError, match=pattern):
+            ad.joint_reactions(*args)
+    with pytest.raises(ad.ModelError, match="made for another model"):
+        ad.joint_reactions(model, z, z, z, data=ad.Data(ad.scenes.four_bar()))
+    _, floating = ur5(fixed_base=False)
+    with pytest.raises(ad.ModelError, match=r"quaternion of free joint 'root_free'"):
+        ad.joint_reactions(floating, np.zeros(13), np.zeros(12), np.zeros(12))
+    # finite inputs whose products overflow: a SolverError naming the largest one, never NaN
+    with pytest.raises(ad.SolverError, match=r"qdd\[0\] = 1.69.*overflow"):
+        ad.joint_reactions(model, z, z, np.full(6, 1.7e308))
+    # the workspace and the model stay usable: the same answer as before
+    t, q, qd, qdd = motion(6, n=2)
+    before = ad.joint_reactions(model, q, qd, qdd, t)
+    with pytest.raises(ad.SolverError):
+        ad.joint_reactions(model, z, np.full(6, 1e300), z)
+    after = ad.joint_reactions(model, q, qd, qdd, t)
+    for a, b in zip(before, after, strict=True):
+        np.testing.assert_array_equal(a, b)
+    # no rows: empty outputs of the right shape
+    f, n = ad.joint_reactions(model, np.zeros((0, 6)), np.zeros((0, 6)), np.zeros((0, 6)))
+    assert f.shape == n.shape == (0, 6, 3)

@@ -441,8 +441,8 @@ class JointSystem : public OdeSystem, public StopAccess {
     const VecX& gear_delta = td_.gear_multipliers(qdd_.data());
     d.aux = z;
     d.joint_torques = stop_tau;
-    load_tree_motion(m_, d, q, qd, qdd_, t, gear_delta.size() ? gear_delta.data() : nullptr,
-                     sweep_, u_, v_, vd_);
+    load_tree_motion(m_, d, q, qd, qdd_, t, gear_delta.size() ? gear_delta.data() : nullptr, sweep_,
+                     u_, v_, vd_);
     d.joint_torques = nullptr;
     double rf, rv;
     loaded_residuals(m_, d, v_.data(), rf, rv);
@@ -478,8 +478,9 @@ class JointSystem : public OdeSystem, public StopAccess {
   MbsSystem& cart_;
   int n_, nq_;
   VecX u_, v_, vd_, qdd_;
-  VecX fo_, fe_;                            // the stops' scratch at outputs and events
-  const std::vector<std::pair<int, int>> sweep_ = tree_sweep(m_);  // children before parents
+  VecX fo_, fe_;  // the stops' scratch at outputs and events
+  // the joints whose multipliers load_tree_motion sweeps, children before parents
+  const std::vector<std::pair<int, int>> sweep_ = tree_sweep(m_);
 };
 
 }  // namespace armdyn::detail
