@@ -352,3 +352,21 @@ def test_hostile_inputs_name_their_culprit():
     # no rows: empty outputs of the right shape
     f, n = ad.joint_reactions(model, np.zeros((0, 6)), np.zeros((0, 6)), np.zeros((0, 6)))
     assert f.shape == n.shape == (0, 6, 3)
+
+
+def test_trajectory_run_carries_the_reactions():
+    # a planned motion (a joint-space run's samples) through trajectory_run: its reactions are
+    # the run's own, for every joint (the welds too); its torques the inverse dynamics'
+    model = welded_pendulums()
+    res = ad.simulate(model, 0.4, coordinates="joint", rtol=1e-10, output_dt=0.05)
+    plan = ad.trajectory_run(model, res.t, res.q, res.qd, res.qdd)
+    n = (len(res.t), len(model.joint_names), 3)
+    assert plan.reaction_forces.shape == plan.reaction_torques.shape == n
+    assert rel_err(plan.reaction_forces, res.reaction_forces) <= 1e-12
+    assert rel_err(plan.reaction_torques, res.reaction_torques) <= 1e-12
+    np.testing.assert_array_equal(
+        plan.joint_torques, ad.inverse_dynamics(model, res.q, res.qd, res.qdd, res.t)
+    )
+    # refused inputs leave no run (trajectory_run's own checks come first)
+    with pytest.raises(ad.ModelError, match="trajectory_run"):
+        ad.trajectory_run(model, res.t, res.q[:, :1], res.qd, res.qdd)
