@@ -76,7 +76,9 @@ py::array_t<double> inverse_dynamics_py(const ModelArg& model, const ArrayLike& 
 
 // (forces, torques) from the reactions of one state (2, n_joints, 3) or of each row (rows, 2,
 // n_joints, 3), batch: the latter
-py::tuple split_reactions(const py::array_t<double>& both, bool batch) {
+using ArrayPair = py::typing::Tuple<py::array_t<double>, py::array_t<double>>;
+
+ArrayPair split_reactions(const py::array_t<double>& both, bool batch) {
   const long rows = batch ? static_cast<long>(both.shape(0)) : 1;
   const auto nj = static_cast<py::ssize_t>(both.shape(batch ? 2 : 1));
   std::vector<py::ssize_t> shape{nj, 3};
@@ -92,7 +94,7 @@ py::tuple split_reactions(const py::array_t<double>& both, bool batch) {
   return py::make_tuple(forces, torques);
 }
 
-py::tuple joint_reactions_py(const ModelArg& model, const ArrayLike& q, const ArrayLike& qd,
+ArrayPair joint_reactions_py(const ModelArg& model, const ArrayLike& q, const ArrayLike& qd,
                              const ArrayLike& qdd, const OptTimes& t, const OptData& data) {
   constexpr const char* fn = "joint_reactions";
   const CallArgs a = call_args(model, data, fn);
