@@ -171,7 +171,7 @@ ID_CHILD = CHILD_PROLOGUE + textwrap.dedent(
         b.add_drive("j2", lambda t: (0.5 * t, 0.5, 0.0))
     model = b.finalize()
     rng = np.random.default_rng(1)
-    n = {"batch": 4_000_000, "reactions": 1_000_000}.get(which, 3_000_000)
+    n = {"batch": 4_000_000, "reactions": 300_000}.get(which, 3_000_000)
     if which in ("batch", "reactions"):
         q, qd, qdd = (rng.standard_normal((n, 2)) for _ in range(3))
     else:
