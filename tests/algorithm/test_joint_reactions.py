@@ -370,3 +370,26 @@ def test_trajectory_run_carries_the_reactions():
     # refused inputs leave no run (trajectory_run's own checks come first)
     with pytest.raises(ad.ModelError, match="trajectory_run"):
         ad.trajectory_run(model, res.t, res.q[:, :1], res.qd, res.qdd)
+
+
+def test_driven_arm_equals_driven_inverse_dynamics():
+    # every joint of the UR5 driven: driven_inverse_dynamics solves the constrained Newton-Euler
+    # system (a KKT solve, the drives' multipliers) along the prescribed motion; joint_reactions
+    # on the same model (its drives ignored) at that motion gives the same reactions, and its
+    # torques are the drives' efforts
+    path, plain = ur5()
+    b = ad.urdf_builder(str(path))
+    for k, name in enumerate(plain.coord_names):
+        b.add_drive(name, ad.profiles.sine(0.4 + 0.1 * k, 0.3 + 0.2 * k, k, common.UR5_Q0[k]))
+    model = b.finalize()
+    times = np.linspace(0.0, 1.0, 11)
+    ref = ad.driven_inverse_dynamics(model, times)
+    forces, torques = ad.joint_reactions(model, ref.q, ref.qd, ref.qdd, times)
+    assert rel_err(forces, ref.reaction_forces) <= 1e-12  # measured 2.8e-16
+    assert rel_err(torques, ref.reaction_torques) <= 1e-12
+    # the drives play no part: the model without them gives the same
+    bare = ad.joint_reactions(plain, ref.q, ref.qd, ref.qdd, times)
+    np.testing.assert_array_equal(bare[0], forces)
+    np.testing.assert_array_equal(bare[1], torques)
+    tau = ad.inverse_dynamics(model, ref.q, ref.qd, ref.qdd, times)
+    assert rel_err(tau, ref.drive_forces) <= 1e-12
