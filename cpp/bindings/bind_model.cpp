@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // armdyn.Model (armdyn/model/model.hpp): sizes, names, topology, limits, actuators, KKT path.
 // What the properties derive is in armdyn/model/properties.hpp; pickling: bind_pickle.cpp.
-#include "armdyn/builder/payload.hpp"
+#include "armdyn/io/payload.hpp"
 #include "armdyn/builder/summary.hpp"
 #include "convert_model.hpp"
 
@@ -221,10 +221,11 @@ std::vector<Payload> payload_list(const py::handle& payloads) {
   static const char* keys[] = {"at", "mass", "com", "inertia", "name"};
   for (const py::handle item : payloads) {
     const std::string who = msg(fn, ": payloads[", out.size(), "]");
-    if (!PyDict_Check(item.ptr()))
+    const py::object mapping = py::module_::import("collections.abc").attr("Mapping");
+    if (!py::isinstance(item, mapping))
       throw ModelError(
           msg(who, " must be a dict (keys at, mass, com, inertia, name), got ", shown(item)));
-    const py::dict d = py::reinterpret_borrow<py::dict>(item);
+    const py::dict d(py::reinterpret_borrow<py::object>(item));
     for (const auto& kv : d) {
       const std::string k = PyUnicode_Check(kv.first.ptr()) ? kv.first.cast<std::string>() : "";
       if (std::find_if(std::begin(keys), std::end(keys), [&](const char* x) { return k == x; }) ==
@@ -263,7 +264,7 @@ void def_model_payload(ModelClass& c) {
       "cannot be copied (ModelError).");
   c.def(
       "with_payloads",
-      [](const Model& md, const py::object& payloads) {
+      [](const Model& md, const PayloadList& payloads) {
         return with_payloads(md, payload_list(payloads), "with_payloads");
       },
       py::arg("payloads"),

@@ -23,6 +23,17 @@ namespace armdyn::py_helpers {
 
 using ModelClass = py::class_<Model, std::shared_ptr<Model>>;
 
+/// Motor.from_row's row and with_payloads' list, typed for the stubs (common.hpp's hinted
+/// objects: any object, checked where it is taken).
+class RowArg : public py::object {
+ public:
+  PYBIND11_OBJECT_DEFAULT(RowArg, py::object, accept_any)
+};
+class PayloadList : public py::object {
+ public:
+  PYBIND11_OBJECT_DEFAULT(PayloadList, py::object, accept_any)
+};
+
 // --- Motor ------------------------------------------------------------------------------------
 
 /// A Motor field from Python: None (not given) or a finite number (> 0: MotorSpec::validate).
@@ -139,7 +150,7 @@ inline std::string motor_row_name(const py::object& row, const py::object& get) 
 }
 
 /// Motor.from_row: the motor fields a mapping (dict, pandas Series) holds, other keys ignored.
-inline MotorSpec motor_from_row(const py::object& row) {
+inline MotorSpec motor_from_row(const RowArg& row) {
   if (PyUnicode_Check(row.ptr()) || PyBytes_Check(row.ptr()) || !py::hasattr(row, "get"))
     throw ModelError(
         msg("Motor.from_row: row must be a mapping (a dict, a pandas Series), got ", shown(row)));
@@ -352,3 +363,16 @@ inline ModelBuilder builder_from_state(const py::tuple& st) {
 }
 
 }  // namespace armdyn::py_helpers
+
+namespace pybind11::detail {
+template <>
+struct handle_type_name<armdyn::py_helpers::RowArg> {
+  static constexpr auto name =
+      const_name("collections.abc.Mapping[str, typing.SupportsFloat | str | None]");
+};
+template <>
+struct handle_type_name<armdyn::py_helpers::PayloadList> {
+  static constexpr auto name = const_name(
+      "collections.abc.Iterable[collections.abc.Mapping[str, numpy.typing.ArrayLike | None]]");
+};
+}  // namespace pybind11::detail

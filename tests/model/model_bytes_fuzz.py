@@ -67,7 +67,16 @@ def builder_model():
     b.add_body("link2", 1.0, box(1.0, 0.04, 0.04, 0.5), (0.0, 0.0, 0.75))
     b.add_revolute("j2", "link1", "link2", (0.0, 0.0, 0.5), (0.0, 1.0, 0.0))
     b.set_joint_limits("j2", -1.0, 1.0, 20.0, 3.0)
-    motor = ad.Motor(name="m1", torque_constant=0.05, resistance=0.4, voltage=48.0)
+    motor = ad.Motor(
+        name="m1",
+        torque_constant=0.05,
+        resistance=0.4,
+        voltage=48.0,
+        rotor_inertia=1e-5,
+        thermal_resistance_winding=0.9,
+        max_winding_temperature=155.0,
+        brake_torque=0.5,
+    )
     b.add_actuator("j1", 50.0, 1e-5, efficiency=0.9, friction_viscous=1e-4, motor=motor)
     b.add_actuator("j2", 30.0, 1e-5, gyroscopic=True, friction_coulomb=1e-3)
     b.add_motor("j2", profiles.cubic(0.0, 0.2, 0.0, 0.1), 50.0, 2.0, 20.0, ki=5.0)

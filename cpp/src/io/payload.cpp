@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Model::with_payloads (armdyn/builder/payload.hpp).
-#include "armdyn/builder/payload.hpp"
+// Model::with_payloads (armdyn/io/payload.hpp).
+#include "armdyn/io/payload.hpp"
 
 #include <algorithm>
 #include <cmath>
