@@ -481,7 +481,7 @@ CASES = [
         "with_payload at a name that is no frame or body",
         lambda: _pendulum().with_payload("nowhere", 1.0),
         ME,
-        r"with_payload: at 'nowhere' is neither a frame nor a body",
+        r"with_payload: at 'nowhere' is neither a frame, a body nor a joint",
     ),
     (
         "payload-name-taken",

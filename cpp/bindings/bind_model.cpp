@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // armdyn.Model (armdyn/model/model.hpp): sizes, names, topology, limits, actuators, KKT path.
 // What the properties derive is in armdyn/model/properties.hpp; pickling: bind_pickle.cpp.
-#include "armdyn/io/payload.hpp"
 #include "armdyn/builder/summary.hpp"
+#include "armdyn/io/payload.hpp"
 #include "convert_model.hpp"
 
 namespace armdyn {
@@ -255,8 +255,10 @@ void def_model_payload(ModelClass& c) {
       "A new finalized model with a payload (this model is unchanged): a rigid body of mass "
       "[kg] with its centre of mass at com [m] and inertia [kg m^2] (3x3 about the centre of "
       "mass, or its 3 principal moments; None: a point mass), both in the axes of `at` and from "
-      "its origin, welded to `at`: a named frame of the model (e.g. a URDF link or tool0), or "
-      "else a body name (its centre of mass and axes). It adds body `name`, fixed joint "
+      "its origin, welded to `at`: a named frame of the model (e.g. a URDF link's frame or "
+      "tool0); else a body (its centre of mass and axes) or 'ground'; else a joint (its point "
+      "and joint frame on the parent's side, z the joint axis; welded to the parent): the first "
+      "kind that has the name wins. It adds body `name`, fixed joint "
       "'<name>_mount' (reactions at at's origin) and frame `name` at the payload's centre of "
       "mass. The dynamics are those of the builder with the same body added (add_body + "
       "add_fixed). ModelError naming the culprit (at, mass, com, inertia, name) and leaving "

@@ -110,6 +110,36 @@ def test_a_name_both_frame_and_body_is_the_frame():
     _close(ad.frame_pose(loaded, Q, "payload")[:3, 3], link[:3, :3] @ [0.0, 0.0, 0.1] + link[:3, 3])
 
 
+def test_at_a_joint_is_its_point_and_frame_on_the_parent():
+    """The selection's housing mass at a joint: ``at=joint`` welds to the joint's parent at the
+    joint point, in the joint frame (z the axis). Reference: the builder's body placed from the
+    bare model's link-frame pose and joint_frame (upper_arm_link's link frame lies 0.28 m from
+    its centre of mass, the joint point is given relative to the centre of mass)."""
+    bare = ad.load_urdf(str(UR5))
+    jf, link = bare.joint_frame("elbow_joint"), bare.frame("upper_arm_link")
+    loaded = bare.with_payload("elbow_joint", 2.0, com=COM, inertia=INERTIA, name="housing")
+    # the joint point and frame in the link frame's coordinates, then in world at q = 0
+    pose = ad.frame_pose(bare, np.zeros(6), "upper_arm_link")
+    rf = link["rotation"]
+    origin = pose[:3, :3] @ rf.T @ (jf["point_parent"] - link["point"]) + pose[:3, 3]
+    axes = pose[:3, :3] @ rf.T @ jf["frame_parent"]
+    b = ad.urdf_builder(str(UR5))
+    b.add_body("housing", 2.0, axes @ INERTIA @ axes.T, position=origin + axes @ COM)
+    b.add_fixed("housing_mount", "upper_arm_link", "housing")
+    ref = b.finalize()
+    rng = np.random.default_rng(5)
+    for _ in range(3):
+        q, qd, qdd = rng.uniform(-2, 2, (3, 6))
+        _close(ad.mass_matrix(loaded, q), ad.mass_matrix(ref, q))
+        _close(ad.inverse_dynamics(loaded, q, qd, qdd), ad.inverse_dynamics(ref, q, qd, qdd))
+    # a point mass on the elbow's axis: no holding torque on the elbow itself, but on the
+    # shoulder lift
+    on_axis = bare.with_payload("elbow_joint", 2.0, com=(0.0, 0.0, 0.03))
+    zero = np.zeros(6)
+    extra = ad.inverse_dynamics(on_axis, Q, zero, zero) - ad.inverse_dynamics(bare, Q, zero, zero)
+    assert abs(extra[2]) <= 1e-12 * abs(extra[1]) and abs(extra[1]) > 1.0
+
+
 def _arm(actuators=False, coupling=False, floating=False):
     """A three-link arm with a tilted body, optionally actuated, coupled or on a floating base."""
     b = ad.ModelBuilder()
@@ -227,6 +257,10 @@ def test_several_payloads_at_once_equal_one_at_a_time():
     # total mass: the payloads' masses added
     assert sum(at_once.masses) == pytest.approx(sum(bare.masses) + sum(h["mass"] for h in housings))
     assert _state(bare.with_payloads([])) == _state(bare)
+    # the model's KKT path and notes are kept
+    dense = bare.with_kkt_path("dense")
+    assert dense.with_payloads(housings).kkt_path == "dense" == dense.kkt_path
+    assert at_once.kkt_path == bare.kkt_path
 
 
 BAD = [
@@ -240,7 +274,7 @@ BAD = [
     (dict(inertia=[1.0, 1.0, -0.1]), r"with_payload: inertia is not positive semidefinite"),
     (dict(inertia=[[1.0, 0.5, 0], [0, 1.0, 0], [0, 0, 1.0]]), r"inertia is not symmetric"),
     (dict(inertia=np.eye(2)), r"with_payload: inertia: expected shape"),
-    (dict(at="nowhere"), r"with_payload: at 'nowhere' is neither a frame nor a body"),
+    (dict(at="nowhere"), r"with_payload: at 'nowhere' is neither a frame, a body nor a joint"),
     (dict(at=3), r"with_payload: at must be a str"),
     (dict(name="wrist_3_link"), r"name 'wrist_3_link' is taken by a body of the model"),
     (dict(name="tool0"), r"name 'tool0' is taken by a frame of the model"),

@@ -36,8 +36,15 @@ Mount resolve_mount(const Model& d, const std::string& at, const std::string& wh
     rot = fr.rotation;
   } else if (auto b = d.body_index.find(at); b != d.body_index.end()) {
     body = b->second;
+  } else if (auto j = d.joint_index.find(at); j != d.joint_index.end()) {
+    // a joint: its point and joint frame on the parent's side
+    const Joint& jt = d.joints[j->second];
+    body = jt.parent;
+    point = jt.point_parent;
+    rot = jt.frame_parent;
   } else if (at != "ground") {
-    throw ModelError(msg(who, ": at '", at, "' is neither a frame nor a body of the model"));
+    throw ModelError(
+        msg(who, ": at '", at, "' is neither a frame, a body nor a joint of the model"));
   }
   mt.body = d.body_name(body);
   if (body == kGround) {

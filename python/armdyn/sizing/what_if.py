@@ -46,14 +46,8 @@ _SWEPT_FIELDS = (
 
 
 def make_motor(**datasheet):
-    """An :class:`armdyn.Motor` from datasheet keywords (SI, motor side: ``torque_constant``
-    N m/A, ``resistance`` ohm, ``voltage`` V, ``no_load_speed`` rad/s, ``continuous_torque`` and
-    ``peak_torque`` N m, ``max_speed`` rad/s, ``thermal_resistance`` K/W,
-    ``thermal_time_constant`` s, ``rotor_inertia`` kg m^2, ``mass`` kg,
-    ``thermal_resistance_winding`` and ``thermal_resistance_housing`` K/W,
-    ``thermal_time_constant_winding`` and ``thermal_time_constant_housing`` s,
-    ``max_winding_temperature`` degC, ``brake_torque`` N m, ``name``: :data:`MOTOR_FIELDS`);
-    an unknown key is a ModelError naming it."""
+    """An :class:`armdyn.Motor` from datasheet keywords: :data:`MOTOR_FIELDS` (SI, motor side;
+    the units in ``armdyn.Motor``'s docstring); an unknown key is a ModelError naming it."""
     unknown = sorted(set(datasheet) - set(MOTOR_FIELDS))
     if unknown:
         raise _core.ModelError(f"motor: unknown datasheet key(s) {unknown}; known {MOTOR_FIELDS}")

@@ -15,8 +15,10 @@ namespace armdyn {
 
 /// One payload: a rigid body of `mass` [kg] with its centre of mass at `com` [m] and inertia
 /// `inertia` [kg m^2] (about the centre of mass), both in the axes of `at` and from its origin.
-/// `at` names a frame of the model (Model::frames), or else a body (its centre of mass and
-/// axes) or "ground".
+/// `at` names a frame of the model (Model::frames); else a body (its centre of mass and axes)
+/// or "ground"; else a joint (its point and joint frame on the parent's side, z the joint axis;
+/// welded to the parent). The first kind that has the name wins (a URDF link is a frame, the
+/// link frame, and a body).
 struct Payload {
   std::string at;
   double mass = 0.0;
