@@ -146,6 +146,16 @@ def test_format_2_bytes_still_load():
             _load(other)
 
 
+def test_a_motor_pickled_before_the_new_fields_loads():
+    """A Motor's pickled state is a dict of its fields: one without the new keys (as pickled
+    before them) loads with them not given."""
+    old_state = {"name": "m1", **OLD_VALUES}
+    motor = ad.Motor.__new__(ad.Motor)
+    motor.__setstate__(old_state)
+    assert motor == ad.Motor(name="m1", **OLD_VALUES)
+    assert set(full_motor().__getstate__()) == {"name", *ad.Motor.FIELDS}
+
+
 def _motor_at(data: bytes, name: str) -> int:
     """The offset of the motor's first datasheet double (after its name) in model bytes."""
     tag = struct.pack("<q", len(name)) + name.encode()
