@@ -91,7 +91,8 @@ void check_numbers(const Payload& p, const std::string& who) {
         msg(who, ": inertia ", ic.problem, " (principal moments ", ic.moments.transpose(), ")"));
 }
 
-/// Add payload `p` to the builder (its checks first: the builder is unchanged when it throws).
+/// Add payload `p` to the builder, its checks first (the builder is with_payloads' own copy:
+/// the model is unchanged whatever throws).
 void add_payload(ModelBuilder& b, const Payload& p, const std::string& who) {
   const Model& d = b.draft();
   check_numbers(p, who);
