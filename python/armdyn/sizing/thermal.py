@@ -1,29 +1,346 @@
-"""The motor winding's temperature rise along a run: the first-order thermal model
-τ_th dΔT/dt = R_th P(t) − ΔT driven by the copper loss (:func:`thermal_rise`), and the
-report's two temperature columns (:func:`temperature_rises`)."""
+"""The motor winding's temperature along a run or a repeated duty cycle, vectorised over k
+candidate motors (:func:`thermal_cycle`), and the sizing report's first-order rise
+(:func:`thermal_rise`, :func:`temperature_rises`), which is its one-node case.
+
+**Two-node model** (winding → housing → ambient; rises θ above the ambient temperature)::
+
+    C_w dθ_w/dt = P_cu − (θ_w − θ_h) / R_w
+    C_h dθ_h/dt = (θ_w − θ_h) / R_w − θ_h / R_h,      C_w = τ_w / R_w,  C_h = τ_h / R_h
+
+(``thermal_resistance_winding`` R_w, ``thermal_resistance_housing`` R_h,
+``thermal_time_constant_winding`` τ_w, ``thermal_time_constant_housing`` τ_h). A motor that
+gives only ``thermal_resistance`` R_th and ``thermal_time_constant`` τ_th has the **one-node**
+model τ_th dθ_w/dt = R_th P_cu − θ_w (its housing is not modelled: NaN); a motor with neither
+is not checked (NaN).
+
+**Exact steps.** With the loss linear in time over a step of length h, x = (θ_w, θ_h),
+x' = A x + b P: x(h) = e^{Ah} x(0) + h φ₁(Ah) b P(0) + h φ₂(Ah) b (P(h) − P(0)), φ₁(z) =
+(e^z − 1)/z, φ₂(z) = (e^z − 1 − z)/z², evaluated in closed form for the 2×2 matrix (its
+eigenvalues are real and distinct: f(A) = [f(λ₁)(A − λ₂) − f(λ₂)(A − λ₁)] / (λ₁ − λ₂), with
+``expm1`` and short series near 0). Steps of zero length (a repeated time) leave the state.
+
+**Copper resistance** R(T_w) = R_ref (1 + α (T_w − T_ref)) (α: the options'
+``copper_temperature_coefficient``, T_ref their ``resistance_temperature``). The loss of a
+step is R(T_w) i² with T_w the winding temperature at the step's start, held over the step:
+the step stays an affine map of the state, so the periodic state below is still the exact
+fixed point of the period's map (no iteration). This is first order in the step: its error
+is of the order α ΔT_w(step) R i², ΔT_w the winding's change over one sample step. A step at
+constant current (a dwell's hold) is exact instead: R(T_w) i² is then linear in θ_w and goes
+into the step's matrix (A + α R_ref i² e₁e₁ᵀ / C_w).
+
+**Repeated cycles.** One period maps the start state affinely, x ↦ Φ x + ψ (Φ, ψ propagated
+along the steps). ``repeat=None`` (forever): the periodic steady state x* = (I − Φ)⁻¹ ψ, which
+exists when the spectral radius of Φ is below 1 (Φ ≥ 0 elementwise: when I − Φ is an
+M-matrix); otherwise the copper's resistance rise runs away and the temperatures are ``inf``.
+``repeat=N``: the start of the N-th period, (Φ, ψ)^{N−1} applied to ambient (exponentiation
+by squaring). Losses are non-negative and Φ ≥ 0, so temperatures rise period after period
+from ambient and the last period holds the peak. Each candidate is independent; the
+candidates are arrays of one chunk (the caller bounds its size).
+"""
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 
 from armdyn._runs import time_mean
 
+#: |z| below which φ₁, φ₂ use their series (5 terms: error below 1e-17 relative)
+_SERIES = 1e-3
+
+
+def _phi(z: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(e^z − 1, φ₁(z), φ₂(z)) elementwise (φ₁(0) = 1, φ₂(0) = 1/2)."""
+    small = np.abs(z) < _SERIES
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        em = np.expm1(z)
+        zs = np.where(small, 1.0, z)
+        p1 = np.where(small, 1 + z * (1 / 2 + z * (1 / 6 + z * (1 / 24 + z / 120))), em / zs)
+        p2 = np.where(
+            small, 1 / 2 + z * (1 / 6 + z * (1 / 24 + z * (1 / 120 + z / 720))), (em - z) / zs**2
+        )
+    return em, p1, p2
+
+
+@dataclass(frozen=True)
+class ThermalNetwork:
+    """The thermal model of k candidates as x' = A x + b P (x = winding and housing rise):
+    the entries of A and b₁ (b₂ = 0), each (k,). A one-node candidate has a₁₂ = a₂₁ = 0 and a
+    decoupled dummy housing mode (a₂₂ = 2 a₁₁, its rise stays 0); ``two_node`` tells which,
+    ``valid`` which candidates have a thermal model at all (the others carry dummy values)."""
+
+    a11: np.ndarray
+    a12: np.ndarray
+    a21: np.ndarray
+    a22: np.ndarray
+    b1: np.ndarray
+    two_node: np.ndarray
+    valid: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.a11)
+
+    def take(self, sel) -> ThermalNetwork:
+        """The candidates ``sel`` (a slice or an index array)."""
+        return ThermalNetwork(*(np.asarray(getattr(self, f))[sel] for f in self.__annotations__))
+
+
+def _positive(x: np.ndarray) -> np.ndarray:
+    with np.errstate(invalid="ignore"):
+        return np.isfinite(x) & (x > 0.0)
+
+
+def thermal_network(
+    r_winding=np.nan,
+    r_housing=np.nan,
+    tau_winding=np.nan,
+    tau_housing=np.nan,
+    r_th=np.nan,
+    tau_th=np.nan,
+) -> ThermalNetwork:
+    """The :class:`ThermalNetwork` of k candidates from their datasheet values (arrays of one
+    shape, or scalars; NaN = not given): two-node where R_w, R_h, τ_w, τ_h are all positive,
+    else one-node where R_th and τ_th are, else none (``valid`` False)."""
+    rw, rh, tw, th, r1, t1 = np.broadcast_arrays(
+        *(
+            np.atleast_1d(np.asarray(x, dtype=float))
+            for x in (r_winding, r_housing, tau_winding, tau_housing, r_th, tau_th)
+        )
+    )
+    two = _positive(rw) & _positive(rh) & _positive(tw) & _positive(th)
+    one = ~two & _positive(r1) & _positive(t1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cw = np.where(two, 1.0 / tw, 0.0)
+        ch = np.where(two, rh / (rw * th), 0.0)  # 1 / (R_w C_h)
+        a11 = np.where(two, -cw, np.where(one, -1.0 / t1, -1.0))
+        a22 = np.where(two, -ch - 1.0 / th, 2.0 * a11)
+        b1 = np.where(two, rw / tw, np.where(one, r1 / t1, 0.0))
+    return ThermalNetwork(a11, cw, ch, a22, b1, two, two | one)
+
+
+@dataclass
+class _Steps:
+    """The exact step coefficients of a set of step lengths (rows) for every candidate
+    (columns): the state matrix E = e^{Ah} and the loss vectors D = h (φ₁ − φ₂)(Ah) b,
+    U = h φ₂(Ah) b, so that x(h) = E x(0) + D P(0) + U P(h)."""
+
+    e11: np.ndarray
+    e12: np.ndarray
+    e21: np.ndarray
+    e22: np.ndarray
+    dw: np.ndarray
+    dh: np.ndarray
+    uw: np.ndarray
+    uh: np.ndarray
+
+
+def _steps(net: ThermalNetwork, h: np.ndarray, feedback=None) -> _Steps:
+    """:class:`_Steps` for step lengths ``h`` ((m, 1) against the (k,) candidates); with
+    ``feedback`` (k,) the winding row of A gains b₁ · feedback (a loss α R_ref i² θ_w at
+    constant current)."""
+    a11 = net.a11 if feedback is None else net.a11 + net.b1 * feedback
+    a12, a21, a22 = net.a12, net.a21, net.a22
+    mu = 0.5 * (a11 + a22)
+    half = np.sqrt((0.5 * (a11 - a22)) ** 2 + a12 * a21)  # > 0 (see ThermalNetwork)
+    l1, l2 = mu + half, mu - half
+    em1, p11, p21 = _phi(l1 * h)
+    em2, p12, p22 = _phi(l2 * h)
+    inv = 0.5 / half
+    with np.errstate(invalid="ignore", over="ignore"):
+        d_em = (em1 - em2) * inv
+        e11 = 1.0 + (em1 * (a11 - l2) - em2 * (a11 - l1)) * inv
+        e22 = 1.0 + (em1 * (a22 - l2) - em2 * (a22 - l1)) * inv
+
+        def first_column(f1, f2):  # f(Ah) e₁
+            return (f1 * (a11 - l2) - f2 * (a11 - l1)) * inv, a21 * (f1 - f2) * inv
+
+        g1w, g1h = first_column(p11, p12)
+        g2w, g2h = first_column(p21, p22)
+        hb = h * net.b1
+        return _Steps(
+            e11, a12 * d_em, a21 * d_em, e22, hb * (g1w - g2w), hb * (g1h - g2h), hb * g2w, hb * g2h
+        )
+
+
+@dataclass
+class _Cycle:
+    """What every pass over one period uses: step lengths, the unique lengths' coefficients
+    (``table``, rows by ``which``), the current squared (n, k), the resistance at ambient
+    and its slope per kelvin (k,), and the constant-current steps (``hold``) whose exact
+    coefficients include the resistance's rise."""
+
+    net: ThermalNetwork
+    h: np.ndarray
+    which: np.ndarray
+    table: _Steps
+    current_sq: np.ndarray
+    r_ambient: np.ndarray
+    r_slope: np.ndarray
+    hold: np.ndarray
+
+
+def _cycle(t, current_sq, net, r_ambient, r_slope) -> _Cycle:
+    h = np.diff(np.asarray(t, dtype=float))
+    hu, which = np.unique(h, return_inverse=True)
+    table = _steps(net, hu[:, None])
+    r_slope = np.broadcast_to(np.asarray(r_slope, dtype=float), (len(net),))
+    hold = np.zeros(len(h), dtype=bool)
+    if np.any(r_slope != 0.0):
+        same = np.all(current_sq[1:] == current_sq[:-1], axis=1)
+        hold = same & (h > 0.0) & np.any(current_sq[:-1] > 0.0, axis=1)
+    r_ambient = np.broadcast_to(np.asarray(r_ambient, dtype=float), (len(net),))
+    return _Cycle(net, h, which, table, current_sq, r_ambient, r_slope, hold)
+
+
+def _sweep(c: _Cycle, w: np.ndarray, hs: np.ndarray, store=None):
+    """Propagate states over one period: ``w``, ``hs`` (m, k) winding and housing rises of m
+    columns. Column 0 is a state (the loss forces it); the others (the period map's matrix
+    columns) see only the resistance's slope. ``store`` (two (n, k) arrays or None) receives
+    column 0 at every sample. Returns the final (w, hs) and column 0's largest winding and
+    housing rises over the samples."""
+    base = np.zeros_like(w)
+    base[0] = c.r_ambient
+    wmax, hmax = w[0].copy(), hs[0].copy()
+    if store is not None:
+        store[0][0], store[1][0] = w[0], hs[0]
+    q = c.current_sq
+    for i, h in enumerate(c.h):
+        if h > 0.0:
+            if c.hold[i]:  # constant current: the resistance's rise in the step's matrix
+                s = _steps(c.net, np.array([[h]]), feedback=c.r_slope * q[i])
+                f = (s.dw[0] + s.uw[0]) * q[i], (s.dh[0] + s.uh[0]) * q[i]
+                r = base
+                e11, e12, e21, e22 = s.e11[0], s.e12[0], s.e21[0], s.e22[0]
+            else:
+                s, u = c.table, c.which[i]
+                f = s.dw[u] * q[i] + s.uw[u] * q[i + 1], s.dh[u] * q[i] + s.uh[u] * q[i + 1]
+                r = c.r_slope * w + base  # R(T_w) at the step's start
+                e11, e12, e21, e22 = s.e11[u], s.e12[u], s.e21[u], s.e22[u]
+            w, hs = e11 * w + e12 * hs + r * f[0], e21 * w + e22 * hs + r * f[1]
+            np.maximum(wmax, w[0], out=wmax)
+            np.maximum(hmax, hs[0], out=hmax)
+        if store is not None:
+            store[0][i + 1], store[1][i + 1] = w[0], hs[0]
+    return w, hs, wmax, hmax
+
+
+def _period_map(c: _Cycle):
+    """(Φ as (φ11, φ12, φ21, φ22), ψ as (ψw, ψh)) of one period, each (k,)."""
+    k = len(c.net)
+    w = np.zeros((3, k))
+    hs = np.zeros((3, k))
+    w[1] = 1.0
+    hs[2] = 1.0
+    w, hs, _, _ = _sweep(c, w, hs)
+    return (w[1], w[2], hs[1], hs[2]), (w[0], hs[0])
+
+
+def _compose(a, b):
+    """The affine map a∘b of maps (Φ, ψ)."""
+    (a11, a12, a21, a22), (aw, ah) = a
+    (b11, b12, b21, b22), (bw, bh) = b
+    with np.errstate(over="ignore", invalid="ignore"):
+        m = (
+            a11 * b11 + a12 * b21,
+            a11 * b12 + a12 * b22,
+            a21 * b11 + a22 * b21,
+            a21 * b12 + a22 * b22,
+        )
+        return m, (a11 * bw + a12 * bh + aw, a21 * bw + a22 * bh + ah)
+
+
+def _start_state(c: _Cycle, repeat: int | None):
+    """The rises at the start of the period that holds the peak: the periodic state
+    (``repeat`` None; inf where it does not exist) or the start of the last of ``repeat``
+    periods from ambient."""
+    k = len(c.net)
+    if repeat == 1:
+        return np.zeros(k), np.zeros(k)
+    phi, psi = _period_map(c)
+    if repeat is None:
+        p11, p12, p21, p22 = phi
+        det = (1.0 - p11) * (1.0 - p22) - p12 * p21
+        stable = (p11 < 1.0) & (p22 < 1.0) & (det > 0.0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            w = ((1.0 - p22) * psi[0] + p12 * psi[1]) / det
+            h = (p21 * psi[0] + (1.0 - p11) * psi[1]) / det
+        return np.where(stable, w, np.inf), np.where(stable, h, np.inf)
+    result = ((np.ones(k), np.zeros(k), np.zeros(k), np.ones(k)), (np.zeros(k), np.zeros(k)))
+    base, m = (phi, psi), repeat - 1
+    while m:
+        if m & 1:
+            result = _compose(base, result)
+        m >>= 1
+        if m:
+            base = _compose(base, base)
+    return result[1]
+
+
+@dataclass
+class ThermalCycle:
+    """The result of :func:`thermal_cycle` (rises above the ambient temperature [K]):
+    ``winding_peak``, ``housing_peak`` (k,) the largest rises over the period that holds the
+    peak (NaN where the candidate has no thermal model, housing NaN for one-node candidates,
+    inf for a thermal runaway); with ``store``, ``winding`` and ``housing`` (n, k): the rises
+    at every sample of that period."""
+
+    winding_peak: np.ndarray
+    housing_peak: np.ndarray
+    winding: np.ndarray | None = None
+    housing: np.ndarray | None = None
+
+
+def thermal_cycle(
+    t,
+    current_sq,
+    net: ThermalNetwork,
+    r_ambient,
+    r_slope=0.0,
+    repeat: int | None = None,
+    store: bool = False,
+) -> ThermalCycle:
+    """Winding and housing temperature rises of k candidates over a repeated period (see the
+    module notes).
+
+    Args:
+        t: (n,) the period's sample times (non-decreasing; t[-1] − t[0] the period).
+        current_sq: (n, k) the square of each candidate's current at the samples (or any
+            quantity whose product with the resistance is the loss).
+        net: the candidates' :class:`ThermalNetwork`.
+        r_ambient: (k,) the winding resistance at the ambient temperature [Ω].
+        r_slope: (k,) dR/dT_w = α R_ref [Ω/K] (0: a constant resistance).
+        repeat: None (the periodic steady state) or the number of periods from ambient.
+        store: keep the rises at every sample of the peak's period.
+    """
+    current_sq = np.asarray(current_sq, dtype=float)
+    c = _cycle(t, current_sq, net, r_ambient, r_slope)
+    w0, h0 = _start_state(c, repeat)
+    n, k = len(c.h) + 1, len(net)
+    arrays = (np.empty((n, k)), np.empty((n, k))) if store else None
+    with np.errstate(invalid="ignore", over="ignore"):
+        _, _, wmax, hmax = _sweep(c, w0[None].copy(), h0[None].copy(), arrays)
+    bad = ~(np.isfinite(wmax) & np.isfinite(hmax))
+    no_w, no_h = ~net.valid, ~(net.valid & net.two_node)
+    out = ThermalCycle(_masked(wmax, bad, no_w), _masked(hmax, bad, no_h))
+    if store:
+        out.winding, out.housing = _masked(arrays[0], bad, no_w), _masked(arrays[1], bad, no_h)
+    return out
+
+
+def _masked(x: np.ndarray, runaway: np.ndarray, none: np.ndarray) -> np.ndarray:
+    """``x`` with its candidates (last axis) ``runaway`` set to inf and ``none`` to NaN."""
+    return np.where(none, np.nan, np.where(runaway, np.inf, x))
+
 
 def thermal_rise(t: np.ndarray, loss: np.ndarray, r_th: float, tau_th: float) -> np.ndarray:
     """Winding temperature rise of the first-order model τ_th dΔT/dt = R_th P(t) − ΔT from
-    ΔT = 0, P linear between samples (exact per step)."""
-    out = np.zeros_like(loss)
-    for k in range(1, len(t)):
-        h = t[k] - t[k - 1]
-        if h <= 0.0:  # a repeated sample (an event's time): nothing elapses
-            out[k] = out[k - 1]
-            continue
-        a = np.exp(-h / tau_th)
-        slope = (loss[k] - loss[k - 1]) / h
-        p1 = r_th * (loss[k] - tau_th * slope)
-        p0 = r_th * (loss[k - 1] - tau_th * slope)
-        out[k] = p1 + (out[k - 1] - p0) * a
-    return out
+    ΔT = 0, P linear between samples (exact per step): :func:`thermal_cycle`'s one-node model
+    over one period from ambient."""
+    loss = np.asarray(loss, dtype=float)
+    net = thermal_network(r_th=r_th, tau_th=tau_th)
+    out = thermal_cycle(t, loss[:, None], net, np.ones(1), repeat=1, store=True)
+    return out.winding[:, 0]
 
 
 def temperature_rises(
