@@ -40,8 +40,11 @@ from armdyn.animation import animate  # k3d and trimesh are imported when animat
 from armdyn.dynamics import InverseDynamicsResult, driven_inverse_dynamics
 from armdyn.simulation import SimulationResult, load_urdf, rollout, simulate
 from armdyn.sizing import (
+    DutyCycle,
+    JointLoad,
     SizingReport,
     TrajectoryRun,
+    duty_cycle,
     gear_ratio_sweep,
     limit_violations,
     sizing_report,
@@ -56,7 +59,9 @@ __version__ = "0.1.0"
 __all__ = [
     "Actuator",
     "Data",
+    "DutyCycle",
     "InverseDynamicsResult",
+    "JointLoad",
     "LagrangeValidator",
     "Model",
     "ModelBuilder",
@@ -75,6 +80,7 @@ __all__ = [
     "body_forces",
     "body_mass_matrix",
     "driven_inverse_dynamics",
+    "duty_cycle",
     "dynamics_cost",
     "energy",
     "evaluate_constraints",

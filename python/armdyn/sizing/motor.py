@@ -11,7 +11,7 @@ from dataclasses import replace
 import numpy as np
 
 from armdyn import _checks, _core
-from armdyn._runs import time_mean, trapezoid
+from armdyn._runs import time_mean
 from armdyn.actuators import gear_input_torque, rotor_torque
 from armdyn.sizing.checks import margin
 from armdyn.sizing.options import sizing_options
@@ -349,9 +349,15 @@ def _thermal_inputs(m: dict, sel, options):
 def _chunk(t, qd, qdd, tau, repeat, ratio, eta, j, m: dict, sel, options, series=False):
     """The cycle values of the candidates ``sel`` (time-major (n, kc) arrays inside); with
     ``series`` the per-sample arrays of those candidates instead."""
-    n_r, eta_c, j_c = ratio[sel][None, :], eta[sel][None, :], j[sel][None, :]
-    torque = j_c * (n_r * qdd[:, None]) + gear_input_torque(tau[:, None], qd[:, None], n_r, eta_c)
-    speed = n_r * qd[:, None]
+    n_r, eta_c, j_c = ratio[sel], eta[sel], j[sel]
+    # T = J N q̈ + gear_input_torque: the gear's factor per power-flow direction (row 0 while
+    # motoring, row 1 backwards), then one outer product per term
+    factor = gear_input_torque(np.ones((2, 1)), np.array([[1.0], [-1.0]]), n_r, eta_c)
+    motoring = tau * qd >= 0.0
+    torque = np.multiply.outer(qdd, j_c * n_r)
+    torque += np.multiply.outer(np.where(motoring, tau, 0.0), factor[0])
+    torque += np.multiply.outer(np.where(motoring, 0.0, tau), factor[1])
+    speed = np.multiply.outer(qd, n_r)
     k_t, r = m["torque_constant"][sel], m["resistance"][sel]
     t0, w0 = envelope_corners(
         k_t, m["voltage"][sel], r, m["peak_torque"][sel], m["no_load_speed"][sel]
@@ -360,7 +366,7 @@ def _chunk(t, qd, qdd, tau, repeat, ratio, eta, j, m: dict, sel, options, series
         current = torque / k_t
         net, r_ambient, r_slope = _thermal_inputs(m, sel, options)
         heat = thermal_cycle(
-            t, np.where(net.valid, current**2, 0.0), net, r_ambient, r_slope, repeat, store=True
+            t, np.where(net.valid, current**2, 0.0), net, r_ambient, r_slope, repeat
         )
         copper = np.isfinite(k_t) & np.isfinite(r)
         # the winding resistance along the cycle (at ambient where there is no thermal model)
@@ -380,24 +386,38 @@ def _chunk(t, qd, qdd, tau, repeat, ratio, eta, j, m: dict, sel, options, series
             "winding_temperature": options.ambient_temperature + heat.winding[:, 0],
             "housing_temperature": options.ambient_temperature + heat.housing[:, 0],
         }
-    period = t[-1] - t[0]
-    rms = np.sqrt(trapezoid(torque**2, t) / period)
+    weights = _trapezoid_weights(t)
+    rms = np.sqrt(np.einsum("i,ij->j", weights, torque**2) / (t[-1] - t[0]))
     with np.errstate(divide="ignore", invalid="ignore"):
-        envelope = np.max(np.abs(torque + (t0 / w0)[None, :] * speed), axis=0)
+        envelope = _peak(torque + (t0 / w0)[None, :] * speed)
     return {
         "motor_rms_torque": rms,
-        "motor_peak_torque": np.max(np.abs(torque), axis=0),
-        "motor_peak_speed": np.abs(ratio[sel]) * np.max(np.abs(qd)),
+        "motor_peak_torque": _peak(torque),
+        "motor_peak_speed": np.abs(n_r) * np.max(np.abs(qd)),
         "envelope_worst": np.where(np.isfinite(t0) & np.isfinite(w0), envelope, np.nan),
         "stall_torque": t0,
         "winding_temperature_peak": options.ambient_temperature + heat.winding_peak,
         "housing_temperature_peak": options.ambient_temperature + heat.housing_peak,
-        "peak_current": np.max(np.abs(current), axis=0),
+        "peak_current": _peak(torque) / np.abs(k_t),
         "rms_current": rms / k_t,
-        "peak_terminal_voltage": np.max(np.abs(voltage), axis=0),
-        "peak_electrical_power": np.max(np.abs(power), axis=0),
-        "energy_regenerated": trapezoid(np.maximum(-power, 0.0), t),
+        "peak_terminal_voltage": _peak(voltage),
+        "peak_electrical_power": _peak(power),
+        "energy_regenerated": np.einsum("i,ij->j", weights, np.maximum(-power, 0.0)),
     }
+
+
+def _peak(x: np.ndarray) -> np.ndarray:
+    """max |x| over axis 0 (NaN propagates)."""
+    return np.maximum(np.max(x, axis=0), -np.min(x, axis=0))
+
+
+def _trapezoid_weights(t: np.ndarray) -> np.ndarray:
+    """w with w @ y = the trapezoid rule's ∫ y dt over the samples (armdyn._runs.trapezoid)."""
+    dt = np.diff(t)
+    w = np.zeros(len(t))
+    w[:-1] += 0.5 * dt
+    w[1:] += 0.5 * dt
+    return w
 
 
 def _cycle_margins(values: dict, m: dict, options) -> dict:

@@ -165,8 +165,9 @@ def _steps(net: ThermalNetwork, h: np.ndarray, feedback=None) -> _Steps:
 
 @dataclass
 class _Cycle:
-    """What every pass over one period uses: step lengths, the unique lengths' coefficients
-    (``table``, rows by ``which``), the current squared (n, k), the resistance at ambient
+    """What a pass over one period uses: the step lengths, their exact coefficients (``table``
+    for the unique lengths, rows by ``which``), the current squared (n, k), the loss forcing
+    per unit resistance of each step (``fw``, ``fh``: (n − 1, k)), the resistance at ambient
     and its slope per kelvin (k,), and the constant-current steps (``hold``) whose exact
     coefficients include the resistance's rise."""
 
@@ -175,6 +176,8 @@ class _Cycle:
     which: np.ndarray
     table: _Steps
     current_sq: np.ndarray
+    fw: np.ndarray
+    fh: np.ndarray
     r_ambient: np.ndarray
     r_slope: np.ndarray
     hold: np.ndarray
@@ -184,80 +187,60 @@ def _cycle(t, current_sq, net, r_ambient, r_slope) -> _Cycle:
     h = np.diff(np.asarray(t, dtype=float))
     hu, which = np.unique(h, return_inverse=True)
     table = _steps(net, hu[:, None])
-    r_slope = np.broadcast_to(np.asarray(r_slope, dtype=float), (len(net),))
+    k = len(net)
+    r_slope = np.broadcast_to(np.asarray(r_slope, dtype=float), (k,))
+    r_ambient = np.broadcast_to(np.asarray(r_ambient, dtype=float), (k,))
     hold = np.zeros(len(h), dtype=bool)
     if np.any(r_slope != 0.0):
         same = np.all(current_sq[1:] == current_sq[:-1], axis=1)
         hold = same & (h > 0.0) & np.any(current_sq[:-1] > 0.0, axis=1)
-    r_ambient = np.broadcast_to(np.asarray(r_ambient, dtype=float), (len(net),))
-    return _Cycle(net, h, which, table, current_sq, r_ambient, r_slope, hold)
+    q0, q1 = current_sq[:-1], current_sq[1:]
+    fw = table.dw[which] * q0
+    fw += table.uw[which] * q1
+    fh = table.dh[which] * q0
+    fh += table.uh[which] * q1
+    return _Cycle(net, h, which, table, current_sq, fw, fh, r_ambient, r_slope, hold)
 
 
-def _sweep(c: _Cycle, w: np.ndarray, hs: np.ndarray, store=None):
-    """Propagate states over one period: ``w``, ``hs`` (m, k) winding and housing rises of m
-    columns. Column 0 is a state (the loss forces it); the others (the period map's matrix
-    columns) see only the resistance's slope. ``store`` (two (n, k) arrays or None) receives
-    column 0 at every sample. Returns the final (w, hs) and column 0's largest winding and
-    housing rises over the samples."""
-    base = np.zeros_like(w)
+def _sweep(c: _Cycle, w0: np.ndarray, h0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The winding and housing rises (n, m, k) over one period from ``w0``, ``h0`` (m, k).
+    Column 0 is a state (the loss forces it); the others (the period map's matrix columns,
+    started at unit vectors) see only the resistance's slope."""
+    n = len(c.h) + 1
+    ws, hs = np.empty((n, *w0.shape)), np.empty((n, *w0.shape))
+    ws[0], hs[0] = w0, h0
+    base = np.zeros_like(w0)
     base[0] = c.r_ambient
-    wmax, hmax = w[0].copy(), hs[0].copy()
-    if store is not None:
-        store[0][0], store[1][0] = w[0], hs[0]
     q = c.current_sq
     for i, h in enumerate(c.h):
-        if h > 0.0:
-            if c.hold[i]:  # constant current: the resistance's rise in the step's matrix
-                s = _steps(c.net, np.array([[h]]), feedback=c.r_slope * q[i])
-                f = (s.dw[0] + s.uw[0]) * q[i], (s.dh[0] + s.uh[0]) * q[i]
-                r = base
-                e11, e12, e21, e22 = s.e11[0], s.e12[0], s.e21[0], s.e22[0]
-            else:
-                s, u = c.table, c.which[i]
-                f = s.dw[u] * q[i] + s.uw[u] * q[i + 1], s.dh[u] * q[i] + s.uh[u] * q[i + 1]
-                r = c.r_slope * w + base  # R(T_w) at the step's start
-                e11, e12, e21, e22 = s.e11[u], s.e12[u], s.e21[u], s.e22[u]
-            w, hs = e11 * w + e12 * hs + r * f[0], e21 * w + e22 * hs + r * f[1]
-            np.maximum(wmax, w[0], out=wmax)
-            np.maximum(hmax, hs[0], out=hmax)
-        if store is not None:
-            store[0][i + 1], store[1][i + 1] = w[0], hs[0]
-    return w, hs, wmax, hmax
+        w, x, wn, xn = ws[i], hs[i], ws[i + 1], hs[i + 1]
+        if not h > 0.0:  # a repeated time: nothing elapses
+            wn[...], xn[...] = w, x
+            continue
+        if c.hold[i]:  # constant current: the resistance's rise in the step's matrix
+            s = _steps(c.net, np.array([[h]]), feedback=c.r_slope * q[i])
+            e11, e12, e21, e22 = s.e11[0], s.e12[0], s.e21[0], s.e22[0]
+            r, fw, fh = base, (s.dw[0] + s.uw[0]) * q[i], (s.dh[0] + s.uh[0]) * q[i]
+        else:
+            s, u = c.table, c.which[i]
+            e11, e12, e21, e22 = s.e11[u], s.e12[u], s.e21[u], s.e22[u]
+            r = c.r_slope * w  # R(T_w) at the step's start
+            r += base
+            fw, fh = c.fw[i], c.fh[i]
+        np.multiply(e11, w, out=wn)
+        wn += e12 * x
+        wn += r * fw
+        np.multiply(e21, w, out=xn)
+        xn += e22 * x
+        xn += r * fh
+    return ws, hs
 
 
-def _period_map(c: _Cycle):
-    """(Φ as (φ11, φ12, φ21, φ22), ψ as (ψw, ψh)) of one period, each (k,)."""
-    k = len(c.net)
-    w = np.zeros((3, k))
-    hs = np.zeros((3, k))
-    w[1] = 1.0
-    hs[2] = 1.0
-    w, hs, _, _ = _sweep(c, w, hs)
-    return (w[1], w[2], hs[1], hs[2]), (w[0], hs[0])
-
-
-def _compose(a, b):
-    """The affine map a∘b of maps (Φ, ψ)."""
-    (a11, a12, a21, a22), (aw, ah) = a
-    (b11, b12, b21, b22), (bw, bh) = b
-    with np.errstate(over="ignore", invalid="ignore"):
-        m = (
-            a11 * b11 + a12 * b21,
-            a11 * b12 + a12 * b22,
-            a21 * b11 + a22 * b21,
-            a21 * b12 + a22 * b22,
-        )
-        return m, (a11 * bw + a12 * bh + aw, a21 * bw + a22 * bh + ah)
-
-
-def _start_state(c: _Cycle, repeat: int | None):
+def _start_state(c: _Cycle, phi, psi, repeat: int | None):
     """The rises at the start of the period that holds the peak: the periodic state
     (``repeat`` None; inf where it does not exist) or the start of the last of ``repeat``
-    periods from ambient."""
+    periods from ambient, from the period map (Φ, ψ)."""
     k = len(c.net)
-    if repeat == 1:
-        return np.zeros(k), np.zeros(k)
-    phi, psi = _period_map(c)
     if repeat is None:
         p11, p12, p21, p22 = phi
         det = (1.0 - p11) * (1.0 - p22) - p12 * p21
@@ -277,28 +260,36 @@ def _start_state(c: _Cycle, repeat: int | None):
     return result[1]
 
 
+def _compose(a, b):
+    """The affine map a∘b of maps (Φ, ψ)."""
+    (a11, a12, a21, a22), (aw, ah) = a
+    (b11, b12, b21, b22), (bw, bh) = b
+    with np.errstate(over="ignore", invalid="ignore"):
+        m = (
+            a11 * b11 + a12 * b21,
+            a11 * b12 + a12 * b22,
+            a21 * b11 + a22 * b21,
+            a21 * b12 + a22 * b22,
+        )
+        return m, (a11 * bw + a12 * bh + aw, a21 * bw + a22 * bh + ah)
+
+
 @dataclass
 class ThermalCycle:
     """The result of :func:`thermal_cycle` (rises above the ambient temperature [K]):
     ``winding_peak``, ``housing_peak`` (k,) the largest rises over the period that holds the
     peak (NaN where the candidate has no thermal model, housing NaN for one-node candidates,
-    inf for a thermal runaway); with ``store``, ``winding`` and ``housing`` (n, k): the rises
-    at every sample of that period."""
+    inf for a thermal runaway); ``winding`` and ``housing`` (n, k): the rises at every sample
+    of that period."""
 
     winding_peak: np.ndarray
     housing_peak: np.ndarray
-    winding: np.ndarray | None = None
-    housing: np.ndarray | None = None
+    winding: np.ndarray
+    housing: np.ndarray
 
 
 def thermal_cycle(
-    t,
-    current_sq,
-    net: ThermalNetwork,
-    r_ambient,
-    r_slope=0.0,
-    repeat: int | None = None,
-    store: bool = False,
+    t, current_sq, net: ThermalNetwork, r_ambient, r_slope=0.0, repeat: int | None = None
 ) -> ThermalCycle:
     """Winding and housing temperature rises of k candidates over a repeated period (see the
     module notes).
@@ -311,25 +302,36 @@ def thermal_cycle(
         r_ambient: (k,) the winding resistance at the ambient temperature [Ω].
         r_slope: (k,) dR/dT_w = α R_ref [Ω/K] (0: a constant resistance).
         repeat: None (the periodic steady state) or the number of periods from ambient.
-        store: keep the rises at every sample of the peak's period.
+
+    Memory: 6 (n, k) arrays besides the input (the caller chunks the candidates).
     """
     current_sq = np.asarray(current_sq, dtype=float)
     c = _cycle(t, current_sq, net, r_ambient, r_slope)
-    w0, h0 = _start_state(c, repeat)
-    n, k = len(c.h) + 1, len(net)
-    arrays = (np.empty((n, k)), np.empty((n, k))) if store else None
+    k = len(net)
     with np.errstate(invalid="ignore", over="ignore"):
-        _, _, wmax, hmax = _sweep(c, w0[None].copy(), h0[None].copy(), arrays)
+        if repeat == 1:
+            ws, hs = _sweep(c, np.zeros((1, k)), np.zeros((1, k)))
+            winding, housing = ws[:, 0], hs[:, 0]
+        else:
+            start = np.zeros((3, k)), np.zeros((3, k))
+            start[0][1] = start[1][2] = 1.0
+            ws, hs = _sweep(c, *start)
+            phi = ws[-1, 1], ws[-1, 2], hs[-1, 1], hs[-1, 2]
+            w0, h0 = _start_state(c, phi, (ws[-1, 0], hs[-1, 0]), repeat)
+            # the states from (w0, h0): column 0 plus the map's columns times the start
+            winding = ws[:, 0] + ws[:, 1] * w0 + ws[:, 2] * h0
+            housing = hs[:, 0] + hs[:, 1] * w0 + hs[:, 2] * h0
+        wmax, hmax = np.max(winding, axis=0), np.max(housing, axis=0)
     bad = ~(np.isfinite(wmax) & np.isfinite(hmax))
     no_w, no_h = ~net.valid, ~(net.valid & net.two_node)
-    out = ThermalCycle(_masked(wmax, bad, no_w), _masked(hmax, bad, no_h))
-    if store:
-        out.winding, out.housing = _masked(arrays[0], bad, no_w), _masked(arrays[1], bad, no_h)
-    return out
+    for x, none in ((winding, no_w), (housing, no_h)):
+        x[:, bad] = np.inf
+        x[:, none] = np.nan
+    return ThermalCycle(_masked(wmax, bad, no_w), _masked(hmax, bad, no_h), winding, housing)
 
 
 def _masked(x: np.ndarray, runaway: np.ndarray, none: np.ndarray) -> np.ndarray:
-    """``x`` with its candidates (last axis) ``runaway`` set to inf and ``none`` to NaN."""
+    """``x`` with its candidates ``runaway`` set to inf and ``none`` to NaN."""
     return np.where(none, np.nan, np.where(runaway, np.inf, x))
 
 
@@ -339,8 +341,7 @@ def thermal_rise(t: np.ndarray, loss: np.ndarray, r_th: float, tau_th: float) ->
     over one period from ambient."""
     loss = np.asarray(loss, dtype=float)
     net = thermal_network(r_th=r_th, tau_th=tau_th)
-    out = thermal_cycle(t, loss[:, None], net, np.ones(1), repeat=1, store=True)
-    return out.winding[:, 0]
+    return thermal_cycle(t, loss[:, None], net, np.ones(1), repeat=1).winding[:, 0]
 
 
 def temperature_rises(
