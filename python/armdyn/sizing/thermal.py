@@ -20,13 +20,14 @@ eigenvalues are real and distinct: f(A) = [f(λ₁)(A − λ₂) − f(λ₂)(A 
 ``expm1`` and short series near 0). Steps of zero length (a repeated time) leave the state.
 
 **Copper resistance** R(T_w) = R_ref (1 + α (T_w − T_ref)) (α: the options'
-``copper_temperature_coefficient``, T_ref their ``resistance_temperature``). The loss of a
-step is R(T_w) i² with T_w the winding temperature at the step's start, held over the step:
-the step stays an affine map of the state, so the periodic state below is still the exact
-fixed point of the period's map (no iteration). This is first order in the step: its error
-is of the order α ΔT_w(step) R i², ΔT_w the winding's change over one sample step. A step at
-constant current (a dwell's hold) is exact instead: R(T_w) i² is then linear in θ_w and goes
-into the step's matrix (A + α R_ref i² e₁e₁ᵀ / C_w).
+``copper_temperature_coefficient``, T_ref their ``resistance_temperature``). The loss at each
+sample is R(T_w) i² with the winding temperature at that sample, linear between samples (as
+any loss is): a step's end temperature is in its own end loss, an affine equation solved in
+closed form (one division), so each step stays an affine map of the state and the periodic
+state below is still the exact fixed point of the period's map (no iteration). Against the
+exact R(T_w(t)) i(t)² this is second order in the sample step (the trapezoid rule's error on
+the resistance's rise). A step at constant current (a dwell's hold) is exact instead: R(T_w)
+i² is then linear in θ_w and goes into the step's matrix (A + α R_ref i² e₁e₁ᵀ / C_w).
 
 **Repeated cycles.** One period maps the start state affinely, x ↦ Φ x + ψ (Φ, ψ propagated
 along the steps). ``repeat=None`` (forever): the periodic steady state x* = (I − Φ)⁻¹ ψ, which
@@ -167,7 +168,8 @@ def _steps(net: ThermalNetwork, h: np.ndarray, feedback=None) -> _Steps:
 class _Cycle:
     """What a pass over one period uses: the step lengths, their exact coefficients (``table``
     for the unique lengths, rows by ``which``), the current squared (n, k), the loss forcing
-    per unit resistance of each step (``fw``, ``fh``: (n − 1, k)), the resistance at ambient
+    per unit resistance of each step's start and end (``aw``, ``ah``, ``bw``, ``bh``: (n − 1,
+    k)) and the factor that solves for the end's own resistance (``inv``), the resistance at ambient
     and its slope per kelvin (k,), and the constant-current steps (``hold``) whose exact
     coefficients include the resistance's rise."""
 
@@ -176,8 +178,11 @@ class _Cycle:
     which: np.ndarray
     table: _Steps
     current_sq: np.ndarray
-    fw: np.ndarray
-    fh: np.ndarray
+    aw: np.ndarray
+    ah: np.ndarray
+    bw: np.ndarray
+    bh: np.ndarray
+    inv: np.ndarray
     r_ambient: np.ndarray
     r_slope: np.ndarray
     hold: np.ndarray
@@ -194,12 +199,14 @@ def _cycle(t, current_sq, net, r_ambient, r_slope) -> _Cycle:
     if np.any(r_slope != 0.0):
         same = np.all(current_sq[1:] == current_sq[:-1], axis=1)
         hold = same & (h > 0.0) & np.any(current_sq[:-1] > 0.0, axis=1)
+    # x(h) = E x(0) + D P(0) + U P(h), P(s) = R(T_w(s)) i²(s) at the samples: the forcing
+    # per unit resistance at each end (aw, ah: the start; bw, bh: the end)
     q0, q1 = current_sq[:-1], current_sq[1:]
-    fw = table.dw[which] * q0
-    fw += table.uw[which] * q1
-    fh = table.dh[which] * q0
-    fh += table.uh[which] * q1
-    return _Cycle(net, h, which, table, current_sq, fw, fh, r_ambient, r_slope, hold)
+    aw, ah = table.dw[which] * q0, table.dh[which] * q0
+    bw, bh = table.uw[which] * q1, table.uh[which] * q1
+    with np.errstate(divide="ignore"):
+        inv = 1.0 / (1.0 - r_slope * bw)  # the end's own R(T_w): solved for in closed form
+    return _Cycle(net, h, which, table, current_sq, aw, ah, bw, bh, inv, r_ambient, r_slope, hold)
 
 
 def _sweep(c: _Cycle, w0: np.ndarray, h0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -211,28 +218,35 @@ def _sweep(c: _Cycle, w0: np.ndarray, h0: np.ndarray) -> tuple[np.ndarray, np.nd
     ws[0], hs[0] = w0, h0
     base = np.zeros_like(w0)
     base[0] = c.r_ambient
-    q = c.current_sq
+    q, slope = c.current_sq, c.r_slope
     for i, h in enumerate(c.h):
         w, x, wn, xn = ws[i], hs[i], ws[i + 1], hs[i + 1]
         if not h > 0.0:  # a repeated time: nothing elapses
             wn[...], xn[...] = w, x
             continue
         if c.hold[i]:  # constant current: the resistance's rise in the step's matrix
-            s = _steps(c.net, np.array([[h]]), feedback=c.r_slope * q[i])
-            e11, e12, e21, e22 = s.e11[0], s.e12[0], s.e21[0], s.e22[0]
-            r, fw, fh = base, (s.dw[0] + s.uw[0]) * q[i], (s.dh[0] + s.uh[0]) * q[i]
-        else:
-            s, u = c.table, c.which[i]
-            e11, e12, e21, e22 = s.e11[u], s.e12[u], s.e21[u], s.e22[u]
-            r = c.r_slope * w  # R(T_w) at the step's start
-            r += base
-            fw, fh = c.fw[i], c.fh[i]
-        np.multiply(e11, w, out=wn)
-        wn += e12 * x
-        wn += r * fw
-        np.multiply(e21, w, out=xn)
-        xn += e22 * x
-        xn += r * fh
+            s = _steps(c.net, np.array([[h]]), feedback=slope * q[i])
+            np.multiply(s.e11[0], w, out=wn)
+            wn += s.e12[0] * x
+            wn += base * ((s.dw[0] + s.uw[0]) * q[i])
+            np.multiply(s.e21[0], w, out=xn)
+            xn += s.e22[0] * x
+            xn += base * ((s.dh[0] + s.uh[0]) * q[i])
+            continue
+        u = c.which[i]
+        r0 = slope * w  # R(T_w) at the step's start (its rise; + R_ambient in column 0)
+        r0 += base
+        np.multiply(c.table.e11[u], w, out=wn)
+        wn += c.table.e12[u] * x
+        wn += r0 * c.aw[i]
+        wn[0] += c.r_ambient * c.bw[i]
+        wn *= c.inv[i]
+        np.multiply(c.table.e21[u], w, out=xn)
+        xn += c.table.e22[u] * x
+        xn += r0 * c.ah[i]
+        r1 = slope * wn  # R(T_w) at the step's end
+        r1 += base
+        xn += r1 * c.bh[i]
     return ws, hs
 
 
