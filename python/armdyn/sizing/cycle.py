@@ -106,6 +106,7 @@ class DutyCycle:
     """
 
     def __init__(self, model, motion: _Motion, dwell: float, repeat: int | None):
+        """Build with :func:`duty_cycle` (it checks the arguments); ``motion`` its samples."""
         self.model = model
         self._motion = motion
         self.dwell = dwell

@@ -166,126 +166,136 @@ def _steps(net: ThermalNetwork, h: np.ndarray, feedback=None) -> _Steps:
 
 @dataclass
 class _Cycle:
-    """What a pass over one period uses: the step lengths, their exact coefficients (``table``
-    for the unique lengths, rows by ``which``), the current squared (n, k), the loss forcing
-    per unit resistance of each step's start and end (``aw``, ``ah``, ``bw``, ``bh``: (n − 1,
-    k)) and the factor that solves for the end's own resistance (``inv``), the resistance at ambient
-    and its slope per kelvin (k,), and the constant-current steps (``hold``) whose exact
-    coefficients include the resistance's rise."""
+    """One period's steps as affine maps of the rises (w, h) ↦ (m11 w + m12 h + f1,
+    m21 w + m22 h + f2), each entry (n − 1, k): what the period map and the pass over the
+    samples use."""
 
-    net: ThermalNetwork
-    h: np.ndarray
-    which: np.ndarray
-    table: _Steps
-    current_sq: np.ndarray
-    aw: np.ndarray
-    ah: np.ndarray
-    bw: np.ndarray
-    bh: np.ndarray
-    inv: np.ndarray
-    r_ambient: np.ndarray
-    r_slope: np.ndarray
-    hold: np.ndarray
+    m11: np.ndarray
+    m12: np.ndarray
+    m21: np.ndarray
+    m22: np.ndarray
+    f1: np.ndarray
+    f2: np.ndarray
 
 
 def _cycle(t, current_sq, net, r_ambient, r_slope) -> _Cycle:
+    """The step maps of one period. A step of length h > 0: x(h) = E x(0) + D P(0) + U P(h)
+    with P = R(T_w) i² at its two ends (R = R_a + s θ_w; the end's own θ_w solved for: one
+    division); a step at constant current with the resistance's rise in E (exact); a step of
+    zero length: the identity."""
     h = np.diff(np.asarray(t, dtype=float))
-    hu, which = np.unique(h, return_inverse=True)
-    table = _steps(net, hu[:, None])
     k = len(net)
-    r_slope = np.broadcast_to(np.asarray(r_slope, dtype=float), (k,))
-    r_ambient = np.broadcast_to(np.asarray(r_ambient, dtype=float), (k,))
-    hold = np.zeros(len(h), dtype=bool)
-    if np.any(r_slope != 0.0):
-        same = np.all(current_sq[1:] == current_sq[:-1], axis=1)
-        hold = same & (h > 0.0) & np.any(current_sq[:-1] > 0.0, axis=1)
-    # x(h) = E x(0) + D P(0) + U P(h), P(s) = R(T_w(s)) i²(s) at the samples: the forcing
-    # per unit resistance at each end (aw, ah: the start; bw, bh: the end)
+    s = np.broadcast_to(np.asarray(r_slope, dtype=float), (k,))
+    ra = np.broadcast_to(np.asarray(r_ambient, dtype=float), (k,))
+    hu, which = np.unique(h, return_inverse=True)
+    tab = _steps(net, hu[:, None])
     q0, q1 = current_sq[:-1], current_sq[1:]
-    aw, ah = table.dw[which] * q0, table.dh[which] * q0
-    bw, bh = table.uw[which] * q1, table.uh[which] * q1
-    with np.errstate(divide="ignore"):
-        inv = 1.0 / (1.0 - r_slope * bw)  # the end's own R(T_w): solved for in closed form
-    return _Cycle(net, h, which, table, current_sq, aw, ah, bw, bh, inv, r_ambient, r_slope, hold)
+    # the loss forcing per unit resistance at the step's start (aw, ah) and end (bw, bh)
+    aw, ah = tab.dw[which] * q0, tab.dh[which] * q0
+    bw, bh = tab.uw[which] * q1, tab.uh[which] * q1
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        den = 1.0 - s * bw
+        inv = np.where(den > 0.0, 1.0 / den, np.inf)  # else the step itself runs away
+        m11 = inv * (tab.e11[which] + s * aw)
+        m12 = inv * tab.e12[which]
+        f1 = inv * ra * (aw + bw)
+        sb = s * bh
+        m21 = tab.e21[which] + s * ah + sb * m11
+        m22 = tab.e22[which] + sb * m12
+        f2 = ra * (ah + bh) + sb * f1
+    c = _Cycle(m11, m12, m21, m22, f1, f2)
+    if np.any(s != 0.0):  # constant current: exact with the resistance's rise in the matrix
+        same = np.all(q1 == q0, axis=1) & (h > 0.0) & np.any(q0 > 0.0, axis=1)
+        idx = np.flatnonzero(same)
+        if len(idx):
+            x = _steps(net, h[idx, None], feedback=s * q0[idx])
+            for name, value in (
+                ("m11", x.e11),
+                ("m12", x.e12),
+                ("m21", x.e21),
+                ("m22", x.e22),
+                ("f1", ra * (x.dw + x.uw) * q0[idx]),
+                ("f2", ra * (x.dh + x.uh) * q0[idx]),
+            ):
+                getattr(c, name)[idx] = value
+    zero = ~(h > 0.0)
+    if np.any(zero):
+        for name, value in (("m11", 1.0), ("m12", 0.0), ("m21", 0.0), ("m22", 1.0)):
+            getattr(c, name)[zero] = value
+        c.f1[zero] = c.f2[zero] = 0.0
+    return c
 
 
 def _sweep(c: _Cycle, w0: np.ndarray, h0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The winding and housing rises (n, m, k) over one period from ``w0``, ``h0`` (m, k).
-    Column 0 is a state (the loss forces it); the others (the period map's matrix columns,
-    started at unit vectors) see only the resistance's slope."""
-    n = len(c.h) + 1
-    ws, hs = np.empty((n, *w0.shape)), np.empty((n, *w0.shape))
+    """The winding and housing rises (n, k) at every sample from (w0, h0) at the first."""
+    n, k = len(c.m11) + 1, len(w0)
+    ws, hs = np.empty((n, k)), np.empty((n, k))
     ws[0], hs[0] = w0, h0
-    base = np.zeros_like(w0)
-    base[0] = c.r_ambient
-    q, slope = c.current_sq, c.r_slope
-    for i, h in enumerate(c.h):
+    tmp = np.empty(k)
+    for i in range(n - 1):
         w, x, wn, xn = ws[i], hs[i], ws[i + 1], hs[i + 1]
-        if not h > 0.0:  # a repeated time: nothing elapses
-            wn[...], xn[...] = w, x
-            continue
-        if c.hold[i]:  # constant current: the resistance's rise in the step's matrix
-            s = _steps(c.net, np.array([[h]]), feedback=slope * q[i])
-            np.multiply(s.e11[0], w, out=wn)
-            wn += s.e12[0] * x
-            wn += base * ((s.dw[0] + s.uw[0]) * q[i])
-            np.multiply(s.e21[0], w, out=xn)
-            xn += s.e22[0] * x
-            xn += base * ((s.dh[0] + s.uh[0]) * q[i])
-            continue
-        u = c.which[i]
-        r0 = slope * w  # R(T_w) at the step's start (its rise; + R_ambient in column 0)
-        r0 += base
-        np.multiply(c.table.e11[u], w, out=wn)
-        wn += c.table.e12[u] * x
-        wn += r0 * c.aw[i]
-        wn[0] += c.r_ambient * c.bw[i]
-        wn *= c.inv[i]
-        np.multiply(c.table.e21[u], w, out=xn)
-        xn += c.table.e22[u] * x
-        xn += r0 * c.ah[i]
-        r1 = slope * wn  # R(T_w) at the step's end
-        r1 += base
-        xn += r1 * c.bh[i]
+        np.multiply(c.m11[i], w, out=wn)
+        np.multiply(c.m12[i], x, out=tmp)
+        wn += tmp
+        wn += c.f1[i]
+        np.multiply(c.m21[i], w, out=xn)
+        np.multiply(c.m22[i], x, out=tmp)
+        xn += tmp
+        xn += c.f2[i]
     return ws, hs
 
 
-def _start_state(c: _Cycle, phi, psi, repeat: int | None):
+def _compose(a, b):
+    """The affine map a∘b (b first) of maps (m11, m12, m21, m22, f1, f2)."""
+    a11, a12, a21, a22, aw, ah = a
+    b11, b12, b21, b22, bw, bh = b
+    return (
+        a11 * b11 + a12 * b21,
+        a11 * b12 + a12 * b22,
+        a21 * b11 + a22 * b21,
+        a21 * b12 + a22 * b22,
+        a11 * bw + a12 * bh + aw,
+        a21 * bw + a22 * bh + ah,
+    )
+
+
+def _period_map(c: _Cycle):
+    """The period's map, the steps composed in order by pairs (log₂ n vectorised levels)."""
+    maps = (c.m11, c.m12, c.m21, c.m22, c.f1, c.f2)
+    while len(maps[0]) > 1:
+        n = len(maps[0])
+        even = n - n % 2
+        pairs = _compose(tuple(x[1:even:2] for x in maps), tuple(x[0:even:2] for x in maps))
+        if n % 2:
+            pairs = tuple(np.concatenate([p, x[-1:]]) for p, x in zip(pairs, maps, strict=True))
+        maps = pairs
+    return tuple(x[0] for x in maps)
+
+
+def _start_state(c: _Cycle, repeat: int | None):
     """The rises at the start of the period that holds the peak: the periodic state
     (``repeat`` None; inf where it does not exist) or the start of the last of ``repeat``
-    periods from ambient, from the period map (Φ, ψ)."""
-    k = len(c.net)
+    periods from ambient."""
+    k = c.m11.shape[1]
+    if repeat == 1:
+        return np.zeros(k), np.zeros(k)
+    period = _period_map(c)
     if repeat is None:
-        p11, p12, p21, p22 = phi
+        p11, p12, p21, p22, pw, ph = period
         det = (1.0 - p11) * (1.0 - p22) - p12 * p21
         stable = (p11 < 1.0) & (p22 < 1.0) & (det > 0.0)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            w = ((1.0 - p22) * psi[0] + p12 * psi[1]) / det
-            h = (p21 * psi[0] + (1.0 - p11) * psi[1]) / det
+        w = ((1.0 - p22) * pw + p12 * ph) / det
+        h = (p21 * pw + (1.0 - p11) * ph) / det
         return np.where(stable, w, np.inf), np.where(stable, h, np.inf)
-    result = ((np.ones(k), np.zeros(k), np.zeros(k), np.ones(k)), (np.zeros(k), np.zeros(k)))
-    base, m = (phi, psi), repeat - 1
-    while m:
+    one, zero = np.ones(k), np.zeros(k)
+    result, base, m = (one, zero, zero, one, zero, zero), period, repeat - 1
+    while m:  # exponentiation by squaring of the affine map
         if m & 1:
             result = _compose(base, result)
         m >>= 1
         if m:
             base = _compose(base, base)
-    return result[1]
-
-
-def _compose(a, b):
-    """The affine map a∘b of maps (Φ, ψ)."""
-    (a11, a12, a21, a22), (aw, ah) = a
-    (b11, b12, b21, b22), (bw, bh) = b
-    with np.errstate(over="ignore", invalid="ignore"):
-        m = (
-            a11 * b11 + a12 * b21,
-            a11 * b12 + a12 * b22,
-            a21 * b11 + a22 * b21,
-            a21 * b12 + a22 * b22,
-        )
-        return m, (a11 * bw + a12 * bh + aw, a21 * bw + a22 * bh + ah)
+    return result[4], result[5]
 
 
 @dataclass
@@ -317,24 +327,14 @@ def thermal_cycle(
         r_slope: (k,) dR/dT_w = α R_ref [Ω/K] (0: a constant resistance).
         repeat: None (the periodic steady state) or the number of periods from ambient.
 
-    Memory: 6 (n, k) arrays besides the input (the caller chunks the candidates).
+    How: the step maps (n − 1, k) are built vectorised, the period map composes them by
+    pairs, then one pass over the samples from the start state. Memory: about 10 (n, k)
+    arrays besides the input (the caller chunks the candidates).
     """
     current_sq = np.asarray(current_sq, dtype=float)
-    c = _cycle(t, current_sq, net, r_ambient, r_slope)
-    k = len(net)
-    with np.errstate(invalid="ignore", over="ignore"):
-        if repeat == 1:
-            ws, hs = _sweep(c, np.zeros((1, k)), np.zeros((1, k)))
-            winding, housing = ws[:, 0], hs[:, 0]
-        else:
-            start = np.zeros((3, k)), np.zeros((3, k))
-            start[0][1] = start[1][2] = 1.0
-            ws, hs = _sweep(c, *start)
-            phi = ws[-1, 1], ws[-1, 2], hs[-1, 1], hs[-1, 2]
-            w0, h0 = _start_state(c, phi, (ws[-1, 0], hs[-1, 0]), repeat)
-            # the states from (w0, h0): column 0 plus the map's columns times the start
-            winding = ws[:, 0] + ws[:, 1] * w0 + ws[:, 2] * h0
-            housing = hs[:, 0] + hs[:, 1] * w0 + hs[:, 2] * h0
+    with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
+        c = _cycle(t, current_sq, net, r_ambient, r_slope)
+        winding, housing = _sweep(c, *_start_state(c, repeat))
         wmax, hmax = np.max(winding, axis=0), np.max(housing, axis=0)
     bad = ~(np.isfinite(wmax) & np.isfinite(hmax))
     no_w, no_h = ~net.valid, ~(net.valid & net.two_node)
