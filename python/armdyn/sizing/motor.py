@@ -364,16 +364,24 @@ def _chunk(t, qd, qdd, tau, repeat, ratio, eta, j, m: dict, sel, options, series
     )
     with np.errstate(divide="ignore", invalid="ignore"):
         current = torque / k_t
+        current_sq = current * current
         net, r_ambient, r_slope = _thermal_inputs(m, sel, options)
-        heat = thermal_cycle(
-            t, np.where(net.valid, current**2, 0.0), net, r_ambient, r_slope, repeat
-        )
+        heated = current_sq
+        if not np.all(net.valid):  # NaN without k_t; no loss where nothing is modelled
+            heated = np.where(net.valid, current_sq, 0.0)
+        heat = thermal_cycle(t, heated, net, r_ambient, r_slope, repeat)
         copper = np.isfinite(k_t) & np.isfinite(r)
         # the winding resistance along the cycle (at ambient where there is no thermal model)
-        r_t = np.where(net.valid, r_ambient + r_slope * heat.winding, r_ambient)
-        loss = np.where(copper, r_t * current**2, 0.0)
-        power = torque * speed + loss
-        voltage = np.where(copper, r_t * current + k_t * speed, np.nan)
+        r_t = heat.winding * r_slope
+        r_t += r_ambient
+        r_t[:, ~net.valid] = r_ambient[~net.valid]
+        loss = r_t * current_sq
+        loss[:, ~copper] = 0.0
+        power = torque * speed
+        power += loss
+        voltage = r_t * current
+        voltage += np.multiply.outer(qd, k_t * n_r)
+        voltage[:, ~copper] = np.nan
     if series:
         return {
             "t": np.asarray(t, dtype=float).copy(),
@@ -389,16 +397,17 @@ def _chunk(t, qd, qdd, tau, repeat, ratio, eta, j, m: dict, sel, options, series
     weights = _trapezoid_weights(t)
     rms = np.sqrt(np.einsum("i,ij->j", weights, torque**2) / (t[-1] - t[0]))
     with np.errstate(divide="ignore", invalid="ignore"):
-        envelope = _peak(torque + (t0 / w0)[None, :] * speed)
+        envelope = _peak(torque + np.multiply.outer(qd, n_r * t0 / w0))
+    peak_torque = _peak(torque)
     return {
         "motor_rms_torque": rms,
-        "motor_peak_torque": _peak(torque),
+        "motor_peak_torque": peak_torque,
         "motor_peak_speed": np.abs(n_r) * np.max(np.abs(qd)),
         "envelope_worst": np.where(np.isfinite(t0) & np.isfinite(w0), envelope, np.nan),
         "stall_torque": t0,
         "winding_temperature_peak": options.ambient_temperature + heat.winding_peak,
         "housing_temperature_peak": options.ambient_temperature + heat.housing_peak,
-        "peak_current": _peak(torque) / np.abs(k_t),
+        "peak_current": peak_torque / np.abs(k_t),
         "rms_current": rms / k_t,
         "peak_terminal_voltage": _peak(voltage),
         "peak_electrical_power": _peak(power),

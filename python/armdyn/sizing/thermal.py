@@ -178,6 +178,10 @@ class _Cycle:
     f2: np.ndarray
 
 
+#: steps per block when the step maps are built and composed (their arrays stay in cache)
+_BLOCK = 16
+
+
 def _cycle(t, current_sq, net, r_ambient, r_slope) -> _Cycle:
     """The step maps of one period. A step of length h > 0: x(h) = E x(0) + D P(0) + U P(h)
     with P = R(T_w) i² at its two ends (R = R_a + s θ_w; the end's own θ_w solved for: one
@@ -189,22 +193,12 @@ def _cycle(t, current_sq, net, r_ambient, r_slope) -> _Cycle:
     ra = np.broadcast_to(np.asarray(r_ambient, dtype=float), (k,))
     hu, which = np.unique(h, return_inverse=True)
     tab = _steps(net, hu[:, None])
-    q0, q1 = current_sq[:-1], current_sq[1:]
-    # the loss forcing per unit resistance at the step's start (aw, ah) and end (bw, bh)
-    aw, ah = tab.dw[which] * q0, tab.dh[which] * q0
-    bw, bh = tab.uw[which] * q1, tab.uh[which] * q1
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        den = 1.0 - s * bw
-        inv = np.where(den > 0.0, 1.0 / den, np.inf)  # else the step itself runs away
-        m11 = inv * (tab.e11[which] + s * aw)
-        m12 = inv * tab.e12[which]
-        f1 = inv * ra * (aw + bw)
-        sb = s * bh
-        m21 = tab.e21[which] + s * ah + sb * m11
-        m22 = tab.e22[which] + sb * m12
-        f2 = ra * (ah + bh) + sb * f1
-    c = _Cycle(m11, m12, m21, m22, f1, f2)
+    c = _Cycle(*(np.empty((len(h), k)) for _ in range(6)))
+    for lo in range(0, len(h), _BLOCK):
+        b = slice(lo, min(lo + _BLOCK, len(h)))
+        _block_maps(c, b, tab, which[b], current_sq[lo : b.stop + 1], s, ra)
     if np.any(s != 0.0):  # constant current: exact with the resistance's rise in the matrix
+        q0, q1 = current_sq[:-1], current_sq[1:]
         same = np.all(q1 == q0, axis=1) & (h > 0.0) & np.any(q0 > 0.0, axis=1)
         idx = np.flatnonzero(same)
         if len(idx):
@@ -224,6 +218,24 @@ def _cycle(t, current_sq, net, r_ambient, r_slope) -> _Cycle:
             getattr(c, name)[zero] = value
         c.f1[zero] = c.f2[zero] = 0.0
     return c
+
+
+def _block_maps(c: _Cycle, b: slice, tab: _Steps, which, q, s, ra) -> None:
+    """The maps of the steps ``b`` (rows of ``c``) from their coefficients ``tab[which]`` and
+    the current squared ``q`` at their samples (one more row than steps)."""
+    q0, q1 = q[:-1], q[1:]
+    # the loss forcing per unit resistance at the step's start (aw, ah) and end (bw, bh)
+    aw, ah = tab.dw[which] * q0, tab.dh[which] * q0
+    bw, bh = tab.uw[which] * q1, tab.uh[which] * q1
+    den = 1.0 - s * bw
+    inv = np.where(den > 0.0, 1.0 / den, np.inf)  # else the step itself runs away
+    m11 = np.multiply(inv, tab.e11[which] + s * aw, out=c.m11[b])
+    m12 = np.multiply(inv, tab.e12[which], out=c.m12[b])
+    f1 = np.multiply(inv * ra, aw + bw, out=c.f1[b])
+    sb = s * bh
+    np.add(tab.e21[which] + s * ah, sb * m11, out=c.m21[b])
+    np.add(tab.e22[which], sb * m12, out=c.m22[b])
+    np.add(ra * (ah + bh), sb * f1, out=c.f2[b])
 
 
 def _sweep(c: _Cycle, w0: np.ndarray, h0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -260,16 +272,21 @@ def _compose(a, b):
 
 
 def _period_map(c: _Cycle):
-    """The period's map, the steps composed in order by pairs (log₂ n vectorised levels)."""
-    maps = (c.m11, c.m12, c.m21, c.m22, c.f1, c.f2)
-    while len(maps[0]) > 1:
-        n = len(maps[0])
-        even = n - n % 2
-        pairs = _compose(tuple(x[1:even:2] for x in maps), tuple(x[0:even:2] for x in maps))
-        if n % 2:
-            pairs = tuple(np.concatenate([p, x[-1:]]) for p, x in zip(pairs, maps, strict=True))
-        maps = pairs
-    return tuple(x[0] for x in maps)
+    """The period's map: each block of steps composed by pairs (vectorised), then the blocks'
+    maps in order."""
+    total = None
+    for lo in range(0, len(c.m11), _BLOCK):
+        maps = tuple(x[lo : lo + _BLOCK] for x in (c.m11, c.m12, c.m21, c.m22, c.f1, c.f2))
+        while len(maps[0]) > 1:
+            n = len(maps[0])
+            even = n - n % 2
+            pairs = _compose(tuple(x[1:even:2] for x in maps), tuple(x[0:even:2] for x in maps))
+            if n % 2:
+                pairs = tuple(np.concatenate([p, x[-1:]]) for p, x in zip(pairs, maps, strict=True))
+            maps = pairs
+        block = tuple(x[0] for x in maps)
+        total = block if total is None else _compose(block, total)
+    return total
 
 
 def _start_state(c: _Cycle, repeat: int | None):
