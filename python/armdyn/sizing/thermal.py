@@ -191,7 +191,7 @@ def _cycle(t, current_sq, net, r_ambient, r_slope) -> _Cycle:
     k = len(net)
     s = np.broadcast_to(np.asarray(r_slope, dtype=float), (k,))
     ra = np.broadcast_to(np.asarray(r_ambient, dtype=float), (k,))
-    hu, which = np.unique(h, return_inverse=True)
+    hu, which = _step_lengths(h)
     tab = _steps(net, hu[:, None])
     c = _Cycle(*(np.empty((len(h), k)) for _ in range(6)))
     for lo in range(0, len(h), _BLOCK):
@@ -220,10 +220,32 @@ def _cycle(t, current_sq, net, r_ambient, r_slope) -> _Cycle:
     return c
 
 
+#: step lengths this close (relative) share their coefficients: a round-off difference (a grid
+#: of equal steps differs by a few ulps from step to step)
+_SAME_STEP = 1e-13
+
+
+def _step_lengths(h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The distinct step lengths (those within ``_SAME_STEP`` of the group's first taken as
+    equal) and each step's index into them."""
+    hu, which = np.unique(h, return_inverse=True)
+    new_group = np.ones(len(hu), dtype=bool)
+    start = 0
+    for i in range(1, len(hu)):
+        if hu[i] - hu[start] <= _SAME_STEP * hu[i]:
+            new_group[i] = False
+        else:
+            start = i
+    group = np.cumsum(new_group) - 1
+    return hu[new_group], group[which]
+
+
 def _block_maps(c: _Cycle, b: slice, tab: _Steps, which, q, s, ra) -> None:
     """The maps of the steps ``b`` (rows of ``c``) from their coefficients ``tab[which]`` and
     the current squared ``q`` at their samples (one more row than steps)."""
     q0, q1 = q[:-1], q[1:]
+    if np.all(which == which[0]):  # one step length: its coefficients' row, broadcast
+        which = which[:1]
     # the loss forcing per unit resistance at the step's start (aw, ah) and end (bw, bh)
     aw, ah = tab.dw[which] * q0, tab.dh[which] * q0
     bw, bh = tab.uw[which] * q1, tab.uh[which] * q1
