@@ -307,6 +307,9 @@ def duty_cycle(model, motion: Any, dwell: float = 0.0, repeat: int | None = None
         dwell: the hold after the motion [s], finite, 0 ≤ dwell ≤ ``MAX_DWELL``.
         repeat: a positive integer, or None (the periodic steady state).
 
+    The repeated cycle goes on from the dwell's end to the motion's first sample: a motion
+    meant to repeat starts where it ends (not checked; its start need not be at rest).
+
     Returns:
         :class:`DutyCycle`.
 
