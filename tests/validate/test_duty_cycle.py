@@ -359,7 +359,8 @@ def test_repeat_is_the_brute_force_last_period():
         ({"ratio": [10.0, 20.0], "efficiency": [0.9, 0.9, 0.9]}, "one length"),
         ({"motors": {"resistance": [-1.0]}}, "resistance"),
         ({"motors": {"resistance": [np.inf]}}, "resistance"),
-        ({"motors": {"resistance": [1.0, 2.0]}}, "resistance"),
+        ({"ratio": [10.0, 20.0, 30.0], "motors": {"resistance": [1.0, 2.0]}}, "resistance"),
+        ({"ratio": [10.0, 20.0], "motors": {"resistance": [1.0, 2.0, 3.0]}}, "2 gears"),
         ({"motors": {"torque_constant": ["a"]}}, "torque_constant"),
         ({"motors": [1.0]}, "motors"),
     ],
@@ -369,3 +370,29 @@ def test_motor_cycle_values_hostile(change, name):
     kw = {"ratio": [50.0], "efficiency": [0.9], "rotor_inertia": [1e-5], "motors": {}} | change
     with pytest.raises(ad.ModelError, match=name):
         sizing_motor.motor_cycle_values(load, **kw)
+
+
+def test_motors_as_a_catalog_frame():
+    """``motors`` may be a pandas DataFrame of catalog rows (columns = motor fields, NaN =
+    blank, extra columns ignored): the same values as the dict of its columns."""
+    pd = pytest.importorskip("pandas")
+    load = ad.duty_cycle(arm(), quintic(41), dwell=1.0).joint_load("shoulder")
+    frame = pd.DataFrame(
+        {
+            "torque_constant": [0.05, 0.1],
+            "resistance": [1.0, np.nan],
+            "continuous_torque": [0.2, 0.3],
+            "thermal_resistance": [2.0, 2.0],
+            "thermal_time_constant": [20.0, 20.0],
+            "source": ["illustrative", "illustrative"],
+        },
+        index=pd.Index(["small", "large"], name="name"),
+    )
+    a = sizing_motor.motor_cycle_values(load, 40.0, 0.9, 2e-5, frame)
+    b = sizing_motor.motor_cycle_values(
+        load, 40.0, 0.9, 2e-5, {c: frame[c].to_numpy() for c in frame.columns[:-1]}
+    )
+    for key, value in a.items():
+        np.testing.assert_array_equal(value, b[key])
+    assert np.isfinite(a["winding_temperature_peak"][0])
+    assert np.isnan(a["winding_temperature_peak"][1])  # no resistance: not checked

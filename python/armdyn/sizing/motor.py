@@ -277,6 +277,14 @@ def _candidate_arrays(who: str, ratio, efficiency, rotor_inertia):
     return ratio, eta, j
 
 
+def _motors_length(who: str, motors) -> int:
+    """The number of motors in the mapping (its longest 1-D field; 1 for scalars)."""
+    if motors is None or not hasattr(motors, "get"):
+        raise _core.ModelError(f"{who}: motors must be a mapping of field -> (k,) arrays")
+    sizes = [np.size(motors.get(f)) for f in _MOTOR_NUMBERS if motors.get(f) is not None]
+    return max(sizes, default=1)
+
+
 def _motor_arrays(who: str, motors, k: int) -> dict[str, np.ndarray]:
     """The numeric datasheet fields of k motors as (k,) float arrays (NaN where a field is
     missing or not given); a given value must be a finite positive number (a finite number for
@@ -492,7 +500,13 @@ def motor_cycle_values(
     options = sizing_options(options)
     t, qd, qdd, tau, repeat = _load_arrays(who, load)
     ratio, eta, j = _candidate_arrays(who, ratio, efficiency, rotor_inertia)
-    k = len(ratio)
+    k = max(len(ratio), _motors_length(who, motors))
+    if len(ratio) == 1 and k > 1:  # one gear for every motor
+        ratio, eta, j = (np.repeat(x, k) for x in (ratio, eta, j))
+    if len(ratio) != k:
+        raise _core.ModelError(
+            f"{who}: {len(ratio)} gears (ratio) but {k} motors (the longest field of motors)"
+        )
     m = _motor_arrays(who, motors, k)
     chunk = int(_checks.integer(who, "chunk", chunk, lo=1))
     values = {name: np.empty(k) for name in CYCLE_VALUES}
