@@ -45,6 +45,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from armdyn import _checks, _core
 from armdyn._runs import time_mean
 
 #: |z| below which φ₁, φ₂ use their series (5 terms: error below 1e-17 relative)
@@ -81,10 +82,6 @@ class ThermalNetwork:
 
     def __len__(self) -> int:
         return len(self.a11)
-
-    def take(self, sel) -> ThermalNetwork:
-        """The candidates ``sel`` (a slice or an index array)."""
-        return ThermalNetwork(*(np.asarray(getattr(self, f))[sel] for f in self.__annotations__))
 
 
 def _positive(x: np.ndarray) -> np.ndarray:
@@ -370,7 +367,14 @@ def thermal_cycle(
     pairs, then one pass over the samples from the start state. Memory: about 10 (n, k)
     arrays besides the input (the caller chunks the candidates).
     """
+    repeat = _checks.integer("thermal_cycle", "repeat", repeat, lo=1, none=True)
+    t = np.asarray(t, dtype=float)
     current_sq = np.asarray(current_sq, dtype=float)
+    if t.ndim != 1 or len(t) < 2 or current_sq.shape != (len(t), len(net)):
+        raise _core.ModelError(
+            f"thermal_cycle: t must be (n,), n >= 2, and current_sq (n, {len(net)}); got "
+            f"{t.shape} and {current_sq.shape}"
+        )
     with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
         c = _cycle(t, current_sq, net, r_ambient, r_slope)
         winding, housing = _sweep(c, *_start_state(c, repeat))
@@ -393,6 +397,8 @@ def thermal_rise(t: np.ndarray, loss: np.ndarray, r_th: float, tau_th: float) ->
     ΔT = 0, P linear between samples (exact per step): :func:`thermal_cycle`'s one-node model
     over one period from ambient."""
     loss = np.asarray(loss, dtype=float)
+    if len(loss) < 2:  # nothing elapses
+        return np.zeros_like(loss)
     net = thermal_network(r_th=r_th, tau_th=tau_th)
     return thermal_cycle(t, loss[:, None], net, np.ones(1), repeat=1).winding[:, 0]
 
