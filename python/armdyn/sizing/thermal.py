@@ -29,13 +29,14 @@ exact R(T_w(t)) i(t)² this is second order in the sample step (the trapezoid ru
 the resistance's rise). A step at constant current (a dwell's hold) is exact instead: R(T_w)
 i² is then linear in θ_w and goes into the step's matrix (A + α R_ref i² e₁e₁ᵀ / C_w).
 
-**Repeated cycles.** One period maps the start state affinely, x ↦ Φ x + ψ (Φ, ψ propagated
-along the steps). ``repeat=None`` (forever): the periodic steady state x* = (I − Φ)⁻¹ ψ, which
+**Repeated cycles.** One period maps the start state affinely, x ↦ Φ x + ψ (the steps' maps
+composed in order, by pairs within blocks of steps). ``repeat=None`` (forever): the periodic steady state x* = (I − Φ)⁻¹ ψ, which
 exists when the spectral radius of Φ is below 1 (Φ ≥ 0 elementwise: when I − Φ is an
 M-matrix); otherwise the copper's resistance rise runs away and the temperatures are ``inf``.
 ``repeat=N``: the start of the N-th period, (Φ, ψ)^{N−1} applied to ambient (exponentiation
-by squaring). Losses are non-negative and Φ ≥ 0, so temperatures rise period after period
-from ambient and the last period holds the peak. Each candidate is independent; the
+by squaring). Losses are non-negative and every step's map is ≥ 0 elementwise, so
+temperatures rise period after period from ambient and the last period holds the peak. The
+temperatures at the samples then come from one pass from that period's start. Each candidate is independent; the
 candidates are arrays of one chunk (the caller bounds its size).
 """
 
