@@ -30,14 +30,15 @@ the resistance's rise). A step at constant current (a dwell's hold) is exact ins
 i² is then linear in θ_w and goes into the step's matrix (A + α R_ref i² e₁e₁ᵀ / C_w).
 
 **Repeated cycles.** One period maps the start state affinely, x ↦ Φ x + ψ (the steps' maps
-composed in order, by pairs within blocks of steps). ``repeat=None`` (forever): the periodic steady state x* = (I − Φ)⁻¹ ψ, which
-exists when the spectral radius of Φ is below 1 (Φ ≥ 0 elementwise: when I − Φ is an
-M-matrix); otherwise the copper's resistance rise runs away and the temperatures are ``inf``.
-``repeat=N``: the start of the N-th period, (Φ, ψ)^{N−1} applied to ambient (exponentiation
-by squaring). Losses are non-negative and every step's map is ≥ 0 elementwise, so
-temperatures rise period after period from ambient and the last period holds the peak. The
-temperatures at the samples then come from one pass from that period's start. Each candidate is independent; the
-candidates are arrays of one chunk (the caller bounds its size).
+composed in order, by pairs within blocks of steps). ``repeat=None`` (forever): the periodic
+steady state x* = (I − Φ)⁻¹ ψ, which exists when the spectral radius of Φ is below 1 (Φ ≥ 0
+elementwise: when I − Φ is an M-matrix); otherwise the copper's resistance rise runs away and
+the temperatures are ``inf``. ``repeat=N``: the start of the N-th period, (Φ, ψ)^{N−1}
+applied to ambient (exponentiation by squaring). Losses are non-negative and every step's map
+is ≥ 0 elementwise, so temperatures rise period after period from ambient and the last period
+holds the peak. The temperatures at the samples then come from one pass from that period's
+start. Each candidate is independent; the candidates are arrays of one chunk (the caller
+bounds its size).
 """
 
 from __future__ import annotations
@@ -191,10 +192,12 @@ def _cycle(t, current_sq, net, r_ambient, r_slope) -> _Cycle:
     ra = np.broadcast_to(np.asarray(r_ambient, dtype=float), (k,))
     hu, which = _step_lengths(h)
     tab = _steps(net, hu[:, None])
+    # the loss vectors scaled by the resistance's slope (s·) and its value at ambient (ra·)
+    scaled = tuple(f * x for f in (s, ra) for x in (tab.dw, tab.uw, tab.dh, tab.uh))
     c = _Cycle(*(np.empty((len(h), k)) for _ in range(6)))
     for lo in range(0, len(h), _BLOCK):
         b = slice(lo, min(lo + _BLOCK, len(h)))
-        _block_maps(c, b, tab, which[b], current_sq[lo : b.stop + 1], s, ra)
+        _block_maps(c, b, tab, scaled, which[b], current_sq[lo : b.stop + 1])
     if np.any(s != 0.0):  # constant current: exact with the resistance's rise in the matrix
         q0, q1 = current_sq[:-1], current_sq[1:]
         same = np.all(q1 == q0, axis=1) & (h > 0.0) & np.any(q0 > 0.0, axis=1)
@@ -238,24 +241,41 @@ def _step_lengths(h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return hu[new_group], group[which]
 
 
-def _block_maps(c: _Cycle, b: slice, tab: _Steps, which, q, s, ra) -> None:
-    """The maps of the steps ``b`` (rows of ``c``) from their coefficients ``tab[which]`` and
-    the current squared ``q`` at their samples (one more row than steps)."""
+def _block_maps(c: _Cycle, b: slice, tab: _Steps, scaled, which, q) -> None:
+    """The maps of the steps ``b`` (rows of ``c``) from their coefficients ``tab[which]``,
+    ``scaled[·][which]`` (s D_w, s U_w, s D_h, s U_h, R_a D_w, R_a U_w, R_a D_h, R_a U_h) and
+    the current squared ``q`` at their samples (one more row than steps):
+    w₁ = (E₁₁ w₀ + E₁₂ h₀ + (R_a + s w₀) D_w i₀² + R_a U_w i₁²) / (1 − s U_w i₁²) and
+    h₁ = E₂₁ w₀ + E₂₂ h₀ + (R_a + s w₀) D_h i₀² + (R_a + s w₁) U_h i₁²."""
     q0, q1 = q[:-1], q[1:]
     if np.all(which == which[0]):  # one step length: its coefficients' row, broadcast
         which = which[:1]
-    # the loss forcing per unit resistance at the step's start (aw, ah) and end (bw, bh)
-    aw, ah = tab.dw[which] * q0, tab.dh[which] * q0
-    bw, bh = tab.uw[which] * q1, tab.uh[which] * q1
-    den = 1.0 - s * bw
-    inv = np.where(den > 0.0, 1.0 / den, np.inf)  # else the step itself runs away
-    m11 = np.multiply(inv, tab.e11[which] + s * aw, out=c.m11[b])
-    m12 = np.multiply(inv, tab.e12[which], out=c.m12[b])
-    f1 = np.multiply(inv * ra, aw + bw, out=c.f1[b])
-    sb = s * bh
-    np.add(tab.e21[which] + s * ah, sb * m11, out=c.m21[b])
-    np.add(tab.e22[which], sb * m12, out=c.m22[b])
-    np.add(ra * (ah + bh), sb * f1, out=c.f2[b])
+    sdw, suw, sdh, suh, rdw, ruw, rdh, ruh = (x[which] for x in scaled)
+    m11, m12, m21, m22, f1, f2 = (x[b] for x in (c.m11, c.m12, c.m21, c.m22, c.f1, c.f2))
+    inv = np.multiply(suw, q1)
+    np.subtract(1.0, inv, out=inv)
+    np.maximum(inv, 0.0, out=inv)  # 0 (inf below): the step itself runs away
+    np.divide(1.0, inv, out=inv)
+    np.multiply(sdw, q0, out=m11)
+    m11 += tab.e11[which]
+    m11 *= inv
+    np.multiply(tab.e12[which], inv, out=m12)
+    tmp = np.multiply(ruw, q1)
+    np.multiply(rdw, q0, out=f1)
+    f1 += tmp
+    f1 *= inv
+    sb = np.multiply(suh, q1)
+    np.multiply(sdh, q0, out=m21)
+    m21 += tab.e21[which]
+    np.multiply(sb, m11, out=tmp)
+    m21 += tmp
+    np.multiply(sb, m12, out=m22)
+    m22 += tab.e22[which]
+    np.multiply(rdh, q0, out=f2)
+    np.multiply(ruh, q1, out=tmp)
+    f2 += tmp
+    np.multiply(sb, f1, out=tmp)
+    f2 += tmp
 
 
 def _sweep(c: _Cycle, w0: np.ndarray, h0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
