@@ -10,6 +10,7 @@ and its peak traced memory (tracemalloc), per chunk size.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 import tracemalloc
@@ -101,6 +102,8 @@ def main(argv=None) -> int:
         "samples": len(load.t),
         "rows": rows,
         "machine": machine(),
+        # a shared machine: the 1-minute load average when the run ended (2 cores)
+        "load_average_1min": os.getloadavg()[0],
     }
     print("written", write_json(Path(args.out) / "motor_cycle.json", result))
     return 0
