@@ -175,17 +175,19 @@ class _Cycle:
     m22: np.ndarray
     f1: np.ndarray
     f2: np.ndarray
+    period: tuple | None = None  # the period's map (the same six entries, each (k,))
 
 
 #: steps per block when the step maps are built and composed (their arrays stay in cache)
 _BLOCK = 16
 
 
-def _cycle(t, current_sq, net, r_ambient, r_slope) -> _Cycle:
-    """The step maps of one period. A step of length h > 0: x(h) = E x(0) + D P(0) + U P(h)
-    with P = R(T_w) i² at its two ends (R = R_a + s θ_w; the end's own θ_w solved for: one
-    division); a step at constant current with the resistance's rise in E (exact); a step of
-    zero length: the identity."""
+def _cycle(t, current_sq, net, r_ambient, r_slope, period: bool = True) -> _Cycle:
+    """The step maps of one period (and with ``period`` the period's map, composed block by
+    block while each block's maps are in cache). A step of length h > 0: x(h) = E x(0) +
+    D P(0) + U P(h) with P = R(T_w) i² at its two ends (R = R_a + s θ_w; the end's own θ_w
+    solved for: one division); a step at constant current with the resistance's rise in E
+    (exact); a step of zero length: the identity."""
     h = np.diff(np.asarray(t, dtype=float))
     k = len(net)
     s = np.broadcast_to(np.asarray(r_slope, dtype=float), (k,))
@@ -194,31 +196,52 @@ def _cycle(t, current_sq, net, r_ambient, r_slope) -> _Cycle:
     tab = _steps(net, hu[:, None])
     # the loss vectors scaled by the resistance's slope (s·) and its value at ambient (ra·)
     scaled = tuple(f * x for f in (s, ra) for x in (tab.dw, tab.uw, tab.dh, tab.uh))
+    idx, exact = _exact_steps(h, current_sq, net, s, ra)
+    zero = ~(h > 0.0)
     c = _Cycle(*(np.empty((len(h), k)) for _ in range(6)))
+    rows = (c.m11, c.m12, c.m21, c.m22, c.f1, c.f2)
     for lo in range(0, len(h), _BLOCK):
         b = slice(lo, min(lo + _BLOCK, len(h)))
         _block_maps(c, b, tab, scaled, which[b], current_sq[lo : b.stop + 1])
-    if np.any(s != 0.0):  # constant current: exact with the resistance's rise in the matrix
+        here = (idx >= lo) & (idx < b.stop)
+        if np.any(here):
+            for x, value in zip(rows, exact, strict=True):
+                x[idx[here]] = value[here]
+        if np.any(zero[b]):
+            for x, value in zip(rows, (1.0, 0.0, 0.0, 1.0, 0.0, 0.0), strict=True):
+                x[b][zero[b]] = value
+        if period:
+            block = _compose_block(tuple(x[b] for x in rows))
+            c.period = block if c.period is None else _compose(block, c.period)
+    return c
+
+
+def _exact_steps(h, current_sq, net, s, ra):
+    """The steps at constant current (with a resistance that rises: else the block maps are
+    exact already) and their exact maps (m11, m12, m21, m22, f1, f2), each (steps, k)."""
+    idx = np.zeros(0, dtype=int)
+    if np.any(s != 0.0):
         q0, q1 = current_sq[:-1], current_sq[1:]
         same = np.all(q1 == q0, axis=1) & (h > 0.0) & np.any(q0 > 0.0, axis=1)
         idx = np.flatnonzero(same)
-        if len(idx):
-            x = _steps(net, h[idx, None], feedback=s * q0[idx])
-            for name, value in (
-                ("m11", x.e11),
-                ("m12", x.e12),
-                ("m21", x.e21),
-                ("m22", x.e22),
-                ("f1", ra * (x.dw + x.uw) * q0[idx]),
-                ("f2", ra * (x.dh + x.uh) * q0[idx]),
-            ):
-                getattr(c, name)[idx] = value
-    zero = ~(h > 0.0)
-    if np.any(zero):
-        for name, value in (("m11", 1.0), ("m12", 0.0), ("m21", 0.0), ("m22", 1.0)):
-            getattr(c, name)[zero] = value
-        c.f1[zero] = c.f2[zero] = 0.0
-    return c
+    if not len(idx):
+        return idx, ()
+    q = current_sq[idx]
+    x = _steps(net, h[idx, None], feedback=s * q)
+    f1, f2 = ra * (x.dw + x.uw) * q, ra * (x.dh + x.uh) * q
+    return idx, (x.e11, x.e12, x.e21, x.e22, f1, f2)
+
+
+def _compose_block(maps):
+    """The map of a block of consecutive steps (rows of ``maps``), composed by pairs."""
+    while len(maps[0]) > 1:
+        n = len(maps[0])
+        even = n - n % 2
+        pairs = _compose(tuple(x[1:even:2] for x in maps), tuple(x[0:even:2] for x in maps))
+        if n % 2:
+            pairs = tuple(np.concatenate([p, x[-1:]]) for p, x in zip(pairs, maps, strict=True))
+        maps = pairs
+    return tuple(x[0] for x in maps)
 
 
 #: step lengths this close (relative) share their coefficients: a round-off difference (a grid
@@ -311,24 +334,6 @@ def _compose(a, b):
     )
 
 
-def _period_map(c: _Cycle):
-    """The period's map: each block of steps composed by pairs (vectorised), then the blocks'
-    maps in order."""
-    total = None
-    for lo in range(0, len(c.m11), _BLOCK):
-        maps = tuple(x[lo : lo + _BLOCK] for x in (c.m11, c.m12, c.m21, c.m22, c.f1, c.f2))
-        while len(maps[0]) > 1:
-            n = len(maps[0])
-            even = n - n % 2
-            pairs = _compose(tuple(x[1:even:2] for x in maps), tuple(x[0:even:2] for x in maps))
-            if n % 2:
-                pairs = tuple(np.concatenate([p, x[-1:]]) for p, x in zip(pairs, maps, strict=True))
-            maps = pairs
-        block = tuple(x[0] for x in maps)
-        total = block if total is None else _compose(block, total)
-    return total
-
-
 def _start_state(c: _Cycle, repeat: int | None):
     """The rises at the start of the period that holds the peak: the periodic state
     (``repeat`` None; inf where it does not exist) or the start of the last of ``repeat``
@@ -336,7 +341,7 @@ def _start_state(c: _Cycle, repeat: int | None):
     k = c.m11.shape[1]
     if repeat == 1:
         return np.zeros(k), np.zeros(k)
-    period = _period_map(c)
+    period = c.period
     if repeat is None:
         p11, p12, p21, p22, pw, ph = period
         det = (1.0 - p11) * (1.0 - p22) - p12 * p21
@@ -397,7 +402,7 @@ def thermal_cycle(
             f"{t.shape} and {current_sq.shape}"
         )
     with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
-        c = _cycle(t, current_sq, net, r_ambient, r_slope)
+        c = _cycle(t, current_sq, net, r_ambient, r_slope, period=repeat != 1)
         winding, housing = _sweep(c, *_start_state(c, repeat))
         wmax, hmax = np.max(winding, axis=0), np.max(housing, axis=0)
     bad = ~(np.isfinite(wmax) & np.isfinite(hmax))
