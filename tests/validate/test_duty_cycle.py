@@ -212,23 +212,22 @@ def reaction_by_hand(cycle):
 
 
 def test_reactions_from_a_simulation():
-    """The cycle's reaction wrench (a joint-space simulation's own, or joint_reactions) equals
-    the hand calculation; no moment about the other axes (a hinge through the centre's
-    plane), and the axis component is the joint's."""
+    """The cycle's reaction wrench (armdyn.joint_reactions along the motion) equals the hand
+    calculation and the simulation's own reactions; no moment about the other axes (a hinge
+    through the centre's plane)."""
     model, res = simulated()
     cycle = ad.duty_cycle(model, res)
     load = cycle.joint_load("shoulder")
-    assert load.force is not None
     np.testing.assert_allclose(load.force, reaction_by_hand(cycle), rtol=1e-9, atol=1e-9)
     np.testing.assert_allclose(load.moment[:, :2], 0.0, atol=1e-9)
+    # joint_reactions along the motion (part 1) equals the simulation's own reactions
+    np.testing.assert_allclose(cycle.reaction_forces, res.reaction_forces, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(cycle.reaction_torques, res.reaction_torques, atol=1e-9)
 
 
-@pytest.mark.skipif(
-    not hasattr(ad, "joint_reactions"), reason="waits for part 1 (armdyn.joint_reactions)"
-)
 def test_reactions_in_the_dwell():
-    """WAITS FOR PART 1: with a dwell the hold's reactions come from armdyn.joint_reactions;
-    at rest the support carries the weight."""
+    """With a dwell the hold's reactions (armdyn.joint_reactions at rest) follow the hand
+    calculation: the support carries the weight."""
     model, res = simulated()
     cycle = ad.duty_cycle(model, res, dwell=2.0)
     load = cycle.joint_load("shoulder")

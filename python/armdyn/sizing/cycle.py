@@ -50,8 +50,7 @@ class JointLoad:
             reflected rotor torque N T_rot is taken off).
         gravity_torque: (n,) the torque that holds the pose at rest (gravity and springs).
         force, moment: (n, 3) the joint's reaction wrench (on the child at the joint point, in
-            the child's joint frame; ``SimulationResult.reaction_forces`` / ``_torques``), or
-            None when this build cannot compute them (see :attr:`DutyCycle.reaction_forces`).
+            the child's joint frame; ``SimulationResult.reaction_forces`` / ``_torques``).
         axis: (3,) the joint axis in that frame (z).
         inertia: (n,) the joint's diagonal of the mass matrix, its own actuator's N² J taken
             off.
@@ -66,8 +65,8 @@ class JointLoad:
     acceleration: npt.NDArray[np.float64]
     torque: npt.NDArray[np.float64]
     gravity_torque: npt.NDArray[np.float64]
-    force: npt.NDArray[np.float64] | None
-    moment: npt.NDArray[np.float64] | None
+    force: npt.NDArray[np.float64]
+    moment: npt.NDArray[np.float64]
     axis: npt.NDArray[np.float64]
     inertia: npt.NDArray[np.float64]
     moving: npt.NDArray[np.bool_]
@@ -77,14 +76,12 @@ class JointLoad:
 
 @dataclass
 class _Motion:
-    """A motion's samples over the model's coordinates, and the reactions a simulation
-    reported along it (None otherwise)."""
+    """A motion's samples over the model's coordinates."""
 
     t: np.ndarray
     q: np.ndarray
     qd: np.ndarray
     qdd: np.ndarray
-    reactions: tuple[np.ndarray, np.ndarray] | None = None
 
 
 class DutyCycle:
@@ -96,10 +93,8 @@ class DutyCycle:
         t: (n,) times [s]; q (n, len(model.coord_names)); qd, qdd (n, ndof).
         torque: (n, ndof) inverse dynamics along the period (the model's actuators included).
         gravity_torque: (n, ndof) the holding torques at each sample's pose (at rest).
-        reaction_forces, reaction_torques: (n, n_joints, 3) every joint's reaction (as
-            ``SimulationResult`` reports them), or None when this build has no
-            ``armdyn.joint_reactions`` and the motion is not a simulation of this model
-            (whose own reactions are then used, without a dwell).
+        reaction_forces, reaction_torques: (n, n_joints, 3) every joint's reaction along the
+            period (``armdyn.joint_reactions``: as ``SimulationResult`` reports them).
         inertia: (n, ndof) the mass matrix's diagonal.
         moving: (n,) False at the dwell's samples.
         period: the period [s]; dwell: the dwell [s]; repeat: periods (None: forever).
@@ -139,16 +134,15 @@ class DutyCycle:
         self.period = float(self.t[-1] - self.t[0])
         m_diag = np.asarray(_core.mass_matrix(model, self.q), dtype=float)
         self.inertia = np.diagonal(m_diag, axis1=1, axis2=2).copy()
-        forces = _reactions(model, self.t, self.q, self.qd, self.qdd, m, dwell)
-        self.reaction_forces, self.reaction_torques = forces if forces else (None, None)
+        self.reaction_forces, self.reaction_torques = _reactions(
+            model, self.t, self.q, self.qd, self.qdd
+        )
 
     def with_model(self, model) -> DutyCycle:
         """The same motion, dwell and repeat on another model (same coordinates): the loads
-        recomputed (a simulation's own reactions are not carried over)."""
-        m = self._motion
-        same = _Motion(m.t, m.q, m.qd, m.qdd)
-        _check_columns(model, same.q, same.qd)
-        return DutyCycle(model, same, self.dwell, self.repeat)
+        recomputed."""
+        _check_columns(model, self._motion.q, self._motion.qd)
+        return DutyCycle(model, self._motion, self.dwell, self.repeat)
 
     def joint_load(self, joint: str) -> JointLoad:
         """The :class:`JointLoad` of ``joint`` (a revolute or prismatic joint of the model's
@@ -173,7 +167,6 @@ class DutyCycle:
             n = float(own.gear_ratio)
             torque -= n * rotor_torque(own, self.qd[:, k], self.qdd[:, k])
             inertia -= n * n * float(own.rotor_inertia)
-        forces = self.reaction_forces
         return JointLoad(
             joint=joint,
             t=self.t.copy(),
@@ -181,8 +174,8 @@ class DutyCycle:
             acceleration=self.qdd[:, k].copy(),
             torque=torque,
             gravity_torque=self.gravity_torque[:, k].copy(),
-            force=None if forces is None else forces[:, j].copy(),
-            moment=None if forces is None else self.reaction_torques[:, j].copy(),
+            force=self.reaction_forces[:, j].copy(),
+            moment=self.reaction_torques[:, j].copy(),
             axis=np.array([0.0, 0.0, 1.0]),
             inertia=inertia,
             moving=self.moving.copy(),
@@ -197,19 +190,13 @@ class DutyCycle:
         )
 
 
-def _reactions(model, t, q, qd, qdd, motion: _Motion, dwell: float):
-    """Every joint's reaction wrench along the period: ``armdyn.joint_reactions`` (the one
-    call to it); without it in this build, a simulation's own reactions when the period is
-    the simulated motion itself (no dwell); else None."""
-    import armdyn
+def _reactions(model, t, q, qd, qdd) -> tuple[np.ndarray, np.ndarray]:
+    """Every joint's reaction wrench along the period: the one call to
+    ``armdyn.joint_reactions`` (part of the cycle's loads: the output bearing's checks)."""
+    from armdyn import _core as core
 
-    fn = getattr(armdyn, "joint_reactions", None)
-    if fn is not None:
-        forces, torques = fn(model, q, qd, qdd, t)
-        return np.asarray(forces, dtype=float), np.asarray(torques, dtype=float)
-    if motion.reactions is not None and dwell == 0.0:
-        return tuple(np.array(x, dtype=float) for x in motion.reactions)
-    return None
+    forces, torques = core.joint_reactions(model, q, qd, qdd, t)
+    return np.asarray(forces, dtype=float), np.asarray(torques, dtype=float)
 
 
 def _check_columns(model, q: np.ndarray, qd: np.ndarray) -> None:
@@ -257,11 +244,7 @@ def _motion(model, motion) -> _Motion:
             f"{_WHO}: the motion's coordinates do not match the model's {list(model.coord_names)}"
         )
     qd, qdd = (_rate_columns(model, getattr(motion, a), a) for a in ("qd", "qdd"))
-    reactions = None
-    forces = getattr(motion, "reaction_forces", None)
-    if forces is not None and getattr(motion, "model", None) is model:
-        reactions = (forces, motion.reaction_torques)
-    return _Motion(*_arrays(motion.t, q, qd, qdd), reactions=reactions)
+    return _Motion(*_arrays(motion.t, q, qd, qdd))
 
 
 def _rate_columns(model, x, name: str) -> np.ndarray:
