@@ -53,6 +53,10 @@ def test_cycle_torques_and_the_dwell_hold():
     np.testing.assert_allclose(cycle.torque[-2:, 0], hold, rtol=1e-12)
     np.testing.assert_allclose(cycle.gravity_torque[:, 0], -M * G * L * np.cos(cycle.q[:, 0]))
     np.testing.assert_allclose(cycle.inertia[:, 0], IYY + M * L * L, rtol=1e-12)
+    # a TrajectoryRun of the motion (on another model: the cycle recomputes) gives the same
+    run = ad.trajectory_run(arm(mass=5.0), t, q, qd, qdd)
+    again = ad.duty_cycle(arm(), run, dwell=2.0, repeat=5)
+    np.testing.assert_array_equal(again.torque, cycle.torque)
     load = cycle.joint_load("shoulder")
     assert load.repeat == 5 and load.period == cycle.period
     np.testing.assert_array_equal(load.moving, [True] * len(t) + [False, False])
