@@ -990,6 +990,30 @@ CASES = [
         ME,
         "column 'peak_torque': 0.4 is less than continuous_torque",
     ),
+    (
+        "cycle-dwell-nan",
+        "sizing",
+        "duty cycle with a NaN dwell",
+        lambda: ad.duty_cycle(_pendulum(), _rest_motion(), dwell=np.nan),
+        ME,
+        "dwell",
+    ),
+    (
+        "cycle-repeat-fraction",
+        "sizing",
+        "duty cycle repeated 1.5 times",
+        lambda: ad.duty_cycle(_pendulum(), _rest_motion(), repeat=1.5),
+        ME,
+        "repeat",
+    ),
+    (
+        "cycle-not-at-rest",
+        "sizing",
+        "duty cycle of a motion that ends moving",
+        lambda: ad.duty_cycle(_pendulum(), _rest_motion(end_rate=0.5), dwell=1.0),
+        ME,
+        "hinge",
+    ),
 ]
 
 
@@ -1000,6 +1024,14 @@ def _motors(**change):
     row.update(mass=[0.3], continuous_torque=[0.5], peak_torque=[1.5])
     row.update(change)
     return {k: (v * n if len(v) == 1 else v) for k, v in row.items()}
+
+
+def _rest_motion(end_rate=0.0):
+    """(t, q, qd, qdd) of the hinge: at rest at both ends (its last rate ``end_rate``)."""
+    t = np.linspace(0.0, 1.0, 11)
+    qd = np.sin(np.pi * t)[:, None]
+    qd[-1] = end_rate
+    return t, np.zeros((11, 1)), qd, np.zeros((11, 1))
 
 
 def _modelless_result():
