@@ -286,11 +286,25 @@ def _pair_stage(load, parts: CatalogParts, mi: np.ndarray, gi: np.ndarray, optio
 
 def _drive_stage(values: dict, parts: CatalogParts, di: np.ndarray) -> tuple[dict, dict]:
     """The drive checks of pairs whose motor values are ``values`` (already tiled to the
-    drives ``di``)."""
+    drives ``di``). A motor value that is +inf (a thermal runaway's current and voltage) fails
+    its drive check (margin 0 where the drive gives the rating); the drive functions take
+    finite values only, so it goes to them as NaN."""
     from armdyn.sizing import drive as drive_module
 
-    out = drive_module.drive_values(values, _rows(parts.drives, di))
-    return _split(out)
+    checks = [c for c in CHECKS if c.part == "drive"]
+    infinite = {c.value: np.isposinf(values[c.value]) for c in checks if c.value in values}
+    clean = dict(values)
+    for key, mask in infinite.items():
+        clean[key] = np.where(mask, np.nan, values[key])
+    out = drive_module.drive_values(clean, _rows(parts.drives, di))
+    out_values, margins = _split(out)
+    for check in checks:
+        mask = infinite.get(check.value)
+        if mask is not None and check.name in margins and np.any(mask):
+            rating = np.asarray(out.get(check.allowable, np.full(len(mask), np.nan)), float)
+            failed = np.where(np.isnan(rating), np.nan, 0.0)
+            margins[check.name] = np.where(mask, failed, margins[check.name])
+    return out_values, margins
 
 
 def _chunks(n_pairs: int, n_samples: int):
