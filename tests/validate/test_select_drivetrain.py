@@ -699,3 +699,33 @@ def test_ur5_pick_and_place_from_the_example_catalog():
     pd.testing.assert_frame_equal(again.table[cols], sel.table[cols])
     np.testing.assert_allclose(again.table["margin"], sel.table["margin"], rtol=1e-12)
     assert again.passes == 2
+
+
+def test_a_thermal_runaway_fails_its_checks(parts, run):
+    """A motor whose copper loss outruns its cooling (R(T) i² R_th grows without bound) has an
+    infinite winding temperature and terminal voltage: it fails the winding and drive voltage
+    checks and the selection goes on."""
+    hot = (
+        MOTORS.loc[["M2"]]
+        .rename(index={"M2": "HOT"})
+        .assign(
+            thermal_resistance_winding=400.0,
+            thermal_resistance_housing=400.0,
+            thermal_time_constant_winding=5.0,
+            thermal_time_constant_housing=50.0,
+            max_winding_temperature=155.0,
+        )
+    )
+    sel = _select(run, catalog(drives=True, motors=pd.concat([MOTORS, hot])), joints=["elbow"])
+    cand = sel.candidates("elbow")
+    hot_rows = cand[cand["motor"] == "HOT"]
+    assert not hot_rows["ok"].any()
+    if "winding_temperature_peak" in cand:  # the real motor side (part 4)
+        runaway = hot_rows[np.isinf(hot_rows["winding_temperature_peak"])]
+        assert len(runaway) > 0
+        assert (runaway["winding_temperature_margin"] == 0.0).all()
+        # the voltage R(T) i + k_t w with R at an infinite temperature
+        assert np.isinf(runaway["peak_terminal_voltage"]).all()
+        if "drive_voltage_margin" in cand:  # the real drive checks (part 5)
+            assert (runaway["drive_voltage_margin"] == 0.0).all()
+    assert sel.table.loc["elbow", "motor"] != "HOT"
