@@ -729,3 +729,21 @@ def test_a_thermal_runaway_fails_its_checks(parts, run):
         if "drive_voltage_margin" in cand:  # the real drive checks (part 5)
             assert (runaway["drive_voltage_margin"] == 0.0).all()
     assert sel.table.loc["elbow", "motor"] != "HOT"
+
+
+def test_a_joint_whose_load_did_not_change_is_not_screened_again(parts, run, monkeypatch):
+    """On a serial arm with the default mounts a joint's load depends on the actuators beyond
+    it only: the second pass finds every load as it was and screens nothing again."""
+    from armdyn.sizing import select as select_module
+
+    screened = []
+    evaluate = select_module.evaluate_joint
+
+    def counted(joint, *args, **kwargs):
+        screened.append(joint)
+        return evaluate(joint, *args, **kwargs)
+
+    monkeypatch.setattr(select_module, "evaluate_joint", counted)
+    sel = _select(run, catalog(), drives=False)
+    assert sel.passes == 2
+    assert screened == ["wrist", "elbow", "shoulder"]  # distal to proximal, once each
