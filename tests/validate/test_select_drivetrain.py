@@ -690,6 +690,21 @@ def test_ur5_pick_and_place_from_the_example_catalog():
     # the model carries every actuator but the base joint's (its housing sits on the ground)
     carried = sel.table["mass"].drop(model.dof_names[0]).sum()
     np.testing.assert_allclose(np.sum(sel.model.masses), np.sum(model.masses) + carried, rtol=1e-12)
+    # each housing at its joint's point on the parent link: the same dynamics as part 2's
+    # joint mount (with_payload at a joint name)
+    housings = [
+        {"at": j, "mass": float(sel.table.loc[j, "mass"]), "name": f"h{k}"}
+        for k, j in enumerate(model.dof_names[1:])
+    ]
+    ref = model.with_payloads(housings)
+    rng = np.random.default_rng(3)
+    x, xd, xdd = rng.uniform(-1.0, 1.0, (3, 6))
+    np.testing.assert_allclose(
+        ad.inverse_dynamics(sel.model, x, xd, xdd),
+        ad.inverse_dynamics(ref, x, xd, xdd),
+        rtol=1e-12,
+        atol=1e-12,
+    )
     # a fixed point: selecting again on the model that already carries the chosen actuators,
     # carrying nothing more, gives the same choice and the same margins
     again = ad.select_drivetrain(
