@@ -225,8 +225,8 @@ MOTORS = pd.DataFrame(
         "resistance": [1.2, 0.8, 0.5, 0.3],
         "rotor_inertia": [2e-6, 5e-6, 1.2e-5, 3e-5],
         "mass": [0.31, 0.52, 0.83, 1.37],
-        "continuous_torque": [0.08, 0.16, 0.45, 0.62],
-        "peak_torque": [0.25, 0.5, 1.3, 1.9],
+        "continuous_torque": [0.08, 0.16, 0.28, 0.62],
+        "peak_torque": [0.25, 0.5, 0.9, 1.9],
         "max_speed": [900.0, 700.0, 600.0, 450.0],
         "cost": [100.0, 160.0, 230.0, 390.0],
     },
@@ -408,6 +408,15 @@ def test_equals_exhaustive_search_mass(parts, run):
     np.testing.assert_allclose(sel.table["mass"].sum(), total, rtol=1e-12)
     _assert_margins(sel, ref_margins, JOINTS)
     assert sel.converged and sel.ok and sel.passes == 2
+    # the case needs the coupling: without the carried masses the choice would differ
+    free = ad.select_drivetrain(
+        model,
+        ad.trajectory_run(model, *run),
+        cat,
+        drives=False,
+        mounts={"elbow": None, "wrist": None},
+    )
+    assert _chosen(free, JOINTS) != combo
     assert list(sel.table.index) == list(JOINTS)
     assert sel.table["ok"].all() and len(sel.infeasible) == 0
 
@@ -465,6 +474,15 @@ def test_equals_exhaustive_search_cost_with_drives(parts, run):
     np.testing.assert_allclose(sel.table["cost"].sum(), total, rtol=1e-12)
     _assert_margins(sel, ref_margins, joints)
     assert sel.bus is not None
+    free = ad.select_drivetrain(
+        model,
+        ad.trajectory_run(model, *run),
+        cat,
+        objective="cost",
+        joints=joints,
+        mounts={"elbow": None},
+    )
+    assert _chosen(free, joints) != combo  # the carried elbow actuator changes the choice
 
 
 def _select(run, cat, **kw):
