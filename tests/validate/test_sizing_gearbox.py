@@ -1,0 +1,510 @@
+"""Gearbox, output-bearing and emergency-stop values (armdyn.sizing.gearbox) against hand
+calculations from the vendors' formulas, computed here independently: loops over the samples
+(or the vendors' load segments) in plain Python floats, never the module's vectorised numpy.
+
+The joint load is a stand-in with JointLoad's fields (issue 33's spec, section 4): the functions
+read the fields only.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import armdyn as ad
+import numpy as np
+import pytest
+from armdyn.sizing import gearbox as gb
+from armdyn.sizing.options import SizingOptions
+
+RPM = 2.0 * math.pi / 60.0  # rad/s per rpm
+
+
+@dataclass(frozen=True)
+class Load:
+    """JointLoad's fields (a stand-in until i33-cycle is merged)."""
+
+    t: np.ndarray
+    speed: np.ndarray
+    torque: np.ndarray
+    gravity_torque: np.ndarray
+    force: np.ndarray
+    moment: np.ndarray
+    axis: np.ndarray
+    inertia: np.ndarray
+    joint: str = "j"
+    acceleration: np.ndarray | None = None
+    moving: np.ndarray | None = None
+    period: float = 0.0
+    repeat: int | None = None
+
+
+def cycle(n=61, dwell=0.5, seed=1):
+    """A motion of n samples over 1.5 s then a dwell at rest (speed 0, holding torque)."""
+    rng = np.random.default_rng(seed)
+    tm = np.linspace(0.0, 1.5, n)
+    speed = 2.0 * np.sin(2.0 * np.pi * tm / 1.5) + 0.3 * np.sin(7.0 * tm)
+    speed[-1] = 0.0
+    torque = 20.0 * np.cos(2.0 * np.pi * tm / 1.5) + 5.0 + rng.normal(0.0, 1.0, n)
+    t = np.concatenate([tm, [1.5, 1.5 + dwell]])
+    speed = np.concatenate([speed, [0.0, 0.0]])
+    torque = np.concatenate([torque, [torque[-1], torque[-1]]])
+    m = t.size
+    return Load(
+        t=t,
+        speed=speed,
+        torque=torque,
+        gravity_torque=7.0 * np.cos(t) + 1.0,
+        force=rng.normal(0.0, 50.0, (m, 3)),
+        moment=rng.normal(0.0, 5.0, (m, 3)),
+        axis=np.array([1.0, 2.0, 2.0]),  # not unit: the functions normalise it
+        inertia=0.4 + 0.1 * np.sin(t),
+        period=float(t[-1] - t[0]),
+    )
+
+
+def hand_integral(f, t):
+    """∫ f dt by the trapezoid rule, a plain loop."""
+    return sum(0.5 * (f[i] + f[i + 1]) * (t[i + 1] - t[i]) for i in range(len(t) - 1))
+
+
+GEARS = {
+    "rated_torque": [30.0, 60.0, np.nan],
+    "rated_input_speed": [2000 * RPM, 3000 * RPM, 2000 * RPM],
+    "rated_life": [35000.0, 50000.0, 35000.0],
+    "life_exponent": [3.0, 10.0 / 3.0, np.nan],
+    "average_torque_limit": [15.0, 40.0, np.nan],
+    "average_input_speed_limit": [3000 * RPM, np.nan, 100.0],
+    "repeated_peak_torque": [20.0, 80.0, 30.0],
+    "momentary_peak_count": [500.0, 2e4, np.nan],
+    "max_input_speed": [6000 * RPM, 50.0, np.nan],
+}
+
+
+def test_gearbox_values_equal_a_hand_calculation():
+    load = cycle()
+    ratio = [50.0, -100.0, 80.0]
+    opts = SizingOptions(required_life=20000.0, emergency_stops=1000.0)
+    out = gb.gearbox_cycle_values(load, np.array(ratio), GEARS, opts)
+    t = [float(x) for x in load.t]
+    w = [abs(float(x)) for x in load.speed]
+    tq = [abs(float(x)) for x in load.torque]
+    period = t[-1] - t[0]
+    t_av = (
+        hand_integral([wi * ti**3 for wi, ti in zip(w, tq, strict=True)], t) / hand_integral(w, t)
+    ) ** (1.0 / 3.0)
+    out_speed = hand_integral(w, t) / period
+    for i in range(3):
+        n = abs(ratio[i])
+        n_av = n * out_speed
+        assert out["gear_average_torque"][i] == pytest.approx(t_av, rel=1e-12)
+        assert out["gear_average_input_speed"][i] == pytest.approx(n_av, rel=1e-12)
+        assert out["gear_peak_input_speed"][i] == pytest.approx(n * max(w), rel=1e-12)
+        assert out["gear_repeated_peak_torque"][i] == pytest.approx(max(tq), rel=1e-12)
+        p = GEARS["life_exponent"][i]
+        p = 3.0 if math.isnan(p) else p
+        life = GEARS["rated_life"][i] * (GEARS["rated_torque"][i] / t_av) ** p
+        life *= GEARS["rated_input_speed"][i] / n_av
+        if math.isnan(life):
+            assert math.isnan(out["gear_life"][i]) and math.isnan(out["gear_life_margin"][i])
+        else:
+            assert out["gear_life"][i] == pytest.approx(life, rel=1e-12)
+            assert out["gear_life_margin"][i] == pytest.approx(life / 20000.0, rel=1e-12)
+        pairs = {
+            "gear_average_torque_margin": GEARS["average_torque_limit"][i] / t_av,
+            "gear_average_input_speed_margin": GEARS["average_input_speed_limit"][i] / n_av,
+            "gear_repeated_peak_margin": GEARS["repeated_peak_torque"][i] / max(tq),
+            "gear_momentary_count_margin": GEARS["momentary_peak_count"][i] / 1000.0,
+            "gear_input_speed_margin": GEARS["max_input_speed"][i] / (n * max(w)),
+        }
+        for key, want in pairs.items():
+            if math.isnan(want):  # a column not given: not checked
+                assert math.isnan(out[key][i]), key
+            else:
+                assert out[key][i] == pytest.approx(want, rel=1e-12), key
+    assert np.all(out["emergency_stops"] == 1000.0)
+
+
+def segments(ts, ns, torques):
+    """The vendors' load segments (T_i, n_i, t_i) as samples: each segment's two ends, equal
+    times at the jumps (a zero-length trapezoid), so the trapezoid integrals are the sums."""
+    t, speed, torque, now = [], [], [], 0.0
+    for dt, n, tq in zip(ts, ns, torques, strict=True):
+        t += [now, now + dt]
+        speed += [n, n]
+        torque += [tq, tq]
+        now += dt
+    m = len(t)
+    z = np.zeros(m)
+    return Load(
+        t=np.array(t),
+        speed=np.array(speed),
+        torque=np.array(torque),
+        gravity_torque=z,
+        force=np.zeros((m, 3)),
+        moment=np.zeros((m, 3)),
+        axis=np.array([0.0, 0.0, 1.0]),
+        inertia=z + 1.0,
+    )
+
+
+def test_vendor_segment_formulas_and_worked_example():
+    """A four-segment cycle (start, constant speed, stop, pause) in the form of the vendors'
+    worked examples: T_av = (Σ|n_i| t_i |T_i|³ / Σ|n_i| t_i)^(1/3), n_av = N Σ|n_i| t_i / Σ t_i
+    with the pause in Σ t_i, L = L_N (T_N/T_av)³ (n_N/n_av). The numbers (150 N m 0.2 s 10 rpm,
+    82 N m 3 s 20 rpm, 130 N m 0.3 s 10 rpm, a 0.2 s pause) give T_av = 89 N m as the
+    published example says; N = 100."""
+    ts, ns, torques = [0.2, 3.0, 0.3, 0.2], [10.0, 20.0, 10.0, 0.0], [150.0, 82.0, 130.0, 0.0]
+    load = segments(ts, [n * RPM for n in ns], torques)
+    gears = {"rated_torque": [100.0], "rated_input_speed": [2000 * RPM], "rated_life": [35000.0]}
+    out = gb.gearbox_cycle_values(load, [100.0], gears)
+    num = sum(n * t * tq**3 for t, n, tq in zip(ts, ns, torques, strict=True))
+    den = sum(n * t for t, n in zip(ts, ns, strict=True))
+    t_av = (num / den) ** (1.0 / 3.0)
+    n_av_rpm = 100.0 * den / sum(ts)
+    assert round(t_av) == 89
+    assert out["gear_average_torque"][0] == pytest.approx(t_av, rel=1e-12)
+    assert out["gear_average_input_speed"][0] / RPM == pytest.approx(n_av_rpm, rel=1e-12)
+    life = 35000.0 * (100.0 / t_av) ** 3 * (2000.0 / n_av_rpm)
+    assert out["gear_life"][0] == pytest.approx(life, rel=1e-12)
+
+
+def test_a_joint_at_rest_holds_its_cubic_mean_and_never_wears():
+    load = segments([1.0, 2.0], [0.0, 0.0], [10.0, 20.0])
+    gears = {"rated_torque": [50.0], "rated_input_speed": [200.0], "rated_life": [1e4]}
+    out = gb.gearbox_cycle_values(load, [30.0], gears)
+    want = ((10.0**3 * 1.0 + 20.0**3 * 2.0) / 3.0) ** (1.0 / 3.0)
+    assert out["gear_average_torque"][0] == pytest.approx(want, rel=1e-12)
+    assert out["gear_average_input_speed"][0] == 0.0
+    assert out["gear_life"][0] == math.inf and out["gear_life_margin"][0] == math.inf
+
+
+# --- output bearing ---------------------------------------------------------------------------
+
+
+def perpendicular_basis(a):
+    """Two unit vectors ⊥ a and each other (Gram-Schmidt, plain floats)."""
+    seed = (1.0, 0.0, 0.0) if abs(a[0]) < 0.9 else (0.0, 1.0, 0.0)
+    d = sum(s * x for s, x in zip(seed, a, strict=True))
+    e1 = [s - d * x for s, x in zip(seed, a, strict=True)]
+    n1 = math.sqrt(sum(x * x for x in e1))
+    e1 = [x / n1 for x in e1]
+    e2 = [a[1] * e1[2] - a[2] * e1[1], a[2] * e1[0] - a[0] * e1[2], a[0] * e1[1] - a[1] * e1[0]]
+    return e1, e2
+
+
+def hand_bearing(load, b):
+    """Per sample (F_a, F_r, M) at the reference point b along the unit axis, by components."""
+    a = [float(x) for x in load.axis]
+    na = math.sqrt(sum(x * x for x in a))
+    a = [x / na for x in a]
+    e1, e2 = perpendicular_basis(a)
+    rows = []
+    for f, m in zip(load.force.tolist(), load.moment.tolist(), strict=True):
+        r = [-b * x for x in a]  # from the reference point P = O + b a back to O
+        rxf = [r[1] * f[2] - r[2] * f[1], r[2] * f[0] - r[0] * f[2], r[0] * f[1] - r[1] * f[0]]
+        mp = [mi + ci for mi, ci in zip(m, rxf, strict=True)]
+        dot = lambda u, v: sum(x * y for x, y in zip(u, v, strict=True))  # noqa: E731
+        rows.append(
+            (
+                dot(f, a),
+                math.hypot(dot(f, e1), dot(f, e2)),
+                math.hypot(dot(mp, e1), dot(mp, e2)),
+            )
+        )
+    return rows
+
+
+def hand_mean(values, w, t, p=10.0 / 3.0):
+    return (
+        hand_integral([wi * abs(v) ** p for wi, v in zip(w, values, strict=True)], t)
+        / hand_integral(w, t)
+    ) ** (1.0 / p)
+
+
+def hand_life(load, b, c_rating, d_p, f_w):
+    """Harmonic Drive's cross-roller L10 [h] with rpm, from the hand wrench."""
+    rows = hand_bearing(load, b)
+    t = [float(x) for x in load.t]
+    w = [abs(float(x)) for x in load.speed]
+    f_a, f_r, m = (hand_mean([r[i] for r in rows], w, t) for i in range(3))
+    radial = f_r + 2.0 * m / d_p
+    x, y = (1.0, 0.45) if f_a / radial <= 1.5 else (0.67, 0.67)
+    p_c = x * radial + y * f_a
+    n_av_rpm = hand_integral(w, t) / (t[-1] - t[0]) / RPM
+    return 1e6 / (60.0 * n_av_rpm) * (c_rating / (f_w * p_c)) ** (10.0 / 3.0), (x, y)
+
+
+BEARINGS = {
+    "bearing_offset": [0.0, 0.035, -0.02, np.nan],
+    "bearing_moment_allowable": [40.0, 10.0, np.nan, 40.0],
+    "bearing_axial_allowable": [300.0, 100.0, 200.0, np.nan],
+    "bearing_radial_allowable": [np.nan, 150.0, 200.0, 300.0],
+    "bearing_dynamic_load_rating": [20e3, 15e3, 10e3, 20e3],
+    "bearing_pitch_diameter": [0.06, 0.05, np.nan, 0.06],
+}
+
+
+@pytest.mark.parametrize("axial", [0.0, 400.0])  # both (x, y) branches of P_c
+def test_bearing_values_equal_a_hand_calculation(axial):
+    load = cycle(seed=3)
+    a = load.axis / np.linalg.norm(load.axis)
+    load = replace(load, force=load.force + axial * a)
+    opts = SizingOptions(bearing_load_factor=1.3, required_life=20000.0)
+    out = gb.bearing_cycle_values(load, BEARINGS, opts)
+    branches = set()
+    for i, b in enumerate(BEARINGS["bearing_offset"]):
+        rows = hand_bearing(load, 0.0 if math.isnan(b) else b)
+        assert out["bearing_peak_axial"][i] == pytest.approx(
+            max(abs(r[0]) for r in rows), rel=1e-12
+        )
+        assert out["bearing_peak_radial"][i] == pytest.approx(max(r[1] for r in rows), rel=1e-12)
+        want = {
+            "bearing_axial_margin": BEARINGS["bearing_axial_allowable"][i]
+            / max(abs(r[0]) for r in rows),
+            "bearing_radial_margin": BEARINGS["bearing_radial_allowable"][i]
+            / max(r[1] for r in rows),
+        }
+        if math.isnan(b):  # no reference point: the moment and the life are not given
+            assert math.isnan(out["bearing_peak_moment"][i])
+            assert math.isnan(out["bearing_moment_margin"][i])
+            assert math.isnan(out["bearing_life_margin"][i])
+        else:
+            peak_m = max(r[2] for r in rows)
+            assert out["bearing_peak_moment"][i] == pytest.approx(peak_m, rel=1e-12)
+            want["bearing_moment_margin"] = BEARINGS["bearing_moment_allowable"][i] / peak_m
+            d_p = BEARINGS["bearing_pitch_diameter"][i]
+            if math.isnan(d_p):
+                assert math.isnan(out["bearing_life"][i])
+            else:
+                c = BEARINGS["bearing_dynamic_load_rating"][i]
+                life, xy = hand_life(load, b, c, d_p, 1.3)
+                branches.add(xy)
+                assert out["bearing_life"][i] == pytest.approx(life, rel=1e-12)
+                want["bearing_life_margin"] = life / 20000.0
+        for key, value in want.items():
+            if math.isnan(value):
+                assert math.isnan(out[key][i]), key
+            else:
+                assert out[key][i] == pytest.approx(value, rel=1e-12), key
+    assert branches == {(1.0, 0.45)} if axial == 0.0 else {(0.67, 0.67)}
+
+
+def test_bearing_moment_is_the_radial_load_times_its_lever_from_the_reference_point():
+    """A weight W hanging at a distance c along a horizontal joint axis x from the joint point:
+    the reaction on the child is F = W z, M_O = −c W y; at the bearing's reference point b
+    along the axis the tilting moment is |c − b| W (Harmonic Drive's F_r (L_r + R) with the
+    lever measured from the reference point), the radial load W, no axial load."""
+    w_load, c = 120.0, 0.08
+    m = 3
+    load = Load(
+        t=np.array([0.0, 1.0, 2.0]),
+        speed=np.array([0.0, 1.0, 0.0]),
+        torque=np.zeros(m),
+        gravity_torque=np.zeros(m),
+        force=np.tile([0.0, 0.0, w_load], (m, 1)),
+        moment=np.tile([0.0, -c * w_load, 0.0], (m, 1)),
+        axis=np.array([1.0, 0.0, 0.0]),
+        inertia=np.ones(m),
+    )
+    offsets = [0.0, 0.03, 0.08, -0.05]
+    out = gb.bearing_cycle_values(load, {"bearing_offset": offsets})
+    for i, b in enumerate(offsets):
+        assert out["bearing_peak_moment"][i] == pytest.approx(abs(c - b) * w_load, abs=1e-12)
+    assert np.all(out["bearing_peak_radial"] == w_load)
+    assert np.all(out["bearing_peak_axial"] == 0.0)
+    assert np.all(np.isnan(out["bearing_life"]))  # no rating given
+
+
+# --- emergency stop ---------------------------------------------------------------------------
+
+
+def hand_stop(n, eta, j, j_l, g, qd, t_s):
+    """Solve the two equations of the stop (link: J_L q̈ = τ − g; rotor:
+    J N q̈ = T_m − c τ / N) for (q̈, τ) by Cramer's rule, trying both power-flow branches and
+    keeping the consistent one (c = η when τ q̇ < 0)."""
+    t_m = -math.copysign(t_s, qd)
+    found = []
+    for c in (eta, 1.0 / eta):
+        # [J_L, -1; J N, c / N] [q̈, τ] = [-g, T_m]
+        a11, a12, a21, a22 = j_l, -1.0, j * n, c / n
+        det = a11 * a22 - a12 * a21
+        tau = (a11 * t_m - a21 * (-g)) / det
+        if (tau * qd < 0.0) == (c == eta):
+            found.append(tau)
+    assert len(found) == 1
+    return found[0]
+
+
+def test_emergency_stop_torque_equals_a_hand_calculation():
+    load = cycle(seed=5)
+    ratio = np.array([50.0, -80.0, 120.0, 100.0])
+    eta = np.array([0.8, 0.7, 0.95, 0.9])
+    j_rot = np.array([2e-5, 1e-4, 5e-6, np.nan])
+    t_s = np.array([1.5, 0.4, 3.0, 1.0])
+    gears = {"momentary_peak_torque": [200.0, 150.0, np.nan, 100.0]}
+    out = gb.emergency_stop_values(load, ratio, eta, j_rot, t_s, gears)
+    for i in range(3):
+        best, when = -1.0, None
+        for s in range(len(load.t)):
+            qd = float(load.speed[s])
+            if qd == 0.0:
+                continue
+            tau = hand_stop(
+                float(ratio[i]),
+                float(eta[i]),
+                float(j_rot[i]),
+                float(load.inertia[s]),
+                float(load.gravity_torque[s]),
+                qd,
+                float(t_s[i]),
+            )
+            if abs(tau) > best:
+                best, when = abs(tau), float(load.t[s])
+        assert out["gear_momentary_torque"][i] == pytest.approx(best, rel=1e-12)
+        assert out["emergency_stop_time"][i] == when
+        limit = gears["momentary_peak_torque"][i]
+        if math.isnan(limit):
+            assert math.isnan(out["gear_momentary_peak_margin"][i])
+        else:
+            assert out["gear_momentary_peak_margin"][i] == pytest.approx(limit / best, rel=1e-12)
+    # the rotor inertia not given: not checked
+    assert math.isnan(out["gear_momentary_torque"][3])
+    assert math.isnan(out["gear_momentary_peak_margin"][3])
+
+
+def test_emergency_stop_limits():
+    """No rotor inertia: the gear passes the stop torque, back-driven: τ = N T_s / η.
+    No load inertia and no gravity: the rotor's inertia takes it all, τ = 0. A cycle at rest
+    has no stop: the largest cycle torque."""
+    m = 4
+    base = Load(
+        t=np.arange(m, dtype=float),
+        speed=np.array([0.0, 1.0, -2.0, 0.0]),
+        torque=np.array([1.0, -9.0, 2.0, 0.0]),
+        gravity_torque=np.zeros(m),
+        force=np.zeros((m, 3)),
+        moment=np.zeros((m, 3)),
+        axis=np.array([0.0, 0.0, 1.0]),
+        inertia=np.full(m, 0.3),
+    )
+    out = gb.emergency_stop_values(base, [60.0], [0.75], [0.0], [2.0])
+    assert out["gear_momentary_torque"][0] == pytest.approx(60.0 * 2.0 / 0.75, rel=1e-14)
+    light = replace(base, inertia=np.zeros(m))
+    out = gb.emergency_stop_values(light, [60.0], [0.75], [1e-4], [2.0])
+    assert out["gear_momentary_torque"][0] == 0.0
+    rest = replace(base, speed=np.zeros(m))
+    out = gb.emergency_stop_values(rest, [60.0], [0.75], [1e-4], [2.0])
+    assert out["gear_momentary_torque"][0] == 9.0 and math.isnan(out["emergency_stop_time"][0])
+
+
+# --- hostile inputs ---------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "call, match",
+    [
+        (lambda L: gb.gearbox_cycle_values(L, [0.0], {}), r"ratio\[0\] must be non-zero"),
+        (lambda L: gb.gearbox_cycle_values(L, [np.nan], {}), r"ratio\[0\] must be given"),
+        (lambda L: gb.gearbox_cycle_values(L, [10.0, np.inf], {}), r"ratio\[1\] must be finite"),
+        (lambda L: gb.gearbox_cycle_values(L, "ten", {}), r"ratio must be numbers"),
+        (
+            lambda L: gb.gearbox_cycle_values(L, [10.0, 20.0], {"rated_torque": [1.0, -2.0]}),
+            r"gearboxes\['rated_torque'\]\[1\] must be > 0",
+        ),
+        (
+            lambda L: gb.gearbox_cycle_values(L, [10.0, 20.0], {"rated_torque": [1.0]}),
+            r"gearboxes\['rated_torque'\] must have shape \(2,\)",
+        ),
+        (
+            lambda L: gb.gearbox_cycle_values(L, [10.0], {"max_input_speed": [-1.0]}),
+            r"\['max_input_speed'\]\[0\] must be >= 0",
+        ),
+        (
+            lambda L: gb.gearbox_cycle_values(replace(L, t=L.t[:1], speed=L.speed[:1]), [1.0], {}),
+            r"load.t must hold at least two samples",
+        ),
+        (
+            lambda L: gb.gearbox_cycle_values(replace(L, t=L.t[::-1]), [1.0], {}),
+            r"load.t decreases",
+        ),
+        (
+            lambda L: gb.gearbox_cycle_values(replace(L, t=0.0 * L.t), [1.0], {}),
+            r"load.t spans no time",
+        ),
+        (
+            lambda L: gb.gearbox_cycle_values(
+                replace(L, speed=np.where(L.t > 1.0, np.nan, L.speed)), [1.0], {}
+            ),
+            r"load.speed has a non-finite value",
+        ),
+        (
+            lambda L: gb.gearbox_cycle_values(replace(L, torque=L.torque[:-1]), [1.0], {}),
+            r"load.torque must have shape",
+        ),
+        (
+            lambda L: gb.bearing_cycle_values(
+                replace(L, axis=np.zeros(3)), {"bearing_offset": [0]}
+            ),
+            r"load.axis must be a non-zero vector",
+        ),
+        (
+            lambda L: gb.bearing_cycle_values(L, {"bearing_offset": [0.0], "x": [1.0, 2.0]}),
+            r"gearboxes must hold \(k,\) columns of one length",
+        ),
+        (
+            lambda L: gb.bearing_cycle_values(L, {}),
+            r"gearboxes must hold \(k,\) columns of one length",
+        ),
+        (
+            lambda L: gb.bearing_cycle_values(L, {"bearing_pitch_diameter": [0.0]}),
+            r"\['bearing_pitch_diameter'\]\[0\] must be > 0",
+        ),
+        (
+            lambda L: gb.emergency_stop_values(L, [10.0], [1.2], [0.0], [1.0]),
+            r"efficiency\[0\] must be in \(0, 1\]",
+        ),
+        (
+            lambda L: gb.emergency_stop_values(L, [10.0], [0.0], [0.0], [1.0]),
+            r"efficiency\[0\] must be > 0",
+        ),
+        (
+            lambda L: gb.emergency_stop_values(L, [10.0], [0.9], [-1e-5], [1.0]),
+            r"rotor_inertia\[0\] must be >= 0",
+        ),
+        (
+            lambda L: gb.emergency_stop_values(L, [10.0], [0.9], [1e-5], [-1.0]),
+            r"stop_torque\[0\] must be >= 0",
+        ),
+        (
+            lambda L: gb.emergency_stop_values(
+                replace(L, inertia=-L.inertia), [10.0], [0.9], [0], [1]
+            ),
+            r"load.inertia\[0\] is < 0",
+        ),
+        (
+            lambda L: gb.gearbox_cycle_values(L, [10.0], {}, options="fast"),
+            r"options must be a SizingOptions",
+        ),
+    ],
+)
+def test_hostile_inputs_name_the_culprit(call, match):
+    load = cycle()
+    with pytest.raises(ad.ModelError, match=match):
+        call(load)
+
+
+def test_missing_field_and_dataframe_columns():
+    pd = pytest.importorskip("pandas")
+    load = cycle()
+
+    class NoForce:
+        t, speed = load.t, load.speed
+
+    with pytest.raises(ad.ModelError, match=r"load has no field 'force'"):
+        gb.bearing_cycle_values(NoForce(), {"bearing_offset": [0.0]})
+    table = pd.DataFrame(BEARINGS, index=["a", "b", "c", "d"])
+    from_frame = gb.bearing_cycle_values(load, table)
+    from_dict = gb.bearing_cycle_values(load, BEARINGS)
+    for key, value in from_dict.items():
+        np.testing.assert_array_equal(from_frame[key], value, err_msg=key)
