@@ -205,7 +205,8 @@ def bus_values(t, electrical_power, period=None, drives=None) -> dict[str, np.nd
         electrical_power: (axes, n) the axes' electrical power [W] (negative: regenerating),
             or (k, axes, n) for k candidate sets.
         period: the cycle's period [s] (default ``t[-1] - t[0]``; the means are per period).
-        drives: the bus parameters, scalars or (k,): ``bus_voltage`` (V_nom), ``bus_voltage_max``
+        drives: the bus parameters, scalars or (k,) (one set of axes against k drives, or k sets
+            against one or k drives): ``bus_voltage`` (V_nom), ``bus_voltage_max``
             (V_max) [V], ``bus_capacitance`` [F], ``braking_resistor_power``,
             ``braking_resistor_peak_power`` [W] (absent or NaN = not given).
 
@@ -234,6 +235,10 @@ def bus_values(t, electrical_power, period=None, drives=None) -> dict[str, np.nd
         "braking_resistor_power": _NONNEG,
         "braking_resistor_peak_power": _NONNEG,
     }
+    if k == 1 and drives is not None:  # one set of axes against k drives' bus parameters
+        sizes = [np.size(drives[c]) for c in spec if c in drives and np.ndim(drives[c]) == 1]
+        k = max(sizes, default=1)
+        p = np.broadcast_to(p, (k, p.shape[1]))
     bus = _inputs.columns(who, drives, spec, k, "drives")
     v_nom, v_max = bus["bus_voltage"], bus["bus_voltage_max"]
     if np.any(v_max < v_nom):
