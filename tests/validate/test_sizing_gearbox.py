@@ -508,3 +508,47 @@ def test_missing_field_and_dataframe_columns():
     from_dict = gb.bearing_cycle_values(load, BEARINGS)
     for key, value in from_dict.items():
         np.testing.assert_array_equal(from_frame[key], value, err_msg=key)
+
+
+def test_bearing_loads_from_a_simulated_reaction_equal_the_statics_of_the_held_link():
+    """A link held at rest by its drive on a tilted axis a (gravity has an axial part): the
+    reaction armdyn reports (on the child at the joint point, child's joint frame, z = the
+    axis) moved to the bearing point P = b a gives F_a = |W · a|, F_r = |W − (W · a) a| and the
+    tilting moment |[(c − P) × W]⊥| of the weight W at the centre of mass c, worked out in
+    world coordinates (the norms do not depend on the frame)."""
+    mass, g = 2.0, 9.81
+    com = np.array([0.08, -0.05, 0.3])
+    axis = np.array([1.0, 0.0, 1.0]) / math.sqrt(2.0)
+    b = ad.ModelBuilder(gravity=(0.0, 0.0, -g))
+    b.add_body("link", mass, np.diag([0.01, 0.02, 0.03]), position=tuple(com))
+    b.add_revolute("hinge", "ground", "link", (0.0, 0.0, 0.0), tuple(axis))
+    b.add_drive("hinge", ad.profiles.cubic(0.0, 0.0, 0.0, 1.0))
+    run = ad.simulate(b.finalize(), 0.2, output_dt=0.1)
+    n = run.t.size
+    load = Load(
+        t=run.t,
+        speed=np.zeros(n),
+        torque=np.zeros(n),
+        gravity_torque=np.zeros(n),
+        force=run.reaction_forces[:, 0, :],
+        moment=run.reaction_torques[:, 0, :],
+        axis=np.array([0.0, 0.0, 1.0]),
+        inertia=np.ones(n),
+    )
+    offsets = [0.0, 0.05, -0.04]
+    out = gb.bearing_cycle_values(load, {"bearing_offset": offsets})
+    weight = [0.0, 0.0, -mass * g]
+    w_a = sum(x * y for x, y in zip(weight, axis, strict=True))
+    w_perp = [x - w_a * y for x, y in zip(weight, axis, strict=True)]
+    assert out["bearing_peak_axial"][0] == pytest.approx(abs(w_a), rel=1e-10)
+    assert out["bearing_peak_radial"][0] == pytest.approx(math.hypot(*w_perp), rel=1e-10)
+    for i, off in enumerate(offsets):
+        r = [c - off * y for c, y in zip(com, axis, strict=True)]
+        m = [
+            r[1] * weight[2] - r[2] * weight[1],
+            r[2] * weight[0] - r[0] * weight[2],
+            r[0] * weight[1] - r[1] * weight[0],
+        ]
+        m_a = sum(x * y for x, y in zip(m, axis, strict=True))
+        m_perp = math.sqrt(sum((x - m_a * y) ** 2 for x, y in zip(m, axis, strict=True)))
+        assert out["bearing_peak_moment"][i] == pytest.approx(m_perp, rel=1e-10)
