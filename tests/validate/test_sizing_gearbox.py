@@ -375,8 +375,9 @@ def test_emergency_stop_torque_equals_a_hand_calculation():
 
 def test_emergency_stop_limits():
     """No rotor inertia: the gear passes the stop torque, back-driven: τ = N T_s / η.
-    No load inertia and no gravity: the rotor's inertia takes it all, τ = 0. A cycle at rest
-    has no stop: the largest cycle torque."""
+    No load inertia and no gravity: the rotor's inertia takes it all, τ = 0. No inertia on
+    either side: the gravity torque (at the moving samples). A cycle at rest has no stop: the
+    largest cycle torque."""
     m = 4
     base = Load(
         t=np.arange(m, dtype=float),
@@ -393,6 +394,10 @@ def test_emergency_stop_limits():
     light = replace(base, inertia=np.zeros(m))
     out = gb.emergency_stop_values(light, [60.0], [0.75], [1e-4], [2.0])
     assert out["gear_momentary_torque"][0] == 0.0
+    heavy = replace(light, gravity_torque=np.array([0.0, 4.0, -6.5, 9.0]))
+    out = gb.emergency_stop_values(heavy, [60.0, 30.0], [0.75, 0.9], [0.0, np.nan], [2.0, 1.0])
+    assert out["gear_momentary_torque"][0] == 6.5  # no inertia at all: gravity alone
+    assert math.isnan(out["gear_momentary_torque"][1])
     rest = replace(base, speed=np.zeros(m))
     out = gb.emergency_stop_values(rest, [60.0], [0.75], [1e-4], [2.0])
     assert out["gear_momentary_torque"][0] == 9.0 and math.isnan(out["emergency_stop_time"][0])
@@ -552,3 +557,22 @@ def test_bearing_loads_from_a_simulated_reaction_equal_the_statics_of_the_held_l
         m_a = sum(x * y for x, y in zip(m, axis, strict=True))
         m_perp = math.sqrt(sum((x - m_a * y) ** 2 for x, y in zip(m, axis, strict=True)))
         assert out["bearing_peak_moment"][i] == pytest.approx(m_perp, rel=1e-10)
+
+
+def test_emergency_stop_blocks_equal_one_block(monkeypatch):
+    """Candidates are evaluated in blocks of bounded size; any block size gives the same."""
+    load = cycle(seed=7)
+    rng = np.random.default_rng(7)
+    k = 23
+    args = (
+        rng.uniform(20.0, 160.0, k) * rng.choice([-1.0, 1.0], k),
+        rng.uniform(0.5, 1.0, k),
+        rng.uniform(0.0, 1e-4, k),
+        rng.uniform(0.0, 5.0, k),
+        {"momentary_peak_torque": rng.uniform(10.0, 500.0, k)},
+    )
+    whole = gb.emergency_stop_values(load, *args)
+    monkeypatch.setattr(gb, "_BLOCK", 3 * int(np.count_nonzero(load.speed)))  # blocks of 3
+    blocks = gb.emergency_stop_values(load, *args)
+    for key, value in whole.items():
+        np.testing.assert_array_equal(blocks[key], value, err_msg=key)

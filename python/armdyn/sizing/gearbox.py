@@ -105,6 +105,9 @@ from armdyn.sizing.checks import CHECKS_BY_NAME, margin
 #: the output bearing's life exponent (roller bearings) and the averaging exponent B
 BEARING_EXPONENT = 10.0 / 3.0
 
+#: candidates x samples per block of the emergency-stop arrays (bounded memory for any k)
+_BLOCK = 1 << 18
+
 _RATING = {"nan": True, "lo": 0.0, "lo_open": True}
 _ALLOWABLE = {"nan": True, "lo": 0.0}
 
@@ -314,18 +317,38 @@ def bearing_cycle_values(load, gearboxes, options=None) -> dict[str, np.ndarray]
     )
 
 
-def stop_torque_at_output(n_ratio, eta, j_rotor, j_load, gravity, speed, stop_torque):
-    """The gearbox output torque τ of a stop (module notes), elementwise (broadcasting):
-    ratio N, efficiency η, motor-shaft inertia J, load inertia J_L, gravity torque g, joint
-    speed q̇ (≠ 0), stop torque T_s ≥ 0 at the motor."""
-    t_m = -np.sign(speed) * stop_torque
-    num = n_ratio * (j_load * t_m + n_ratio * j_rotor * gravity)
-    c = np.where(num * speed < 0.0, eta, 1.0 / eta)
-    den = n_ratio * n_ratio * j_rotor + c * j_load
+def _stop_block(n_ratio, eta, j_rotor, stop_torque, j_load, gravity, sign):
+    """The gearbox output torque τ of a stop (module notes) for a block of candidates (b,)
+    (finite parameters) at the moving samples (m,) (σ = sign(q̇) ≠ 0): a (b, m) array, built
+    in place (a few passes over one buffer)."""
+    b_k = n_ratio * n_ratio * j_rotor  # N² J
+    num = np.multiply.outer(-n_ratio * stop_torque, sign * j_load)  # N T_m J_L
+    num += np.multiply.outer(b_k, gravity)  # + N² J g
+    back = num * sign < 0.0  # τ q̇ < 0: the link back-drives the gear, c = η
+    den = np.multiply.outer(1.0 / eta, j_load)
+    np.multiply(den, (eta * eta)[:, None], out=den, where=back)
+    den += b_k[:, None]
     with np.errstate(divide="ignore", invalid="ignore"):
-        tau = num / den
-    # den is NaN (not given) -> NaN; den = 0 (no inertia at all) -> the load sees g alone
-    return np.where(den == 0.0, gravity + 0.0 * tau, tau)
+        tau = np.divide(num, den, out=num)
+    if not np.all(b_k > 0.0) and not np.all(j_load > 0.0):
+        # no inertia at all (J = J_L = 0): the load sees its gravity torque alone
+        np.copyto(tau, np.broadcast_to(gravity, tau.shape), where=den == 0.0)
+    return tau
+
+
+def _worst_stops(n_ratio, eta, j_rot, t_s, j_load, gravity, sign):
+    """The largest |τ| over the moving samples and its sample, per candidate; NaN (sample 0)
+    where a parameter is not given. Candidates in blocks of at most _BLOCK elements."""
+    k, m = n_ratio.shape[0], j_load.shape[0]
+    peak, worst = np.full(k, np.nan), np.zeros(k, dtype=np.intp)
+    given = np.flatnonzero(~np.isnan(j_rot + t_s))
+    step = max(1, _BLOCK // m)
+    for lo in range(0, given.size, step):
+        c = given[lo : lo + step]
+        mag = np.abs(_stop_block(n_ratio[c], eta[c], j_rot[c], t_s[c], j_load, gravity, sign))
+        worst[c] = np.argmax(mag, axis=1)
+        peak[c] = np.take_along_axis(mag, worst[c, None], axis=1)[:, 0]
+    return peak, worst
 
 
 def emergency_stop_values(
@@ -371,18 +394,8 @@ def emergency_stop_values(
 
     moving = speed != 0.0
     if np.any(moving):
-        tau = stop_torque_at_output(
-            n_ratio[:, None],
-            eta[:, None],
-            j_rot[:, None],
-            j_load[moving][None, :],
-            gravity[moving][None, :],
-            speed[moving][None, :],
-            t_s[:, None],
-        )
-        mag = np.abs(tau)
-        worst = np.argmax(np.where(np.isnan(mag), -np.inf, mag), axis=1)
-        peak = mag[np.arange(k), worst]
+        sign = np.sign(speed[moving])
+        peak, worst = _worst_stops(n_ratio, eta, j_rot, t_s, j_load[moving], gravity[moving], sign)
         when = np.where(np.isnan(peak), np.nan, t[moving][worst])
     else:
         peak = np.where(np.isnan(j_rot + t_s), np.nan, float(np.max(np.abs(torque))))
