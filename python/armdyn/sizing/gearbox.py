@@ -93,6 +93,24 @@ torque does not depend on the speed (the kinetic energy sets how long the stop l
 torque), so the state of the largest kinetic energy or speed is not in general the worst: the
 maximum over every moving sample contains it and is never smaller. A cycle that never moves
 has no stop: its momentary torque is the cycle's largest |T|. With J = J_L = 0, τ = g.
+
+Sources (the vendors' public manuals; the formulas above are theirs, the sampled-cycle form and
+the choices stated above are armdyn's):
+
+- Harmonic Drive, "CSD-2A component sets" engineering data (1019659, 11/2014) and "HFUS-2SH"
+  (1021387, 12/2018), §4.1 selection procedure: T_av, n_in,av, L50 = L_n (n_N / n_in,av)
+  (T_N / T_av)³ with L_n = 35,000 h (CSD, CSF, HFUS, HFUC, SHD) or 50,000 h (CSG, SHG,
+  CobaltLine), L10 ≈ L50 / 5; the momentary peak torque "should not occur during the normal
+  operating cycle" and its allowed number of events.
+- Harmonic Drive "CHA" (1018854) and "SHG/HFUS-2SH" manuals, output bearing: the dynamic
+  equivalent load P_C = x (F_rav + 2M/d_p) + y F_aav, (x, y) = (1, 0.45) for
+  F_aav / (F_rav + 2M/d_p) ≤ 1.5 else (0.67, 0.67), the averages with exponent B and weights
+  |n_i| t_i, and the pause time t_p between cycles; "FHA-C" and "CSF/CSG-2UH" manuals:
+  L_B-10 = 10⁶ / (60 N_av) (C / (f_w P_c))^(10/3), f_w = 1–1.2 smooth, 1.2–1.5 normal, 1.5–3
+  with shocks.
+- Nabtesco "RV-E / RH-E" glossary: rated service life, allowable acceleration/deceleration
+  torque (the repeated peak), momentary maximum allowable torque (emergency stop or external
+  shock), allowable moment and maximum thrust load; the RV life law has the exponent 10/3.
 """
 
 from __future__ import annotations
