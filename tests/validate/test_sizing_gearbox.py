@@ -576,3 +576,30 @@ def test_emergency_stop_blocks_equal_one_block(monkeypatch):
     blocks = gb.emergency_stop_values(load, *args)
     for key, value in whole.items():
         np.testing.assert_array_equal(blocks[key], value, err_msg=key)
+
+
+def test_margins_by_check_feed_the_verdict():
+    from armdyn.sizing.checks import verdict
+
+    load = cycle()
+    values = gb.gearbox_cycle_values(load, [50.0, -100.0, 80.0], GEARS)
+    values.update(gb.bearing_cycle_values(load, {"bearing_offset": [0.0, 0.01, np.nan]}))
+    margins = gb.margins_by_check(values)
+    assert set(margins) == {
+        "gear_life",
+        "gear_average_torque",
+        "gear_average_input_speed",
+        "gear_repeated_peak",
+        "gear_momentary_count",
+        "gear_input_speed",
+        "bearing_moment",
+        "bearing_axial",
+        "bearing_radial",
+        "bearing_life",
+    }
+    ok, binding, least = verdict(margins)
+    for i in range(3):
+        checked = {k: v[i] for k, v in margins.items() if not math.isnan(v[i])}
+        name = min(checked, key=checked.get)
+        assert binding[i] == name and least[i] == checked[name]
+        assert ok[i] == all(v >= 1.0 for v in checked.values())

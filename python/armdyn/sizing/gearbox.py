@@ -173,6 +173,17 @@ def _margins(out: dict, values: dict[str, tuple]) -> dict:
     return out
 
 
+def margins_by_check(values: dict) -> dict[str, np.ndarray]:
+    """``{check name: margin}`` from a dict of this module's or :mod:`armdyn.sizing.drive`'s
+    values (their ``"<name>_margin"`` keys; the values keep that key because two checks,
+    ``gear_life`` and ``gear_average_torque``, share their name with their value column), in
+    the form :func:`armdyn.sizing.checks.verdict` takes."""
+    from armdyn.sizing.drive import BUS_CHECKS
+
+    checks = (*CHECKS_BY_NAME.values(), *BUS_CHECKS)
+    return {c.name: values[c.margin_column] for c in checks if c.margin_column in values}
+
+
 def gearbox_cycle_values(load, ratio, gearboxes, options=None) -> dict[str, np.ndarray]:
     """The gearbox's cycle values and margins for k candidates (see the module notes).
 
