@@ -204,7 +204,8 @@ def bus_values(t, electrical_power, period=None, drives=None) -> dict[str, np.nd
         t: (n,) the common time grid of one period [s] (non-decreasing, n >= 2).
         electrical_power: (axes, n) the axes' electrical power [W] (negative: regenerating),
             or (k, axes, n) for k candidate sets.
-        period: the cycle's period [s] (default ``t[-1] - t[0]``; the means are per period).
+        period: the cycle's period [s] (default ``t[-1] - t[0]``; the means are per period;
+            a period longer than the grid counts no power outside it).
         drives: the bus parameters, scalars or (k,) (one set of axes against k drives, or k sets
             against one or k drives): ``bus_voltage`` (V_nom), ``bus_voltage_max``
             (V_max) [V], ``bus_capacitance`` [F], ``braking_resistor_power``,
