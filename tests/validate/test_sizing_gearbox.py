@@ -123,6 +123,7 @@ def test_gearbox_values_equal_a_hand_calculation():
             else:
                 assert out[key][i] == pytest.approx(want, rel=1e-12), key
     assert np.all(out["emergency_stops"] == 1000.0)
+    assert np.all(out["gear_cycles_per_hour"] == 3600.0 / period)
 
 
 def segments(ts, ns, torques):
@@ -153,7 +154,7 @@ def test_vendor_segment_formulas_and_worked_example():
     worked examples: T_av = (Σ|n_i| t_i |T_i|³ / Σ|n_i| t_i)^(1/3), n_av = N Σ|n_i| t_i / Σ t_i
     with the pause in Σ t_i, L = L_N (T_N/T_av)³ (n_N/n_av). The numbers (150 N m 0.2 s 10 rpm,
     82 N m 3 s 20 rpm, 130 N m 0.3 s 10 rpm, a 0.2 s pause) give T_av = 89 N m as the
-    published example says; N = 100."""
+    published example says (Honpine, "How to select a harmonic reduction gear"); N = 100."""
     ts, ns, torques = [0.2, 3.0, 0.3, 0.2], [10.0, 20.0, 10.0, 0.0], [150.0, 82.0, 130.0, 0.0]
     load = segments(ts, [n * RPM for n in ns], torques)
     gears = {"rated_torque": [100.0], "rated_input_speed": [2000 * RPM], "rated_life": [35000.0]}

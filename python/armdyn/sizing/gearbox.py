@@ -26,13 +26,17 @@ Nabtesco's RV glossary and selection flow chart are the same with the exponent 1
   T_av = (∫ |n| |T|³ dt / ∫ |n| dt)^(1/3). A joint that never moves has no speed weights:
   its T_av is the time-weighted cubic mean (∫ |T|³ dt / period)^(1/3) (the torque it holds),
   and its life is infinite (no revolutions);
-- average input speed n_av = |N| ∫ |n| dt / period. Harmonic Drive divides by the whole cycle
-  time *including the pause* t_p (the manuals' t_p, "the pause time between cycles"): the
-  rated life counts the hours of the machine's operation, pauses included, so the revolutions
-  over the life are n_av L only with the pause in the average. Vendors who leave the pause out
-  (some planetary-gearbox worksheets) give a larger n_av and a shorter life; the pause is
-  included here because the required life (:class:`SizingOptions` ``required_life``) is
-  counted in the same hours;
+- average input speed n_av = |N| ∫ |n| dt / period, the vendors' Σ |n_i| t_i / Σ t_i over a
+  cycle whose segments include the pause (Harmonic Drive's cycle diagrams mark t_p, "the pause
+  time between cycles"). The pause is in the average because the rated life counts the hours
+  of operation, pauses included: the revolutions over the life are n_av L only so. Leaving the
+  pause out (as some worksheets do for the speed only while moving) gives a larger n_av and a
+  shorter life; the required life (:class:`SizingOptions` ``required_life``) is counted in the
+  same hours as here;
+- cycles per hour 3600 / period (``gear_cycles_per_hour``): Wittenstein and Beckhoff rate the
+  acceleration (repeated peak) torque for at most 1000 cycles per hour and reduce it by a
+  shock factor above; that factor is not applied here (the catalog's ``repeated_peak_torque``
+  should be the value for the cycle's rate);
 - life L = L_N (T_N / T_av)^p (n_N / n_av) with (T_N, n_N, L_N) the catalog's
   ``rated_torque``, ``rated_input_speed``, ``rated_life`` and p = ``life_exponent`` (3 for
   strain-wave gears, 10/3 for RV; absent or NaN = 3). Harmonic Drive's L_N is an L50 life
@@ -197,7 +201,8 @@ def gearbox_cycle_values(load, ratio, gearboxes, options=None) -> dict[str, np.n
     Returns:
         dict of (k,) arrays: ``gear_average_torque`` [N m], ``gear_average_output_speed``,
         ``gear_average_input_speed``, ``gear_peak_input_speed`` [rad/s], ``gear_life`` [h],
-        ``gear_repeated_peak_torque`` [N m], ``emergency_stops`` and the margins
+        ``gear_repeated_peak_torque`` [N m], ``gear_cycles_per_hour``, ``emergency_stops`` and
+        the margins
         ``gear_life_margin``, ``gear_average_torque_margin``,
         ``gear_average_input_speed_margin``, ``gear_repeated_peak_margin``,
         ``gear_momentary_count_margin``, ``gear_input_speed_margin``.
@@ -233,6 +238,7 @@ def gearbox_cycle_values(load, ratio, gearboxes, options=None) -> dict[str, np.n
         "gear_peak_input_speed": n_ratio * float(np.max(w)),
         "gear_life": life,
         "gear_repeated_peak_torque": np.full(k, float(np.max(np.abs(torque)))),
+        "gear_cycles_per_hour": np.full(k, 3600.0 / period),
         "emergency_stops": np.full(k, float(opts.emergency_stops)),
     }
     return _margins(
