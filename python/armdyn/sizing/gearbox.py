@@ -51,8 +51,11 @@ Nabtesco's RV glossary and selection flow chart are the same with the exponent 1
 **Output bearing** (:func:`bearing_cycle_values`). The load's ``force`` F and ``moment`` M_O
 are the reaction wrench on the child at the joint point O, in the child's joint frame, and
 ``axis`` a (normalised here) the joint axis in that frame. The bearing's reference point is
-P = O + b a with b the catalog's ``bearing_offset`` [m], **positive towards the child** (along
-+a, the side of the output flange) and negative towards the parent. Moving the wrench to P::
+P = O + b a with b the catalog's ``bearing_offset`` [m], **positive along the joint axis a as
+the model states it** (the load's ``axis``). When the axis points from the parent's side of the
+joint towards the child's (the usual mounting: the output flange on the child's side), b > 0
+is towards the child; a model whose axis points the other way takes b with the opposite sign
+(a mount's geometry, not a catalog's: the load knows no more than the axis). Moving the wrench to P::
 
     F_a = F · a                         (axial force, signed; its peak is max |F_a|)
     F_r = |F − (F · a) a|               (radial force)
