@@ -55,7 +55,8 @@ P = O + b a with b the catalog's ``bearing_offset`` [m], **positive along the jo
 the model states it** (the load's ``axis``). When the axis points from the parent's side of the
 joint towards the child's (the usual mounting: the output flange on the child's side), b > 0
 is towards the child; a model whose axis points the other way takes b with the opposite sign
-(a mount's geometry, not a catalog's: the load knows no more than the axis). Moving the wrench to P::
+(a mount's geometry, not a catalog's: the load knows no more than the axis). Moving the
+wrench to P::
 
     F_a = F · a                         (axial force, signed; its peak is max |F_a|)
     F_r = |F − (F · a) a|               (radial force)
