@@ -604,3 +604,47 @@ def test_margins_by_check_feed_the_verdict():
         name = min(checked, key=checked.get)
         assert binding[i] == name and least[i] == checked[name]
         assert ok[i] == all(v >= 1.0 for v in checked.values())
+
+
+@pytest.mark.parametrize("ratio", [80.0, -50.0])
+def test_emergency_stop_equals_the_dynamics_of_a_model_with_its_actuator(ratio):
+    """Second method, η = 1: a pendulum with the actuator in its dynamics (rotor J behind the
+    gear N) and the stop torque T_s on the rotor (a joint-side torque N T_m) accelerates by
+    armdyn's forward dynamics; the gear output torque on the link is then J_L q̈ + g (the
+    rotor-free model's inertia and gravity torque), which the module's closed form must give
+    at every moving sample."""
+    j_rot, t_s = 3e-5, 0.8
+
+    def pendulum(actuated):
+        b = ad.ModelBuilder(gravity=(0.0, 0.0, -9.81))
+        b.add_body("link", 1.5, np.diag([0.01, 0.02, 0.015]), position=(0.25, 0.0, 0.05))
+        b.add_revolute("hinge", "ground", "link", (0.0, 0.0, 0.0), (0.0, 1.0, 0.0))
+        if actuated:
+            b.add_actuator("hinge", ratio, j_rot)
+        return b.finalize()
+
+    bare, geared = pendulum(False), pendulum(True)
+    q = np.linspace(-1.0, 2.0, 7)
+    qd = np.array([0.5, -1.0, 2.0, -0.3, 1.2, -2.5, 0.7])
+    gravity = np.array([ad.inverse_dynamics(bare, [x], [0.0], [0.0])[0] for x in q])
+    j_load = np.array([ad.mass_matrix(bare, [x])[0, 0] for x in q])
+    taus = []
+    for x, v, g, jl in zip(q, qd, gravity, j_load, strict=True):
+        t_m = -math.copysign(t_s, v)
+        qdd = ad.forward_dynamics(geared, [x], [v], [ratio * t_m])[0]
+        taus.append(jl * qdd + g)
+    n = q.size
+    load = Load(
+        t=np.arange(n, dtype=float),
+        speed=qd,
+        torque=np.zeros(n),
+        gravity_torque=gravity,
+        force=np.zeros((n, 3)),
+        moment=np.zeros((n, 3)),
+        axis=np.array([0.0, 0.0, 1.0]),
+        inertia=j_load,
+    )
+    out = gb.emergency_stop_values(load, [ratio], [1.0], [j_rot], [t_s])
+    worst = int(np.argmax(np.abs(taus)))
+    assert out["gear_momentary_torque"][0] == pytest.approx(abs(taus[worst]), rel=1e-10)
+    assert out["emergency_stop_time"][0] == load.t[worst]
