@@ -505,7 +505,7 @@ def test_missing_field_and_dataframe_columns():
     load = cycle()
 
     class NoForce:
-        t, speed = load.t, load.speed
+        t, speed, axis = load.t, load.speed, load.axis
 
     with pytest.raises(ad.ModelError, match=r"load has no field 'force'"):
         gb.bearing_cycle_values(NoForce(), {"bearing_offset": [0.0]})
@@ -648,3 +648,12 @@ def test_emergency_stop_equals_the_dynamics_of_a_model_with_its_actuator(ratio):
     worst = int(np.argmax(np.abs(taus)))
     assert out["gear_momentary_torque"][0] == pytest.approx(abs(taus[worst]), rel=1e-10)
     assert out["emergency_stop_time"][0] == load.t[worst]
+
+
+def test_a_cycle_without_reactions_leaves_the_bearing_not_checked():
+    """JointLoad's force/moment are None when the build cannot compute the reactions."""
+    load = replace(cycle(), force=None, moment=None)
+    out = gb.bearing_cycle_values(load, BEARINGS)
+    assert set(out) >= {"bearing_peak_moment", "bearing_life", "bearing_life_margin"}
+    for key, value in out.items():
+        assert value.shape == (4,) and np.all(np.isnan(value)), key

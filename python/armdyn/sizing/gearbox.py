@@ -287,11 +287,45 @@ def _bearing_life(f_rav, f_aav, m_av, out_speed, rating, pitch, load_factor):
     return np.where(given, life, np.nan)
 
 
+_BEARING_VALUES = (
+    "bearing_peak_moment",
+    "bearing_peak_axial",
+    "bearing_peak_radial",
+    "bearing_average_moment",
+    "bearing_average_axial",
+    "bearing_average_radial",
+    "bearing_life",
+)
+
+
+def _bearing_loads(t, w, force, moment, axis, offset) -> dict[str, np.ndarray]:
+    """The peaks and the 10/3 means (weights w = |n|) of the bearing's loads, per candidate
+    offset (NaN offset: the moment is not given); each distinct offset is computed once."""
+    k = offset.shape[0]
+    f_a, f_r, _ = bearing_wrench(force, moment, axis, 0.0)
+    peak_m, avg_m = np.full(k, np.nan), np.full(k, np.nan)
+    for b in np.unique(offset[~np.isnan(offset)]):
+        m = bearing_wrench(force, moment, axis, float(b))[2]
+        at = offset == b
+        peak_m[at] = float(np.max(m))
+        avg_m[at] = weighted_mean(m, w, t, BEARING_EXPONENT)
+    return {
+        "bearing_peak_moment": peak_m,
+        "bearing_peak_axial": np.full(k, float(np.max(np.abs(f_a)))),
+        "bearing_peak_radial": np.full(k, float(np.max(f_r))),
+        "bearing_average_moment": avg_m,
+        "bearing_average_axial": np.full(k, weighted_mean(f_a, w, t, BEARING_EXPONENT)),
+        "bearing_average_radial": np.full(k, weighted_mean(f_r, w, t, BEARING_EXPONENT)),
+    }
+
+
 def bearing_cycle_values(load, gearboxes, options=None) -> dict[str, np.ndarray]:
     """The output bearing's cycle values and margins for k candidate gearboxes (module notes).
 
     Args:
-        load: the joint's load (``t``, ``speed``, ``force``, ``moment``, ``axis``).
+        load: the joint's load (``t``, ``speed``, ``force``, ``moment``, ``axis``); ``force``
+            or ``moment`` None (a cycle without reactions): every value and margin is NaN
+            (not checked).
         gearboxes: the k gearboxes' catalog columns, those of :data:`BEARING_COLUMNS` used
             (a NaN ``bearing_offset`` leaves the moment and the life not given).
         options: :class:`armdyn.sizing.options.SizingOptions` (``bearing_load_factor``,
@@ -309,42 +343,31 @@ def bearing_cycle_values(load, gearboxes, options=None) -> dict[str, np.ndarray]
     t = _inputs.cycle_times(who, load)
     n = t.shape[0]
     speed = _inputs.series(who, load, "speed", (n,))
-    force = _inputs.series(who, load, "force", (n, 3))
-    moment = _inputs.series(who, load, "moment", (n, 3))
     axis = _inputs.unit_axis(who, load)
     cols = _inputs.columns(who, gearboxes, BEARING_COLUMNS, None, "gearboxes")
     offset = cols["bearing_offset"]
     k = offset.shape[0]
-
-    w = np.abs(speed)
-    f_a, f_r, _ = bearing_wrench(force, moment, axis, 0.0)
-    peak_m, avg_m = np.full(k, np.nan), np.full(k, np.nan)
-    for b in np.unique(offset[~np.isnan(offset)]):
-        m = bearing_wrench(force, moment, axis, float(b))[2]
-        at = offset == b
-        peak_m[at] = float(np.max(m))
-        avg_m[at] = weighted_mean(m, w, t, BEARING_EXPONENT)
-    f_rav = weighted_mean(f_r, w, t, BEARING_EXPONENT)
-    f_aav = weighted_mean(f_a, w, t, BEARING_EXPONENT)
-    out_speed = float(trapezoid(w, t)) / (t[-1] - t[0])
-    life = _bearing_life(
-        f_rav,
-        f_aav,
-        avg_m,
-        out_speed,
-        cols["bearing_dynamic_load_rating"],
-        cols["bearing_pitch_diameter"],
-        float(opts.bearing_load_factor),
-    )
-    out = {
-        "bearing_peak_moment": peak_m,
-        "bearing_peak_axial": np.full(k, float(np.max(np.abs(f_a)))),
-        "bearing_peak_radial": np.full(k, float(np.max(f_r))),
-        "bearing_average_moment": avg_m,
-        "bearing_average_axial": np.full(k, f_aav),
-        "bearing_average_radial": np.full(k, f_rav),
-        "bearing_life": life,
-    }
+    for name in ("force", "moment"):
+        if not hasattr(load, name):
+            raise _inputs.fail(who, f"load has no field {name!r}")
+    if load.force is None or load.moment is None:
+        # the cycle has no reaction wrench (a build without it): nothing is checked
+        out = {name: np.full(k, np.nan) for name in _BEARING_VALUES}
+    else:
+        force = _inputs.series(who, load, "force", (n, 3))
+        moment = _inputs.series(who, load, "moment", (n, 3))
+        out = _bearing_loads(t, np.abs(speed), force, moment, axis, offset)
+        out["bearing_life"] = _bearing_life(
+            out["bearing_average_radial"],
+            out["bearing_average_axial"],
+            out["bearing_average_moment"],
+            float(trapezoid(np.abs(speed), t)) / (t[-1] - t[0]),
+            cols["bearing_dynamic_load_rating"],
+            cols["bearing_pitch_diameter"],
+            float(opts.bearing_load_factor),
+        )
+    peak_m = out["bearing_peak_moment"]
+    life = out["bearing_life"]
     return _margins(
         out,
         {
