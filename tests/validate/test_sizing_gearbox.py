@@ -657,3 +657,27 @@ def test_a_cycle_without_reactions_leaves_the_bearing_not_checked():
     assert set(out) >= {"bearing_peak_moment", "bearing_life", "bearing_life_margin"}
     for key, value in out.items():
         assert value.shape == (4,) and np.all(np.isnan(value)), key
+
+
+def test_extreme_finite_inputs_give_no_nan():
+    """|x|^p of large loads and the lives' powers overflow in a naive form (inf * 0 = NaN):
+    finite inputs give finite, zero or infinite values, never NaN."""
+    base = cycle()
+    for scale, speed_scale in ((1e150, 1.0), (1e-150, 1e-300), (1.0, 1e250)):
+        load = replace(
+            base,
+            torque=base.torque * scale,
+            force=base.force * scale,
+            moment=base.moment * scale,
+            speed=base.speed * speed_scale,
+        )
+        gears = {c: [1.0] for c in ("rated_torque", "rated_input_speed", "rated_life")}
+        values = gb.gearbox_cycle_values(load, [100.0], gears)
+        bearings = {"bearing_offset": [0.01], "bearing_dynamic_load_rating": [1e4]}
+        values.update(gb.bearing_cycle_values(load, {**bearings, "bearing_pitch_diameter": [0.05]}))
+        for key in ("gear_average_torque", "gear_life", "bearing_average_moment", "bearing_life"):
+            assert not np.isnan(values[key][0]), (scale, speed_scale, key)
+        assert values["gear_average_torque"][0] == pytest.approx(
+            scale * gb.gearbox_cycle_values(base, [100.0], gears)["gear_average_torque"][0],
+            rel=1e-12,
+        )

@@ -167,11 +167,16 @@ def trapezoid(f: np.ndarray, t: np.ndarray) -> np.ndarray:
 
 
 def weighted_mean(x: np.ndarray, w: np.ndarray, t: np.ndarray, p: float) -> float:
-    """(∫ w |x|^p dt / ∫ w dt)^(1/p); time weights when ∫ w dt = 0."""
+    """(∫ w |x|^p dt / ∫ w dt)^(1/p); time weights when ∫ w dt = 0. Computed on |x| / max |x|
+    (no overflow of |x|^p for any finite x)."""
+    scale = float(np.max(np.abs(x)))
+    if scale == 0.0:
+        return 0.0
+    y = (np.abs(x) / scale) ** p
     den = float(trapezoid(w, t))
     if den > 0.0:
-        return float(trapezoid(w * np.abs(x) ** p, t) / den) ** (1.0 / p)
-    return float(trapezoid(np.abs(x) ** p, t) / (t[-1] - t[0])) ** (1.0 / p)
+        return scale * float(trapezoid(w * y, t) / den) ** (1.0 / p)
+    return scale * float(trapezoid(y, t) / (t[-1] - t[0])) ** (1.0 / p)
 
 
 def _margins(out: dict, values: dict[str, tuple]) -> dict:
@@ -228,12 +233,10 @@ def gearbox_cycle_values(load, ratio, gearboxes, options=None) -> dict[str, np.n
     t_av = weighted_mean(torque, w, t, 3.0)
     out_speed = float(trapezoid(w, t)) / period
     n_av = n_ratio * out_speed
-    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
-        life = cols["rated_life"] * (cols["rated_torque"] / t_av) ** p
-        life = life * (cols["rated_input_speed"] / n_av)
-    # T_av = 0 or n_av = 0: no wear, an infinite life (where the ratings are given)
-    rated = ~np.isnan(cols["rated_life"] + cols["rated_torque"] + cols["rated_input_speed"])
-    life = np.where(rated & ((t_av == 0.0) | (n_av == 0.0)), np.inf, life)
+    # in logarithms: no overflow to inf * 0; T_av = 0 or n_av = 0 (no wear) gives inf
+    with np.errstate(divide="ignore", over="ignore"):
+        log_life = np.log(cols["rated_life"]) + p * (np.log(cols["rated_torque"]) - np.log(t_av))
+        life = np.exp(log_life + np.log(cols["rated_input_speed"]) - np.log(n_av))
 
     out = {
         "gear_average_torque": np.full(k, t_av),
@@ -280,10 +283,11 @@ def _bearing_life(f_rav, f_aav, m_av, out_speed, rating, pitch, load_factor):
         x = np.where(ratio <= 1.5, 1.0, 0.67)
         y = np.where(ratio <= 1.5, 0.45, 0.67)
         p_c = x * radial + y * f_aav
-        revs_per_hour = out_speed * 3600.0 / (2.0 * np.pi)
-        life = 1e6 / revs_per_hour * (rating / (load_factor * p_c)) ** BEARING_EXPONENT
+        # in logarithms (no inf * 0); P_c = 0 or no motion gives inf
+        log_revs = np.log(out_speed * 3600.0 / (2.0 * np.pi))  # revolutions per hour
+        log_ratio = np.log(rating) - np.log(load_factor * p_c)
+        life = np.exp(np.log(1e6) - log_revs + BEARING_EXPONENT * log_ratio)
     given = ~np.isnan(rating + pitch + m_av)
-    life = np.where(given & ((p_c == 0.0) | (out_speed == 0.0)), np.inf, life)
     return np.where(given, life, np.nan)
 
 
