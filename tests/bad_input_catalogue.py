@@ -924,10 +924,34 @@ CASES = [
         "sizing",
         "bus_values with the chopper voltage below the nominal bus voltage",
         lambda: _drive().bus_values(
-            [0.0, 1.0], [[1.0, -1.0]], drives={"bus_voltage": 48.0, "bus_voltage_max": 40.0}
+            [0.0, 1.0], [[1.0, -1.0]], drives={"bus_voltage": 48.0, "max_bus_voltage": 40.0}
         ),
         ME,
-        r"drives\['bus_voltage_max'\]\[0\] is below",
+        r"drives\['max_bus_voltage'\]\[0\] is below",
+    ),
+    (
+        "catalog-mass-negative",
+        "catalogs",
+        "a motor of mass −1 kg (also read from motors.csv: named by file:line)",
+        lambda: ad.Catalog(_motors(mass=[-1.0])),
+        ME,
+        "part 'M1': column 'mass'",
+    ),
+    (
+        "catalog-duplicate",
+        "catalogs",
+        "two motors of one name",
+        lambda: ad.Catalog(_motors(name=["M1", "M1"])),
+        ME,
+        "motor 'M1' is already at",
+    ),
+    (
+        "catalog-peak-below-continuous",
+        "catalogs",
+        "a motor whose peak torque is below its continuous torque",
+        lambda: ad.Catalog(_motors(peak_torque=[0.4])),
+        ME,
+        "column 'peak_torque': 0.4 is less than continuous_torque",
     ),
 ]
 
@@ -951,6 +975,15 @@ def _joint_load(n=5, axis=(0.0, 0.0, 1.0)):
     t = np.linspace(0.0, 1.0, n)
     z = np.zeros((n, 3))
     return SimpleNamespace(t=t, speed=np.sin(t), torque=np.cos(t), force=z, moment=z, axis=axis)
+
+
+def _motors(**change):
+    """A one-motor table (two rows when ``name`` has two), with ``change`` applied."""
+    n = len(change.get("name", ["M1"]))
+    row = dict(name=["M1"], torque_constant=[0.1], resistance=[0.5], rotor_inertia=[1e-5])
+    row.update(mass=[0.3], continuous_torque=[0.5], peak_torque=[1.5])
+    row.update(change)
+    return {k: (v * n if len(v) == 1 else v) for k, v in row.items()}
 
 
 def _modelless_result():
