@@ -54,7 +54,7 @@ def calls(n: int, k: int) -> dict:
     motor["peak_terminal_voltage"] = rng.uniform(10.0, 60.0, k)
     drives = {"peak_current": rng.uniform(1, 20, k), "continuous_current": rng.uniform(1, 10, k)}
     drives["bus_voltage"] = np.full(k, 48.0)
-    bus = {"bus_voltage": 48.0, "bus_voltage_max": 60.0, "bus_capacitance": rng.uniform(0, 1e-3, k)}
+    bus = {"bus_voltage": 48.0, "max_bus_voltage": 60.0, "bus_capacitance": rng.uniform(0, 1e-3, k)}
     powers = rng.normal(0.0, 100.0, (6, n))
     return {
         "gearbox_cycle_values": lambda: gb.gearbox_cycle_values(load, ratio, gears),

@@ -97,7 +97,7 @@ def test_bus_values_equal_the_repeated_cycle_run_by_hand(net):
     t, p = axes_powers(net)
     drives = {
         "bus_voltage": [48.0, 48.0, 48.0],
-        "bus_voltage_max": [60.0, 56.0, np.nan],
+        "max_bus_voltage": [60.0, 56.0, np.nan],
         "bus_capacitance": [0.05, 0.2, 0.05],
         "braking_resistor_power": [100.0, np.nan, 50.0],
         "braking_resistor_peak_power": [500.0, 100.0, np.nan],
@@ -107,7 +107,7 @@ def test_bus_values_equal_the_repeated_cycle_run_by_hand(net):
     pl = [[float(x) for x in row] for row in p]
     period = tl[-1] - tl[0]
     for i in range(3):
-        v_max = drives["bus_voltage_max"][i]
+        v_max = drives["max_bus_voltage"][i]
         cap = (
             0.0 if math.isnan(v_max) else 0.5 * drives["bus_capacitance"][i] * (v_max**2 - 48.0**2)
         )
@@ -146,7 +146,7 @@ def test_candidate_sets_equal_one_call_each_and_the_period_scales_the_means():
     t, p = axes_powers(120.0)
     sets = np.stack([p, 0.5 * p, 2.0 * p])
     caps = [0.01, 0.1, 0.0]
-    drives = {"bus_voltage": 48.0, "bus_voltage_max": 58.0, "bus_capacitance": caps}
+    drives = {"bus_voltage": 48.0, "max_bus_voltage": 58.0, "bus_capacitance": caps}
     together = dv.bus_values(t, sets, drives=drives)
     for i in range(3):
         one = dv.bus_values(t, sets[i], drives={**drives, "bus_capacitance": caps[i]})
@@ -172,9 +172,9 @@ def test_candidate_sets_equal_one_call_each_and_the_period_scales_the_means():
         (lambda: dv.bus_values([0.0, 1.0], [[1.0, 1.0]], period=-1.0), r"period\[0\] must be > 0"),
         (
             lambda: dv.bus_values(
-                [0.0, 1.0], [[1.0, 1.0]], drives={"bus_voltage": 48.0, "bus_voltage_max": 40.0}
+                [0.0, 1.0], [[1.0, 1.0]], drives={"bus_voltage": 48.0, "max_bus_voltage": 40.0}
             ),
-            r"drives\['bus_voltage_max'\]\[0\] is below",
+            r"drives\['max_bus_voltage'\]\[0\] is below",
         ),
         (
             lambda: dv.bus_values([0.0, 1.0], [[1.0, 1.0]], drives={"bus_capacitance": -1.0}),

@@ -26,7 +26,7 @@ when regenerating), given on one common time grid, add up to the bus power P = �
 axis braking feeds another one's motoring). Per sample interval the bus takes the net
 trapezoid energy e = (P_i + P_{i+1}) Δt / 2: e > 0 is drawn, e < 0 returned (regenerated). The
 bus capacitance C stores up to E_C = ½ C (V_max² − V_nom²) above its nominal voltage V_nom
-(``bus_voltage``) before the braking chopper switches on at V_max (``bus_voltage_max``); the
+(``bus_voltage``) before the braking chopper switches on at V_max (``max_bus_voltage``); the
 supply does not take energy back. The stored energy s follows, per interval,
 s ← min(s − e, E_C) when e < 0 (the overflow goes to the braking resistor) and
 s ← max(s − e, 0) when e > 0 (motoring draws the stored energy first). The resistor's energy
@@ -207,7 +207,7 @@ def bus_values(t, electrical_power, period=None, drives=None) -> dict[str, np.nd
         period: the cycle's period [s] (default ``t[-1] - t[0]``; the means are per period;
             a period longer than the grid counts no power outside it).
         drives: the bus parameters, scalars or (k,) (one set of axes against k drives, or k sets
-            against one or k drives): ``bus_voltage`` (V_nom), ``bus_voltage_max``
+            against one or k drives): ``bus_voltage`` (V_nom), ``max_bus_voltage``
             (V_max) [V], ``bus_capacitance`` [F], ``braking_resistor_power``,
             ``braking_resistor_peak_power`` [W] (absent or NaN = not given).
 
@@ -231,7 +231,7 @@ def bus_values(t, electrical_power, period=None, drives=None) -> dict[str, np.nd
         raise _inputs.fail(who, f"period ({period!r}) is shorter than the time grid ({span!r})")
     spec = {
         "bus_voltage": _NONNEG,
-        "bus_voltage_max": _NONNEG,
+        "max_bus_voltage": _NONNEG,
         "bus_capacitance": _NONNEG,
         "braking_resistor_power": _NONNEG,
         "braking_resistor_peak_power": _NONNEG,
@@ -241,10 +241,10 @@ def bus_values(t, electrical_power, period=None, drives=None) -> dict[str, np.nd
         k = max(sizes, default=1)
         p = np.broadcast_to(p, (k, p.shape[1]))
     bus = _inputs.columns(who, drives, spec, k, "drives")
-    v_nom, v_max = bus["bus_voltage"], bus["bus_voltage_max"]
+    v_nom, v_max = bus["bus_voltage"], bus["max_bus_voltage"]
     if np.any(v_max < v_nom):
         i = int(np.flatnonzero(v_max < v_nom)[0])
-        raise _inputs.fail(who, f"drives['bus_voltage_max'][{i}] is below drives['bus_voltage']")
+        raise _inputs.fail(who, f"drives['max_bus_voltage'][{i}] is below drives['bus_voltage']")
     cap = 0.5 * bus["bus_capacitance"] * (v_max**2 - v_nom**2)
     cap = np.where(np.isnan(cap), 0.0, cap)
 
