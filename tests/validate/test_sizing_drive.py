@@ -212,3 +212,24 @@ def test_candidate_sets_equal_one_call_each_and_the_period_scales_the_means():
 def test_hostile_inputs_name_the_culprit(call, match):
     with pytest.raises(ad.ModelError, match=match):
         call()
+
+
+def test_the_example_catalog_drives_vectorised_equal_one_drive_at_a_time():
+    drives = ad.load_catalog(ad.sizing.EXAMPLE_CATALOG).drives
+    k = len(drives)
+    rng = np.random.default_rng(4)
+    motor = {
+        "peak_current": rng.uniform(1.0, 20.0, k),
+        "rms_current": rng.uniform(0.5, 8.0, k),
+        "peak_terminal_voltage": rng.uniform(10.0, 60.0, k),
+    }
+    t, p = axes_powers(150.0)
+    together = dv.drive_values(motor, drives)
+    together.update(dv.bus_values(t, p, drives=drives))
+    assert np.all(np.isfinite(together["resistor_energy"]))
+    for i in range(k):
+        row = drives.iloc[i : i + 1]
+        alone = dv.drive_values({key: v[i : i + 1] for key, v in motor.items()}, row)
+        alone.update(dv.bus_values(t, p, drives=row))
+        for key, value in alone.items():
+            np.testing.assert_array_equal(together[key][i], value[0], err_msg=f"{key} row {i}")
