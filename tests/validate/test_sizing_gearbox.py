@@ -455,7 +455,9 @@ def test_emergency_stop_limits():
             r"load.axis must be a non-zero vector",
         ),
         (
-            lambda L: gb.bearing_cycle_values(L, {"bearing_offset": [0.0], "x": [1.0, 2.0]}),
+            lambda L: gb.bearing_cycle_values(
+                L, {"bearing_offset": [0.0], "bearing_pitch_diameter": [1.0, 2.0]}
+            ),
             r"gearboxes must hold \(k,\) columns of one length",
         ),
         (
@@ -710,3 +712,18 @@ def test_the_example_catalog_vectorised_equals_one_part_at_a_time():
         )
         for key, value in alone.items():
             np.testing.assert_array_equal(together[key][i], value[0], err_msg=f"{key} row {i}")
+
+
+def test_one_catalog_part_as_a_dataclass():
+    catalog = ad.load_catalog(ad.sizing.EXAMPLE_CATALOG)
+    name = catalog.gearboxes.index[3]
+    part, row = catalog.gearbox(name), catalog.gearboxes.loc[[name]]
+    load = cycle(seed=2)
+    for fn in (
+        lambda g: gb.gearbox_cycle_values(load, [part.ratio], g),
+        lambda g: gb.bearing_cycle_values(load, g),
+        lambda g: gb.emergency_stop_values(load, [part.ratio], [0.8], [1e-5], [1.0], g),
+    ):
+        by_part, by_row = fn(part), fn(row)
+        for key, value in by_row.items():
+            np.testing.assert_array_equal(by_part[key], value, err_msg=key)

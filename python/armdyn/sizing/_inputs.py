@@ -6,6 +6,7 @@ candidate."""
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping
 
 import numpy as np
@@ -117,17 +118,21 @@ def candidates(
 def columns(
     who: str, table, spec: Mapping[str, dict], k: int | None, label: str
 ) -> dict[str, np.ndarray]:
-    """Per-candidate catalog columns from ``table`` (a mapping or pandas DataFrame of column ->
-    (k,) values): ``spec`` maps each column name to :func:`candidates`' keywords plus an
-    optional ``default`` used when the column is absent (absent without a default = NaN, not
-    given)."""
+    """Per-candidate catalog columns from ``table``: a mapping or pandas DataFrame of column ->
+    (k,) values, or one part (a catalog dataclass such as ``Gearbox``: k = 1). ``spec`` maps
+    each column name to :func:`candidates`' keywords plus an optional ``default`` used when the
+    column is absent (absent without a default = NaN, not given). k None: the length of the
+    columns read (other columns are ignored)."""
     if table is None:
         table = {}
+    if dataclasses.is_dataclass(table) and not isinstance(table, type):  # one catalog part
+        table = {f.name: getattr(table, f.name) for f in dataclasses.fields(table)}
     if not isinstance(table, Mapping) and not hasattr(table, "columns"):
         raise fail(who, f"{label} must be a mapping of column -> (k,) values")
     keys = set(table.keys()) if isinstance(table, Mapping) else set(table.columns)
     if k is None:
-        lengths = {len(np.atleast_1d(np.asarray(table[c], dtype=object))) for c in keys}
+        known = keys & set(spec) or keys  # k from the columns read (else from any column)
+        lengths = {len(np.atleast_1d(np.asarray(table[c], dtype=object))) for c in known}
         if len(lengths) != 1:
             raise fail(
                 who,
