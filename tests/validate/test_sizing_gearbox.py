@@ -2,41 +2,46 @@
 calculations from the vendors' formulas, computed here independently: loops over the samples
 (or the vendors' load segments) in plain Python floats, never the module's vectorised numpy.
 
-The joint load is a stand-in with JointLoad's fields (issue 33's spec, section 4): the functions
-read the fields only.
+The joint loads are :class:`armdyn.JointLoad` built from arrays (``make_load``), so that each case
+controls its samples; one test takes them from a real :func:`armdyn.duty_cycle`.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import armdyn as ad
 import numpy as np
 import pytest
+from armdyn.sizing import drive as dv
 from armdyn.sizing import gearbox as gb
+from armdyn.sizing.cycle import JointLoad
 from armdyn.sizing.options import SizingOptions
 
 RPM = 2.0 * math.pi / 60.0  # rad/s per rpm
 
 
-@dataclass(frozen=True)
-class Load:
-    """JointLoad's fields (a stand-in until i33-cycle is merged)."""
-
-    t: np.ndarray
-    speed: np.ndarray
-    torque: np.ndarray
-    gravity_torque: np.ndarray
-    force: np.ndarray
-    moment: np.ndarray
-    axis: np.ndarray
-    inertia: np.ndarray
-    joint: str = "j"
-    acceleration: np.ndarray | None = None
-    moving: np.ndarray | None = None
-    period: float = 0.0
-    repeat: int | None = None
+def make_load(t, speed, torque, gravity_torque, force, moment, axis, inertia, period=None):
+    """A :class:`armdyn.JointLoad` from its arrays (the acceleration and the dwell flags are not
+    read by the functions tested here: zeros, and moving where the speed is non-zero)."""
+    t = np.asarray(t, dtype=float)
+    speed = np.asarray(speed, dtype=float)
+    return JointLoad(
+        joint="j",
+        t=t,
+        speed=speed,
+        acceleration=np.zeros_like(t),
+        torque=np.asarray(torque, dtype=float),
+        gravity_torque=np.asarray(gravity_torque, dtype=float),
+        force=force,
+        moment=moment,
+        axis=np.asarray(axis, dtype=float),
+        inertia=np.asarray(inertia, dtype=float),
+        moving=speed != 0.0,
+        period=float(t[-1] - t[0]) if period is None else period,
+        repeat=None,
+    )
 
 
 def cycle(n=61, dwell=0.5, seed=1):
@@ -50,7 +55,7 @@ def cycle(n=61, dwell=0.5, seed=1):
     speed = np.concatenate([speed, [0.0, 0.0]])
     torque = np.concatenate([torque, [torque[-1], torque[-1]]])
     m = t.size
-    return Load(
+    return make_load(
         t=t,
         speed=speed,
         torque=torque,
@@ -137,7 +142,7 @@ def segments(ts, ns, torques):
         now += dt
     m = len(t)
     z = np.zeros(m)
-    return Load(
+    return make_load(
         t=np.array(t),
         speed=np.array(speed),
         torque=np.array(torque),
@@ -298,7 +303,7 @@ def test_bearing_moment_is_the_radial_load_times_its_lever_from_the_reference_po
     lever measured from the reference point), the radial load W, no axial load."""
     w_load, c = 120.0, 0.08
     m = 3
-    load = Load(
+    load = make_load(
         t=np.array([0.0, 1.0, 2.0]),
         speed=np.array([0.0, 1.0, 0.0]),
         torque=np.zeros(m),
@@ -380,7 +385,7 @@ def test_emergency_stop_limits():
     either side: the gravity torque (at the moving samples). A cycle at rest has no stop: the
     largest cycle torque."""
     m = 4
-    base = Load(
+    base = make_load(
         t=np.arange(m, dtype=float),
         speed=np.array([0.0, 1.0, -2.0, 0.0]),
         torque=np.array([1.0, -9.0, 2.0, 0.0]),
@@ -533,7 +538,7 @@ def test_bearing_loads_from_a_simulated_reaction_equal_the_statics_of_the_held_l
     b.add_drive("hinge", ad.profiles.cubic(0.0, 0.0, 0.0, 1.0))
     run = ad.simulate(b.finalize(), 0.2, output_dt=0.1)
     n = run.t.size
-    load = Load(
+    load = make_load(
         t=run.t,
         speed=np.zeros(n),
         torque=np.zeros(n),
@@ -636,7 +641,7 @@ def test_emergency_stop_equals_the_dynamics_of_a_model_with_its_actuator(ratio):
         qdd = ad.forward_dynamics(geared, [x], [v], [ratio * t_m])[0]
         taus.append(jl * qdd + g)
     n = q.size
-    load = Load(
+    load = make_load(
         t=np.arange(n, dtype=float),
         speed=qd,
         torque=np.zeros(n),
@@ -792,7 +797,7 @@ def test_bearing_loads_along_a_motion_equal_newton_euler():
     qdd = 3.0 * np.pi**2 * np.cos(2.0 * np.pi * t)
     forces, torques = ad.joint_reactions(model, q[:, None], qd[:, None], qdd[:, None])
     n = t.size
-    load = Load(
+    load = make_load(
         t=t,
         speed=qd,
         torque=np.zeros(n),
@@ -818,3 +823,68 @@ def test_bearing_loads_along_a_motion_equal_newton_euler():
         assert out["bearing_average_axial"][i] == pytest.approx(hand_mean(f_a, w, tl), rel=1e-10)
         assert out["bearing_average_radial"][i] == pytest.approx(hand_mean(f_r, w, tl), rel=1e-10)
         assert out["bearing_average_moment"][i] == pytest.approx(hand_mean(m, w, tl), rel=1e-10)
+
+
+def two_link_cycle(dwell):
+    """A two-link arm in a vertical plane, a rest-to-rest quintic move of 1 s, then ``dwell``
+    seconds holding the last pose: :func:`armdyn.duty_cycle`."""
+    b = ad.ModelBuilder(gravity=(0.0, 0.0, -9.81))
+    b.add_body("upper", 4.0, np.diag([0.05, 0.05, 0.01]), position=(0.2, 0.0, 0.0))
+    b.add_revolute("shoulder", "ground", "upper", (0.0, 0.0, 0.0), (0.0, 1.0, 0.0))
+    b.add_body("fore", 2.0, np.diag([0.02, 0.02, 0.005]), position=(0.55, 0.03, 0.0))
+    b.add_revolute("elbow", "upper", "fore", (0.4, 0.0, 0.0), (0.0, 1.0, 0.0))
+    model = b.finalize()
+    t = np.linspace(0.0, 1.0, 101)
+    s = 10 * t**3 - 15 * t**4 + 6 * t**5
+    sd = 30 * t**2 - 60 * t**3 + 30 * t**4
+    sdd = 60 * t - 180 * t**2 + 120 * t**3
+    delta = np.array([1.2, -0.8])
+    q = np.array([-0.3, 0.5]) + np.outer(s, delta)
+    return ad.duty_cycle(model, (t, q, np.outer(sd, delta), np.outer(sdd, delta)), dwell=dwell)
+
+
+def test_a_duty_cycle_with_a_dwell_averages_the_input_speed_over_the_pause():
+    """The real JointLoad of a duty cycle: a dwell adds no speed weight, so the cubic-mean
+    torque, the peaks, the bearing loads and the emergency stop are those of the motion alone,
+    while the average input speed is spread over the longer period (life x period ratio); the
+    brake holds the largest gravity torque of the cycle, dwell included."""
+    dwell = 1.5
+    moving, holding = two_link_cycle(0.0), two_link_cycle(dwell)
+    gears = {"rated_torque": [30.0], "rated_input_speed": [200.0], "rated_life": [1e4]}
+    bearings = {
+        "bearing_offset": [0.02],
+        "bearing_dynamic_load_rating": [8e3],
+        "bearing_pitch_diameter": [0.05],
+    }
+    values = []
+    for dc in (moving, holding):
+        load = dc.joint_load("shoulder")
+        assert isinstance(load, JointLoad) and load.force is not None
+        v = gb.gearbox_cycle_values(load, [100.0], gears)
+        v.update(gb.bearing_cycle_values(load, bearings))
+        v.update(gb.emergency_stop_values(load, [100.0], [0.9], [2e-5], [1.0]))
+        values.append(v)
+    a, b = values
+    period_a = moving.joint_load("shoulder").t[-1] - moving.joint_load("shoulder").t[0]
+    ratio = (period_a + dwell) / period_a
+    assert b["gear_average_input_speed"][0] == pytest.approx(
+        a["gear_average_input_speed"][0] / ratio, rel=1e-12
+    )
+    assert b["gear_life"][0] == pytest.approx(a["gear_life"][0] * ratio, rel=1e-12)
+    for key in (
+        "gear_average_torque",
+        "gear_repeated_peak_torque",
+        "gear_peak_input_speed",
+        "bearing_peak_moment",
+        "bearing_peak_axial",
+        "bearing_peak_radial",
+        "bearing_average_moment",
+        "gear_momentary_torque",
+    ):
+        assert b[key][0] == pytest.approx(a[key][0], rel=1e-12), key
+    assert b["bearing_life"][0] == pytest.approx(a["bearing_life"][0] * ratio, rel=1e-12)
+    load = holding.joint_load("shoulder")
+    out = dv.brake_values(load, [100.0], [0.5], SizingOptions(brake_safety_factor=2.0))
+    worst = max(abs(float(g)) for g in load.gravity_torque)
+    assert out["brake_required_torque"][0] == pytest.approx(2.0 * worst, rel=1e-14)
+    assert out["brake_holding_margin"][0] == pytest.approx(50.0 / (2.0 * worst), rel=1e-14)
