@@ -888,3 +888,36 @@ def test_a_duty_cycle_with_a_dwell_averages_the_input_speed_over_the_pause():
     worst = max(abs(float(g)) for g in load.gravity_torque)
     assert out["brake_required_torque"][0] == pytest.approx(2.0 * worst, rel=1e-14)
     assert out["brake_holding_margin"][0] == pytest.approx(50.0 / (2.0 * worst), rel=1e-14)
+
+
+def test_drive_and_bus_from_the_motor_side_of_a_real_duty_cycle():
+    """End to end on a real cycle: the motor side of both joints (``motor_cycle_values`` /
+    ``motor_cycle_series``, the example catalog's first motor and drive) into the drive check
+    and the common bus. The bus regenerates at most what the axes regenerate alone (the axes
+    exchange power on the bus), and without a capacitance the resistor takes all of it."""
+    from armdyn.sizing.motor import motor_cycle_series, motor_cycle_values
+
+    catalog = ad.load_catalog(ad.sizing.EXAMPLE_CATALOG)
+    motor = catalog.motors.iloc[-1]
+    fields = {f: np.array([motor[f]]) for f in ad.sizing.MOTOR_FIELDS if f in motor.index}
+    drive = catalog.drives.iloc[[-1]]
+    dc = two_link_cycle(0.5)
+    powers, regenerated = [], 0.0
+    for joint in ("shoulder", "elbow"):
+        load = dc.joint_load(joint)
+        values = motor_cycle_values(load, [100.0], [0.85], [motor["rotor_inertia"]], fields)
+        out = dv.drive_values(values, drive)
+        for check, value, rating in (
+            ("drive_peak_current_margin", "peak_current", "peak_current"),
+            ("drive_rms_current_margin", "rms_current", "continuous_current"),
+        ):
+            want = drive[rating].iloc[0] / values[value][0]
+            assert out[check][0] == pytest.approx(want, rel=1e-14), check
+        series = motor_cycle_series(load, 100.0, 0.85, motor["rotor_inertia"], motor.to_dict())
+        np.testing.assert_array_equal(series["t"], load.t)
+        powers.append(series["electrical_power"])
+        e = 0.5 * (series["electrical_power"][1:] + series["electrical_power"][:-1])
+        regenerated += float(np.sum(np.maximum(-e * np.diff(load.t), 0.0)))
+    bus = dv.bus_values(load.t, np.stack(powers), drives={"bus_voltage": 48.0})
+    assert 0.0 < bus["bus_energy_regenerated"][0] <= regenerated
+    assert bus["resistor_energy"][0] == pytest.approx(bus["bus_energy_regenerated"][0], rel=1e-12)
