@@ -534,22 +534,24 @@ def _infeasible(search: _Search, joints: list[str]):
 
 
 def _bus_parameters(drives: dict[str, np.ndarray]) -> dict[str, float]:
-    """The common DC bus of the chosen drives (one per axis): the capacitances, braking
-    resistors' continuous and peak powers add up (those given; NaN when none is), the nominal
-    voltage is the largest and the maximum voltage the smallest of the drives' (the capacitors
-    absorb the least energy)."""
+    """The common DC bus of the chosen drives (one per axis), in the catalog's column names:
+    the capacitances and the braking resistors' continuous and peak powers add up (those given;
+    NaN when none is); the nominal voltage is the largest of the drives' and the chopper's
+    voltage the smallest (the capacitors absorb the least energy); NaN when that is below the
+    nominal one (drives of different bus voltages: no common capacitor window)."""
     out = {}
-    for key, column, reduce in (
-        ("bus_voltage", "bus_voltage", np.max),
-        ("bus_voltage_max", "max_bus_voltage", np.min),  # the catalog's column name
-        ("bus_capacitance", "bus_capacitance", np.sum),
-        ("braking_resistor_power", "braking_resistor_power", np.sum),
-        ("braking_resistor_peak_power", "braking_resistor_peak_power", np.sum),
+    for key, reduce in (
+        ("bus_voltage", np.max),
+        ("max_bus_voltage", np.min),
+        ("bus_capacitance", np.sum),
+        ("braking_resistor_power", np.sum),
+        ("braking_resistor_peak_power", np.sum),
     ):
-        values = drives.get(column, drives.get(key))
-        if values is not None:
-            given = values[~np.isnan(values)]
+        if key in drives:
+            given = drives[key][~np.isnan(drives[key])]
             out[key] = float(reduce(given)) if len(given) else np.nan
+    if out.get("max_bus_voltage", np.nan) < out.get("bus_voltage", np.nan):
+        out["max_bus_voltage"] = np.nan
     return out
 
 
