@@ -390,7 +390,7 @@ def evaluate_joint(joint: str, load, parts: CatalogParts, options, objective: st
     mi, gi, di = rows
     values["gear_ratio"] = parts.gearboxes["ratio"][gi]
     values["mass"] = parts.motor_mass[mi] + parts.gearbox_mass[gi]
-    if parts.cost_motor is not None:
+    if parts.cost_motor is not None and parts.cost_gearbox is not None:
         cost = parts.cost_motor[mi] + parts.cost_gearbox[gi]
         if parts.cost_drive is not None:
             cost = cost + parts.cost_drive[di]

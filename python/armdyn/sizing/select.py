@@ -634,7 +634,7 @@ def select_drivetrain(
     """
     objective = _checks.choice(_WHO, "objective", objective, OBJECTIVES)
     drives = _checks.flag(_WHO, "drives", drives)
-    max_passes = _checks.integer(_WHO, "max_passes", max_passes, lo=1, hi=1000)
+    max_passes = int(_checks.integer(_WHO, "max_passes", max_passes, lo=1, hi=1000))
     options = sizing_options(options, **option_overrides)
     if not isinstance(model, _core.Model):
         raise _core.ModelError(f"{_WHO}: model must be an armdyn.Model, got {type(model).__name__}")
