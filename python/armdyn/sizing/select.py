@@ -634,7 +634,8 @@ def select_drivetrain(
     """
     objective = _checks.choice(_WHO, "objective", objective, OBJECTIVES)
     drives = _checks.flag(_WHO, "drives", drives)
-    max_passes = int(_checks.integer(_WHO, "max_passes", max_passes, lo=1, hi=1000))
+    allowed = _checks.integer(_WHO, "max_passes", max_passes, lo=1, hi=1000)
+    assert allowed is not None  # not none=True
     options = sizing_options(options, **option_overrides)
     if not isinstance(model, _core.Model):
         raise _core.ModelError(f"{_WHO}: model must be an armdyn.Model, got {type(model).__name__}")
@@ -643,7 +644,7 @@ def select_drivetrain(
     joints = _joints(model, cycle, joints)
     mounts = _mounts(model, joints, mounts)
     search = _Search(model, cycle, _distal_first(model, joints), parts, mounts, options, objective)
-    passes, converged, history = _run_passes(search, max_passes)
+    passes, converged, history = _run_passes(search, allowed)
     return DrivetrainSelection(
         table=_table(search, joints),
         objective=objective,
