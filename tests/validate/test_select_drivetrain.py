@@ -488,6 +488,13 @@ def test_hostile_model_catalog_and_candidates(parts, run):
         ad.select_drivetrain(model, traj, _Catalog([1, 2], GEARBOXES), drives=False)
     with pytest.raises(ad.ModelError, match="the catalog has no motors"):
         ad.select_drivetrain(model, traj, object(), drives=False)
+    with pytest.raises(ad.ModelError, match="motion must be a TrajectoryRun"):
+        ad.select_drivetrain(model, None, catalog(), drives=False)
+    held = planar_arm([("hand", 1.0, (0.1, 0.0, 0.0))])  # a fixed joint 'weld0'
+    with pytest.raises(ad.ModelError, match="'weld0' is not a revolute or prismatic joint"):
+        ad.select_drivetrain(
+            held, ad.trajectory_run(held, *run), catalog(), drives=False, joints=["weld0"]
+        )
     with pytest.raises(ad.ModelError, match="drives=True but the catalog has no drives"):
         ad.select_drivetrain(model, traj, catalog())  # a Catalog without drives.csv
     sel = ad.select_drivetrain(model, traj, catalog(), drives=False, joints=["wrist"])
