@@ -467,6 +467,10 @@ def test_mount_on_a_frame_and_the_model_carries_the_actuators(parts, run):
         ({"gearboxes": GEARBOXES.assign(ratio=[50.0, 0.0, 160.0])}, "'G100' has ratio = 0.0"),
         ({"gearboxes": GEARBOXES.drop(columns="input_inertia")}, "no 'input_inertia'"),
         ({"required_lif": 1.0}, "unknown option"),
+        (
+            {"motors": pd.concat([MOTORS] * 300), "gearboxes": pd.concat([GEARBOXES] * 900)},
+            "1200 motors x 2700 gearboxes = 3240000 candidates per joint, more than",
+        ),
     ],
 )
 def test_hostile_inputs(parts, run, kwargs, match):

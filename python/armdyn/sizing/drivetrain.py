@@ -49,6 +49,10 @@ OBJECTIVES: tuple[str, ...] = ("mass", "cost", "bus_power", "margin")
 #: (k, n) arrays the vectorised functions build)
 CHUNK_ELEMENTS = 1_000_000
 
+#: the most candidates of one joint (motors × gearboxes × drives) a selection screens: every
+#: candidate keeps its values and margins (about 60 floats), so this bounds the memory (~0.5 GB)
+MAX_CANDIDATES = 1_000_000
+
 _WHO = "select_drivetrain"
 
 
@@ -151,6 +155,14 @@ def catalog_parts(catalog, drives: bool, objective: str) -> CatalogParts:
         "gearbox": _columns(gearboxes),
         "drive": {} if drive_table is None else _columns(drive_table),
     }
+    n_candidates = len(names["motor"]) * len(names["gearbox"]) * max(len(names["drive"]), 1)
+    if n_candidates > MAX_CANDIDATES:
+        raise _core.ModelError(
+            f"{_WHO}: {len(names['motor'])} motors x {len(names['gearbox'])} gearboxes"
+            + (f" x {len(names['drive'])} drives" if len(names["drive"]) else "")
+            + f" = {n_candidates} candidates per joint, more than MAX_CANDIDATES = "
+            f"{MAX_CANDIDATES} (narrow the catalog, or pass drives=False)"
+        )
     carried = "the arm carries it"
     parts = CatalogParts(
         names["motor"],

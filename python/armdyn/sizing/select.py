@@ -627,7 +627,8 @@ def select_drivetrain(
         ModelError: an unknown objective, joint, mount or option; a catalog without motors or
             gearboxes, without drives with ``drives=True``, or a part without a value the
             selection needs (mass, rotor inertia, ratio, efficiency, input inertia; cost for
-            the cost objective), naming it.
+            the cost objective), naming it; more than
+            :data:`armdyn.sizing.drivetrain.MAX_CANDIDATES` candidates per joint.
 
     Warns:
         UserWarning: when the passes do not converge (the result's ``converged`` is False).
