@@ -468,8 +468,8 @@ def test_mount_on_a_frame_and_the_model_carries_the_actuators(parts, run):
         ({"gearboxes": GEARBOXES.drop(columns="input_inertia")}, "no 'input_inertia'"),
         ({"required_lif": 1.0}, "unknown option"),
         (
-            {"motors": pd.concat([MOTORS] * 300), "gearboxes": pd.concat([GEARBOXES] * 900)},
-            "1200 motors x 2700 gearboxes = 3240000 candidates per joint, more than",
+            {"motors": pd.concat([MOTORS] * 200), "gearboxes": pd.concat([GEARBOXES] * 100)},
+            "800 motors x 300 gearboxes = 240000 candidates per joint, more than",
         ),
     ],
 )

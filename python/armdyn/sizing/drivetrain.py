@@ -50,8 +50,9 @@ OBJECTIVES: tuple[str, ...] = ("mass", "cost", "bus_power", "margin")
 CHUNK_ELEMENTS = 1_000_000
 
 #: the most candidates of one joint (motors × gearboxes × drives) a selection screens: every
-#: candidate keeps its values and margins (about 60 floats), so this bounds the memory (~0.5 GB)
-MAX_CANDIDATES = 1_000_000
+#: candidate keeps its values and margins (about 60 numbers, 0.5 kB), so this bounds the memory
+#: to about 0.1 GB per joint
+MAX_CANDIDATES = 200_000
 
 _WHO = "select_drivetrain"
 
