@@ -450,6 +450,8 @@ def test_mount_on_a_frame_and_the_model_carries_the_actuators(parts, run):
         ({"objective": "weight"}, "objective must be one of"),
         ({"joints": ["knee"]}, "'knee' is not a revolute or prismatic joint"),
         ({"joints": []}, "joints is empty"),
+        ({"joints": 5}, "joints must be a list of joint names"),
+        ({"objective": None}, "objective must be one of"),
         ({"joints": ["elbow", "elbow"]}, "listed twice"),
         ({"mounts": {"knee": "upper"}}, "'knee' is not a selected joint"),
         ({"mounts": {"elbow": "nowhere"}}, "'nowhere' is not a body or frame"),
