@@ -967,6 +967,22 @@ CASES = [
         "model is required",
     ),
     (
+        "select-objective",
+        "sizing",
+        "select_drivetrain with an unknown objective",
+        lambda: ad.select_drivetrain(_pendulum(), None, None, objective="weight"),
+        ME,
+        "objective",
+    ),
+    (
+        "select-no-drives",
+        "sizing",
+        "select_drivetrain with drives=True and a catalog without drives",
+        lambda: ad.select_drivetrain(_pendulum(), None, _catalog_without_drives()),
+        ME,
+        "drives=True but the catalog has no drives",
+    ),
+    (
         "gearbox-ratio-zero",
         "sizing",
         "gearbox_cycle_values with a zero gear ratio",
@@ -1059,6 +1075,20 @@ CASES = [
         "hinge",
     ),
 ]
+
+
+def _catalog_without_drives():
+    """A catalog of one motor and one gearbox (the attributes select_drivetrain reads)."""
+    from types import SimpleNamespace
+
+    import pandas as pd
+
+    motors = pd.DataFrame({"mass": [0.5], "rotor_inertia": [1e-5]}, index=["M"])
+    gearboxes = pd.DataFrame(
+        {"mass": [0.4], "ratio": [100.0], "efficiency": [0.8], "input_inertia": [1e-6]},
+        index=["G"],
+    )
+    return SimpleNamespace(motors=motors, gearboxes=gearboxes, drives=None)
 
 
 def _gearbox():
