@@ -50,14 +50,18 @@ class SizingReport:
     motors: dict[str, Any] = field(default_factory=dict)
     envelopes: dict[str, Any] = field(default_factory=dict)
 
-    def save(self, directory: str | os.PathLike[str]) -> Path:
-        """Write ``table.csv``, ``report.html`` (the table, one torque-against-time figure per
-        joint with a non-zero torque, and each motor's operating points on its speed–torque
-        plane) and the figures ``torque_<k>.png`` / ``motor_<k>.png`` into ``directory`` (created if
-        missing). Needs matplotlib (the ``plot`` extra). Returns the HTML page's path."""
+    def save(self, directory: str | os.PathLike[str], sweep: Any = None) -> Path:
+        """Write ``table.csv``, ``report.html`` and the figures ``torque_<k>.png`` /
+        ``motor_<k>.png`` into ``directory`` (created if missing). The page opens with the
+        verdict (overall, then per joint: motor, gear ratio, pass/fail, the binding check and
+        its margin), then the checks by part, the torque and thermal histories, each motor's
+        operating points on its speed–torque plane, the gear-ratio sweep ``sweep`` (a
+        :class:`GearRatioSweep`, when given) and the whole table; every figure is embedded,
+        so the page is one self-contained file (:mod:`armdyn.sizing.writer`). Needs
+        matplotlib (the ``plot`` extra). Returns the HTML page's path."""
         from armdyn.sizing.writer import write_report
 
-        return write_report(self, directory)
+        return write_report(self, directory, sweep=sweep)
 
     def envelope_figure(self, joint: str) -> Figure:
         """A bare matplotlib Figure: the operating points (ω, T) of ``joint``'s motor over its

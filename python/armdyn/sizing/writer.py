@@ -1,66 +1,402 @@
 """The sizing report's files (:meth:`SizingReport.save`): ``table.csv``, the figures
-``torque_<k>.png`` / ``motor_<k>.png`` and the HTML page ``report.html`` that shows them."""
+``torque_<k>.png`` / ``motor_<k>.png`` and the page ``report.html``, which opens with the
+verdict and embeds every figure (:mod:`armdyn.sizing.html`; it needs no other file).
+
+:func:`report_model` turns a :class:`SizingReport` into the page's
+:class:`~armdyn.sizing.html.ReportModel`:
+
+- the verdict row of a joint: its motor (the :class:`armdyn.Motor`'s name) and gear ratio,
+  ``status`` from the table's ``ok`` (fail when a made check fails, "not checked" when ``ok``
+  is False only because a motor check could not be made: the table's ``unchecked``), and the
+  binding check and margin of :func:`armdyn.sizing.checks.verdict` over the joint's checks;
+- the checks: the joint's own limits (:data:`JOINT_CHECKS`: ``torque_margin``,
+  ``speed_margin``), the motor checks of :data:`armdyn.sizing.checks.CHECKS` from the report's
+  motor columns and its motor's datasheet, and every other check of CHECKS whose value column
+  the table has (the gearbox, bearing, drive and brake values, when present);
+- the sections: torque histories, thermal histories (the first-order winding rise of
+  :func:`armdyn.sizing.thermal.thermal_rise`, where the motor gives ``thermal_resistance`` and
+  ``thermal_time_constant`` and the copper loss is known), each motor's operating points on
+  its speed–torque plane, the gear-ratio sweep (when one is passed) and the full table.
+"""
 
 from __future__ import annotations
 
-import html
 import os
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from armdyn.sizing.checks import CHECKS, Check
+from armdyn.sizing.html import (
+    ReportFigure,
+    ReportModel,
+    Section,
+    VerdictRow,
+    check_details,
+    figure_png,
+    render_page,
+    row_status,
+    verdict_of,
+)
+
 #: a SizingReport (armdyn.sizing.report imports this module)
 _SizingReport = Any
 
+#: the joint's own limits (URDF ``<limit>``), checked by every sizing report
+JOINT_CHECKS: tuple[Check, ...] = (
+    Check(
+        "effort_limit",
+        "joint",
+        "joint_peak_torque",
+        "effort_limit",
+        False,
+        "N m or N",
+        "largest joint torque/force (the rotor's share included) against the effort limit",
+    ),
+    Check(
+        "velocity_limit",
+        "joint",
+        "joint_peak_speed",
+        "velocity_limit",
+        False,
+        "rad/s or m/s",
+        "largest joint speed against the velocity limit",
+    ),
+)
 
-def write_report(report: _SizingReport, directory: str | os.PathLike[str]) -> Path:
+#: the report's motor margin columns by check name (armdyn.sizing.motor.MOTOR_CHECKS)
+_MOTOR_MARGINS = {
+    "continuous_torque": "continuous_torque_margin",
+    "peak_torque": "peak_torque_margin",
+    "speed": "motor_speed_margin",
+    "envelope": "envelope_margin",
+}
+
+
+def write_report(
+    report: _SizingReport, directory: str | os.PathLike[str], sweep: Any = None
+) -> Path:
     """Write ``table.csv``, the figures and ``report.html`` of ``report`` into ``directory``
     (created if missing); returns the HTML page's path (see :meth:`SizingReport.save`)."""
     out = Path(os.fspath(directory))
     out.mkdir(parents=True, exist_ok=True)
     report.table.to_csv(out / "table.csv")
-    figures = _write_figures(report, out)
+    model = report_model(report, sweep=sweep)
+    for section in model.sections:
+        for f in section.figures:
+            if f.file:
+                (out / f.file).write_bytes(f.png)
     page = out / "report.html"
-    page.write_text(_page(report, figures), encoding="utf-8")
+    page.write_text(render_page(model), encoding="utf-8")
     return page
 
 
-def _write_figures(report: _SizingReport, out: Path) -> list[tuple[Any, list[tuple[str, str]]]]:
-    """Save each joint's figures (its torque when non-zero, its motor's speed–torque plane when
-    it has one); ``[(joint, [(png, alt text), ...]), ...]``."""
-    # bare Figures (Agg canvas): no pyplot state, the user's backend is left alone
-    from armdyn.plotting import sizing_envelope_figure, sizing_torque_figure
+def _motor_attr(motor, name: str) -> float:
+    value = getattr(motor, name, None) if motor is not None else None
+    return np.nan if value is None else float(value)
+
+
+def _check_columns(report: _SizingReport) -> dict[str, np.ndarray]:
+    """The wide columns :func:`armdyn.sizing.html.check_details` reads (CHECKS' value,
+    allowable and margin column names), per joint of the report's table."""
+    from armdyn.sizing.motor import motor_envelope
+
+    table = report.table
+    joints = list(table.index)
+    n = len(joints)
+    cols: dict[str, np.ndarray] = {}
+    # the other parts' values, when the table has them (CHECKS' own column names)
+    for c in CHECKS:
+        if c.part != "motor":
+            for name in (c.value, c.allowable, c.margin_column):
+                if name in table.columns:
+                    cols[name] = table[name].to_numpy(dtype=float)
+    # the joint's limits
+    for c, v, m in zip(
+        JOINT_CHECKS, ("peak_torque", "peak_speed"), ("torque_margin", "speed_margin"), strict=True
+    ):
+        cols[c.value] = table[v].to_numpy(dtype=float)
+        cols[c.allowable] = table[c.allowable].to_numpy(dtype=float)
+        cols[c.margin_column] = table[m].to_numpy(dtype=float)
+    # the motor: the report's columns, the datasheet's limits
+    allow = {k: np.full(n, np.nan) for k in ("continuous_torque", "peak_torque", "max_speed")}
+    stall, worst = np.full(n, np.nan), np.full(n, np.nan)
+    for k, joint in enumerate(joints):
+        motor = report.envelopes.get(joint)
+        if joint not in report.motors or motor is None:
+            continue
+        allow["continuous_torque"][k] = _motor_attr(motor, "continuous_torque")
+        allow["peak_torque"][k] = _motor_attr(motor, "peak_torque")
+        speed = _motor_attr(motor, "max_speed")
+        allow["max_speed"][k] = speed if np.isfinite(speed) else _motor_attr(motor, "no_load_speed")
+        t0, w0 = motor_envelope(motor)
+        side = report.motors[joint]
+        if np.isfinite(t0) and np.isfinite(w0) and t0 > 0 and w0 > 0:
+            stall[k] = t0
+            worst[k] = float(np.max(np.abs(side.torque + t0 * side.speed / w0)))
+    cols.update(allow)
+    cols["stall_torque"], cols["envelope_worst"] = stall, worst
+    for name in ("motor_rms_torque", "motor_peak_torque", "motor_peak_speed"):
+        if name in table.columns:
+            cols[name] = table[name].to_numpy(dtype=float)
+    for check, column in _MOTOR_MARGINS.items():
+        if column in table.columns:
+            cols[f"{check}_margin"] = table[column].to_numpy(dtype=float)
+        else:  # no actuator in the report: the motor checks are not made
+            cols[f"{check}_margin"] = np.full(n, np.nan)
+    cols["winding_temperature_margin"] = cols.get("winding_temperature_margin", np.full(n, np.nan))
+    return cols
+
+
+def _verdict_rows(report: _SizingReport, details) -> list[VerdictRow]:
+    table = report.table
+    rows = []
+    for joint in table.index:
+        _, binding, least = verdict_of(details, str(joint))
+        ok = bool(table.loc[joint, "ok"])
+        parts = {}
+        motor = report.envelopes.get(joint)
+        if joint in report.motors:
+            parts["motor"] = (getattr(motor, "name", "") or "unnamed motor") if motor else "none"
+            ratio = table.loc[joint, "gear_ratio"] if "gear_ratio" in table.columns else np.nan
+            if np.isfinite(ratio):
+                parts["gearbox"] = f"N = {ratio:g}"
+        for kind in ("gearbox", "drive"):  # part names, when the table has them
+            if kind in table.columns and isinstance(table.loc[joint, kind], str):
+                parts[kind] = table.loc[joint, kind]
+        unchecked = str(table.loc[joint, "unchecked"]) if "unchecked" in table.columns else ""
+        note = ""
+        if unchecked == "motor":
+            note = "no motor data"
+        elif unchecked and unchecked != "nan":
+            note = f"not checked: {unchecked.replace(',', ', ')}"
+        rows.append(VerdictRow(str(joint), parts, row_status(ok, least), binding, least, note))
+    return rows
+
+
+def report_model(report: _SizingReport, sweep: Any = None) -> ReportModel:
+    """The page's :class:`~armdyn.sizing.html.ReportModel` of a :class:`SizingReport` (see the
+    module notes); ``sweep``: a :class:`~armdyn.sizing.selection.GearRatioSweep` shown in its
+    own section."""
+    joints = [str(j) for j in report.table.index]
+    details = check_details(joints, _check_columns(report), JOINT_CHECKS + CHECKS)
+    sections = [
+        _torque_section(report),
+        _thermal_section(report),
+        _envelope_section(report),
+        sweep_section(sweep),
+        Section("All values", tables=[("the sizing table", report.table)]),
+    ]
+    span = f"{report.t[0]:.6g} s to {report.t[-1]:.6g} s, {len(report.t)} samples"
+    return ReportModel(
+        "Sizing report",
+        _verdict_rows(report, details),
+        details,
+        sections,
+        subtitle=f"run from {span}",
+    )
+
+
+def _torque_section(report: _SizingReport) -> Section:
+    from armdyn.plotting import sizing_torque_figure
 
     figures = []
     for k, name in enumerate(report.table.index):
         tau = report.torque[:, k]
         if np.all(np.isnan(tau) | (tau == 0.0)):  # no actuation on this joint
             continue
-        fig = sizing_torque_figure(report, name)
-        png = f"torque_{k}.png"
-        fig.savefig(out / png, dpi=100)
-        items = [(png, f"torque of {name}")]
+        png = figure_png(sizing_torque_figure(report, name))
+        figures.append(
+            ReportFigure(f"torque of {name}", png, f"torque of {name}", f"torque_{k}.png")
+        )
+    text = "" if figures else "no joint has a non-zero torque in the run"
+    return Section("Torque histories", text=text, figures=figures)
+
+
+def _thermal_section(report: _SizingReport) -> Section:
+    from armdyn.plotting import _matplotlib_figure
+    from armdyn.sizing.thermal import thermal_rise
+
+    curves = []
+    for joint, side in report.motors.items():
+        motor = report.envelopes.get(joint)
+        r_th, tau_th = (
+            _motor_attr(motor, a) for a in ("thermal_resistance", "thermal_time_constant")
+        )
+        if side.copper_included and np.isfinite(r_th) and np.isfinite(tau_th) and tau_th > 0:
+            curves.append((joint, thermal_rise(side.t, side.loss_copper, r_th, tau_th)))
+    if not curves:
+        return Section(
+            "Thermal histories",
+            text="not available: no motor gives thermal_resistance, thermal_time_constant, "
+            "torque_constant and resistance",
+        )
+    fig = _matplotlib_figure()(figsize=(7.5, 3.2))
+    ax = fig.subplots()
+    for joint, rise in curves:
+        ax.plot(report.t, rise, lw=1.0, label=str(joint))
+    ax.set_xlabel("t [s]")
+    ax.set_ylabel("winding temperature rise [K]")
+    ax.set_title("winding temperature rise from the start of the run (first-order model)")
+    ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize="small")
+    ax.grid(lw=0.3)
+    fig.tight_layout()
+    alt = "winding temperature rise against time per motor"
+    return Section("Thermal histories", figures=[ReportFigure(alt, figure_png(fig), alt)])
+
+
+def _envelope_section(report: _SizingReport) -> Section:
+    from armdyn.plotting import sizing_envelope_figure
+
+    figures = []
+    for k, name in enumerate(report.table.index):
         if name in report.motors:
-            png_m = f"motor_{k}.png"
-            sizing_envelope_figure(report, name).savefig(out / png_m, dpi=100)
-            items.append((png_m, f"speed-torque plane of the motor of {name}"))
-        figures.append((name, items))
-    return figures
+            png = figure_png(sizing_envelope_figure(report, name))
+            alt = f"speed-torque plane of the motor of {name}"
+            figures.append(ReportFigure(alt, png, alt, f"motor_{k}.png"))
+    text = "" if figures else "no joint has a motor (pass actuators= to sizing_report)"
+    return Section("Operating points on the motor envelopes", text=text, figures=figures)
 
 
-def _page(report: _SizingReport, figures) -> str:
-    """The HTML page: the table, then each joint's figures under its name."""
-    parts = [
-        "<!DOCTYPE html>",
-        '<html><head><meta charset="utf-8"><title>armdyn sizing report</title></head><body>',
-        "<h1>Sizing report</h1>",
-        report.table.to_html(float_format=lambda v: f"{v:.6g}"),
+def sweep_section(sweep: Any) -> Section:
+    """The gear-ratio sweep's section: per joint the RMS motor torque against the swept ratio
+    (ratios where every check passes marked, the best ratio circled) and the sweep's summary
+    table; a note when no sweep was given."""
+    title = "Gear-ratio sweep"
+    if sweep is None:
+        return Section(title, text="not run (pass sweep=armdyn.gear_ratio_sweep(...) to save)")
+    from armdyn.plotting import _matplotlib_figure
+
+    table, summary = sweep.table, sweep.summary
+    joints = list(summary.index)
+    fig = _matplotlib_figure()(figsize=(7.5, 2.4 * len(joints) + 0.6), layout="constrained")
+    axes = fig.subplots(len(joints), 1, squeeze=False)[:, 0]
+    for ax, joint in zip(axes, joints, strict=True):
+        rows = table.xs(joint, level=0)
+        ratio = rows.index.to_numpy(dtype=float)
+        rms = rows["motor_rms_torque"].to_numpy(dtype=float)
+        ok = rows["ok"].to_numpy(dtype=bool)
+        ax.plot(ratio, rms, "-", color="0.6", lw=0.8)
+        ax.plot(ratio[ok], rms[ok], "o", color="#1b7f3b", ms=4, label="every check passes")
+        ax.plot(ratio[~ok], rms[~ok], "x", color="#c62828", ms=5, label="some check fails")
+        best = summary.loc[joint, "best_ratio"]
+        if np.isfinite(best):
+            ax.plot(
+                [best],
+                [summary.loc[joint, "best_rms_torque"]],
+                "o",
+                mfc="none",
+                mec="k",
+                ms=10,
+                label="least RMS torque",
+            )
+        ax.set_xscale("log")
+        ax.set_ylabel("RMS motor\ntorque [N m]")
+        ax.set_title(str(joint), fontsize="medium")
+        ax.grid(lw=0.3, which="both")
+    axes[-1].set_xlabel("gear ratio N")
+    axes[0].legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize="small")
+    alt = "RMS motor torque against the gear ratio per joint"
+    return Section(
+        title,
+        figures=[ReportFigure(alt, figure_png(fig), alt, "sweep.png")],
+        tables=[("summary per joint", summary)],
+    )
+
+
+# ------------------------------------------------------------------------ a selection's page
+
+#: how many ranked candidates per joint the selection's page lists
+RANKED_ROWS = 10
+
+
+def selection_report_model(selection: Any) -> ReportModel:
+    """The page's model of a drivetrain selection (:func:`armdyn.select_drivetrain`): its
+    ``.table`` indexed by joint (``motor, gearbox, drive, ok, binding_check, margin`` and the
+    value, allowable and margin columns of :data:`armdyn.sizing.checks.CHECKS` it has) gives
+    the verdict and the checks; ``.candidates(joint)`` (ranked, best first) the ranking table
+    and the plot of the objective against the least margin (``selection.objective``, a
+    column of the candidates; ``margin`` their least margin)."""
+    table = selection.table
+    joints = [str(j) for j in table.index]
+    values = {c: table[c].to_numpy() for c in table.columns if _is_number_column(table[c])}
+    details = check_details(joints, values, CHECKS)
+    rows = []
+    for joint in table.index:
+        parts = {
+            k: str(table.loc[joint, k])
+            for k in ("motor", "gearbox", "drive")
+            if k in table.columns and isinstance(table.loc[joint, k], str)
+        }
+        margin = float(table.loc[joint, "margin"])
+        ok = bool(table.loc[joint, "ok"])
+        status = "fail" if not ok or margin < 1.0 else "pass"
+        note = "" if "note" not in table.columns else str(table.loc[joint, "note"] or "")
+        binding = str(table.loc[joint, "binding_check"] or "")
+        rows.append(VerdictRow(str(joint), parts, status, binding, margin, note))
+    objective = str(getattr(selection, "objective", "") or "")
+    passes = getattr(selection, "passes", None)
+    sub = f"objective: {objective}" + (f"; {passes} coupled pass(es)" if passes else "")
+    sections = [_ranking_section(selection, joints, objective)]
+    sections.append(Section("All values", tables=[("the selection table", table)]))
+    return ReportModel("Drivetrain selection", rows, details, sections, subtitle=sub)
+
+
+def _is_number_column(column) -> bool:
+    return column.dtype.kind in "fiub"
+
+
+def _ranking_section(selection: Any, joints: list[str], objective: str) -> Section:
+    """Per joint the ranked candidates (the first :data:`RANKED_ROWS`) and one figure: each
+    candidate's objective against its least margin, the chosen one ringed, margin 1 dashed."""
+    from armdyn.plotting import _matplotlib_figure
+
+    ranked = {j: selection.candidates(j) for j in joints}
+    fig = _matplotlib_figure()(figsize=(7.5, 2.4 * len(joints) + 0.6), layout="constrained")
+    axes = fig.subplots(len(joints), 1, squeeze=False)[:, 0]
+    for ax, joint in zip(axes, joints, strict=True):
+        cand = ranked[joint]
+        column = objective if objective in cand.columns else "objective"
+        if column not in cand.columns or "margin" not in cand.columns or cand.empty:
+            ax.set_title(f"{joint}: no candidate values", fontsize="medium")
+            continue
+        y = cand[column].to_numpy(dtype=float)
+        m = cand["margin"].to_numpy(dtype=float)
+        ok = m >= 1.0
+        ax.plot(m[ok], y[ok], "o", color="#1b7f3b", ms=3, label="passes")
+        ax.plot(m[~ok], y[~ok], "x", color="#c62828", ms=4, label="fails")
+        ax.plot(m[:1], y[:1], "o", mfc="none", mec="k", ms=11, label="ranked first")
+        ax.axvline(1.0, color="k", ls="--", lw=0.8)
+        ax.set_xscale("log")
+        ax.set_ylabel(column)
+        ax.set_title(str(joint), fontsize="medium")
+        ax.grid(lw=0.3, which="both")
+    axes[-1].set_xlabel("least margin (log; >= 1 passes)")
+    axes[0].legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize="small")
+    alt = f"{objective or 'objective'} against the least margin of every candidate per joint"
+    tables = [
+        (f"{j}: the first {RANKED_ROWS} candidates", ranked[j].head(RANKED_ROWS)) for j in joints
     ]
-    for name, items in figures:
-        label = html.escape(str(name))
-        parts.append(f"<h2>{label}</h2>")
-        for png, alt in items:
-            parts.append(f'<img src="{png}" alt="{html.escape(alt)}">')
-    parts.append("</body></html>")
-    return "\n".join(parts)
+    return Section(
+        "Ranking",
+        figures=[ReportFigure(alt, figure_png(fig), alt, "ranking.png")],
+        tables=tables,
+    )
+
+
+def write_selection_report(selection: Any, directory: str | os.PathLike[str]) -> Path:
+    """Write ``selection.csv`` (its table), the ranking figure and ``report.html`` (one
+    self-contained page, :func:`selection_report_model`) into ``directory``; returns the
+    page's path."""
+    out = Path(os.fspath(directory))
+    out.mkdir(parents=True, exist_ok=True)
+    selection.table.to_csv(out / "selection.csv")
+    model = selection_report_model(selection)
+    for section in model.sections:
+        for f in section.figures:
+            if f.file:
+                (out / f.file).write_bytes(f.png)
+    page = out / "report.html"
+    page.write_text(render_page(model), encoding="utf-8")
+    return page
