@@ -1,0 +1,293 @@
+"""`armdyn size` / `armdyn select`: the payload, duty-cycle and check-option arguments and the
+select command's argument checking. Bad arguments exit with code 2 and one line naming the
+option and the bad value (never a traceback), before any file is read where the argument alone
+decides; the check options are generated from ``armdyn.sizing.options`` (one per
+``OPTION_NAMES`` field, with its docstring's sentence and its default)."""
+
+import os
+import socket
+
+import armdyn as ad
+import numpy as np
+import pandas as pd
+import pytest
+from armdyn.__main__ import main
+from armdyn.sizing import cli
+from armdyn.sizing.options import OPTION_NAMES, SizingOptions
+
+from tests.validate.test_size_cli_bad_input import URDF, assert_one_line_exit_2, good_csv
+
+I_P, MGL, G = 0.01 + 2.0 * 0.5**2, 2.0 * 9.81 * 0.5, 9.81
+
+
+def run_cli(capsys, command, *args, urdf=URDF):
+    code = main([command, str(urdf), *map(str, args)])
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+@pytest.fixture
+def traj(tmp_path):
+    return good_csv(tmp_path / "t.csv")
+
+
+# ------------------------------------------------------------------------------- parsing
+
+
+def test_payload_strings_parse_to_mass_and_com():
+    assert cli.parse_payload("3") == (3.0, (0.0, 0.0, 0.0))
+    assert cli.parse_payload(" 2.5 , 0.1,-0.2 , 5e-2") == (2.5, (0.1, -0.2, 0.05))
+
+
+@pytest.mark.parametrize(
+    "text, fragment",
+    [
+        ("", "the mass (kg) must be a finite number"),
+        ("abc", "the mass (kg) must be a finite number"),
+        ("nan", "the mass (kg) must be a finite number"),
+        ("inf", "the mass (kg) must be a finite number"),
+        ("1e400", "the mass (kg) must be a finite number"),
+        ("-1", "the mass must be > 0 kg, got -1"),
+        ("0", "the mass must be > 0 kg, got 0"),
+        ("1,2", "expected MASS or MASS,X,Y,Z"),
+        ("1,2,3", "got 3 comma-separated value(s)"),
+        ("1,0,0,0,0", "got 5 comma-separated value(s)"),
+        ("3,x,0,0", "the centre of mass' x (m) ('x') must be a finite number"),
+        ("3,0,nan,0", "the centre of mass' y (m) ('nan') must be a finite number"),
+        ("3,0,0,-inf", "the centre of mass' z (m) ('-inf') must be a finite number"),
+        ("3,,0,0", "the centre of mass' x (m)"),
+    ],
+)
+def test_bad_payload_exits_2_naming_it(capsys, traj, text, fragment):
+    code, out, err = run_cli(capsys, "size", "--trajectory", traj, f"--payload={text}")
+    assert_one_line_exit_2(code, err, "armdyn size: --payload", repr(text), fragment)
+    assert out == ""  # refused before anything is computed
+
+
+@pytest.mark.parametrize("command", ["size", "select"])
+def test_payload_strings_are_checked_before_any_file(capsys, tmp_path, command):
+    """A bad payload is reported even when the files are missing: the argument is checked
+    first (the message names the argument, not a file)."""
+    args = ["--trajectory", tmp_path / "none.csv", "--payload", "-2"]
+    if command == "select":
+        args += ["--catalog", tmp_path / "no_catalog"]
+    code, _, err = run_cli(capsys, command, *args, urdf=tmp_path / "none.urdf")
+    assert_one_line_exit_2(code, err, f"armdyn {command}: --payload '-2'")
+
+
+def test_unknown_payload_frame_names_it_and_the_frames(capsys, traj):
+    code, _, err = run_cli(
+        capsys, "size", "--trajectory", traj, "--payload", "1", "--payload-frame", "tool0"
+    )
+    assert_one_line_exit_2(code, err, "--payload-frame 'tool0'", "no such frame", "['base', 'arm']")
+
+
+def test_payload_frame_without_payload_is_refused(capsys, traj):
+    code, _, err = run_cli(capsys, "size", "--trajectory", traj, "--payload-frame", "arm")
+    assert_one_line_exit_2(code, err, "--payload-frame is given without --payload")
+
+
+def test_default_payload_frame_is_the_last_frame():
+    model = ad.load_urdf(URDF)
+    assert list(model.frame_names) == ["base", "arm"]
+    assert cli.payload_frame(model, None) == "arm"
+    assert cli.payload_frame(model, "base") == "base"
+
+
+@pytest.mark.skipif(
+    hasattr(ad.load_urdf(URDF), "with_payload"), reason="Model.with_payload is in this build"
+)
+def test_payload_without_the_helper_says_so(capsys, traj):
+    code, _, err = run_cli(capsys, "size", "--trajectory", traj, "--payload", "1")
+    assert_one_line_exit_2(code, err, "--payload needs Model.with_payload")
+
+
+@pytest.mark.skipif(
+    not hasattr(ad.load_urdf(URDF), "with_payload"), reason="Model.with_payload not merged yet"
+)
+def test_payload_adds_its_closed_form_torque(tmp_path, capsys):
+    """A point mass m_p at (0, 0, -0.8) in the axes of the pendulum's link 'arm' (its origin on
+    the pivot axis): tau = (I_p + m_p 0.8^2) qdd + (m g l + m_p g 0.8) sin q."""
+    t = np.linspace(0.0, 2.0, 801)
+    w = np.pi
+    q, qd, qdd = 0.5 * np.sin(w * t), 0.5 * w * np.cos(w * t), -0.5 * w * w * np.sin(w * t)
+    frame = {"t": t, "pivot": q, "pivot.qd": qd, "pivot.qdd": qdd}
+    pd.DataFrame(frame).to_csv(tmp_path / "p.csv", index=False, float_format="%.17g")
+    code, _, err = run_cli(
+        capsys,
+        "size",
+        "--trajectory",
+        tmp_path / "p.csv",
+        "--payload",
+        "1.5,0,0,-0.8",
+        "--out",
+        tmp_path / "rep",
+    )
+    assert code in (0, 1), err
+    tab = pd.read_csv(tmp_path / "rep" / "table.csv", index_col="joint")
+    tau = (I_P + 1.5 * 0.8**2) * qdd + (MGL + 1.5 * G * 0.8) * np.sin(q)
+    assert tab.loc["pivot", "peak_torque"] == pytest.approx(np.max(np.abs(tau)), rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    "args, fragment",
+    [
+        (["--cycle", "0"], "--cycle '0': expected a positive whole number of repeats or 'forever'"),
+        (["--cycle", "-3"], "--cycle '-3'"),
+        (["--cycle", "2.5"], "--cycle '2.5'"),
+        (["--cycle", "never"], "--cycle 'never'"),
+        (["--cycle", ""], "--cycle ''"),
+        (["--dwell", "-1"], "--dwell '-1': the duration must be >= 0 s"),
+        (["--dwell", "nan"], "--dwell 'nan': the duration (s) must be a finite number"),
+        (["--dwell", "inf"], "--dwell 'inf'"),
+        (["--dwell", "1s"], "--dwell '1s'"),
+    ],
+)
+def test_bad_cycle_or_dwell_exits_2_naming_it(capsys, traj, args, fragment):
+    code, _, err = run_cli(capsys, "size", "--trajectory", traj, *args)
+    assert_one_line_exit_2(code, err, fragment)
+
+
+def test_cycle_strings():
+    assert cli.parse_repeat("forever") is None and cli.parse_repeat("FOREVER") is None
+    assert cli.parse_repeat("12") == 12
+    assert cli.parse_seconds("0") == 0.0 and cli.parse_seconds("2.5") == 2.5
+    # a dwell alone repeats forever; nothing given: a single pass (_UNSET)
+    assert cli._cycle_strings(None, "1") == (None, 1.0)
+    assert cli._cycle_strings("3", None) == (3, None)
+    assert cli._cycle_strings(None, None) == (cli._UNSET, None)
+
+
+# --------------------------------------------------------------------------- the options
+
+
+@pytest.mark.parametrize("command", ["size", "select"])
+def test_every_sizing_option_is_an_argument_with_its_default(capsys, command):
+    with pytest.raises(SystemExit):
+        main([command, "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    docs = cli.option_docs()
+    assert set(docs) == set(OPTION_NAMES)
+    for name in OPTION_NAMES:
+        flag = f"--{name.replace('_', '-')}"
+        assert flag in text, flag
+        assert f"Default {getattr(SizingOptions(), name):g}." in text
+        assert " ".join(docs[name].split()[:4]) in text
+    assert "--ambient X" in text and "--life X" in text
+
+
+def test_option_arguments_reach_the_options(tmp_path):
+    import argparse
+
+    parser = argparse.ArgumentParser()
+    cli.add_option_arguments(parser)
+    args = parser.parse_args(["--ambient", "25", "--life", "30000", "--emergency-stops", "10"])
+    strings = cli.option_strings(args)
+    assert strings == {
+        "ambient_temperature": "25",
+        "required_life": "30000",
+        "emergency_stops": "10",
+    }
+    values = cli.sizing_options_from_strings(strings)
+    assert values == {
+        "ambient_temperature": 25.0,
+        "required_life": 30000.0,
+        "emergency_stops": 10.0,
+    }
+
+
+@pytest.mark.parametrize(
+    "args, fragment",
+    [
+        (["--ambient", "nan"], "--ambient-temperature 'nan': the value must be a finite number"),
+        (["--ambient", "-300"], "--ambient-temperature: SizingOptions: ambient_temperature"),
+        (["--life", "-5"], "--required-life: SizingOptions: required_life"),
+        (["--required-life", "0"], "--required-life: SizingOptions: required_life"),
+        (["--emergency-stops", "-1"], "--emergency-stops: SizingOptions: emergency_stops"),
+        (["--brake-safety-factor", "inf"], "--brake-safety-factor 'inf'"),
+        (["--bearing-load-factor", "x"], "--bearing-load-factor 'x'"),
+    ],
+)
+def test_bad_option_values_exit_2_naming_the_option(capsys, traj, args, fragment):
+    code, _, err = run_cli(capsys, "size", "--trajectory", traj, *args)
+    assert_one_line_exit_2(code, err, fragment)
+
+
+@pytest.mark.skipif(hasattr(ad, "duty_cycle"), reason="armdyn.duty_cycle is in this build")
+def test_size_with_a_cycle_says_what_it_needs(capsys, traj):
+    """Never ignored: until the duty cycles are in the build, a cycle or an option is refused."""
+    code, _, err = run_cli(capsys, "size", "--trajectory", traj, "--dwell", "1", "--life", "9")
+    assert_one_line_exit_2(code, err, "--required-life, --dwell:", "armdyn.duty_cycle")
+
+
+# ---------------------------------------------------------------------------- armdyn select
+
+
+def select(capsys, traj, *args, catalog=None, urdf=URDF):
+    extra = [] if catalog is None else ["--catalog", catalog]
+    return run_cli(capsys, "select", "--trajectory", traj, *extra, *args, urdf=urdf)
+
+
+def test_select_needs_a_catalog(capsys, traj):
+    with pytest.raises(SystemExit) as stop:
+        select(capsys, traj)
+    assert stop.value.code == 2
+    assert "--catalog" in capsys.readouterr().err
+
+
+def test_select_unknown_objective(capsys, traj, tmp_path):
+    code, _, err = select(capsys, traj, "--objective", "speed", catalog=tmp_path)
+    assert_one_line_exit_2(
+        code, err, "--objective 'speed'", "['mass', 'cost', 'bus_power', 'margin']"
+    )
+
+
+def test_select_missing_catalog(capsys, traj, tmp_path):
+    code, _, err = select(capsys, traj, catalog=tmp_path / "nowhere")
+    assert_one_line_exit_2(code, err, "armdyn select:", "nowhere")
+
+
+def test_select_catalog_special_files(capsys, traj, tmp_path):
+    code, _, err = select(capsys, traj, catalog="/dev/zero")
+    assert_one_line_exit_2(code, err, "--catalog '/dev/zero' is a character device")
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    code, _, err = select(capsys, traj, catalog=fifo)
+    assert_one_line_exit_2(code, err, "is a FIFO (named pipe), not a folder or a regular file")
+    sock_path = tmp_path / "s.sock"
+    with socket.socket(socket.AF_UNIX) as s:
+        s.bind(str(sock_path))
+        code, _, err = select(capsys, traj, catalog=sock_path)
+    assert_one_line_exit_2(code, err, "is a socket")
+
+
+def test_select_missing_or_special_robot_and_trajectory(capsys, traj, tmp_path):
+    code, _, err = select(capsys, traj, catalog=tmp_path, urdf=tmp_path / "none.urdf")
+    assert code == 2 and "none.urdf" in err and "Traceback" not in err
+    code, _, err = select(capsys, tmp_path / "none.csv", catalog=tmp_path)
+    assert_one_line_exit_2(code, err, "none.csv")
+    code, _, err = select(capsys, "/dev/zero", catalog=tmp_path)
+    assert_one_line_exit_2(code, err, "/dev/zero", "not a regular file")
+    code, _, err = select(capsys, tmp_path, catalog=tmp_path)
+    assert_one_line_exit_2(code, err, "is a directory")
+
+
+def test_select_bad_payload_cycle_and_options(capsys, traj, tmp_path):
+    for args, fragment in [
+        (["--payload", "1,2"], "--payload '1,2'"),
+        (["--cycle", "0"], "--cycle '0'"),
+        (["--dwell", "-2"], "--dwell '-2'"),
+        (["--life", "nan"], "--required-life 'nan'"),
+        (["--payload", "1", "--payload-frame", "tool9"], "--payload-frame 'tool9'"),
+    ]:
+        code, _, err = select(capsys, traj, *args, catalog=tmp_path)
+        assert_one_line_exit_2(code, err, "armdyn select: " + fragment)
+
+
+@pytest.mark.skipif(
+    hasattr(ad, "select_drivetrain") and hasattr(ad, "duty_cycle"),
+    reason="the selection is in this build",
+)
+def test_select_says_what_this_build_lacks(capsys, traj, tmp_path):
+    code, _, err = select(capsys, traj, "--dwell", "0.5", catalog=tmp_path)
+    assert_one_line_exit_2(code, err, "armdyn select needs armdyn.")
