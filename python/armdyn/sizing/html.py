@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from armdyn.sizing.checks import CHECKS, Check, verdict
+from armdyn.sizing.checks import CHECKS, CHECKS_BY_NAME, Check, verdict
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -202,7 +202,8 @@ table { border-collapse: collapse; }
 td, th { padding: 3px 9px; border: 1px solid #d0d0d0; text-align: left; vertical-align: top; }
 th { background: #f1f1f1; }
 td.num { text-align: right; font-variant-numeric: tabular-nums; }
-table.verdict td { font-size: 15px; }
+table.verdict td { font-size: 15px; white-space: nowrap; }
+.part { color: #555; font-size: 12px; }
 .status { font-weight: 700; white-space: nowrap; color: #fff; }
 .pass { background: var(--pass); color: #fff; }
 .fail { background: var(--fail); color: #fff; }
@@ -223,6 +224,7 @@ figcaption { font-size: 12px; color: #444; }
   body { max-width: none; padding: 0; font-size: 11px; }
   * { -webkit-print-color-adjust: exact; print-color-adjust: exact; }
   section.page { break-before: page; }
+  table.verdict td { font-size: 12px; }
   table.verdict, figure, tr { break-inside: avoid; }
   h2, h3 { break-after: avoid; }
   .wide { overflow: visible; }
@@ -255,6 +257,11 @@ def _margin_cell(m: float) -> str:
 
 def _verdict_block(model: ReportModel) -> str:
     overall = model.status
+    details = model.checks
+    extra = {}  # the model's own checks (e.g. the joint limits): name -> Check-like row
+    if len(details):
+        for r in details.drop_duplicates("check").itertuples():
+            extra[r.check] = Check(r.check, r.part, "", "", False, r.unit, r.doc)
     counts = {s: sum(r.status == s for r in model.rows) for s in STATUSES}
     summary = ", ".join(f"{counts[s]} {s.replace('unchecked', 'not checked')}" for s in STATUSES)
     out = [
@@ -271,12 +278,18 @@ def _verdict_block(model: ReportModel) -> str:
     for r in model.rows:
         note = f'<span class="note">{_esc(r.note)}</span>' if r.note else ""
         cells = "".join(f"<td>{_esc(r.parts.get(k, '') or DASH)}</td>" for k in ROW_PARTS)
-        check = r.binding_check or DASH
+        check = _esc(r.binding_check) if r.binding_check else DASH
+        known = CHECKS_BY_NAME.get(r.binding_check) or extra.get(r.binding_check)
+        if known is not None:
+            check = (
+                f'<span title="{_esc(known.doc)}">{check}</span> '
+                f'<span class="part">({known.part})</span>'
+            )
         out.append(
             f'<tr class="verdict-row" data-joint="{_esc(r.joint)}" data-status="{r.status}">'
             f"<td><b>{_esc(r.joint)}</b></td>{cells}"
             f'<td class="status {r.status}">{_STATUS_TEXT[r.status]}{note}</td>'
-            f"<td>{_esc(check)}</td>{_margin_cell(r.margin)}</tr>"
+            f"<td>{check}</td>{_margin_cell(r.margin)}</tr>"
         )
     out.append("</tbody></table>")
     out.append(

@@ -175,12 +175,19 @@ def _verdict_rows(report: _SizingReport, details) -> list[VerdictRow]:
     return rows
 
 
+def report_verdict(report: _SizingReport) -> tuple[list[VerdictRow], Any]:
+    """``(rows, details)`` of a :class:`SizingReport`: its verdict rows and the long table of
+    its checks (see the module notes); no figure is drawn."""
+    joints = [str(j) for j in report.table.index]
+    details = check_details(joints, _check_columns(report), JOINT_CHECKS + CHECKS)
+    return _verdict_rows(report, details), details
+
+
 def report_model(report: _SizingReport, sweep: Any = None) -> ReportModel:
     """The page's :class:`~armdyn.sizing.html.ReportModel` of a :class:`SizingReport` (see the
     module notes); ``sweep``: a :class:`~armdyn.sizing.selection.GearRatioSweep` shown in its
     own section."""
-    joints = [str(j) for j in report.table.index]
-    details = check_details(joints, _check_columns(report), JOINT_CHECKS + CHECKS)
+    rows, details = report_verdict(report)
     sections = [
         _torque_section(report),
         _thermal_section(report),
@@ -191,7 +198,7 @@ def report_model(report: _SizingReport, sweep: Any = None) -> ReportModel:
     span = f"{report.t[0]:.6g} s to {report.t[-1]:.6g} s, {len(report.t)} samples"
     return ReportModel(
         "Sizing report",
-        _verdict_rows(report, details),
+        rows,
         details,
         sections,
         subtitle=f"run from {span}",
