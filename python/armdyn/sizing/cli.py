@@ -1,5 +1,5 @@
-"""``armdyn size ROBOT.urdf --trajectory FILE.csv [--actuators FILE.toml] [--out DIR]``: the
-sizing report of a planned motion from the command line (also importable as ``armdyn.size``,
+"""``armdyn size ROBOT.urdf --trajectory FILE.csv [--actuators FILE.toml] [--payload ...]
+[--cycle ...] [--dwell ...] [--out DIR]``: the sizing report of a planned motion from the command line (also importable as ``armdyn.size``,
 its former module).
 
 Trajectory CSV: a header row, then one row per sample. Columns: ``t`` (strictly increasing, s),
@@ -28,6 +28,22 @@ The command prints the report's table and, with ``--out``, writes the report the
 (``report.html``, ``table.csv``, figures), and a line for each joint whose positions leave its
 URDF ``<limit>`` (such a joint is not ok either). Exit code: 0 when every joint is ``ok``, 1
 when some joint is not, 2 for bad input (one line names the file, column and data row, or key).
+
+Options: ``--payload MASS[,X,Y,Z]`` welds a point mass [kg] to the robot (its centre of mass
+[m] in the axes of ``--payload-frame NAME``, default the model's last frame
+``model.frame_names[-1]``, from the frame's origin; :func:`add_payload`); ``--cycle
+N|forever`` and ``--dwell SECONDS`` make the motion a duty cycle (a dwell alone repeats
+forever); one option per :class:`~armdyn.sizing.options.SizingOptions` field, generated from
+the dataclass (:func:`add_option_arguments`). Every option string is checked before a file is
+read; a build without ``Model.with_payload`` or ``armdyn.duty_cycle`` refuses the options that
+need them (exit code 2, naming what is missing) rather than ignoring them.
+
+``armdyn select ROBOT.urdf --trajectory FILE.csv --catalog PATH [--objective
+mass|cost|bus_power|margin] [the options above] [--out DIR]`` (:func:`select_run`): the
+drivetrain selection (``armdyn.select_drivetrain``) on the catalog(s) (``armdyn.load_catalog``;
+a path must be a folder or a regular file) and the duty cycle; prints the selection's table,
+writes its page with ``--out``; exit code 0 when every joint has a drivetrain that passes, 1
+when not, 2 for bad input.
 
 Both files are read as the URDF loader reads its own: a regular file (never a FIFO or a
 device such as ``/dev/zero``) of at most ``MAX_INPUT_BYTES`` (64 MiB), UTF-8. Every value must
