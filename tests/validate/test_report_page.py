@@ -188,35 +188,55 @@ def test_names_are_escaped_and_nothing_is_loaded(ur5):
 
 
 class FakeSelection:
-    """The spec's DrivetrainSelection as the page reads it: ``table`` by joint, ``objective``,
-    ``passes``, ``candidates(joint)`` ranked."""
+    """The DrivetrainSelection of issue 33 part 6 as the page reads it (branch i33-select):
+    ``table`` by joint (parts, ok, binding_check, margin, objective, values, <check>_margin),
+    ``objective``, ``passes``, ``converged``, ``infeasible``, ``bus`` and
+    ``candidates(joint)`` ranked best first."""
 
     objective = "mass"
     passes = 2
+    converged = True
 
     def __init__(self):
         self.table = pd.DataFrame(
             {
                 "motor": ["M1", "M2"],
                 "gearbox": ["G100", "G50"],
-                "drive": ["D5", "D5"],
+                "drive": [None, None],
                 "ok": [True, False],
                 "binding_check": ["gear_life", "peak_torque"],
                 "margin": [1.4, 0.8],
-                "gear_life": [2.8e4, 1e5],
-                "required_life": [2e4, 2e4],
-                "motor_peak_torque": [1.0, 2.5],
-                "peak_torque": [3.0, 2.0],
+                "objective": [1.2, 3.4],
                 "mass": [1.2, 3.4],
+                "gear_life": [2.8e4, 1e5],
+                "gear_life_margin": [1.4, 5.0],
+                "motor_peak_torque": [1.0, 2.5],
+                "peak_torque_margin": [3.0, 0.8],
             },
             index=pd.Index(["j1", "j2"], name="joint"),
         )
+        self.infeasible = pd.DataFrame(
+            {
+                "joint": ["j2"],
+                "check": ["peak_torque"],
+                "part": ["motor"],
+                "best_margin": [0.8],
+                "motor": ["M2"],
+                "gearbox": ["G50"],
+                "drive": [None],
+                "reason": ["no candidate passes peak_torque (motor): best margin 0.8"],
+            }
+        )
+        self.bus = {"peak_bus_power": 812.5, "bus_voltage_margin": 1.3, "power": np.zeros(5)}
 
     def candidates(self, joint):
         rng = np.random.default_rng(len(joint))
         m = np.sort(rng.uniform(0.5, 3.0, 14))[::-1]
+        m[3] = np.inf  # a zero load: drawn at the axis' end, not lost
+        y = rng.uniform(1, 4, 14)
         return pd.DataFrame(
-            {"motor": [f"M{k}" for k in range(14)], "mass": rng.uniform(1, 4, 14), "margin": m}
+            {"motor": [f"M{k}" for k in range(14)], "objective": y, "margin": m, "x": y},
+            index=pd.RangeIndex(1, 15, name="rank"),
         )
 
 
@@ -227,16 +247,26 @@ def test_a_selection_feeds_the_same_page(tmp_path):
         ("j1", "pass", "gear_life", 1.4),
         ("j2", "fail", "peak_torque", 0.8),
     ]
-    assert model.rows[0].parts == {"motor": "M1", "gearbox": "G100", "drive": "D5"}
+    assert model.rows[0].parts == {"motor": "M1", "gearbox": "G100"}  # no drive: not shown
+    assert model.rows[1].note == "no feasible candidate: closest shown; peak_torque best margin 0.8"
     d = model.checks.set_index(["joint", "check"])["margin"]
-    assert d[("j1", "gear_life")] == pytest.approx(1.4) and d[("j2", "peak_torque")] == 0.8
+    assert d[("j1", "gear_life")] == 1.4 and d[("j2", "peak_torque")] == 0.8
+    assert np.isnan(d[("j1", "bearing_moment")])
     assert model.status == "fail" and "2 coupled pass(es)" in model.subtitle
+    titles = [s.title for s in model.sections]
+    assert titles == ["Ranking", "Where nothing fits", "DC bus of the chosen set", "All values"]
+    ranking = model.sections[0]
+    assert list(ranking.tables[0][1].columns) == ["motor", "margin", "objective"]
+    assert len(ranking.tables[0][1]) == 10
+    bus = model.sections[2].tables[0][1]
+    assert list(bus.index) == ["peak_bus_power", "bus_voltage_margin"]  # the scalars
+    sel.converged = False
+    assert "NOT CONVERGED" in selection_report_model(sel).subtitle
+    sel.converged = True
     page = write_selection_report(sel, tmp_path / "sel")
     html = page.read_text("utf-8")
-    assert "Ranking" in html and html.count("<h3>j1: the first 10 candidates</h3>") == 1
     assert (tmp_path / "sel" / "ranking.png").read_bytes()[:4] == b"\x89PNG"
-    assert pd.read_csv(tmp_path / "sel" / "selection.csv", index_col="joint").shape == (2, 11)
-    # the figure: one panel per joint, the candidates' objective against their margin
+    assert pd.read_csv(tmp_path / "sel" / "selection.csv", index_col="joint").shape == (2, 12)
     assert html.index('id="verdict"') < html.index('id="checks"') < html.index("Ranking")
 
 

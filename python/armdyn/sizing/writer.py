@@ -321,14 +321,17 @@ RANKED_ROWS = 10
 def selection_report_model(selection: Any) -> ReportModel:
     """The page's model of a drivetrain selection (:func:`armdyn.select_drivetrain`): its
     ``.table`` indexed by joint (``motor, gearbox, drive, ok, binding_check, margin`` and the
-    value, allowable and margin columns of :data:`armdyn.sizing.checks.CHECKS` it has) gives
-    the verdict and the checks; ``.candidates(joint)`` (ranked, best first) the ranking table
-    and the plot of the objective against the least margin (``selection.objective``, a
-    column of the candidates; ``margin`` their least margin)."""
+    value, allowable and ``<check>_margin`` columns of :data:`armdyn.sizing.checks.CHECKS` it
+    has) gives the verdict and the checks; ``.infeasible`` (a joint with no feasible
+    candidate: which check none passes and the best margin reached) the rows' notes and a
+    section; ``.candidates(joint)`` (ranked, best first) the ranking tables and the plot of each
+    candidate's objective (its ``objective`` column) against its least margin (``margin``);
+    ``.bus`` (the chosen set's DC bus) a table; ``.converged`` False is said in the subtitle."""
     table = selection.table
     joints = [str(j) for j in table.index]
     values = {c: table[c].to_numpy() for c in table.columns if _is_number_column(table[c])}
     details = check_details(joints, values, CHECKS)
+    infeasible = getattr(selection, "infeasible", None)
     rows = []
     for joint in table.index:
         parts = {
@@ -339,13 +342,32 @@ def selection_report_model(selection: Any) -> ReportModel:
         margin = float(table.loc[joint, "margin"])
         ok = bool(table.loc[joint, "ok"])
         status = "fail" if not ok or margin < 1.0 else "pass"
-        note = "" if "note" not in table.columns else str(table.loc[joint, "note"] or "")
+        note = ""
+        if infeasible is not None and len(infeasible):
+            reasons = infeasible[infeasible["joint"] == joint]
+            if len(reasons):
+                note = "no feasible candidate: closest shown; " + "; ".join(
+                    f"{r.check} best margin {r.best_margin:.3g}" for r in reasons.itertuples()
+                )
         binding = str(table.loc[joint, "binding_check"] or "")
         rows.append(VerdictRow(str(joint), parts, status, binding, margin, note))
     objective = str(getattr(selection, "objective", "") or "")
     passes = getattr(selection, "passes", None)
     sub = f"objective: {objective}" + (f"; {passes} coupled pass(es)" if passes else "")
+    if getattr(selection, "converged", True) is False:
+        sub += "; NOT CONVERGED (the choice still changed in the last pass)"
     sections = [_ranking_section(selection, joints, objective)]
+    if infeasible is not None and len(infeasible):
+        sections.append(
+            Section("Where nothing fits", tables=[("checks no candidate passes", infeasible)])
+        )
+    bus = getattr(selection, "bus", None)
+    if bus:
+        import pandas as pd
+
+        scalars = {k: v for k, v in bus.items() if np.ndim(v) == 0}
+        frame = pd.DataFrame({"value": list(scalars.values())}, index=list(scalars))
+        sections.append(Section("DC bus of the chosen set", tables=[("bus values", frame)]))
     sections.append(Section("All values", tables=[("the selection table", table)]))
     return ReportModel("Drivetrain selection", rows, details, sections, subtitle=sub)
 
@@ -364,32 +386,45 @@ def _ranking_section(selection: Any, joints: list[str], objective: str) -> Secti
     axes = fig.subplots(len(joints), 1, squeeze=False)[:, 0]
     for ax, joint in zip(axes, joints, strict=True):
         cand = ranked[joint]
-        column = objective if objective in cand.columns else "objective"
+        column = "objective" if "objective" in cand.columns else objective
         if column not in cand.columns or "margin" not in cand.columns or cand.empty:
             ax.set_title(f"{joint}: no candidate values", fontsize="medium")
             continue
         y = cand[column].to_numpy(dtype=float)
-        m = cand["margin"].to_numpy(dtype=float)
+        # the log axis shows margins from 1e-3 to 1e3 (an infinite margin: a zero load)
+        m = np.clip(cand["margin"].to_numpy(dtype=float), 1e-3, 1e3)
         ok = m >= 1.0
         ax.plot(m[ok], y[ok], "o", color="#1b7f3b", ms=3, label="passes")
         ax.plot(m[~ok], y[~ok], "x", color="#c62828", ms=4, label="fails")
         ax.plot(m[:1], y[:1], "o", mfc="none", mec="k", ms=11, label="ranked first")
         ax.axvline(1.0, color="k", ls="--", lw=0.8)
         ax.set_xscale("log")
-        ax.set_ylabel(column)
+        ax.set_ylabel(objective or column)
         ax.set_title(str(joint), fontsize="medium")
         ax.grid(lw=0.3, which="both")
     axes[-1].set_xlabel("least margin (log; >= 1 passes)")
     axes[0].legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize="small")
     alt = f"{objective or 'objective'} against the least margin of every candidate per joint"
     tables = [
-        (f"{j}: the first {RANKED_ROWS} candidates", ranked[j].head(RANKED_ROWS)) for j in joints
+        (f"{j}: the first {RANKED_ROWS} candidates", _ranking_columns(ranked[j])) for j in joints
     ]
+
     return Section(
         "Ranking",
         figures=[ReportFigure(alt, figure_png(fig), alt, "ranking.png")],
         tables=tables,
     )
+
+
+#: the columns of the ranking tables (those a candidates frame has)
+RANKING_COLUMNS = ("motor", "gearbox", "drive", "ok", "binding_check", "margin", "objective")
+
+
+def _ranking_columns(cand):
+    """The first :data:`RANKED_ROWS` candidates, the :data:`RANKING_COLUMNS` they have plus
+    ``mass`` and ``cost`` when given."""
+    keep = [c for c in (*RANKING_COLUMNS, "mass", "cost") if c in cand.columns]
+    return cand.head(RANKED_ROWS)[keep]
 
 
 def write_selection_report(selection: Any, directory: str | os.PathLike[str]) -> Path:
