@@ -9,9 +9,11 @@
   not, 2 for bad input. File formats: ``armdyn.size``.
   ``--payload MASS[,X,Y,Z]`` welds a point mass (kg; its centre of mass in m, in the axes of
   ``--payload-frame``, default the model's last frame, ``model.frame_names[-1]``: a UR5's
-  ``tool0``) to the robot; ``--cycle N|forever`` and ``--dwell SECONDS`` make the motion a
-  duty cycle (a dwell alone repeats forever); the check options (``--ambient``, ``--life``...)
-  are :class:`armdyn.sizing.SizingOptions`'.
+  ``tool0``) to the robot; ``--dwell SECONDS`` holds the motion's last pose at the end of
+  each cycle (the report is of the periodic cycle); ``--cycle N|forever`` and the check options
+  (``--ambient``, ``--life``... :class:`armdyn.sizing.SizingOptions`') are ``armdyn
+  select``'s: ``armdyn size`` refuses them (it does not check the repeated cycle's thermal
+  state nor the gearbox).
 * ``armdyn select ROBOT.urdf --trajectory FILE.csv --catalog PATH [--objective
   mass|cost|bus_power|margin] [--payload ...] [--cycle ...] [--dwell ...] [--out DIR]`` chooses
   each joint's motor, gearbox and drive from the catalog (``armdyn.select_drivetrain``), prints
@@ -111,7 +113,8 @@ def _motion_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--cycle",
         metavar="N|forever",
-        help="repeat the motion (and its dwell) N times, or forever (the default with --dwell)",
+        help="repeat the motion (and its dwell) N times, or forever (the default); armdyn "
+        "size refuses it (its thermal state is armdyn select's check)",
     )
     p.add_argument(
         "--dwell",

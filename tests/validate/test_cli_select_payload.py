@@ -213,11 +213,69 @@ def test_bad_option_values_exit_2_naming_the_option(capsys, traj, args, fragment
     assert_one_line_exit_2(code, err, fragment)
 
 
+def test_size_refuses_what_it_does_not_check(capsys, traj):
+    """Never ignored: a repeat count and the check options set the repeated cycle's thermal
+    state and the gearbox/brake checks, which armdyn size does not make."""
+    code, _, err = run_cli(capsys, "size", "--trajectory", traj, "--cycle", "3", "--life", "9")
+    assert_one_line_exit_2(code, err, "--required-life, --cycle: armdyn size checks the periodic")
+
+
 @pytest.mark.skipif(hasattr(ad, "duty_cycle"), reason="armdyn.duty_cycle is in this build")
-def test_size_with_a_cycle_says_what_it_needs(capsys, traj):
-    """Never ignored: until the duty cycles are in the build, a cycle or an option is refused."""
-    code, _, err = run_cli(capsys, "size", "--trajectory", traj, "--dwell", "1", "--life", "9")
-    assert_one_line_exit_2(code, err, "--required-life, --dwell:", "armdyn.duty_cycle")
+def test_size_with_a_dwell_says_what_it_needs(capsys, traj):
+    code, _, err = run_cli(capsys, "size", "--trajectory", traj, "--dwell", "1")
+    assert_one_line_exit_2(code, err, "armdyn size --dwell needs armdyn.duty_cycle")
+
+
+def stand_in_duty_cycle(model, motion, dwell=0.0, repeat=None):
+    """The spec's DutyCycle contract (issue 33 part 4) for this test: the motion's samples, then
+    the dwell's at its start and end holding the last pose with the holding torques."""
+    from types import SimpleNamespace
+
+    t, q, qd, qdd = motion.t, motion.q, motion.qd, motion.qdd
+    hold = ad.inverse_dynamics(model, q[-1:], np.zeros_like(qd[-1:]), np.zeros_like(qd[-1:]))
+    return SimpleNamespace(
+        t=np.concatenate([t, [t[-1], t[-1] + dwell]]),
+        q=np.concatenate([q, q[-1:], q[-1:]]),
+        qd=np.concatenate([qd, np.zeros((2, qd.shape[1]))]),
+        qdd=np.concatenate([qdd, np.zeros((2, qd.shape[1]))]),
+        torque=np.concatenate([motion.joint_torques, hold, hold]),
+        repeat=repeat,
+    )
+
+
+@pytest.mark.parametrize("which", ["stand-in", "armdyn.duty_cycle"])
+def test_dwell_counts_the_holding_torque(tmp_path, capsys, monkeypatch, which):
+    """The pendulum swung from 0 to A = 0.6 rad in 1 s (ending at rest), then held 2 s: the
+    report's RMS torque is sqrt((int_0^1 tau^2 dt + 2 (m g l sin A)^2) / 3) with tau = I_p qdd
+    + m g l sin q (the trapezoid rule over the motion's samples), its peak the larger of the
+    motion's and the holding torque."""
+    if which == "stand-in":
+        monkeypatch.setattr(ad, "duty_cycle", stand_in_duty_cycle, raising=False)
+    elif not hasattr(ad, "duty_cycle"):
+        pytest.skip("armdyn.duty_cycle (issue 33 part 4) is not merged yet")
+    a, t = 0.6, np.linspace(0.0, 1.0, 401)
+    q = a * (1 - np.cos(np.pi * t)) / 2
+    qd, qdd = a * np.pi / 2 * np.sin(np.pi * t), a * np.pi**2 / 2 * np.cos(np.pi * t)
+    qd[-1] = 0.0  # at rest (sin(pi) is 1.2e-16)
+    frame = {"t": t, "pivot": q, "pivot.qd": qd, "pivot.qdd": qdd}
+    pd.DataFrame(frame).to_csv(tmp_path / "m.csv", index=False, float_format="%.17g")
+    out = tmp_path / "rep"
+    code, _, err = run_cli(
+        capsys, "size", "--trajectory", tmp_path / "m.csv", "--dwell", "2", "--out", out
+    )
+    assert code == 0, err
+    tab = pd.read_csv(out / "table.csv", index_col="joint")
+    tau = I_P * qdd + MGL * np.sin(q)
+    hold = MGL * np.sin(a)
+    rms = np.sqrt((np.trapezoid(tau**2, t) + 2.0 * hold**2) / 3.0)
+    assert tab.loc["pivot", "rms_torque"] == pytest.approx(rms, rel=1e-12)
+    assert tab.loc["pivot", "peak_torque"] == pytest.approx(
+        max(np.max(np.abs(tau)), hold), rel=1e-12
+    )
+    # without the dwell the RMS is the motion's alone (the dwell is what changed it)
+    assert tab.loc["pivot", "rms_torque"] != pytest.approx(
+        np.sqrt(np.trapezoid(tau**2, t)), rel=1e-3
+    )
 
 
 # ---------------------------------------------------------------------------- armdyn select

@@ -1,6 +1,6 @@
 """``armdyn size ROBOT.urdf --trajectory FILE.csv [--actuators FILE.toml] [--payload ...]
-[--cycle ...] [--dwell ...] [--out DIR]``: the sizing report of a planned motion from the command line (also importable as ``armdyn.size``,
-its former module).
+[--dwell ...] [--out DIR]``: the sizing report of a planned motion from the command line (also
+importable as ``armdyn.size``, its former module).
 
 Trajectory CSV: a header row, then one row per sample. Columns: ``t`` (strictly increasing, s),
 one column per joint coordinate of the URDF (``model.coord_names``: positions, rad or m), and
@@ -31,10 +31,13 @@ when some joint is not, 2 for bad input (one line names the file, column and dat
 
 Options: ``--payload MASS[,X,Y,Z]`` welds a point mass [kg] to the robot (its centre of mass
 [m] in the axes of ``--payload-frame NAME``, default the model's last frame
-``model.frame_names[-1]``, from the frame's origin; :func:`add_payload`); ``--cycle
-N|forever`` and ``--dwell SECONDS`` make the motion a duty cycle (a dwell alone repeats
-forever); one option per :class:`~armdyn.sizing.options.SizingOptions` field, generated from
-the dataclass (:func:`add_option_arguments`). Every option string is checked before a file is
+``model.frame_names[-1]``, from the frame's origin; :func:`add_payload`); ``--dwell SECONDS``
+makes the motion a duty cycle (:func:`cycle_motion`: the report is of one period, the dwell
+holding the last pose with its holding torques, hence of the periodic cycle); ``--cycle
+N|forever`` and one option per :class:`~armdyn.sizing.options.SizingOptions` field (generated
+from the dataclass, :func:`add_option_arguments`) set the repeated cycle's thermal state and
+the gearbox and brake checks, which ``armdyn size`` does not make: it refuses them (exit code
+2, saying so; ``armdyn select`` takes them). Every option string is checked before a file is
 read; a build without ``Model.with_payload`` or ``armdyn.duty_cycle`` refuses the options that
 need them (exit code 2, naming what is missing) rather than ignoring them.
 
@@ -246,12 +249,14 @@ def run(
     from armdyn.sizing.report import sizing_report
 
     mass_com = parse_payload(payload) if payload is not None else None
-    _cycle_strings(cycle, dwell)  # checked before any file is read
+    repeat, dwell_s = _cycle_strings(cycle, dwell)  # checked before any file is read
     overrides = sizing_options_from_strings(options or {})
     spec = read_actuators(actuators) if actuators else None
     model = load_robot(urdf, mass_com, payload_frame)
     run_ = planned_motion(model, trajectory)
-    _size_needs(overrides, cycle, dwell)
+    _size_needs(overrides, cycle)
+    if dwell_s is not None:
+        run_ = cycle_motion(model, run_, dwell_s, repeat)
     report = sizing_report(run_, model, out=out, actuators=spec)
     with pd.option_context("display.max_columns", None, "display.width", 200):
         echo(report.table.to_string(float_format=lambda v: f"{v:.4g}"))
@@ -296,19 +301,35 @@ def planned_motion(model, trajectory):
         raise _core.ModelError(f"{trajectory}: {_culprit(str(exc), model)}") from None
 
 
-def _size_needs(overrides, cycle, dwell) -> None:
-    """``armdyn size`` with a duty cycle or check options: they need the duty cycles of issue
-    33 (``armdyn.duty_cycle``); refused with the reason until this build has them, never
-    ignored."""
+def cycle_motion(model, motion, dwell: float, repeat: int | None):
+    """One period of the duty cycle ``armdyn.duty_cycle(model, motion, dwell, repeat)`` as a run
+    the sizing report takes: its samples (the motion's, then the dwell's at its start and end,
+    holding the last pose) with its torques (the dwell's: the holding torques). The report's
+    peaks, RMS values and energies are then those of the periodic cycle, the dwell included
+    (the same for any repeat count); its temperature columns are of one period from the start
+    (the repeated cycle's thermal state is the two-node check of the selection)."""
+    from types import SimpleNamespace
+
+    cycle = _public("duty_cycle", "part 4", "armdyn size --dwell")(
+        model, motion, dwell=dwell, repeat=repeat
+    )
+    return SimpleNamespace(
+        t=cycle.t, q=cycle.q, qd=cycle.qd, qdd=cycle.qdd, joint_torques=cycle.torque, model=model
+    )
+
+
+def _size_needs(overrides, cycle) -> None:
+    """``armdyn size`` with a repeat count or check options: the sizing report checks the
+    periodic cycle (with ``--dwell``) but not yet the repeated cycle's thermal state, which is
+    what they set; refused with the reason, never ignored."""
     given = [f"--{k.replace('_', '-')}" for k in overrides]
     if cycle is not None:
         given.append("--cycle")
-    if dwell is not None:
-        given.append("--dwell")
     if given:
         raise _core.ModelError(
-            f"{', '.join(given)}: the sizing report of this build checks one pass of the motion "
-            "(duty cycles and their check options need armdyn.duty_cycle, not in this build)"
+            f"{', '.join(given)}: armdyn size checks the periodic cycle (its peaks and RMS "
+            "values, with --dwell) but not the repeated cycle's thermal state these set (the "
+            "selection's two-node check: armdyn select)"
         )
 
 
@@ -540,15 +561,13 @@ def catalog_paths(paths) -> list[Path]:
     return out
 
 
-def _public(name: str, part: str):
+def _public(name: str, part: str, who: str = "armdyn select"):
     """``armdyn.<name>``, or a ModelError saying this build does not have it yet."""
     import armdyn
 
     fn = getattr(armdyn, name, None)
     if fn is None:
-        raise _core.ModelError(
-            f"armdyn select needs armdyn.{name} ({part} of issue 33), not in this build"
-        )
+        raise _core.ModelError(f"{who} needs armdyn.{name} ({part} of issue 33), not in this build")
     return fn
 
 
