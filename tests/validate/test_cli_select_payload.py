@@ -349,3 +349,49 @@ def test_select_bad_payload_cycle_and_options(capsys, traj, tmp_path):
 def test_select_says_what_this_build_lacks(capsys, traj, tmp_path):
     code, _, err = select(capsys, traj, "--dwell", "0.5", catalog=tmp_path)
     assert_one_line_exit_2(code, err, "armdyn select needs armdyn.")
+
+
+def test_select_wiring_with_stand_ins(capsys, traj, tmp_path, monkeypatch):
+    """The command's calls, with stand-ins of parts 3, 4 and 6 (their contracts in the issue's
+    spec): the catalog paths, the cycle's dwell and repeat, the objective and the options reach
+    them; the table is printed, the page written, the exit code is 1 when a joint fails."""
+    from test_report_page import FakeSelection
+
+    calls = {}
+
+    def duty_cycle(model, motion, dwell=0.0, repeat=None):
+        calls["cycle"] = (list(model.dof_names), len(motion.t), dwell, repeat)
+        return "the cycle"
+
+    def load_catalog(*paths):
+        calls["catalog"] = paths
+        return "the catalog"
+
+    def select_drivetrain(model, cycle, catalog, objective="mass", **overrides):
+        calls["select"] = (cycle, catalog, objective, overrides)
+        return FakeSelection()
+
+    for name, fn in [
+        ("duty_cycle", duty_cycle),
+        ("load_catalog", load_catalog),
+        ("select_drivetrain", select_drivetrain),
+    ]:
+        monkeypatch.setattr(ad, name, fn, raising=False)
+    (tmp_path / "more.csv").write_text("name\n")
+    args = ["--catalog", tmp_path / "more.csv", "--objective", "cost", "--cycle", "50"]
+    args += ["--dwell", "0.5", "--life", "3e4", "--ambient", "25", "--out", tmp_path / "out"]
+    code, out, err = select(capsys, traj, *args, catalog=tmp_path)
+    assert code == 1, err
+    assert calls["cycle"] == (["pivot"], 41, 0.5, 50)
+    assert calls["catalog"] == (tmp_path, tmp_path / "more.csv")
+    assert calls["select"] == (
+        "the cycle",
+        "the catalog",
+        "cost",
+        {"required_life": 30000.0, "ambient_temperature": 25.0},
+    )
+    assert "G100" in out and "not ok: j2" in out
+    assert (tmp_path / "out" / "report.html").is_file()
+    # forever: no --cycle
+    code, out, err = select(capsys, traj, "--dwell", "1", catalog=tmp_path)
+    assert calls["cycle"][2:] == (1.0, None)
