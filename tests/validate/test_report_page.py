@@ -14,6 +14,7 @@ browser (tests/viz/test_report.py renders it):
 from __future__ import annotations
 
 import re
+from types import SimpleNamespace
 
 import armdyn as ad
 import numpy as np
@@ -30,6 +31,7 @@ from armdyn.sizing.html import (
     row_status,
 )
 from armdyn.sizing.writer import (
+    cycle_torque_figure,
     report_verdict,
     selection_report_model,
     sweep_section,
@@ -228,6 +230,15 @@ class FakeSelection:
             }
         )
         self.bus = {"peak_bus_power": 812.5, "bus_voltage_margin": 1.3, "power": np.zeros(5)}
+        t = np.array([0.0, 0.5, 1.0, 1.0, 3.0])
+        torque = np.array([[1.0, 2.0], [3.0, -1.0], [2.0, 0.5], [2.5, 0.4], [2.5, 0.4]])
+        self.cycle = SimpleNamespace(
+            t=t,
+            names=["j1", "j2", "j3"],
+            torque=np.c_[torque, np.zeros(5)],
+            gravity_torque=np.c_[torque * 0.5, np.zeros(5)],
+            moving=t < 1.0,
+        )
 
     def candidates(self, joint):
         rng = np.random.default_rng(len(joint))
@@ -254,11 +265,28 @@ def test_a_selection_feeds_the_same_page(tmp_path):
     assert np.isnan(d[("j1", "bearing_moment")])
     assert model.status == "fail" and "2 coupled pass(es)" in model.subtitle
     titles = [s.title for s in model.sections]
-    assert titles == ["Ranking", "Where nothing fits", "DC bus of the chosen set", "All values"]
+    assert titles == [
+        "Ranking",
+        "Torque histories",
+        "Where nothing fits",
+        "DC bus of the chosen set",
+        "All values",
+    ]
+    # the cycle's panels: one per selected joint, the torque and the holding torque as given
+    assert model.sections[1].figures[0].png[:4] == b"\x89PNG"
+    fig = cycle_torque_figure(sel.cycle, ["j1", "j2"])
+    for ax, k in zip(fig.axes[:2], (0, 1), strict=True):
+        (_, y), (_, g) = (line.get_data() for line in ax.lines[:2])
+        np.testing.assert_array_equal(y, sel.cycle.torque[:, k])
+        np.testing.assert_array_equal(g, sel.cycle.gravity_torque[:, k])
+        # the shaded dwell (axvspan: a Rectangle, x in data units) where the cycle does not move
+        span = ax.patches[0]
+        assert (span.get_x(), span.get_x() + span.get_width()) == (1.0, 3.0)
+    assert [a.get_ylabel() for a in fig.axes[:2]] == ["j1\n[N m]", "j2\n[N m]"]
+    bus = model.sections[3].tables[0][1]
     ranking = model.sections[0]
     assert list(ranking.tables[0][1].columns) == ["motor", "margin", "objective"]
     assert len(ranking.tables[0][1]) == 10
-    bus = model.sections[2].tables[0][1]
     assert list(bus.index) == ["peak_bus_power", "bus_voltage_margin"]  # the scalars
     sel.converged = False
     assert "NOT CONVERGED" in selection_report_model(sel).subtitle

@@ -357,6 +357,9 @@ def selection_report_model(selection: Any) -> ReportModel:
     if getattr(selection, "converged", True) is False:
         sub += "; NOT CONVERGED (the choice still changed in the last pass)"
     sections = [_ranking_section(selection, joints, objective)]
+    cycle = getattr(selection, "cycle", None)
+    if cycle is not None:
+        sections.append(cycle_torque_section(cycle, joints))
     if infeasible is not None and len(infeasible):
         sections.append(
             Section("Where nothing fits", tables=[("checks no candidate passes", infeasible)])
@@ -370,6 +373,41 @@ def selection_report_model(selection: Any) -> ReportModel:
         sections.append(Section("DC bus of the chosen set", tables=[("bus values", frame)]))
     sections.append(Section("All values", tables=[("the selection table", table)]))
     return ReportModel("Drivetrain selection", rows, details, sections, subtitle=sub)
+
+
+def cycle_torque_section(cycle: Any, joints: list[str]) -> Section:
+    """The load torques of a duty cycle (``cycle.t``, ``cycle.names``, ``cycle.torque`` and
+    ``cycle.gravity_torque``, issue 33's DutyCycle) at the selected joints: one panel per joint,
+    the torque against time over one period and the holding (gravity) torque at each pose, the
+    dwell shaded (``cycle.moving`` False)."""
+    if not any(j in list(cycle.names) for j in joints):
+        return Section("Torque histories", text="the cycle has none of the selected joints")
+    alt = "load torque of each selected joint over one period of the cycle"
+    png = figure_png(cycle_torque_figure(cycle, joints))
+    return Section("Torque histories", figures=[ReportFigure(alt, png, alt, "torque.png")])
+
+
+def cycle_torque_figure(cycle: Any, joints: list[str]):
+    """The figure of :func:`cycle_torque_section` (a bare matplotlib Figure)."""
+    from armdyn.plotting import _matplotlib_figure
+
+    names = list(cycle.names)
+    shown = [j for j in joints if j in names]
+    t = np.asarray(cycle.t, dtype=float)
+    moving = np.asarray(getattr(cycle, "moving", np.ones(len(t), bool)), dtype=bool)
+    fig = _matplotlib_figure()(figsize=(7.5, 2.0 * len(shown) + 0.6), layout="constrained")
+    axes = fig.subplots(len(shown), 1, squeeze=False, sharex=True)[:, 0]
+    for ax, joint in zip(axes, shown, strict=True):
+        k = names.index(joint)
+        ax.plot(t, np.asarray(cycle.torque)[:, k], lw=1.0, label="load torque")
+        ax.plot(t, np.asarray(cycle.gravity_torque)[:, k], lw=0.8, ls="--", label="holding")
+        if not moving.all():
+            ax.axvspan(t[~moving].min(), t[~moving].max(), color="0.9", label="dwell")
+        ax.set_ylabel(f"{joint}\n[N m]")
+        ax.grid(lw=0.3)
+    axes[-1].set_xlabel("t [s] (one period)")
+    axes[0].legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize="small")
+    return fig
 
 
 def _is_number_column(column) -> bool:
