@@ -949,6 +949,30 @@ CASES = [
         ME,
         r"--catalog '/dev/zero' is a character device",
     ),
+    (
+        "catalog-mass-negative",
+        "catalogs",
+        "a motor of mass −1 kg (also read from motors.csv: named by file:line)",
+        lambda: ad.Catalog(_motors(mass=[-1.0])),
+        ME,
+        "part 'M1': column 'mass'",
+    ),
+    (
+        "catalog-duplicate",
+        "catalogs",
+        "two motors of one name",
+        lambda: ad.Catalog(_motors(name=["M1", "M1"])),
+        ME,
+        "motor 'M1' is already at",
+    ),
+    (
+        "catalog-peak-below-continuous",
+        "catalogs",
+        "a motor whose peak torque is below its continuous torque",
+        lambda: ad.Catalog(_motors(peak_torque=[0.4])),
+        ME,
+        "column 'peak_torque': 0.4 is less than continuous_torque",
+    ),
 ]
 
 
@@ -956,6 +980,15 @@ def _cli():
     from armdyn.sizing import cli
 
     return cli
+
+
+def _motors(**change):
+    """A one-motor table (two rows when ``name`` has two), with ``change`` applied."""
+    n = len(change.get("name", ["M1"]))
+    row = dict(name=["M1"], torque_constant=[0.1], resistance=[0.5], rotor_inertia=[1e-5])
+    row.update(mass=[0.3], continuous_torque=[0.5], peak_torque=[1.5])
+    row.update(change)
+    return {k: (v * n if len(v) == 1 else v) for k, v in row.items()}
 
 
 def _modelless_result():

@@ -40,10 +40,12 @@ from armdyn.animation import animate  # k3d and trimesh are imported when animat
 from armdyn.dynamics import InverseDynamicsResult, driven_inverse_dynamics
 from armdyn.simulation import SimulationResult, load_urdf, rollout, simulate
 from armdyn.sizing import (
+    Catalog,
     SizingReport,
     TrajectoryRun,
     gear_ratio_sweep,
     limit_violations,
+    load_catalog,
     sizing_report,
     trajectory_run,
 )
@@ -55,6 +57,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "Actuator",
+    "Catalog",
     "Data",
     "InverseDynamicsResult",
     "LagrangeValidator",
@@ -87,6 +90,7 @@ __all__ = [
     "inverse_dynamics",
     "joint_coordinates",
     "limit_violations",
+    "load_catalog",
     "load_urdf",
     "mass_matrix",
     "profiles",

@@ -43,11 +43,23 @@ One module per concern (every name below is also importable from ``armdyn.sizing
 - :mod:`armdyn.sizing.html`: the verdict-first page, rendered from an explicit model;
 - :mod:`armdyn.sizing.cli`: the ``armdyn size`` and ``armdyn select`` commands (trajectory CSV,
   actuators TOML, payload, duty cycle and check options).
+- :mod:`armdyn.sizing.catalog`: catalogs of motors, gearboxes and drives (:func:`load_catalog`,
+  :class:`Catalog`, the example ``EXAMPLE_CATALOG``, the declared columns).
 
 The rotor's torque T_rot (:func:`rotor_torque`) is :mod:`armdyn.actuators`'.
 """
 
 from armdyn.actuators import rotor_torque
+from armdyn.sizing.catalog import (
+    DRIVE_COLUMNS,
+    EXAMPLE_CATALOG,
+    GEARBOX_COLUMNS,
+    MOTOR_COLUMNS,
+    Catalog,
+    Drive,
+    Gearbox,
+    load_catalog,
+)
 from armdyn.sizing.limits import limit_violations
 from armdyn.sizing.motor import MOTOR_CHECKS, inertia_ratios, motor_envelope, motor_values
 from armdyn.sizing.report import SizingReport, sizing_report
@@ -57,14 +69,22 @@ from armdyn.sizing.trajectory import TrajectoryRun, trajectory_run
 from armdyn.sizing.what_if import MOTOR_FIELDS, make_motor, what_if_actuators
 
 __all__ = [
+    "DRIVE_COLUMNS",
+    "EXAMPLE_CATALOG",
+    "GEARBOX_COLUMNS",
     "MOTOR_CHECKS",
+    "MOTOR_COLUMNS",
     "MOTOR_FIELDS",
+    "Catalog",
+    "Drive",
     "GearRatioSweep",
+    "Gearbox",
     "SizingReport",
     "TrajectoryRun",
     "gear_ratio_sweep",
     "inertia_ratios",
     "limit_violations",
+    "load_catalog",
     "make_motor",
     "motor_envelope",
     "motor_values",
