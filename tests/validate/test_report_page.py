@@ -149,6 +149,11 @@ def test_other_parts_enter_when_the_table_has_them(ur5):
     for part in ("bearing", "drive", "brake"):
         assert f'data-part="{part}">not checked: no {part} data' in html
     assert 'data-part="gearbox"' not in html
+    # a joint without a motor: one line in the motor table, not a row per check
+    for joint in ("wrist_1_joint", "wrist_3_joint"):
+        line = f'<td>{joint}</td><td colspan="5" class="m-none">not checked: no motor data'
+        assert html.count(line) == 1
+    assert html.count('<td colspan="5"') == 2  # every joint has a gearbox value here
 
 
 def test_row_status_and_overall():

@@ -319,6 +319,14 @@ def _checks_block(model: ReportModel) -> str:
         out.append("<th>allowable</th><th>unit</th><th>margin</th></tr></thead><tbody>")
         for joint in joints:
             mine = rows[rows["joint"] == joint]
+            if mine.empty:
+                continue
+            if mine["margin"].isna().all() and mine["value"].isna().all():
+                out.append(
+                    f'<tr><td>{_esc(joint)}</td><td colspan="5" class="m-none">not checked: '
+                    f"no {part} data for this joint</td></tr>"
+                )
+                continue
             for r in mine.itertuples():
                 out.append(
                     f'<tr><td>{_esc(joint)}</td><td title="{_esc(r.doc)}">{_esc(r.check)}</td>'
