@@ -11,8 +11,9 @@ verdict and embeds every figure (:mod:`armdyn.sizing.html`; it needs no other fi
   binding check and margin of :func:`armdyn.sizing.checks.verdict` over the joint's checks;
 - the checks: the joint's own limits (:data:`JOINT_CHECKS`: ``torque_margin``,
   ``speed_margin``), the motor checks of :data:`armdyn.sizing.checks.CHECKS` from the report's
-  motor columns and its motor's datasheet, and every other check of CHECKS whose value column
-  the table has (the gearbox, bearing, drive and brake values, when present);
+  motor columns and its motor's datasheet, and every other check of CHECKS whose columns the
+  table has (the winding temperature, the gearbox, bearing, drive and brake values, when
+  present: CHECKS' value, allowable and margin column names);
 - the sections: torque histories, thermal histories (the first-order winding rise of
   :func:`armdyn.sizing.thermal.thermal_rise`, where the motor gives ``thermal_resistance`` and
   ``thermal_time_constant`` and the copper loss is known), each motor's operating points on
@@ -106,9 +107,10 @@ def _check_columns(report: _SizingReport) -> dict[str, np.ndarray]:
     joints = list(table.index)
     n = len(joints)
     cols: dict[str, np.ndarray] = {}
-    # the other parts' values, when the table has them (CHECKS' own column names)
+    # the other checks' values, when the table has them (CHECKS' own column names; the four
+    # motor checks below have the report's own columns, "speed_margin" there is the joint's)
     for c in CHECKS:
-        if c.part != "motor":
+        if c.name not in _MOTOR_MARGINS:
             for name in (c.value, c.allowable, c.margin_column):
                 if name in table.columns:
                     cols[name] = table[name].to_numpy(dtype=float)
@@ -145,7 +147,6 @@ def _check_columns(report: _SizingReport) -> dict[str, np.ndarray]:
             cols[f"{check}_margin"] = table[column].to_numpy(dtype=float)
         else:  # no actuator in the report: the motor checks are not made
             cols[f"{check}_margin"] = np.full(n, np.nan)
-    cols["winding_temperature_margin"] = cols.get("winding_temperature_margin", np.full(n, np.nan))
     return cols
 
 
