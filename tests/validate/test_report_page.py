@@ -140,13 +140,17 @@ def test_other_parts_enter_when_the_table_has_them(ur5):
     n = len(rep.table)
     rep.table["gear_repeated_peak_torque"] = np.full(n, 40.0)
     rep.table["repeated_peak_torque"] = [30.0] + [400.0] * (n - 1)
-    rep.table["winding_temperature_peak"] = np.full(n, 80.0)  # the two-node check's columns
-    rep.table["max_winding_temperature"] = np.full(n, 120.0)
-    rep.table["winding_temperature_margin"] = np.full(n, 2.0)
+    # the two-node check's columns, on the joints with a motor (NaN elsewhere)
+    has = np.array([j in report.motors for j in rep.table.index])
+    rep.table["winding_temperature_peak"] = np.where(has, 80.0, np.nan)
+    rep.table["max_winding_temperature"] = np.where(has, 120.0, np.nan)
+    rep.table["winding_temperature_margin"] = np.where(has, 2.0, np.nan)
     rows, details = report_verdict(rep)
-    w = details[details["check"] == "winding_temperature"]
-    assert (w["value"] == 80.0).all() and (w["allowable"] == 120.0).all()
-    assert (w["margin"] == 2.0).all()
+    w = details[details["check"] == "winding_temperature"].set_index("joint")
+    assert (
+        (w.loc[list(report.motors), ["value", "allowable", "margin"]] == [80, 120, 2]).all().all()
+    )
+    assert w.loc["wrist_3_joint"].isna()[["value", "allowable", "margin"]].all()
     g = details[(details["check"] == "gear_repeated_peak")].set_index("joint")["margin"]
     assert g.iloc[0] == 30.0 / 40.0 and g.iloc[1] == 10.0
     assert rows[0].binding_check == "gear_repeated_peak" and rows[0].status == "fail"
