@@ -434,6 +434,63 @@ CASES = [
         ME,
         r"format version 1",
     ),
+    # ---- motor datasheet and payloads (issue 33)
+    (
+        "motor-brake-negative",
+        "motor",
+        "a motor's brake_torque −1",
+        lambda: ad.Motor(brake_torque=-1.0),
+        ME,
+        r"Motor: brake_torque must be finite and > 0",
+    ),
+    (
+        "motor-row-bad-value",
+        "motor",
+        "a catalog row with mass 'heavy'",
+        lambda: ad.Motor.from_row({"name": "M1", "mass": "heavy"}),
+        ME,
+        r"Motor.from_row 'M1': mass must be a real number",
+    ),
+    (
+        "motor-row-not-mapping",
+        "motor",
+        "a list as a catalog row",
+        lambda: ad.Motor.from_row([1.0]),
+        ME,
+        r"Motor.from_row: row must be a mapping",
+    ),
+    (
+        "payload-mass-negative",
+        "payload",
+        "with_payload mass −1",
+        lambda: _pendulum().with_payload("link", -1.0),
+        ME,
+        r"with_payload: mass must be finite and >= 0, got -1",
+    ),
+    (
+        "payload-inertia-unphysical",
+        "payload",
+        "with_payload inertia (1, 1, 3): triangle inequality",
+        lambda: _pendulum().with_payload("link", 1.0, inertia=[1.0, 1.0, 3.0]),
+        ME,
+        r"with_payload: inertia violates the triangle inequality",
+    ),
+    (
+        "payload-at-unknown",
+        "payload",
+        "with_payload at a name that is no frame or body",
+        lambda: _pendulum().with_payload("nowhere", 1.0),
+        ME,
+        r"with_payload: at 'nowhere' is neither a frame, a body nor a joint",
+    ),
+    (
+        "payload-name-taken",
+        "payload",
+        "with_payload named as a body of the model",
+        lambda: _pendulum().with_payload("link", 1.0, name="link"),
+        ME,
+        r"with_payload: name 'link' is taken by a body",
+    ),
     # ---- URDF
     (
         "urdf-mass-overflow",
@@ -997,6 +1054,30 @@ CASES = [
         ME,
         "column 'peak_torque': 0.4 is less than continuous_torque",
     ),
+    (
+        "cycle-dwell-nan",
+        "sizing",
+        "duty cycle with a NaN dwell",
+        lambda: ad.duty_cycle(_pendulum(), _rest_motion(), dwell=np.nan),
+        ME,
+        "dwell",
+    ),
+    (
+        "cycle-repeat-fraction",
+        "sizing",
+        "duty cycle repeated 1.5 times",
+        lambda: ad.duty_cycle(_pendulum(), _rest_motion(), repeat=1.5),
+        ME,
+        "repeat",
+    ),
+    (
+        "cycle-not-at-rest",
+        "sizing",
+        "duty cycle of a motion that ends moving",
+        lambda: ad.duty_cycle(_pendulum(), _rest_motion(end_rate=0.5), dwell=1.0),
+        ME,
+        "hinge",
+    ),
 ]
 
 
@@ -1013,6 +1094,14 @@ def _motors(**change):
     row.update(mass=[0.3], continuous_torque=[0.5], peak_torque=[1.5])
     row.update(change)
     return {k: (v * n if len(v) == 1 else v) for k, v in row.items()}
+
+
+def _rest_motion(end_rate=0.0):
+    """(t, q, qd, qdd) of the hinge: at rest at both ends (its last rate ``end_rate``)."""
+    t = np.linspace(0.0, 1.0, 11)
+    qd = np.sin(np.pi * t)[:, None]
+    qd[-1] = end_rate
+    return t, np.zeros((11, 1)), qd, np.zeros((11, 1))
 
 
 def _modelless_result():

@@ -7,7 +7,7 @@ import numpy
 import numpy.typing
 import typing
 from . import profiles
-__all__: list[str] = ['Actuator', 'Data', 'LagrangeValidator', 'Model', 'ModelBuilder', 'ModelError', 'Motor', 'Profile', 'SolverError', 'URDF_COULOMB_SMOOTHING', 'URDF_MAX_ATTRIBUTES', 'URDF_MAX_BYTES', 'UrdfError', 'body_accelerations', 'body_forces', 'body_mass_matrix', 'dynamics_cost', 'end_effector_position', 'energy', 'evaluate_constraints', 'forward_dynamics', 'frame_jacobian', 'frame_jacobian_cartesian', 'frame_pose', 'frame_pose_cartesian', 'inverse_dynamics', 'joint_coordinates', 'joint_reactions', 'mass_matrix', 'paper_3dof_torques', 'paper_5dof_end_effector', 'profiles', 'state_from_joints', 'torque_error_metrics', 'urdf_builder']
+__all__: list[str] = ['Actuator', 'Data', 'LagrangeValidator', 'Model', 'ModelBuilder', 'ModelError', 'Motor', 'Profile', 'SolverError', 'URDF_COULOMB_SMOOTHING', 'URDF_MAX_ATTRIBUTES', 'URDF_MAX_BYTES', 'UrdfError', 'body_accelerations', 'body_forces', 'body_mass_matrix', 'dynamics_cost', 'end_effector_position', 'energy', 'evaluate_constraints', 'forward_dynamics', 'frame_jacobian', 'frame_jacobian_cartesian', 'frame_pose', 'frame_pose_cartesian', 'inverse_dynamics', 'joint_coordinates', 'mass_matrix', 'paper_3dof_torques', 'paper_5dof_end_effector', 'profiles', 'state_from_joints', 'torque_error_metrics', 'urdf_builder']
 class ModelError(ValueError):
     """
     Bad input: a model, builder call, array shape or option that armdyn refuses, the message naming the culprit (the body, joint, argument and the expected shape). The model or builder is left as it was. A ValueError.
@@ -652,10 +652,6 @@ def inverse_dynamics(model: Model, q: numpy.typing.ArrayLike, qd: numpy.typing.A
 def joint_coordinates(model: Model, u: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
     """
     Joint-space q (n_coords: floating bases' poses, then joint coordinates with angles in (-pi, pi]) and qd (n_dofs) at the Cartesian state (u, v): a coupled model's independent coordinates, as state_from_joints takes.
-    """
-def joint_reactions(model: Model, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike, t: float | numpy.typing.ArrayLike | None = None, data: Data | None = None) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
-    """
-    Every joint's reaction along a joint-space motion of a tree: (forces, torques), each (n_joints, 3) for one state (q: n_coords, qd and qdd: n_dofs; a coupled model's independent coordinates, as inverse_dynamics takes them) or (rows, n_joints, 3) for one state per row; t [s] a number, one per row, or None (0). The same quantity as SimulationResult.reaction_forces/reaction_torques: what the joint's constraint applies to its child at the joint point, in the child's joint frame, for every joint of the model (fixed joints included; zero for floating bases); the components about/along a joint's free axes are zero (the actuator's torque there is inverse_dynamics'). The joint torques are the inverse dynamics' (the motion is exactly the one given); gravity and the force elements act, drives are ignored.
     """
 def mass_matrix(model: Model, q: numpy.typing.ArrayLike, data: Data | None = None) -> numpy.typing.NDArray[numpy.float64]:
     """

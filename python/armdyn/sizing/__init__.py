@@ -30,9 +30,14 @@ One module per concern (every name below is also importable from ``armdyn.sizing
 - :mod:`armdyn.sizing.limits`: :func:`limit_violations` and each column's effort and velocity
   limit;
 - :mod:`armdyn.sizing.trajectory`: :func:`trajectory_run`, :class:`TrajectoryRun`;
+- :mod:`armdyn.sizing.cycle`: duty cycles (:func:`duty_cycle`, :class:`DutyCycle`) and a
+  joint's load along one (:class:`JointLoad`);
 - :mod:`armdyn.sizing.motor`: the motor-side columns and checks (:func:`motor_values`,
-  :func:`motor_envelope`, :func:`inertia_ratios`, ``MOTOR_CHECKS``);
-- :mod:`armdyn.sizing.thermal`: the winding's temperature rise (:func:`thermal_rise`);
+  :func:`motor_envelope`, :func:`inertia_ratios`, ``MOTOR_CHECKS``) and a duty cycle's motor
+  side for many candidates at once (:func:`~armdyn.sizing.motor.motor_cycle_values`,
+  :func:`~armdyn.sizing.motor.motor_cycle_series`);
+- :mod:`armdyn.sizing.thermal`: the winding's temperature rise (:func:`thermal_rise`) and the
+  two-node model over repeated cycles (:func:`~armdyn.sizing.thermal.thermal_cycle`);
 - :mod:`armdyn.sizing.what_if`: what-if actuators from specs (:func:`what_if_actuators`) and
   motors from datasheet keywords (:func:`make_motor`, ``MOTOR_FIELDS``);
 - :mod:`armdyn.sizing.selection`: the gear-ratio sweep (:func:`gear_ratio_sweep`,
@@ -60,6 +65,7 @@ from armdyn.sizing.catalog import (
     Gearbox,
     load_catalog,
 )
+from armdyn.sizing.cycle import DutyCycle, JointLoad, duty_cycle
 from armdyn.sizing.limits import limit_violations
 from armdyn.sizing.motor import MOTOR_CHECKS, inertia_ratios, motor_envelope, motor_values
 from armdyn.sizing.report import SizingReport, sizing_report
@@ -77,10 +83,13 @@ __all__ = [
     "MOTOR_FIELDS",
     "Catalog",
     "Drive",
+    "DutyCycle",
     "GearRatioSweep",
     "Gearbox",
+    "JointLoad",
     "SizingReport",
     "TrajectoryRun",
+    "duty_cycle",
     "gear_ratio_sweep",
     "inertia_ratios",
     "limit_violations",

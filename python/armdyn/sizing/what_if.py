@@ -11,18 +11,9 @@ from types import SimpleNamespace
 from armdyn import _checks, _core
 from armdyn.actuators import ROTOR_COULOMB_SMOOTHING
 
-MOTOR_FIELDS = (
-    "torque_constant",
-    "resistance",
-    "voltage",
-    "no_load_speed",
-    "continuous_torque",
-    "peak_torque",
-    "max_speed",
-    "thermal_resistance",
-    "thermal_time_constant",
-    "name",
-)
+#: armdyn.Motor's keywords: its datasheet fields (``armdyn.Motor.FIELDS``, the C++ list
+#: ``MotorSpec::fields()``) and ``name``; the one list the Python side uses
+MOTOR_FIELDS = (*_core.Motor.FIELDS, "name")
 
 #: the keys of an actuator spec (add_actuator's keywords)
 _ACTUATOR_FIELDS = (
@@ -55,10 +46,8 @@ _SWEPT_FIELDS = (
 
 
 def make_motor(**datasheet):
-    """An :class:`armdyn.Motor` from datasheet keywords (SI, motor side: ``torque_constant``
-    N m/A, ``resistance`` ohm, ``voltage`` V, ``no_load_speed`` rad/s, ``continuous_torque`` and
-    ``peak_torque`` N m, ``max_speed`` rad/s, ``thermal_resistance`` K/W,
-    ``thermal_time_constant`` s, ``name``); an unknown key is a ModelError naming it."""
+    """An :class:`armdyn.Motor` from datasheet keywords: :data:`MOTOR_FIELDS` (SI, motor side;
+    the units in ``armdyn.Motor``'s docstring); an unknown key is a ModelError naming it."""
     unknown = sorted(set(datasheet) - set(MOTOR_FIELDS))
     if unknown:
         raise _core.ModelError(f"motor: unknown datasheet key(s) {unknown}; known {MOTOR_FIELDS}")
@@ -67,7 +56,8 @@ def make_motor(**datasheet):
 
 def what_if_actuators(model, names, actuators) -> list:
     """Stand-in actuators (the attributes of ``model.actuators`` entries) from
-    ``{joint: spec}``: ``gear_ratio`` and ``rotor_inertia`` required, ``efficiency`` (1),
+    ``{joint: spec}``: ``gear_ratio`` and ``rotor_inertia`` required (``rotor_inertia``: else
+    the motor's datasheet value), ``efficiency`` (1),
     ``friction_viscous``, ``friction_coulomb`` (0), ``friction_smoothing`` (None: 1e-3 |N|)
     and ``motor`` (an :class:`armdyn.Motor`, a dict of its keywords, or None) optional; a dict
     or an object with those attributes."""
@@ -84,25 +74,33 @@ def what_if_actuators(model, names, actuators) -> list:
         if joint not in names or joint not in dofs:
             raise _core.ModelError(f"actuators: {joint!r} is not a joint coordinate ({dofs})")
 
-        def get(key, default=None, spec=spec):
-            if isinstance(spec, dict):
-                return spec.get(key, default)
-            return getattr(spec, key, default)
-
         unknown = sorted(set(spec) - set(_ACTUATOR_FIELDS)) if isinstance(spec, dict) else []
         if unknown:
             raise _core.ModelError(f"actuators: [{joint}] unknown key(s) {unknown}")
+        motor = spec.get("motor") if isinstance(spec, dict) else getattr(spec, "motor", None)
+        if isinstance(motor, dict):
+            motor = make_motor(**motor)
+
+        def get(key, default=None, spec=spec, motor=motor):
+            if isinstance(spec, dict):
+                value = spec.get(key, default)
+            else:
+                value = getattr(spec, key, default)
+            if value is None and key == "rotor_inertia":  # the motor's datasheet value
+                value = getattr(motor, "rotor_inertia", None)
+            return value
+
         for key in ("gear_ratio", "rotor_inertia"):
             if get(key) is None:
-                raise _core.ModelError(f"actuators: [{joint}] needs {key}")
+                raise _core.ModelError(
+                    f"actuators: [{joint}] needs {key}"
+                    + (" (in the spec or its motor's datasheet)" if key == "rotor_inertia" else "")
+                )
         if get("gyroscopic", False):
             raise _core.ModelError(
                 f"actuators: [{joint}] gyroscopic rotors need the actuator in the model "
                 "(ModelBuilder.add_actuator); the what-if evaluation is the gear-reduced model"
             )
-        motor = get("motor")
-        if isinstance(motor, dict):
-            motor = make_motor(**motor)
         out.append(
             SimpleNamespace(
                 joint=joint,
@@ -149,8 +147,8 @@ def _swept_actuator(joint: str, spec, existing) -> SimpleNamespace:
     """The stand-in actuator the gear-ratio sweep evaluates on ``joint`` (its ``gear_ratio``
     set per ratio): each value of :data:`_SWEPT_FIELDS` from ``spec`` (a dict, an object with
     those attributes, or None), else from the model's own actuator ``existing``, else the
-    default. An inherited default Coulomb smoothing (add_actuator's 1e-3 |N₀|) becomes None,
-    so that at ratio N it is 1e-3 |N|."""
+    default (``rotor_inertia``: else the motor's datasheet value). An inherited default Coulomb
+    smoothing (add_actuator's 1e-3 |N₀|) becomes None, so that at ratio N it is 1e-3 |N|."""
     if isinstance(spec, dict):
         unknown = sorted(set(spec) - set(_ACTUATOR_FIELDS))
         if unknown:
@@ -177,9 +175,14 @@ def _swept_actuator(joint: str, spec, existing) -> SimpleNamespace:
             <= 1e-15 * abs(value)
         ):
             value = None  # add_actuator's default 1e-3 |N0|: at ratio N it is 1e-3 |N|
-        if value is None and name == "rotor_inertia":
-            raise _core.ModelError(f"gear_ratio_sweep: joint {joint!r} needs a rotor_inertia")
         if name == "motor" and isinstance(value, dict):
             value = make_motor(**value)
         values[name] = value
+    if values["rotor_inertia"] is None:  # the motor's datasheet value
+        values["rotor_inertia"] = getattr(values["motor"], "rotor_inertia", None)
+    if values["rotor_inertia"] is None:
+        raise _core.ModelError(
+            f"gear_ratio_sweep: joint {joint!r} needs a rotor_inertia (in the spec or its "
+            "motor's datasheet)"
+        )
     return SimpleNamespace(joint=joint, gear_ratio=1.0, **values)
