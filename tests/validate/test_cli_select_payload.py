@@ -214,10 +214,12 @@ def test_bad_option_values_exit_2_naming_the_option(capsys, traj, args, fragment
 
 
 def test_size_refuses_what_it_does_not_check(capsys, traj):
-    """Never ignored: a repeat count and the check options set the repeated cycle's thermal
-    state and the gearbox/brake checks, which armdyn size does not make."""
+    """Never ignored: the options of checks armdyn size does not make (gearbox life, emergency
+    stops, bearing, brake) are refused, and the thermal ones need a duty cycle."""
     code, _, err = run_cli(capsys, "size", "--trajectory", traj, "--cycle", "3", "--life", "9")
-    assert_one_line_exit_2(code, err, "--required-life, --cycle: armdyn size checks the periodic")
+    assert_one_line_exit_2(code, err, "--required-life: armdyn size does not make the checks")
+    code, _, err = run_cli(capsys, "size", "--trajectory", traj, "--ambient", "25")
+    assert_one_line_exit_2(code, err, "--ambient-temperature: the winding temperature is checked")
 
 
 @pytest.mark.skipif(hasattr(ad, "duty_cycle"), reason="armdyn.duty_cycle is in this build")
@@ -395,3 +397,48 @@ def test_select_wiring_with_stand_ins(capsys, traj, tmp_path, monkeypatch):
     # forever: no --cycle
     code, out, err = select(capsys, traj, "--dwell", "1", catalog=tmp_path)
     assert calls["cycle"][2:] == (1.0, None)
+
+
+@pytest.mark.skipif(not hasattr(ad, "duty_cycle"), reason="armdyn.duty_cycle not merged yet")
+def test_size_checks_the_winding_temperature_of_the_repeated_cycle(tmp_path, capsys):
+    """A motor with a one-node thermal model whose time constant (1e6 s) is far longer than the
+    3 s period: at the periodic steady state (--cycle forever) the winding's temperature is the
+    ambient one (--ambient 25) plus R_th times the period's mean copper loss R i², i = T / k_t
+    (R constant: --copper-temperature-coefficient 0), within the ripple (period / tau_th);
+    its margin compares the rises; a smaller allowed temperature fails the joint."""
+    a, t = 0.6, np.linspace(0.0, 1.0, 401)
+    q = a * (1 - np.cos(np.pi * t)) / 2
+    qd, qdd = a * np.pi / 2 * np.sin(np.pi * t), a * np.pi**2 / 2 * np.cos(np.pi * t)
+    qd[-1] = 0.0
+    frame = {"t": t, "pivot": q, "pivot.qd": qd, "pivot.qdd": qdd}
+    pd.DataFrame(frame).to_csv(tmp_path / "m.csv", index=False, float_format="%.17g")
+    k_t, r, r_th = 0.05, 0.8, 3.0
+
+    def size_with(max_temp, out):
+        (tmp_path / "a.toml").write_text(
+            "[pivot]\ngear_ratio = 50.0\nrotor_inertia = 2e-5\nefficiency = 0.9\n"
+            f"[pivot.motor]\ntorque_constant = {k_t}\nresistance = {r}\n"
+            f"thermal_resistance = {r_th}\nthermal_time_constant = 1e6\n"
+            f"max_winding_temperature = {max_temp}\nvoltage = 48.0\nno_load_speed = 900.0\n"
+            "continuous_torque = 10.0\npeak_torque = 20.0\nmax_speed = 900.0\n"
+        )
+        args = ["--trajectory", tmp_path / "m.csv", "--actuators", tmp_path / "a.toml"]
+        args += ["--dwell", "2", "--cycle", "forever", "--ambient", "25"]
+        args += ["--copper-temperature-coefficient", "0", "--out", tmp_path / out]
+        code, _, err = run_cli(capsys, "size", *args)
+        assert code in (0, 1), err
+        return code, pd.read_csv(tmp_path / out / "table.csv", index_col="joint").loc["pivot"]
+
+    code, row = size_with(120.0, "hot")
+    # the report's motor torque over the period (the dwell in it): its RMS, motor_rms_torque
+    mean_sq = row["motor_rms_torque"] ** 2
+    expected = 25.0 + r_th * r * mean_sq / k_t**2
+    assert row["winding_temperature_peak"] == pytest.approx(expected, rel=1e-5)
+    rise = expected - 25.0
+    assert row["winding_temperature_margin"] == pytest.approx((120.0 - 25.0) / rise, rel=1e-5)
+    assert code == 0 and bool(row["ok"])
+    code, row = size_with(25.0 + 0.5 * rise, "cold")  # allows half the rise: fails
+    assert row["winding_temperature_margin"] == pytest.approx(0.5, rel=1e-5)
+    assert code == 1 and not bool(row["ok"])
+    html = (tmp_path / "cold" / "report.html").read_text("utf-8")
+    assert 'data-status="fail"' in html and "winding_temperature" in html

@@ -254,10 +254,18 @@ def run(
     spec = read_actuators(actuators) if actuators else None
     model = load_robot(urdf, mass_com, payload_frame)
     run_ = planned_motion(model, trajectory)
-    _size_needs(overrides, cycle)
-    if dwell_s is not None:
-        run_ = cycle_motion(model, run_, dwell_s, repeat)
-    report = sizing_report(run_, model, out=out, actuators=spec)
+    _size_needs(overrides, cycle, dwell)
+    duty = None
+    if repeat is not _UNSET:
+        duty = _public("duty_cycle", "part 4", "armdyn size --cycle/--dwell")(
+            model, run_, dwell=dwell_s or 0.0, repeat=repeat
+        )
+        run_ = cycle_motion(duty, model)
+    report = sizing_report(run_, model, actuators=spec)
+    if duty is not None:
+        winding_temperature_check(report, duty, spec or {}, overrides)
+    if out is not None:
+        report.save(out)
     with pd.option_context("display.max_columns", None, "display.width", 200):
         echo(report.table.to_string(float_format=lambda v: f"{v:.4g}"))
     bad = [str(j) for j, ok in report.table["ok"].items() if not ok]
@@ -301,35 +309,81 @@ def planned_motion(model, trajectory):
         raise _core.ModelError(f"{trajectory}: {_culprit(str(exc), model)}") from None
 
 
-def cycle_motion(model, motion, dwell: float, repeat: int | None):
-    """One period of the duty cycle ``armdyn.duty_cycle(model, motion, dwell, repeat)`` as a run
-    the sizing report takes: its samples (the motion's, then the dwell's at its start and end,
-    holding the last pose) with its torques (the dwell's: the holding torques). The report's
-    peaks, RMS values and energies are then those of the periodic cycle, the dwell included
-    (the same for any repeat count); its temperature columns are of one period from the start
-    (the repeated cycle's thermal state is the two-node check of the selection)."""
+def cycle_motion(duty, model):
+    """One period of the duty cycle ``duty`` (``armdyn.duty_cycle``) as a run the sizing report
+    takes: its samples (the motion's, then the dwell's at its start and end, holding the last
+    pose) with its torques (the dwell's: the holding torques). The report's peaks, RMS values
+    and energies are then those of the periodic cycle, the dwell included (the same for any
+    repeat count); its ``temperature_rise_*`` columns are of one period from the start, the
+    repeated cycle's winding temperature is :func:`winding_temperature_check`'s."""
     from types import SimpleNamespace
 
-    cycle = _public("duty_cycle", "part 4", "armdyn size --dwell")(
-        model, motion, dwell=dwell, repeat=repeat
-    )
     return SimpleNamespace(
-        t=cycle.t, q=cycle.q, qd=cycle.qd, qdd=cycle.qdd, joint_torques=cycle.torque, model=model
+        t=duty.t, q=duty.q, qd=duty.qd, qdd=duty.qdd, joint_torques=duty.torque, model=model
     )
 
 
-def _size_needs(overrides, cycle) -> None:
-    """``armdyn size`` with a repeat count or check options: the sizing report checks the
-    periodic cycle (with ``--dwell``) but not yet the repeated cycle's thermal state, which is
-    what they set; refused with the reason, never ignored."""
-    given = [f"--{k.replace('_', '-')}" for k in overrides]
-    if cycle is not None:
-        given.append("--cycle")
-    if given:
+#: the check options ``armdyn size`` uses (the winding temperature's); the others set checks
+#: it does not make (gearbox life, emergency stops, bearing, brake)
+SIZE_OPTIONS = ("ambient_temperature", "copper_temperature_coefficient", "resistance_temperature")
+
+
+def winding_temperature_check(report, duty, spec: dict, overrides: dict) -> None:
+    """Add the winding temperature check of the repeated cycle to ``report.table`` (in place):
+    per actuated joint with a motor, ``winding_temperature_peak`` [°C] (the two-node model, or
+    the one-node one with ``thermal_resistance`` / ``thermal_time_constant``, over
+    ``duty.repeat`` periods from the ambient temperature or at the periodic steady state:
+    :func:`armdyn.sizing.motor.motor_cycle_values` on ``duty.joint_load(joint)``, the gear's
+    ratio, efficiency and the rotor inertia of the actuator; motor-side friction is not in
+    that model), ``max_winding_temperature`` and ``winding_temperature_margin`` (rises above
+    the ambient temperature; NaN: not checked, the datasheet values missing). A made check
+    that fails makes the joint not ``ok``."""
+    from armdyn.sizing.motor import motor_cycle_values
+    from armdyn.sizing.options import sizing_options
+
+    options = sizing_options(**overrides)
+    table = report.table
+    peak, allowed, margin = (np.full(len(table), np.nan) for _ in range(3))
+    for k, joint in enumerate(table.index):
+        motor = report.envelopes.get(joint)
+        if joint not in report.motors or motor is None:
+            continue
+        a = spec.get(joint, {})
+        fields = {
+            f: np.array([np.nan if getattr(motor, f, None) is None else getattr(motor, f)])
+            for f in MOTOR_FIELDS
+            if f != "name"
+        }
+        values = motor_cycle_values(
+            duty.joint_load(joint),
+            np.array([float(table.loc[joint, "gear_ratio"])]),
+            np.array([float(a.get("efficiency", 1.0))]),
+            np.array([float(a.get("rotor_inertia", 0.0))]),
+            fields,
+            options,
+        )
+        peak[k] = values["winding_temperature_peak"][0]
+        allowed[k] = fields["max_winding_temperature"][0]
+        margin[k] = values["winding_temperature"][0]
+    table["winding_temperature_peak"] = peak
+    table["max_winding_temperature"] = allowed
+    table["winding_temperature_margin"] = margin
+    table["ok"] = table["ok"].to_numpy(dtype=bool) & ~(margin < 1.0)
+
+
+def _size_needs(overrides, cycle, dwell) -> None:
+    """``armdyn size``'s options: those of checks it does not make are refused (never
+    ignored), and the thermal ones need a duty cycle (``--cycle`` or ``--dwell``)."""
+    other = [f"--{k.replace('_', '-')}" for k in overrides if k not in SIZE_OPTIONS]
+    if other:
         raise _core.ModelError(
-            f"{', '.join(given)}: armdyn size checks the periodic cycle (its peaks and RMS "
-            "values, with --dwell) but not the repeated cycle's thermal state these set (the "
-            "selection's two-node check: armdyn select)"
+            f"{', '.join(other)}: armdyn size does not make the checks these set (gearbox life, "
+            "emergency stops, output bearing, brake: armdyn select makes them)"
+        )
+    if overrides and cycle is None and dwell is None:
+        given = ", ".join(f"--{k.replace('_', '-')}" for k in overrides)
+        raise _core.ModelError(
+            f"{given}: the winding temperature is checked on a duty cycle: give --cycle or --dwell"
         )
 
 
