@@ -9,11 +9,10 @@
   not, 2 for bad input. File formats: ``armdyn.size``.
   ``--payload MASS[,X,Y,Z]`` welds a point mass (kg; its centre of mass in m, in the axes of
   ``--payload-frame``, default the model's last frame, ``model.frame_names[-1]``: a UR5's
-  ``tool0``) to the robot; ``--dwell SECONDS`` holds the motion's last pose at the end of
-  each cycle (the report is of the periodic cycle); ``--cycle N|forever`` and the check options
-  (``--ambient``, ``--life``... :class:`armdyn.sizing.SizingOptions`') are ``armdyn
-  select``'s: ``armdyn size`` refuses them (it does not check the repeated cycle's thermal
-  state nor the gearbox).
+  ``tool0``) to the robot; ``--dwell SECONDS`` and ``--cycle N|forever`` make the motion a
+  duty cycle (the report is of one period, plus the winding temperature of the repeated
+  cycle); of the check options (:class:`armdyn.sizing.SizingOptions`') it takes the thermal
+  ones (``--ambient``...) and refuses the others (``--life``...: ``armdyn select``'s checks).
 * ``armdyn select ROBOT.urdf --trajectory FILE.csv --catalog PATH [--objective
   mass|cost|bus_power|margin] [--payload ...] [--cycle ...] [--dwell ...] [--out DIR]`` chooses
   each joint's motor, gearbox and drive from the catalog (``armdyn.select_drivetrain``), prints
@@ -113,8 +112,8 @@ def _motion_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--cycle",
         metavar="N|forever",
-        help="repeat the motion (and its dwell) N times, or forever (the default); armdyn "
-        "size refuses it (its thermal state is armdyn select's check)",
+        help="repeat the motion (and its dwell) N times from the ambient temperature, or "
+        "forever (the periodic steady state; the default with --dwell)",
     )
     p.add_argument(
         "--dwell",

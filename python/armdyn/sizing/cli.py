@@ -1,6 +1,6 @@
 """``armdyn size ROBOT.urdf --trajectory FILE.csv [--actuators FILE.toml] [--payload ...]
-[--dwell ...] [--out DIR]``: the sizing report of a planned motion from the command line (also
-importable as ``armdyn.size``, its former module).
+[--cycle ...] [--dwell ...] [--out DIR]``: the sizing report of a planned motion from the
+command line (also importable as ``armdyn.size``, its former module).
 
 Trajectory CSV: a header row, then one row per sample. Columns: ``t`` (strictly increasing, s),
 one column per joint coordinate of the URDF (``model.coord_names``: positions, rad or m), and
@@ -31,15 +31,18 @@ when some joint is not, 2 for bad input (one line names the file, column and dat
 
 Options: ``--payload MASS[,X,Y,Z]`` welds a point mass [kg] to the robot (its centre of mass
 [m] in the axes of ``--payload-frame NAME``, default the model's last frame
-``model.frame_names[-1]``, from the frame's origin; :func:`add_payload`); ``--dwell SECONDS``
-makes the motion a duty cycle (:func:`cycle_motion`: the report is of one period, the dwell
-holding the last pose with its holding torques, hence of the periodic cycle); ``--cycle
-N|forever`` and one option per :class:`~armdyn.sizing.options.SizingOptions` field (generated
-from the dataclass, :func:`add_option_arguments`) set the repeated cycle's thermal state and
-the gearbox and brake checks, which ``armdyn size`` does not make: it refuses them (exit code
-2, saying so; ``armdyn select`` takes them). Every option string is checked before a file is
-read; a build without ``Model.with_payload`` or ``armdyn.duty_cycle`` refuses the options that
-need them (exit code 2, naming what is missing) rather than ignoring them.
+``model.frame_names[-1]``, from the frame's origin; :func:`add_payload`). ``--dwell SECONDS``
+and ``--cycle N|forever`` make the motion a duty cycle (``armdyn.duty_cycle``; a dwell alone
+repeats forever, ``--cycle`` alone has no dwell): the report is of one period
+(:func:`cycle_motion`: the dwell holds the last pose with its holding torques, so peaks and RMS
+values are those of the periodic cycle), plus the winding temperature check of the repeated
+cycle (:func:`winding_temperature_check`). Of the check options (one per
+:class:`~armdyn.sizing.options.SizingOptions` field, generated from the dataclass:
+:func:`add_option_arguments`) ``armdyn size`` uses the thermal ones (:data:`SIZE_OPTIONS`,
+with a duty cycle) and refuses the others, whose checks it does not make (exit code 2, saying
+so; ``armdyn select`` takes them). Every option string is checked before a file is read; a
+build without ``Model.with_payload`` or ``armdyn.duty_cycle`` refuses the options that need
+them (exit code 2, naming what is missing) rather than ignoring them.
 
 ``armdyn select ROBOT.urdf --trajectory FILE.csv --catalog PATH [--objective
 mass|cost|bus_power|margin] [the options above] [--out DIR]`` (:func:`select_run`): the
