@@ -442,3 +442,13 @@ def test_size_checks_the_winding_temperature_of_the_repeated_cycle(tmp_path, cap
     assert code == 1 and not bool(row["ok"])
     html = (tmp_path / "cold" / "report.html").read_text("utf-8")
     assert 'data-status="fail"' in html and "winding_temperature" in html
+    assert "winding and housing temperature over one period of the repeated cycle" in html
+    # the drawn temperatures: the series whose peak the check is of
+    model = ad.load_urdf(URDF)
+    spec = cli.read_actuators(tmp_path / "a.toml")
+    duty = ad.duty_cycle(model, cli.planned_motion(model, tmp_path / "m.csv"), dwell=2.0)
+    report = ad.sizing_report(cli.cycle_motion(duty, model), model, actuators=spec)
+    cli.winding_temperature_check(report, duty, spec, {"ambient_temperature": 25.0})
+    t_s, winding, housing = report.thermal["pivot"]
+    assert np.max(winding) == report.table.loc["pivot", "winding_temperature_peak"]
+    assert t_s[-1] - t_s[0] == pytest.approx(3.0) and np.isnan(housing).all()  # one node

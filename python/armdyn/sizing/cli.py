@@ -340,8 +340,9 @@ def winding_temperature_check(report, duty, spec: dict, overrides: dict) -> None
     ratio, efficiency and the rotor inertia of the actuator; motor-side friction is not in
     that model), ``max_winding_temperature`` and ``winding_temperature_margin`` (rises above
     the ambient temperature; NaN: not checked, the datasheet values missing). A made check
-    that fails makes the joint not ``ok``."""
-    from armdyn.sizing.motor import motor_cycle_values
+    that fails makes the joint not ``ok``. The temperatures over the period of the peak
+    (:func:`armdyn.sizing.motor.motor_cycle_series`) go to ``report.thermal``."""
+    from armdyn.sizing.motor import motor_cycle_series, motor_cycle_values
     from armdyn.sizing.options import sizing_options
 
     options = sizing_options(**overrides)
@@ -357,14 +358,18 @@ def winding_temperature_check(report, duty, spec: dict, overrides: dict) -> None
             for f in MOTOR_FIELDS
             if f != "name"
         }
-        values = motor_cycle_values(
-            duty.joint_load(joint),
+        load = duty.joint_load(joint)
+        gear = (
             np.array([float(table.loc[joint, "gear_ratio"])]),
             np.array([float(a.get("efficiency", 1.0))]),
             np.array([float(a.get("rotor_inertia", 0.0))]),
-            fields,
-            options,
         )
+        values = motor_cycle_values(load, *gear, fields, options)
+        if np.isfinite(values["winding_temperature_peak"][0]):
+            series = motor_cycle_series(load, *gear, motor, options)
+            report.thermal[str(joint)] = tuple(
+                series[c] for c in ("t", "winding_temperature", "housing_temperature")
+            )
         peak[k] = values["winding_temperature_peak"][0]
         allowed[k] = fields["max_winding_temperature"][0]
         margin[k] = values["winding_temperature"][0]

@@ -41,6 +41,9 @@ class SizingReport:
         speed: (n, n_columns) joint rates ``result.qd``.
         motors: ``{joint: armdyn.actuators.MotorSide}`` for every actuated joint.
         envelopes: ``{joint: motor}`` (the :class:`armdyn.Motor`, or None) per actuated joint.
+        thermal: ``{joint: (t, winding, housing)}`` temperatures [°C] over one period of a
+            repeated duty cycle (filled by ``armdyn size --cycle/--dwell``:
+            :func:`armdyn.sizing.cli.winding_temperature_check`), drawn by :meth:`save`.
     """
 
     table: pd.DataFrame
@@ -49,6 +52,7 @@ class SizingReport:
     speed: npt.NDArray[np.float64]
     motors: dict[str, Any] = field(default_factory=dict)
     envelopes: dict[str, Any] = field(default_factory=dict)
+    thermal: dict[str, Any] = field(default_factory=dict)
 
     def save(self, directory: str | os.PathLike[str], sweep: Any = None) -> Path:
         """Write ``table.csv``, ``report.html`` and the figures ``torque_<k>.png`` /

@@ -222,9 +222,36 @@ def _torque_section(report: _SizingReport) -> Section:
     return Section("Torque histories", text=text, figures=figures)
 
 
+def _cycle_thermal_section(report: _SizingReport) -> Section:
+    """The winding (solid) and housing (dashed) temperatures of each motor over the period of
+    the repeated cycle's peak (``report.thermal``), with its maximum winding temperature."""
+    from armdyn.plotting import _matplotlib_figure
+
+    fig = _matplotlib_figure()(figsize=(7.5, 3.2))
+    ax = fig.subplots()
+    for k, (joint, (t, winding, housing)) in enumerate(report.thermal.items()):
+        ax.plot(t, winding, lw=1.0, color=f"C{k}", label=f"{joint} winding")
+        if np.any(np.isfinite(housing)):  # a one-node model has no housing node
+            ax.plot(t, housing, lw=0.8, ls="--", color=f"C{k}", label=f"{joint} housing")
+        limit = _motor_attr(report.envelopes.get(joint), "max_winding_temperature")
+        if np.isfinite(limit):
+            ax.axhline(limit, lw=0.8, ls=":", color=f"C{k}", label=f"{joint} max winding")
+    ax.set_xlabel("t [s] (the period of the peak)")
+    ax.set_ylabel("temperature [°C]")
+    ax.set_title("motor temperatures over the repeated cycle (two-node, else one-node model)")
+    ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize="small")
+    ax.grid(lw=0.3)
+    fig.tight_layout()
+    alt = "winding and housing temperature over one period of the repeated cycle per motor"
+    return Section("Thermal histories", figures=[ReportFigure(alt, figure_png(fig), alt)])
+
+
 def _thermal_section(report: _SizingReport) -> Section:
     from armdyn.plotting import _matplotlib_figure
     from armdyn.sizing.thermal import thermal_rise
+
+    if getattr(report, "thermal", None):
+        return _cycle_thermal_section(report)
 
     curves = []
     for joint, side in report.motors.items():
