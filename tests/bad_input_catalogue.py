@@ -1029,6 +1029,48 @@ CASES = [
         lambda: _cli().catalog_paths(["/dev/zero"]),
         ME,
         r"--catalog '/dev/zero' is a character device",
+        "gearbox-ratio-zero",
+        "sizing",
+        "gearbox_cycle_values with a zero gear ratio",
+        lambda: _gearbox().gearbox_cycle_values(_joint_load(), [0.0], {}),
+        ME,
+        r"ratio\[0\] must be non-zero",
+    ),
+    (
+        "gearbox-column-negative",
+        "sizing",
+        "a gearbox catalog column below zero (rated_torque −1)",
+        lambda: _gearbox().gearbox_cycle_values(_joint_load(), [50.0], {"rated_torque": [-1.0]}),
+        ME,
+        r"gearboxes\['rated_torque'\]\[0\] must be > 0",
+    ),
+    (
+        "gearbox-empty-cycle",
+        "sizing",
+        "a joint load of one sample (no cycle to average over)",
+        lambda: _gearbox().gearbox_cycle_values(_joint_load(1), [50.0], {}),
+        ME,
+        "load.t must hold at least two samples",
+    ),
+    (
+        "bearing-axis-zero",
+        "sizing",
+        "bearing_cycle_values of a load whose joint axis is zero",
+        lambda: _gearbox().bearing_cycle_values(
+            _joint_load(axis=(0, 0, 0)), {"bearing_offset": [0]}
+        ),
+        ME,
+        "load.axis must be a non-zero vector",
+    ),
+    (
+        "bus-voltage-max-below",
+        "sizing",
+        "bus_values with the chopper voltage below the nominal bus voltage",
+        lambda: _drive().bus_values(
+            [0.0, 1.0], [[1.0, -1.0]], drives={"bus_voltage": 48.0, "max_bus_voltage": 40.0}
+        ),
+        ME,
+        r"drives\['max_bus_voltage'\]\[0\] is below",
     ),
     (
         "catalog-mass-negative",
@@ -1085,6 +1127,27 @@ def _cli():
     from armdyn.sizing import cli
 
     return cli
+
+
+def _gearbox():
+    from armdyn.sizing import gearbox
+
+    return gearbox
+
+
+def _drive():
+    from armdyn.sizing import drive
+
+    return drive
+
+
+def _joint_load(n=5, axis=(0.0, 0.0, 1.0)):
+    """JointLoad's fields (a stand-in) for a small cycle of n samples."""
+    from types import SimpleNamespace
+
+    t = np.linspace(0.0, 1.0, n)
+    z = np.zeros((n, 3))
+    return SimpleNamespace(t=t, speed=np.sin(t), torque=np.cos(t), force=z, moment=z, axis=axis)
 
 
 def _motors(**change):
