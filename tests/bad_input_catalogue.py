@@ -1029,6 +1029,8 @@ CASES = [
         lambda: _cli().catalog_paths(["/dev/zero"]),
         ME,
         r"--catalog '/dev/zero' is a character device",
+    ),
+    (
         "gearbox-ratio-zero",
         "sizing",
         "gearbox_cycle_values with a zero gear ratio",
