@@ -188,6 +188,11 @@ def test_check_details_margin_from_value_and_allowable():
     np.testing.assert_array_equal(life, [0.5, 2.0])
     assert CHECKS_BY_NAME["gear_life"].lower
     assert d[d["check"] == "peak_torque"]["margin"].isna().all()
+    # derived allowables: never for the winding temperature (its margin compares rises)
+    cols = {"winding_temperature_peak": [80.0], "winding_temperature_margin": [2.0]}
+    cols |= {"motor_rms_torque": [0.5], "continuous_torque_margin": [1.5]}
+    d = check_details(["a"], cols, derive_allowable=True).set_index("check")["allowable"]
+    assert np.isnan(d["winding_temperature"]) and d["continuous_torque"] == 0.75
 
 
 def test_names_are_escaped_and_nothing_is_loaded(ur5):
@@ -277,6 +282,12 @@ def test_a_selection_feeds_the_same_page(tmp_path):
     assert model.rows[1].note == "no feasible candidate: closest shown; peak_torque best margin 0.8"
     d = model.checks.set_index(["joint", "check"])["margin"]
     assert d[("j1", "gear_life")] == 1.4 and d[("j2", "peak_torque")] == 0.8
+    # the allowables the margins imply: a life (lower limit) value / margin, a torque margin x
+    # value (the catalog's 2e4 h and 3 N m, 2 N m of the fake's table)
+    a = model.checks.set_index(["joint", "check"])["allowable"]
+    assert a[("j1", "gear_life")] == pytest.approx(2.8e4 / 1.4, rel=1e-15)
+    assert a[("j1", "peak_torque")] == 3.0 and a[("j2", "peak_torque")] == 2.0
+    assert np.isnan(a[("j1", "speed")])  # no value, no margin
     assert np.isnan(d[("j1", "bearing_moment")])
     assert model.status == "fail" and "2 coupled pass(es)" in model.subtitle
     titles = [s.title for s in model.sections]

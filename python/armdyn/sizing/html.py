@@ -130,16 +130,25 @@ def row_status(ok: bool, margin: float) -> str:
     return "pass" if ok else "unchecked"
 
 
+#: checks whose margin is not allowable / value (or value / allowable): their allowable is
+#: never derived from the margin
+_NOT_A_QUOTIENT = ("winding_temperature",)
+
+
 def check_details(
     joints: Sequence[str],
     values: Mapping[str, Any],
     checks: Sequence[Check] = CHECKS,
+    derive_allowable: bool = False,
 ) -> pd.DataFrame:
     """The long details table from wide per-joint columns: ``values`` maps column names to
     per-joint arrays (or a DataFrame indexed by joint); for each check, ``value`` is the
     check's value column, ``allowable`` its allowable column and ``margin`` its margin column
     — or :func:`armdyn.sizing.checks.margin` of the two when the margin column is absent. A
-    missing column is NaN (a NaN margin: not checked)."""
+    missing column is NaN (a NaN margin: not checked). ``derive_allowable``: where the
+    allowable column is absent, it is the margin's definition solved for it (margin × value
+    for an upper limit, value / margin for a lower one) where both are finite and positive —
+    not for the winding temperature, whose margin compares rises above the ambient."""
     import pandas as pd
 
     from armdyn.sizing.checks import margin as check_margin
@@ -159,6 +168,11 @@ def check_details(
             m = column(c.margin_column)
         else:
             m = check_margin(value, allowable, c.lower)
+        if derive_allowable and c.allowable not in values and c.name not in _NOT_A_QUOTIENT:
+            with np.errstate(all="ignore"):
+                solved = value / m if c.lower else m * value
+            usable = np.isfinite(m) & np.isfinite(value) & (m > 0) & (value > 0)
+            allowable = np.where(usable, solved, np.nan)
         for k, joint in enumerate(joints):
             rows.append(
                 (str(joint), c.part, c.name, value[k], allowable[k], c.unit, float(m[k]), c.doc)

@@ -358,7 +358,8 @@ def selection_report_model(selection: Any) -> ReportModel:
     table = selection.table
     joints = [str(j) for j in table.index]
     values = {c: table[c].to_numpy() for c in table.columns if _is_number_column(table[c])}
-    details = check_details(joints, values, CHECKS)
+    # the table gives values and margins, the catalog's allowables follow from them
+    details = check_details(joints, values, CHECKS, derive_allowable=True)
     infeasible = getattr(selection, "infeasible", None)
     rows = []
     for joint in table.index:
