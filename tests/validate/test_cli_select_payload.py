@@ -452,3 +452,50 @@ def test_size_checks_the_winding_temperature_of_the_repeated_cycle(tmp_path, cap
     t_s, winding, housing = report.thermal["pivot"]
     assert np.max(winding) == report.table.loc["pivot", "winding_temperature_peak"]
     assert t_s[-1] - t_s[0] == pytest.approx(3.0) and np.isnan(housing).all()  # one node
+
+
+@pytest.mark.skipif(not hasattr(ad, "select_drivetrain"), reason="part 6 not merged yet")
+def test_select_end_to_end_equals_the_python_api(tmp_path, capsys):
+    """`armdyn select` on the UR5 (example-robot-data) with the example catalog, a 3 kg payload
+    at the last frame (tool0) and a 1 s dwell: the same choice as the Python calls it stands
+    for, the page's verdict rows the selection's."""
+    from armdyn.sizing import EXAMPLE_CATALOG
+
+    from benchmarks import common
+
+    urdf = common.robot_urdf("ur5")
+    assert urdf is not None, "example-robot-data is part of the test extra"
+    model = ad.load_urdf(urdf)
+    t = np.linspace(0.0, 2.0, 201)
+    w = np.pi / 2
+    s, sd, sdd = 0.5 - 0.5 * np.cos(w * t), 0.5 * w * np.sin(w * t), 0.5 * w * w * np.cos(w * t)
+    sd[-1] = 0.0
+    q0 = np.array([0.0, -1.2, 1.0, -0.5, 0.4, 0.0])
+    dq = np.array([1.2, 0.6, -0.6, -0.7, 0.6, 0.8])
+    cols = {"t": t}
+    for k, name in enumerate(model.coord_names):
+        cols[name], cols[f"{name}.qd"], cols[f"{name}.qdd"] = (
+            q0[k] + s * dq[k],
+            sd * dq[k],
+            sdd * dq[k],
+        )
+    pd.DataFrame(cols).to_csv(tmp_path / "ur5.csv", index=False, float_format="%.17g")
+    args = ["--trajectory", tmp_path / "ur5.csv", "--catalog", EXAMPLE_CATALOG]
+    args += ["--payload", "3", "--dwell", "1", "--out", tmp_path / "out"]
+    code, out, err = run_cli(capsys, "select", *args, urdf=urdf)
+    assert code in (0, 1), err
+    assert "shoulder_lift_joint" in out and "report written to" in out
+    loaded = model.with_payload("tool0", 3.0)
+    run = cli.planned_motion(loaded, tmp_path / "ur5.csv")
+    sel = ad.select_drivetrain(
+        loaded, ad.duty_cycle(loaded, run, dwell=1.0), ad.load_catalog(EXAMPLE_CATALOG)
+    )
+    got = pd.read_csv(tmp_path / "out" / "selection.csv", index_col="joint")
+    for col in ("motor", "gearbox", "ok", "binding_check"):
+        assert list(got[col]) == list(sel.table[col]), col
+    np.testing.assert_allclose(got["margin"], sel.table["margin"], rtol=1e-12)
+    html = (tmp_path / "out" / "report.html").read_text("utf-8")
+    for joint, row in sel.table.iterrows():
+        status = "pass" if row["ok"] and row["margin"] >= 1 else "fail"
+        assert f'data-joint="{joint}" data-status="{status}"' in html
+    assert code == (0 if sel.table["ok"].all() else 1)
