@@ -1031,6 +1031,22 @@ CASES = [
         r"--catalog '/dev/zero' is a character device",
     ),
     (
+        "select-objective",
+        "sizing",
+        "select_drivetrain with an unknown objective",
+        lambda: ad.select_drivetrain(_pendulum(), None, None, objective="weight"),
+        ME,
+        "objective",
+    ),
+    (
+        "select-no-drives",
+        "sizing",
+        "select_drivetrain with drives=True and a catalog without drives",
+        lambda: ad.select_drivetrain(_pendulum(), None, _catalog_without_drives()),
+        ME,
+        "drives=True but the catalog has no drives",
+    ),
+    (
         "gearbox-ratio-zero",
         "sizing",
         "gearbox_cycle_values with a zero gear ratio",
@@ -1129,6 +1145,20 @@ def _cli():
     from armdyn.sizing import cli
 
     return cli
+
+
+def _catalog_without_drives():
+    """A catalog of one motor and one gearbox (the attributes select_drivetrain reads)."""
+    from types import SimpleNamespace
+
+    import pandas as pd
+
+    motors = pd.DataFrame({"mass": [0.5], "rotor_inertia": [1e-5]}, index=["M"])
+    gearboxes = pd.DataFrame(
+        {"mass": [0.4], "ratio": [100.0], "efficiency": [0.8], "input_inertia": [1e-6]},
+        index=["G"],
+    )
+    return SimpleNamespace(motors=motors, gearboxes=gearboxes, drives=None)
 
 
 def _gearbox():

@@ -53,6 +53,7 @@ from armdyn.sizing import (
     sizing_report,
     trajectory_run,
 )
+from armdyn.sizing.select import DrivetrainSelection, select_drivetrain
 from armdyn.sweeps import sweep  # dask and xarray are imported when sweep() runs
 from armdyn.validation import LagrangeValidator
 from armdyn.workprecision import WorkPrecisionResult, work_precision
@@ -63,6 +64,7 @@ __all__ = [
     "Actuator",
     "Catalog",
     "Data",
+    "DrivetrainSelection",
     "DutyCycle",
     "InverseDynamicsResult",
     "JointLoad",
@@ -104,6 +106,7 @@ __all__ = [
     "profiles",
     "rollout",
     "scenes",
+    "select_drivetrain",
     "simulate",
     "sizing_report",
     "state_from_joints",

@@ -42,6 +42,8 @@ One module per concern (every name below is also importable from ``armdyn.sizing
   motors from datasheet keywords (:func:`make_motor`, ``MOTOR_FIELDS``);
 - :mod:`armdyn.sizing.selection`: the gear-ratio sweep (:func:`gear_ratio_sweep`,
   :class:`GearRatioSweep`);
+- :mod:`armdyn.sizing.drivetrain` / :mod:`armdyn.sizing.select`: the drivetrain selection from
+  a catalog (:func:`select_drivetrain`, :class:`DrivetrainSelection`);
 - :mod:`armdyn.sizing.report`: :func:`sizing_report`, :class:`SizingReport`;
 - :mod:`armdyn.sizing.writer`: the report's files (``table.csv``, figures, ``report.html``) and
   the page's models of a report and of a selection;
@@ -69,6 +71,7 @@ from armdyn.sizing.cycle import DutyCycle, JointLoad, duty_cycle
 from armdyn.sizing.limits import limit_violations
 from armdyn.sizing.motor import MOTOR_CHECKS, inertia_ratios, motor_envelope, motor_values
 from armdyn.sizing.report import SizingReport, sizing_report
+from armdyn.sizing.select import DrivetrainSelection, select_drivetrain
 from armdyn.sizing.selection import GearRatioSweep, gear_ratio_sweep
 from armdyn.sizing.thermal import thermal_rise
 from armdyn.sizing.trajectory import TrajectoryRun, trajectory_run
@@ -83,6 +86,7 @@ __all__ = [
     "MOTOR_FIELDS",
     "Catalog",
     "Drive",
+    "DrivetrainSelection",
     "DutyCycle",
     "GearRatioSweep",
     "Gearbox",
@@ -98,6 +102,7 @@ __all__ = [
     "motor_envelope",
     "motor_values",
     "rotor_torque",
+    "select_drivetrain",
     "sizing_report",
     "thermal_rise",
     "trajectory_run",
