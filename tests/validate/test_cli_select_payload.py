@@ -499,3 +499,15 @@ def test_select_end_to_end_equals_the_python_api(tmp_path, capsys):
         status = "pass" if row["ok"] and row["margin"] >= 1 else "fail"
         assert f'data-joint="{joint}" data-status="{status}"' in html
     assert code == (0 if sel.table["ok"].all() else 1)
+    # the chosen motors drawn over the cycle: the series the selection's values are of
+    from armdyn.sizing.writer import selection_series
+
+    for joint, (_, ratio, series) in selection_series(
+        sel, ad.load_catalog(EXAMPLE_CATALOG)
+    ).items():
+        row = sel.table.loc[joint]
+        assert ratio == row["gear_ratio"]
+        peak = np.max(series["winding_temperature"])
+        assert peak == pytest.approx(row["winding_temperature_peak"], rel=1e-9), joint
+        assert np.max(np.abs(series["torque"])) == pytest.approx(row["motor_peak_torque"], rel=1e-9)
+    assert "Thermal histories" in html and html.count("speed-torque plane of the motor of") >= 6

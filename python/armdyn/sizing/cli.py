@@ -666,10 +666,10 @@ def select_run(
     )
     catalog = load_catalog(*paths)
     selection = select_drivetrain(model, duty, catalog, objective=objective, **overrides)
-    return _print_selection(selection, out, echo)
+    return _print_selection(selection, out, echo, catalog)
 
 
-def _print_selection(selection, out, echo) -> int:
+def _print_selection(selection, out, echo, catalog=None) -> int:
     import pandas as pd
 
     table = selection.table
@@ -678,7 +678,7 @@ def _print_selection(selection, out, echo) -> int:
     if out is not None:
         from armdyn.sizing.writer import write_selection_report
 
-        page = write_selection_report(selection, out)
+        page = write_selection_report(selection, out, catalog)
         echo(f"report written to {page.resolve()}")
     bad = [str(j) for j, ok in table["ok"].items() if not ok]
     echo("every joint has a drivetrain that passes" if not bad else f"not ok: {', '.join(bad)}")

@@ -346,7 +346,70 @@ def sweep_section(sweep: Any) -> Section:
 RANKED_ROWS = 10
 
 
-def selection_report_model(selection: Any) -> ReportModel:
+def selection_series(selection: Any, catalog: Any) -> dict[str, tuple[Any, float, dict]]:
+    """``{joint: (motor, gear ratio, series)}`` of each chosen drivetrain: its
+    :class:`armdyn.Motor` (``catalog.motor``), its gearbox's ratio and
+    :func:`armdyn.sizing.motor.motor_cycle_series` on the selection's duty cycle
+    (``selection.cycle.joint_load``) with the gearbox's efficiency and the rotor inertia plus
+    the gearbox's input inertia (the selection's motor side), at ``selection.options``."""
+    from armdyn.sizing.motor import motor_cycle_series
+
+    out = {}
+    for joint, row in selection.table.iterrows():
+        motor, gearbox = catalog.motor(row["motor"]), catalog.gearbox(row["gearbox"])
+        inertia = (motor.rotor_inertia or 0.0) + (gearbox.input_inertia or 0.0)
+        series = motor_cycle_series(
+            selection.cycle.joint_load(str(joint)),
+            gearbox.ratio,
+            gearbox.efficiency,
+            inertia,
+            motor,
+            selection.options,
+        )
+        out[str(joint)] = (motor, float(gearbox.ratio), series)
+    return out
+
+
+def _selection_motor_sections(selection: Any, catalog: Any) -> list[Section]:
+    """The chosen motors' temperatures over the cycle and their operating points on their
+    speed-torque planes (:func:`selection_series`)."""
+    from types import SimpleNamespace
+
+    import pandas as pd
+
+    from armdyn.plotting import sizing_envelope_figure
+    from armdyn.sizing.motor import motor_envelope
+
+    chosen = selection_series(selection, catalog)
+    thermal = SimpleNamespace(
+        thermal={
+            j: (s["t"], s["winding_temperature"], s["housing_temperature"])
+            for j, (_, _, s) in chosen.items()
+            if np.any(np.isfinite(s["winding_temperature"]))
+        },
+        envelopes={j: m for j, (m, _, _) in chosen.items()},
+    )
+    sections = [
+        _cycle_thermal_section(thermal)
+        if thermal.thermal
+        else Section("Thermal histories", text="no chosen motor has a thermal model")
+    ]
+    figures = []
+    for k, (joint, (motor, ratio, s)) in enumerate(chosen.items()):
+        one = SimpleNamespace(
+            motors={joint: SimpleNamespace(speed=s["speed"], torque=s["torque"])},
+            envelopes={joint: motor},
+            table=pd.DataFrame({"gear_ratio": [ratio]}, index=[joint]),
+            _motor_envelope=lambda _j, m=motor: motor_envelope(m),
+        )
+        alt = f"speed-torque plane of the motor of {joint}"
+        png = figure_png(sizing_envelope_figure(one, joint))
+        figures.append(ReportFigure(alt, png, alt, f"motor_{k}.png"))
+    sections.append(Section("Operating points on the motor envelopes", figures=figures))
+    return sections
+
+
+def selection_report_model(selection: Any, catalog: Any = None) -> ReportModel:
     """The page's model of a drivetrain selection (:func:`armdyn.select_drivetrain`): its
     ``.table`` indexed by joint (``motor, gearbox, drive, ok, binding_check, margin`` and the
     value, allowable and ``<check>_margin`` columns of :data:`armdyn.sizing.checks.CHECKS` it
@@ -354,7 +417,9 @@ def selection_report_model(selection: Any) -> ReportModel:
     candidate: which check none passes and the best margin reached) the rows' notes and a
     section; ``.candidates(joint)`` (ranked, best first) the ranking tables and the plot of each
     candidate's objective (its ``objective`` column) against its least margin (``margin``);
-    ``.bus`` (the chosen set's DC bus) a table; ``.converged`` False is said in the subtitle."""
+    ``.bus`` (the chosen set's DC bus) a table; ``.converged`` False is said in the subtitle.
+    With the ``catalog`` the selection was made from, the chosen motors' temperatures and
+    operating points over the cycle are drawn too (:func:`selection_series`)."""
     table = selection.table
     joints = [str(j) for j in table.index]
     values = {c: table[c].to_numpy() for c in table.columns if _is_number_column(table[c])}
@@ -389,6 +454,8 @@ def selection_report_model(selection: Any) -> ReportModel:
     cycle = getattr(selection, "cycle", None)
     if cycle is not None:
         sections.append(cycle_torque_section(cycle, joints))
+        if catalog is not None:
+            sections.extend(_selection_motor_sections(selection, catalog))
     if infeasible is not None and len(infeasible):
         sections.append(
             Section("Where nothing fits", tables=[("checks no candidate passes", infeasible)])
@@ -494,14 +561,16 @@ def _ranking_columns(cand):
     return cand.head(RANKED_ROWS)[keep]
 
 
-def write_selection_report(selection: Any, directory: str | os.PathLike[str]) -> Path:
+def write_selection_report(
+    selection: Any, directory: str | os.PathLike[str], catalog: Any = None
+) -> Path:
     """Write ``selection.csv`` (its table), the ranking figure and ``report.html`` (one
     self-contained page, :func:`selection_report_model`) into ``directory``; returns the
     page's path."""
     out = Path(os.fspath(directory))
     out.mkdir(parents=True, exist_ok=True)
     selection.table.to_csv(out / "selection.csv")
-    model = selection_report_model(selection)
+    model = selection_report_model(selection, catalog)
     for section in model.sections:
         for f in section.figures:
             if f.file:
