@@ -371,7 +371,9 @@ def test_select_wiring_with_stand_ins(capsys, traj, tmp_path, monkeypatch):
 
     def select_drivetrain(model, cycle, catalog, objective="mass", **overrides):
         calls["select"] = (cycle, catalog, objective, overrides)
-        return FakeSelection()
+        sel = FakeSelection()
+        sel.cycle = None  # the stand-in cycle has no joint loads to draw
+        return sel
 
     for name, fn in [
         ("duty_cycle", duty_cycle),
