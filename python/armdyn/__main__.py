@@ -59,6 +59,12 @@ def main(argv: list[str] | None = None) -> int:
     _motion_arguments(size)
     size.add_argument("--actuators", help="TOML: per joint gear_ratio, rotor_inertia, [motor]")
     size.add_argument("--out", help="write the report (HTML, CSV, figures) into this folder")
+    size.add_argument(
+        "--sweep",
+        metavar="MIN:MAX:N",
+        help="with --out: the report adds the gear-ratio sweep of the --actuators joints over N "
+        "ratios spaced geometrically from MIN to MAX",
+    )
     select = sub.add_parser(
         "select",
         help="choose each joint's motor, gearbox and drive from a catalog (exit 0: every joint "

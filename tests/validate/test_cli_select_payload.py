@@ -513,3 +513,50 @@ def test_select_end_to_end_equals_the_python_api(tmp_path, capsys):
         assert peak == pytest.approx(row["winding_temperature_peak"], rel=1e-9), joint
         assert np.max(np.abs(series["torque"])) == pytest.approx(row["motor_peak_torque"], rel=1e-9)
     assert "Thermal histories" in html and html.count("speed-torque plane of the motor of") >= 6
+
+
+@pytest.mark.parametrize(
+    "text, fragment",
+    [
+        ("20:200", "expected MIN:MAX:N"),
+        ("0:200:5", "need 0 < MIN <= MAX"),
+        ("300:200:5", "need 0 < MIN <= MAX"),
+        ("nan:200:5", "MIN ('nan') must be a finite number"),
+        ("20:inf:5", "MAX ('inf') must be a finite number"),
+        ("20:200:0", "N must be a whole number from 1 to 10000"),
+        ("20:200:1e9", "N must be a whole number"),
+        ("20:200:100000", "N must be a whole number from 1 to 10000"),
+    ],
+)
+def test_bad_sweep_exits_2(capsys, traj, tmp_path, text, fragment):
+    args = ["--trajectory", traj, "--actuators", tmp_path / "a.toml", "--out", tmp_path]
+    code, _, err = run_cli(capsys, "size", *args, f"--sweep={text}")
+    assert_one_line_exit_2(code, err, f"--sweep {text!r}", fragment)
+
+
+def test_sweep_needs_actuators_and_out(capsys, traj, tmp_path):
+    code, _, err = run_cli(capsys, "size", "--trajectory", traj, "--sweep", "10:100:5")
+    assert_one_line_exit_2(code, err, "--sweep needs --actuators")
+    (tmp_path / "a.toml").write_text("[pivot]\ngear_ratio = 50.0\nrotor_inertia = 2e-5\n")
+    args = ["--trajectory", traj, "--actuators", tmp_path / "a.toml", "--sweep", "10:100:5"]
+    code, _, err = run_cli(capsys, "size", *args)
+    assert_one_line_exit_2(code, err, "--sweep needs --out")
+
+
+def test_sweep_in_the_report_is_gear_ratio_sweep(capsys, traj, tmp_path):
+    toml = "[pivot]\ngear_ratio = 50.0\nrotor_inertia = 2e-5\n[pivot.motor]\n"
+    toml += "torque_constant = 0.05\ncontinuous_torque = 0.2\npeak_torque = 1.0\n"
+    (tmp_path / "a.toml").write_text(toml)
+    args = ["--trajectory", traj, "--actuators", tmp_path / "a.toml", "--out", tmp_path / "o"]
+    code, _, err = run_cli(capsys, "size", *args, "--sweep", "10:300:13")
+    assert code in (0, 1), err
+    html = (tmp_path / "o" / "report.html").read_text("utf-8")
+    model = ad.load_urdf(URDF)
+    run = cli.planned_motion(model, traj)
+    sweep = ad.gear_ratio_sweep(
+        run, model, np.geomspace(10, 300, 13), cli.read_actuators(tmp_path / "a.toml")
+    )
+    best = sweep.summary.loc["pivot", "best_ratio"]
+    assert "RMS motor torque against the gear ratio per joint" in html
+    assert f"<td>{best:.4g}</td>" in html  # the summary table's best ratio
+    assert (tmp_path / "o" / "sweep.png").read_bytes()[:4] == b"\x89PNG"

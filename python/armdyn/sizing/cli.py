@@ -44,6 +44,9 @@ so; ``armdyn select`` takes them). Every option string is checked before a file 
 build without ``Model.with_payload`` or ``armdyn.duty_cycle`` refuses the options that need
 them (exit code 2, naming what is missing) rather than ignoring them.
 
+``--sweep MIN:MAX:N`` (with ``--actuators`` and ``--out``, :func:`parse_sweep`): the report
+adds the gear-ratio sweep of the TOML's joints (:func:`armdyn.gear_ratio_sweep`).
+
 ``armdyn select ROBOT.urdf --trajectory FILE.csv --catalog PATH [--objective
 mass|cost|bus_power|margin] [the options above] [--out DIR]`` (:func:`select_run`): the
 drivetrain selection (``armdyn.select_drivetrain``) on the catalog(s) (``armdyn.load_catalog``;
@@ -239,6 +242,7 @@ def run(
     cycle=None,
     dwell=None,
     options=None,
+    sweep=None,
 ) -> int:
     """The ``armdyn size`` command: returns the exit code (0 all ok, 1 some joint not ok).
 
@@ -254,6 +258,11 @@ def run(
     mass_com = parse_payload(payload) if payload is not None else None
     repeat, dwell_s = _cycle_strings(cycle, dwell)  # checked before any file is read
     overrides = sizing_options_from_strings(options or {})
+    ratios = parse_sweep(sweep) if sweep is not None else None
+    if ratios is not None and not actuators:
+        raise _core.ModelError("--sweep needs --actuators (the motors and rotors it sweeps)")
+    if ratios is not None and out is None:
+        raise _core.ModelError("--sweep needs --out (the sweep is a section of the report)")
     spec = read_actuators(actuators) if actuators else None
     model = load_robot(urdf, mass_com, payload_frame)
     run_ = planned_motion(model, trajectory)
@@ -268,7 +277,10 @@ def run(
     if duty is not None:
         winding_temperature_check(report, duty, spec or {}, overrides)
     if out is not None:
-        report.save(out)
+        from armdyn.sizing.selection import gear_ratio_sweep
+
+        swept = gear_ratio_sweep(run_, model, ratios, spec) if ratios is not None else None
+        report.save(out, sweep=swept)
     with pd.option_context("display.max_columns", None, "display.width", 200):
         echo(report.table.to_string(float_format=lambda v: f"{v:.4g}"))
     bad = [str(j) for j, ok in report.table["ok"].items() if not ok]
@@ -481,6 +493,26 @@ def add_payload(model, mass_com: tuple[float, tuple[float, float, float]], frame
     return model.with_payload(frame, mass, com=com)
 
 
+#: the most gear ratios ``--sweep`` evaluates
+MAX_SWEEP = 10_000
+
+
+def parse_sweep(text: str) -> np.ndarray:
+    """``--sweep MIN:MAX:N``: N gear ratios spaced geometrically from MIN to MAX (0 < MIN <=
+    MAX finite, 1 <= N <= :data:`MAX_SWEEP`)."""
+    fields = str(text).split(":")
+    if len(fields) != 3:
+        raise _core.ModelError(f"--sweep {text!r}: expected MIN:MAX:N (e.g. 20:200:19)")
+    lo = _number("--sweep", fields[0].strip(), "MIN", str(text))
+    hi = _number("--sweep", fields[1].strip(), "MAX", str(text))
+    n = fields[2].strip()
+    if not (0.0 < lo <= hi):
+        raise _core.ModelError(f"--sweep {text!r}: need 0 < MIN <= MAX")
+    if not n.isdigit() or not 1 <= int(n) <= MAX_SWEEP:
+        raise _core.ModelError(f"--sweep {text!r}: N must be a whole number from 1 to {MAX_SWEEP}")
+    return np.geomspace(lo, hi, int(n))
+
+
 def parse_repeat(text: str) -> int | None:
     """``--cycle N|forever``: a positive repeat count, or None for ``forever``."""
     t = str(text).strip()
@@ -593,6 +625,7 @@ def main(args) -> int:
             cycle=args.cycle,
             dwell=args.dwell,
             options=option_strings(args),
+            sweep=args.sweep,
         )
     except (_core.ModelError, _core.UrdfError, _core.SolverError, OSError) as exc:
         print(f"armdyn size: {exc}", file=sys.stderr)
