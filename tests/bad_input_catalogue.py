@@ -967,6 +967,70 @@ CASES = [
         "model is required",
     ),
     (
+        "cli-payload-count",
+        "sizing",
+        "`--payload 1,2` (neither MASS nor MASS,X,Y,Z)",
+        lambda: _cli().parse_payload("1,2"),
+        ME,
+        r"--payload '1,2'.*MASS,X,Y,Z",
+    ),
+    (
+        "cli-payload-mass",
+        "sizing",
+        "`--payload -1` (a negative mass)",
+        lambda: _cli().parse_payload("-1"),
+        ME,
+        r"--payload '-1'.*> 0 kg",
+    ),
+    (
+        "cli-payload-com-nan",
+        "sizing",
+        "`--payload 3,0,nan,0` (a NaN centre of mass)",
+        lambda: _cli().parse_payload("3,0,nan,0"),
+        ME,
+        r"--payload '3,0,nan,0'.*centre of mass' y",
+    ),
+    (
+        "cli-payload-frame",
+        "sizing",
+        "`--payload-frame` naming no frame of the robot",
+        lambda: _cli().payload_frame(_pendulum(), "tool0"),
+        ME,
+        r"--payload-frame 'tool0'.*no such frame",
+    ),
+    (
+        "cli-cycle",
+        "sizing",
+        "`--cycle 0` (not a positive count nor forever)",
+        lambda: _cli().parse_repeat("0"),
+        ME,
+        r"--cycle '0'",
+    ),
+    (
+        "cli-dwell",
+        "sizing",
+        "`--dwell -1` (a negative duration)",
+        lambda: _cli().parse_seconds("-1"),
+        ME,
+        r"--dwell '-1'",
+    ),
+    (
+        "cli-option",
+        "sizing",
+        "`--life 0` (a check option out of its range)",
+        lambda: _cli().sizing_options_from_strings({"required_life": "0"}),
+        ME,
+        r"--required-life.*required_life",
+    ),
+    (
+        "cli-catalog-device",
+        "sizing",
+        "`--catalog /dev/zero` (a device, not a folder or a file)",
+        lambda: _cli().catalog_paths(["/dev/zero"]),
+        ME,
+        r"--catalog '/dev/zero' is a character device",
+    ),
+    (
         "select-objective",
         "sizing",
         "select_drivetrain with an unknown objective",
@@ -1075,6 +1139,12 @@ CASES = [
         "hinge",
     ),
 ]
+
+
+def _cli():
+    from armdyn.sizing import cli
+
+    return cli
 
 
 def _catalog_without_drives():

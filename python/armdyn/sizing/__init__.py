@@ -45,8 +45,11 @@ One module per concern (every name below is also importable from ``armdyn.sizing
 - :mod:`armdyn.sizing.drivetrain` / :mod:`armdyn.sizing.select`: the drivetrain selection from
   a catalog (:func:`select_drivetrain`, :class:`DrivetrainSelection`);
 - :mod:`armdyn.sizing.report`: :func:`sizing_report`, :class:`SizingReport`;
-- :mod:`armdyn.sizing.writer`: the report's files (``table.csv``, figures, ``report.html``);
-- :mod:`armdyn.sizing.cli`: the ``armdyn size`` command (trajectory CSV, actuators TOML);
+- :mod:`armdyn.sizing.writer`: the report's files (``table.csv``, figures, ``report.html``) and
+  the page's models of a report and of a selection;
+- :mod:`armdyn.sizing.html`: the verdict-first page, rendered from an explicit model;
+- :mod:`armdyn.sizing.cli`: the ``armdyn size`` and ``armdyn select`` commands (trajectory CSV,
+  actuators TOML, payload, duty cycle and check options).
 - :mod:`armdyn.sizing.catalog`: catalogs of motors, gearboxes and drives (:func:`load_catalog`,
   :class:`Catalog`, the example ``EXAMPLE_CATALOG``, the declared columns).
 
