@@ -70,6 +70,7 @@ from pathlib import Path
 import numpy as np
 
 from armdyn import _checks, _core
+from armdyn.sizing import drivetrain as _drivetrain
 from armdyn.sizing.what_if import _ACTUATOR_FIELDS, MOTOR_FIELDS, _actuator_numbers
 
 #: the keys of a joint's table (add_actuator's keywords; its motor is a sub-table)
@@ -635,7 +636,7 @@ def main(args) -> int:
 # --------------------------------------------------------------------------- armdyn select
 
 #: the objectives of ``armdyn select`` (armdyn.select_drivetrain's)
-OBJECTIVES = ("mass", "cost", "bus_power", "margin")
+OBJECTIVES = _drivetrain.OBJECTIVES
 
 
 def catalog_paths(paths) -> list[Path]:

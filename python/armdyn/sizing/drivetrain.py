@@ -42,8 +42,15 @@ from armdyn import _core
 from armdyn.sizing import motor as _motor_module
 from armdyn.sizing.checks import CHECKS, verdict
 
+#: the objectives of the selection, each with its label (and unit) in figures
+OBJECTIVE_LABELS: dict[str, str] = {
+    "mass": "mass [kg]",
+    "cost": "cost",
+    "bus_power": "peak electrical power [W]",
+    "margin": "least margin",
+}
 #: the objectives of the selection
-OBJECTIVES: tuple[str, ...] = ("mass", "cost", "bus_power", "margin")
+OBJECTIVES: tuple[str, ...] = tuple(OBJECTIVE_LABELS)
 
 #: candidates × samples per chunk of the motor-side evaluation (bounds the memory of the
 #: (k, n) arrays the vectorised functions build)

@@ -31,8 +31,10 @@ best margin reached on it, by which parts.
 from __future__ import annotations
 
 import dataclasses
+import os
 import warnings
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -100,6 +102,7 @@ class DrivetrainSelection:
         model: the model carrying the chosen actuators (the one the table's values are of).
         cycle: the duty cycle on that model.
         options: the :class:`armdyn.sizing.options.SizingOptions` used.
+        catalog: the catalog the parts were chosen from.
     """
 
     table: Any
@@ -112,6 +115,7 @@ class DrivetrainSelection:
     model: Any
     cycle: Any
     options: Any
+    catalog: Any = field(repr=False)
     _parts: CatalogParts = field(repr=False)
     _evaluations: dict = field(repr=False)
 
@@ -127,6 +131,18 @@ class DrivetrainSelection:
                 if k.endswith("_margin") and np.ndim(v) == 0
             )
         return bool(self.converged and bool(self.table["ok"].all()) and bus_ok)
+
+    def save(self, directory: str | os.PathLike[str]) -> Path:
+        """Write the selection's report into ``directory`` (created if missing):
+        ``report.html`` (one self-contained page: the verdict first, one row per joint with its
+        parts, pass or fail, binding check and margin; then the checks by part, the duty
+        cycle's torques, each chosen motor's temperatures and operating points, the ranking
+        and each joint's objective against its least margin), its figures and
+        ``selection.csv`` (:attr:`table`). Needs matplotlib (the ``plot`` extra). Returns the
+        page's path."""
+        from armdyn.sizing.writer import write_selection_report
+
+        return write_selection_report(self, directory, self.catalog)
 
     def candidates(self, joint: str, n: int | None = None):
         """The joint's candidates ranked, best first (the choice is rank 1): a DataFrame
@@ -657,6 +673,7 @@ def select_drivetrain(
         model=search.current_model,
         cycle=search.cycle_now(),
         options=options,
+        catalog=catalog,
         _parts=parts,
         _evaluations={j: search.evaluations[j] for j in joints},
     )

@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from armdyn.sizing.checks import CHECKS, Check
+from armdyn.sizing.drivetrain import OBJECTIVE_LABELS
 from armdyn.sizing.html import (
     ReportFigure,
     ReportModel,
@@ -533,7 +534,7 @@ def _ranking_section(selection: Any, joints: list[str], objective: str) -> Secti
         ax.plot(m[:1], y[:1], "o", mfc="none", mec="k", ms=11, label="ranked first")
         ax.axvline(1.0, color="k", ls="--", lw=0.8)
         ax.set_xscale("log")
-        ax.set_ylabel(objective or column)
+        ax.set_ylabel(OBJECTIVE_LABELS.get(objective, objective or column))
         ax.set_title(str(joint), fontsize="medium")
         ax.grid(lw=0.3, which="both")
     axes[-1].set_xlabel("least margin (log; >= 1 passes)")
