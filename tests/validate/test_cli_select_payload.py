@@ -94,17 +94,6 @@ def test_default_payload_frame_is_the_last_frame():
     assert cli.payload_frame(model, "base") == "base"
 
 
-@pytest.mark.skipif(
-    hasattr(ad.load_urdf(URDF), "with_payload"), reason="Model.with_payload is in this build"
-)
-def test_payload_without_the_helper_says_so(capsys, traj):
-    code, _, err = run_cli(capsys, "size", "--trajectory", traj, "--payload", "1")
-    assert_one_line_exit_2(code, err, "--payload needs Model.with_payload")
-
-
-@pytest.mark.skipif(
-    not hasattr(ad.load_urdf(URDF), "with_payload"), reason="Model.with_payload not merged yet"
-)
 def test_payload_adds_its_closed_form_torque(tmp_path, capsys):
     """A point mass m_p at (0, 0, -0.8) in the axes of the pendulum's link 'arm' (its origin on
     the pivot axis): tau = (I_p + m_p 0.8^2) qdd + (m g l + m_p g 0.8) sin q."""
@@ -222,39 +211,11 @@ def test_size_refuses_what_it_does_not_check(capsys, traj):
     assert_one_line_exit_2(code, err, "--ambient-temperature: the winding temperature is checked")
 
 
-@pytest.mark.skipif(hasattr(ad, "duty_cycle"), reason="armdyn.duty_cycle is in this build")
-def test_size_with_a_dwell_says_what_it_needs(capsys, traj):
-    code, _, err = run_cli(capsys, "size", "--trajectory", traj, "--dwell", "1")
-    assert_one_line_exit_2(code, err, "armdyn size --dwell needs armdyn.duty_cycle")
-
-
-def stand_in_duty_cycle(model, motion, dwell=0.0, repeat=None):
-    """The spec's DutyCycle contract (issue 33 part 4) for this test: the motion's samples, then
-    the dwell's at its start and end holding the last pose with the holding torques."""
-    from types import SimpleNamespace
-
-    t, q, qd, qdd = motion.t, motion.q, motion.qd, motion.qdd
-    hold = ad.inverse_dynamics(model, q[-1:], np.zeros_like(qd[-1:]), np.zeros_like(qd[-1:]))
-    return SimpleNamespace(
-        t=np.concatenate([t, [t[-1], t[-1] + dwell]]),
-        q=np.concatenate([q, q[-1:], q[-1:]]),
-        qd=np.concatenate([qd, np.zeros((2, qd.shape[1]))]),
-        qdd=np.concatenate([qdd, np.zeros((2, qd.shape[1]))]),
-        torque=np.concatenate([motion.joint_torques, hold, hold]),
-        repeat=repeat,
-    )
-
-
-@pytest.mark.parametrize("which", ["stand-in", "armdyn.duty_cycle"])
-def test_dwell_counts_the_holding_torque(tmp_path, capsys, monkeypatch, which):
+def test_dwell_counts_the_holding_torque(tmp_path, capsys):
     """The pendulum swung from 0 to A = 0.6 rad in 1 s (ending at rest), then held 2 s: the
     report's RMS torque is sqrt((int_0^1 tau^2 dt + 2 (m g l sin A)^2) / 3) with tau = I_p qdd
     + m g l sin q (the trapezoid rule over the motion's samples), its peak the larger of the
     motion's and the holding torque."""
-    if which == "stand-in":
-        monkeypatch.setattr(ad, "duty_cycle", stand_in_duty_cycle, raising=False)
-    elif not hasattr(ad, "duty_cycle"):
-        pytest.skip("armdyn.duty_cycle (issue 33 part 4) is not merged yet")
     a, t = 0.6, np.linspace(0.0, 1.0, 401)
     q = a * (1 - np.cos(np.pi * t)) / 2
     qd, qdd = a * np.pi / 2 * np.sin(np.pi * t), a * np.pi**2 / 2 * np.cos(np.pi * t)
@@ -344,15 +305,6 @@ def test_select_bad_payload_cycle_and_options(capsys, traj, tmp_path):
         assert_one_line_exit_2(code, err, "armdyn select: " + fragment)
 
 
-@pytest.mark.skipif(
-    hasattr(ad, "select_drivetrain") and hasattr(ad, "duty_cycle"),
-    reason="the selection is in this build",
-)
-def test_select_says_what_this_build_lacks(capsys, traj, tmp_path):
-    code, _, err = select(capsys, traj, "--dwell", "0.5", catalog=tmp_path)
-    assert_one_line_exit_2(code, err, "armdyn select needs armdyn.")
-
-
 def test_select_wiring_with_stand_ins(capsys, traj, tmp_path, monkeypatch):
     """The command's calls, with stand-ins of parts 3, 4 and 6 (their contracts in the issue's
     spec): the catalog paths, the cycle's dwell and repeat, the objective and the options reach
@@ -375,12 +327,16 @@ def test_select_wiring_with_stand_ins(capsys, traj, tmp_path, monkeypatch):
         sel.cycle = None  # the stand-in cycle has no joint loads to draw
         return sel
 
-    for name, fn in [
-        ("duty_cycle", duty_cycle),
-        ("load_catalog", load_catalog),
-        ("select_drivetrain", select_drivetrain),
+    import armdyn.sizing.catalog
+    import armdyn.sizing.cycle
+    import armdyn.sizing.select
+
+    for module, fn in [
+        (armdyn.sizing.cycle, duty_cycle),
+        (armdyn.sizing.catalog, load_catalog),
+        (armdyn.sizing.select, select_drivetrain),
     ]:
-        monkeypatch.setattr(ad, name, fn, raising=False)
+        monkeypatch.setattr(module, fn.__name__, fn)
     (tmp_path / "more.csv").write_text("name\n")
     args = ["--catalog", tmp_path / "more.csv", "--objective", "cost", "--cycle", "50"]
     args += ["--dwell", "0.5", "--life", "3e4", "--ambient", "25", "--out", tmp_path / "out"]
@@ -401,7 +357,6 @@ def test_select_wiring_with_stand_ins(capsys, traj, tmp_path, monkeypatch):
     assert calls["cycle"][2:] == (1.0, None)
 
 
-@pytest.mark.skipif(not hasattr(ad, "duty_cycle"), reason="armdyn.duty_cycle not merged yet")
 def test_size_checks_the_winding_temperature_of_the_repeated_cycle(tmp_path, capsys):
     """A motor with a one-node thermal model whose time constant (1e6 s) is far longer than the
     3 s period: at the periodic steady state (--cycle forever) the winding's temperature is the
@@ -456,7 +411,6 @@ def test_size_checks_the_winding_temperature_of_the_repeated_cycle(tmp_path, cap
     assert t_s[-1] - t_s[0] == pytest.approx(3.0) and np.isnan(housing).all()  # one node
 
 
-@pytest.mark.skipif(not hasattr(ad, "select_drivetrain"), reason="part 6 not merged yet")
 def test_select_end_to_end_equals_the_python_api(tmp_path, capsys):
     """`armdyn select` on the UR5 (example-robot-data) with the example catalog, a 3 kg payload
     at the last frame (tool0) and a 1 s dwell: the same choice as the Python calls it stands

@@ -552,7 +552,6 @@ def _ur5_pick_and_place():
     path = common.robot_urdf("ur5")
     if path is None:
         pytest.skip("example-robot-data is not installed")
-    pytest.importorskip("armdyn.sizing.gearbox", reason="issue 33 part 5 not merged yet")
     arm = ad.load_urdf(str(path))
     model = arm.with_payload("tool0", 3.0, com=(0.0, 0.0, 0.05))
     t = np.linspace(0.0, 1.5, 151)

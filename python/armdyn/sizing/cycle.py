@@ -225,7 +225,7 @@ def _motion(model, motion) -> _Motion:
     """The motion's samples over the model's coordinates from a TrajectoryRun, a
     SimulationResult, a trajectory CSV path or a (t, q, qd, qdd) tuple."""
     if isinstance(motion, (str, os.PathLike)):
-        from armdyn.sizing.cli import read_trajectory
+        from armdyn.sizing.files import read_trajectory
 
         return _Motion(*read_trajectory(motion, model))
     if isinstance(motion, tuple) and len(motion) == 4:
@@ -285,7 +285,7 @@ def duty_cycle(model, motion: Any, dwell: float = 0.0, repeat: int | None = None
         model: a joint-space model (the torques are its inverse dynamics along the motion).
         motion: a :class:`armdyn.sizing.TrajectoryRun`, an :class:`armdyn.SimulationResult`
             of a joint-space model (its joint columns), a trajectory CSV path (the format of
-            ``armdyn size``: :func:`armdyn.sizing.cli.read_trajectory`) or ``(t, q, qd,
+            ``armdyn size``: :func:`armdyn.sizing.files.read_trajectory`) or ``(t, q, qd,
             qdd)``. Its times must be strictly increasing and it must end at rest.
         dwell: the hold after the motion [s], finite, 0 ≤ dwell ≤ ``MAX_DWELL``.
         repeat: a positive integer, or None (the periodic steady state).
