@@ -12,7 +12,8 @@
 // finalize makes from that description: bit for bit the original on the same armdyn build.
 // The format is private to armdyn: it starts with a magic tag and a format version, checked on
 // load; this armdyn writes version 3 and reads 2 and 3 (2 lacks the motor datasheet fields after
-// the first nine of MotorSpec::fields(): they load as not given). The derived caches (KKT plans, the welded model) are built again on first use.
+// the first nine of MotorSpec::fields(): they load as not given). The derived caches (KKT plans,
+// the welded model) are built again on first use.
 #pragma once
 
 #include <string>
