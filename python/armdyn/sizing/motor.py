@@ -230,23 +230,9 @@ CYCLE_VALUES = (
     "energy_regenerated",
 )
 
-#: the motor's numeric datasheet fields the cycle values read (NaN where a mapping lacks one)
-_MOTOR_NUMBERS = (
-    "torque_constant",
-    "resistance",
-    "voltage",
-    "no_load_speed",
-    "continuous_torque",
-    "peak_torque",
-    "max_speed",
-    "thermal_resistance",
-    "thermal_time_constant",
-    "thermal_resistance_winding",
-    "thermal_resistance_housing",
-    "thermal_time_constant_winding",
-    "thermal_time_constant_housing",
-    "max_winding_temperature",
-)
+#: the motor's numeric datasheet fields the cycle values read (NaN where a mapping lacks one):
+#: armdyn.Motor's, its one list
+_MOTOR_NUMBERS: tuple[str, ...] = tuple(_core.Motor.FIELDS)
 
 
 def _candidate_arrays(who: str, ratio, efficiency, rotor_inertia):
