@@ -1,6 +1,6 @@
 """What-if actuators: stand-ins with the attributes of ``model.actuators`` entries, built from a
-``{joint: spec}`` (a dict or an object with those attributes) for a joint the model does not
-actuate (:func:`what_if_actuators`, the ``actuators=`` of :func:`sizing_report`) or for the
+``{joint: spec}`` (a dict or an object with those attributes; catalog parts may stand for the
+numbers) for a joint the model does not actuate (:func:`what_if_actuators`, the ``actuators=`` of :func:`sizing_report`) or for the
 gear-ratio sweep; and motors from their datasheet keywords (:func:`make_motor`). The numbers
 are checked by the rules of ``ModelBuilder.add_actuator``."""
 
@@ -59,8 +59,12 @@ def what_if_actuators(model, names, actuators) -> list:
     ``{joint: spec}``: ``gear_ratio`` and ``rotor_inertia`` required (``rotor_inertia``: else
     the motor's datasheet value), ``efficiency`` (1),
     ``friction_viscous``, ``friction_coulomb`` (0), ``friction_smoothing`` (None: 1e-3 |N|)
-    and ``motor`` (an :class:`armdyn.Motor`, a dict of its keywords, or None) optional; a dict
-    or an object with those attributes."""
+    and ``motor`` (an :class:`armdyn.Motor`, a dict of its keywords, a catalog row, or None)
+    optional; a dict or an object with those attributes. Catalog parts may stand for the
+    numbers: ``gearbox`` (a :class:`armdyn.sizing.catalog.Gearbox` or a row of
+    ``catalog.gearboxes``) gives ``gear_ratio`` (its ``ratio``) and ``efficiency``, and the
+    rotor inertia is then the motor's ``rotor_inertia`` plus the gearbox's ``input_inertia``;
+    a value the spec gives wins."""
     own = {str(a.joint) for a in (getattr(model, "actuators", None) or [])}
     dofs = list(model.dof_names)
     out = []
@@ -74,21 +78,21 @@ def what_if_actuators(model, names, actuators) -> list:
         if joint not in names or joint not in dofs:
             raise _core.ModelError(f"actuators: {joint!r} is not a joint coordinate ({dofs})")
 
-        unknown = sorted(set(spec) - set(_ACTUATOR_FIELDS)) if isinstance(spec, dict) else []
+        allowed = (*_ACTUATOR_FIELDS, "gearbox")
+        unknown = sorted(set(spec) - set(allowed)) if isinstance(spec, dict) else []
         if unknown:
             raise _core.ModelError(f"actuators: [{joint}] unknown key(s) {unknown}")
-        motor = spec.get("motor") if isinstance(spec, dict) else getattr(spec, "motor", None)
-        if isinstance(motor, dict):
-            motor = make_motor(**motor)
+        motor = _spec_motor(joint, spec)
+        gearbox = spec.get("gearbox") if isinstance(spec, dict) else getattr(spec, "gearbox", None)
 
-        def get(key, default=None, spec=spec, motor=motor):
+        def get(key, default=None, spec=spec, motor=motor, gearbox=gearbox):
             if isinstance(spec, dict):
-                value = spec.get(key, default)
+                value = spec.get(key)
             else:
-                value = getattr(spec, key, default)
-            if value is None and key == "rotor_inertia":  # the motor's datasheet value
-                value = getattr(motor, "rotor_inertia", None)
-            return value
+                value = getattr(spec, key, None)
+            if value is None:
+                value = _from_parts(key, motor, gearbox)
+            return default if value is None else value
 
         for key in ("gear_ratio", "rotor_inertia"):
             if get(key) is None:
@@ -112,6 +116,42 @@ def what_if_actuators(model, names, actuators) -> list:
             )
         )
     return out
+
+
+def _spec_motor(joint: str, spec):
+    """The spec's motor: an armdyn.Motor, None, a dict of Motor keywords (make_motor: an unknown
+    key is an error), or a catalog row (a pandas Series or other mapping: Motor.from_row, its
+    other columns ignored)."""
+    motor = spec.get("motor") if isinstance(spec, dict) else getattr(spec, "motor", None)
+    if isinstance(motor, dict):
+        return make_motor(**motor)
+    if motor is not None and not isinstance(motor, _core.Motor) and hasattr(motor, "keys"):
+        return _core.Motor.from_row(motor)
+    return motor
+
+
+def _part_value(part, key: str):
+    """A part's value: an attribute (a catalog Gearbox) or an entry (a row, a mapping); None
+    when it has none or it is NaN."""
+    value = part.get(key) if hasattr(part, "keys") else getattr(part, key, None)
+    if value is None or (isinstance(value, float) and value != value):
+        return None
+    return value
+
+
+def _from_parts(key: str, motor, gearbox):
+    """What the spec's parts give for an actuator key it leaves out: a gearbox (a catalog
+    Gearbox or row) its ``ratio`` and ``efficiency``; the rotor inertia is the motor's
+    ``rotor_inertia`` plus the gearbox's ``input_inertia`` (the gearbox's alone needs the
+    motor's: None without it)."""
+    if gearbox is not None and key in ("gear_ratio", "efficiency"):
+        return _part_value(gearbox, "ratio" if key == "gear_ratio" else "efficiency")
+    if key == "rotor_inertia" and motor is not None:
+        j = getattr(motor, "rotor_inertia", None)
+        if j is not None and gearbox is not None:
+            j += _part_value(gearbox, "input_inertia") or 0.0
+        return j
+    return None
 
 
 def _actuator_numbers(who: str, get) -> dict:
