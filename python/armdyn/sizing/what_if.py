@@ -1,8 +1,8 @@
 """What-if actuators: stand-ins with the attributes of ``model.actuators`` entries, built from a
 ``{joint: spec}`` (a dict or an object with those attributes; catalog parts may stand for the
-numbers) for a joint the model does not actuate (:func:`what_if_actuators`, the ``actuators=`` of :func:`sizing_report`) or for the
-gear-ratio sweep; and motors from their datasheet keywords (:func:`make_motor`). The numbers
-are checked by the rules of ``ModelBuilder.add_actuator``."""
+numbers) for a joint the model does not actuate (:func:`what_if_actuators`, the ``actuators=``
+of :func:`sizing_report`) or for the gear-ratio sweep; and motors from their datasheet keywords
+(:func:`make_motor`). The numbers are checked by the rules of ``ModelBuilder.add_actuator``."""
 
 from __future__ import annotations
 
