@@ -434,6 +434,63 @@ CASES = [
         ME,
         r"format version 1",
     ),
+    # ---- motor datasheet and payloads (issue 33)
+    (
+        "motor-brake-negative",
+        "motor",
+        "a motor's brake_torque −1",
+        lambda: ad.Motor(brake_torque=-1.0),
+        ME,
+        r"Motor: brake_torque must be finite and > 0",
+    ),
+    (
+        "motor-row-bad-value",
+        "motor",
+        "a catalog row with mass 'heavy'",
+        lambda: ad.Motor.from_row({"name": "M1", "mass": "heavy"}),
+        ME,
+        r"Motor.from_row 'M1': mass must be a real number",
+    ),
+    (
+        "motor-row-not-mapping",
+        "motor",
+        "a list as a catalog row",
+        lambda: ad.Motor.from_row([1.0]),
+        ME,
+        r"Motor.from_row: row must be a mapping",
+    ),
+    (
+        "payload-mass-negative",
+        "payload",
+        "with_payload mass −1",
+        lambda: _pendulum().with_payload("link", -1.0),
+        ME,
+        r"with_payload: mass must be finite and >= 0, got -1",
+    ),
+    (
+        "payload-inertia-unphysical",
+        "payload",
+        "with_payload inertia (1, 1, 3): triangle inequality",
+        lambda: _pendulum().with_payload("link", 1.0, inertia=[1.0, 1.0, 3.0]),
+        ME,
+        r"with_payload: inertia violates the triangle inequality",
+    ),
+    (
+        "payload-at-unknown",
+        "payload",
+        "with_payload at a name that is no frame or body",
+        lambda: _pendulum().with_payload("nowhere", 1.0),
+        ME,
+        r"with_payload: at 'nowhere' is neither a frame, a body nor a joint",
+    ),
+    (
+        "payload-name-taken",
+        "payload",
+        "with_payload named as a body of the model",
+        lambda: _pendulum().with_payload("link", 1.0, name="link"),
+        ME,
+        r"with_payload: name 'link' is taken by a body",
+    ),
     # ---- URDF
     (
         "urdf-mass-overflow",
@@ -862,6 +919,30 @@ CASES = [
         "qdd",
     ),
     (
+        "jr-qdd-nan",
+        "inverse dynamics",
+        "joint_reactions with qdd NaN",
+        lambda: ad.joint_reactions(_pendulum(), [0.0], [0.0], [np.nan]),
+        ME,
+        "qdd",
+    ),
+    (
+        "jr-on-loop",
+        "inverse dynamics",
+        "joint_reactions on a closed loop",
+        lambda: ad.joint_reactions(ad.scenes.four_bar(), np.zeros(4), np.zeros(4), np.zeros(4)),
+        ME,
+        "loop",
+    ),
+    (
+        "jr-overflow",
+        "inverse dynamics",
+        "joint_reactions with qdd = 1.7e308 (finite; the forces overflow)",
+        lambda: ad.joint_reactions(_heavy_pendulum(), [0.0], [0.0], [1.7e308]),
+        SE,
+        r"qdd\[0\].*overflow",
+    ),
+    (
         "lagrange-loop",
         "validators",
         "Lagrange validator of a closed loop",
@@ -885,7 +966,237 @@ CASES = [
         ME,
         "model is required",
     ),
+    (
+        "cli-payload-count",
+        "sizing",
+        "`--payload 1,2` (neither MASS nor MASS,X,Y,Z)",
+        lambda: _cli().parse_payload("1,2"),
+        ME,
+        r"--payload '1,2'.*MASS,X,Y,Z",
+    ),
+    (
+        "cli-payload-mass",
+        "sizing",
+        "`--payload -1` (a negative mass)",
+        lambda: _cli().parse_payload("-1"),
+        ME,
+        r"--payload '-1'.*> 0 kg",
+    ),
+    (
+        "cli-payload-com-nan",
+        "sizing",
+        "`--payload 3,0,nan,0` (a NaN centre of mass)",
+        lambda: _cli().parse_payload("3,0,nan,0"),
+        ME,
+        r"--payload '3,0,nan,0'.*centre of mass' y",
+    ),
+    (
+        "cli-payload-frame",
+        "sizing",
+        "`--payload-frame` naming no frame of the robot",
+        lambda: _cli().payload_frame(_pendulum(), "tool0"),
+        ME,
+        r"--payload-frame 'tool0'.*no such frame",
+    ),
+    (
+        "cli-cycle",
+        "sizing",
+        "`--cycle 0` (not a positive count nor forever)",
+        lambda: _cli().parse_repeat("0"),
+        ME,
+        r"--cycle '0'",
+    ),
+    (
+        "cli-dwell",
+        "sizing",
+        "`--dwell -1` (a negative duration)",
+        lambda: _cli().parse_seconds("-1"),
+        ME,
+        r"--dwell '-1'",
+    ),
+    (
+        "cli-option",
+        "sizing",
+        "`--life 0` (a check option out of its range)",
+        lambda: _cli().sizing_options_from_strings({"required_life": "0"}),
+        ME,
+        r"--required-life.*required_life",
+    ),
+    (
+        "cli-catalog-device",
+        "sizing",
+        "`--catalog /dev/zero` (a device, not a folder or a file)",
+        lambda: _cli().catalog_paths(["/dev/zero"]),
+        ME,
+        r"--catalog '/dev/zero' is a character device",
+    ),
+    (
+        "select-objective",
+        "sizing",
+        "select_drivetrain with an unknown objective",
+        lambda: ad.select_drivetrain(_pendulum(), None, None, objective="weight"),
+        ME,
+        "objective",
+    ),
+    (
+        "select-no-drives",
+        "sizing",
+        "select_drivetrain with drives=True and a catalog without drives",
+        lambda: ad.select_drivetrain(_pendulum(), None, _catalog_without_drives()),
+        ME,
+        "drives=True but the catalog has no drives",
+    ),
+    (
+        "gearbox-ratio-zero",
+        "sizing",
+        "gearbox_cycle_values with a zero gear ratio",
+        lambda: _gearbox().gearbox_cycle_values(_joint_load(), [0.0], {}),
+        ME,
+        r"ratio\[0\] must be non-zero",
+    ),
+    (
+        "gearbox-column-negative",
+        "sizing",
+        "a gearbox catalog column below zero (rated_torque −1)",
+        lambda: _gearbox().gearbox_cycle_values(_joint_load(), [50.0], {"rated_torque": [-1.0]}),
+        ME,
+        r"gearboxes\['rated_torque'\]\[0\] must be > 0",
+    ),
+    (
+        "gearbox-empty-cycle",
+        "sizing",
+        "a joint load of one sample (no cycle to average over)",
+        lambda: _gearbox().gearbox_cycle_values(_joint_load(1), [50.0], {}),
+        ME,
+        "load.t must hold at least two samples",
+    ),
+    (
+        "bearing-axis-zero",
+        "sizing",
+        "bearing_cycle_values of a load whose joint axis is zero",
+        lambda: _gearbox().bearing_cycle_values(
+            _joint_load(axis=(0, 0, 0)), {"bearing_offset": [0]}
+        ),
+        ME,
+        "load.axis must be a non-zero vector",
+    ),
+    (
+        "bus-voltage-max-below",
+        "sizing",
+        "bus_values with the chopper voltage below the nominal bus voltage",
+        lambda: _drive().bus_values(
+            [0.0, 1.0], [[1.0, -1.0]], drives={"bus_voltage": 48.0, "max_bus_voltage": 40.0}
+        ),
+        ME,
+        r"drives\['max_bus_voltage'\]\[0\] is below",
+    ),
+    (
+        "catalog-mass-negative",
+        "catalogs",
+        "a motor of mass −1 kg (also read from motors.csv: named by file:line)",
+        lambda: ad.Catalog(_motors(mass=[-1.0])),
+        ME,
+        "part 'M1': column 'mass'",
+    ),
+    (
+        "catalog-duplicate",
+        "catalogs",
+        "two motors of one name",
+        lambda: ad.Catalog(_motors(name=["M1", "M1"])),
+        ME,
+        "motor 'M1' is already at",
+    ),
+    (
+        "catalog-peak-below-continuous",
+        "catalogs",
+        "a motor whose peak torque is below its continuous torque",
+        lambda: ad.Catalog(_motors(peak_torque=[0.4])),
+        ME,
+        "column 'peak_torque': 0.4 is less than continuous_torque",
+    ),
+    (
+        "cycle-dwell-nan",
+        "sizing",
+        "duty cycle with a NaN dwell",
+        lambda: ad.duty_cycle(_pendulum(), _rest_motion(), dwell=np.nan),
+        ME,
+        "dwell",
+    ),
+    (
+        "cycle-repeat-fraction",
+        "sizing",
+        "duty cycle repeated 1.5 times",
+        lambda: ad.duty_cycle(_pendulum(), _rest_motion(), repeat=1.5),
+        ME,
+        "repeat",
+    ),
+    (
+        "cycle-not-at-rest",
+        "sizing",
+        "duty cycle of a motion that ends moving",
+        lambda: ad.duty_cycle(_pendulum(), _rest_motion(end_rate=0.5), dwell=1.0),
+        ME,
+        "hinge",
+    ),
 ]
+
+
+def _cli():
+    from armdyn.sizing import cli
+
+    return cli
+
+
+def _catalog_without_drives():
+    """A catalog of one motor and one gearbox (the attributes select_drivetrain reads)."""
+    from types import SimpleNamespace
+
+    import pandas as pd
+
+    motors = pd.DataFrame({"mass": [0.5], "rotor_inertia": [1e-5]}, index=["M"])
+    gearboxes = pd.DataFrame(
+        {"mass": [0.4], "ratio": [100.0], "efficiency": [0.8], "input_inertia": [1e-6]},
+        index=["G"],
+    )
+    return SimpleNamespace(motors=motors, gearboxes=gearboxes, drives=None)
+
+
+def _gearbox():
+    from armdyn.sizing import gearbox
+
+    return gearbox
+
+
+def _drive():
+    from armdyn.sizing import drive
+
+    return drive
+
+
+def _joint_load(n=5, axis=(0.0, 0.0, 1.0)):
+    """JointLoad's fields (a stand-in) for a small cycle of n samples."""
+    from types import SimpleNamespace
+
+    t = np.linspace(0.0, 1.0, n)
+    z = np.zeros((n, 3))
+    return SimpleNamespace(t=t, speed=np.sin(t), torque=np.cos(t), force=z, moment=z, axis=axis)
+
+
+def _motors(**change):
+    """A one-motor table (two rows when ``name`` has two), with ``change`` applied."""
+    n = len(change.get("name", ["M1"]))
+    row = dict(name=["M1"], torque_constant=[0.1], resistance=[0.5], rotor_inertia=[1e-5])
+    row.update(mass=[0.3], continuous_torque=[0.5], peak_torque=[1.5])
+    row.update(change)
+    return {k: (v * n if len(v) == 1 else v) for k, v in row.items()}
+
+
+def _rest_motion(end_rate=0.0):
+    """(t, q, qd, qdd) of the hinge: at rest at both ends (its last rate ``end_rate``)."""
+    t = np.linspace(0.0, 1.0, 11)
+    qd = np.sin(np.pi * t)[:, None]
+    qd[-1] = end_rate
+    return t, np.zeros((11, 1)), qd, np.zeros((11, 1))
 
 
 def _modelless_result():

@@ -1,13 +1,14 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Bindings of the joint-space algorithms (armdyn/algorithm/): armdyn.Data, forward_dynamics,
-// inverse_dynamics, mass_matrix and dynamics_cost. One state (1-D arrays) or one state per row
-// (2-D arrays, evaluated in one C++ loop without the GIL). Without data=, each thread keeps one
-// Data per model, so repeated calls allocate nothing but their output array (rows.hpp).
+// inverse_dynamics, joint_reactions, mass_matrix and dynamics_cost. One state (1-D arrays) or one
+// state per row (2-D arrays, evaluated in one C++ loop without the GIL). Without data=, each thread
+// keeps one Data per model, so repeated calls allocate nothing but their output array (rows.hpp).
 #include <pybind11/stl.h>
 
 #include "armdyn/algorithm/cost_model.hpp"
 #include "armdyn/algorithm/crba.hpp"
 #include "armdyn/algorithm/dynamics.hpp"
+#include "armdyn/algorithm/reactions.hpp"
 #include "common.hpp"
 #include "rows.hpp"
 
@@ -71,6 +72,59 @@ py::array_t<double> inverse_dynamics_py(const ModelArg& model, const ArrayLike& 
                  });
   const VecArg qa(q, "q", d.niq), qda(qd, "qd", d.ni), aa(qdd, "qdd", d.ni);
   return vector_out(one(*qa, *qda, *aa, scalar_time(t, fn)));
+}
+
+// (forces, torques) from the reactions of one state (2, n_joints, 3) or of each row (rows, 2,
+// n_joints, 3), batch: the latter
+using ArrayPair = py::typing::Tuple<py::array_t<double>, py::array_t<double>>;
+
+ArrayPair split_reactions(const py::array_t<double>& both, bool batch) {
+  const long rows = batch ? static_cast<long>(both.shape(0)) : 1;
+  const auto nj = static_cast<py::ssize_t>(both.shape(batch ? 2 : 1));
+  std::vector<py::ssize_t> shape{nj, 3};
+  if (batch) shape.insert(shape.begin(), rows);
+  py::array_t<double> forces(shape), torques(shape);
+  const long block = 3 * static_cast<long>(nj);
+  const double* src = both.data();
+  double *fo = forces.mutable_data(), *to = torques.mutable_data();
+  for (long i = 0; i < rows; ++i) {
+    std::copy(src + 2 * i * block, src + (2 * i + 1) * block, fo + i * block);
+    std::copy(src + (2 * i + 1) * block, src + (2 * i + 2) * block, to + i * block);
+  }
+  return py::make_tuple(forces, torques);
+}
+
+ArrayPair joint_reactions_py(const ModelArg& model, const ArrayLike& q, const ArrayLike& qd,
+                             const ArrayLike& qdd, const OptTimes& t, const OptData& data) {
+  constexpr const char* fn = "joint_reactions";
+  const CallArgs a = call_args(model, data, fn);
+  Data& d = a.data;
+  const auto nj = static_cast<py::ssize_t>(a.model().joints.size());
+  const py::object tt = t.is_none() ? py::object(py::float_(0.0)) : py::object(t);
+  // forces then torques of one state, each (n_joints, 3) row-major
+  auto one = [&](const auto& qi, const auto& qdi, const auto& ai, double ti, double* out) {
+    const auto in = {named_input("q", qi), named_input("qd", qdi), named_input("qdd", ai)};
+    naming_huge_inputs(fn, in, [&]() {
+      joint_reactions(a.model(), d, qi, qdi, ai, ti, out, out + 3 * nj);
+      return 0;
+    });
+    check_finite_output(fn, "the reactions", out, 6 * nj, in);
+  };
+  if (is_batch(q)) {
+    try {
+      return split_reactions(batch(fn, d.niq, d.ni, q, qd, "qd", qdd, "qdd", tt, {2, nj, 3}, one),
+                             true);
+    } catch (PyInterrupted& e) {
+      // Ctrl-C: the rows done, as (forces, torques) too
+      const py::object err = e.err.value();
+      err.attr("result") = split_reactions(err.attr("result").cast<py::array_t<double>>(), true);
+      throw;
+    }
+  }
+  const VecArg qa(q, "q", d.niq), qda(qd, "qd", d.ni), aa(qdd, "qdd", d.ni);
+  py::array_t<double> both(std::vector<py::ssize_t>{2, nj, 3});
+  one(*qa, *qda, *aa, scalar_time(tt, fn), both.mutable_data());
+  return split_reactions(both, false);
 }
 
 py::array_t<double> mass_matrix_py(const ModelArg& model, const ArrayLike& q, const OptData& data) {
@@ -156,6 +210,19 @@ void bind_algorithm(py::module_& m) {
         "axis, gravity and the model's force elements included, drives ignored. method: 'joint' "
         "(recursive Newton-Euler), 'cartesian' (every coordinate driven, the drives' KKT "
         "multipliers), 'auto' (joint).");
+
+  m.def("joint_reactions", &joint_reactions_py, py::arg("model"), py::arg("q"), py::arg("qd"),
+        py::arg("qdd"), py::arg("t") = py::none(), py::arg("data") = py::none(),
+        "Every joint's reaction along a joint-space motion of a tree: (forces, torques), each "
+        "(n_joints, 3) for one state (q: n_coords, qd and qdd: n_dofs; a coupled model's "
+        "independent coordinates, as inverse_dynamics takes them) or (rows, n_joints, 3) for one "
+        "state per row; t [s] a number, one per row, or None (0). The same quantity as "
+        "SimulationResult.reaction_forces/reaction_torques: what the joint's constraint applies "
+        "to its child at the joint point, in the child's joint frame, for every joint of the "
+        "model (fixed joints included; zero for floating bases); the components about/along a "
+        "joint's free axes are zero (the actuator's torque there is inverse_dynamics'). The "
+        "joint torques are the inverse dynamics' (the motion is exactly the one given); gravity "
+        "and the force elements act, drives are ignored.");
 
   m.def("mass_matrix", &mass_matrix_py, py::arg("model"), py::arg("q"),
         py::arg("data") = py::none(),

@@ -2,6 +2,7 @@
 // armdyn.Model (armdyn/model/model.hpp): sizes, names, topology, limits, actuators, KKT path.
 // What the properties derive is in armdyn/model/properties.hpp; pickling: bind_pickle.cpp.
 #include "armdyn/builder/summary.hpp"
+#include "armdyn/io/payload.hpp"
 #include "convert_model.hpp"
 
 namespace armdyn {
@@ -195,6 +196,85 @@ void def_model_solver(ModelClass& c) {
       .def("__repr__", &model_repr);
 }
 
+/// A payload from with_payload's arguments (their types; with_payloads checks the values).
+Payload payload_arg(const py::handle& at, const py::handle& mass, const py::handle& com,
+                    const py::handle& inertia, const py::handle& name, const std::string& who) {
+  Payload p;
+  p.name = str_arg(name, who.c_str(), "name");
+  p.at = str_arg(at, who.c_str(), "at");
+  p.mass = float_arg(mass, who.c_str(), "mass");
+  p.com = to_vec3(com, who + ": com");
+  if (!inertia.is_none()) p.inertia = to_inertia(inertia, who + ": inertia");
+  return p;
+}
+
+/// with_payloads' list: mappings with keys at, mass (required), com, inertia, name.
+std::vector<Payload> payload_list(const py::handle& payloads) {
+  const char* fn = "with_payloads";
+  if (PyUnicode_Check(payloads.ptr()) || PyBytes_Check(payloads.ptr()) ||
+      PyDict_Check(payloads.ptr()) || !py::isinstance<py::iterable>(payloads))
+    throw ModelError(msg(fn,
+                         ": payloads must be a list of dicts (keys at, mass, com, inertia, "
+                         "name), got ",
+                         shown(payloads)));
+  std::vector<Payload> out;
+  static const char* keys[] = {"at", "mass", "com", "inertia", "name"};
+  for (const py::handle item : payloads) {
+    const std::string who = msg(fn, ": payloads[", out.size(), "]");
+    const py::object mapping = py::module_::import("collections.abc").attr("Mapping");
+    if (!py::isinstance(item, mapping))
+      throw ModelError(
+          msg(who, " must be a dict (keys at, mass, com, inertia, name), got ", shown(item)));
+    const py::dict d(py::reinterpret_borrow<py::object>(item));
+    for (const auto& kv : d) {
+      const std::string k = PyUnicode_Check(kv.first.ptr()) ? kv.first.cast<std::string>() : "";
+      if (std::find_if(std::begin(keys), std::end(keys), [&](const char* x) { return k == x; }) ==
+          std::end(keys))
+        throw ModelError(
+            msg(who, ": unknown key ", shown(kv.first), " (known: at, mass, com, inertia, name)"));
+    }
+    for (const char* req : {"at", "mass"})
+      if (!d.contains(req)) throw ModelError(msg(who, ": needs '", req, "'"));
+    auto get = [&](const char* k, py::object dflt) { return d.contains(k) ? d[k] : dflt; };
+    out.push_back(payload_arg(d["at"], d["mass"], get("com", py::make_tuple(0.0, 0.0, 0.0)),
+                              get("inertia", py::none()), get("name", py::str("payload")), who));
+  }
+  return out;
+}
+
+void def_model_payload(ModelClass& c) {
+  c.def(
+      "with_payload",
+      [](const Model& md, const StrArg& at, const FloatArg& mass, const ArrayLike& com,
+         const OptArrayLike& inertia, const StrArg& name) {
+        const Payload p = payload_arg(at, mass, com, inertia, name, "with_payload");
+        return with_payloads(md, {p}, "with_payload");
+      },
+      py::arg("at"), py::arg("mass"), py::arg("com") = py::make_tuple(0.0, 0.0, 0.0),
+      py::arg("inertia") = py::none(), py::arg("name") = "payload",
+      "A new finalized model with a payload (this model is unchanged): a rigid body of mass "
+      "[kg] with its centre of mass at com [m] and inertia [kg m^2] (3x3 about the centre of "
+      "mass, or its 3 principal moments; None: a point mass), both in the axes of `at` and from "
+      "its origin, welded to `at`: a named frame of the model (e.g. a URDF link's frame or "
+      "tool0); else a body (its centre of mass and axes) or 'ground'; else a joint (its point "
+      "and joint frame on the parent's side, z the joint axis; welded to the parent): the first "
+      "kind that has the name wins. It adds body `name`, fixed joint "
+      "'<name>_mount' (reactions at at's origin) and frame `name` at the payload's centre of "
+      "mass. The dynamics are those of the builder with the same body added (add_body + "
+      "add_fixed). ModelError naming the culprit (at, mass, com, inertia, name) and leaving "
+      "this model intact on bad input; a model holding a profile made from a Python function "
+      "cannot be copied (ModelError).");
+  c.def(
+      "with_payloads",
+      [](const Model& md, const PayloadList& payloads) {
+        return with_payloads(md, payload_list(payloads), "with_payloads");
+      },
+      py::arg("payloads"),
+      "with_payload for several payloads at once (one finalize): payloads is a list of dicts "
+      "with keys at, mass (required), com, inertia, name (with_payload's arguments and "
+      "defaults); each needs its own name. An empty list: a copy of the model.");
+}
+
 }  // namespace
 
 void bind_model(py::module_& m) {
@@ -204,6 +284,7 @@ void bind_model(py::module_& m) {
   def_model_bodies(c);
   def_model_limits(c);
   def_model_solver(c);
+  def_model_payload(c);
 }
 
 }  // namespace armdyn

@@ -1,6 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // armdyn.Motor (a motor's datasheet, armdyn/model/model.hpp MotorSpec) and armdyn.Actuator (a
 // gearbox and rotor as Model.actuators lists it). Pickling: bind_pickle.cpp.
+#include <stdexcept>
+#include <string>
+#include <utility>
+
 #include "convert_model.hpp"
 
 namespace armdyn {
@@ -8,32 +12,59 @@ namespace armdyn {
 namespace py = pybind11;
 using namespace py_helpers;
 
+namespace {
+
+template <std::size_t>
+using MotorFieldArg = OptFloat;
+
+/// armdyn.Motor(*, name="", <every MotorSpec::fields() entry>=None): one keyword per field.
+template <std::size_t... I>
+void def_motor_init(py::class_<MotorSpec>& c, std::index_sequence<I...>) {
+  const std::string doc =
+      "A motor's datasheet values (every one optional, None when not given; given ones finite "
+      "and > 0, else ModelError naming the field), all motor side: " +
+      motor_fields_with_units() + ".";
+  c.def(py::init([](const StrArg& name, const MotorFieldArg<I>&... v) {
+          return motor_from_args(name, {v...});
+        }),
+        py::kw_only(), py::arg("name") = "",
+        (py::arg(MotorSpec::fields()[I].first) = py::none())..., doc.c_str());
+}
+
+/// The docstrings' table follows MotorSpec::fields() (an import error otherwise: a field added
+/// without its unit and description).
+void check_motor_field_docs() {
+  for (std::size_t k = 0; k < MotorSpec::kNumFields; ++k)
+    if (std::string(motor_field_docs()[k].name) != MotorSpec::fields()[k].first)
+      throw std::logic_error(msg("armdyn.Motor: the docstring table's field ", k, " is '",
+                                 motor_field_docs()[k].name, "', MotorSpec::fields() has '",
+                                 MotorSpec::fields()[k].first, "'"));
+}
+
+}  // namespace
+
 void bind_motor(py::module_& m) {
-  py::class_<MotorSpec> motor(
-      m, "Motor",
+  check_motor_field_docs();
+  const std::string class_doc =
       "A motor's datasheet values, motor side, SI units, every one optional (None when not "
-      "given): torque_constant [N m/A], resistance [ohm, terminal], voltage [V, supply], "
-      "no_load_speed [rad/s], continuous_torque [N m], peak_torque [N m], max_speed [rad/s], "
-      "thermal_resistance [K/W, winding to ambient], thermal_time_constant [s], and a name. "
-      "Given values must be finite and > 0 (ModelError naming the field). Attach one with "
-      "ModelBuilder.add_actuator(..., motor=armdyn.Motor(...)); it does not enter the "
-      "dynamics (the rotor inertia, gear ratio and friction do), the motor-side sizing reads "
-      "it. Keyword-only constructor; comparable (==) and picklable.");
-  motor.def(py::init([](const StrArg& name, OptFloat kt, OptFloat r, OptFloat u, OptFloat w0,
-                        OptFloat tc, OptFloat tp, OptFloat wmax, OptFloat rth, OptFloat tau_th) {
-              return motor_from_args(name, {kt, r, u, w0, tc, tp, wmax, rth, tau_th});
-            }),
-            py::kw_only(), py::arg("name") = "", py::arg("torque_constant") = py::none(),
-            py::arg("resistance") = py::none(), py::arg("voltage") = py::none(),
-            py::arg("no_load_speed") = py::none(), py::arg("continuous_torque") = py::none(),
-            py::arg("peak_torque") = py::none(), py::arg("max_speed") = py::none(),
-            py::arg("thermal_resistance") = py::none(),
-            py::arg("thermal_time_constant") = py::none(),
-            "A motor's datasheet values (every one optional, None when not given; given ones "
-            "finite and > 0, else ModelError naming the field): torque_constant [N m/A], "
-            "resistance [ohm, terminal], voltage [V, supply], no_load_speed [rad/s], "
-            "continuous_torque [N m], peak_torque [N m], max_speed [rad/s], thermal_resistance "
-            "[K/W, winding to ambient], thermal_time_constant [s], all motor side.");
+      "given): " +
+      motor_fields_with_units() +
+      ", and a name. Given values must be finite and > 0 (ModelError naming the field). "
+      "Attach one with ModelBuilder.add_actuator(..., motor=armdyn.Motor(...)); it does not "
+      "enter the dynamics (the actuator's rotor inertia, gear ratio and friction do), the "
+      "motor-side sizing reads it. Keyword-only constructor (the keywords: Motor.FIELDS and "
+      "name); Motor.from_row(row) from a mapping; comparable (==) and picklable.";
+  py::class_<MotorSpec> motor(m, "Motor", class_doc.c_str());
+  def_motor_init(motor, std::make_index_sequence<MotorSpec::kNumFields>());
+  py::list names;
+  for (const auto& [n, p] : MotorSpec::fields()) names.append(n);
+  motor.attr("FIELDS") = py::tuple(names);
+  motor.def_static(
+      "from_row", &motor_from_row, py::arg("row"),
+      "The Motor of a catalog row: a mapping (a dict, a pandas Series) holding any of the "
+      "fields in Motor.FIELDS (SI units; None, NaN or pandas' NA = not given; given ones finite "
+      "and > 0, else ModelError naming the field); other keys are ignored. The name: the row's "
+      "'name' entry when given, else the Series' name when it is a str, else ''.");
   motor.def_readonly("name", &MotorSpec::name, "The motor's name ('' when not given).");
   // one read-only property per datasheet field, in MotorSpec::fields() order
   for (const auto& [n, p] : MotorSpec::fields())

@@ -46,6 +46,7 @@ ARMDYN_HINTED_OBJECT(FrameRef)        // str | int (a frame's name or index)
 ARMDYN_HINTED_OBJECT(OptMotor)        // Motor | None
 ARMDYN_HINTED_OBJECT(OptProgress)     // Callable[[float, float], object] | None
 ARMDYN_HINTED_OBJECT(FloatOrArray)    // float | numpy.typing.ArrayLike
+ARMDYN_HINTED_OBJECT(OptTimes)        // float | numpy.typing.ArrayLike | None
 ARMDYN_HINTED_OBJECT(OptData)         // Data | None
 ARMDYN_HINTED_OBJECT(ProfileValues)   // Profile.eval's (y, yd, ydd): floats or float64 arrays
 #undef ARMDYN_HINTED_OBJECT
@@ -292,6 +293,7 @@ ARMDYN_TYPE_HINT(FrameRef, "str | int")
 ARMDYN_TYPE_HINT(OptMotor, "armdyn._core.Motor | None")
 ARMDYN_TYPE_HINT(OptProgress, "collections.abc.Callable[[float, float], object] | None")
 ARMDYN_TYPE_HINT(FloatOrArray, "float | numpy.typing.ArrayLike")
+ARMDYN_TYPE_HINT(OptTimes, "float | numpy.typing.ArrayLike | None")
 ARMDYN_TYPE_HINT(OptData, "armdyn._core.Data | None")
 ARMDYN_TYPE_HINT(ProfileValues,
                  "tuple[float, float, float] | tuple[numpy.typing.NDArray[numpy.float64], "

@@ -23,6 +23,17 @@ namespace armdyn::py_helpers {
 
 using ModelClass = py::class_<Model, std::shared_ptr<Model>>;
 
+/// Motor.from_row's row and with_payloads' list, typed for the stubs (common.hpp's hinted
+/// objects: any object, checked where it is taken).
+class RowArg : public py::object {
+ public:
+  PYBIND11_OBJECT_DEFAULT(RowArg, py::object, accept_any)
+};
+class PayloadList : public py::object {
+ public:
+  PYBIND11_OBJECT_DEFAULT(PayloadList, py::object, accept_any)
+};
+
 // --- Motor ------------------------------------------------------------------------------------
 
 /// A Motor field from Python: None (not given) or a finite number (> 0: MotorSpec::validate).
@@ -48,22 +59,57 @@ inline MotorSpec motor_from_args(const StrArg& name, const std::vector<py::objec
   return s;
 }
 
-/// The docstring of a Motor field (MotorSpec::fields()).
-inline std::string motor_field_doc(const std::string& n) {
-  static const std::pair<const char*, const char*> docs[] = {
-      {"torque_constant", "Torque constant k_t [N m/A] (motor side), or None."},
-      {"resistance", "Terminal resistance [ohm], or None."},
-      {"voltage", "Supply voltage [V], or None."},
-      {"no_load_speed", "No-load speed at the supply voltage [rad/s], or None."},
-      {"continuous_torque", "Rated continuous torque [N m] (motor side), or None."},
-      {"peak_torque", "Peak torque [N m] (motor side), or None."},
-      {"max_speed", "Maximum permissible speed [rad/s], or None."},
-      {"thermal_resistance", "Thermal resistance winding to ambient [K/W], or None."},
-      {"thermal_time_constant", "Thermal time constant of the winding [s], or None."},
+/// A Motor field's unit and description (MotorSpec::fields()), for the docstrings.
+struct MotorFieldDoc {
+  const char* name;
+  const char* unit;
+  const char* text;
+};
+
+inline const MotorFieldDoc* motor_field_docs() {
+  static const MotorFieldDoc docs[MotorSpec::kNumFields] = {
+      {"torque_constant", "N m/A", "Torque constant k_t (motor side)"},
+      {"resistance", "ohm", "Terminal resistance"},
+      {"voltage", "V", "Supply voltage"},
+      {"no_load_speed", "rad/s", "No-load speed at the supply voltage"},
+      {"continuous_torque", "N m", "Rated continuous torque (motor side)"},
+      {"peak_torque", "N m", "Peak torque (motor side)"},
+      {"max_speed", "rad/s", "Maximum permissible speed"},
+      {"thermal_resistance", "K/W", "Thermal resistance winding to ambient (one-node model)"},
+      {"thermal_time_constant", "s", "Thermal time constant of the winding (one-node model)"},
+      {"rotor_inertia", "kg m^2", "Rotor inertia (motor side)"},
+      {"mass", "kg", "Motor mass"},
+      {"thermal_resistance_winding", "K/W",
+       "Thermal resistance winding to housing (two-node model)"},
+      {"thermal_resistance_housing", "K/W",
+       "Thermal resistance housing to ambient (two-node model)"},
+      {"thermal_time_constant_winding", "s",
+       "Thermal time constant of the winding (two-node model)"},
+      {"thermal_time_constant_housing", "s",
+       "Thermal time constant of the housing (two-node model)"},
+      {"max_winding_temperature", "degC", "Maximum permissible winding temperature"},
+      {"brake_torque", "N m", "Holding brake torque (motor side)"},
   };
-  for (const auto& [k, d] : docs)
-    if (n == k) return d;
+  return docs;
+}
+
+/// The docstring of a Motor field (MotorSpec::fields()): "<text> [<unit>], or None."
+inline std::string motor_field_doc(const std::string& n) {
+  for (std::size_t k = 0; k < MotorSpec::kNumFields; ++k) {
+    const MotorFieldDoc& d = motor_field_docs()[k];
+    if (n == d.name) return msg(d.text, " [", d.unit, "], or None.");
+  }
   return "Datasheet value '" + n + "' (SI units, motor side), or None.";
+}
+
+/// "torque_constant [N m/A], resistance [ohm], ..." (every field, MotorSpec::fields() order).
+inline std::string motor_fields_with_units() {
+  std::string r;
+  for (std::size_t k = 0; k < MotorSpec::kNumFields; ++k) {
+    const MotorFieldDoc& d = motor_field_docs()[k];
+    r += msg(k ? ", " : "", MotorSpec::fields()[k].first, " [", d.unit, "]");
+  }
+  return r;
 }
 
 /// armdyn.Motor(name=..., <the given fields>=...), Python's reprs of the values.
@@ -80,6 +126,41 @@ inline std::string motor_repr(const MotorSpec& s) {
     first = false;
   }
   return r + ")";
+}
+
+/// A value of Motor.from_row's row: None, NaN (Python's or numpy's) or pandas' NA = not given;
+/// else a real number (finite and > 0: MotorSpec::validate, naming the field).
+inline double motor_row_value(const py::object& v, const std::string& who, const char* name) {
+  if (v.is_none() || py::str(py::type::of(v).attr("__name__")).cast<std::string>() == "NAType")
+    return MotorSpec::kUnset;
+  const double x = float_arg(v, who.c_str(), name);
+  return std::isnan(x) ? MotorSpec::kUnset : x;
+}
+
+/// The name of Motor.from_row's row: its "name" entry when given (a str), else the pandas
+/// Series' name when a str, else ''.
+inline std::string motor_row_name(const py::object& row, const py::object& get) {
+  const py::object n = get("name", py::none());
+  const bool missing =
+      n.is_none() || (PyFloat_Check(n.ptr()) && std::isnan(PyFloat_AS_DOUBLE(n.ptr())));
+  if (!missing) return str_arg(n, "Motor.from_row", "name");
+  if (py::isinstance<py::dict>(row)) return "";
+  const py::object series_name = py::getattr(row, "name", py::none());
+  return PyUnicode_Check(series_name.ptr()) ? str_arg(series_name, "Motor.from_row", "name") : "";
+}
+
+/// Motor.from_row: the motor fields a mapping (dict, pandas Series) holds, other keys ignored.
+inline MotorSpec motor_from_row(const RowArg& row) {
+  if (PyUnicode_Check(row.ptr()) || PyBytes_Check(row.ptr()) || !py::hasattr(row, "get"))
+    throw ModelError(
+        msg("Motor.from_row: row must be a mapping (a dict, a pandas Series), got ", shown(row)));
+  const py::object get = row.attr("get");
+  MotorSpec s;
+  s.name = motor_row_name(row, get);
+  const std::string who = s.name.empty() ? "Motor.from_row" : msg("Motor.from_row '", s.name, "'");
+  for (const auto& [n, p] : MotorSpec::fields()) s.*p = motor_row_value(get(n, py::none()), who, n);
+  s.validate(who);
+  return s;
 }
 
 /// == with any Python object (False unless a Motor).
@@ -282,3 +363,16 @@ inline ModelBuilder builder_from_state(const py::tuple& st) {
 }
 
 }  // namespace armdyn::py_helpers
+
+namespace pybind11::detail {
+template <>
+struct handle_type_name<armdyn::py_helpers::RowArg> {
+  static constexpr auto name =
+      const_name("collections.abc.Mapping[str, typing.SupportsFloat | str | None]");
+};
+template <>
+struct handle_type_name<armdyn::py_helpers::PayloadList> {
+  static constexpr auto name = const_name(
+      "collections.abc.Iterable[collections.abc.Mapping[str, numpy.typing.ArrayLike | None]]");
+};
+}  // namespace pybind11::detail

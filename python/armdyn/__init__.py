@@ -31,6 +31,7 @@ from armdyn._core import (
     frame_pose_cartesian,
     inverse_dynamics,
     joint_coordinates,
+    joint_reactions,
     mass_matrix,
     profiles,
     state_from_joints,
@@ -40,13 +41,19 @@ from armdyn.animation import animate  # k3d and trimesh are imported when animat
 from armdyn.dynamics import InverseDynamicsResult, driven_inverse_dynamics
 from armdyn.simulation import SimulationResult, load_urdf, rollout, simulate
 from armdyn.sizing import (
+    Catalog,
+    DutyCycle,
+    JointLoad,
     SizingReport,
     TrajectoryRun,
+    duty_cycle,
     gear_ratio_sweep,
     limit_violations,
+    load_catalog,
     sizing_report,
     trajectory_run,
 )
+from armdyn.sizing.select import DrivetrainSelection, select_drivetrain
 from armdyn.sweeps import sweep  # dask and xarray are imported when sweep() runs
 from armdyn.validation import LagrangeValidator
 from armdyn.workprecision import WorkPrecisionResult, work_precision
@@ -55,8 +62,12 @@ __version__ = "0.1.0"
 
 __all__ = [
     "Actuator",
+    "Catalog",
     "Data",
+    "DrivetrainSelection",
+    "DutyCycle",
     "InverseDynamicsResult",
+    "JointLoad",
     "LagrangeValidator",
     "Model",
     "ModelBuilder",
@@ -75,6 +86,7 @@ __all__ = [
     "body_forces",
     "body_mass_matrix",
     "driven_inverse_dynamics",
+    "duty_cycle",
     "dynamics_cost",
     "energy",
     "evaluate_constraints",
@@ -86,12 +98,15 @@ __all__ = [
     "gear_ratio_sweep",
     "inverse_dynamics",
     "joint_coordinates",
+    "joint_reactions",
     "limit_violations",
+    "load_catalog",
     "load_urdf",
     "mass_matrix",
     "profiles",
     "rollout",
     "scenes",
+    "select_drivetrain",
     "simulate",
     "sizing_report",
     "state_from_joints",

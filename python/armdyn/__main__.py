@@ -7,6 +7,17 @@
   the sizing report of a planned motion (joint side, and motor side for the actuators of the
   TOML file) and writes it to DIR; exit code 0 when every joint is ok, 1 when some joint is
   not, 2 for bad input. File formats: ``armdyn.size``.
+  ``--payload MASS[,X,Y,Z]`` welds a point mass (kg; its centre of mass in m, in the axes of
+  ``--payload-frame``, default the model's last frame, ``model.frame_names[-1]``: a UR5's
+  ``tool0``) to the robot; ``--dwell SECONDS`` and ``--cycle N|forever`` make the motion a
+  duty cycle (the report is of one period, plus the winding temperature of the repeated
+  cycle); of the check options (:class:`armdyn.sizing.SizingOptions`') it takes the thermal
+  ones (``--ambient``...) and refuses the others (``--life``...: ``armdyn select``'s checks).
+* ``armdyn select ROBOT.urdf --trajectory FILE.csv --catalog PATH [--objective
+  mass|cost|bus_power|margin] [--payload ...] [--cycle ...] [--dwell ...] [--out DIR]`` chooses
+  each joint's motor, gearbox and drive from the catalog (``armdyn.select_drivetrain``), prints
+  the choice and writes its report to DIR; exit code 0 when every joint has a drivetrain that
+  passes, 1 when some has none, 2 for bad input.
 * ``armdyn verify`` prints the solver's accuracy figures: pendulum period, energy and momentum
   conservation, constraint drift, and forward dynamics against the Euler–Lagrange equations.
 
@@ -45,12 +56,36 @@ def main(argv: list[str] | None = None) -> int:
     size = sub.add_parser(
         "size", help="sizing report of a planned motion (exit 0: every joint ok, 1: not)"
     )
-    size.add_argument("urdf", help="the robot's URDF file")
-    size.add_argument(
-        "--trajectory", required=True, help="CSV: t, one column per joint, optional .qd/.qdd"
-    )
+    _motion_arguments(size)
     size.add_argument("--actuators", help="TOML: per joint gear_ratio, rotor_inertia, [motor]")
     size.add_argument("--out", help="write the report (HTML, CSV, figures) into this folder")
+    size.add_argument(
+        "--sweep",
+        metavar="MIN:MAX:N",
+        help="with --out: the report adds the gear-ratio sweep of the --actuators joints over N "
+        "ratios spaced geometrically from MIN to MAX",
+    )
+    select = sub.add_parser(
+        "select",
+        help="choose each joint's motor, gearbox and drive from a catalog (exit 0: every joint "
+        "has one that passes, 1: not)",
+    )
+    _motion_arguments(select)
+    select.add_argument(
+        "--catalog",
+        required=True,
+        action="append",
+        metavar="PATH",
+        help="a catalog folder (motors.csv, gearboxes.csv, drives.csv) or CSV file; repeat to "
+        "merge several",
+    )
+    select.add_argument(
+        "--objective",
+        default="mass",
+        metavar="mass|cost|bus_power|margin",
+        help="what the choice minimises (margin: maximises the least margin); default mass",
+    )
+    select.add_argument("--out", help="write the selection's report into this folder")
     args = parser.parse_args(argv)
     try:
         return _run(args)
@@ -60,11 +95,49 @@ def main(argv: list[str] | None = None) -> int:
         return 2
 
 
+def _motion_arguments(p: argparse.ArgumentParser) -> None:
+    """The arguments ``size`` and ``select`` share: the robot, its motion, the payload, the
+    duty cycle and the check options (one per armdyn.sizing.SizingOptions field)."""
+    from armdyn.sizing.cli import add_option_arguments
+
+    p.add_argument("urdf", help="the robot's URDF file")
+    p.add_argument(
+        "--trajectory", required=True, help="CSV: t, one column per joint, optional .qd/.qdd"
+    )
+    p.add_argument(
+        "--payload",
+        metavar="MASS[,X,Y,Z]",
+        help="a point mass [kg] welded to the robot, its centre of mass [m] in the axes of "
+        "--payload-frame from its origin (default the origin)",
+    )
+    p.add_argument(
+        "--payload-frame",
+        metavar="NAME",
+        help="the frame carrying the payload; default the model's last frame (a UR5: tool0)",
+    )
+    p.add_argument(
+        "--cycle",
+        metavar="N|forever",
+        help="repeat the motion (and its dwell) N times from the ambient temperature, or "
+        "forever (the periodic steady state; the default with --dwell)",
+    )
+    p.add_argument(
+        "--dwell",
+        metavar="SECONDS",
+        help="hold the motion's last pose this long at the end of each cycle",
+    )
+    add_option_arguments(p)
+
+
 def _run(args: argparse.Namespace) -> int:
     if args.command == "size":
         from armdyn.size import main as size_main
 
         return size_main(args)
+    if args.command == "select":
+        from armdyn.sizing.cli import select_main
+
+        return select_main(args)
     if args.command == "verify":
         from armdyn.verify import main as verify_main
 

@@ -90,6 +90,16 @@ def _rotor(actuator, n: float, j: float, b: float, c: float, qd, qdd):
     return w, wd, coulomb, j * wd + b * w + coulomb
 
 
+def gear_input_torque(load_torque, qd, ratio, efficiency):
+    """The motor-side torque that drives the gear: τ_gear / (N η) while the gear transmits
+    power from the motor to the load (τ_gear q̇ ≥ 0), else τ_gear η / N (the load drives it
+    backwards). Elementwise with numpy broadcasting (``load_torque``, ``qd`` the joint side;
+    ``ratio``, ``efficiency`` of one or many gears): the one place the formula is written
+    (:func:`motor_side`, :func:`armdyn.sizing.motor.motor_cycle_values`)."""
+    motoring = load_torque * qd >= 0.0
+    return np.where(motoring, load_torque / (ratio * efficiency), load_torque * efficiency / ratio)
+
+
 @dataclass
 class MotorSide:
     """Motor-side values of one actuator at the samples of a run (SI units, 1-D arrays).
@@ -203,7 +213,7 @@ def motor_side(
     tau_gear = tau - n_ratio * t_rot
     p_load = tau_gear * qd
     motoring = p_load >= 0.0
-    torque = t_rot + np.where(motoring, tau_gear / (n_ratio * eta), tau_gear * eta / n_ratio)
+    torque = t_rot + gear_input_torque(tau_gear, qd, n_ratio, eta)
     loss_gear = np.where(motoring, p_load * (1.0 / eta - 1.0), -p_load * (1.0 - eta))
     loss_friction = b * w * w + coulomb * w
     p_mech = p_load + j_rot * w * wd

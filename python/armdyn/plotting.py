@@ -549,8 +549,15 @@ def sizing_torque_figure(
     ax_.plot(report.t, tau, lw=1.0, label="joint torque/force")
     limit = report.table["effort_limit"].iloc[k]
     if np.isfinite(limit):
-        ax_.axhline(limit, color="r", ls="--", lw=0.8, label="effort limit")
+        peak = float(np.nanmax(np.abs(tau)))
+        # a limit far above the torque would flatten its curve: the axis spans the torque and
+        # the legend gives the limit
+        off_scale = 0.0 < peak and limit > 3.0 * peak
+        label = f"effort limit ±{limit:g} (off scale)" if off_scale else "effort limit"
+        ax_.axhline(limit, color="r", ls="--", lw=0.8, label=label)
         ax_.axhline(-limit, color="r", ls="--", lw=0.8)
+        if off_scale:
+            ax_.set_ylim(-1.3 * peak, 1.3 * peak)
     ax_.set_xlabel("t [s]")
     ax_.set_ylabel("torque [N m] or force [N]")
     ax_.set_title(str(joint))

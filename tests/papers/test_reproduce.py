@@ -137,6 +137,22 @@ def test_sizing_notebook_executes(tmp_path):
         assert float(rebuilt.group(1)) <= 1e-9
 
 
+def test_select_notebook_executes(tmp_path):
+    """notebooks/select_ur5.ipynb runs end to end (the UR5 with a 3 kg payload, a pick-and-place
+    cycle with a dwell, the drivetrain selection from the example catalog, its report); its own
+    checks: the payload's static torques equal J^T m g, every joint has a feasible drivetrain,
+    and the chosen set's motor torques equal those of the arm rebuilt with the chosen actuators
+    in its dynamics (a second route: add_actuator and with_payloads, then inverse dynamics)."""
+    outputs = execute_notebook("select_ur5.ipynb", tmp_path)
+    payload = float(re.search(r"max difference to J\^T m g: (\S+)", outputs).group(1))
+    assert payload <= 1e-10
+    assert "converged: True, every joint ok: True" in outputs
+    rebuilt = float(re.search(r"rebuilt vs closed form: (\S+)", outputs).group(1))
+    assert rebuilt <= 1e-9
+    page = tmp_path / "ur5-selection" / "report.html"
+    assert page.is_file() and "Drivetrain selection" in page.read_text(encoding="utf-8")
+
+
 def test_sweep_notebook_executes(tmp_path):
     """notebooks/sweep_ur5.ipynb runs end to end on its 2-worker LocalCluster: the UR5's payload
     x move duration x shoulder ratio sweep (none failed) equals calling the point function in

@@ -171,8 +171,8 @@ ID_CHILD = CHILD_PROLOGUE + textwrap.dedent(
         b.add_drive("j2", lambda t: (0.5 * t, 0.5, 0.0))
     model = b.finalize()
     rng = np.random.default_rng(1)
-    n = 4_000_000 if which == "batch" else 3_000_000
-    if which == "batch":
+    n = {"batch": 4_000_000, "reactions": 300_000}.get(which, 3_000_000)
+    if which in ("batch", "reactions"):
         q, qd, qdd = (rng.standard_normal((n, 2)) for _ in range(3))
     else:
         ts = np.linspace(0.0, 1e4, n)
@@ -182,6 +182,8 @@ ID_CHILD = CHILD_PROLOGUE + textwrap.dedent(
         while True:  # until interrupted: a fast machine cannot finish before the signal
             if which == "batch":
                 out = ad.inverse_dynamics(model, q, qd, qdd)
+            elif which == "reactions":
+                out = ad.joint_reactions(model, q, qd, qdd)
             else:
                 out = ad.driven_inverse_dynamics(model, ts)
             calls += 1
@@ -192,18 +194,25 @@ ID_CHILD = CHILD_PROLOGUE + textwrap.dedent(
         k = len(partial)
         ref = ad.inverse_dynamics(model, q[:k], qd[:k], qdd[:k])
         report.update(rows=k, n=n, diff=float(np.max(np.abs(ref - partial))) if k else 0.0)
+    if which == "reactions":  # the rows done, as (forces, torques)
+        k = len(partial[0])
+        ref = ad.joint_reactions(model, q[:k], qd[:k], qdd[:k])
+        diff = max(float(np.max(np.abs(r - p), initial=0.0)) for r, p in zip(ref, partial))
+        report.update(rows=k, n=n, diff=diff, same=len(partial[1]) == k)
     print(json.dumps(report), flush=True)
     """
 )
 
 
-@pytest.mark.parametrize("which", ["batch", "driven"])
+@pytest.mark.parametrize("which", ["batch", "driven", "reactions"])
 def test_sigint_stops_inverse_dynamics_loops(which):
     # one call takes about 1 s on an idle machine (the batch 0.93 s)
     report = _interrupted_child(ID_CHILD, which, delay=0.25)
     assert report["inside"]  # stopped by the loop's poll, inside the call
-    if which == "batch":  # the rows done, as a batch of those rows computes them
+    if which in ("batch", "reactions"):  # the rows done, as a batch of those rows computes them
         assert 0 <= report["rows"] < report["n"] and report["diff"] == 0.0
+    if which == "reactions":
+        assert report["same"]
 
 
 # --- callbacks --------------------------------------------------------------------------------

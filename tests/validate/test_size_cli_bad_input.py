@@ -100,10 +100,10 @@ def test_a_directory_is_refused(tmp_path, capsys):
 
 
 def test_a_large_file_is_refused_before_it_is_read(tmp_path, capsys, monkeypatch):
-    import armdyn.sizing.cli
+    import armdyn.sizing.files
 
     csv = good_csv(tmp_path / "t.csv")
-    monkeypatch.setattr(armdyn.sizing.cli, "MAX_INPUT_BYTES", 100)
+    monkeypatch.setattr(armdyn.sizing.files, "MAX_INPUT_BYTES", 100)
     code, _, err = run_cli(capsys, "--trajectory", csv)
     size = csv.stat().st_size
     assert_one_line_exit_2(code, err, f"is {size} bytes, more than the limit of 100 bytes")

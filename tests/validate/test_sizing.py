@@ -10,6 +10,8 @@ of samples per period): the RMS values are then exact up to the samples' own err
 the trapezoid rule's error bound (b − a) h² / 12 · max|f''| gives the tolerance.
 """
 
+import base64
+
 import armdyn as ad
 import numpy as np
 import pandas as pd
@@ -234,8 +236,11 @@ def test_save_writes_table_html_and_figures(tmp_path, two_periods):
     back = pd.read_csv(tmp_path / "out" / "table.csv", index_col="joint")
     pd.testing.assert_frame_equal(back, report.table, check_exact=False, rtol=1e-15)
     html = page.read_text("utf-8")
-    assert "<table" in html and "peak_torque" in html and 'src="torque_0.png"' in html
-    assert (tmp_path / "out" / "torque_0.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "<table" in html and "peak_torque" in html
+    # the page embeds the figure it also writes (one self-contained file)
+    png = (tmp_path / "out" / "torque_0.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n"
+    assert f'src="data:image/png;base64,{base64.b64encode(png).decode()}"' in html
     # the undriven joint has no (or a zero) torque, so no figure
     assert not (tmp_path / "out" / "torque_1.png").exists()
 

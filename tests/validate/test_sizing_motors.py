@@ -8,6 +8,7 @@ with the actuator reports it. With η = 1 and no friction the motor torque is
 T = (J N + I / N) q̈ = −(J N + I / N) A ω² sin(ω t) and its speed ω_m = N A ω cos(ω t).
 """
 
+import base64
 from types import SimpleNamespace
 
 import armdyn as ad
@@ -214,8 +215,10 @@ def test_save_draws_the_speed_torque_plane(run, tmp_path, monkeypatch):
     monkeypatch.setattr(sizing_motor, "_mass_matrix", lambda md, q: _core.mass_matrix(md._model, q))
     report = ad.sizing_report(geared, WithActuators(model, [stand_in(full_motor())]), out=tmp_path)
     html = (tmp_path / "report.html").read_text("utf-8")
-    assert 'src="motor_0.png"' in html and 'src="torque_0.png"' in html
-    assert (tmp_path / "motor_0.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    for name in ("motor_0.png", "torque_0.png"):  # written, and embedded in the page
+        png = (tmp_path / name).read_bytes()
+        assert png[:8] == b"\x89PNG\r\n\x1a\n"
+        assert f'src="data:image/png;base64,{base64.b64encode(png).decode()}"' in html
     fig = report.envelope_figure("spin")
     ax = fig.axes[0]
     x, y = ax.lines[0].get_data()

@@ -66,6 +66,7 @@
 // validators independent of the Cartesian path
 #include "armdyn/validate/validators.hpp"
 
-// URDF import and model bytes
+// URDF import, model bytes, payloads
+#include "armdyn/io/payload.hpp"
 #include "armdyn/io/serialize.hpp"
 #include "armdyn/io/urdf.hpp"

@@ -6,6 +6,7 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "armdyn/integrate/integrators.hpp"
@@ -151,6 +152,11 @@ class Data {
   std::unique_ptr<Model> driven;      ///< inverse dynamics: the model with every coordinate driven
   std::unique_ptr<Data> driven_data;  ///< made on first use, for *driven
   VecX drive_ref;                     ///< (3 n) drive values (q, qd, qdd) of driven_data
+
+  // --- joint reactions along a joint-space motion (algorithm/reactions) ---
+  /// the joints joint_reactions sweeps (tree_sweep), made on its first call
+  std::vector<std::pair<int, int>> reaction_sweep;
+  bool reaction_sweep_made = false;
 
   // --- named frames (algorithm/frames) ---
   Mat4 frame_pose = Mat4::Identity();  ///< the last frame pose [R p; 0 1]

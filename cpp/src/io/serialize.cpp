@@ -22,7 +22,12 @@ namespace armdyn {
 namespace {
 
 constexpr char kMagic[8] = {'A', 'R', 'M', 'D', 'Y', 'N', 'M', '1'};
-constexpr std::uint32_t kFormat = 2;
+// Format versions: 3 adds the motor's datasheet fields after the first nine (MotorSpec::fields);
+// this armdyn writes kFormat and reads every version from kOldestFormat (an older one's missing
+// fields load as not given).
+constexpr std::uint32_t kFormat = 3, kOldestFormat = 2;
+/// The motor fields the bytes of format 2 hold: the first nine of MotorSpec::fields().
+constexpr std::size_t kMotorFieldsFormat2 = 9;
 constexpr std::uint8_t kKindModel = 'M', kKindDraft = 'D';
 
 // Guard: a field added to one of these structs must be stored (or derived on load) too (then
@@ -44,9 +49,9 @@ static_assert(sizeof(GearPair) == 88,
               "GearPair changed: store the new field here, then update its size");
 static_assert(sizeof(GearConstraint) == 72,
               "GearConstraint changed: store the new field here, then update its size");
-static_assert(sizeof(Actuator) == 168,
+static_assert(sizeof(Actuator) == 232,
               "Actuator changed: store the new field here, then update its size");
-static_assert(sizeof(MotorSpec) == 104,
+static_assert(sizeof(MotorSpec) == 168,
               "MotorSpec changed: store the new field here, then update its size");
 static_assert(sizeof(Coord) == 48, "Coord changed: store the new field here, then update its size");
 static_assert(sizeof(NamedFrame) == 136,
@@ -333,6 +338,8 @@ class Reader {
     return v;
   }
   bool done() const { return pos_ == in_.size(); }
+  /// the format version of the bytes (read_header)
+  std::uint32_t format = kFormat;
 
  private:
   const std::string& in_;
@@ -344,12 +351,14 @@ std::uint8_t read_header(Reader& r) {
   for (char c : kMagic)
     if (r.pod<char>("tag") != c) r.fail("tag", "wrong tag");
   const auto format = r.pod<std::uint32_t>("format");
-  if (format != kFormat)
-    r.fail("format", msg("format version ", format, ", this armdyn reads version ", kFormat,
+  if (format < kOldestFormat || format > kFormat)
+    r.fail("format", msg("format version ", format, ", this armdyn reads versions ", kOldestFormat,
+                         " to ", kFormat,
                          " (bytes of another armdyn version: store the model's source -- its "
                          "builder script or URDF -- rather than its bytes)"));
   const auto kind = r.pod<std::uint8_t>("kind");
   if (kind != kKindModel && kind != kKindDraft) r.fail("kind", msg("unknown kind ", int(kind)));
+  r.format = format;
   return kind;
 }
 
@@ -655,7 +664,10 @@ void read_actuator(Reader& r, Model& m, int k, const std::vector<int>& follows,
   x.gyroscopic = r.b("gyroscopic");
   x.has_motor = r.b("has_motor");
   x.motor.name = r.s("motor.name");
-  for (const auto& [name, field] : MotorSpec::fields()) x.motor.*field = r.d(name);
+  const std::size_t stored =
+      r.format >= 3 ? MotorSpec::kNumFields : kMotorFieldsFormat2;  // the rest: not given
+  for (std::size_t f = 0; f < stored; ++f)
+    x.motor.*MotorSpec::fields()[f].second = r.d(MotorSpec::fields()[f].first);
   try {
     x.motor.validate("motor");
   } catch (const ModelError& e) {

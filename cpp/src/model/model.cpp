@@ -142,8 +142,8 @@ void IndependentCoords::align(const std::vector<Coord>& coords, double* coord_q)
   }
 }
 
-const std::vector<std::pair<const char*, double MotorSpec::*>>& MotorSpec::fields() {
-  static const std::vector<std::pair<const char*, double MotorSpec::*>> f = {
+const std::array<MotorSpec::Field, MotorSpec::kNumFields>& MotorSpec::fields() {
+  static const std::array<Field, kNumFields> f = {{
       {"torque_constant", &MotorSpec::torque_constant},
       {"resistance", &MotorSpec::resistance},
       {"voltage", &MotorSpec::voltage},
@@ -152,9 +152,22 @@ const std::vector<std::pair<const char*, double MotorSpec::*>>& MotorSpec::field
       {"peak_torque", &MotorSpec::peak_torque},
       {"max_speed", &MotorSpec::max_speed},
       {"thermal_resistance", &MotorSpec::thermal_resistance},
-      {"thermal_time_constant", &MotorSpec::thermal_time_constant}};
+      {"thermal_time_constant", &MotorSpec::thermal_time_constant},
+      {"rotor_inertia", &MotorSpec::rotor_inertia},
+      {"mass", &MotorSpec::mass},
+      {"thermal_resistance_winding", &MotorSpec::thermal_resistance_winding},
+      {"thermal_resistance_housing", &MotorSpec::thermal_resistance_housing},
+      {"thermal_time_constant_winding", &MotorSpec::thermal_time_constant_winding},
+      {"thermal_time_constant_housing", &MotorSpec::thermal_time_constant_housing},
+      {"max_winding_temperature", &MotorSpec::max_winding_temperature},
+      {"brake_torque", &MotorSpec::brake_torque},
+  }};
   return f;
 }
+
+// every double member is listed in fields() (a member added without it changes the size)
+static_assert(sizeof(MotorSpec) == sizeof(std::string) + MotorSpec::kNumFields * sizeof(double),
+              "MotorSpec: list every datasheet field in MotorSpec::fields() and kNumFields");
 
 void MotorSpec::validate(const std::string& who) const {
   for (const auto& [n, p] : fields()) {

@@ -379,8 +379,6 @@ class JointSystem : public OdeSystem, public StopAccess {
     v_ = VecX::Zero(m.nv);
     vd_ = VecX::Zero(m.nv);
     qdd_ = VecX::Zero(n_);
-    for (auto it = m.tree_order.rbegin(); it != m.tree_order.rend(); ++it)
-      if (joint_rows(m.joints[*it].type) > 0) sweep_.emplace_back(*it, m.joints[*it].child);
   }
 
   // y = (q (nq_), qd (n_), z); q holds the floating bases' quaternions where qd has 3 rates
@@ -438,23 +436,13 @@ class JointSystem : public OdeSystem, public StopAccess {
       td_.accelerations(t, q.data(), qd.data(), z, stop_tau, qdd_.data());
     }
     // the same Data: the tree's kinematics and joint frames at (q, qd), read before the
-    // Cartesian pipeline loads the same state
+    // Cartesian pipeline loads the same state (load_tree_motion)
     Data& d = cart_.data();
-    rne_forward(m_, d.kin, qd, qdd_, d.rne);
-    tree_body_accelerations(m_, d.kin, d.rne, vd_.data());
-    cartesian_state(m_, d.kin, u_.data(), v_.data());
-    base_orientations(m_, q.data(), u_.data());
-    d.aux = z;
-    d.track_ref = q.tail(d.nco);
-    load_kinematics(m_, d, u_.data(), v_.data());
-    evaluate_constraints(m_, d, t, false);
-    d.joint_torques = stop_tau;
-    cartesian_forces(m_, d, t);
     const VecX& gear_delta = td_.gear_multipliers(qdd_.data());
-    d.delta.setZero();
-    for (size_t g = 0; g < m_.gear_constraints.size(); ++g)
-      d.delta[m_.gear_constraints[g].row] = gear_delta[static_cast<long>(g)];
-    sweep_multipliers(m_, d, vd_, sweep_);
+    d.aux = z;
+    d.joint_torques = stop_tau;
+    load_tree_motion(m_, d, q, qd, qdd_, t, gear_delta.size() ? gear_delta.data() : nullptr, sweep_,
+                     u_, v_, vd_);
     d.joint_torques = nullptr;
     double rf, rv;
     loaded_residuals(m_, d, v_.data(), rf, rv);
@@ -490,9 +478,9 @@ class JointSystem : public OdeSystem, public StopAccess {
   MbsSystem& cart_;
   int n_, nq_;
   VecX u_, v_, vd_, qdd_;
-  VecX fo_, fe_;                            // the stops' scratch at outputs and events
-  RneWork rne_;                             // the forward sweep at the output's accelerations
-  std::vector<std::pair<int, int>> sweep_;  // (joint, child), children before parents
+  VecX fo_, fe_;  // the stops' scratch at outputs and events
+  // the joints whose multipliers load_tree_motion sweeps, children before parents
+  const std::vector<std::pair<int, int>> sweep_ = tree_sweep(m_);
 };
 
 }  // namespace armdyn::detail

@@ -7,7 +7,7 @@ import numpy
 import numpy.typing
 import typing
 from . import profiles
-__all__: list[str] = ['Actuator', 'Data', 'LagrangeValidator', 'Model', 'ModelBuilder', 'ModelError', 'Motor', 'Profile', 'SolverError', 'URDF_COULOMB_SMOOTHING', 'URDF_MAX_ATTRIBUTES', 'URDF_MAX_BYTES', 'UrdfError', 'body_accelerations', 'body_forces', 'body_mass_matrix', 'dynamics_cost', 'end_effector_position', 'energy', 'evaluate_constraints', 'forward_dynamics', 'frame_jacobian', 'frame_jacobian_cartesian', 'frame_pose', 'frame_pose_cartesian', 'inverse_dynamics', 'joint_coordinates', 'mass_matrix', 'paper_3dof_torques', 'paper_5dof_end_effector', 'profiles', 'state_from_joints', 'torque_error_metrics', 'urdf_builder']
+__all__: list[str] = ['Actuator', 'Data', 'LagrangeValidator', 'Model', 'ModelBuilder', 'ModelError', 'Motor', 'Profile', 'SolverError', 'URDF_COULOMB_SMOOTHING', 'URDF_MAX_ATTRIBUTES', 'URDF_MAX_BYTES', 'UrdfError', 'body_accelerations', 'body_forces', 'body_mass_matrix', 'dynamics_cost', 'end_effector_position', 'energy', 'evaluate_constraints', 'forward_dynamics', 'frame_jacobian', 'frame_jacobian_cartesian', 'frame_pose', 'frame_pose_cartesian', 'inverse_dynamics', 'joint_coordinates', 'joint_reactions', 'mass_matrix', 'paper_3dof_torques', 'paper_5dof_end_effector', 'profiles', 'state_from_joints', 'torque_error_metrics', 'urdf_builder']
 class ModelError(ValueError):
     """
     Bad input: a model, builder call, array shape or option that armdyn refuses, the message naming the culprit (the body, joint, argument and the expected shape). The model or builder is left as it was. A ValueError.
@@ -22,30 +22,51 @@ class SolverError(RuntimeError):
     """
 class Motor:
     """
-    A motor's datasheet values, motor side, SI units, every one optional (None when not given): torque_constant [N m/A], resistance [ohm, terminal], voltage [V, supply], no_load_speed [rad/s], continuous_torque [N m], peak_torque [N m], max_speed [rad/s], thermal_resistance [K/W, winding to ambient], thermal_time_constant [s], and a name. Given values must be finite and > 0 (ModelError naming the field). Attach one with ModelBuilder.add_actuator(..., motor=armdyn.Motor(...)); it does not enter the dynamics (the rotor inertia, gear ratio and friction do), the motor-side sizing reads it. Keyword-only constructor; comparable (==) and picklable.
+    A motor's datasheet values, motor side, SI units, every one optional (None when not given): torque_constant [N m/A], resistance [ohm], voltage [V], no_load_speed [rad/s], continuous_torque [N m], peak_torque [N m], max_speed [rad/s], thermal_resistance [K/W], thermal_time_constant [s], rotor_inertia [kg m^2], mass [kg], thermal_resistance_winding [K/W], thermal_resistance_housing [K/W], thermal_time_constant_winding [s], thermal_time_constant_housing [s], max_winding_temperature [degC], brake_torque [N m], and a name. Given values must be finite and > 0 (ModelError naming the field). Attach one with ModelBuilder.add_actuator(..., motor=armdyn.Motor(...)); it does not enter the dynamics (the actuator's rotor inertia, gear ratio and friction do), the motor-side sizing reads it. Keyword-only constructor (the keywords: Motor.FIELDS and name); Motor.from_row(row) from a mapping; comparable (==) and picklable.
     """
+    FIELDS: typing.ClassVar[tuple] = ('torque_constant', 'resistance', 'voltage', 'no_load_speed', 'continuous_torque', 'peak_torque', 'max_speed', 'thermal_resistance', 'thermal_time_constant', 'rotor_inertia', 'mass', 'thermal_resistance_winding', 'thermal_resistance_housing', 'thermal_time_constant_winding', 'thermal_time_constant_housing', 'max_winding_temperature', 'brake_torque')
     __hash__: typing.ClassVar[None] = None
+    @staticmethod
+    def from_row(row: collections.abc.Mapping[str, typing.SupportsFloat | str | None]) -> Motor:
+        """
+        The Motor of a catalog row: a mapping (a dict, a pandas Series) holding any of the fields in Motor.FIELDS (SI units; None, NaN or pandas' NA = not given; given ones finite and > 0, else ModelError naming the field); other keys are ignored. The name: the row's 'name' entry when given, else the Series' name when it is a str, else ''.
+        """
     def __eq__(self, arg0: typing.Any) -> bool:
         ...
     def __getstate__(self) -> dict:
         ...
-    def __init__(self, *, name: str = '', torque_constant: float | None = None, resistance: float | None = None, voltage: float | None = None, no_load_speed: float | None = None, continuous_torque: float | None = None, peak_torque: float | None = None, max_speed: float | None = None, thermal_resistance: float | None = None, thermal_time_constant: float | None = None) -> None:
+    def __init__(self, *, name: str = '', torque_constant: float | None = None, resistance: float | None = None, voltage: float | None = None, no_load_speed: float | None = None, continuous_torque: float | None = None, peak_torque: float | None = None, max_speed: float | None = None, thermal_resistance: float | None = None, thermal_time_constant: float | None = None, rotor_inertia: float | None = None, mass: float | None = None, thermal_resistance_winding: float | None = None, thermal_resistance_housing: float | None = None, thermal_time_constant_winding: float | None = None, thermal_time_constant_housing: float | None = None, max_winding_temperature: float | None = None, brake_torque: float | None = None) -> None:
         """
-        A motor's datasheet values (every one optional, None when not given; given ones finite and > 0, else ModelError naming the field): torque_constant [N m/A], resistance [ohm, terminal], voltage [V, supply], no_load_speed [rad/s], continuous_torque [N m], peak_torque [N m], max_speed [rad/s], thermal_resistance [K/W, winding to ambient], thermal_time_constant [s], all motor side.
+        A motor's datasheet values (every one optional, None when not given; given ones finite and > 0, else ModelError naming the field), all motor side: torque_constant [N m/A], resistance [ohm], voltage [V], no_load_speed [rad/s], continuous_torque [N m], peak_torque [N m], max_speed [rad/s], thermal_resistance [K/W], thermal_time_constant [s], rotor_inertia [kg m^2], mass [kg], thermal_resistance_winding [K/W], thermal_resistance_housing [K/W], thermal_time_constant_winding [s], thermal_time_constant_housing [s], max_winding_temperature [degC], brake_torque [N m].
         """
     def __repr__(self) -> str:
         ...
     def __setstate__(self, arg0: dict) -> None:
         ...
     @property
+    def brake_torque(self) -> float | None:
+        """
+        Holding brake torque (motor side) [N m], or None.
+        """
+    @property
     def continuous_torque(self) -> float | None:
         """
-        Rated continuous torque [N m] (motor side), or None.
+        Rated continuous torque (motor side) [N m], or None.
+        """
+    @property
+    def mass(self) -> float | None:
+        """
+        Motor mass [kg], or None.
         """
     @property
     def max_speed(self) -> float | None:
         """
         Maximum permissible speed [rad/s], or None.
+        """
+    @property
+    def max_winding_temperature(self) -> float | None:
+        """
+        Maximum permissible winding temperature [degC], or None.
         """
     @property
     def name(self) -> str:
@@ -60,7 +81,7 @@ class Motor:
     @property
     def peak_torque(self) -> float | None:
         """
-        Peak torque [N m] (motor side), or None.
+        Peak torque (motor side) [N m], or None.
         """
     @property
     def resistance(self) -> float | None:
@@ -68,19 +89,44 @@ class Motor:
         Terminal resistance [ohm], or None.
         """
     @property
+    def rotor_inertia(self) -> float | None:
+        """
+        Rotor inertia (motor side) [kg m^2], or None.
+        """
+    @property
     def thermal_resistance(self) -> float | None:
         """
-        Thermal resistance winding to ambient [K/W], or None.
+        Thermal resistance winding to ambient (one-node model) [K/W], or None.
+        """
+    @property
+    def thermal_resistance_housing(self) -> float | None:
+        """
+        Thermal resistance housing to ambient (two-node model) [K/W], or None.
+        """
+    @property
+    def thermal_resistance_winding(self) -> float | None:
+        """
+        Thermal resistance winding to housing (two-node model) [K/W], or None.
         """
     @property
     def thermal_time_constant(self) -> float | None:
         """
-        Thermal time constant of the winding [s], or None.
+        Thermal time constant of the winding (one-node model) [s], or None.
+        """
+    @property
+    def thermal_time_constant_housing(self) -> float | None:
+        """
+        Thermal time constant of the housing (two-node model) [s], or None.
+        """
+    @property
+    def thermal_time_constant_winding(self) -> float | None:
+        """
+        Thermal time constant of the winding (two-node model) [s], or None.
         """
     @property
     def torque_constant(self) -> float | None:
         """
-        Torque constant k_t [N m/A] (motor side), or None.
+        Torque constant k_t (motor side) [N m/A], or None.
         """
     @property
     def voltage(self) -> float | None:
@@ -191,6 +237,14 @@ class Model:
     def with_kkt_path(self, path: str) -> Model:
         """
         A copy of the model on another KKT path: 'dense' (the reference: one dense Cholesky of the Schur complement) or 'auto' (the plan finalize() picks).
+        """
+    def with_payload(self, at: str, mass: typing.SupportsFloat | typing.SupportsIndex, com: numpy.typing.ArrayLike = (0.0, 0.0, 0.0), inertia: numpy.typing.ArrayLike | None = None, name: str = 'payload') -> Model:
+        """
+        A new finalized model with a payload (this model is unchanged): a rigid body of mass [kg] with its centre of mass at com [m] and inertia [kg m^2] (3x3 about the centre of mass, or its 3 principal moments; None: a point mass), both in the axes of `at` and from its origin, welded to `at`: a named frame of the model (e.g. a URDF link's frame or tool0); else a body (its centre of mass and axes) or 'ground'; else a joint (its point and joint frame on the parent's side, z the joint axis; welded to the parent): the first kind that has the name wins. It adds body `name`, fixed joint '<name>_mount' (reactions at at's origin) and frame `name` at the payload's centre of mass. The dynamics are those of the builder with the same body added (add_body + add_fixed). ModelError naming the culprit (at, mass, com, inertia, name) and leaving this model intact on bad input; a model holding a profile made from a Python function cannot be copied (ModelError).
+        """
+    def with_payloads(self, payloads: collections.abc.Iterable[collections.abc.Mapping[str, numpy.typing.ArrayLike | None]]) -> Model:
+        """
+        with_payload for several payloads at once (one finalize): payloads is a list of dicts with keys at, mass (required), com, inertia, name (with_payload's arguments and defaults); each needs its own name. An empty list: a copy of the model.
         """
     @property
     def actuators(self) -> list[Actuator]:
@@ -652,6 +706,10 @@ def inverse_dynamics(model: Model, q: numpy.typing.ArrayLike, qd: numpy.typing.A
 def joint_coordinates(model: Model, u: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
     """
     Joint-space q (n_coords: floating bases' poses, then joint coordinates with angles in (-pi, pi]) and qd (n_dofs) at the Cartesian state (u, v): a coupled model's independent coordinates, as state_from_joints takes.
+    """
+def joint_reactions(model: Model, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike, t: float | numpy.typing.ArrayLike | None = None, data: Data | None = None) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
+    """
+    Every joint's reaction along a joint-space motion of a tree: (forces, torques), each (n_joints, 3) for one state (q: n_coords, qd and qdd: n_dofs; a coupled model's independent coordinates, as inverse_dynamics takes them) or (rows, n_joints, 3) for one state per row; t [s] a number, one per row, or None (0). The same quantity as SimulationResult.reaction_forces/reaction_torques: what the joint's constraint applies to its child at the joint point, in the child's joint frame, for every joint of the model (fixed joints included; zero for floating bases); the components about/along a joint's free axes are zero (the actuator's torque there is inverse_dynamics'). The joint torques are the inverse dynamics' (the motion is exactly the one given); gravity and the force elements act, drives are ignored.
     """
 def mass_matrix(model: Model, q: numpy.typing.ArrayLike, data: Data | None = None) -> numpy.typing.NDArray[numpy.float64]:
     """

@@ -41,6 +41,9 @@ class SizingReport:
         speed: (n, n_columns) joint rates ``result.qd``.
         motors: ``{joint: armdyn.actuators.MotorSide}`` for every actuated joint.
         envelopes: ``{joint: motor}`` (the :class:`armdyn.Motor`, or None) per actuated joint.
+        thermal: ``{joint: (t, winding, housing)}`` temperatures [°C] over one period of a
+            repeated duty cycle (filled by ``armdyn size --cycle/--dwell``:
+            :func:`armdyn.sizing.cli.winding_temperature_check`), drawn by :meth:`save`.
     """
 
     table: pd.DataFrame
@@ -49,15 +52,20 @@ class SizingReport:
     speed: npt.NDArray[np.float64]
     motors: dict[str, Any] = field(default_factory=dict)
     envelopes: dict[str, Any] = field(default_factory=dict)
+    thermal: dict[str, Any] = field(default_factory=dict)
 
-    def save(self, directory: str | os.PathLike[str]) -> Path:
-        """Write ``table.csv``, ``report.html`` (the table, one torque-against-time figure per
-        joint with a non-zero torque, and each motor's operating points on its speed–torque
-        plane) and the figures ``torque_<k>.png`` / ``motor_<k>.png`` into ``directory`` (created if
-        missing). Needs matplotlib (the ``plot`` extra). Returns the HTML page's path."""
+    def save(self, directory: str | os.PathLike[str], sweep: Any = None) -> Path:
+        """Write ``table.csv``, ``report.html`` and the figures ``torque_<k>.png`` /
+        ``motor_<k>.png`` into ``directory`` (created if missing). The page opens with the
+        verdict (overall, then per joint: motor, gear ratio, pass/fail, the binding check and
+        its margin), then the checks by part, the torque and thermal histories, each motor's
+        operating points on its speed–torque plane, the gear-ratio sweep ``sweep`` (a
+        :class:`GearRatioSweep`, when given) and the whole table; every figure is embedded,
+        so the page is one self-contained file (:mod:`armdyn.sizing.writer`). Needs
+        matplotlib (the ``plot`` extra). Returns the HTML page's path."""
         from armdyn.sizing.writer import write_report
 
-        return write_report(self, directory)
+        return write_report(self, directory, sweep=sweep)
 
     def envelope_figure(self, joint: str) -> Figure:
         """A bare matplotlib Figure: the operating points (ω, T) of ``joint``'s motor over its

@@ -27,6 +27,12 @@ class TrajectoryRun:
         q: (n, len(model.coord_names)) coordinates.
         qd, qdd: (n, len(model.dof_names)) rates and accelerations.
         joint_torques: (n, len(model.dof_names)) ``armdyn.inverse_dynamics`` at each sample.
+        reaction_forces, reaction_torques: (n, len(model.joint_names), 3)
+            ``armdyn.joint_reactions`` at each sample: what each joint's constraint applies to
+            its child at the joint point, in the child's joint frame (every joint, fixed ones
+            included; zero about/along a joint's free axes, where the joint torque acts), as
+            ``SimulationResult.reaction_forces/reaction_torques``. None on a run not made by
+            :func:`trajectory_run`.
         actuators: ``{joint: armdyn.actuators.MotorSide}`` for every actuator of the model
             (empty without actuators).
         model: the model the torques were computed with (:func:`trajectory_run` sets it; the
@@ -41,6 +47,8 @@ class TrajectoryRun:
     joint_torques: npt.NDArray[np.float64]
     actuators: dict[str, Any] = field(default_factory=dict)
     model: _core.Model | None = field(default=None, repr=False, compare=False)
+    reaction_forces: npt.NDArray[np.float64] | None = field(default=None, repr=False)
+    reaction_torques: npt.NDArray[np.float64] | None = field(default=None, repr=False)
 
     def limit_violations(self, model: _core.Model | None = None) -> pd.DataFrame:
         """See :func:`limit_violations`; ``model`` default :attr:`model`."""
@@ -52,7 +60,8 @@ def trajectory_run(
 ) -> TrajectoryRun:
     """The joint torques of a tree model along a planned motion: ``armdyn.inverse_dynamics``
     (recursive Newton–Euler, gravity, force elements and, with actuators, the reflected rotor
-    terms included) at every sample, as a result :func:`sizing_report` takes.
+    terms included) at every sample, and every joint's reaction there
+    (``armdyn.joint_reactions``), as a result :func:`sizing_report` takes.
 
     Args:
         model: a joint-space model (``model.joint_space``).
@@ -79,8 +88,16 @@ def trajectory_run(
     from armdyn.actuators import motor_side_of_result
 
     tau = np.asarray(_core.inverse_dynamics(model, q, qd, qdd, t), dtype=float)
+    forces, torques = _core.joint_reactions(model, q, qd, qdd, t)
     run = TrajectoryRun(
-        t=t.copy(), q=q.copy(), qd=qd.copy(), qdd=qdd.copy(), joint_torques=tau, model=model
+        t=t.copy(),
+        q=q.copy(),
+        qd=qd.copy(),
+        qdd=qdd.copy(),
+        joint_torques=tau,
+        model=model,
+        reaction_forces=forces,
+        reaction_torques=torques,
     )
     if getattr(model, "actuators", None):
         run.actuators = motor_side_of_result(model, run)

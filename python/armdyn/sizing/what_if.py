@@ -1,8 +1,8 @@
 """What-if actuators: stand-ins with the attributes of ``model.actuators`` entries, built from a
-``{joint: spec}`` (a dict or an object with those attributes) for a joint the model does not
-actuate (:func:`what_if_actuators`, the ``actuators=`` of :func:`sizing_report`) or for the
-gear-ratio sweep; and motors from their datasheet keywords (:func:`make_motor`). The numbers
-are checked by the rules of ``ModelBuilder.add_actuator``."""
+``{joint: spec}`` (a dict or an object with those attributes; catalog parts may stand for the
+numbers) for a joint the model does not actuate (:func:`what_if_actuators`, the ``actuators=``
+of :func:`sizing_report`) or for the gear-ratio sweep; and motors from their datasheet keywords
+(:func:`make_motor`). The numbers are checked by the rules of ``ModelBuilder.add_actuator``."""
 
 from __future__ import annotations
 
@@ -11,18 +11,9 @@ from types import SimpleNamespace
 from armdyn import _checks, _core
 from armdyn.actuators import ROTOR_COULOMB_SMOOTHING
 
-MOTOR_FIELDS = (
-    "torque_constant",
-    "resistance",
-    "voltage",
-    "no_load_speed",
-    "continuous_torque",
-    "peak_torque",
-    "max_speed",
-    "thermal_resistance",
-    "thermal_time_constant",
-    "name",
-)
+#: armdyn.Motor's keywords: its datasheet fields (``armdyn.Motor.FIELDS``, the C++ list
+#: ``MotorSpec::fields()``) and ``name``; the one list the Python side uses
+MOTOR_FIELDS = (*_core.Motor.FIELDS, "name")
 
 #: the keys of an actuator spec (add_actuator's keywords)
 _ACTUATOR_FIELDS = (
@@ -55,10 +46,8 @@ _SWEPT_FIELDS = (
 
 
 def make_motor(**datasheet):
-    """An :class:`armdyn.Motor` from datasheet keywords (SI, motor side: ``torque_constant``
-    N m/A, ``resistance`` ohm, ``voltage`` V, ``no_load_speed`` rad/s, ``continuous_torque`` and
-    ``peak_torque`` N m, ``max_speed`` rad/s, ``thermal_resistance`` K/W,
-    ``thermal_time_constant`` s, ``name``); an unknown key is a ModelError naming it."""
+    """An :class:`armdyn.Motor` from datasheet keywords: :data:`MOTOR_FIELDS` (SI, motor side;
+    the units in ``armdyn.Motor``'s docstring); an unknown key is a ModelError naming it."""
     unknown = sorted(set(datasheet) - set(MOTOR_FIELDS))
     if unknown:
         raise _core.ModelError(f"motor: unknown datasheet key(s) {unknown}; known {MOTOR_FIELDS}")
@@ -67,10 +56,15 @@ def make_motor(**datasheet):
 
 def what_if_actuators(model, names, actuators) -> list:
     """Stand-in actuators (the attributes of ``model.actuators`` entries) from
-    ``{joint: spec}``: ``gear_ratio`` and ``rotor_inertia`` required, ``efficiency`` (1),
+    ``{joint: spec}``: ``gear_ratio`` and ``rotor_inertia`` required (``rotor_inertia``: else
+    the motor's datasheet value), ``efficiency`` (1),
     ``friction_viscous``, ``friction_coulomb`` (0), ``friction_smoothing`` (None: 1e-3 |N|)
-    and ``motor`` (an :class:`armdyn.Motor`, a dict of its keywords, or None) optional; a dict
-    or an object with those attributes."""
+    and ``motor`` (an :class:`armdyn.Motor`, a dict of its keywords, a catalog row, or None)
+    optional; a dict or an object with those attributes. Catalog parts may stand for the
+    numbers: ``gearbox`` (a :class:`armdyn.sizing.catalog.Gearbox` or a row of
+    ``catalog.gearboxes``) gives ``gear_ratio`` (its ``ratio``) and ``efficiency``, and the
+    rotor inertia is then the motor's ``rotor_inertia`` plus the gearbox's ``input_inertia``;
+    a value the spec gives wins."""
     own = {str(a.joint) for a in (getattr(model, "actuators", None) or [])}
     dofs = list(model.dof_names)
     out = []
@@ -84,25 +78,33 @@ def what_if_actuators(model, names, actuators) -> list:
         if joint not in names or joint not in dofs:
             raise _core.ModelError(f"actuators: {joint!r} is not a joint coordinate ({dofs})")
 
-        def get(key, default=None, spec=spec):
-            if isinstance(spec, dict):
-                return spec.get(key, default)
-            return getattr(spec, key, default)
-
-        unknown = sorted(set(spec) - set(_ACTUATOR_FIELDS)) if isinstance(spec, dict) else []
+        allowed = (*_ACTUATOR_FIELDS, "gearbox")
+        unknown = sorted(set(spec) - set(allowed)) if isinstance(spec, dict) else []
         if unknown:
             raise _core.ModelError(f"actuators: [{joint}] unknown key(s) {unknown}")
+        motor = _spec_motor(joint, spec)
+        gearbox = spec.get("gearbox") if isinstance(spec, dict) else getattr(spec, "gearbox", None)
+
+        def get(key, default=None, spec=spec, motor=motor, gearbox=gearbox):
+            if isinstance(spec, dict):
+                value = spec.get(key)
+            else:
+                value = getattr(spec, key, None)
+            if value is None:
+                value = _from_parts(key, motor, gearbox)
+            return default if value is None else value
+
         for key in ("gear_ratio", "rotor_inertia"):
             if get(key) is None:
-                raise _core.ModelError(f"actuators: [{joint}] needs {key}")
+                raise _core.ModelError(
+                    f"actuators: [{joint}] needs {key}"
+                    + (" (in the spec or its motor's datasheet)" if key == "rotor_inertia" else "")
+                )
         if get("gyroscopic", False):
             raise _core.ModelError(
                 f"actuators: [{joint}] gyroscopic rotors need the actuator in the model "
                 "(ModelBuilder.add_actuator); the what-if evaluation is the gear-reduced model"
             )
-        motor = get("motor")
-        if isinstance(motor, dict):
-            motor = make_motor(**motor)
         out.append(
             SimpleNamespace(
                 joint=joint,
@@ -114,6 +116,42 @@ def what_if_actuators(model, names, actuators) -> list:
             )
         )
     return out
+
+
+def _spec_motor(joint: str, spec):
+    """The spec's motor: an armdyn.Motor, None, a dict of Motor keywords (make_motor: an unknown
+    key is an error), or a catalog row (a pandas Series or other mapping: Motor.from_row, its
+    other columns ignored)."""
+    motor = spec.get("motor") if isinstance(spec, dict) else getattr(spec, "motor", None)
+    if isinstance(motor, dict):
+        return make_motor(**motor)
+    if motor is not None and not isinstance(motor, _core.Motor) and hasattr(motor, "keys"):
+        return _core.Motor.from_row(motor)
+    return motor
+
+
+def _part_value(part, key: str):
+    """A part's value: an attribute (a catalog Gearbox) or an entry (a row, a mapping); None
+    when it has none or it is NaN."""
+    value = part.get(key) if hasattr(part, "keys") else getattr(part, key, None)
+    if value is None or (isinstance(value, float) and value != value):
+        return None
+    return value
+
+
+def _from_parts(key: str, motor, gearbox):
+    """What the spec's parts give for an actuator key it leaves out: a gearbox (a catalog
+    Gearbox or row) its ``ratio`` and ``efficiency``; the rotor inertia is the motor's
+    ``rotor_inertia`` plus the gearbox's ``input_inertia`` (the gearbox's alone needs the
+    motor's: None without it)."""
+    if gearbox is not None and key in ("gear_ratio", "efficiency"):
+        return _part_value(gearbox, "ratio" if key == "gear_ratio" else "efficiency")
+    if key == "rotor_inertia" and motor is not None:
+        j = getattr(motor, "rotor_inertia", None)
+        if j is not None and gearbox is not None:
+            j += _part_value(gearbox, "input_inertia") or 0.0
+        return j
+    return None
 
 
 def _actuator_numbers(who: str, get) -> dict:
@@ -149,8 +187,8 @@ def _swept_actuator(joint: str, spec, existing) -> SimpleNamespace:
     """The stand-in actuator the gear-ratio sweep evaluates on ``joint`` (its ``gear_ratio``
     set per ratio): each value of :data:`_SWEPT_FIELDS` from ``spec`` (a dict, an object with
     those attributes, or None), else from the model's own actuator ``existing``, else the
-    default. An inherited default Coulomb smoothing (add_actuator's 1e-3 |N₀|) becomes None,
-    so that at ratio N it is 1e-3 |N|."""
+    default (``rotor_inertia``: else the motor's datasheet value). An inherited default Coulomb
+    smoothing (add_actuator's 1e-3 |N₀|) becomes None, so that at ratio N it is 1e-3 |N|."""
     if isinstance(spec, dict):
         unknown = sorted(set(spec) - set(_ACTUATOR_FIELDS))
         if unknown:
@@ -177,9 +215,14 @@ def _swept_actuator(joint: str, spec, existing) -> SimpleNamespace:
             <= 1e-15 * abs(value)
         ):
             value = None  # add_actuator's default 1e-3 |N0|: at ratio N it is 1e-3 |N|
-        if value is None and name == "rotor_inertia":
-            raise _core.ModelError(f"gear_ratio_sweep: joint {joint!r} needs a rotor_inertia")
         if name == "motor" and isinstance(value, dict):
             value = make_motor(**value)
         values[name] = value
+    if values["rotor_inertia"] is None:  # the motor's datasheet value
+        values["rotor_inertia"] = getattr(values["motor"], "rotor_inertia", None)
+    if values["rotor_inertia"] is None:
+        raise _core.ModelError(
+            f"gear_ratio_sweep: joint {joint!r} needs a rotor_inertia (in the spec or its "
+            "motor's datasheet)"
+        )
     return SimpleNamespace(joint=joint, gear_ratio=1.0, **values)

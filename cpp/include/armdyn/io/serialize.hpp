@@ -10,8 +10,10 @@
 // semidefinite inertias, coupling chains), then finalizes it again by the builder's own path, so
 // no byte string loads as a model the builder could not have made. The copy is the model
 // finalize makes from that description: bit for bit the original on the same armdyn build.
-// The format is private to one armdyn version: it starts with a magic tag and a format version,
-// checked on load. The derived caches (KKT plans, the welded model) are built again on first use.
+// The format is private to armdyn: it starts with a magic tag and a format version, checked on
+// load; this armdyn writes version 3 and reads 2 and 3 (2 lacks the motor datasheet fields after
+// the first nine of MotorSpec::fields(): they load as not given). The derived caches (KKT plans,
+// the welded model) are built again on first use.
 #pragma once
 
 #include <string>

@@ -8,6 +8,7 @@
 // omega_i [rad/s] in the BODY frame). nq = 7 nb, nv = 6 nb. Body index -1 is ground.
 #pragma once
 
+#include <array>
 #include <limits>
 #include <map>
 #include <memory>
@@ -236,24 +237,37 @@ struct IndependentCoords {
 
 /// A motor's datasheet values, motor side, SI units; NaN = not given (every field optional).
 /// Informative for the dynamics (the rotor inertia, gear ratio and friction of an Actuator are
-/// what enters them); the motor-side sizing maths (Python armdyn.actuators) reads them.
+/// what enters them); the motor-side sizing maths (Python armdyn.actuators, armdyn.sizing) reads
+/// them.
 struct MotorSpec {
   static constexpr double kUnset = std::numeric_limits<double>::quiet_NaN();
   std::string name;
-  double torque_constant = kUnset;        ///< [N m/A]
-  double resistance = kUnset;             ///< terminal resistance [ohm]
-  double voltage = kUnset;                ///< supply voltage [V]
-  double no_load_speed = kUnset;          ///< [rad/s]
-  double continuous_torque = kUnset;      ///< rated continuous torque [N m]
-  double peak_torque = kUnset;            ///< [N m]
-  double max_speed = kUnset;              ///< [rad/s]
-  double thermal_resistance = kUnset;     ///< winding to ambient [K/W]
-  double thermal_time_constant = kUnset;  ///< winding [s]
-  /// The numeric fields, in declaration order, with their names (bindings, validation).
-  static const std::vector<std::pair<const char*, double MotorSpec::*>>& fields();
+  double torque_constant = kUnset;                ///< [N m/A]
+  double resistance = kUnset;                     ///< terminal resistance [ohm]
+  double voltage = kUnset;                        ///< supply voltage [V]
+  double no_load_speed = kUnset;                  ///< [rad/s]
+  double continuous_torque = kUnset;              ///< rated continuous torque [N m]
+  double peak_torque = kUnset;                    ///< [N m]
+  double max_speed = kUnset;                      ///< [rad/s]
+  double thermal_resistance = kUnset;             ///< winding to ambient [K/W] (one-node model)
+  double thermal_time_constant = kUnset;          ///< winding [s] (one-node model)
+  double rotor_inertia = kUnset;                  ///< [kg m^2]
+  double mass = kUnset;                           ///< [kg]
+  double thermal_resistance_winding = kUnset;     ///< winding to housing [K/W] (two-node model)
+  double thermal_resistance_housing = kUnset;     ///< housing to ambient [K/W] (two-node model)
+  double thermal_time_constant_winding = kUnset;  ///< [s] (two-node model)
+  double thermal_time_constant_housing = kUnset;  ///< [s] (two-node model)
+  double max_winding_temperature = kUnset;        ///< [degC]
+  double brake_torque = kUnset;                   ///< holding brake, motor side [N m]
+  /// The number of numeric fields (every double member above).
+  static constexpr std::size_t kNumFields = 17;
+  using Field = std::pair<const char*, double MotorSpec::*>;
+  /// The numeric fields, in declaration order, with their names: the one list the bindings
+  /// (constructor keywords, properties, repr, ==, pickling), validation and the model bytes
+  /// follow. New fields go at the end (the bytes of format 2 hold the first nine).
+  static const std::array<Field, kNumFields>& fields();
   /// @throws ModelError naming the field when a given value is not finite and > 0.
   void validate(const std::string& who) const;
-  /// Equal names and fields (two unset fields compare equal).
   bool operator==(const MotorSpec& o) const;
 };
 
