@@ -173,7 +173,12 @@ GEARBOX_COLUMNS: tuple[Column, ...] = (
         hi=20.0,
         default=3.0,
     ),
-    Column("average_torque_limit", "N m", False, "limit for the cubic-mean output torque"),
+    Column(
+        "average_torque_limit",
+        "N m",
+        False,
+        "limit for the mean output torque (exponent life_exponent)",
+    ),
     Column("average_input_speed_limit", "rad/s", False, "limit for the average input speed"),
     Column("repeated_peak_torque", "N m", True, "limit for repeated peak (start/stop) torque"),
     Column("momentary_peak_torque", "N m", False, "limit for momentary (emergency stop) torque"),

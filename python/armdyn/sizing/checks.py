@@ -115,7 +115,7 @@ CHECKS: tuple[Check, ...] = (
         "average_torque_limit",
         False,
         "N m",
-        "cubic-mean output torque against the limit for average torque",
+        "mean output torque (cubic; 10/3 for RV) against the limit for average torque",
     ),
     Check(
         "gear_average_input_speed",

@@ -22,9 +22,10 @@ period ``t[-1] - t[0]``, the dwell (the vendors' pause time t_p) included.
 HFUS-2A/-2SH engineering data, "Selection procedure" and "Life of the Wave Generator bearing";
 Nabtesco's RV glossary and selection flow chart are the same with the exponent 10/3):
 
-- average (cubic-mean) output torque, weights |n| dt:
-  T_av = (∫ |n| |T|³ dt / ∫ |n| dt)^(1/3). A joint that never moves has no speed weights:
-  its T_av is the time-weighted cubic mean (∫ |T|³ dt / period)^(1/3) (the torque it holds),
+- average output torque, weights |n| dt, with each gearbox's life exponent p (the cubic mean
+  of strain-wave gears, p = 3; Nabtesco's mean torque of RV gears, p = 10/3):
+  T_av = (∫ |n| |T|^p dt / ∫ |n| dt)^(1/p). A joint that never moves has no speed weights:
+  its T_av is the time-weighted mean (∫ |T|^p dt / period)^(1/p) (the torque it holds),
   and its life is infinite (no revolutions);
 - average input speed n_av = |N| ∫ |n| dt / period, the vendors' Σ |n_i| t_i / Σ t_i over a
   cycle whose segments include the pause (Harmonic Drive's cycle diagrams mark t_p, "the pause
@@ -230,7 +231,10 @@ def gearbox_cycle_values(load, ratio, gearboxes, options=None) -> dict[str, np.n
 
     period = t[-1] - t[0]
     w = np.abs(speed)
-    t_av = weighted_mean(torque, w, t, 3.0)
+    # the mean torque of each gearbox's own life law (3 strain-wave, 10/3 RV: Nabtesco's T_m)
+    t_av = np.empty(k)
+    for exponent in np.unique(p):
+        t_av[p == exponent] = weighted_mean(torque, w, t, float(exponent))
     out_speed = float(trapezoid(w, t)) / period
     n_av = n_ratio * out_speed
     # in logarithms: no overflow to inf * 0; T_av = 0 or n_av = 0 (no wear) gives inf
@@ -239,7 +243,7 @@ def gearbox_cycle_values(load, ratio, gearboxes, options=None) -> dict[str, np.n
         life = np.exp(log_life + np.log(cols["rated_input_speed"]) - np.log(n_av))
 
     out = {
-        "gear_average_torque": np.full(k, t_av),
+        "gear_average_torque": t_av,
         "gear_average_output_speed": np.full(k, out_speed),
         "gear_average_input_speed": n_av,
         "gear_peak_input_speed": n_ratio * float(np.max(w)),
