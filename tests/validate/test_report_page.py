@@ -337,3 +337,31 @@ def test_the_sweep_section():
     assert len(s.figures) == 1 and s.figures[0].png[:4] == b"\x89PNG"
     pd.testing.assert_frame_equal(s.tables[0][1], sweep.summary)
     assert "not run" in sweep_section(None).text
+
+
+def test_a_joint_without_limits_or_motor_is_not_checked():
+    """An infinite joint limit is none given: a joint without limits and without a motor has
+    nothing checked (status 'unchecked', no binding check), while a joint with a limit is
+    checked against it."""
+    b = ad.ModelBuilder(gravity=(0, 0, -9.81))
+    b.add_body("upper", mass=2.0, inertia=[0.02, 0.17, 0.17], position=(0.4, 0, 0))
+    b.add_body("fore", mass=1.0, inertia=[0.005, 0.05, 0.05], position=(1.0, 0, 0))
+    b.add_revolute("shoulder", "ground", "upper", point=(0, 0, 0), axis=(0, 1, 0))
+    b.add_revolute("elbow", "upper", "fore", point=(0.8, 0, 0), axis=(0, 1, 0))
+    b.set_joint_limits("shoulder", -3.0, 3.0, effort=60.0, velocity=5.0)
+    model = b.finalize()
+    t = np.linspace(0.0, 1.0, 101)
+    q, qd, qdd = ad.profiles.quintic(0.0, 1.0, 0.0, 1.0).eval(t)
+    two = [np.stack([x, x], axis=1) for x in (q, qd, qdd)]
+    report = ad.sizing_report(ad.trajectory_run(model, t, *two))
+    rows, _ = report_verdict(report)
+    by = {r.joint: r for r in rows}
+    assert by["elbow"].status == "unchecked" and by["elbow"].binding_check == ""
+    assert np.isnan(by["elbow"].margin)
+    margins = {
+        "effort_limit": 60.0 / float(np.max(np.abs(report.torque[:, 0]))),
+        "velocity_limit": 5.0 / float(np.max(np.abs(qd))),
+    }
+    least = min(margins, key=margins.get)
+    assert by["shoulder"].status == "pass" and by["shoulder"].binding_check == least
+    assert by["shoulder"].margin == pytest.approx(margins[least], rel=1e-12)

@@ -123,10 +123,13 @@ class ReportModel:
 
 def row_status(ok: bool, margin: float) -> str:
     """The status of a joint from its ``ok`` and its least margin: fail when a made check
-    fails (margin < 1), unchecked when ``ok`` is False only because a required check could not
-    be made, else pass."""
+    fails (margin < 1), unchecked when nothing was checked (margin NaN: no limit and no part
+    data) or when ``ok`` is False only because a required check could not be made, else
+    pass."""
     if margin < 1.0:
         return "fail"
+    if np.isnan(margin):
+        return "unchecked"
     return "pass" if ok else "unchecked"
 
 

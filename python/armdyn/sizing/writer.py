@@ -120,8 +120,10 @@ def _check_columns(report: _SizingReport) -> dict[str, np.ndarray]:
         JOINT_CHECKS, ("peak_torque", "peak_speed"), ("torque_margin", "speed_margin"), strict=True
     ):
         cols[c.value] = table[v].to_numpy(dtype=float)
-        cols[c.allowable] = table[c.allowable].to_numpy(dtype=float)
-        cols[c.margin_column] = table[m].to_numpy(dtype=float)
+        limit = table[c.allowable].to_numpy(dtype=float)
+        # an infinite limit is none given (the URDF or builder set none): not checked
+        cols[c.allowable] = np.where(np.isinf(limit), np.nan, limit)
+        cols[c.margin_column] = np.where(np.isinf(limit), np.nan, table[m].to_numpy(dtype=float))
     # the motor: the report's columns, the datasheet's limits
     allow = {k: np.full(n, np.nan) for k in ("continuous_torque", "peak_torque", "max_speed")}
     stall, worst = np.full(n, np.nan), np.full(n, np.nan)
@@ -173,6 +175,8 @@ def _verdict_rows(report: _SizingReport, details) -> list[VerdictRow]:
             note = "no motor data"
         elif unchecked and unchecked != "nan":
             note = f"not checked: {unchecked.replace(',', ', ')}"
+        elif not binding:
+            note = "nothing to check against: no joint limit and no part data"
         rows.append(VerdictRow(str(joint), parts, row_status(ok, least), binding, least, note))
     return rows
 
