@@ -11,6 +11,7 @@ from __future__ import annotations
 import armdyn as ad
 import numpy as np
 import pytest
+from welded_scene import quat, welded_pendulums
 
 from benchmarks import common
 
@@ -56,8 +57,8 @@ def test_ur5_reactions_equal_pinocchio_rnea_joint_forces(fixed_base):
     if not fixed_base:
         # the base: a position, a unit quaternion (scalar first) and its rates in its own frame
         _, qb, qdb, qddb = motion(6, seed=5)
-        quat = np.stack([np.cos(qb[:, 3]), *(np.sin(qb[:, 3]) * np.c_[0.6, 0.0, 0.8].T)], axis=1)
-        q = np.hstack([qb[:, :3], quat, q])
+        q_base = np.stack([np.cos(qb[:, 3]), *(np.sin(qb[:, 3]) * np.c_[0.6, 0.0, 0.8].T)], axis=1)
+        q = np.hstack([qb[:, :3], q_base, q])
         qd, qdd = np.hstack([qdb, qd]), np.hstack([qddb, qdd])
     forces, torques = ad.joint_reactions(model, q, qd, qdd, t)
     assert forces.shape == torques.shape == (len(t), len(model.joint_names), 3)
@@ -127,50 +128,6 @@ def test_one_state_and_scalar_or_default_time():
     np.testing.assert_array_equal(n0, n1)
 
 
-def _quat(axis, angle):
-    axis = np.asarray(axis, float) / np.linalg.norm(axis)
-    return np.concatenate([[np.cos(angle / 2)], np.sin(angle / 2) * axis])
-
-
-def welded_pendulums():
-    """Two links on revolutes with parts welded at odd angles (a bracket welded to ground, a
-    weight and a sensor welded in a chain to link 1, a tip to link 2), a spring and a load on
-    welded members and a PI motor on the second joint (an integral state): fixed joints, force
-    elements and a motor whose torque joint_reactions does not know (its integral state is the
-    run's), which the reactions do not depend on."""
-    b = ad.ModelBuilder(gravity=(0.0, 0.0, -9.81))
-    b.add_body(
-        "bracket", 2.0, [0.02, 0.03, 0.04], position=(0, 0, 0.1), orientation=_quat((1, 1, 0), 0.4)
-    )
-    b.add_fixed("bracket_mount", "ground", "bracket", point=(0, 0, 0))
-    b.add_body("link1", 1.0, [0.001, 0.02, 0.02], position=(0.2, 0, 0.2))
-    b.add_revolute("pivot1", "bracket", "link1", point=(0, 0, 0.2), axis=(0, 1, 0))
-    b.add_body(
-        "weight",
-        0.5,
-        [1e-3, 2e-3, 3e-3],
-        position=(0.4, 0.05, 0.2),
-        orientation=_quat((0, 0.3, 1), 1.1),
-    )
-    b.add_fixed("weight_mount", "link1", "weight", point=(0.4, 0, 0.2))
-    b.add_body(
-        "sensor",
-        0.1,
-        [1e-4, 1e-4, 2e-4],
-        position=(0.45, 0.1, 0.25),
-        orientation=_quat((1, 0, 0), -0.7),
-    )
-    b.add_fixed("sensor_mount", "weight", "sensor", point=(0.45, 0.1, 0.2))
-    b.add_body("link2", 0.8, [0.001, 0.015, 0.015], position=(0.55, 0, 0.2))
-    b.add_revolute("pivot2", "link1", "link2", point=(0.4, 0, 0.2), axis=(0, 0, 1))
-    b.add_body("tip", 0.2, [1e-4, 1e-4, 1e-4], position=(0.7, 0, 0.2))
-    b.add_fixed("tip_mount", "link2", "tip", point=(0.7, 0, 0.2))
-    b.add_spring_damper("spring", "ground", (0.5, 0.3, 0.6), "sensor", (0.45, 0.1, 0.25), 40.0, 0.5)
-    b.add_body_force("tip", force=(0.0, 1.5, 0.0), point=(0.72, 0.0, 0.21))
-    b.add_motor("pivot2", ad.profiles.sine(0.5, 1.0, 0.0, 0.0), 20.0, 1.0, ki=5.0)
-    return b.finalize()
-
-
 def independent(model, res):
     """The run's independent coordinates (model.coord_names) and rates, the floating bases'
     entries first, from its columns over every joint."""
@@ -210,7 +167,7 @@ def test_ur5_equal_to_a_joint_space_run(fixed_base):
     _, model = ur5(fixed_base=fixed_base)
     q0, qd0 = np.array(common.UR5_Q0), np.array([0.4, -0.3, 0.5, 0.2, -0.6, 0.3])
     if not fixed_base:  # a base thrown spinning
-        q0 = np.r_[0.1, -0.2, 0.3, _quat((1, 2, 3), 0.5), q0]
+        q0 = np.r_[0.1, -0.2, 0.3, quat((1, 2, 3), 0.5), q0]
         qd0 = np.r_[0.5, 0.0, 1.0, 0.3, -0.2, 0.4, qd0]
     res = ad.simulate(
         model, 1.0, q0=q0, qd0=qd0, coordinates="joint", limits="ignore", output_dt=0.1

@@ -6,9 +6,9 @@ mechanism) and against a closed-form fixed-joint reaction."""
 import armdyn as ad
 import numpy as np
 import pytest
-from armdyn import _core
 from armdyn.papers.geared_arm import geared_arm_6dof
 from conftest import rel_err
+from welded_scene import welded_pendulums
 
 FIELDS = (
     "q",
@@ -43,50 +43,8 @@ def _pair(model, t_end, **kw):
     return merged, full
 
 
-def _quat(axis, angle):
-    axis = np.asarray(axis, float) / np.linalg.norm(axis)
-    return np.concatenate([[np.cos(angle / 2)], np.sin(angle / 2) * axis])
-
-
-def _welded_pendulums():
-    """Two links on revolutes with welded parts at odd angles: a bracket welded to ground
-    carrying the first pivot, a weight and a sensor welded (in a chain) to link 1, a spring
-    and a load on welded members, and a PI motor on the second joint (an auxiliary state)."""
-    b = ad.ModelBuilder(gravity=(0.0, 0.0, -9.81))
-    b.add_body(
-        "bracket", 2.0, [0.02, 0.03, 0.04], position=(0, 0, 0.1), orientation=_quat((1, 1, 0), 0.4)
-    )
-    b.add_fixed("bracket_mount", "ground", "bracket", point=(0, 0, 0))
-    b.add_body("link1", 1.0, [0.001, 0.02, 0.02], position=(0.2, 0, 0.2))
-    b.add_revolute("pivot1", "bracket", "link1", point=(0, 0, 0.2), axis=(0, 1, 0))
-    b.add_body(
-        "weight",
-        0.5,
-        [1e-3, 2e-3, 3e-3],
-        position=(0.4, 0.05, 0.2),
-        orientation=_quat((0, 0.3, 1), 1.1),
-    )
-    b.add_fixed("weight_mount", "link1", "weight", point=(0.4, 0, 0.2))
-    b.add_body(
-        "sensor",
-        0.1,
-        [1e-4, 1e-4, 2e-4],
-        position=(0.45, 0.1, 0.25),
-        orientation=_quat((1, 0, 0), -0.7),
-    )
-    b.add_fixed("sensor_mount", "weight", "sensor", point=(0.45, 0.1, 0.2))
-    b.add_body("link2", 0.8, [0.001, 0.015, 0.015], position=(0.55, 0, 0.2))
-    b.add_revolute("pivot2", "link1", "link2", point=(0.4, 0, 0.2), axis=(0, 0, 1))
-    b.add_body("tip", 0.2, [1e-4, 1e-4, 1e-4], position=(0.7, 0, 0.2))
-    b.add_fixed("tip_mount", "link2", "tip", point=(0.7, 0, 0.2))
-    b.add_spring_damper("spring", "ground", (0.5, 0.3, 0.6), "sensor", (0.45, 0.1, 0.25), 40.0, 0.5)
-    b.add_body_force("tip", force=(0.0, 1.5, 0.0), point=(0.72, 0.0, 0.21))
-    b.add_motor("pivot2", _core.profiles.sine(0.5, 1.0, 0.0, 0.0), 20.0, 1.0, ki=5.0)
-    return b.finalize()
-
-
 def test_welded_model_is_the_same_mechanism_with_fewer_bodies():
-    model = _welded_pendulums()
+    model = welded_pendulums()
     merged, full = _pair(model, 1.0, rtol=1e-11, atol=1e-12, output_dt=0.02)
     # bracket -> ground; weight and sensor -> link1; tip -> link2
     assert merged.stats["solver_bodies"] == 2 and merged.stats["solver_rows"] == 10
@@ -134,7 +92,7 @@ def test_joint_space_run_reports_the_cartesian_tables_without_a_kkt_solve(merge)
     from the joint-space dynamics, every joint's multipliers (the fixed joints' too) from the
     bodies' Newton-Euler balances. Its tables equal the Cartesian run's (the paper's KKT
     multipliers) and it makes no KKT solve."""
-    model = _welded_pendulums()
+    model = welded_pendulums()
     kw = dict(rtol=1e-11, atol=1e-12, output_dt=0.02, merge_welded=merge)
     cart = ad.simulate(model, 1.0, **kw)
     joint = ad.simulate(model, 1.0, coordinates="joint", **kw)

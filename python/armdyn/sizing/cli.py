@@ -456,9 +456,20 @@ def _option_flag(message: str) -> str:
     return ""
 
 
-def main(args) -> int:
+def _command(name: str, call) -> int:
+    """``call()``'s exit code; bad input (a ModelError, UrdfError, SolverError or OSError) one
+    line on stderr naming the command, exit code 2."""
     try:
-        return run(
+        return call()
+    except (_core.ModelError, _core.UrdfError, _core.SolverError, OSError) as exc:
+        print(f"armdyn {name}: {exc}", file=sys.stderr)
+        return 2
+
+
+def main(args) -> int:
+    return _command(
+        "size",
+        lambda: run(
             args.urdf,
             args.trajectory,
             args.actuators,
@@ -469,10 +480,8 @@ def main(args) -> int:
             dwell=args.dwell,
             options=option_strings(args),
             sweep=args.sweep,
-        )
-    except (_core.ModelError, _core.UrdfError, _core.SolverError, OSError) as exc:
-        print(f"armdyn size: {exc}", file=sys.stderr)
-        return 2
+        ),
+    )
 
 
 # --------------------------------------------------------------------------- armdyn select
@@ -551,8 +560,9 @@ def _print_selection(selection, out, echo, catalog=None) -> int:
 
 
 def select_main(args) -> int:
-    try:
-        return select_run(
+    return _command(
+        "select",
+        lambda: select_run(
             args.urdf,
             args.trajectory,
             args.catalog,
@@ -563,7 +573,5 @@ def select_main(args) -> int:
             cycle=args.cycle,
             dwell=args.dwell,
             options=option_strings(args),
-        )
-    except (_core.ModelError, _core.UrdfError, _core.SolverError, OSError) as exc:
-        print(f"armdyn select: {exc}", file=sys.stderr)
-        return 2
+        ),
+    )

@@ -35,14 +35,7 @@ _DEFAULTS = {
 }
 #: the keys the gear-ratio sweep takes from a spec (or the model's actuator): every one but the
 #: ratio it sweeps and gyroscopic
-_SWEPT_FIELDS = (
-    "rotor_inertia",
-    "efficiency",
-    "friction_viscous",
-    "friction_coulomb",
-    "friction_smoothing",
-    "motor",
-)
+_SWEPT_FIELDS = tuple(f for f in _ACTUATOR_FIELDS if f not in ("gear_ratio", "gyroscopic"))
 
 
 def make_motor(**datasheet):

@@ -241,13 +241,23 @@ def _cycle_thermal_section(report: _SizingReport) -> Section:
         limit = _motor_attr(report.envelopes.get(joint), "max_winding_temperature")
         if np.isfinite(limit):
             ax.axhline(limit, lw=0.8, ls=":", color=f"C{k}", label=f"{joint} max winding")
-    ax.set_xlabel("t [s] (the period of the peak)")
-    ax.set_ylabel("temperature [°C]")
-    ax.set_title("motor temperatures over the repeated cycle (two-node, else one-node model)")
+    return _thermal_figure(
+        fig,
+        ("t [s] (the period of the peak)", "temperature [°C]"),
+        "motor temperatures over the repeated cycle (two-node, else one-node model)",
+        "winding and housing temperature over one period of the repeated cycle per motor",
+    )
+
+
+def _thermal_figure(fig, labels: tuple[str, str], title: str, alt: str) -> Section:
+    """The thermal section of a figure whose one axes is drawn: labels, title, legend, grid."""
+    ax = fig.axes[0]
+    ax.set_xlabel(labels[0])
+    ax.set_ylabel(labels[1])
+    ax.set_title(title)
     ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize="small")
     ax.grid(lw=0.3)
     fig.tight_layout()
-    alt = "winding and housing temperature over one period of the repeated cycle per motor"
     return Section("Thermal histories", figures=[ReportFigure(alt, figure_png(fig), alt)])
 
 
@@ -276,14 +286,12 @@ def _thermal_section(report: _SizingReport) -> Section:
     ax = fig.subplots()
     for joint, rise in curves:
         ax.plot(report.t, rise, lw=1.0, label=str(joint))
-    ax.set_xlabel("t [s]")
-    ax.set_ylabel("winding temperature rise [K]")
-    ax.set_title("winding temperature rise from the start of the run (first-order model)")
-    ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize="small")
-    ax.grid(lw=0.3)
-    fig.tight_layout()
-    alt = "winding temperature rise against time per motor"
-    return Section("Thermal histories", figures=[ReportFigure(alt, figure_png(fig), alt)])
+    return _thermal_figure(
+        fig,
+        ("t [s]", "winding temperature rise [K]"),
+        "winding temperature rise from the start of the run (first-order model)",
+        "winding temperature rise against time per motor",
+    )
 
 
 def _envelope_section(report: _SizingReport) -> Section:
