@@ -244,7 +244,7 @@ def _cycle_thermal_section(report: _SizingReport) -> Section:
     return _thermal_figure(
         fig,
         ("t [s] (the period of the peak)", "temperature [°C]"),
-        "motor temperatures over the repeated cycle (two-node, else one-node model)",
+        "motor temperatures over the repeated cycle",
         "winding and housing temperature over one period of the repeated cycle per motor",
     )
 
