@@ -7,7 +7,7 @@ actuator efforts) come from the augmented system ``[Γ ζᵀ; ζ 0][v'; δ] = [�
 projection keeps the constraints satisfied to round-off.
 """
 
-from armdyn import actuators, scenes, validation
+from armdyn import actuators, motion, scenes, validation
 from armdyn._core import (
     Actuator,
     Data,
@@ -103,6 +103,7 @@ __all__ = [
     "load_catalog",
     "load_urdf",
     "mass_matrix",
+    "motion",
     "profiles",
     "rollout",
     "scenes",

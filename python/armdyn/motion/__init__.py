@@ -1,0 +1,11 @@
+"""Motion for design: joint trajectories (point-to-point and through waypoints, trapezoidal,
+jerk-limited and spline), Cartesian moves by inverse kinematics, the time-optimal timing of a
+path under joint, torque and motor limits (and the shortest repeated cycle within the motors'
+thermal limits), and the least-energy motion. Every planner returns a :class:`Trajectory`
+(``t, q, qd, qdd``: what ``armdyn.trajectory_run``, ``duty_cycle`` and ``select_drivetrain``
+take) or a :class:`Path` (geometric, timed by :func:`time_optimal`).
+"""
+
+from armdyn.motion.trajectory import Path, Trajectory
+
+__all__ = ["Path", "Trajectory"]
