@@ -1,0 +1,27 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Analytical derivatives of the model's force elements, as joint-space generalised forces: the
+// part of inverse dynamics' tau = M qdd + b - J^T eta - Q that the rigid-body recursion does not
+// cover (body loads and point-to-point spring-dampers in eta; coordinate forces and gear pairs in
+// Q). Gravity and the gyroscopic terms are the rigid-body recursion's own
+// (algorithm/derivatives.hpp).
+#pragma once
+
+#include "armdyn/data.hpp"
+
+namespace armdyn {
+
+/// Adds the derivatives of the force elements' generalised force F(q, qd, t) = J^T eta_elements +
+/// Q (every coordinate, followers of couplings included: the full joint-space layout, floating
+/// bases' blocks first) to dF_dq and dF_dqd (nv_joint x nv_joint, not zeroed here): q-derivatives
+/// along the rates (a floating base's along its qd block, Pinocchio's convention), at time t and
+/// auxiliary states zero (as inverse_dynamics). Needs data.kin and data.rne at (q, qd)
+/// (joint_space_kinematics). Allocates nothing.
+/// @throws SolverError naming the element when a profile or force is not finite.
+void add_force_element_derivatives(const Model& m, Data& d, const double* q, const double* qd,
+                                   double t, Eigen::Ref<MatX> dF_dq, Eigen::Ref<MatX> dF_dqd);
+
+/// True when the model has force elements (body loads, spring-dampers, coordinate forces, gear
+/// pairs): add_force_element_derivatives has something to add.
+bool has_force_elements(const Model& m);
+
+}  // namespace armdyn
