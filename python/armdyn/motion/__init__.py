@@ -6,6 +6,14 @@ thermal limits), and the least-energy motion. Every planner returns a :class:`Tr
 take) or a :class:`Path` (geometric, timed by :func:`time_optimal`).
 """
 
+from armdyn.motion.profiles import point_to_point, spline, through_waypoints, waypoint_path
 from armdyn.motion.trajectory import Path, Trajectory
 
-__all__ = ["Path", "Trajectory"]
+__all__ = [
+    "Path",
+    "Trajectory",
+    "point_to_point",
+    "spline",
+    "through_waypoints",
+    "waypoint_path",
+]
