@@ -101,7 +101,7 @@ def _limit(who: str, name: str, value, n: int, *, allow_inf: bool = False) -> np
     if bad.any():
         j = int(np.argmax(bad))
         allowed = "positive" + (" (inf: no limit)" if allow_inf else " and finite")
-        raise _core.ModelError(f"{who}: {name}[{j}] = {a[j]!r} must be {allowed}")
+        raise _core.ModelError(f"{who}: {name}[{j}] = {float(a[j])!r} must be {allowed}")
     return a
 
 
@@ -118,7 +118,9 @@ def _model_joints(who: str, model, n: int) -> tuple[str, ...] | None:
             "plan the joints of a fixed-base model"
         )
     if len(names) != n:
-        raise _core.ModelError(f"{who}: {n} joints given, the model has {len(names)} ({names})")
+        raise _core.ModelError(
+            f"{who}: {n} joints given, the model has {len(names)}: {list(names)}"
+        )
     return names
 
 
@@ -218,9 +220,12 @@ def _solve(start, v0, goal, v1, limits, where: str):
     traj = rk.Trajectory(n)
     try:
         result = rk.Ruckig(n).calculate(inp, traj)
-    except RuntimeError as err:  # ruckig.RuckigError
+    except rk.RuckigError as err:  # its first line names the step and the joint
+        first = str(err).strip().splitlines()[0].replace("[ruckig] ", "").strip()
+        first = first.removesuffix(" input:")
         raise _core.SolverError(
-            f"{where}: ruckig refused the segment: {str(err).strip()}"
+            f"{where}: ruckig found no profile ({first}; are the distances and limits of "
+            "sensible scales?)"
         ) from None
     if result != rk.Result.Working or not np.isfinite(traj.duration):
         raise _core.SolverError(f"{where}: ruckig found no profile ({result})")
@@ -662,11 +667,18 @@ def waypoint_path(waypoints: npt.ArrayLike, *, model: _core.Model | None = None)
         raise _core.ModelError(f"{who}: {m} waypoints (> {MAX_SAMPLES})")
     names = _model_joints(who, model, n)
     _within_range(who, model, points, "waypoints")
-    chords = np.linalg.norm(np.diff(points, axis=0), axis=1)
+    with np.errstate(over="ignore", invalid="ignore"):
+        chords = np.linalg.norm(np.diff(points, axis=0), axis=1)
+    if not np.all(np.isfinite(chords)):
+        k = int(np.argmin(np.isfinite(chords)))
+        raise _core.ModelError(
+            f"{who}: the distance from waypoints[{k}] to waypoints[{k + 1}] overflows"
+        )
     if not np.all(chords > 0.0):
         k = int(np.argmin(chords > 0.0))
         raise _core.ModelError(f"{who}: waypoints[{k}] and waypoints[{k + 1}] are equal")
-    total = float(np.sum(chords))
+    with np.errstate(over="ignore"):
+        total = float(np.sum(chords))
     if not np.isfinite(total):
         raise _core.ModelError(f"{who}: the waypoints' distances overflow (total length inf)")
     s = np.concatenate([[0.0], np.cumsum(chords) / total])
