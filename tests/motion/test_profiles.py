@@ -219,6 +219,8 @@ def test_synchronised_joints_arrive_together():
         for s, g, vi, ai in zip(start[moving], goal[moving], v[moving], a[moving], strict=True)
     ]
     assert traj.duration == pytest.approx(max(alone), rel=1e-9)
+    # these limits leave no common phase profile: ruckig's time synchronisation
+    np.testing.assert_array_equal(traj.info["phase_synchronized"], [False])
     # every moving joint is still short of its goal just before the end; the still joint stays
     before = traj.sample([traj.duration - 1e-3])
     assert np.all(np.abs(before.q[0, moving] - goal[moving]) > 1e-9)
@@ -242,6 +244,7 @@ def test_synchronised_joints_with_common_limits_move_on_the_line(profile):
         assert traj.duration == pytest.approx(double_s(abs(d[lead]), 1.0, 2.0, 8.0)[0], rel=1e-9)
     else:
         assert traj.duration == pytest.approx(trapezoid([0.0], abs(d[lead]), 1.0, 2.0)[0])
+    np.testing.assert_array_equal(traj.info["phase_synchronized"], [True])
     frac = (traj.q[:, moving] - start[moving]) / d[moving]
     np.testing.assert_allclose(frac, np.tile(frac[:, [0]], (1, moving.sum())), rtol=0, atol=1e-9)
 
@@ -315,6 +318,38 @@ def test_through_waypoints_is_continuous_at_the_joins(profile):
     ]
     np.testing.assert_allclose(stop.info["segment_durations"], legs, rtol=1e-12)
     assert traj.duration < stop.duration
+
+
+def test_evaluation_is_ruckigs_at_time():
+    """The closed-form phase integration equals ruckig's own Trajectory.at_time on segments
+    solved here directly from the waypoints and the velocities the planner chose; so does the
+    at_time fallback."""
+    import ruckig
+    from armdyn.motion import profiles
+
+    traj = through_waypoints(WAYPOINTS, max_velocity=1.0, max_acceleration=2.0, max_jerk=6.0)
+    vel, times = traj.info["waypoint_velocities"], traj.info["waypoint_times"]
+    x = np.sort(np.random.default_rng(7).uniform(0.0, traj.duration, 300))
+    got = traj.sample(x)
+    for k in range(len(WAYPOINTS) - 1):
+        inp = ruckig.InputParameter(3)
+        inp.current_position, inp.current_velocity = WAYPOINTS[k], vel[k]
+        inp.target_position, inp.target_velocity = WAYPOINTS[k + 1], vel[k + 1]
+        inp.max_velocity, inp.max_acceleration, inp.max_jerk = [1.0] * 3, [2.0] * 3, [6.0] * 3
+        inp.synchronization = ruckig.Synchronization.Phase
+        seg = ruckig.Trajectory(3)
+        assert ruckig.Ruckig(3).calculate(inp, seg) == ruckig.Result.Working
+        assert seg.duration == pytest.approx(times[k + 1] - times[k], rel=1e-12)
+        inside = (x >= times[k]) & (x < times[k + 1])
+        want = np.array([seg.at_time(xi - times[k]) for xi in x[inside]])
+        for r, got_r in enumerate((got.q, got.qd, got.qdd)):
+            np.testing.assert_allclose(got_r[inside], want[:, r], rtol=0, atol=1e-12)
+    # the per-sample at_time path (taken when ruckig adds a brake phase) gives the same
+    lim = (np.ones(3), np.full(3, 2.0), np.full(3, 6.0))
+    chain, _ = profiles._chain("test", WAYPOINTS, [0, 1, 2], lim, False)
+    fast = chain.at(x)
+    chain.tables = None
+    np.testing.assert_allclose(chain.at(x), fast, rtol=0, atol=1e-12)
 
 
 def test_through_waypoints_per_joint_runs_each_column():

@@ -232,15 +232,38 @@ def _solve(start, v0, goal, v1, limits, where: str):
     return traj
 
 
+def _phases(segment) -> np.ndarray | None:
+    """(joints, 5, 8): per joint of a ruckig segment its 7 phases' start times (and the end),
+    jerks (0 after the end), and the acceleration, velocity and position at each phase start
+    (and at the end); None when a brake phase precedes the profile (then ``at_time``)."""
+    profiles = segment.profiles[0]
+    out = np.zeros((len(profiles), 5, 8))
+    for d, prof in enumerate(profiles):
+        if prof.brake.duration > 0.0 or prof.accel.duration > 0.0:
+            return None
+        out[d, 0, 1:] = np.cumsum(prof.t)
+        out[d, 1, :7] = prof.j
+        out[d, 2], out[d, 3], out[d, 4] = prof.a, prof.v, prof.p
+    return out
+
+
 class _Chain:
     """Consecutive ruckig segments of one group of joints (every joint when synchronised, one
-    joint otherwise), each starting where the previous ended; holds the last state after."""
+    joint otherwise), each starting where the previous ended; holds the last state after.
+
+    Evaluation integrates each segment's constant-jerk phases in closed form from ruckig's own
+    phase data (``Profile.t, j, a, v, p``: the arithmetic of ``Trajectory.at_time``, vectorised
+    over the samples); a segment with a brake phase falls back to ``at_time`` per sample."""
+
+    CHUNK = 1 << 16  # samples per vectorised block (bounds the temporaries)
 
     def __init__(self, joints: list[int], segments: list) -> None:
         self.joints = joints
         self.segments = segments
         self.durations = np.array([s.duration for s in segments])
         self.starts = np.concatenate([[0.0], np.cumsum(self.durations)])
+        tables = [_phases(s) for s in segments]
+        self.tables = None if any(x is None for x in tables) else np.stack(tables)
 
     @property
     def duration(self) -> float:
@@ -251,9 +274,41 @@ class _Chain:
         k = np.clip(np.searchsorted(self.starts, t, side="right") - 1, 0, len(self.segments) - 1)
         local = np.clip(t - self.starts[k], 0.0, self.durations[k])
         out = np.empty((3, len(t), len(self.joints)))
-        for i in range(len(t)):
-            p, v, a = self.segments[k[i]].at_time(float(local[i]))
-            out[0, i], out[1, i], out[2, i] = p, v, a
+        if self.tables is None:
+            for i in range(len(t)):
+                out[:, i] = self.segments[k[i]].at_time(float(local[i]))
+            return out
+        for lo in range(0, len(t), self.CHUNK):
+            part = slice(lo, lo + self.CHUNK)
+            out[:, part] = self._integrate(k[part], local[part])
+        return out
+
+    def phase_synchronized(self) -> np.ndarray | None:
+        """Per segment: do the moving joints share their phase times (ruckig's phase
+        synchronisation: the straight line in joint space), or only the duration (its time
+        synchronisation)? None without the phase data."""
+        if self.tables is None:
+            return None
+        starts, v, p = self.tables[:, :, 0, :], self.tables[:, :, 3, :], self.tables[:, :, 4, :]
+        moving = (p[:, :, 0] != p[:, :, 7]) | np.any(v != 0.0, axis=2)
+        out = np.empty(len(starts), dtype=bool)
+        for k, (st, mv) in enumerate(zip(starts, moving, strict=True)):
+            rows = st[mv]
+            out[k] = len(rows) == 0 or bool(np.allclose(rows, rows[0], rtol=1e-9, atol=1e-12))
+        return out
+
+    def _integrate(self, k: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        n = len(self.joints)
+        flat = self.tables.reshape(-1, 5, 8)  # row: segment * joints + joint
+        out = np.empty((3, len(k), n))
+        for d in range(n):
+            row = k * n + d
+            phase = np.sum(tau[:, None] >= flat[row, 0, 1:], axis=1)  # 7: after the end
+            h = tau - flat[row, 0, phase]
+            j, a, v, p = (flat[row, r, phase] for r in (1, 2, 3, 4))
+            out[0, :, d] = p + h * (v + h * (a / 2.0 + h * j / 6.0))
+            out[1, :, d] = v + h * (a + h * j / 2.0)
+            out[2, :, d] = a + h * j
         return out
 
 
@@ -343,7 +398,9 @@ def _limited(who: str, points, limits, synchronize: bool, stop: bool, dt, names,
         max_acceleration=limits[1],
         max_jerk=None if np.all(np.isinf(limits[2])) else limits[2],
     )
-    if not synchronize:
+    if synchronize:
+        info["phase_synchronized"] = chains[0].phase_synchronized()
+    else:
         info["joint_durations"] = np.array([c.duration for c in chains])
     return Trajectory(grid, *evaluate(grid), names=names, info=info, evaluate=evaluate)
 
@@ -383,7 +440,9 @@ def point_to_point(
 
     Returns:
         :class:`Trajectory` from t = 0, exact ``evaluate``; ``info``: method, profile,
-        synchronize, duration, segment_durations, the limits, joint_durations (per joint).
+        synchronize, duration, segment_durations, the limits, phase_synchronized
+        (synchronised: did ruckig move the joints on the straight line?), joint_durations
+        (per joint).
 
     Raises:
         ModelError: a bad argument (named: NaN, inf, a limit ≤ 0, shapes, dt giving too many
@@ -430,7 +489,8 @@ def through_waypoints(
     Returns:
         :class:`Trajectory` from t = 0 with exact ``evaluate``; ``info``: method, profile,
         synchronize, stop_at_waypoints, duration, segment_durations ((m-1,) or, per joint,
-        (n, m-1)), waypoint_times (synchronised), waypoint_velocities (m, n), the limits.
+        (n, m-1)), waypoint_times and phase_synchronized (per segment; synchronised),
+        waypoint_velocities (m, n), the limits, joint_durations (per joint).
 
     Raises:
         ModelError: a bad argument (named), fewer than two waypoints, a waypoint outside the
