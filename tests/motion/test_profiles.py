@@ -371,6 +371,28 @@ def test_through_waypoints_per_joint_runs_each_column():
     _assert_within(traj, 1.0, 2.0, 6.0)
 
 
+@pytest.mark.parametrize("seed", range(6))
+def test_random_via_point_moves_stay_within_limits_and_between_waypoints(seed):
+    """Random waypoints (some joints still on some legs), limits and profiles: every solve
+    succeeds, every limit holds on a fine grid, and inside each leg every joint stays
+    between the leg's end values (the pass-through velocities never force an overshoot)."""
+    rng = np.random.default_rng(seed)
+    n, m = int(rng.integers(1, 5)), int(rng.integers(3, 7))
+    steps = rng.normal(0.0, 1.0, (m, n)) * rng.choice([1.0, 0.01, 0.0], (m, n), p=[0.8, 0.1, 0.1])
+    wp = np.cumsum(steps, axis=0)
+    v, a = rng.uniform(0.2, 3.0, n), rng.uniform(0.2, 5.0, n)
+    for profile, j in (("double_s", rng.uniform(1.0, 50.0, n)), ("trapezoidal", None)):
+        traj = through_waypoints(
+            wp, max_velocity=v, max_acceleration=a, max_jerk=j, profile=profile, dt=0.01
+        )
+        fine = _assert_within(traj, v, a, j)
+        times = traj.info["waypoint_times"]
+        k = np.clip(np.searchsorted(times, fine.t, side="right") - 1, 0, m - 2)
+        lo = np.minimum(wp[k], wp[k + 1]) - 1e-9
+        hi = np.maximum(wp[k], wp[k + 1]) + 1e-9
+        assert np.all((fine.q >= lo) & (fine.q <= hi))
+
+
 # ---------------------------------------------------------------- splines
 
 
@@ -514,6 +536,15 @@ def test_ur5_sizing_takes_the_trajectories():
             max_jerk=1.0,
             model=model,
         )
+    # splines and paths that leave a joint's range between in-range waypoints
+    turn = np.zeros((4, 6))
+    turn[:, 2] = [0.0, 2.8, 3.1, 2.8]
+    with pytest.raises(ad.SolverError, match=r"joint 'elbow_joint' to 3\.2035\d* at t = 2\.61"):
+        spline([0.0, 2.0, 3.0, 4.0], turn, model=model)
+    turn[:, 2], turn[:, 0] = [0.0, 3.1, 3.1, 0.0], [0.0, 0.0, 1.0, 1.0]
+    with pytest.raises(ad.SolverError, match=r"joint 'elbow_joint' to 3\.18152 at s = 0\.5,"):
+        waypoint_path(turn, model=model)
+    assert waypoint_path(turn).n_joints == 6  # without the model nothing is checked
     with pytest.raises(ad.ModelError, match="2 joints given, the model has 6"):
         point_to_point([0.0, 0.0], [1.0, 1.0], max_acceleration=1.0, max_jerk=1.0, model=model)
 
@@ -607,8 +638,14 @@ L = {"max_velocity": 1.0, "max_acceleration": 2.0, "max_jerk": 10.0}
             lambda: waypoint_path([[0.0, 1.0], [0.0, 1.0], [1.0, 1.0]]),
             r"waypoints\[0\] and waypoints\[1\] are equal",
         ),
-        (lambda: waypoint_path([[0.0], [1e308], [-1e308]]), "overflow"),
         (lambda: point_to_point(0, 1, **L, model="ur5"), "model must be an armdyn.Model"),
+        (lambda: spline([0.0, 1e-300], [0.0, 1e300]), "the spline overflows"),
+        (lambda: spline([0, 1, 2], [[0], [1e308], [-1e308]]), "the spline overflows"),
+        (lambda: spline([1e15, 1e15 + 1], [0, 1], dt=0.01), "below the floating-point resolution"),
+        (
+            lambda: waypoint_path([[0.0], [1e308], [-1e308]]),
+            r"waypoints\[0\] to waypoints\[1\] overflows",
+        ),
     ],
 )
 def test_hostile_inputs_name_the_argument(call, match):

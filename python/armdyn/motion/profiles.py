@@ -187,7 +187,12 @@ def _grid(who: str, t0: float, t1: float, dt) -> np.ndarray:
         )
     k = int(np.ceil(count - 1e-9))
     grid = t0 + step * np.arange(k)
-    return np.append(grid[grid < t1], t1)
+    grid = np.append(grid[grid < t1], t1)
+    if len(grid) > 1 and not np.all(np.diff(grid) > 0.0):
+        raise _core.ModelError(
+            f"{who}: dt = {step:g} s is below the floating-point resolution of times near {t1:g} s"
+        )
+    return grid
 
 
 # ---------------------------------------------------------------- ruckig segments
@@ -578,21 +583,64 @@ def _piecewise(t, points, kind, end_conditions, v_ends):
     return PPoly(c, t)
 
 
-def _peaks(poly, order: int) -> tuple[np.ndarray, np.ndarray]:
-    """Per joint: the largest |d^order q/dt^order| over the spline and a time where it is
-    reached (at a breakpoint or a root of the next derivative, exact)."""
+def _finite_spline(who, t, points, kind, end_conditions, v_ends):
+    """The spline's PPoly; ModelError when its coefficients or those of its first three
+    derivatives overflow (waypoints too far apart for their times)."""
+    with np.errstate(all="ignore"):
+        try:
+            poly = _piecewise(t, points, kind, end_conditions, v_ends)
+            finite = all(np.all(np.isfinite(poly.derivative(k).c)) for k in range(4))
+        except (ValueError, np.linalg.LinAlgError):
+            finite = False
+    if not finite:
+        raise _core.ModelError(
+            f"{who}: the spline overflows: the waypoints are too far apart (or the times too "
+            "close) for its coefficients to be finite"
+        )
+    return poly
+
+
+def _extrema(poly, order: int) -> np.ndarray:
+    """(4, joints): per joint the least value of the ``order``-th derivative, where, the
+    largest, where (exact: at a breakpoint or a root of the next derivative)."""
     from scipy.interpolate import PPoly
 
     d, dd = poly.derivative(order), poly.derivative(order + 1)
     n = d.c.shape[2]
-    peak, where = np.empty(n), np.empty(n)
+    out = np.empty((4, n))
     for j in range(n):
         roots = PPoly(dd.c[:, :, j], dd.x).roots(extrapolate=False)
         cand = np.concatenate([d.x, roots[np.isfinite(roots)]])
-        val = np.abs(d(cand)[:, j])
-        i = int(np.argmax(val))
-        peak[j], where[j] = val[i], cand[i]
-    return peak, where
+        val = d(cand)[:, j]
+        lo, hi = int(np.argmin(val)), int(np.argmax(val))
+        out[:, j] = val[lo], cand[lo], val[hi], cand[hi]
+    return out
+
+
+def _peaks(poly, order: int) -> tuple[np.ndarray, np.ndarray]:
+    """Per joint: the largest |d^order q/dt^order| over the spline and where it is reached."""
+    lo, lo_at, hi, hi_at = _extrema(poly, order)
+    top = np.abs(hi) >= np.abs(lo)
+    return np.where(top, np.abs(hi), np.abs(lo)), np.where(top, hi_at, lo_at)
+
+
+def _stays_in_range(who: str, poly, model, names, var: str) -> None:
+    """SolverError when the spline takes a joint outside the model's position range between
+    its waypoints (naming the joint, the value and where)."""
+    if model is None:
+        return
+    lo, lo_at, hi, hi_at = _extrema(poly, 0)
+    lower, upper = np.asarray(model.coord_lower), np.asarray(model.coord_upper)
+    for j, name in enumerate(names):
+        for value, at, bad in (
+            (lo[j], lo_at[j], lo[j] < lower[j]),
+            (hi[j], hi_at[j], hi[j] > upper[j]),
+        ):
+            if bad:
+                raise _core.SolverError(
+                    f"{who}: the spline takes joint '{name}' to {value:.6g} at {var} = {at:.6g}, "
+                    f"outside its range [{lower[j]:g}, {upper[j]:g}] (between the waypoints)"
+                )
 
 
 def _check_spline_limits(who, poly, names, max_velocity, max_acceleration, model, n, info):
@@ -676,7 +724,7 @@ def spline(
     v_ends = _end_velocities(who, end_velocities, n, end_conditions == "clamped")
     names = _model_joints(who, model, n)
     _within_range(who, model, points, "waypoints")
-    poly = _piecewise(t, points, kind, end_conditions, v_ends)
+    poly = _finite_spline(who, t, points, kind, end_conditions, v_ends)
     d1, d2 = poly.derivative(1), poly.derivative(2)
     t0, t1 = float(t[0]), float(t[-1])
     info: dict[str, Any] = {
@@ -687,6 +735,7 @@ def spline(
         "segment_durations": np.diff(t),
         "duration": t1 - t0,
     }
+    _stays_in_range(who, poly, model, names, "t")
     _check_spline_limits(who, poly, names, max_velocity, max_acceleration, model, n, info)
 
     def evaluate(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -749,7 +798,12 @@ def waypoint_path(waypoints: npt.ArrayLike, *, model: _core.Model | None = None)
             f"{who}: waypoints[{k}] to waypoints[{k + 1}] is too short beside the path's "
             f"length {total:g} (its knot would repeat)"
         )
-    poly = CubicSpline(s, points, axis=0, bc_type="natural")
+    with np.errstate(all="ignore"):
+        poly = CubicSpline(s, points, axis=0, bc_type="natural")
+        finite = all(np.all(np.isfinite(poly.derivative(k).c)) for k in range(3))
+    if not finite:
+        raise _core.ModelError(f"{who}: the path overflows: the waypoints are too far apart")
+    _stays_in_range(who, poly, model, names, "s")
     d1, d2 = poly.derivative(1), poly.derivative(2)
 
     def evaluate(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
