@@ -590,6 +590,10 @@ L = {"max_velocity": 1.0, "max_acceleration": 2.0, "max_jerk": 10.0}
             r"dt = 1e-06 s over .* samples \(> 10000000\)",
         ),
         (lambda: point_to_point(np.zeros(10_001), np.ones(10_001), **L), "10001 joints"),
+        (
+            lambda: point_to_point(np.zeros(20), np.ones(20), **L, dt=1e-6),
+            r"samples of 20 joints \(> 20000000 values\)",
+        ),
         (lambda: through_waypoints([[0.0, 1.0]], **L), "at least two points, got 1"),
         (
             lambda: through_waypoints([[0.0, 1.0], [1.0]], **L),

@@ -14,23 +14,25 @@ its time synchronisation otherwise (all joints start and arrive together); per j
 
 Via points. Intermediate waypoints are a ruckig *Pro* feature: the community version installed
 here refuses them offline (it would call ruckig's cloud API). So a move through waypoints is
-chained from one ruckig solve per segment, each from the state the previous one ended in.
-``stop_at_waypoints=True`` stops at every waypoint (rest to rest: each segment time-optimal,
-the exact motion a controller does with ``move_and_stop``). Without stopping, this module
-chooses the velocity each joint passes a waypoint with (zero acceleration there), by the
-heuristic rule of Biagiotti & Melchiorri (*Trajectory Planning for Automatic Machines and
-Robots*, 2008, eq. 4.10) on the chord velocities of the rest-to-rest segments: zero where the
-joint turns back (or stops) at the waypoint, else the mean of the two chord velocities, then
-bounded so that the joint could stop within half of either adjacent segment (so the joint
-never overshoots a waypoint or backs up inside a segment) and by its velocity limit. These
-pass-through velocities are a choice, not ruckig Pro's time-optimal ones: the move is
-continuous in position, velocity and acceleration, within every limit, and typically much
-faster than stopping, but not time-optimal through the waypoints.
+chained from one ruckig solve per segment, each starting from the state the previous one ended
+in. ``stop_at_waypoints=True`` stops at every waypoint (rest to rest, each segment
+time-optimal). Without stopping, this module chooses the velocity each joint passes a waypoint
+with (at zero acceleration), by the heuristic rule of Biagiotti & Melchiorri (*Trajectory
+Planning for Automatic Machines and Robots*, 2008, ch. 4, for the velocities of multipoint
+trajectories) applied to the chord velocities of the rest-to-rest segments: zero where the
+joint turns back (or stays) at the waypoint, else the mean of the two chord velocities; then
+bounded by the joint's velocity limit and by the speed it could stop from within half of either
+adjacent segment, so that no segment needs to overshoot its waypoint or back up (the tests
+check this on fine grids). These pass-through velocities are a choice, not ruckig Pro's
+time-optimal ones: the move is continuous in position and velocity (and, jerk-limited, in
+acceleration), within every limit, faster than stopping, but not time-optimal through the
+waypoints.
 
 Every planner returns an :class:`armdyn.motion.Trajectory` sampled every ``dt`` (the end
-included) whose ``evaluate`` is exact (ruckig's ``Trajectory.at_time`` per segment; the
-spline's piecewise polynomial), so ``traj.sample(...)`` re-grids without interpolation error;
-its ``info`` holds the method, the limits used and the segment durations.
+included) whose ``evaluate`` is exact: for ruckig segments the constant-jerk phases of ruckig's
+own profile integrated in closed form (what ``ruckig.Trajectory.at_time`` computes, vectorised);
+for splines their piecewise polynomial. So ``traj.sample(...)`` re-grids without interpolation
+error. Its ``info`` holds the method, the limits used and the segment durations.
 """
 
 from __future__ import annotations
@@ -52,6 +54,8 @@ MAX_SAMPLES = 10_000_000
 MAX_WAYPOINTS = 100_000
 #: most joints
 MAX_JOINTS = 10_000
+#: most values (samples x joints) in each of a returned trajectory's q, qd, qdd
+MAX_VALUES = 20_000_000
 
 _PROFILES = ("double_s", "trapezoidal")
 _CUBIC_ENDS = ("clamped", "natural", "not-a-knot", "periodic")
@@ -61,8 +65,8 @@ _CUBIC_ENDS = ("clamped", "natural", "not-a-knot", "periodic")
 
 
 def _points(who: str, name: str, x, n: int | None = None) -> np.ndarray:
-    """``x`` as a (m, n) array of joint positions (a scalar or (m,) is one joint only when
-    ``n`` is None or 1; a (n,) vector is one point when ``m``-rows are not meant)."""
+    """``x`` as an (m, joints) array of finite joint positions: (m,) is m points of one joint
+    when ``n == 1``, else one point; ``n``: the joint count required (None: any)."""
     a = np.asarray(_checks.array(who, name, x, finite=True), dtype=float)
     if a.ndim == 0:
         a = a.reshape(1, 1)
@@ -174,8 +178,9 @@ def _limits(who: str, n: int, max_velocity, max_acceleration, max_jerk, profile,
     return profile, v, a, _limit(who, "max_jerk", max_jerk, n)
 
 
-def _grid(who: str, t0: float, t1: float, dt) -> np.ndarray:
-    """``t0, t0 + dt, ...`` and ``t1`` (at most MAX_SAMPLES)."""
+def _grid(who: str, t0: float, t1: float, dt, n: int) -> np.ndarray:
+    """``t0, t0 + dt, ...`` and ``t1``: at most MAX_SAMPLES samples and MAX_VALUES values of
+    ``n`` joints."""
     step = _checks.number(who, "dt", dt, lo=0.0, lo_open=True)
     span = t1 - t0
     if span <= 0.0:
@@ -184,6 +189,11 @@ def _grid(who: str, t0: float, t1: float, dt) -> np.ndarray:
     if not count < MAX_SAMPLES:
         raise _core.ModelError(
             f"{who}: dt = {step:g} s over {span:g} s gives {count:.3g} samples (> {MAX_SAMPLES})"
+        )
+    if not count * n < MAX_VALUES:
+        raise _core.ModelError(
+            f"{who}: dt = {step:g} s over {span:g} s gives {count:.3g} samples of {n} joints "
+            f"(> {MAX_VALUES} values)"
         )
     k = int(np.ceil(count - 1e-9))
     grid = t0 + step * np.arange(k)
@@ -348,13 +358,16 @@ def _pass_velocities(points, rest_durations, limits) -> np.ndarray:
     return np.vstack([zero, v, zero])
 
 
-def _chain(who: str, points, joints, limits, stop: bool) -> tuple[_Chain, np.ndarray]:
+def _chain(who: str, points, joints, limits, stop: bool, names=None) -> tuple[_Chain, np.ndarray]:
     """The chain of ruckig segments through ``points`` (m, len(joints)) and its waypoint
     velocities."""
     m, n = points.shape
     lim = tuple(x[joints] for x in limits)
     zero = np.zeros(n)
-    label = "joint " + str(joints[0]) if len(joints) == 1 else "the joints"
+    if len(joints) > 1:
+        label = "the joints"
+    else:
+        label = f"joint '{names[joints[0]]}'" if names else f"joint {joints[0]}"
 
     def where(k):
         return f"{who}: segment {k} (waypoint {k} to {k + 1}) of {label}"
@@ -375,7 +388,7 @@ def _limited(who: str, points, limits, synchronize: bool, stop: bool, dt, names,
     groups = [list(range(n))] if synchronize else [[j] for j in range(n)]
     chains, velocities = [], np.zeros_like(points)
     for g in groups:
-        chain, vel = _chain(who, points[:, g], g, limits, stop)
+        chain, vel = _chain(who, points[:, g], g, limits, stop, names)
         chains.append(chain)
         velocities[:, g] = vel
     duration = max(c.duration for c in chains)
@@ -389,7 +402,7 @@ def _limited(who: str, points, limits, synchronize: bool, stop: bool, dt, names,
             out[:, :, c.joints] = c.at(t)
         return out[0], out[1], out[2]
 
-    grid = _grid(who, 0.0, duration, dt)
+    grid = _grid(who, 0.0, duration, dt, n)
     if synchronize:
         segment_durations = chains[0].durations
     else:
@@ -439,7 +452,8 @@ def point_to_point(
         synchronize: all joints start and arrive together (phase-synchronised on the straight
             line in joint space where possible); False: each joint its own fastest profile,
             then it holds its goal.
-        dt: the sample step [s] (the end is a sample; at most ``MAX_SAMPLES`` samples).
+        dt: the sample step [s] (the end is a sample; at most ``MAX_SAMPLES`` samples and
+            ``MAX_VALUES`` samples x joints).
         model: a fixed-base model: its joint count and names, its position range (start and
             goal must lie in it) and its velocity limits as the default.
 
@@ -452,7 +466,8 @@ def point_to_point(
     Raises:
         ModelError: a bad argument (named: NaN, inf, a limit ≤ 0, shapes, dt giving too many
             samples, a position outside the model's range).
-        SolverError: ruckig finds no profile.
+        SolverError: ruckig finds no profile (distances and limits of wildly different
+            scales), naming the joint.
     """
     who = "point_to_point"
     a = _vector(who, "start", start, 0)
@@ -709,8 +724,8 @@ def spline(
     Raises:
         ModelError: a bad argument (named), fewer than two waypoints, times not increasing,
             a periodic spline whose ends differ, a waypoint outside the model's range.
-        SolverError: the spline exceeds a velocity or acceleration limit (naming the joint
-            and the time).
+        SolverError: the spline exceeds a velocity or acceleration limit, or leaves the
+            model's range between the waypoints (naming the joint, the value and the time).
     """
     who = "spline"
     t, points = _spline_args(who, times, waypoints)
@@ -742,15 +757,16 @@ def spline(
         x = np.clip(np.asarray(x, dtype=float), t0, t1)
         return poly(x), d1(x), d2(x)
 
-    grid = _grid(who, t0, t1, dt)
+    grid = _grid(who, t0, t1, dt, n)
     return Trajectory(grid, *evaluate(grid), names=names, info=info, evaluate=evaluate)
 
 
 def waypoint_path(waypoints: npt.ArrayLike, *, model: _core.Model | None = None) -> Path:
     """The smooth geometric path through joint ``waypoints`` for :func:`time_optimal`: the
     natural cubic spline (C2) in the cumulative chord length (the knot of waypoint k is the
-    joint-space distance travelled to it over the total), so a straight run of waypoints stays
-    exactly straight and uniformly parametrised, and dq/ds never vanishes at the ends.
+    joint-space distance travelled to it over the total): waypoints on one straight line give
+    exactly that line at constant dq/ds, and, unlike a clamped spline, dq/ds is not forced to
+    zero at the ends (where a zero path speed would make the timing singular).
 
     Args:
         waypoints: (m, n), m ≥ 2, no two consecutive equal ((m,): one joint).
@@ -763,6 +779,8 @@ def waypoint_path(waypoints: npt.ArrayLike, *, model: _core.Model | None = None)
     Raises:
         ModelError: a bad argument (named), fewer than two waypoints, two consecutive equal
             waypoints (naming them), a waypoint outside the model's range.
+        SolverError: the spline leaves a joint's range between the waypoints (naming the
+            joint, the value and s).
     """
     from scipy.interpolate import CubicSpline
 
