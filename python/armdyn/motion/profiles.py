@@ -181,7 +181,7 @@ def _limits(who: str, n: int, max_velocity, max_acceleration, max_jerk, profile,
 def _grid(who: str, t0: float, t1: float, dt, n: int) -> np.ndarray:
     """``t0, t0 + dt, ...`` and ``t1``: at most MAX_SAMPLES samples and MAX_VALUES values of
     ``n`` joints."""
-    step = _checks.number(who, "dt", dt, lo=0.0, lo_open=True)
+    step = float(_checks.number(who, "dt", dt, lo=0.0, lo_open=True))  # type: ignore[arg-type]
     span = t1 - t0
     if span <= 0.0:
         return np.array([t0])
@@ -210,7 +210,7 @@ def _grid(who: str, t0: float, t1: float, dt, n: int) -> np.ndarray:
 
 def _ruckig():
     try:
-        import ruckig
+        import ruckig  # type: ignore[import-not-found]
     except ImportError as err:  # pragma: no cover - a runtime dependency
         raise _core.ModelError(
             "armdyn.motion: the jerk-limited profiles need the 'ruckig' package "
@@ -278,7 +278,8 @@ class _Chain:
         self.durations = np.array([s.duration for s in segments])
         self.starts = np.concatenate([[0.0], np.cumsum(self.durations)])
         tables = [_phases(s) for s in segments]
-        self.tables = None if any(x is None for x in tables) else np.stack(tables)
+        ok = [x for x in tables if x is not None]
+        self.tables: np.ndarray | None = np.stack(ok) if len(ok) == len(tables) else None
 
     @property
     def duration(self) -> float:
@@ -314,7 +315,7 @@ class _Chain:
 
     def _integrate(self, k: np.ndarray, tau: np.ndarray) -> np.ndarray:
         n = len(self.joints)
-        flat = self.tables.reshape(-1, 5, 8)  # row: segment * joints + joint
+        flat = np.asarray(self.tables).reshape(-1, 5, 8)  # row: segment * joints + joint
         out = np.empty((3, len(k), n))
         for d in range(n):
             row = k * n + d
