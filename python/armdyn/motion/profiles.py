@@ -268,18 +268,19 @@ class _Chain:
 
     Evaluation integrates each segment's constant-jerk phases in closed form from ruckig's own
     phase data (``Profile.t, j, a, v, p``: the arithmetic of ``Trajectory.at_time``, vectorised
-    over the samples); a segment with a brake phase falls back to ``at_time`` per sample."""
+    over the samples), and the ruckig objects are let go; a segment with a brake phase (or
+    ``phases=False``) keeps them and evaluates with ``at_time`` per sample."""
 
     CHUNK = 1 << 16  # samples per vectorised block (bounds the temporaries)
 
-    def __init__(self, joints: list[int], segments: list) -> None:
+    def __init__(self, joints: list[int], segments: list, phases: bool = True) -> None:
         self.joints = joints
-        self.segments = segments
         self.durations = np.array([s.duration for s in segments])
         self.starts = np.concatenate([[0.0], np.cumsum(self.durations)])
-        tables = [_phases(s) for s in segments]
+        tables = [_phases(s) for s in segments] if phases else [None]
         ok = [x for x in tables if x is not None]
         self.tables: np.ndarray | None = np.stack(ok) if len(ok) == len(tables) else None
+        self.segments = segments if self.tables is None else None
 
     @property
     def duration(self) -> float:
@@ -287,10 +288,10 @@ class _Chain:
 
     def at(self, t: np.ndarray) -> np.ndarray:
         """(3, len(t), len(joints)): position, velocity, acceleration at times ``t``."""
-        k = np.clip(np.searchsorted(self.starts, t, side="right") - 1, 0, len(self.segments) - 1)
+        k = np.clip(np.searchsorted(self.starts, t, side="right") - 1, 0, len(self.durations) - 1)
         local = np.clip(t - self.starts[k], 0.0, self.durations[k])
         out = np.empty((3, len(t), len(self.joints)))
-        if self.tables is None:
+        if self.segments is not None:
             for i in range(len(t)):
                 out[:, i] = self.segments[k[i]].at_time(float(local[i]))
             return out
@@ -359,7 +360,9 @@ def _pass_velocities(points, rest_durations, limits) -> np.ndarray:
     return np.vstack([zero, v, zero])
 
 
-def _chain(who: str, points, joints, limits, stop: bool, names=None) -> tuple[_Chain, np.ndarray]:
+def _chain(
+    who: str, points, joints, limits, stop: bool, names=None, phases: bool = True
+) -> tuple[_Chain, np.ndarray]:
     """The chain of ruckig segments through ``points`` (m, len(joints)) and its waypoint
     velocities."""
     m, n = points.shape
@@ -375,12 +378,12 @@ def _chain(who: str, points, joints, limits, stop: bool, names=None) -> tuple[_C
 
     rest = [_solve(points[k], zero, points[k + 1], zero, lim, where(k)) for k in range(m - 1)]
     if stop or m == 2:
-        return _Chain(joints, rest), np.zeros((m, n))
+        return _Chain(joints, rest, phases), np.zeros((m, n))
     vel = _pass_velocities(points, np.array([s.duration for s in rest]), lim)
     segs = [
         _solve(points[k], vel[k], points[k + 1], vel[k + 1], lim, where(k)) for k in range(m - 1)
     ]
-    return _Chain(joints, segs), vel
+    return _Chain(joints, segs, phases), vel
 
 
 def _limited(who: str, points, limits, synchronize: bool, stop: bool, dt, names, info):
