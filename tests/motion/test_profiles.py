@@ -12,7 +12,15 @@ from pathlib import Path as FilePath
 import armdyn as ad
 import numpy as np
 import pytest
-from armdyn.motion import Path, Trajectory, point_to_point, spline, through_waypoints, waypoint_path
+from armdyn.motion import (
+    Path,
+    Trajectory,
+    drive_profile,
+    point_to_point,
+    spline,
+    through_waypoints,
+    waypoint_path,
+)
 from armdyn.motion.profiles import MAX_WAYPOINTS
 
 ROOT = FilePath(__file__).resolve().parents[2]
@@ -547,6 +555,41 @@ def test_ur5_sizing_takes_the_trajectories():
     assert waypoint_path(turn).n_joints == 6  # without the model nothing is checked
     with pytest.raises(ad.ModelError, match="2 joints given, the model has 6"):
         point_to_point([0.0, 0.0], [1.0, 1.0], max_acceleration=1.0, max_jerk=1.0, model=model)
+
+
+def _hinge(gravity=(0.0, 0.0, -9.81)):
+    b = ad.ModelBuilder(gravity=gravity)
+    b.add_body("link", 1.0, np.diag([0.01, 0.02, 0.025]), position=(0.0, 0.0, -0.5))
+    b.add_revolute("hinge", "ground", "link", (0, 0, 0), (0, 1, 0))
+    return b
+
+
+def test_drive_profile_prescribes_the_motion_in_a_simulation():
+    """A pendulum driven by the profile follows it exactly, holds its goal afterwards, and the
+    drive's effort is the inverse dynamics torque of the motion."""
+    free = _hinge().finalize()
+    traj = point_to_point(0.2, 1.2, **L, model=free)
+    b = _hinge()
+    b.add_drive("hinge", drive_profile(traj, "hinge"))
+    run = ad.simulate(b.finalize(), traj.duration + 0.3, output_dt=0.01)
+    inside = run.t <= traj.duration
+    want = traj.sample(run.t[inside])
+    np.testing.assert_allclose(run.q[inside, 0], want.q[:, 0], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(run.qd[inside, 0], want.qd[:, 0], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(run.q[~inside, 0], 1.2, rtol=0, atol=1e-12)
+    tau = ad.inverse_dynamics(free, want.q, want.qd, want.qdd)[:, 0]
+    np.testing.assert_allclose(run.drive_forces[inside, 0], tau, rtol=0, atol=1e-9)
+    assert np.max(np.abs(tau)) > 1.0
+    # by index too; refusals
+    assert drive_profile(traj, 0)(0.5) == drive_profile(traj, "hinge")(0.5)
+    with pytest.raises(ad.ModelError, match=r"joint 'elbow' is not one of traj\.names"):
+        drive_profile(traj, "elbow")
+    with pytest.raises(ad.ModelError, match="joint must be an integer in"):
+        drive_profile(traj, 1)
+    moving = drive_profile(spline([0.0, 1.0], [0.0, 1.0], end_velocities=[[0.0], [0.5]]), 0)
+    with pytest.raises(ad.ModelError, match=r"t = 1\.5 s is outside .* not at rest at its end"):
+        moving(1.5)
+    assert moving(-1.0) == (0.0, 0.0, 0.0)
 
 
 # ---------------------------------------------------------------- hostile inputs

@@ -38,6 +38,7 @@ error. Its ``info`` holds the method, the limits used and the segment durations.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -46,7 +47,7 @@ import numpy.typing as npt
 from armdyn import _checks, _core
 from armdyn.motion.trajectory import Path, Trajectory
 
-__all__ = ["point_to_point", "spline", "through_waypoints", "waypoint_path"]
+__all__ = ["drive_profile", "point_to_point", "spline", "through_waypoints", "waypoint_path"]
 
 #: most samples a planner returns (the bound of Trajectory.sample)
 MAX_SAMPLES = 10_000_000
@@ -836,3 +837,53 @@ def waypoint_path(waypoints: npt.ArrayLike, *, model: _core.Model | None = None)
         "chord_lengths": chords,
     }
     return Path(s, points, evaluate=evaluate, names=names, info=info)
+
+
+def drive_profile(
+    traj: Trajectory, joint: int | str
+) -> Callable[[float], tuple[float, float, float]]:
+    """One joint of ``traj`` as ``ModelBuilder.add_drive`` takes it: a callable ``t -> (q, qd,
+    qdd)``, exact where ``traj`` has an evaluator (every planner of this module's does), and at
+    rest at the end position after the motion (and at the start position before it) when the
+    motion ends (starts) at rest. A Python drive runs at every evaluation of the simulation:
+    correct, but slower than ``armdyn.profiles``.
+
+    Args:
+        traj: a :class:`Trajectory` (fixed-base columns).
+        joint: the column: an index, or a name of ``traj.names``.
+
+    Raises:
+        ModelError: an unknown joint (when built); a time outside the motion whose end is not
+            at rest, or a non-finite time (when called, naming the time).
+    """
+    who = "drive_profile"
+    if not isinstance(traj, Trajectory):
+        raise _core.ModelError(f"{who}: traj must be an armdyn.motion.Trajectory")
+    n = traj.qd.shape[1]
+    if traj.q.shape[1] != n:
+        raise _core.ModelError(f"{who}: traj has a floating base's quaternion; drive joints only")
+    if isinstance(joint, str):
+        if traj.names is None or joint not in traj.names:
+            raise _core.ModelError(f"{who}: joint {joint!r} is not one of traj.names {traj.names}")
+        j = traj.names.index(joint)
+    else:
+        j = int(_checks.integer(who, "joint", joint, lo=0, hi=n - 1))  # type: ignore[arg-type]
+    t0, t1 = float(traj.t[0]), float(traj.t[-1])
+    rest = [bool(abs(traj.qd[i, j]) <= 1e-12 and abs(traj.qdd[i, j]) <= 1e-9) for i in (0, -1)]
+    ends = (float(traj.q[0, j]), float(traj.q[-1, j]))
+
+    def profile(t: float) -> tuple[float, float, float]:
+        if not np.isfinite(t):
+            raise _core.ModelError(f"{who}: time {t!r} is not finite")
+        for side, outside in ((0, t < t0), (1, t > t1)):
+            if outside:
+                if not rest[side]:
+                    raise _core.ModelError(
+                        f"{who}: t = {t:g} s is outside the motion [{t0:g}, {t1:g}] s, which "
+                        f"is not at rest at its {('start', 'end')[side]}"
+                    )
+                return ends[side], 0.0, 0.0
+        s = traj.sample([t])
+        return float(s.q[0, j]), float(s.qd[0, j]), float(s.qdd[0, j])
+
+    return profile
