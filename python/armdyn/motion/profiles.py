@@ -86,8 +86,8 @@ def _vector(who: str, name: str, x, n: int) -> np.ndarray:
     """One configuration: a scalar (one joint) or (n,)."""
     a = np.atleast_1d(np.asarray(_checks.array(who, name, x, finite=True), dtype=float))
     if a.ndim != 1 or (n and len(a) != n) or len(a) < 1:
-        want = f"({n},)" if n else "a 1-D array of joint positions"
-        raise _core.ModelError(f"{who}: {name} must have shape {want}, got {a.shape}")
+        want = f"have shape ({n},)" if n else "be a 1-D array of joint positions"
+        raise _core.ModelError(f"{who}: {name} must {want}, got shape {a.shape}")
     if len(a) > MAX_JOINTS:
         raise _core.ModelError(f"{who}: {name} has {len(a)} joints (> {MAX_JOINTS})")
     return a
