@@ -174,7 +174,10 @@ def test_double_s_durations_are_biagiotti_melchiorri(d, vmax, amax, jmax):
     # the acceleration phase: ramp of jerk jmax, q = j t^3 / 6 during the first Tj
     early = traj.sample(np.linspace(0.0, tj, 11))
     np.testing.assert_allclose(early.q[:, 0], jmax * early.t**3 / 6, rtol=1e-9, atol=1e-15)
-    assert ta > 0
+    # the acceleration phase ends at Ta with the peak velocity reached
+    end = traj.sample([ta])
+    assert end.qd[0, 0] == pytest.approx(vlim, rel=1e-9)
+    assert end.qdd[0, 0] == pytest.approx(0.0, abs=1e-9 * alim)
 
 
 # ---------------------------------------------------------------- limits, synchronisation
