@@ -236,7 +236,7 @@ def _solve(start, v0, goal, v1, limits, where: str):
     traj = rk.Trajectory(n)
     try:
         result = rk.Ruckig(n).calculate(inp, traj)
-    except rk.RuckigError as err:  # its first line names the step and the joint
+    except getattr(rk, "RuckigError", RuntimeError) as err:  # names the step and the joint
         first = str(err).strip().splitlines()[0].replace("[ruckig] ", "").strip()
         first = first.removesuffix(" input:")
         raise _core.SolverError(
@@ -252,14 +252,17 @@ def _phases(segment) -> np.ndarray | None:
     """(joints, 5, 8): per joint of a ruckig segment its 7 phases' start times (and the end),
     jerks (0 after the end), and the acceleration, velocity and position at each phase start
     (and at the end); None when a brake phase precedes the profile (then ``at_time``)."""
-    profiles = segment.profiles[0]
-    out = np.zeros((len(profiles), 5, 8))
-    for d, prof in enumerate(profiles):
-        if prof.brake.duration > 0.0 or prof.accel.duration > 0.0:
-            return None
-        out[d, 0, 1:] = np.cumsum(prof.t)
-        out[d, 1, :7] = prof.j
-        out[d, 2], out[d, 3], out[d, 4] = prof.a, prof.v, prof.p
+    try:
+        profiles = segment.profiles[0]
+        out = np.zeros((len(profiles), 5, 8))
+        for d, prof in enumerate(profiles):
+            if prof.brake.duration > 0.0 or prof.accel.duration > 0.0:
+                return None
+            out[d, 0, 1:] = np.cumsum(prof.t)
+            out[d, 1, :7] = prof.j
+            out[d, 2], out[d, 3], out[d, 4] = prof.a, prof.v, prof.p
+    except (AttributeError, ValueError):  # a ruckig whose bindings do not show the phases
+        return None
     return out
 
 
