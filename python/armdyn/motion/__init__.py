@@ -6,6 +6,21 @@ thermal limits), and the least-energy motion. Every planner returns a :class:`Tr
 take) or a :class:`Path` (geometric, timed by :func:`time_optimal`).
 """
 
+from armdyn.motion.profiles import (
+    drive_profile,
+    point_to_point,
+    spline,
+    through_waypoints,
+    waypoint_path,
+)
 from armdyn.motion.trajectory import Path, Trajectory
 
-__all__ = ["Path", "Trajectory"]
+__all__ = [
+    "Path",
+    "Trajectory",
+    "drive_profile",
+    "point_to_point",
+    "spline",
+    "through_waypoints",
+    "waypoint_path",
+]
