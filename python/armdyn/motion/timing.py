@@ -47,8 +47,9 @@ here takes the largest u within the stage's constraints and the next controllabl
 with a convex solution of the same discretisation (cvxpy; Verscheure et al. 2009).
 
 **The output.** The trajectory's samples are the grid points: ``ṡ_i = √x_i`` and ``s̈_i = u_i``
-(the acceleration over the next interval; at the last point the last interval's, clipped into
-that point's limits), so the limits hold at every sample as above; between samples they hold to
+(the acceleration over the next interval; at the last point 0: the arrival at rest, where the
+hold begins; ``info["qdd_arrival"]`` is the last interval's q̈ there), so the limits hold at
+every sample as above; between samples they hold to
 the discretisation error (refine ``grid``). ``evaluate(t)`` is exact between samples
 (``s = s_i + ṡ_i τ + u_i τ²/2``). Duration: ``Σ 2 Δ_i / (ṡ_i + ṡ_{i+1})``. The motion starts and
 ends at rest.
@@ -199,7 +200,7 @@ def _along(who: str, model, path: Path, s: np.ndarray) -> _Along:
     a = tau[rows : 2 * rows] - c
     one = tau[2 * rows : 3 * rows] - c - _friction(model, d1, 1.0)
     two = tau[3 * rows :] - c - _friction(model, d1, 2.0)
-    scale = np.max(np.abs(two)) + np.max(np.abs(c)) + 1e-300
+    scale = np.max(np.abs(tau)) + 1e-300
     off = np.abs(two - 4.0 * one)
     if np.max(off) > 1e-9 * scale:
         i, j = np.unravel_index(int(np.argmax(off)), off.shape)
@@ -405,13 +406,11 @@ def _forward(s, a, b, c, k_sets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     delta = np.diff(s)
     x, u = np.zeros(n + 1), np.zeros(n + 1)
     for i in range(n):
-        lo, hi = _u_range(a[i], b[i] * x[i] + c[i])
+        hi = _u_range(a[i], b[i] * x[i] + c[i])[1]
         u_next = (k_sets[i + 1, 1] - x[i]) / (2.0 * delta[i])
         u[i] = min(hi, u_next) if i < n - 1 else -x[i] / (2.0 * delta[i])
         x[i + 1] = max(x[i] + 2.0 * delta[i] * u[i], 0.0)
-    x[n] = 0.0
-    lo, hi = _u_range(a[n], c[n])
-    u[n] = min(max(u[n - 1], lo), hi) if lo <= hi else u[n - 1]
+    x[n] = 0.0  # u[n] = 0: at rest after the end (the hold)
     return x, u
 
 
@@ -563,6 +562,7 @@ def time_optimal(
         "active": _active(p, lin, x, u),
         "limits": {"max_velocity": v_max, "max_acceleration": a_max, "max_torque": tau_max},
         "envelope_iterations": iterations,
+        "qdd_arrival": along.d1[-1] * u[-2],
         "motor_treatment": "conservative: speed terms by tangents (exact at convergence where "
         "they bind), gear efficiency branches and Coulomb friction by their worst case",
     }
@@ -615,12 +615,17 @@ def _scaled(traj: Trajectory, k: float) -> Trajectory:
     )
 
 
-def _cycle_margins(model, traj: Trajectory, dwell: float, actuators, options) -> dict:
-    """{(joint, check): margin} of the repeated cycle (motion + dwell, periodic steady state)."""
+def _cycle_margins(model, traj: Trajectory, dwell: float, actuators, options, k: float) -> dict:
+    """{(joint, check): margin} of the repeated cycle (motion + dwell, periodic steady state).
+    The motion's last sample takes the arrival's acceleration (the last interval's, not the
+    hold's 0: the dwell's first sample holds), so the trapezoid rule of the RMS and the losses
+    keeps the last interval whole."""
     from armdyn.sizing.cycle import duty_cycle
     from armdyn.sizing.motor import motor_cycle_values
 
-    cycle = duty_cycle(model, (traj.t, traj.q, traj.qd, traj.qdd), dwell=dwell, repeat=None)
+    qdd = traj.qdd.copy()
+    qdd[-1] = traj.info["qdd_arrival"] / (k * k)
+    cycle = duty_cycle(model, (traj.t, traj.q, traj.qd, qdd), dwell=dwell, repeat=None)
     out = {}
     for act in actuators:
         load = cycle.joint_load(str(act.joint))
@@ -727,7 +732,7 @@ def shortest_cycle(
 
     def check(k: float):
         traj = _scaled(fastest, k) if k != 1.0 else fastest
-        return traj, _cycle_margins(model, traj, dwell, actuators, options)
+        return traj, _cycle_margins(model, traj, dwell, actuators, options, k)
 
     best, margins = check(1.0)
     k_best = 1.0
