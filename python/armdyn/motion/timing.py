@@ -70,8 +70,10 @@ from armdyn.motion.trajectory import Path, Trajectory
 DEFAULT_GRID = 1000
 #: the most grid intervals (memory: a few (grid, rows) arrays)
 MAX_GRID = 200_000
-#: an upper bound on x = ṡ² where nothing else bounds it (detected: ModelError)
-_X_CAP = 1e14
+#: an upper bound on x = ṡ² where nothing else bounds it (reached: ModelError)
+_X_CAP = 1e20
+#: toppra's Seidel solver bounds x at 1e8: its problem is x / scale, scale found by re-solving
+_TOPPRA_X = 1e8
 #: the most tangent updates of the speed terms (envelope, viscous friction)
 MAX_ITERATIONS = 30
 #: stop updating the tangents when the duration changes less than this (relative)
@@ -388,6 +390,29 @@ def _controllable(s: np.ndarray, a, b, c, xmax: np.ndarray) -> np.ndarray:
     return np.asarray(solver.compute_controllable_sets(0.0, 0.0), dtype=float)
 
 
+def _scaled_controllable(s: np.ndarray, a, b, c, xmax: np.ndarray) -> np.ndarray:
+    """:func:`_controllable` in units of x that keep toppra's sets between 1e-2 and its cap
+    (``_TOPPRA_X``): with x = scale · x̃ (and u = scale · ũ) the rows are (a scale) ũ +
+    (b scale) x̃ + c ≤ 0."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.abs(c) / np.abs(a)  # the accelerations the rows allow, a first guess of x
+    ratio = ratio[np.isfinite(ratio) & (ratio > 0.0)]
+    scale = float(np.clip(np.median(ratio), 1e-12, 1e12)) if len(ratio) else 1.0
+    for _ in range(6):
+        sa, sb = a * scale, b * scale
+        norm = np.maximum(np.maximum(np.abs(sa), np.abs(sb)), np.abs(c))
+        norm = np.where(norm > 0.0, norm, 1.0)  # each row divided by its largest coefficient
+        k = _controllable(s, sa / norm, sb / norm, c / norm, np.minimum(xmax / scale, _TOPPRA_X))
+        top = float(np.max(k[:, 1])) if not np.isnan(k).any() else np.nan
+        if top >= 0.5 * _TOPPRA_X and scale * top < _X_CAP:
+            scale *= 1e6
+        elif 0.0 < top < 1e-2:
+            scale *= top
+        else:
+            break
+    return k * scale
+
+
 def _u_range(a: np.ndarray, r: np.ndarray) -> tuple[float, float]:
     """The interval of u with a u + r ≤ 0 for every row (empty: lo > hi)."""
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -439,11 +464,11 @@ def _fail(who: str, p: _Problem, i: int, why: str):
 def _solve(who: str, p: _Problem, x_ref: np.ndarray):
     s = p.along.s
     a, b, c = _linearised(p, x_ref)
-    k_sets = _controllable(s, a, b, c, p.xmax)
+    k_sets = _scaled_controllable(s, a, b, c, p.xmax)
     bad = np.flatnonzero(np.isnan(k_sets).any(axis=1))
     if len(bad):
         raise _fail(who, p, int(bad[-1]), "the limits admit no path speed from there to the end")
-    if k_sets[0, 0] > 0.0:
+    if k_sets[0, 0] > 1e-9 * k_sets[0, 1]:  # above round-off
         raise _fail(who, p, 0, "the path cannot start from rest within the limits")
     x, u = _forward(s, a, b, c, k_sets)
     if np.max(x) >= 0.5 * _X_CAP:
@@ -639,8 +664,12 @@ def _cycle_margins(model, traj: Trajectory, dwell: float, actuators, options, k:
     return out
 
 
+#: a margin passes from 1 − this (the time-optimal motion meets its peaks to round-off)
+_MARGIN_TOL = 1e-9
+
+
 def _passes(margins: dict) -> bool:
-    return all(not (m < 1.0) for m in margins.values())  # NaN: not checked
+    return all(not (m < 1.0 - _MARGIN_TOL) for m in margins.values())  # NaN: not checked
 
 
 def _least(margins: dict) -> tuple[tuple[str, str], float]:
