@@ -201,27 +201,30 @@ def _geared(eta=0.8, j=2e-5, n=50.0, **motor):
     return arm(dict(gear_ratio=n, rotor_inertia=j, efficiency=eta, motor=ad.Motor(**motor)))
 
 
-def test_gear_efficiency_branches_give_an_asymmetric_bang_bang():
+@pytest.mark.parametrize("n, direction", [(50.0, 1.0), (-50.0, 1.0), (50.0, -1.0)])
+def test_gear_efficiency_branches_give_an_asymmetric_bang_bang(n, direction):
     """A motor of peak torque T_p behind a gear (N, η, rotor J): accelerating, T = (J N +
     I/(N η)) q̈; braking, the load drives the gear and T = (J N + I η/N) q̈. The fastest motion
     accelerates at a₁ = T_p/(J N + I/(N η)), brakes at a₂ = T_p/(J N + I η/N): T = v/a₁ + v/a₂
     with v = √(2 Q a₁ a₂/(a₁ + a₂)). The switch falls between grid points: the error is second
     order in the grid step."""
-    n, j, eta, t_p, q_end = 50.0, 2e-5, 0.8, 0.2, 1.5
-    a1, a2 = t_p / (j * n + INERTIA / (n * eta)), t_p / (j * n + INERTIA * eta / n)
+    j, eta, t_p, q_end = 2e-5, 0.8, 0.2, 1.5
+    m = abs(n)  # a reversed gear (N < 0) or a move backwards: the same times
+    a1, a2 = t_p / (j * m + INERTIA / (m * eta)), t_p / (j * m + INERTIA * eta / m)
     v = np.sqrt(2 * q_end * a1 * a2 / (a1 + a2))
     exact = v / a1 + v / a2
     model = _geared(eta, j, n, peak_torque=t_p)
     errors = []
     for grid in (100, 1000):
         traj = time_optimal(
-            model, segment(q_end), max_torque=np.inf, max_velocity=np.inf, grid=grid
+            model, segment(direction * q_end), max_torque=np.inf, max_velocity=np.inf, grid=grid
         )
         errors.append(abs(traj.duration / exact - 1.0))
     assert errors[1] < 1e-6
     assert errors[1] < errors[0] / 20.0  # second order: 100× from 10× the grid
-    assert traj.info["active"][1] == "motor peak torque 'j' upper"
-    assert traj.info["active"][-2] == "motor peak torque 'j' lower"
+    speeding, braking = ("upper", "lower") if n * direction > 0 else ("lower", "upper")
+    assert traj.info["active"][1] == f"motor peak torque 'j' {speeding}"
+    assert traj.info["active"][-2] == f"motor peak torque 'j' {braking}"
 
 
 def test_motor_envelope_speed_and_peak_respected_on_the_motor_side():
@@ -377,6 +380,15 @@ def test_static_torque_above_the_limit_is_infeasible_and_named():
     model = arm(axis=(0, 1, 0))
     with pytest.raises(ad.SolverError, match=r"s = 0 .*torque 'j' at rest is -?9\.81, .*±8"):
         time_optimal(model, segment(-1.0), max_torque=8.0, grid=100)
+
+
+def test_an_end_pose_that_cannot_be_held_is_infeasible_and_named():
+    """Swinging up through horizontal (9.81 N m to hold there, above the 8 N m limit) is
+    possible with momentum, but the poses near the end cannot be held (m g L cos q: 8.61 N m
+    at q = 0.5, 8.70 N m at the grid point before): named there."""
+    model = arm(axis=(0, 1, 0))
+    with pytest.raises(ad.SolverError, match=r"s = 0\.99 .*torque 'j' at rest is -?8\.70"):
+        time_optimal(model, segment(0.5, -np.pi / 2 + 0.1), max_torque=8.0, grid=100)
 
 
 def test_ur5_static_torque_above_the_limit_names_the_joint(ur5, ur5_path):

@@ -449,19 +449,26 @@ def _violation(a, b, c, x, u) -> np.ndarray:
 
 
 def _fail(who: str, p: _Problem, i: int, why: str):
-    """SolverError naming the grid point and what cannot be met there at rest."""
+    """SolverError naming the grid point and what cannot be met there at rest: the failing
+    point ``i`` or the next one, whichever exceeds a limit at rest the more (the backward pass
+    fails one point before the end pose it cannot hold)."""
     al = p.along
     c = p.rows.arrays()[2]
+    limits = np.array([max(col[1], 1e-300) for col in p.rows.cols])
+    worst, excess = None, 0.0
+    for k in range(i, min(i + 2, len(al.s))):
+        if c.shape[1]:
+            r = int(np.argmax(c[k] / limits))
+            if c[k, r] / limits[r] > excess:
+                worst, excess, i = r, c[k, r] / limits[r], k
     where = f"at s = {al.s[i]:.6g} (grid point {i}, q = {np.array2string(al.q[i], precision=4)})"
-    if c.shape[1]:
-        worst = int(np.argmax(c[i] / np.array([max(col[1], 1e-300) for col in p.rows.cols])))
+    if worst is not None:
         label, limit, side = p.rows.cols[worst][:3]
-        if c[i, worst] > 0.0:
-            value = side * (c[i, worst] + limit)
-            return _core.SolverError(
-                f"{who}: no feasible timing: {where} the {label} at rest is {value:.6g}, beyond "
-                f"its limit ±{limit:.6g} ({why})"
-            )
+        value = side * (c[i, worst] + limit)
+        return _core.SolverError(
+            f"{who}: no feasible timing: {where} the {label} at rest is {value:.6g}, beyond "
+            f"its limit ±{limit:.6g} ({why})"
+        )
     return _core.SolverError(f"{who}: no feasible timing {where}: {why}")
 
 
