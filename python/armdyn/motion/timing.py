@@ -32,9 +32,10 @@ stage's speed bound ``[0, X]`` where it relaxes it (0 without a bound); the effi
 branches by both linear pieces on the side where their maximum (minimum) is the true value and
 by the regenerating piece alone on the other (exact wherever that branch holds); the Coulomb
 term by its saturated value ``±c`` on the side where it hurts and 0 on the other. The tangents
-are then moved to the new solution and the problem solved again (``envelope_iterations``):
-every iterate satisfies the true constraints at the grid points, none is slower than the one
-before, and at convergence the speed terms are exact where they bind. Joint-torque rows get the
+are then moved to the new solution and the problem solved again (``envelope_iterations``,
+until the duration stops falling by more than 1e-9 relative): every iterate satisfies the true
+constraints at the grid points, the fastest is returned, and at convergence the speed terms are
+exact where they bind (a tangent touches √x at its own point). Joint-torque rows get the
 same treatment for the actuators' friction (inverse dynamics includes it).
 
 **Why toppra.** The ``toppra`` package (0.6) computes the controllable sets: the backward pass
@@ -202,6 +203,12 @@ def _along(who: str, model, path: Path, s: np.ndarray) -> _Along:
         ),
         dtype=float,
     )
+    if not np.all(np.isfinite(tau)):
+        i = int(np.argmax(~np.all(np.isfinite(tau), axis=1))) % rows
+        raise _core.ModelError(
+            f"{who}: the inverse dynamics along the path is not finite at s = {s[i]:.6g} (the "
+            "path's derivatives overflow the joint torques)"
+        )
     c = tau[:rows]
     a = tau[rows : 2 * rows] - c
     one = tau[2 * rows : 3 * rows] - c - _friction(model, d1, 1.0)
@@ -567,10 +574,12 @@ def time_optimal(
 
     Returns:
         :class:`~armdyn.motion.Trajectory` sampled at the grid points, with an exact
-        ``evaluate``; ``info``: ``method``, ``duration``, ``s``, ``sd``, ``sdd`` (the timing at
-        the samples), ``active`` (per sample, the constraint that binds: ``"torque
-        'joint' upper"``, ``"velocity 'joint'"``, ``"motor envelope 'joint' upper"``, ... or
-        ``""``), ``limits``, ``envelope_iterations``, ``motor_treatment``.
+        ``evaluate`` and the model's joint names (the path's when it has them); ``info``:
+        ``method``, ``duration``, ``grid`` (= ``s``), ``sd``, ``sdd`` (the timing at the
+        samples), ``qdd_arrival`` (the last interval's q̈ at the end), ``active`` (per
+        sample, the constraint that binds: ``"torque 'joint' upper"``, ``"velocity
+        'joint'"``, ``"motor envelope 'joint' upper"``, ... or ``""``), ``limits``,
+        ``envelope_iterations``, ``motor_treatment``.
 
     Raises:
         ModelError: a bad argument (named), a model that is not fixed-base or has dampers, a
@@ -592,6 +601,7 @@ def time_optimal(
     info = {
         "method": "time_optimal (TOPP-RA: toppra's controllable sets, exact forward pass)",
         "duration": float(t[-1]),
+        "grid": s.copy(),
         "s": s.copy(),
         "sd": sd,
         "sdd": u.copy(),
@@ -602,10 +612,10 @@ def time_optimal(
         "motor_treatment": "conservative: speed terms by tangents (exact at convergence where "
         "they bind), gear efficiency branches and Coulomb friction by their worst case",
     }
-    return _trajectory(path, t, s, sd, u, info)
+    return _trajectory(path, t, s, sd, u, info, names)
 
 
-def _trajectory(path: Path, t, s, sd, u, info) -> Trajectory:
+def _trajectory(path: Path, t, s, sd, u, info, names) -> Trajectory:
     q, d1, d2 = path.evaluate(s)
     qd = d1 * sd[:, None]
     qdd = d1 * u[:, None] + d2 * (sd**2)[:, None]
@@ -621,9 +631,8 @@ def _trajectory(path: Path, t, s, sd, u, info) -> Trajectory:
         qs, e1, e2 = path.evaluate(sp)
         return qs, e1 * sdot[:, None], e1 * acc[:, None] + e2 * (sdot**2)[:, None]
 
-    return Trajectory(
-        t, q, qd, qdd, names=path.names, info={**path.info, **info}, evaluate=evaluate
-    )
+    names = path.names if path.names is not None else names
+    return Trajectory(t, q, qd, qdd, names=names, info={**path.info, **info}, evaluate=evaluate)
 
 
 # --- the shortest repeated cycle --------------------------------------------------------------
