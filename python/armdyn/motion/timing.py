@@ -63,6 +63,7 @@ ends at rest.
 from __future__ import annotations
 
 import logging
+import re
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -194,21 +195,23 @@ def _along(who: str, model, path: Path, s: np.ndarray) -> _Along:
         raise _core.ModelError(f"{who}: the path does not move (dq/ds is zero everywhere)")
     zero = np.zeros_like(d1)
     rows = len(s)
-    tau = np.asarray(
-        _core.inverse_dynamics(
-            model,
-            np.concatenate([q, q, q, q]),
-            np.concatenate([zero, zero, d1, 2.0 * d1]),
-            np.concatenate([zero, d1, d2, 4.0 * d2]),
-        ),
-        dtype=float,
-    )
-    if not np.all(np.isfinite(tau)):
-        i = int(np.argmax(~np.all(np.isfinite(tau), axis=1))) % rows
-        raise _core.ModelError(
-            f"{who}: the inverse dynamics along the path is not finite at s = {s[i]:.6g} (the "
-            "path's derivatives overflow the joint torques)"
+    try:
+        tau = np.asarray(
+            _core.inverse_dynamics(
+                model,
+                np.concatenate([q, q, q, q]),
+                np.concatenate([zero, zero, d1, 2.0 * d1]),
+                np.concatenate([zero, d1, d2, 4.0 * d2]),
+            ),
+            dtype=float,
         )
+    except _core.SolverError as err:  # overflow: name the path point, not the batch's row
+        found = re.match(r"row (\d+): ", str(err))
+        where = f" at s = {s[int(found.group(1)) % rows]:.6g}" if found else ""
+        raise _core.ModelError(
+            f"{who}: the inverse dynamics along the path overflows{where} (the path's "
+            f"derivatives are too large): {str(err).split(': ', 1)[-1]}"
+        ) from None
     c = tau[:rows]
     a = tau[rows : 2 * rows] - c
     one = tau[2 * rows : 3 * rows] - c - _friction(model, d1, 1.0)
