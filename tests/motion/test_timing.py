@@ -118,6 +118,44 @@ def test_ur5_torque_limits_respected_and_duration_matches_a_convex_topp(ur5, ur5
     assert traj.duration >= reference * (1.0 - 1e-6)  # the reference is the optimum
 
 
+def test_ur5_with_motors_respects_every_joint_and_motor_limit(ur5_path):
+    """The UR5 with a geared motor on every joint (N = 100, η = 0.85, viscous friction): the
+    joint torques (the URDF's efforts) and speeds by an independent inverse dynamics, and each
+    motor's peak torque, envelope and speed by armdyn.actuators.motor_side; a motor binds."""
+    path = common.robot_urdf("ur5")
+    if path is None:
+        pytest.skip("example-robot-data is not installed")
+    b = ad.urdf_builder(str(path))
+    big = dict(torque_constant=0.1, resistance=0.5, voltage=48.0, peak_torque=1.5)
+    small = dict(torque_constant=0.05, resistance=1.0, voltage=24.0, peak_torque=0.4)
+    for k, joint in enumerate(ad.load_urdf(path).dof_names):
+        b.add_actuator(
+            joint,
+            gear_ratio=100.0,
+            rotor_inertia=3e-5 if k < 3 else 1e-5,
+            efficiency=0.85,
+            friction_viscous=1e-5,
+            motor=ad.Motor(no_load_speed=450.0, **(big if k < 3 else small)),
+        )
+    model = b.finalize()
+    traj = time_optimal(model, ur5_path, grid=300)
+    tau = ad.inverse_dynamics(model, traj.q, traj.qd, traj.qdd)
+    assert np.max(np.abs(tau) / model.coord_effort_limit) <= 1 + 1e-6
+    assert np.max(np.abs(traj.qd) / model.coord_velocity_limit) <= 1 + 1e-6
+    worst = 0.0
+    for act in model.actuators:
+        k = act.dof
+        side = motor_side(act, traj.t, traj.qd[:, k], traj.qdd[:, k], tau[:, k])
+        t0, w0 = motor_envelope(act.motor)
+        peak = np.max(np.abs(side.torque)) / act.motor.peak_torque
+        envelope = np.max(np.abs(side.torque + t0 * side.speed / w0)) / t0
+        assert max(peak, envelope) <= 1 + 1e-6, act.joint
+        assert np.max(np.abs(side.speed)) <= 450.0 * (1 + 1e-9)
+        worst = max(worst, peak, envelope)
+    assert worst >= 1 - 1e-6
+    assert any(a.startswith("motor") for a in traj.info["active"])
+
+
 def test_samples_follow_the_timing_and_evaluate_is_exact(ur5, ur5_path):
     traj = time_optimal(ur5, ur5_path, max_torque=UR5_TORQUE, grid=200)
     s, sd, sdd = (traj.info[k] for k in ("s", "sd", "sdd"))
