@@ -429,6 +429,35 @@ def test_an_end_pose_that_cannot_be_held_is_infeasible_and_named():
         time_optimal(model, segment(0.5, -np.pi / 2 + 0.1), max_torque=8.0, grid=100)
 
 
+def test_holding_at_the_end_takes_the_motoring_branch_of_the_gear():
+    """Lifting the link to horizontal through a gear of η = 0.5: holding it there at rest takes
+    m g L / (N η) = 0.3924 N m from the motor (the gear drives the load: motoring, whatever the
+    sign), above the 0.9 × that peak torque, though the gear's other branch (m g L η / N) would
+    fit: infeasible, named at the end."""
+    n, eta = 50.0, 0.5
+    hold = MASS * 9.81 * ARM / (n * eta)
+    model = arm(
+        dict(
+            gear_ratio=n, rotor_inertia=1e-5, efficiency=eta, motor=ad.Motor(peak_torque=0.9 * hold)
+        ),
+        axis=(0, 1, 0),
+    )
+    with pytest.raises(ad.SolverError, match=r"s = 1 .*motor peak torque 'j' at rest is -?0\.3924"):
+        time_optimal(model, segment(0.0, -1.2), max_velocity=np.inf, max_torque=np.inf, grid=100)
+    # with the peak above the hold, the motion is feasible and the end sample holds within it
+    model = arm(
+        dict(
+            gear_ratio=n, rotor_inertia=1e-5, efficiency=eta, motor=ad.Motor(peak_torque=1.1 * hold)
+        ),
+        axis=(0, 1, 0),
+    )
+    traj = time_optimal(model, segment(0.0, -1.2), max_velocity=np.inf, max_torque=np.inf, grid=100)
+    tau = ad.inverse_dynamics(model, traj.q, traj.qd, traj.qdd)
+    side = motor_side(model.actuators[0], traj.t, traj.qd[:, 0], traj.qdd[:, 0], tau[:, 0])
+    assert np.max(np.abs(side.torque)) <= 1.1 * hold * (1 + 1e-6)
+    assert abs(side.torque[-1]) == pytest.approx(hold, rel=1e-9)
+
+
 def test_ur5_static_torque_above_the_limit_names_the_joint(ur5, ur5_path):
     q0 = UR5_WAYPOINTS[0]
     hold = ad.inverse_dynamics(ur5, q0, np.zeros(6), np.zeros(6))

@@ -75,7 +75,7 @@ from armdyn.motion.trajectory import Path, Trajectory
 #: grid intervals when ``grid`` is None
 DEFAULT_GRID = 1000
 #: the most grid intervals (memory: a few (grid, rows) arrays)
-MAX_GRID = 200_000
+MAX_GRID = 100_000
 #: an upper bound on x = ṡ² where nothing else bounds it (reached: ModelError)
 _X_CAP = 1e20
 #: toppra's Seidel solver bounds x at 1e8: its problem is x / scale, scale found by re-solving
@@ -231,6 +231,7 @@ def _along(who: str, model, path: Path, s: np.ndarray) -> _Along:
         k, n = int(act.dof), float(act.gear_ratio)
         visc[:, k] += n * n * float(act.friction_viscous) * d1[:, k]
         coulomb[:, k] += abs(n) * float(act.friction_coulomb) * np.sign(d1[:, k])
+    coulomb[[0, -1]] = 0.0  # at rest at both ends: tanh(0) = 0
     return _Along(s, q, d1, d2, a, one, c, visc, coulomb)
 
 
@@ -291,7 +292,7 @@ def _speed_bound(p: _Problem, speed: np.ndarray, limit: float, label: str) -> No
         p.xmax_label[i] = label
 
 
-def _motor_rows(p: _Problem, act, model) -> None:
+def _motor_rows(p: _Problem, act) -> None:
     """The motor's speed, peak torque and envelope constraints of one actuator (module notes)."""
     from armdyn.sizing.motor import motor_envelope, speed_limit
 
@@ -312,8 +313,13 @@ def _motor_rows(p: _Problem, act, model) -> None:
     sigma = np.sign(d1)
     convex, zero = sigma * n > 0.0, sigma == 0.0
     concave = ~convex & ~zero
+    # at rest (q̇ = 0: the path's ends, where ṡ = 0) the motoring branch holds whatever the
+    # torque's sign (holding takes τ_gear / (N η)): its piece on both sides there
+    rest = zero.copy()
+    rest[[0, -1]] = True
     visc = float(act.friction_viscous) * n * d1
     coul = float(act.friction_coulomb) * np.sign(n * d1)
+    coul[[0, -1]] = 0.0  # at rest at both ends
     t0, w0 = motor_envelope(motor)
     limits = []
     if motor.peak_torque is not None:
@@ -322,7 +328,7 @@ def _motor_rows(p: _Problem, act, model) -> None:
         limits.append((f"motor envelope {name!r}", float(t0), t0 / w0 * n * d1))
     for label, limit, env in limits:
         for piece, up, lo in (
-            (1.0 / (n * eta), convex | zero, concave | zero),
+            (1.0 / (n * eta), convex | rest, concave | rest),
             (eta / n, ~zero, ~zero),
         ):
             a = j * n * d1 + piece * g_u
@@ -351,7 +357,7 @@ def _problem(model, along: _Along, names, v_max, a_max, tau_max, motors: bool) -
     if motors:
         for act in _actuators(model):
             if getattr(act, "motor", None) is not None:
-                _motor_rows(p, act, model)
+                _motor_rows(p, act)
     return p
 
 
@@ -359,6 +365,7 @@ def _linearised(p: _Problem, x_ref: np.ndarray):
     """(A, B, C) with the √x terms replaced by linear bounds (module notes): the tangent at
     ``x_ref`` where D > 0, the chord x/√X on [0, X] (X the stage's bound on x) where D < 0."""
     a, b, c, d = p.rows.arrays()
+    d[[0, -1]] = 0.0  # x = 0 at both ends: the √x terms vanish there exactly
     if not np.any(d):
         return a, b, c
     b, c = b.copy(), c.copy()
@@ -491,6 +498,9 @@ def _solve(who: str, p: _Problem, x_ref: np.ndarray):
         raise _fail(who, p, int(bad[-1]), "the limits admit no path speed from there to the end")
     if k_sets[0, 0] > 1e-9 * k_sets[0, 1]:  # above round-off
         raise _fail(who, p, 0, "the path cannot start from rest within the limits")
+    hold = p.rows.arrays()[2][-1]  # the last sample: at rest, s̈ = 0 (the hold)
+    if np.any(hold > 1e-12 * np.array([col[1] for col in p.rows.cols])):
+        raise _fail(who, p, len(s) - 1, "the end pose cannot be held at rest within the limits")
     x, u = _forward(s, a, b, c, k_sets)
     if np.max(x) >= 0.5 * _X_CAP:
         i = int(np.argmax(x))
