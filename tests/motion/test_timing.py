@@ -375,7 +375,10 @@ def test_shortest_cycle_winding_temperature_binds_as_in_closed_form():
 
 
 def test_shortest_cycle_is_the_time_optimal_one_when_the_thermal_limits_are_loose():
-    model = _geared(1.0, J_ROT, N_GEAR, peak_torque=T_PEAK, continuous_torque=1.0)
+    """η = 0.8: the arrival brakes through the gear's regenerating branch; the cycle's samples
+    keep it (a sample at rest with the braking torque would take the motoring branch and exceed
+    the peak by 1/η²)."""
+    model = _geared(0.8, J_ROT, N_GEAR, peak_torque=T_PEAK, continuous_torque=1.0)
     cycle = shortest_cycle(
         model, segment(Q_END), dwell=DWELL, max_torque=np.inf, max_velocity=np.inf, grid=200
     )

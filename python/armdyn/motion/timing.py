@@ -673,17 +673,25 @@ def _scaled(traj: Trajectory, k: float) -> Trajectory:
     )
 
 
-def _cycle_margins(model, traj: Trajectory, dwell: float, actuators, options, k: float) -> dict:
+def _cycle_margins(model, traj: Trajectory, dwell: float, actuators, options) -> dict:
     """{(joint, check): margin} of the repeated cycle (motion + dwell, periodic steady state).
-    The motion's last sample takes the arrival's acceleration (the last interval's, not the
-    hold's 0: the dwell's first sample holds), so the trapezoid rule of the RMS and the losses
-    keeps the last interval whole."""
+    A sample is added a millionth of the last interval before the end, with that interval's
+    motion (the arrival: still moving, the braking torque through the gear's branch of that
+    motion): the samples' trapezoid rule of the RMS and the losses then keeps the last interval
+    whole, and the end sample holds (s̈ = 0, the torque of the dwell)."""
     from armdyn.sizing.cycle import duty_cycle
     from armdyn.sizing.motor import motor_cycle_values
 
-    qdd = traj.qdd.copy()
-    qdd[-1] = traj.info["qdd_arrival"] / (k * k)
-    cycle = duty_cycle(model, (traj.t, traj.q, traj.qd, qdd), dwell=dwell, repeat=None)
+    t = traj.t
+    t_arrival = t[-1] - 1e-6 * (t[-1] - t[-2])
+    q_a, qd_a, qdd_a = traj._evaluate(np.array([t_arrival]))
+    samples = [
+        np.concatenate([x[:-1], extra, x[-1:]])
+        for x, extra in zip(
+            (t, traj.q, traj.qd, traj.qdd), ([t_arrival], q_a, qd_a, qdd_a), strict=True
+        )
+    ]
+    cycle = duty_cycle(model, tuple(samples), dwell=dwell, repeat=None)
     out = {}
     for act in actuators:
         load = cycle.joint_load(str(act.joint))
@@ -794,7 +802,7 @@ def shortest_cycle(
 
     def check(k: float):
         traj = _scaled(fastest, k) if k != 1.0 else fastest
-        return traj, _cycle_margins(model, traj, dwell, actuators, options, k)
+        return traj, _cycle_margins(model, traj, dwell, actuators, options)
 
     best, margins = check(1.0)
     k_best = 1.0
