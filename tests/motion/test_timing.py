@@ -504,6 +504,8 @@ def test_hostile_paths_and_models(ur5_path):
         time_optimal(model, np.zeros((2, 1)))
     with pytest.raises(ad.ModelError, match="the path has 6 joints, the model 1"):
         time_optimal(model, ur5_path)
+    with pytest.raises(ad.ModelError, match=r"the path's joints \['k'\] are not the model's"):
+        time_optimal(model, Path([0.0, 1.0], [[0.0], [1.0]], names=["k"]))
     with pytest.raises(ad.ModelError, match="does not move"):
         time_optimal(model, Path([0.0, 1.0], [[0.2], [0.2]]), max_torque=1.0)
     with pytest.raises(ad.ModelError, match=r"the path's dq/ds\[0, 0\]"):

@@ -147,6 +147,10 @@ def _model_path(who: str, model, path) -> list[str]:
         raise _core.ModelError(
             f"{who}: the path has {path.n_joints} joints, the model {len(coords)} ({coords})"
         )
+    if path.names is not None and list(path.names) != coords:
+        raise _core.ModelError(
+            f"{who}: the path's joints {list(path.names)} are not the model's {coords} (in order)"
+        )
     return dofs
 
 
@@ -546,18 +550,18 @@ def _active(p: _Problem, lin, x, u) -> list[str]:
     """Per sample, the constraint that binds (least slack within 1e-6 of its limit), the bound
     on x, or '' (the speed is set by a constraint further on)."""
     a, b, c = lin
-    out = []
-    values = _violation(a, b, c, x, u)
-    limits = np.array([max(col[1], 1e-300) for col in p.rows.cols])
-    for i in range(len(x)):
-        label = ""
-        if values.shape[1]:
-            r = int(np.argmax(values[i] / limits))
-            if values[i, r] >= -1e-6 * limits[r]:
-                label = f"{p.rows.cols[r][0]} {'upper' if p.rows.cols[r][2] > 0 else 'lower'}"
-        if not label and x[i] >= p.xmax[i] * (1.0 - 1e-9) and x[i] > 0.0:
-            label = p.xmax_label[i]
-        out.append(label)
+    out = [""] * len(x)
+    if a.shape[1]:
+        limits = np.array([max(col[1], 1e-300) for col in p.rows.cols])
+        ratio = _violation(a, b, c, x, u) / limits
+        worst = np.argmax(ratio, axis=1)
+        for i in np.flatnonzero(ratio[np.arange(len(x)), worst] >= -1e-6):
+            label, _, side = p.rows.cols[worst[i]][:3]
+            out[i] = f"{label} {'upper' if side > 0 else 'lower'}"
+    at_bound = (x >= p.xmax * (1.0 - 1e-9)) & (x > 0.0)
+    for i in np.flatnonzero(at_bound):
+        if not out[i]:
+            out[i] = p.xmax_label[i]
     return out
 
 
