@@ -387,6 +387,20 @@ def test_shortest_cycle_is_the_time_optimal_one_when_the_thermal_limits_are_loos
     assert cycle.info["margins"][("j", "peak_torque")] == pytest.approx(1.0, rel=1e-9)
 
 
+def test_shortest_cycle_limited_by_a_joint_limit_has_no_motor_binding():
+    """A joint torque limit (0.5 N m) below what the motor gives: the time-optimal cycle is the
+    shortest, no motor check binds (binding None), every motor margin above 1."""
+    model = _geared(0.8, J_ROT, N_GEAR, peak_torque=T_PEAK, continuous_torque=1.0)
+    cycle = shortest_cycle(
+        model, segment(Q_END), dwell=DWELL, max_torque=0.5, max_velocity=np.inf, grid=200
+    )
+    assert cycle.info["slowdown"] == 1.0 and cycle.info["binding"] is None
+    assert np.nanmin(list(cycle.info["margins"].values())) > 1.0 + 1e-6
+    assert cycle.info["time_optimal_duration"] == pytest.approx(
+        2 * np.sqrt(Q_END * (INERTIA + N_GEAR**2 * J_ROT) / 0.5), rel=1e-12
+    )
+
+
 def test_shortest_cycle_that_cannot_hold_in_the_dwell_names_the_check():
     """A lifted link held in the dwell: its holding current alone overheats the winding, so no
     slowdown helps: SolverError naming the check."""

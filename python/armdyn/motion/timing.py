@@ -392,7 +392,6 @@ def _controllable(s: np.ndarray, a, b, c, xmax: np.ndarray) -> np.ndarray:
     import toppra.algorithm as algo
     from toppra.constraint import DiscretizationType, LinearConstraint
 
-    logging.getLogger("toppra").setLevel(logging.ERROR)
     m = a.shape[1]
 
     class _Stagewise(LinearConstraint):
@@ -411,8 +410,14 @@ def _controllable(s: np.ndarray, a, b, c, xmax: np.ndarray) -> np.ndarray:
         path_interval = np.array([0.0, 1.0])
         dof = 1
 
-    solver = algo.TOPPRA([_Stagewise()], _Interval(), gridpoints=s, solver_wrapper="seidel")
-    return np.asarray(solver.compute_controllable_sets(0.0, 0.0), dtype=float)
+    log = logging.getLogger("toppra")
+    level = log.level
+    log.setLevel(logging.ERROR)  # its warnings of an empty set: this module reports them
+    try:
+        solver = algo.TOPPRA([_Stagewise()], _Interval(), gridpoints=s, solver_wrapper="seidel")
+        return np.asarray(solver.compute_controllable_sets(0.0, 0.0), dtype=float)
+    finally:
+        log.setLevel(level)
 
 
 def _scaled_controllable(s: np.ndarray, a, b, c, xmax: np.ndarray) -> np.ndarray:
