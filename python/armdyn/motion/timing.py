@@ -30,8 +30,10 @@ constraints that imply them (conservative): ``√x`` by its tangent at the previ
 it tightens the constraint (concave: the tangent lies above), by the chord ``x/√X`` on the
 stage's speed bound ``[0, X]`` where it relaxes it (0 without a bound); the efficiency's two
 branches by both linear pieces on the side where their maximum (minimum) is the true value and
-by the regenerating piece alone on the other (exact wherever that branch holds); the Coulomb
-term by its saturated value ``±c`` on the side where it hurts and 0 on the other. The tangents
+by the regenerating piece alone on the other (exact wherever that branch holds), and at the
+path's ends, at rest, by the motoring piece on both sides (holding takes ``τ_gear/(N η)``
+whatever its sign); the Coulomb term by its saturated value ``±c`` on the side where it hurts
+and 0 on the other (0 at the ends: at rest it is exactly 0). The tangents
 are then moved to the new solution and the problem solved again (``envelope_iterations``,
 until the duration stops falling by more than 1e-9 relative): every iterate satisfies the true
 constraints at the grid points, the fastest is returned, and at convergence the speed terms are
@@ -53,9 +55,9 @@ largest coefficient.
 
 **The output.** The trajectory's samples are the grid points: ``ṡ_i = √x_i`` and ``s̈_i = u_i``
 (the acceleration over the next interval; at the last point 0: the arrival at rest, where the
-hold begins; ``info["qdd_arrival"]`` is the last interval's q̈ there), so the limits hold at
-every sample as above; between samples they hold to
-the discretisation error (refine ``grid``). ``evaluate(t)`` is exact between samples
+hold begins, checked against every limit; ``info["qdd_arrival"]`` is the last interval's q̈
+there), so the limits hold at every sample as above; between samples they hold to the
+discretisation error (refine ``grid``). ``evaluate(t)`` is exact between samples
 (``s = s_i + ṡ_i τ + u_i τ²/2``). Duration: ``Σ 2 Δ_i / (ṡ_i + ṡ_{i+1})``. The motion starts and
 ends at rest.
 """
