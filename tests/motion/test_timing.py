@@ -194,6 +194,16 @@ def test_one_joint_constant_torque_limit_is_bang_bang(q_end):
     np.testing.assert_allclose(np.abs(tau[:-1, 0]), tau_max, rtol=1e-10)
 
 
+def test_a_given_uneven_grid_is_used_as_it_is():
+    """A cosine-spaced grid (denser at the ends, s = 1/2 on it): the samples are at those
+    path parameters and the bang-bang time is still exact."""
+    grid = 0.5 - 0.5 * np.cos(np.pi * np.arange(81) / 80)
+    grid[0], grid[-1] = 0.0, 1.0
+    traj = time_optimal(arm(), segment(1.5), max_torque=3.0, max_velocity=np.inf, grid=grid)
+    np.testing.assert_array_equal(traj.info["grid"], grid)
+    assert traj.duration == pytest.approx(2 * np.sqrt(1.5 * INERTIA / 3.0), rel=1e-12)
+
+
 def test_spring_torque_is_in_the_static_term_and_dampers_are_refused():
     """A joint spring (k = 4 N m/rad) adds k q to the torque: the limit holds with it, checked
     by an independent inverse dynamics, and binds; a damper (velocity-dependent) is refused."""
