@@ -13,6 +13,7 @@ from armdyn.motion.profiles import (
     through_waypoints,
     waypoint_path,
 )
+from armdyn.motion.timing import shortest_cycle, time_optimal
 from armdyn.motion.trajectory import Path, Trajectory
 
 __all__ = [
@@ -20,7 +21,9 @@ __all__ = [
     "Trajectory",
     "drive_profile",
     "point_to_point",
+    "shortest_cycle",
     "spline",
     "through_waypoints",
+    "time_optimal",
     "waypoint_path",
 ]
