@@ -6,6 +6,17 @@ thermal limits), and the least-energy motion. Every planner returns a :class:`Tr
 take) or a :class:`Path` (geometric, timed by :func:`time_optimal`).
 """
 
+from armdyn.motion.cartesian import CartesianPath, arc_move, linear_move
+from armdyn.motion.ik import IKResult, inverse_kinematics, manipulability
 from armdyn.motion.trajectory import Path, Trajectory
 
-__all__ = ["Path", "Trajectory"]
+__all__ = [
+    "CartesianPath",
+    "IKResult",
+    "Path",
+    "Trajectory",
+    "arc_move",
+    "inverse_kinematics",
+    "linear_move",
+    "manipulability",
+]
