@@ -114,7 +114,7 @@ class CartesianPath(Path):
     rotation [rad], the lowest manipulability and the knots the step limiting added.
     """
 
-    __slots__ = ("_dq", "_geometry", "_task", "_tol", "manipulability", "poses")
+    __slots__ = ("_dq", "_geometry", "_min", "_task", "_tol", "manipulability", "poses")
 
     def _solve_at(self, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         task, geo = self._task, self._geometry
@@ -124,7 +124,7 @@ class CartesianPath(Path):
         p, r, xi, dxi = geo.at(s)
         q = _newton_rows(task, p, r, start, self._tol, s)
         _within_limits(task, q, s)
-        return _derivatives(task, q, xi, dxi)
+        return _derivatives(task, q, xi, dxi, s, p, self._min)[:3]
 
 
 def _square(task: Task, j: np.ndarray) -> np.ndarray:
@@ -169,16 +169,27 @@ def _within_limits(task: Task, q: np.ndarray, s: np.ndarray) -> None:
         )
 
 
-def _derivatives(task: Task, q: np.ndarray, xi: np.ndarray, dxi: np.ndarray):
-    """``(q, dq/ds, d²q/ds²)`` from the frame's twist per unit s ``xi`` and its derivative."""
+def _derivatives(task: Task, q, xi, dxi, s, p, min_manip: float):
+    """``(q, dq/ds, d²q/ds², det J)`` from the frame's twist per unit s ``xi`` and its
+    derivative; SolverError naming the first ``s`` (position ``p``) where the manipulability
+    ``|det J|`` (J square: the kept rows, the moving joints) is below ``min_manip`` or zero."""
     j = task.jacobian(q)
     js = _square(task, j)
+    det = np.linalg.det(js)
+    low = np.flatnonzero((np.abs(det) < min_manip) | (det == 0.0))
+    if len(low):
+        k = int(low[0])
+        raise _core.SolverError(
+            f"{task.who}: singularity at s = {s[k]:.9g} (position "
+            f"{np.round(p[k], 6).tolist()} m): manipulability {abs(det[k]):.3g} < "
+            f"min_manipulability = {min_manip:g}"
+        )
     dq = np.zeros_like(q)
     dq[:, task.chain] = np.linalg.solve(js, xi[:, task.rows, None])[:, :, 0]
     bias = task.jdot_qdot(q, j, dq)[:, task.rows]
     ddq = np.zeros_like(q)
     ddq[:, task.chain] = np.linalg.solve(js, (dxi[:, task.rows] - bias)[:, :, None])[:, :, 0]
-    return q, dq, ddq
+    return q, dq, ddq, det
 
 
 def _check_square(task: Task) -> None:
@@ -211,23 +222,34 @@ def _grid(who: str, geo: _Geometry, samples, max_step, max_joint_step: float) ->
 
 
 class _Knots:
-    """The knots solved so far (s, q, dq/ds, manipulability)."""
+    """The knots solved so far (s, q, dq/ds, signed det J; the manipulability is |det J|)."""
 
-    def __init__(self) -> None:
-        self.s, self.q, self.dq, self.m = [], [], [], []
+    def __init__(self, task: Task, geo: _Geometry, min_manip: float) -> None:
+        self.task, self.geo, self.min_manip = task, geo, min_manip
+        self.s, self.q, self.dq, self.det = [], [], [], []
 
-    def add(self, s: float, q, dq, m: float) -> None:
+    @property
+    def m(self) -> list[float]:
+        return [abs(d) for d in self.det]
+
+    def add(self, s: float, q: np.ndarray) -> None:
+        """Add the IK solution ``q`` at ``s``, with its tangent; SolverError at a singularity:
+        the manipulability below ``min_manip`` there, or det J changing sign since the last
+        knot (det J is continuous along a continuous path: it crossed zero in between)."""
+        ss = np.array([s])
+        p, _, xi, dxi = self.geo.at(ss)
+        _, dq, _, det = _derivatives(self.task, q[None, :], xi, dxi, ss, p, self.min_manip)
+        if self.det and np.sign(det[0]) != np.sign(self.det[-1]):
+            mid = self.geo.at(np.array([0.5 * (s + self.s[-1])]))[0][0]
+            raise _core.SolverError(
+                f"{self.task.who}: singularity met between s = {self.s[-1]:.9g} and {s:.9g} "
+                f"(position {np.round(mid, 6).tolist()} m between them): det J changes sign "
+                f"(manipulability {abs(self.det[-1]):.3g} and {abs(det[0]):.3g} at those knots)"
+            )
         self.s.append(s)
         self.q.append(q)
-        self.dq.append(dq)
-        self.m.append(m)
-
-
-def _knot(task: Task, geo: _Geometry, s: float, q: np.ndarray, tol: float):
-    """``(q, dq/ds, manipulability)`` at ``s`` from the IK solution ``q``."""
-    _, _, xi, dxi = geo.at(np.array([s]))
-    qq, dq, _ = _derivatives(task, q[None, :], xi, dxi)
-    return qq[0], dq[0], float(task.manipulability(task.jacobian(q)))
+        self.dq.append(dq[0])
+        self.det.append(float(det[0]))
 
 
 def _unreachable(task, geo, s, q, e, knots) -> _core.SolverError:
@@ -248,15 +270,11 @@ def _solve_knots(task, geo, q_start, grid, *, tol, max_joint_step, min_manip):
     """Walk the knots from s = 0: each solved by inverse kinematics from the last knot's
     tangent prediction; a step whose joints move more than ``max_joint_step`` (or stray from the
     prediction by more than half that: another branch) is halved (a knot inserted) down to
-    1e-7 in s. SolverError at the first unreachable pose or at a knot whose manipulability is
-    below ``min_manip``."""
-    knots = _Knots()
-    p0, r0, _, _ = geo.at(np.zeros(1))
-    q, e, _, ok = solve(task, p0[0], r0[0], q_start, tol=tol, max_iterations=50, damping=1e-12)
-    if not ok or np.max(np.abs(q - q_start)) > max_joint_step:
-        raise _unreachable(task, geo, 0.0, q, e, knots)  # pragma: no cover - start is q_start
-    knots.add(0.0, *_knot(task, geo, 0.0, q, tol))
-    _singular(task, geo, knots, min_manip)
+    1e-7 in s. SolverError at the first unreachable pose, at a knot whose manipulability is
+    below ``min_manip`` or where det J changes sign between two knots (a singularity
+    crossed)."""
+    knots = _Knots(task, geo, min_manip)
+    knots.add(0.0, q_start)  # the path starts at q_start's pose
     planned, k = list(grid[1:]), 0
     added = 0
     while k < len(planned):
@@ -266,8 +284,7 @@ def _solve_knots(task, geo, q_start, grid, *, tol, max_joint_step, min_manip):
         q, e, _, ok = solve(task, p[0], r[0], pred, tol=tol, max_iterations=50, damping=1e-12)
         jump = np.max(np.abs(q - knots.q[-1]))
         if ok and jump <= max_joint_step and np.max(np.abs(q - pred)) <= 0.5 * max_joint_step:
-            knots.add(s1, *_knot(task, geo, s1, q, tol))
-            _singular(task, geo, knots, min_manip)
+            knots.add(s1, q)
             k += 1
             continue
         if s1 - s0 < _MIN_DS:
@@ -281,16 +298,6 @@ def _solve_knots(task, geo, q_start, grid, *, tol, max_joint_step, min_manip):
         planned.insert(k, 0.5 * (s0 + s1))
         added += 1
     return knots, added
-
-
-def _singular(task: Task, geo: _Geometry, knots: _Knots, min_manip: float) -> None:
-    if knots.m[-1] < min_manip:
-        s = knots.s[-1]
-        p = geo.at(np.array([s]))[0][0]
-        raise _core.SolverError(
-            f"{task.who}: singularity at s = {s:.9g} (position {np.round(p, 6).tolist()} m): "
-            f"manipulability {knots.m[-1]:.3g} < min_manipulability = {min_manip:g}"
-        )
 
 
 def _build(who, model, frame, q_start, make_geometry, options) -> CartesianPath:
@@ -314,7 +321,7 @@ def _build(who, model, frame, q_start, make_geometry, options) -> CartesianPath:
     poses = np.zeros((len(s), 4, 4))
     poses[:, :3, :3], poses[:, :3, 3], poses[:, 3, 3] = r, p, 1.0
     path = CartesianPath.__new__(CartesianPath)
-    path._task, path._geometry, path._tol = task, geo, tol
+    path._task, path._geometry, path._tol, path._min = task, geo, tol, min_manip
     path._dq = np.asarray(knots.dq)
     path.poses, path.manipulability = poses, np.asarray(knots.m)
     info = dict(
