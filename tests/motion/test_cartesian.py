@@ -3,11 +3,9 @@ arms, the UR5 round trip, lines and arcs to 1e-9 m at any s, slerp against scipy
 derivatives against finite differences, branch continuity, singular and unreachable moves,
 hostile inputs."""
 
+import armdyn as ad
 import numpy as np
 import pytest
-from scipy.spatial.transform import Rotation, Slerp
-
-import armdyn as ad
 from armdyn.motion import (
     CartesianPath,
     IKResult,
@@ -17,6 +15,8 @@ from armdyn.motion import (
     manipulability,
 )
 from armdyn.motion.ik import Task
+from scipy.spatial.transform import Rotation, Slerp
+
 from benchmarks.common import UR5_Q0, robot_urdf
 
 L1, L2, L3 = 1.0, 0.8, 0.3
@@ -222,11 +222,11 @@ def test_a_timed_linear_move_stays_on_the_line(ur5):
     poses = ad.frame_pose(ur5, traj.q, "tool0")
     off, _ = _distance_to_line(poses[:, :3, 3], t0[:3, 3], t1[:3, 3])
     assert off.max() <= 1e-9
-    np.testing.assert_allclose(poses[:, :3, :3], np.broadcast_to(t0[:3, :3], (777, 3, 3)), atol=1e-9)
-    twist = np.einsum("rij,rj->ri", ad.frame_jacobian(ur5, traj.q, "tool0"), traj.qd)
     np.testing.assert_allclose(
-        twist[:, :3], np.outer(sd, t1[:3, 3] - t0[:3, 3]), rtol=0, atol=1e-9
+        poses[:, :3, :3], np.broadcast_to(t0[:3, :3], (777, 3, 3)), atol=1e-9
     )
+    twist = np.einsum("rij,rj->ri", ad.frame_jacobian(ur5, traj.q, "tool0"), traj.qd)
+    np.testing.assert_allclose(twist[:, :3], np.outer(sd, t1[:3, 3] - t0[:3, 3]), rtol=0, atol=1e-9)
     np.testing.assert_allclose(twist[:, 3:], 0.0, atol=1e-9)
 
 
@@ -272,7 +272,9 @@ def test_arc_move_stays_on_its_circle_and_passes_the_via_point(ur5):
     np.testing.assert_allclose(x[-1], t1[:3, 3], atol=1e-12)
     assert np.min(np.linalg.norm(x - via, axis=1)) < 2 * path.info["length"] / 1500
     # constant speed along the arc, one way round: the length is the arc's
-    speed = np.linalg.norm(np.einsum("rij,rj->ri", ad.frame_jacobian(ur5, q, "tool0"), d1)[:, :3], axis=1)
+    speed = np.linalg.norm(
+        np.einsum("rij,rj->ri", ad.frame_jacobian(ur5, q, "tool0"), d1)[:, :3], axis=1
+    )
     np.testing.assert_allclose(speed, path.info["length"], rtol=1e-9)
     chord = np.sum(np.linalg.norm(np.diff(x, axis=0), axis=1))
     assert chord == pytest.approx(path.info["length"], rel=1e-6)
@@ -350,7 +352,7 @@ def test_a_move_through_the_ur5_wrist_singularity_is_refused(ur5):
         t[:3, :3] = Rotation.from_rotvec(k * dw).as_matrix() @ t_sing[:3, :3]
         return t
 
-    q_start = inverse_kinematics(ur5, "tool0", pose(-1), q_sing + [0, 0, 0, 0, 0.1, 0]).q
+    q_start = inverse_kinematics(ur5, "tool0", pose(-1), q_sing + np.array([0, 0, 0, 0, 0.1, 0])).q
     with pytest.raises(
         ad.SolverError, match=r"singularity met between s = 0\.45.* and 0\.54.*det J changes sign"
     ):
@@ -451,14 +453,14 @@ def test_degenerate_moves_are_refused(ur5):
     t0 = ad.frame_pose(ur5, q0, "tool0")
     p0 = t0[:3, 3]
     with pytest.raises(ad.ModelError, match="collinear"):
-        arc_move(ur5, "tool0", q0, p0 + [0.05, 0, 0], p0 + [0.1, 0, 0])
+        arc_move(ur5, "tool0", q0, p0 + np.array([0.05, 0, 0]), p0 + np.array([0.1, 0, 0]))
     with pytest.raises(ad.ModelError, match="collinear or coincide"):
-        arc_move(ur5, "tool0", q0, p0, p0 + [0.1, 0, 0])
+        arc_move(ur5, "tool0", q0, p0, p0 + np.array([0.1, 0, 0]))
     half = t0.copy()
     half[:3, :3] = Rotation.from_rotvec([0, 0, np.pi]).as_matrix() @ t0[:3, :3]
     with pytest.raises(ad.ModelError, match="half turn"):
         linear_move(ur5, "tool0", q0, half)
-    path = linear_move(ur5, "tool0", q0, p0 + [0.02, 0, 0])
+    path = linear_move(ur5, "tool0", q0, p0 + np.array([0.02, 0, 0]))
     with pytest.raises(ad.ModelError, match="within"):
         path.evaluate([0.5, 1.2])
     with pytest.raises(ad.ModelError, match="s"):
@@ -470,7 +472,7 @@ def test_a_floating_model_is_refused():
     b.add_body("box", 1.0, np.eye(3) * 0.01)
     b.add_free("free", "box")
     b.add_frame("c", "box")
-    with pytest.raises(ad.ModelError, match="coordinates for .* rates"):
+    with pytest.raises(ad.ModelError, match=r"coordinates for .* rates"):
         inverse_kinematics(b.finalize(), "c", np.eye(4), np.zeros(7))
 
 

@@ -10,11 +10,11 @@ vector in world axes, radians): ``J dq = e`` is the Newton step.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
-from scipy.spatial.transform import Rotation
 
 from armdyn import _checks, _core
 
@@ -119,14 +119,55 @@ def check_pose(who: str, name: str, pose) -> tuple[np.ndarray, np.ndarray]:
     return a[:3, 3].copy(), u @ vt
 
 
+def rotation_log(r: np.ndarray) -> np.ndarray:
+    """The rotation vectors ``theta a`` (..., 3) of rotation matrices (..., 3, 3): ``R = exp([theta
+    a]x)``, theta in [0, pi]. With ``R = cos(theta) I + sin(theta) [a]x + (1 - cos(theta)) a a^T``:
+    ``v = vee(R - R^T) / 2 = sin(theta) a`` and theta = atan2(|v|, (tr R - 1) / 2) (accurate at
+    every angle); the axis is ``v / |v|`` up to a quarter turn, beyond that (where ``|v|`` loses
+    precision, up to the half turn where it vanishes) the column of ``(R + R^T) / 2 - cos(theta)
+    I = (1 - cos(theta)) a a^T`` with the largest diagonal entry, signed along ``v``."""
+    v = 0.5 * np.stack(
+        [r[..., 2, 1] - r[..., 1, 2], r[..., 0, 2] - r[..., 2, 0], r[..., 1, 0] - r[..., 0, 1]],
+        axis=-1,
+    )
+    sin = np.linalg.norm(v, axis=-1)
+    cos = np.clip(0.5 * (np.trace(r, axis1=-2, axis2=-1) - 1.0), -1.0, 1.0)
+    theta = np.arctan2(sin, cos)
+    small = theta < 1e-4  # theta / sin(theta) = 1 + theta^2 / 6 + 7 theta^4 / 360 + ...
+    scale = np.where(small, 1.0 + theta**2 / 6.0, theta / np.where(small | (sin == 0.0), 1.0, sin))
+    w = scale[..., None] * v
+    wide = cos < 0.0
+    if np.any(wide):
+        sym = 0.5 * (r[wide] + np.swapaxes(r[wide], -1, -2)) - cos[wide][:, None, None] * np.eye(3)
+        i = np.argmax(np.diagonal(sym, axis1=-2, axis2=-1), axis=-1)
+        col = np.take_along_axis(sym, i[:, None, None], axis=-1)[..., 0]
+        axis = col / np.linalg.norm(col, axis=-1, keepdims=True)
+        sign = np.where(np.sum(axis * v[wide], axis=-1) < 0.0, -1.0, 1.0)
+        w[wide] = (sign * theta[wide])[:, None] * axis
+    return w
+
+
 def pose_error(poses: np.ndarray, p: np.ndarray, r: np.ndarray) -> np.ndarray:
     """``[p* - p; log(R* R^T)]`` (..., 6) of frame poses (..., 4, 4) against targets ``p``
     (..., 3) and ``R`` (..., 3, 3)."""
     dp = p - poses[..., :3, 3]
     rel = r @ np.swapaxes(poses[..., :3, :3], -1, -2)
-    shape = rel.shape[:-2]
-    w = Rotation.from_matrix(rel.reshape(-1, 3, 3)).as_rotvec().reshape(*shape, 3)
-    return np.concatenate([dp, w], axis=-1)
+    if rel.ndim == 2:  # one pose: the same formulas without numpy's per-call overheads
+        return np.concatenate([dp, _rotation_log_one(rel)])
+    return np.concatenate([dp, rotation_log(rel)], axis=-1)
+
+
+def _rotation_log_one(r: np.ndarray) -> np.ndarray:
+    """:func:`rotation_log` of one matrix (3, 3), in Python floats."""
+    (a, b, c), (d, e, f), (g, h, i) = r.tolist()
+    v = (0.5 * (h - f), 0.5 * (c - g), 0.5 * (d - b))
+    sin = math.sqrt(v[0] ** 2 + v[1] ** 2 + v[2] ** 2)
+    cos = min(1.0, max(-1.0, 0.5 * (a + e + i - 1.0)))
+    if cos < 0.0:
+        return rotation_log(r[None])[0]
+    theta = math.atan2(sin, cos)
+    scale = 1.0 + theta**2 / 6.0 if theta < 1e-4 else theta / sin
+    return np.array([scale * v[0], scale * v[1], scale * v[2]])
 
 
 def _chain_order(model, frame: str) -> list[int] | None:
@@ -278,7 +319,7 @@ def solve(
     """Levenberg–Marquardt from ``q0`` (clipped into the limits) towards the pose ``(p, R)``:
     the damping ``E + damping`` with ``E = |e|²/2`` (Sugihara 2011: large far from the target,
     vanishing at it, so the last steps are Newton's), each step halved until the error drops
-    (at most 30 times) and projected onto the joint limits. Returns ``(q, e (kept rows),
+    (at most 20 times) and projected onto the joint limits. Returns ``(q, e (kept rows),
     iterations, converged)``: converged when both the position and orientation error norms are
     at most ``tol``; not converged when ``max_iterations`` pass or no step lowers the error."""
     q = np.clip(q0, task.lower, task.upper)
@@ -291,7 +332,7 @@ def solve(
             break
         j = task.jacobian(q)[task.rows]
         dq = _limited_step(task, q, j, e, cost + damping)
-        for _ in range(30):
+        for _ in range(20):
             qn = np.clip(q + dq, task.lower, task.upper)
             en = pose_error(task.pose(qn), p, r)[task.rows]
             cn = 0.5 * float(en @ en)
