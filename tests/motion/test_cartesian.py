@@ -14,7 +14,7 @@ from armdyn.motion import (
     linear_move,
     manipulability,
 )
-from armdyn.motion.ik import Task
+from armdyn.motion.ik import Task, rotation_exp, rotation_log
 from scipy.spatial.transform import Rotation, Slerp
 
 from benchmarks.common import UR5_Q0, robot_urdf
@@ -161,6 +161,28 @@ def test_jdot_qdot_equals_a_difference_of_the_jacobian(ur5):
         want = np.einsum("rij,rj->ri", (jp - jm) / (2 * h), qd)
         got = task.jdot_qdot(q, ad.frame_jacobian(model, q, frame), qd)
         np.testing.assert_allclose(got, want, rtol=0, atol=1e-8 * np.abs(want).max())
+
+
+def test_rotation_log_and_exp_equal_scipys_at_every_angle():
+    """The IK's rotation error (log) and the slerp (exp) against scipy's rotation vectors, from
+    1e-15 rad to the half turn (where the log's axis comes from the symmetric part)."""
+    rng = np.random.default_rng(11)
+    axis = rng.normal(size=(4000, 3))
+    axis /= np.linalg.norm(axis, axis=1, keepdims=True)
+    angle = np.concatenate(
+        [
+            rng.uniform(0.0, np.pi, 1000),
+            10 ** rng.uniform(-15, -1, 1000),
+            np.pi - 10 ** rng.uniform(-12, -1, 1000),
+            rng.uniform(1.5, 1.7, 1000),
+        ]
+    )
+    w = axis * angle[:, None]
+    r = Rotation.from_rotvec(w).as_matrix()
+    np.testing.assert_allclose(rotation_log(r), w, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(rotation_exp(w), r, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(rotation_log(np.diag([-1.0, -1.0, 1.0])), [0, 0, np.pi], atol=1e-15)
+    assert not np.any(rotation_log(np.eye(3)))
 
 
 # ---- linear moves

@@ -13,10 +13,18 @@ from __future__ import annotations
 
 import numpy as np
 import numpy.typing as npt
-from scipy.spatial.transform import Rotation
 
 from armdyn import _checks, _core
-from armdyn.motion.ik import ROWS, Task, check_pose, check_position, pose_error, solve
+from armdyn.motion.ik import (
+    ROWS,
+    Task,
+    check_pose,
+    check_position,
+    pose_error,
+    rotation_exp,
+    rotation_log,
+    solve,
+)
 from armdyn.motion.trajectory import Path
 
 _MIN_DS = 1e-7  # the smallest knot spacing the refinement tries before giving up
@@ -30,7 +38,7 @@ class _Geometry:
 
     def __init__(self, r0: np.ndarray, r1: np.ndarray, who: str) -> None:
         self.r0 = r0
-        self.phi = Rotation.from_matrix(r1 @ r0.T).as_rotvec()
+        self.phi = rotation_log(r1 @ r0.T)
         if np.linalg.norm(self.phi) > np.pi - 1e-6:
             raise _core.ModelError(
                 f"{who}: the target's orientation is a half turn from the start's: the slerp "
@@ -49,7 +57,7 @@ class _Geometry:
         """``(p (r, 3), R (r, 3, 3), xi (r, 6), xi' (r, 6))``: the pose at ``s`` and the frame's
         twist per unit s ``[dp/ds; w]`` and its s-derivative."""
         p, dp, ddp = self.position(s)
-        r = Rotation.from_rotvec(s[:, None] * self.phi).as_matrix() @ self.r0
+        r = rotation_exp(s[:, None] * self.phi) @ self.r0
         w = np.broadcast_to(self.phi, p.shape)
         xi = np.concatenate([dp, w], axis=1)
         dxi = np.concatenate([ddp, np.zeros_like(ddp)], axis=1)

@@ -157,6 +157,20 @@ def rotation_log(r: np.ndarray) -> np.ndarray:
     return w
 
 
+def rotation_exp(w: np.ndarray) -> np.ndarray:
+    """The rotation matrices (..., 3, 3) of rotation vectors ``w`` (..., 3) (Rodrigues: ``I +
+    sin(t)/t [w]x + (1 - cos(t))/t² [w]x²``, t = |w|, by their series below t = 1e-4)."""
+    t = np.linalg.norm(w, axis=-1)[..., None, None]
+    small = t < 1e-4
+    safe = np.where(small, 1.0, t)
+    a = np.where(small, 1.0 - t**2 / 6.0, np.sin(safe) / safe)
+    b = np.where(small, 0.5 - t**2 / 24.0, (1.0 - np.cos(safe)) / safe**2)
+    k = np.zeros((*w.shape[:-1], 3, 3))
+    k[..., 0, 1], k[..., 0, 2], k[..., 1, 2] = -w[..., 2], w[..., 1], -w[..., 0]
+    k[..., 1, 0], k[..., 2, 0], k[..., 2, 1] = w[..., 2], -w[..., 1], w[..., 0]
+    return np.eye(3) + a * k + b * (k @ k)
+
+
 def pose_error(poses: np.ndarray, p: np.ndarray, r: np.ndarray) -> np.ndarray:
     """``[p* - p; log(R* R^T)]`` (..., 6) of frame poses (..., 4, 4) against targets ``p``
     (..., 3) and ``R`` (..., 3, 3)."""
