@@ -15,6 +15,8 @@ import numpy as np
 import numpy.typing as npt
 
 from armdyn import _checks, _core
+
+__all__ = ["CartesianPath", "arc_move", "linear_move"]
 from armdyn.motion.ik import (
     ROWS,
     Task,

@@ -18,6 +18,8 @@ import numpy.typing as npt
 
 from armdyn import _checks, _core
 
+__all__ = ["IKResult", "inverse_kinematics", "manipulability"]
+
 #: the rows of a frame Jacobian and of a pose error, in order
 ROWS = ("vx", "vy", "vz", "wx", "wy", "wz")
 _ROTATION_TOL = 1e-9  # |R^T R - I| a target's rotation may have (it is then projected)
