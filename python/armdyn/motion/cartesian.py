@@ -413,20 +413,26 @@ def linear_move(
     axis), both linear in ``s``.
 
     Args:
-        model: a fixed-base :class:`armdyn.Model` (coordinates = rates, no couplings).
+        model: a fixed-base :class:`armdyn.Model` (coordinates = rates; no joint between the
+            frame and the ground may follow another through a coupling).
         frame: a name or an index of ``model.frame_names``.
         q_start: where the move starts (n_coords,), within the joint limits.
         target: the end pose (4, 4) ``[R p; 0 0 0 1]``, or a position (3,) keeping the start's
             orientation.
-        samples: the number of evenly spaced first knots (at least 2); or
+        samples: the number of evenly spaced first knots (2 to 10000); or
         max_step: the largest step of the frame between first knots [m] (default 0.01;
             rotations in steps of at most ``max_joint_step`` rad). Knots are then added where
-            the joints move more than ``max_joint_step`` between two (step limiting).
+            the joints move more than ``max_joint_step`` between two, or stray from the
+            previous knot's tangent by more than half that (step limiting; at most 10000
+            knots in all, SolverError beyond). Between the knots, each midpoint is evaluated
+            once more to check that it stays on the branch and within the joint limits.
         orientation: ``"slerp"`` (the only interpolation).
         max_joint_step: the largest joint step between knots [rad or m]: keeps the branch
             continuous (a larger step, or one far from the tangent prediction, is halved).
-        min_manipulability: SolverError at a knot whose manipulability is below this
-            (a singularity on the way, or the workspace's boundary).
+        min_manipulability: SolverError where the manipulability (``|det J|``, J the kept rows
+            and the moving joints) is below this, at a knot or wherever the path is evaluated
+            (a singularity on the way, or the workspace's boundary); and wherever det J changes
+            sign between two knots (a singularity crossed between them), whatever this is.
         tol: the inverse kinematics tolerance, at the knots and wherever the path is evaluated
             [m and rad].
         mask: the rows of ``[vx, vy, vz, wx, wy, wz]`` to follow (6 booleans), as many as
@@ -438,8 +444,9 @@ def linear_move(
 
     Raises:
         ModelError: a bad argument (named), a half-turn rotation (no unique slerp axis).
-        SolverError: the first unreachable pose (``s`` and position), a singularity (the first
-            knot below ``min_manipulability``) or the joint path jumping (branch lost).
+        SolverError: the first unreachable pose (``s`` and position), the first singularity
+            (``s`` and position, or the two knots around it) or the joint path jumping (the
+            branch lost).
     """
     who = "linear_move"
     _checks.choice(who, "orientation", orientation, ("slerp",))

@@ -402,7 +402,8 @@ def inverse_kinematics(
     descent reaches from ``q0`` (no restarts: give a ``q0`` near the branch you want).
 
     Args:
-        model: a fixed-base :class:`armdyn.Model` (coordinates = rates, no couplings).
+        model: a fixed-base :class:`armdyn.Model` (coordinates = rates; no joint between the
+            frame and the ground may follow another through a coupling).
         frame: a name or an index of ``model.frame_names``.
         target: the frame's world pose (4, 4) ``[R p; 0 0 0 1]``; ``R`` must be a rotation
             to 1e-9.
