@@ -398,6 +398,23 @@ def test_a_move_blocked_by_a_joint_limit_names_the_first_unreachable_point():
     np.testing.assert_allclose([x, y, z], [1.5 - 0.6 * s, 0.0, 0.0], atol=1e-6)
 
 
+def test_a_limit_crossed_between_two_knots_is_caught_by_the_midpoint_check():
+    """A chord of the 2R arm's reach circle: |p| is smallest at s = 0.5, so the elbow bends
+    most there (q2 = 1.180 against 1.118 at the ends, closed form); with the only knots at the
+    ends (within j1's upper limit 1.15), the midpoint's exact evaluation finds the limit
+    crossed."""
+    model = _planar(2, limits={"j1": (-1.15, 1.15)})
+    q_start = _two_link(np.array([1.5, -0.3]), 1)
+    assert q_start[1] == pytest.approx(np.arccos((1.5**2 + 0.3**2 - L1**2 - L2**2) / 1.6))
+    with pytest.raises(ad.SolverError, match=r"at s = 0\.5 joint 'j1' leaves its limits") as err:
+        linear_move(model, "tip", q_start, [1.5, 0.3, 0.0], mask=XY, samples=2, max_joint_step=1.0)
+    q_mid = float(str(err.value).split("(q = ")[1].rstrip(")"))
+    assert q_mid == pytest.approx(np.arccos((1.5**2 - L1**2 - L2**2) / 1.6), abs=1e-8)
+    # up to y = -0.22 (|p|² = 2.2984 > L1² + L2² + 2 L1 L2 cos 1.15 = 2.2936): within the limit
+    ok = linear_move(model, "tip", q_start, [1.5, -0.22, 0.0], mask=XY)
+    assert 1.14 < ok.q[-1, 1] < 1.15
+
+
 def test_an_unreachable_ur5_target_is_refused_with_where(ur5):
     q0, t0, _ = _ur5_move(ur5)
     with pytest.raises(ad.SolverError, match=r"at s = 0\.[0-9]+.*position \["):
