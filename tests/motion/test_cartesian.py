@@ -218,6 +218,20 @@ def test_linear_move_stays_on_the_line_at_any_s(ur5):
     assert path.info["lowest_manipulability"] == path.manipulability.min()
 
 
+def test_a_path_evaluates_the_same_from_several_threads(ur5):
+    from concurrent.futures import ThreadPoolExecutor
+
+    q0, _, t1 = _ur5_move(ur5)
+    path = linear_move(ur5, "tool0", q0, t1)
+    grids = [np.linspace(0.0, 1.0, 301) ** k for k in (1, 2, 3, 4)]
+    serial = [path.evaluate(g) for g in grids]
+    with ThreadPoolExecutor(4) as pool:
+        parallel = list(pool.map(path.evaluate, grids * 3))
+    for got, want in zip(parallel, serial * 3, strict=True):
+        for a, b in zip(got, want, strict=True):
+            np.testing.assert_array_equal(a, b)
+
+
 def test_linear_move_derivatives_equal_finite_differences(ur5):
     """dq/ds against central differences of the exact q(s), d2q/ds2 against those of dq/ds
     (h = 1e-4: truncation about 1e-8, the IK's 1e-12 noise / h about 1e-8)."""

@@ -119,7 +119,8 @@ class CartesianPath(Path):
     """A joint :class:`~armdyn.motion.Path` that moves a frame along a Cartesian line or arc.
 
     Besides the knots ``s`` and their configurations ``q``: ``poses`` (m, 4, 4) the frame's
-    target pose at each knot (the frame is there to the solver's tolerance) and
+    target pose at each knot (the frame is there to the solver's tolerance in the rows the
+    ``mask`` keeps) and
     ``manipulability`` (m,) at each knot (over the kept rows). :meth:`evaluate` is exact at
     any ``s`` (inverse kinematics there). ``info``: ``method``, ``frame``, ``length`` [m],
     ``rotation`` [rad], ``lowest_manipulability`` (over the knots), ``refined_knots`` (the

@@ -235,7 +235,6 @@ class Task:
         self.lower = np.asarray(model.coord_lower, dtype=float)
         self.upper = np.asarray(model.coord_upper, dtype=float)
         self.names = list(model.coord_names)
-        self.data = _core.Data(model)
         try:
             j = self.jacobian(np.zeros(self.n))
         except _core.ModelError as err:
@@ -251,11 +250,13 @@ class Task:
         if len(self.chain) == 0:
             raise _core.ModelError(f"{who}: frame {self.frame!r} is not moved by any joint")
 
+    # without data=: the core keeps one workspace per thread, so a path evaluates safely from
+    # several threads
     def pose(self, q: np.ndarray) -> np.ndarray:
-        return _core.frame_pose(self.model, q, self.frame, data=self.data)
+        return _core.frame_pose(self.model, q, self.frame)
 
     def jacobian(self, q: np.ndarray) -> np.ndarray:
-        return _core.frame_jacobian(self.model, q, self.frame, data=self.data)
+        return _core.frame_jacobian(self.model, q, self.frame)
 
     def at_limits(self, q: np.ndarray) -> tuple[str, ...]:
         hit = (q <= self.lower) | (q >= self.upper)
