@@ -6,6 +6,7 @@ thermal limits), and the least-energy motion. Every planner returns a :class:`Tr
 take) or a :class:`Path` (geometric, timed by :func:`time_optimal`).
 """
 
+from armdyn.motion.energy import least_energy
 from armdyn.motion.trajectory import Path, Trajectory
 
-__all__ = ["Path", "Trajectory"]
+__all__ = ["Path", "Trajectory", "least_energy"]
