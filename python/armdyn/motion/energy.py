@@ -7,11 +7,17 @@ B-spline of degree 5 in ``u = t / T`` whose value and first derivative vanish at
 (``end_acceleration="free"``, the default: the optimum of a quadratic torque cost starts and
 ends with a step in torque, as the cubic that minimises ∫ τ² for a free inertia does) or also
 its second derivative (``"zero"``: the motion starts and ends with zero acceleration, as the
-quintic). The correction's free coefficients are the unknowns; scipy's SLSQP minimises the
-cost, a trapezoid rule over ``samples`` uniform samples, with its exact gradient by the chain
-rule: ``dτ/dp = ∂τ/∂q dq/dp + ∂τ/∂q̇ dq̇/dp + M dq̈/dp`` (:func:`armdyn.inverse_dynamics_derivatives`,
-:func:`armdyn.mass_matrix`), the motor side through the gear as :mod:`armdyn.actuators` writes
-it.
+quintic). The correction's free coefficients p are the unknowns. The cost is Simpson's rule over
+``samples`` uniform samples; scipy's SLSQP minimises it with its exact gradient by the chain
+rule, ``dτ/dp = ∂τ/∂q dq/dp + ∂τ/∂q̇ dq̇/dp + M dq̈/dp``
+(:func:`armdyn.inverse_dynamics_derivatives`, :func:`armdyn.mass_matrix`), and the motor side
+through the gear as :func:`armdyn.actuators.motor_side` writes it. The unknowns are scaled by
+the Cholesky factor of the cost's Gauss–Newton Hessian at the quintic (SLSQP's quasi-Newton
+Hessian starts as the identity, which is then about right).
+
+The gear's efficiency switches where a joint reverses with a load (the power flow changes
+direction): the cost's integrand jumps there, which the samples resolve to their spacing; the
+reported costs are therefore Simpson's rule on the check grid, ``check_factor`` times finer.
 """
 
 from __future__ import annotations
@@ -416,18 +422,20 @@ def least_energy(
     """The least-energy rest-to-rest motion from ``start`` to ``goal`` in ``duration`` seconds.
 
     Minimises, over the motion (the quintic move plus a B-spline correction: see the module
-    notes), the trapezoid rule over ``samples`` uniform samples of
+    notes), Simpson's rule over ``samples`` uniform samples of
 
     - ``objective="copper"``: the motors' copper loss ∫ Σ R i² dt [J], i = T / k_t, T the motor
       torque of :func:`armdyn.actuators.motor_side` (the joint torque less the rotor's share
       through the gear: / (N η) while the motor drives the load, · η / N while the load drives
       it back, plus the rotor's inertia and friction torque), R the motor's resistance (at the
       datasheet's temperature): every joint needs an actuator whose motor gives
-      ``torque_constant`` and ``resistance``;
+      ``torque_constant`` and ``resistance``. At the rest ends (q̇ = 0) the gear's branch is
+      its limit from inside the move (motor_side takes the holding branch there: one instant);
     - ``objective="rms_torque"``: ∫ Σ w_j τ_j² dt [N² m² s] of the joint torques τ
       (``weights`` w, default 1; the result reports each joint's RMS torque).
 
-    subject to, at every sample (the interior ones for the linear limits):
+    subject to, at every sample (the interior ones for the position and speed, whose end values
+    are fixed):
 
     - the joint position limits (``model.coord_lower``/``coord_upper``);
     - the joint speed: ``max_velocity`` (a number or per joint; default the model's
@@ -437,12 +445,12 @@ def least_energy(
     - with ``motors`` and an actuator's motor data: the motor's ``peak_torque`` and its
       speed–torque envelope |T + T0 ω / ω0| ≤ T0 (:func:`armdyn.sizing.motor.motor_envelope`).
 
-    Each limit is enforced at ``(1 - margin)`` of its value at the samples; the result is then
-    checked against the full value on a grid ``check_factor`` times finer, and where it is
-    exceeded between samples those instants join the constrained ones and the solve resumes
-    (at most three times). The solve is scipy's SLSQP on the correction's coefficients with the
-    exact gradient of the cost and the limits (``armdyn.inverse_dynamics_derivatives``,
-    ``armdyn.mass_matrix``), starting from the quintic.
+    Each limit is enforced at ``(1 - margin)`` of its value at the samples, on the side the
+    motion leans to (|x| ≤ L as x ≤ L where x ≥ 0, −x ≤ L where x ≤ 0: the other side is
+    slack). After a solve the motion is checked against the full limits on a grid
+    ``check_factor`` times finer: the instants found beyond a limit join the constrained
+    samples, and so do sides the new motion leans to that were left out, and the solve resumes
+    (at most :data:`ROUNDS` solves). Starting point: the quintic.
 
     Args:
         model: a fixed-base model (as many coordinates as rates); gravity and its force
@@ -450,30 +458,35 @@ def least_energy(
         start, goal: (n,) joint positions, within the position limits.
         duration: the move's time T [s] > 0.
         objective: ``"copper"`` or ``"rms_torque"``.
-        knots: interior knots of the correction's B-spline (unknowns per joint: ``knots + 2``
-            with ``end_acceleration="free"``, ``knots`` with ``"zero"``).
-        samples: samples of the cost and the limits (≥ 11).
+        knots: interior knots of the correction's B-spline, 0 to 200 (unknowns per joint:
+            ``knots + 2`` with ``end_acceleration="free"``, ``knots`` with ``"zero"``, which
+            needs one at least).
+        samples: samples of the cost and the limits (odd, ≥ 11: Simpson's rule).
         end_acceleration: ``"free"`` (the motion may start and end with a step in acceleration
             and torque) or ``"zero"`` (starts and ends with zero acceleration, as the quintic).
         max_velocity, max_torque: joint limits replacing the model's (> 0; inf: none).
         motors: enforce the motors' speed, peak torque and envelope limits.
         weights: (n,) positive weights of ``"rms_torque"``'s joints.
-        margin: the fraction of each limit kept free at the samples, in [0, 0.5).
-        check_factor: the check grid's refinement (≥ 2).
-        max_iterations, tol: SLSQP's iteration limit and tolerance (on the cost relative to
-            the quintic's).
+        margin: the fraction of each limit kept free at the samples, in [0, 0.49].
+        check_factor: the check grid's refinement (≥ 2; ``samples * check_factor`` at most
+            :data:`MAX_SAMPLES`).
+        max_iterations, tol: SLSQP's iteration limit (per solve) and tolerance (on the cost
+            relative to the quintic's).
 
     Returns:
         A :class:`Trajectory` on the ``samples`` grid from t = 0 with an exact ``evaluate``;
-        ``info``: ``method`` ``"least_energy"``, ``objective``, ``value`` (the cost: J for
-        copper, N² m² s for rms_torque), ``baseline`` (the quintic's, same duration and
-        samples), ``saving_percent`` (100 (1 − value / baseline)), ``per_joint`` (copper loss
-        [J] or RMS torque [N m] per joint), ``baseline_per_joint``, ``limit_usage`` ({limit:
-        {joint: the largest |x| / limit on the check grid, NaN where not limited}}; the limits
-        of :data:`LIMITS`), ``baseline_limit_usage`` (the quintic's: above 1 where the quintic
-        itself exceeds a limit), ``active_limits``
-        (a list of (limit, joint, t) where the usage at the samples reaches 1 − margin),
-        ``iterations``, ``converged``, ``message``, ``knots``, ``end_acceleration``.
+        ``info``: ``method`` ``"least_energy"``, ``objective``, ``value`` (the cost by Simpson's
+        rule on the check grid: J for copper, N² m² s for rms_torque), ``baseline`` (the
+        quintic's of the same duration, likewise), ``saving_percent`` (100 (1 − value /
+        baseline)), ``per_joint`` (copper loss [J] or RMS torque [N m] per joint),
+        ``baseline_per_joint``, ``limit_usage`` ({limit: {joint: the largest |x| / limit on
+        the check grid, NaN where not limited}}, the limits of :data:`LIMITS`),
+        ``baseline_limit_usage`` (the quintic's: above 1 where the quintic itself exceeds a
+        limit), ``active_limits`` (a list of (limit, joint, t) where the usage at the samples
+        reaches 1 − margin, t where it is largest), ``iterations`` (SLSQP's, all solves),
+        ``converged``, ``message``, ``unknowns``, ``end_acceleration``, ``duration``. A solve
+        that SLSQP stops unconverged (its iteration limit, a failed line search) with a motion
+        within the limits returns it with ``converged`` False and a RuntimeWarning.
 
     Raises:
         ModelError: a bad argument (named), a floating-base model, a joint without motor data
@@ -639,7 +652,7 @@ def _solve(
                 options={"maxiter": max_iterations, "ftol": tol},
             )
         p, iterations = back @ np.asarray(result.x, dtype=float), iterations + int(result.nit)
-        if result.status not in (0, 9):
+        if result.status not in (0, 9) and _worst(_usage(problem, p)).max() > 1.0:
             break
         left_out = _left_out(problem, p, mask, margin)
         used = problem.screen(p, SCREEN)
@@ -761,10 +774,10 @@ def _result(problem, p, result, iterations, fine, margin, end):
         "end_acceleration": end,
         "duration": problem.duration,
     }
-    if result.status == 9:
+    if result.status != 0:
         warnings.warn(
-            f"least_energy: SLSQP stopped at its iteration limit ({iterations} iterations); the "
-            "motion respects the limits but may not be the least-energy one",
+            f"least_energy: SLSQP stopped unconverged ({result.message}, {iterations} "
+            "iterations); the motion respects the limits but may not be the least-energy one",
             RuntimeWarning,
             stacklevel=3,
         )
@@ -773,21 +786,17 @@ def _result(problem, p, result, iterations, fine, margin, end):
 
 
 def _refuse(result, limit_usage, check, fine, problem, names) -> None:
-    """SolverError when the solve failed or a limit is exceeded on the check grid."""
+    """SolverError when a limit is exceeded on the check grid (naming the limit most exceeded,
+    its joint and the time)."""
     worst_name, worst_j, worst = None, 0, 0.0
     for k, v in limit_usage.items():
         if np.isfinite(v).any() and np.nanmax(v) > worst:
             worst_name, worst_j, worst = k, int(np.nanargmax(v)), float(np.nanmax(v))
-    if worst <= 1.0 and result.status in (0, 9):
+    if worst <= 1.0:
         return
-    where = ""
-    if worst_name is not None:
-        i = int(np.nanargmax(check[worst_name][:, worst_j]))
-        where = (
-            f"; the most used limit is {worst_name} of joint {names[worst_j]!r} at "
-            f"t = {fine[i] * problem.duration:.4g} s ({worst:.4g} x the limit)"
-        )
+    i = int(np.nanargmax(check[worst_name][:, worst_j]))
     raise _core.SolverError(
-        f"least_energy: no motion within the limits found in {problem.duration:g} s "
-        f"(SLSQP: {result.message}){where}"
+        f"least_energy: no motion within the limits found in {problem.duration:g} s (SLSQP: "
+        f"{result.message}); the most exceeded limit is {worst_name} of joint "
+        f"{names[worst_j]!r} at t = {fine[i] * problem.duration:.4g} s ({worst:.4g} x the limit)"
     )
