@@ -17,6 +17,8 @@ from armdyn.motion import energy as en
 from armdyn.sizing.motor import motor_envelope, speed_limit
 from scipy.integrate import quad
 
+from benchmarks.least_energy import PICK, PLACE
+
 # --- models ------------------------------------------------------------------------------------
 
 
@@ -31,47 +33,15 @@ def _disc(actuator=None, gravity=(0.0, 0.0, -9.81)):
     return b.finalize()
 
 
-#: the UR5's drivetrains from the example catalog: (motor, strain-wave gear) per joint
-UR5_DRIVES = {
-    "shoulder_pan_joint": ("FL-85x23", "SW-32-100"),
-    "shoulder_lift_joint": ("FL-85x23", "SW-32-100"),
-    "elbow_joint": ("FL-85x13", "SW-25-100"),
-    "wrist_1_joint": ("FL-50x14", "SW-14-100"),
-    "wrist_2_joint": ("FL-50x14", "SW-14-100"),
-    "wrist_3_joint": ("FL-50x14", "SW-14-100"),
-}
-PICK = np.array([0.7, -1.05, 1.85, -2.37, -1.57, 0.7])
-PLACE = np.array([-0.9, -1.05, 1.85, -2.37, -1.57, -0.9])
-
-
 def _ur5(friction=False):
-    """The UR5 (example-robot-data) with a 3 kg payload 5 cm beyond tool0 (as
-    tests/sizing/test_catalog.py) and an actuator on every joint: the example catalog's motor
-    (its rotor plus the gear's input inertia) behind its strain-wave gear's ratio and
-    efficiency; ``friction`` adds motor-side viscous and Coulomb friction."""
-    from benchmarks import common
+    """The UR5 with a 3 kg payload and the example catalog's drivetrains on every joint
+    (benchmarks.least_energy.ur5_actuated, the example's model)."""
+    from benchmarks.least_energy import ur5_actuated
 
-    path = common.robot_urdf("ur5")
-    if path is None:
+    model = ur5_actuated(friction=friction)
+    if model is None:
         pytest.skip("example-robot-data is not installed")
-    cat = ad.load_catalog(ad.sizing.EXAMPLE_CATALOG)
-    bare = ad.load_urdf(path)
-    at = (ad.frame_pose(bare, np.zeros(6), "tool0") @ [0.0, 0.0, 0.05, 1.0])[:3]
-    b = ad.urdf_builder(str(path))
-    b.add_body("payload", 3.0, [3.0 * 0.1**2 / 6] * 3, position=at)
-    b.add_fixed("payload_mount", bare.frame("tool0")["body"], "payload")
-    for joint, (motor, gear) in UR5_DRIVES.items():
-        m, g = cat.motors.loc[motor], cat.gearboxes.loc[gear]
-        b.add_actuator(
-            joint,
-            gear_ratio=float(g["ratio"]),
-            rotor_inertia=float(m["rotor_inertia"] + g["input_inertia"]),
-            efficiency=float(g["efficiency"]),
-            friction_viscous=2e-5 if friction else 0.0,
-            friction_coulomb=0.01 if friction else 0.0,
-            motor=cat.motor(motor),
-        )
-    return b.finalize()
+    return model
 
 
 @pytest.fixture(scope="module")
