@@ -351,6 +351,12 @@ BAD = [
     (dict(samples=100), "samples must be odd"),
     (dict(samples=10**12), "samples must be an integer in"),
     (dict(samples=20001, check_factor=100), "samples \\* check_factor = .* exceeds"),
+    (
+        dict(samples=9999, knots=200, check_factor=2),
+        r"samples \* joints \* unknowns = 9999 \* 1 \* 202 exceeds",
+    ),
+    (dict(duration=1e-200), "the quintic move's cost is not finite"),
+    (dict(goal=[1e300]), "the quintic move's cost is not finite"),
     (dict(end_acceleration="jerk"), "end_acceleration must be 'free' or 'zero'"),
     (dict(end_acceleration="zero", knots=0), "knots must be >= 1"),
     (dict(max_velocity=0.0), r"max_velocity\[0\] = 0 \(joint 'spin'\) must be > 0"),

@@ -46,10 +46,18 @@ LIMITS = ("position", "speed", "torque", "motor_peak_torque", "motor_envelope")
 #: the largest number of samples (and of check samples) a solve takes
 MAX_SAMPLES = 100_000
 
+#: the largest samples * joints * unknowns (the entries of dτ/dp a solve holds: 8 bytes each,
+#: and about ten times as many in the limits' Jacobian)
+MAX_ENTRIES = 2_000_000
+
 #: a solve takes the limits' sides used to at least this fraction (0: the side x has the sign of)
 SCREEN = 0.0
 #: ... and resumes with those it left out that the motion came to use, at most this many times
 ROUNDS = 8
+
+
+class _Diverged(Exception):
+    """The solve stepped to a non-finite motion."""
 
 
 class _Basis:
@@ -144,7 +152,8 @@ class _Problem:
     limit check adds), each with its derivative in the unknowns ``p`` ((n, K) flattened)."""
 
     def __init__(self, model, start, goal, duration, basis, drives, objective, weights, limits):
-        self.model, self.start, self.goal, self.duration = model, start, goal, duration
+        self.model, self.start, self.goal = model, start, goal
+        self.duration = np.float64(duration)  # T³ overflows to inf, not OverflowError
         self.basis, self.drives, self.objective = basis, drives, objective
         self.weights, self.limits = weights, limits
         self.n, self.k = len(start), basis.size
@@ -154,20 +163,24 @@ class _Problem:
         self.set_grid(np.linspace(0.0, 1.0, 2), np.zeros(2))
 
     def set_grid(self, u: np.ndarray, w: np.ndarray) -> None:
+        """Samples ``u`` (in t / T) and the cost's weights there: the quintic's motion and the
+        basis at them (non-finite where T² or T³ underflows: :meth:`state` refuses those)."""
         self.u, self.w = u, w
-        self.base = [
-            f(u)[:, None] * (self.goal - self.start) / self.duration**k
-            for k, f in enumerate(_QUINTIC)
-        ]
-        self.base[0] = self.base[0] + self.start
-        self.b = self.basis.at(u, self.duration)
+        with np.errstate(all="ignore"):
+            self.base = [
+                f(u)[:, None] * (self.goal - self.start) / self.duration**k
+                for k, f in enumerate(_QUINTIC)
+            ]
+            self.base[0] = self.base[0] + self.start
+            self.b = self.basis.at(u, self.duration)
         self._cache = None
 
     def motion(self, p: np.ndarray, u: np.ndarray | None = None):
         """(q, qd, qdd), each (rows, n), on the grid (or at ``u``)."""
         c = p.reshape(self.n, self.k)
         if u is None:
-            return tuple(base + b @ c.T for base, b in zip(self.base, self.b, strict=True))
+            with np.errstate(all="ignore"):
+                return tuple(base + b @ c.T for base, b in zip(self.base, self.b, strict=True))
         dq = self.goal - self.start
         b = self.basis.at(u, self.duration)
         return tuple(
@@ -184,6 +197,8 @@ class _Problem:
             if "dtau" in self._cache[1] or not derivatives:
                 return self._cache[1]
         q, qd, qdd = self.motion(p)
+        if not (np.all(np.isfinite(q)) and np.all(np.isfinite(qdd))):
+            raise _Diverged
         t = self.u * self.duration
         s = {"q": q, "qd": qd, "qdd": qdd, "t": t}
         s["tau"] = np.asarray(_core.inverse_dynamics(self.model, q, qd, qdd, t), dtype=float)
@@ -544,6 +559,13 @@ def _setup(model, start, goal, duration, **kw) -> tuple[_Problem, dict]:
     tol = _checks.number(who, "tol", tol, lo=0.0, lo_open=True, hi=1.0)
     if end == "zero" and knots == 0:
         raise _core.ModelError(f"{who}: knots must be >= 1 with end_acceleration='zero'")
+    unknowns = n * (knots + (2 if end == "free" else 0))
+    if samples * n * unknowns > MAX_ENTRIES:
+        raise _core.ModelError(
+            f"{who}: samples * joints * unknowns = {samples} * {n} * {unknowns} exceeds "
+            f"{MAX_ENTRIES:.0e} (the torque derivatives held per iteration): fewer samples or "
+            "knots"
+        )
     w = _weights(who, weights, n, model)
     drives = _drives(model, n)
     limits = _limits(who, model, n, drives, kw["max_velocity"], kw["max_torque"], motors)
@@ -620,13 +642,20 @@ def _solve(
     others are slack); after each solve, the sides the motion now uses that much join, and so
     do the check grid's instants over a limit, and the solve resumes while a side left out is
     exceeded (at most :data:`ROUNDS` solves)."""
-    from scipy.optimize import minimize
-
     u = np.linspace(0.0, 1.0, samples)
     w = _simpson(u, problem.duration)
     problem.set_grid(u, w)
     p = np.zeros(problem.n * problem.k)
-    baseline = problem.value(p)
+    try:
+        with np.errstate(all="ignore"):
+            baseline = problem.value(p)
+    except _Diverged:
+        baseline = np.inf
+    if not np.isfinite(baseline):
+        raise _core.ModelError(
+            f"least_energy: the quintic move's cost is not finite (duration = "
+            f"{problem.duration:g} s too short for the distance, or coordinates too large)"
+        )
     problem.scale = baseline if baseline > 0.0 else 1.0
     fine = np.linspace(0.0, 1.0, (samples - 1) * check_factor + 1)
     grid, iterations, result = u, 0, None
@@ -643,7 +672,7 @@ def _solve(
         problem.mask = mask
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
-            result = minimize(
+            result = _minimize(
                 lambda z: problem.value(back @ z),
                 np.linalg.solve(back, p),
                 jac=lambda z: back.T @ problem.gradient(back @ z),
@@ -685,6 +714,19 @@ def _preconditioner(problem: _Problem, p: np.ndarray) -> np.ndarray:
     hessian += np.eye(len(p)) * 1e-9 * max(float(np.max(np.diag(hessian))), 1e-300)
     lower = np.linalg.cholesky(hessian)
     return np.linalg.inv(lower).T
+
+
+def _minimize(*args, **kw):
+    """scipy's minimize, a step to a non-finite motion a SolverError."""
+    from scipy.optimize import minimize
+
+    try:
+        return minimize(*args, **kw)
+    except _Diverged:
+        raise _core.SolverError(
+            "least_energy: the solve diverged (a step to a non-finite motion); try more "
+            "samples, fewer knots or a longer duration"
+        ) from None
 
 
 def _left_out(problem: _Problem, p: np.ndarray, mask: dict, margin: float) -> bool:
@@ -744,7 +786,7 @@ def _result(problem, p, result, iterations, fine, margin, end):
     check = _usage(problem, p, fine)
     limit_usage = _largest(check)
     baseline_usage = _largest(_usage(problem, np.zeros_like(p), fine))
-    _refuse(result, limit_usage, check, fine, problem, names)
+    _refuse(result, p, limit_usage, check, fine, problem, names)
     s = problem.state(p, derivatives=False)
     coefficients = p.copy()
 
@@ -772,7 +814,7 @@ def _result(problem, p, result, iterations, fine, margin, end):
         "message": str(result.message),
         "unknowns": int(p.size),
         "end_acceleration": end,
-        "duration": problem.duration,
+        "duration": float(problem.duration),
     }
     if result.status != 0:
         warnings.warn(
@@ -785,7 +827,7 @@ def _result(problem, p, result, iterations, fine, margin, end):
     return Trajectory(t, s["q"], s["qd"], s["qdd"], names=names, info=info, evaluate=evaluate)
 
 
-def _refuse(result, limit_usage, check, fine, problem, names) -> None:
+def _refuse(result, p, limit_usage, check, fine, problem, names) -> None:
     """SolverError when a limit is exceeded on the check grid (naming the limit most exceeded,
     its joint and the time)."""
     worst_name, worst_j, worst = None, 0, 0.0
