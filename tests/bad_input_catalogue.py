@@ -1170,7 +1170,96 @@ CASES = [
         SE,
         "most exceeded limit is torque of joint 'hinge'",
     ),
+    # ---- motion: joint trajectories
+    (
+        "p2p-start-nan",
+        "motion",
+        "point-to-point move from a NaN joint position",
+        lambda: _motion().point_to_point([0.0, np.nan], [1.0, 1.0], **_LIMITS),
+        ME,
+        r"point_to_point: start\[1\] = .*nan.* is not finite",
+    ),
+    (
+        "p2p-velocity-limit-zero",
+        "motion",
+        "a zero velocity limit",
+        lambda: _motion().point_to_point(0.0, 1.0, **{**_LIMITS, "max_velocity": 0.0}),
+        ME,
+        r"max_velocity\[0\] = 0\.0 must be positive",
+    ),
+    (
+        "p2p-limit-shape",
+        "motion",
+        "three velocity limits for two joints",
+        lambda: _motion().point_to_point([0, 0], [1, 1], **{**_LIMITS, "max_velocity": [1, 2, 3]}),
+        ME,
+        r"max_velocity must be a scalar or have shape \(2,\)",
+    ),
+    (
+        "p2p-jerk-missing",
+        "motion",
+        "a jerk-limited profile without a jerk limit",
+        lambda: _motion().point_to_point(0.0, 1.0, max_velocity=1.0, max_acceleration=1.0),
+        ME,
+        "profile='double_s' needs max_jerk",
+    ),
+    (
+        "p2p-too-many-samples",
+        "motion",
+        "a 10 000 s move sampled every microsecond",
+        lambda: _motion().point_to_point(0.0, 1e4, **_LIMITS, dt=1e-6),
+        ME,
+        r"dt = 1e-06 s over .* samples \(> 10000000\)",
+    ),
+    (
+        "p2p-scales",
+        "motion",
+        "a move of 1e300 rad at 1 rad/s (ruckig finds no profile)",
+        lambda: _motion().point_to_point(0.0, 1e300, **_LIMITS),
+        SE,
+        r"segment 0 \(waypoint 0 to 1\) of joint 0",
+    ),
+    (
+        "via-one-waypoint",
+        "motion",
+        "a move through a single waypoint",
+        lambda: _motion().through_waypoints([[0.0, 1.0]], **_LIMITS),
+        ME,
+        "waypoints must hold at least two points, got 1",
+    ),
+    (
+        "spline-times-repeat",
+        "motion",
+        "a spline whose times repeat",
+        lambda: _motion().spline([0.0, 1.0, 1.0], [0.0, 1.0, 2.0]),
+        ME,
+        r"times must be strictly increasing \(times\[2\]",
+    ),
+    (
+        "spline-over-limit",
+        "motion",
+        "a spline too fast for its velocity limit",
+        lambda: _motion().spline([0.0, 0.5], [[0.0, 0.0], [0.1, 2.0]], max_velocity=[1.0, 3.0]),
+        SE,
+        r"joint 1 reaches velocity 7\.5 at t = 0\.25 s",
+    ),
+    (
+        "path-repeated-waypoint",
+        "motion",
+        "a waypoint path through the same point twice in a row",
+        lambda: _motion().waypoint_path([[0.0, 1.0], [0.0, 1.0], [1.0, 1.0]]),
+        ME,
+        r"waypoints\[0\] and waypoints\[1\] are equal",
+    ),
 ]
+
+_LIMITS = {"max_velocity": 1.0, "max_acceleration": 2.0, "max_jerk": 10.0}
+
+
+def _motion():
+    import armdyn.motion
+
+    return armdyn.motion
 
 
 def _least_energy(**change):

@@ -7,6 +7,22 @@ take) or a :class:`Path` (geometric, timed by :func:`time_optimal`).
 """
 
 from armdyn.motion.energy import least_energy
+from armdyn.motion.profiles import (
+    drive_profile,
+    point_to_point,
+    spline,
+    through_waypoints,
+    waypoint_path,
+)
 from armdyn.motion.trajectory import Path, Trajectory
 
-__all__ = ["Path", "Trajectory", "least_energy"]
+__all__ = [
+    "Path",
+    "Trajectory",
+    "drive_profile",
+    "least_energy",
+    "point_to_point",
+    "spline",
+    "through_waypoints",
+    "waypoint_path",
+]

@@ -68,6 +68,9 @@ class Trajectory:
         info: dict[str, Any] | None = None,
         evaluate: Evaluator | None = None,
     ) -> None:
+        """The samples (checked: finite, t strictly increasing, matching rows; copied as
+        float arrays), optional joint names (one per column of qd), planner info and exact
+        evaluator ``evaluate(t) -> (q, qd, qdd)``."""
         who = "Trajectory"
         self.t = _increasing(who, "t", t)
         n = len(self.t)
@@ -200,6 +203,8 @@ class Path:
         names: tuple[str, ...] | list[str] | None = None,
         info: dict[str, Any] | None = None,
     ) -> None:
+        """Knots ``s`` (strictly increasing from 0 to 1) and configurations ``q`` (one row per
+        knot), with the planner's exact ``evaluate(s) -> (q, dq/ds, d2q/ds2)`` when it has one."""
         who = "Path"
         self.s = _increasing(who, "s", s)
         if len(self.s) < 2 or self.s[0] != 0.0 or self.s[-1] != 1.0:
@@ -224,6 +229,7 @@ class Path:
 
     @property
     def n_joints(self) -> int:
+        """The number of joint coordinates (columns of ``q``)."""
         return self.q.shape[1]
 
     def evaluate(self, s: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
