@@ -148,7 +148,10 @@ def test_the_result_is_a_rest_to_rest_trajectory_with_an_exact_evaluator(ur5, pi
     h = 1e-6
     qp, qm = traj.sample(t + h).q, traj.sample(t - h).q
     np.testing.assert_allclose((qp - qm) / (2 * h), traj.sample(t).qd, atol=1e-7)
-    # what the sizing takes
+    # what the sizing takes: a run, and a duty cycle (it ends at rest: q̇ = 0, with the free
+    # end acceleration's step in torque when the hold begins)
+    cycle = ad.duty_cycle(ur5, tuple(traj), dwell=0.5)
+    assert cycle.dwell == 0.5
     run = ad.trajectory_run(ur5, traj)
     np.testing.assert_allclose(
         run.joint_torques, ad.inverse_dynamics(ur5, *_motion(traj)), atol=1e-9
