@@ -465,8 +465,12 @@ def least_energy(
     motion leans to (|x| ≤ L as x ≤ L where x ≥ 0, −x ≤ L where x ≤ 0: the other side is
     slack). After a solve the motion is checked against the full limits on a grid
     ``check_factor`` times finer: the instants found beyond a limit join the constrained
-    samples, and so do sides the new motion leans to that were left out, and the solve resumes
-    (at most :data:`ROUNDS` solves). Starting point: the quintic.
+    samples, and so do sides the new motion leans to that were left out (used to at least
+    :data:`SCREEN` of their limit), and the solve resumes (at most :data:`ROUNDS` solves).
+    Starting point: the quintic. The problem is not convex (gravity, the gear's two branches):
+    the result is the local optimum SLSQP reaches from the quintic (``info["saving_percent"]``
+    compares it with the quintic). Models with force elements need their
+    derivatives (``armdyn.inverse_dynamics_derivatives`` raises ModelError where it has none).
 
     Args:
         model: a fixed-base model (as many coordinates as rates); gravity and its force
