@@ -1138,6 +1138,38 @@ CASES = [
         ME,
         "hinge",
     ),
+    (
+        "least-energy-duration-nan",
+        "motion",
+        "least_energy with a NaN duration",
+        lambda: _least_energy(duration=np.nan),
+        ME,
+        "least_energy: duration must be a positive number",
+    ),
+    (
+        "least-energy-start-shape",
+        "motion",
+        "least_energy from a start of two coordinates on a one-joint model",
+        lambda: _least_energy(start=[0.0, 0.0]),
+        ME,
+        r"least_energy: start must have shape \(1,\)",
+    ),
+    (
+        "least-energy-copper-no-motor",
+        "motion",
+        "least_energy's copper loss on a joint without a motor's torque constant and resistance",
+        lambda: _least_energy(objective="copper"),
+        ME,
+        "joint 'hinge' has none",
+    ),
+    (
+        "least-energy-infeasible",
+        "motion",
+        "least_energy in less time than any motion within the torque limit takes",
+        lambda: _least_energy(duration=0.2, max_torque=0.5),
+        SE,
+        "most exceeded limit is torque of joint 'hinge'",
+    ),
     # ---- motion: joint trajectories
     (
         "p2p-start-nan",
@@ -1389,6 +1421,11 @@ def _tip_pose(x=1.2, y=0.5, scale=1.0):
     t[:3, :3] *= scale
     t[:2, 3] = (x, y)
     return t
+def _least_energy(**change):
+    from armdyn.motion import least_energy
+    args = dict(start=[0.0], goal=[1.0], duration=1.0, objective="rms_torque")
+    args.update(change)
+    return least_energy(_pendulum(), **args)
 
 
 def _cli():

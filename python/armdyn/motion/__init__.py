@@ -7,6 +7,7 @@ take) or a :class:`Path` (geometric, timed by :func:`time_optimal`).
 """
 
 from armdyn.motion.cartesian import CartesianPath, arc_move, linear_move
+from armdyn.motion.energy import least_energy
 from armdyn.motion.ik import IKResult, inverse_kinematics, manipulability
 from armdyn.motion.profiles import (
     drive_profile,
@@ -26,6 +27,7 @@ __all__ = [
     "arc_move",
     "drive_profile",
     "inverse_kinematics",
+    "least_energy",
     "linear_move",
     "manipulability",
     "point_to_point",
