@@ -52,9 +52,11 @@ def _add_elements(b, kinds, floating):
         b.add_gear_pair("g", "j0", "j5", 0.3, 0.2, 0.05, 800.0, 1.5, 0.4)
 
 
-def branched_tree(kinds=(), floating=False, seed=7):
+def branched_tree(kinds=(), floating=False, seed=7, coupled=False):
     """A branched tree of every joint-space joint type (random points, axes, full inertias) on
-    ground or on a floating base, with the force elements `kinds` (a subset of ELEMENTS)."""
+    ground or on a floating base, with the force elements `kinds` (a subset of ELEMENTS).
+    coupled: j5 follows j0 (a coupling) and j4 and j2 carry actuators (their rotors' couplings;
+    with "coordinate" in kinds, their motor-side friction on the rotors' coordinates)."""
     rng = np.random.default_rng(seed)
     b = ad.ModelBuilder(gravity=(0.0, 0.0, -G))
     names = ["base"] if floating else []
@@ -87,6 +89,13 @@ def branched_tree(kinds=(), floating=False, seed=7):
             b.add_fixed(name, parent, child, point)
         else:
             getattr(b, f"add_{kind}")(name, parent, child, point, random_unit(rng))
+    if coupled:
+        b.add_coupling("c", "j5", "j0", 0.5, 0.1)
+        fric = 1.0 if "coordinate" in kinds else 0.0
+        b.add_actuator("j4", 30.0, 2e-4, friction_viscous=1e-3 * fric, gyroscopic=True)
+        b.add_actuator(
+            "j2", 200.0, 1e-5, friction_viscous=2e-5 * fric, friction_coulomb=0.01 * fric
+        )
     _add_elements(b, kinds, floating)
     return b.finalize()
 
@@ -202,6 +211,21 @@ def test_all_elements_together_on_a_floating_base(rng):
     for _ in range(2):
         q, qd = _random_state(full, rng, True)
         _check(bare, full, q, qd, 0.7)
+
+
+@pytest.mark.parametrize("floating", [False, True], ids=["fixed", "floating"])
+def test_coupled_actuated_model_in_independent_coordinates(floating, rng):
+    """A coupling (j5 follows j0) and two actuators (rotor bodies on follower coordinates, their
+    motor-side friction there): the derivatives in the independent coordinates inverse_dynamics
+    takes, G^T dF G, every element acting, some on followers (j5's spring, motor and gear pair
+    with j0, the rotors' friction, the spring to b5)."""
+    kinds = ("loads", "springs", "coordinate")
+    bare = branched_tree(floating=floating, coupled=True)
+    full = branched_tree(kinds, floating=floating, coupled=True)
+    assert full.n_dofs == (11 if floating else 5)
+    for _ in range(2):
+        q, qd = _random_state(full, rng, floating)
+        _check(bare, full, q, qd, 0.3)
 
 
 def test_gear_pair_both_mesh_directions(rng):
@@ -333,3 +357,38 @@ def test_bad_input():
         f(full, q, qd, np.inf)
     with pytest.raises(ad.ModelError, match=r"model must be an armdyn\.Model"):
         f(None, q, qd)
+
+
+def test_failing_elements_are_named():
+    """A load's profile that fails or is not finite, a motor's reference that fails, a
+    spring-damper of zero length: SolverError naming the element, as inverse_dynamics."""
+
+    def build(element):
+        b = ad.ModelBuilder(gravity=(0.0, 0.0, -G))
+        b.add_body("slider", 1.0, np.diag([0.01, 0.02, 0.02]))
+        b.add_prismatic("j", "ground", "slider", (0.0, 0.0, 0.0), (1.0, 0.0, 0.0))
+        element(b)
+        return b.finalize()
+
+    def fails(t):
+        raise ValueError("no value")
+
+    cases = [
+        (lambda b: b.add_body_force("slider", (1.0, 0, 0), profile=fails), "load on body 'slider'"),
+        (
+            lambda b: b.add_body_force("slider", (1.0, 0, 0), profile=lambda t: (np.nan, 0, 0)),
+            "load on body 'slider'",
+        ),
+        (lambda b: b.add_motor("j", fails, kp=1.0, kd=0.1), "joint coordinate 'j'"),
+        (
+            lambda b: b.add_spring_damper("s", "ground", (1.0, 0, 0), "slider", (0, 0, 0), 5.0),
+            "spring-damper 's'",
+        ),
+    ]
+    q, qd = np.array([1.0]), np.array([0.2])
+    for element, name in cases:
+        model = build(element)
+        with pytest.raises(ad.SolverError, match=name):
+            ad.inverse_dynamics(model, q, qd, [0.0])
+        with pytest.raises(ad.SolverError, match=name):
+            _core._force_element_derivatives(model, q, qd)
