@@ -392,3 +392,32 @@ def test_failing_elements_are_named():
             ad.inverse_dynamics(model, q, qd, [0.0])
         with pytest.raises(ad.SolverError, match=name):
             _core._force_element_derivatives(model, q, qd)
+
+
+@pytest.mark.parametrize(
+    "rel, fixed_base",
+    [("panda_description/urdf/panda.urdf", True), ("solo_description/robots/solo12.urdf", False)],
+    ids=["panda", "solo12"],
+)
+def test_urdf_joint_friction(rel, fixed_base, rng):
+    """The URDF's <dynamics damping friction> (joint friction) on the Panda (its mimicking
+    fingers: a coupled model) and on a floating solo12 (given damping and friction here: its
+    file has zeros); the bare model is the same file without its <dynamics> tags."""
+    import re
+
+    from benchmarks import common
+
+    ur5 = common.robot_urdf("ur5")
+    assert ur5 is not None, "example-robot-data is part of the test extra"
+    robots = next(p for p in ur5.parents if p.name == "robots")
+    xml = (robots / rel).read_text()
+    xml = xml.replace('damping="0.0" friction="0.0"', 'damping="0.05" friction="0.2"')
+    bare = ad.load_urdf(re.sub(r"<dynamics[^>]*/>", "", xml), fixed_base=fixed_base)
+    full = ad.load_urdf(xml, fixed_base=fixed_base)
+    assert full.n_dofs == bare.n_dofs == (8 if fixed_base else 18)
+    vs = _core.URDF_COULOMB_SMOOTHING
+    for _ in range(2):
+        q, qd = _random_state(full, rng, not fixed_base)
+        qd[rng.uniform(size=qd.size) < 0.3] = 0.2 * vs  # inside the Coulomb smoothing too
+        dq, dqd = _check(bare, full, q, qd, 0.0, h=1e-3 * vs)
+        assert not dq.any() and np.abs(np.diag(dqd)[6 if not fixed_base else 0 :]).min() > 0
