@@ -40,6 +40,8 @@ def _add_elements(b, kinds, floating):
         b.add_spring_damper("s2", "ground", (1.0, -1.0, 0.5), "b5", (0.2, 0.3, -0.4), 50.0, 2.0)
         b.add_spring_damper("s3", "b0", (0.1, -0.4, 0.0), "b2", (0.5, 0.1, 0.6), 120.0, 0.0, 0.2)
         b.add_spring_damper("s4", base, (-0.5, 0.3, 0.9), "b1", (0.0, 0.0, 0.0), 30.0, 5.0, 1.5)
+        # b3 hangs on b1 by a fixed joint: the chains meet at a joint without coordinates
+        b.add_spring_damper("s5", "b3", (0.3, -0.2, 0.1), "b4", (0.6, 0.4, -0.3), 70.0, 4.0, 0.1)
     if "coordinate" in kinds:
         b.add_joint_spring_damper("j0", stiffness=30.0, damping=2.0, rest=0.3)
         b.add_joint_spring_damper("j1", stiffness=50.0, damping=1.0, rest=-0.1, coord=1)

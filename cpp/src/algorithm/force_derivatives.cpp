@@ -110,13 +110,16 @@ bool on_chain(const Model& m, const Data& d, int body, int joint) {
   return false;
 }
 
-// the lowest joint on the chains of both bodies a and b (-1: none)
+// the lowest joint with degrees of freedom on the chains of both bodies a and b (-1: none);
+// every joint above it is on both (a fixed joint where the chains meet is passed over: for_union
+// marks the common part at a degree of freedom)
 int common_joint(const Model& m, const Data& d, int a, int b) {
   for (int c = b; c != kGround;) {
     const int ji = d.joint_of_body[c];
     if (ji < 0) return -1;
-    if (on_chain(m, d, a, ji)) return ji;
-    c = m.joints[ji].parent;
+    const Joint& j = m.joints[ji];
+    if (j.dof0 >= 0 && joint_dofs(j.type) > 0 && on_chain(m, d, a, ji)) return ji;
+    c = j.parent;
   }
   return -1;
 }
