@@ -309,7 +309,7 @@ def test_backlash_edge_one_sided_choice():
 
 def test_hunt_crossley_clamp():
     """Separating fast, 1 + alpha d' < 0: the force is clamped at zero, and so are its slopes;
-    just inside the contact law, its slopes."""
+    just inside the contact law, its slopes; at the clamp's start, the contact law's."""
 
     def build(with_pair):
         b = ad.ModelBuilder(gravity=(0.0, 0.0, 0.0))
@@ -326,6 +326,14 @@ def test_hunt_crossley_clamp():
         qd = np.array([sd / 0.5, 0.0])
         dq, dqd = _check(bare, full, q, qd, 0.0)
         assert (not dq.any() and not dqd.any()) == clamped
+    # where the clamp starts, 1 + alpha s' = 1 + 2 (0.5 * -1) = 0 exactly: the contact law's
+    # slopes (the one-sided difference towards contact), not the clamped side's zero
+    qd = np.array([-1.0, 0.0])
+    dq, dqd = _core._force_element_derivatives(full, q, qd)
+    _, fqd = finite_differences(bare, full, q, qd, 0.0, h=1e-7, side=+1)
+    _, bqd = finite_differences(bare, full, q, qd, 0.0, h=1e-7, side=-1)
+    assert not dq.any() and dqd[0, 0] < 0 and not bqd.any()
+    assert rel_err(dqd, fqd) <= 1e-6
 
 
 def test_coulomb_at_rest_is_smooth():
