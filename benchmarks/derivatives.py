@@ -317,7 +317,7 @@ def main(argv=None) -> None:
     common.write_json(
         common.RESULTS / "derivatives.json",
         {
-            "command": "python -m benchmarks.derivatives " + " ".join(sys.argv[1:]),
+            "command": " ".join(["python -m benchmarks.derivatives", *sys.argv[1:]]),
             "machine": common.machine(),
             "targets": {
                 "python_ratio_to_pinocchio": TARGET_PYTHON,
