@@ -1011,7 +1011,7 @@ CASES = [
         "inverse_dynamics_derivatives with qdd = 1e308 on a two-link arm (finite; overflows)",
         lambda: ad.inverse_dynamics_derivatives(_two_links(), [0.0, 0.5], [0.0, 0.0], [1e308] * 2),
         SE,
-        r"overflow",
+        r"overflow.*qdd\[0\]",
     ),
     (
         "fdd-tau-nan",
@@ -1076,8 +1076,8 @@ CASES = [
     (
         "fdd-overflow",
         "derivatives",
-        "forward_dynamics_derivatives with tau = 1.7e308 (finite; the accelerations overflow)",
-        lambda: ad.forward_dynamics_derivatives(_pendulum(), [0.0], [0.0], [1.7e308]),
+        "forward_dynamics_derivatives with tau = 1.7e308 on a two-link arm (finite; overflows)",
+        lambda: ad.forward_dynamics_derivatives(_two_links(), [0.0, 0.5], [0.0, 0.0], [1.7e308, 0]),
         SE,
         r"overflow.*tau\[0\]",
     ),

