@@ -6,13 +6,13 @@ Per robot (example-robot-data: the UR5 and the Panda on a fixed base, solo12 on 
 
 * From Python, one state per call: ``armdyn.inverse_dynamics_derivatives`` against
   ``pin.computeRNEADerivatives`` and ``armdyn.forward_dynamics_derivatives`` against
-  ``pin.computeABADerivatives``, timed in interleaved rounds (``common.interleaved_times``), the
-  ratio taken round by round (target: ≤ 1.0).
+  ``pin.computeABADerivatives``, timed in interleaved rounds on the process's CPU clock
+  (:func:`interleaved_cpu_times`), the ratio taken round by round (target: ≤ 1.0).
 * "From C++": the per-row time of the 2-D batch call of each derivative function (``--rows``
   states in one call, the loop in C++) over the per-row time of the 2-D batch
-  ``armdyn.inverse_dynamics`` call on the same states (target: ≤ 4 for
-  ``inverse_dynamics_derivatives``; ``forward_dynamics_derivatives`` is also given against the
-  batch ``forward_dynamics``).
+  ``armdyn.inverse_dynamics`` call on the same states (the issue's target: ≤ 4; read here for
+  both functions, ``meets_targets``); ``forward_dynamics_derivatives`` is also given against the
+  batch ``forward_dynamics``.
 * The answers against Pinocchio's in the same run (worst relative error over the batch's first
   states; the tests assert them: ``tests/algorithm/test_derivatives_pinocchio.py``).
 
@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import time
 
 import armdyn as ad
 import numpy as np
@@ -175,6 +176,25 @@ class DerivativePair:
         return self.matrix(dq), self.matrix(dv + minv @ dtau_f), self.matrix(minv)
 
 
+def interleaved_cpu_times(fns: dict, number: int, repeat: int) -> dict:
+    """``common.interleaved_times`` on the process's CPU clock: on the shared 2-core machine
+    (load averages of 10 are common) the wall clock counts the time other processes hold the
+    core, the CPU clock does not. The batch calls run on one thread, so their CPU time is their
+    running time."""
+    for fn in fns.values():
+        fn()
+    rounds = {name: [] for name in fns}
+    for _ in range(repeat):
+        for name, fn in fns.items():
+            t0 = time.process_time()
+            for _ in range(number):
+                fn()
+            rounds[name].append((time.process_time() - t0) / number)
+    out = {name: float(np.median(t)) for name, t in rounds.items()}
+    out["rounds"] = rounds
+    return out
+
+
 def rel_error(obs, ref) -> float:
     """Largest deviation relative to the reference's largest entry."""
     obs, ref = np.asarray(obs), np.asarray(ref)
@@ -187,7 +207,7 @@ def python_timings(pair: DerivativePair, number: int, repeat: int) -> dict:
     pin, pm, pd, am = pair.pin, pair.pm, pair.pd, pair.am
     q, qd, x = pair.random_state(np.random.default_rng(1))
     qp, vp, xp = pair.q_pin(q), pair.v_pin(qd), pair.v_pin(x)
-    t = common.interleaved_times(
+    t = interleaved_cpu_times(
         {
             "pin_rnea_derivatives": lambda: pin.computeRNEADerivatives(pm, pd, qp, vp, xp),
             "armdyn_inverse_dynamics_derivatives": lambda: ad.inverse_dynamics_derivatives(
@@ -224,7 +244,7 @@ def batch_timings(pair: DerivativePair, rows: int, number: int, repeat: int) -> 
     and the batch answers' worst relative error against Pinocchio on the first states."""
     am = pair.am
     q, qd, x = pair.random_state(np.random.default_rng(2), rows)
-    t = common.interleaved_times(
+    t = interleaved_cpu_times(
         {
             "inverse_dynamics": lambda: ad.inverse_dynamics(am, q, qd, x),
             "inverse_dynamics_derivatives": lambda: ad.inverse_dynamics_derivatives(am, q, qd, x),
