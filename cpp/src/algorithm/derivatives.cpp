@@ -175,7 +175,8 @@ void backward_pass(const Model& m, Data& d) {
       const Vec6& S = w.S[c];
       w.YS[c] = inertia_times(Y, S);
       w.BS[c] = variation_transpose_times(B, L, S);
-      w.dFq[c] = inertia_times(Y, w.w[c]) + variation_times(B, L, w.u[c]);
+      w.dFq[c] = inertia_times(Y, w.w[c]);
+      if (j.parent != kGround) w.dFq[c] += variation_times(B, L, w.u[c]);  // (u = 0 on ground)
       w.dFqx[c] = w.dFq[c] + fcross(S, w.Fc[b]);
       w.dFv[c] = inertia_times(Y, w.av[c]) + variation_times(B, L, S);
     }
