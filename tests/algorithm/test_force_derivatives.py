@@ -40,6 +40,8 @@ def _add_elements(b, kinds, floating):
         b.add_spring_damper("s2", "ground", (1.0, -1.0, 0.5), "b5", (0.2, 0.3, -0.4), 50.0, 2.0)
         b.add_spring_damper("s3", "b0", (0.1, -0.4, 0.0), "b2", (0.5, 0.1, 0.6), 120.0, 0.0, 0.2)
         b.add_spring_damper("s4", base, (-0.5, 0.3, 0.9), "b1", (0.0, 0.0, 0.0), 30.0, 5.0, 1.5)
+        # b3 hangs on b1 by a fixed joint: the chains meet at a joint without coordinates
+        b.add_spring_damper("s5", "b3", (0.3, -0.2, 0.1), "b4", (0.6, 0.4, -0.3), 70.0, 4.0, 0.1)
     if "coordinate" in kinds:
         b.add_joint_spring_damper("j0", stiffness=30.0, damping=2.0, rest=0.3)
         b.add_joint_spring_damper("j1", stiffness=50.0, damping=1.0, rest=-0.1, coord=1)
@@ -392,3 +394,75 @@ def test_failing_elements_are_named():
             ad.inverse_dynamics(model, q, qd, [0.0])
         with pytest.raises(ad.SolverError, match=name):
             _core._force_element_derivatives(model, q, qd)
+
+
+@pytest.mark.parametrize(
+    "rel, fixed_base",
+    [("panda_description/urdf/panda.urdf", True), ("solo_description/robots/solo12.urdf", False)],
+    ids=["panda", "solo12"],
+)
+def test_urdf_joint_friction(rel, fixed_base, rng):
+    """The URDF's <dynamics damping friction> (joint friction) on the Panda (its mimicking
+    fingers: a coupled model) and on a floating solo12 (given damping and friction here: its
+    file has zeros); the bare model is the same file without its <dynamics> tags."""
+    import re
+
+    from benchmarks import common
+
+    ur5 = common.robot_urdf("ur5")
+    assert ur5 is not None, "example-robot-data is part of the test extra"
+    robots = next(p for p in ur5.parents if p.name == "robots")
+    xml = (robots / rel).read_text()
+    xml = xml.replace('damping="0.0" friction="0.0"', 'damping="0.05" friction="0.2"')
+    bare = ad.load_urdf(re.sub(r"<dynamics[^>]*/>", "", xml), fixed_base=fixed_base)
+    full = ad.load_urdf(xml, fixed_base=fixed_base)
+    assert full.n_dofs == bare.n_dofs == (8 if fixed_base else 18)
+    vs = _core.URDF_COULOMB_SMOOTHING
+    for _ in range(2):
+        q, qd = _random_state(full, rng, not fixed_base)
+        qd[rng.uniform(size=qd.size) < 0.3] = 0.2 * vs  # inside the Coulomb smoothing too
+        dq, dqd = _check(bare, full, q, qd, 0.0, h=1e-3 * vs)
+        assert not dq.any() and np.abs(np.diag(dqd)[6 if not fixed_base else 0 :]).min() > 0
+
+
+def random_tree(seed, floating, with_elements):
+    """A random tree (each body on a random earlier one or the root, random joint types,
+    fixed joints included) with loads and spring-dampers between random bodies (ground too)."""
+    rng = np.random.default_rng(seed)
+    b = ad.ModelBuilder(gravity=(0.0, 0.0, -G))
+    names = [f"r{i}" for i in range(7)]
+    for n in names:
+        m = rng.uniform(0.5, 2.0)
+        b.add_body(n, m, random_inertia(rng, m), rng.normal(scale=0.6, size=3), random_quat(rng))
+    if floating:
+        b.add_free("free", "r0")
+    else:
+        b.add_revolute("j0", "ground", "r0", rng.normal(scale=0.3, size=3), random_unit(rng))
+    for i in range(1, len(names)):
+        parent = names[rng.integers(0, i)]
+        kind = ("revolute", "prismatic", "cylindrical", "fixed")[rng.integers(0, 4)]
+        point = rng.normal(scale=0.5, size=3)
+        if kind == "fixed":
+            b.add_fixed(f"j{i}", parent, names[i], point)
+        else:
+            getattr(b, f"add_{kind}")(f"j{i}", parent, names[i], point, random_unit(rng))
+    # the elements' random draws happen either way: the two models share their tree
+    loads = [(names[rng.integers(0, 7)], rng.normal(size=(3, 3))) for _ in range(3)]
+    pairs = [rng.choice(["ground", *names], size=2, replace=False) for _ in range(4)]
+    ends = rng.normal(scale=0.5, size=(4, 2, 3))
+    if with_elements:
+        for body, (f, tau, p) in loads:
+            b.add_body_force(body, f, tau, p, SINE)
+        for i, ((a, c), (pa, pc)) in enumerate(zip(pairs, ends, strict=True)):
+            b.add_spring_damper(f"s{i}", a, pa, c, pc, 60.0, 2.0, 0.3)
+    return b.finalize()
+
+
+@pytest.mark.parametrize("floating", [False, True], ids=["fixed", "floating"])
+def test_random_trees(floating, rng):
+    """Loads and spring-dampers on random tree shapes (chains meeting anywhere, at fixed
+    joints too, or only at ground)."""
+    for seed in range(6):
+        bare, full = random_tree(seed, floating, False), random_tree(seed, floating, True)
+        q, qd = _random_state(full, rng, floating)
+        _check(bare, full, q, qd, 0.4)

@@ -60,6 +60,16 @@ class Data {
   // --- forces (body_forces, coordinate_forces, cartesian_forces) ---
   VecX eta;        ///< (nv) applied and gyroscopic forces on the bodies
   VecX coord_tau;  ///< (nco) joint-coordinate forces and gear contact forces (coordinate_forces)
+  /// add_force_element_derivatives (algorithm/force_derivatives.hpp), sized by its first call:
+  /// per degree of freedom its world twist (angular; velocity of the origin); per entry of a
+  /// body's chain or of a spring-damper's two chains: the degree of freedom, its joint's level
+  /// (1 at the body), and the terms of algorithm/force_derivatives.cpp (dd, fa, tc, g, dT)
+  struct ForceDerivScratch {
+    std::vector<Vec6> twist;
+    std::vector<int> dofs, level;
+    std::vector<Vec3> dd, fa, tc;
+    VecX g, dT;
+  } force_deriv;
   // --- recursive Newton-Euler (rnea) ---
   RneWork rne;
   VecX tau;  ///< (n) the last rnea's joint torques/forces

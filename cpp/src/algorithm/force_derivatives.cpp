@@ -42,13 +42,14 @@ Twist cross(const Twist& a, const Twist& b) {
 
 Twist body_twist(const BodyKin& k) { return {k.W, k.xd - k.W.cross(k.x)}; }
 
-// the twist of degree of freedom `sub` of joint ji (data.rne's joint frames at q)
-Twist dof_twist(const Model& m, const Data& d, int ji, int sub) {
+// the twist of degree of freedom `sub` of joint ji (data.rne's joint frames at q; B: a free
+// joint's frame)
+Twist dof_twist(const Model& m, const Data& d, int ji, int sub, const Mat3& B) {
   const Joint& j = m.joints[ji];
   const Vec3& z = d.rne.axis[ji];
   const Vec3& P = d.rne.point[ji];
   if (j.type == JointType::Free) {
-    const Vec3 e = free_frame(j, d.kin[j.child]).col(sub % 3);
+    const Vec3 e = B.col(sub % 3);
     if (sub < 3) return {Vec3::Zero(), e};
     return {e, P.cross(e)};
   }
@@ -58,6 +59,34 @@ Twist dof_twist(const Model& m, const Data& d, int ji, int sub) {
   return {Vec3::Zero(), z};
 }
 
+// every degree of freedom's twist into d.force_deriv.twist (sized here on the first call)
+void load_twists(const Model& m, Data& d) {
+  Data::ForceDerivScratch& w = d.force_deriv;
+  if (static_cast<int>(w.twist.size()) != d.n) {
+    w.twist.assign(d.n, Vec6::Zero());
+    w.dofs.assign(d.n, 0);
+    w.level.assign(d.n, 0);
+    for (auto* v : {&w.dd, &w.fa, &w.tc}) v->assign(d.n, Vec3::Zero());
+    w.g = VecX::Zero(d.n);
+    w.dT = VecX::Zero(d.n);
+  }
+  for (int ji = 0; ji < static_cast<int>(m.joints.size()); ++ji) {
+    const Joint& j = m.joints[ji];
+    const int nd = j.dof0 < 0 ? 0 : joint_dofs(j.type);
+    if (nd == 0) continue;
+    const Mat3 B = j.type == JointType::Free ? free_frame(j, d.kin[j.child]) : Mat3::Identity();
+    for (int s = 0; s < nd; ++s) {
+      const Twist t = dof_twist(m, d, ji, s, B);
+      w.twist[j.dof0 + s] << t.w, t.v;
+    }
+  }
+}
+
+Twist twist_of(const Data& d, int dof) {
+  const Vec6& s = d.force_deriv.twist[dof];
+  return {s.head<3>(), s.tail<3>()};
+}
+
 // f(joint, dof, twist) for each degree of freedom on body's chain, from the body to the root
 template <class F>
 void for_chain(const Model& m, const Data& d, int body, F&& f) {
@@ -65,7 +94,8 @@ void for_chain(const Model& m, const Data& d, int body, F&& f) {
     const int ji = d.joint_of_body[b];
     if (ji < 0) return;
     const Joint& j = m.joints[ji];
-    for (int s = 0; s < joint_dofs(j.type); ++s) f(ji, j.dof0 + s, dof_twist(m, d, ji, s));
+    const int nd = j.dof0 < 0 ? 0 : joint_dofs(j.type);
+    for (int s = 0; s < nd; ++s) f(ji, j.dof0 + s, twist_of(d, j.dof0 + s));
     b = j.parent;
   }
 }
@@ -80,13 +110,16 @@ bool on_chain(const Model& m, const Data& d, int body, int joint) {
   return false;
 }
 
-// the lowest joint on the chains of both bodies a and b (-1: none)
+// the lowest joint with degrees of freedom on the chains of both bodies a and b (-1: none);
+// every joint above it is on both (a fixed joint where the chains meet is passed over: for_union
+// marks the common part at a degree of freedom)
 int common_joint(const Model& m, const Data& d, int a, int b) {
   for (int c = b; c != kGround;) {
     const int ji = d.joint_of_body[c];
     if (ji < 0) return -1;
-    if (on_chain(m, d, a, ji)) return ji;
-    c = m.joints[ji].parent;
+    const Joint& j = m.joints[ji];
+    if (j.dof0 >= 0 && joint_dofs(j.type) > 0 && on_chain(m, d, a, ji)) return ji;
+    c = j.parent;
   }
   return -1;
 }
@@ -110,25 +143,38 @@ void for_union(const Model& m, const Data& d, int a, int b, int lca, F&& f) {
 // the q-derivative of the generalised force of a world force f at point p fixed on `body` and a
 // world torque tau, f and tau held fixed in world axes (their own dependence on the state is
 // the caller's): dF_j/dq_k = f . (w_j x S_k(p)) + [k at or above j] (f . (S_k x S_j)(p) +
-// tau . (w_k x w_j)), j and k on the body's chain
-void add_fixed_load(const Model& m, const Data& d, int body, const Vec3& p, const Vec3& f,
+// tau . (w_k x w_j)), j and k on the body's chain; with (S_k x S_j)(p) = w_k x S_j(p) - w_j x
+// S_k(p):
+//   k at or above j:  S_j(p) . (f x w_k) + w_k . (w_j x tau),
+//   k below j:        S_k(p) . (f x w_j)
+void add_fixed_load(const Model& m, Data& d, int body, const Vec3& p, const Vec3& f,
                     const Vec3& tau, Eigen::Ref<MatX> dF_dq) {
-  for_chain(m, d, body, [&](int jj, int j, const Twist& sj) {
-    bool above = false;
-    for_chain(m, d, body, [&](int kj, int k, const Twist& sk) {
-      if (kj == jj) above = true;
-      double v = f.dot(sj.w.cross(sk.at(p)));
-      if (above) {
-        const Twist c = cross(sk, sj);
-        v += f.dot(c.at(p)) + tau.dot(c.w);
-      }
-      dF_dq(j, k) += v;
-    });
+  Data::ForceDerivScratch& w = d.force_deriv;
+  int nc = 0, level = 0, last = -1;
+  for_chain(m, d, body, [&](int ji, int k, const Twist& sk) {
+    if (ji != last) {
+      ++level;
+      last = ji;
+    }
+    w.dofs[nc] = k;
+    w.level[nc] = level;
+    w.dd[nc] = sk.at(p);
+    w.fa[nc] = f.cross(sk.w);
+    w.tc[nc] = sk.w.cross(tau);
+    ++nc;
   });
+  for (int a = 0; a < nc; ++a) {
+    const int j = w.dofs[a];
+    for (int b = 0; b < nc; ++b) {
+      const int k = w.dofs[b];
+      dF_dq(j, k) += w.level[b] >= w.level[a]
+                         ? w.dd[a].dot(w.fa[b]) + w.twist[k].head<3>().dot(w.tc[a])
+                         : w.dd[b].dot(w.fa[a]);
+    }
+  }
 }
 
-void add_body_load(const Model& m, const Data& d, const BodyLoad& l, double t,
-                   Eigen::Ref<MatX> dF_dq) {
+void add_body_load(const Model& m, Data& d, const BodyLoad& l, double t, Eigen::Ref<MatX> dF_dq) {
   double s = 1.0;
   if (l.has_profile) {
     try {
@@ -191,36 +237,45 @@ Vec3 point_rate_derivative(const Model& m, const Data& d, int ji, const Twist& s
 
 // F_j = -T dL/dq_j: the tension's dependence on the state (dT/dq_k = k g_k + c dL'/dq_k, dT/dqd_k =
 // c g_k, g = dL/dq) and the direction's (dn/dq_k = (I - n n^T) dd_k / L, dd_k = S_k(p_b) -
-// S_k(p_a)) over the two chains; the geometry of the two points by add_fixed_load
-void add_spring_damper(const Model& m, const Data& d, const SpringDamper& sd, double t,
+// S_k(p_a)) over the union of the two chains (its per-dof terms in d.force_deriv); the geometry
+// of the two points by add_fixed_load
+void add_spring_damper(const Model& m, Data& d, const SpringDamper& sd, double t,
                        Eigen::Ref<MatX> dF_dq, Eigen::Ref<MatX> dF_dqd) {
   const SpringState s = spring_state(d, sd, t);
   add_fixed_load(m, d, sd.body_b, s.pb, -s.T * s.n, Vec3::Zero(), dF_dq);
   add_fixed_load(m, d, sd.body_a, s.pa, s.T * s.n, Vec3::Zero(), dF_dq);
+  // per degree of freedom of the union of the chains: dd_k, g_k, dT/dq_k
+  Data::ForceDerivScratch& w = d.force_deriv;
+  int nu = 0;
   const int lca = common_joint(m, d, sd.body_a, sd.body_b);
-  auto separation = [&](const Twist& sk, bool on_a, bool on_b) {
-    Vec3 r = Vec3::Zero();
-    if (on_b) r += sk.at(s.pb);
-    if (on_a) r -= sk.at(s.pa);
-    return r;
-  };
-  const double c = sd.damping, k_over = s.T / s.L;
   for_union(m, d, sd.body_a, sd.body_b, lca,
-            [&](int kj, int k, const Twist& sk, bool ka_on, bool kb_on) {
-              const Vec3 ddk = separation(sk, ka_on, kb_on);
-              const double gk = s.n.dot(ddk);
-              double dLd = ddk.dot(s.ddot_perp);  // dL'/dq_k
-              if (kb_on) dLd += s.n.dot(point_rate_derivative(m, d, kj, sk, *s.kb, s.vb, s.pb));
-              if (ka_on) dLd -= s.n.dot(point_rate_derivative(m, d, kj, sk, *s.ka, s.va, s.pa));
-              const double dT = sd.stiffness * gk + c * dLd;
-              for_union(m, d, sd.body_a, sd.body_b, lca,
-                        [&](int, int j, const Twist& sj, bool ja_on, bool jb_on) {
-                          const Vec3 ddj = separation(sj, ja_on, jb_on);
-                          const double gj = s.n.dot(ddj);
-                          dF_dq(j, k) -= dT * gj + k_over * (ddj.dot(ddk) - gj * gk);
-                          dF_dqd(j, k) -= c * gj * gk;
-                        });
+            [&](int kj, int k, const Twist& sk, bool on_a, bool on_b) {
+              Vec3 dd = Vec3::Zero();
+              double dLd = 0.0;  // dL'/dq_k
+              if (on_b) {
+                dd += sk.at(s.pb);
+                dLd += s.n.dot(point_rate_derivative(m, d, kj, sk, *s.kb, s.vb, s.pb));
+              }
+              if (on_a) {
+                dd -= sk.at(s.pa);
+                dLd -= s.n.dot(point_rate_derivative(m, d, kj, sk, *s.ka, s.va, s.pa));
+              }
+              dLd += dd.dot(s.ddot_perp);
+              w.dofs[nu] = k;
+              w.dd[nu] = dd;
+              w.g[nu] = s.n.dot(dd);
+              w.dT[nu] = sd.stiffness * w.g[nu] + sd.damping * dLd;
+              ++nu;
             });
+  const double c = sd.damping, k_over = s.T / s.L;
+  for (int u = 0; u < nu; ++u) {
+    const int k = w.dofs[u];
+    for (int v = 0; v < nu; ++v) {
+      const int j = w.dofs[v];
+      dF_dq(j, k) -= w.dT[u] * w.g[v] + k_over * (w.dd[v].dot(w.dd[u]) - w.g[v] * w.g[u]);
+      dF_dqd(j, k) -= c * w.g[v] * w.g[u];
+    }
+  }
 }
 
 // d tau / dq and d tau / dqd of one coordinate force (coord_force_value at z = 0)
@@ -293,6 +348,7 @@ void add_gear_pairs(const Model& m, const double* q, const double* qd, Eigen::Re
 
 void add_force_element_derivatives(const Model& m, Data& d, const double* q, const double* qd,
                                    double t, Eigen::Ref<MatX> dF_dq, Eigen::Ref<MatX> dF_dqd) {
+  if (!m.body_loads.empty() || !m.springs.empty()) load_twists(m, d);
   for (const BodyLoad& l : m.body_loads) add_body_load(m, d, l, t, dF_dq);
   for (const SpringDamper& sd : m.springs) add_spring_damper(m, d, sd, t, dF_dq, dF_dqd);
   // the coordinates follow the floating bases' blocks in q and qd
