@@ -58,6 +58,14 @@ def _heavy_pendulum():
     return b.finalize()
 
 
+def _two_links():
+    """Two links on parallel hinges: the mass matrix depends on the elbow angle."""
+    b = _hinged()
+    b.add_body("forearm", 1.0, I3, position=(0.0, 0.0, -1.5))
+    b.add_revolute("elbow", "link", "forearm", (0, 0, -1.0), (0, 1, 0))
+    return b.finalize()
+
+
 def _driven():
     b = _hinged()
     b.add_drive("hinge", _core.profiles.cubic(0.0, 1.0, 0.0, 1.0))
@@ -941,6 +949,137 @@ CASES = [
         lambda: ad.joint_reactions(_heavy_pendulum(), [0.0], [0.0], [1.7e308]),
         SE,
         r"qdd\[0\].*overflow",
+    ),
+    # ---- derivatives of the dynamics (issue 34)
+    (
+        "idd-q-length",
+        "derivatives",
+        "inverse_dynamics_derivatives with q of length 2 for 1 coordinate",
+        lambda: ad.inverse_dynamics_derivatives(_pendulum(), [0.0, 0.0], [0.0], [0.0]),
+        ME,
+        r"\bq\b",
+    ),
+    (
+        "idd-qdd-nan",
+        "derivatives",
+        "inverse_dynamics_derivatives with qdd NaN",
+        lambda: ad.inverse_dynamics_derivatives(_pendulum(), [0.0], [0.0], [np.nan]),
+        ME,
+        "qdd",
+    ),
+    (
+        "idd-rows",
+        "derivatives",
+        "inverse_dynamics_derivatives with 3 rows of q and 2 of qd",
+        lambda: ad.inverse_dynamics_derivatives(
+            _pendulum(), np.zeros((3, 1)), np.zeros((2, 1)), np.zeros((3, 1))
+        ),
+        ME,
+        r"\bqd\b",
+    ),
+    (
+        "idd-t-rows",
+        "derivatives",
+        "inverse_dynamics_derivatives with 2 times for 3 rows",
+        lambda: ad.inverse_dynamics_derivatives(
+            _pendulum(), np.zeros((3, 1)), np.zeros((3, 1)), np.zeros((3, 1)), t=[0.0, 1.0]
+        ),
+        ME,
+        r"\bt\b",
+    ),
+    (
+        "idd-model",
+        "derivatives",
+        "inverse_dynamics_derivatives of a ModelBuilder (not finalized)",
+        lambda: ad.inverse_dynamics_derivatives(_hinged(), [0.0], [0.0], [0.0]),
+        ME,
+        "model must be an armdyn.Model",
+    ),
+    (
+        "idd-data-other-model",
+        "derivatives",
+        "inverse_dynamics_derivatives with data made for another model",
+        lambda: ad.inverse_dynamics_derivatives(
+            _pendulum(), [0.0], [0.0], [0.0], data=ad.Data(_heavy_pendulum())
+        ),
+        ME,
+        "data.*another model",
+    ),
+    (
+        "idd-overflow",
+        "derivatives",
+        "inverse_dynamics_derivatives with qdd = 1e308 on a two-link arm (finite; overflows)",
+        lambda: ad.inverse_dynamics_derivatives(_two_links(), [0.0, 0.5], [0.0, 0.0], [1e308] * 2),
+        SE,
+        r"overflow.*qdd\[0\]",
+    ),
+    (
+        "fdd-tau-nan",
+        "derivatives",
+        "forward_dynamics_derivatives with tau NaN",
+        lambda: ad.forward_dynamics_derivatives(_pendulum(), [0.0], [0.0], [np.nan]),
+        ME,
+        "tau",
+    ),
+    (
+        "fdd-qd-inf",
+        "derivatives",
+        "forward_dynamics_derivatives with qd inf",
+        lambda: ad.forward_dynamics_derivatives(_pendulum(), [0.0], [np.inf], [0.0]),
+        ME,
+        r"\bqd\b",
+    ),
+    (
+        "fdd-q-3d",
+        "derivatives",
+        "forward_dynamics_derivatives with a 3-D q",
+        lambda: ad.forward_dynamics_derivatives(_pendulum(), np.zeros((2, 2, 1)), [0.0], [0.0]),
+        ME,
+        r"\bq\b",
+    ),
+    (
+        "fdd-model",
+        "derivatives",
+        "forward_dynamics_derivatives with model None",
+        lambda: ad.forward_dynamics_derivatives(None, [0.0], [0.0], [0.0]),
+        ME,
+        "model must be an armdyn.Model",
+    ),
+    (
+        "fdd-data-type",
+        "derivatives",
+        "forward_dynamics_derivatives with data a Model (not a Data)",
+        lambda: ad.forward_dynamics_derivatives(_pendulum(), [0.0], [0.0], [0.0], data=_pendulum()),
+        ME,
+        r"data must be an armdyn\.Data",
+    ),
+    (
+        "fdd-data-other-model",
+        "derivatives",
+        "forward_dynamics_derivatives with data made for another model",
+        lambda: ad.forward_dynamics_derivatives(
+            _pendulum(), [0.0], [0.0], [0.0], data=ad.Data(_two_links())
+        ),
+        ME,
+        "data.*another model",
+    ),
+    (
+        "fdd-on-loop",
+        "derivatives",
+        "forward_dynamics_derivatives on a closed loop",
+        lambda: ad.forward_dynamics_derivatives(
+            ad.scenes.four_bar(), np.zeros(4), np.zeros(4), np.zeros(4)
+        ),
+        ME,
+        "loop",
+    ),
+    (
+        "fdd-overflow",
+        "derivatives",
+        "forward_dynamics_derivatives with tau = 1.7e308 on a two-link arm (finite; overflows)",
+        lambda: ad.forward_dynamics_derivatives(_two_links(), [0.0, 0.5], [0.0, 0.0], [1.7e308, 0]),
+        SE,
+        r"overflow.*tau\[0\]",
     ),
     (
         "lagrange-loop",

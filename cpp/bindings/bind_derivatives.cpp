@@ -20,11 +20,12 @@ using ArrayPair = py::typing::Tuple<py::array_t<double>, py::array_t<double>>;
 using ArrayTriple =
     py::typing::Tuple<py::array_t<double>, py::array_t<double>, py::array_t<double>>;
 
-// k matrices row-major into out[j] + offset, each checked finite
+// k matrices row-major into out[j] + offset, each checked finite (vectorised; the element-wise
+// check names the entry)
 void write_matrices(const char* fn, std::initializer_list<std::pair<const char*, const MatX*>> ms,
                     std::initializer_list<NamedInput> in, double* const* out, long offset) {
   for (const auto& [name, x] : ms) {
-    check_finite_output(fn, name, x->data(), x->size(), in);
+    if (!x->allFinite()) check_finite_output(fn, name, x->data(), x->size(), in);
     copy_row_major(*x, *out++ + offset);
   }
 }
@@ -87,8 +88,10 @@ ArrayPair inverse_dynamics_derivatives_py(const ModelArg& model, const ArrayLike
       inverse_dynamics_derivatives(a.model(), d, qi, qdi, ai, tt);
       return 0;
     });
-    write_matrices(fn, {{"dtau_dq", &d.deriv.tau_q}, {"dtau_dqd", &d.deriv.tau_qd}}, in, out,
-                   offset);
+    write_matrices(
+        fn,
+        {{"dtau_dq (column-major)", &d.deriv.tau_q}, {"dtau_dqd (column-major)", &d.deriv.tau_qd}},
+        in, out, offset);
   };
   return matrices_call(fn, d, 2, q, qd, "qd", qdd, "qdd", t, one);
 }
@@ -107,9 +110,9 @@ ArrayTriple forward_dynamics_derivatives_py(const ModelArg& model, const ArrayLi
       return 0;
     });
     write_matrices(fn,
-                   {{"dqdd_dq", &d.deriv.qdd_q},
-                    {"dqdd_dqd", &d.deriv.qdd_qd},
-                    {"dqdd_dtau", &d.deriv.qdd_tau}},
+                   {{"dqdd_dq (column-major)", &d.deriv.qdd_q},
+                    {"dqdd_dqd (column-major)", &d.deriv.qdd_qd},
+                    {"dqdd_dtau (column-major)", &d.deriv.qdd_tau}},
                    in, out, offset);
   };
   return matrices_call(fn, d, 3, q, qd, "qd", tau, "tau", t, one);
