@@ -158,6 +158,25 @@ class Data {
   std::vector<std::pair<int, int>> reaction_sweep;
   bool reaction_sweep_made = false;
 
+  // --- first-order derivatives of the dynamics (algorithm/derivatives), sized on first use
+  // (ensure_derivatives: quadratic in the coordinates, never per call) ---
+  struct Derivatives {
+    /// per body: its subtree's spatial inertia about the reference point o (angular rows first),
+    /// the inertia's velocity variation (dY/dt with the momentum's cross terms), and the
+    /// subtree's Newton-Euler wrench (gravity and gyroscopic terms, no force elements)
+    std::vector<Mat6> Yc, Bc;
+    std::vector<Vec6> V, A, Fc;  ///< per body: spatial velocity, acceleration (gravity offset)
+    /// per degree of freedom (n): its motion S, the parent's terms u = V_p x S, w = A_p x S +
+    /// V_p x u, a = (V_p + V_c) x S; the subtree's Yc S and Bc^T S; the subtree wrench's
+    /// derivatives along q (without and with S x* Fc) and along qd
+    std::vector<Vec6> S, u, w, av, YS, BS, dFq, dFqx, dFv;
+    MatX dq, dqd;  ///< (n, n) the rigid-body derivatives of tau_full, then the force elements'
+    /// the public results (ni, ni): dtau/dq and dtau/dqd; forward: dqdd/dq, dqdd/dqd, M^-1
+    MatX tau_q, tau_qd, qdd_q, qdd_qd, qdd_tau;
+    VecX qdd_full, qdd;  ///< (n) the forward derivatives' accelerations (full), (ni) independent
+    bool sized = false;
+  } deriv;
+
   // --- named frames (algorithm/frames) ---
   Mat4 frame_pose = Mat4::Identity();  ///< the last frame pose [R p; 0 1]
   Mat6X frame_jacobian;                ///< (6, n) the last joint-space frame Jacobian

@@ -641,6 +641,10 @@ class Data:
         """
         The model this workspace serves.
         """
+def _force_element_derivatives(model: Model, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, t: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
+    """
+    (dF_dq, dF_dqd), each (n_dofs, n_dofs): the derivatives of the generalised force F of the model's force elements (body loads, spring-dampers, coordinate forces, gear pairs; F = inverse_dynamics of the model without them - inverse_dynamics with them) at (q, qd) and time t, q-derivatives along the rates (a floating base's along qd's base-frame velocity), integral states zero (a coupled model's in its independent coordinates: G^T dF G). Private: the tests' and part deriv's check of the C++ function.
+    """
 def _inverse_dynamics_driven(model: Model, t: numpy.typing.ArrayLike) -> dict:
     ...
 def _output_row_bytes(model: Model) -> int:

@@ -15,8 +15,15 @@ namespace armdyn {
 /// bases' blocks first) to dF_dq and dF_dqd (nv_joint x nv_joint, not zeroed here): q-derivatives
 /// along the rates (a floating base's along its qd block, Pinocchio's convention), at time t and
 /// auxiliary states zero (as inverse_dynamics). Needs data.kin and data.rne at (q, qd)
-/// (joint_space_kinematics). Allocates nothing.
-/// @throws SolverError naming the element when a profile or force is not finite.
+/// (joint_space_kinematics). Allocates nothing. Where a law is not differentiable, the
+/// derivative is that of the branch the law evaluates at that state: a PD/PI motor's limit
+/// (std::clamp) is the identity on the closed band |u| <= limit (the unsaturated slopes -kp, -kd
+/// at |u| = limit); a gear pair exerts no force while its penetration is <= 0 (zero slopes at
+/// the backlash edge) and its Hunt-Crossley force k d^n (1 + alpha d') is clamped only below 0
+/// (the contact slopes where it is exactly 0); an angle difference's wrap at +-pi is ignored
+/// (slope 1). The smoothed Coulomb friction is smooth (slope -F_c / v_s at qd = 0).
+/// @throws SolverError naming the element when a profile or force is not finite, or a
+///   spring-damper's length is zero.
 void add_force_element_derivatives(const Model& m, Data& d, const double* q, const double* qd,
                                    double t, Eigen::Ref<MatX> dF_dq, Eigen::Ref<MatX> dF_dqd);
 

@@ -1,0 +1,331 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "armdyn/algorithm/derivatives.hpp"
+
+#include <cmath>
+
+#include "armdyn/algorithm/crba.hpp"
+#include "armdyn/algorithm/dynamics.hpp"
+#include "armdyn/algorithm/force_derivatives.hpp"
+#include "armdyn/errors.hpp"
+#include "armdyn/kernels/joint_space.hpp"
+#include "armdyn/kernels/kkt_factor.hpp"
+#include "armdyn/math/cholesky.hpp"
+
+namespace armdyn {
+
+// (a named namespace: the algorithm sources share one unity translation unit)
+namespace derivatives_detail {
+
+// [a]x, the cross-product matrix
+inline Mat3 skew(const Vec3& a) {
+  Mat3 s;
+  s << 0.0, -a.z(), a.y(), a.z(), 0.0, -a.x(), -a.y(), a.x(), 0.0;
+  return s;
+}
+
+// motion cross product (w, v) x (w2, v2) = (w x w2, w x v2 + v x w2)
+inline Vec6 mcross(const Vec6& a, const Vec6& b) {
+  Vec6 r;
+  r.head<3>() = a.head<3>().cross(b.head<3>());
+  r.tail<3>() = a.head<3>().cross(b.tail<3>()) + a.tail<3>().cross(b.head<3>());
+  return r;
+}
+
+// force cross product (w, v) x* (n, f) = (w x n + v x f, w x f)
+inline Vec6 fcross(const Vec6& a, const Vec6& f) {
+  Vec6 r;
+  r.head<3>() = a.head<3>().cross(f.head<3>()) + a.tail<3>().cross(f.tail<3>());
+  r.tail<3>() = a.head<3>().cross(f.tail<3>());
+  return r;
+}
+
+// The fixed point o the spatial quantities are taken about: the world origin, or with a floating
+// base its first base's centre of mass at this instant (crba_loaded's choice: products m |c|^2
+// about a far origin lose precision). The derivatives do not depend on it (o is fixed in space).
+Vec3 about_point(const Model& m, const Data& d) {
+  if (m.n_free == 0) return Vec3::Zero();
+  for (int ji : m.tree_order)
+    if (m.joints[ji].type == JointType::Free) return d.kin[m.joints[ji].child].x;
+  return Vec3::Zero();
+}
+
+// body b's spatial inertia about o: [I_o, [h]x; -[h]x, m 1], h = m (x - o)
+void spatial_inertia(const Body& b, const BodyKin& k, const Vec3& o, Mat6& Y) {
+  const Vec3 c = k.x - o;
+  const Vec3 h = b.mass * c;
+  Mat3 I;
+  I.noalias() = k.R * b.inertia * k.R.transpose();
+  I.noalias() -= h * c.transpose();
+  I.diagonal().array() += h.dot(c);
+  const Mat3 H = skew(h);
+  Y.topLeftCorner<3, 3>() = I;
+  Y.topRightCorner<3, 3>() = H;
+  Y.bottomLeftCorner<3, 3>() = -H;
+  Y.bottomRightCorner<3, 3>() = b.mass * Mat3::Identity();
+}
+
+// B = crf(V) Y - Y crm(V) + X(h), h = Y V: B u = Y (u x V) + u x* h + V x* (Y u), the
+// inertia's variation along V with the momentum's cross terms (crm(V) = -crf(V)^T)
+void velocity_variation(const Mat6& Y, const Vec6& V, const Vec6& h, Mat6& B) {
+  Mat6 C = Mat6::Zero();
+  const Mat3 W = skew(V.head<3>());
+  C.topLeftCorner<3, 3>() = W;
+  C.topRightCorner<3, 3>() = skew(V.tail<3>());
+  C.bottomRightCorner<3, 3>() = W;
+  B.noalias() = C * Y;
+  B.noalias() += Y * C.transpose();
+  const Mat3 Hn = skew(h.head<3>()), Hf = skew(h.tail<3>());
+  B.topLeftCorner<3, 3>() -= Hn;
+  B.topRightCorner<3, 3>() -= Hf;
+  B.bottomLeftCorner<3, 3>() -= Hf;
+}
+
+// degree of freedom k of joint j (the k-th of its own): its world motion about o (crba_loaded's)
+Vec6 dof_motion(const Joint& j, int k, const BodyKin& child, const Vec3& point, const Vec3& axis,
+                const Vec3& o) {
+  Vec6 s;
+  const Vec3 p = point - o;
+  if (j.type == JointType::Free) {
+    const Vec3 e = free_frame(j, child).col(k % 3);
+    if (k < 3)
+      s << Vec3::Zero(), e;
+    else
+      s << e, p.cross(e);
+    return s;
+  }
+  if (j.type == JointType::Prismatic || k == 1)
+    s << Vec3::Zero(), axis;
+  else
+    s << axis, p.cross(axis);
+  return s;
+}
+
+// forward, per body: the spatial inertia, velocity, acceleration (gravity offset) and the
+// Newton-Euler wrench; per degree of freedom: S, u, w and a (derivatives.hpp)
+void forward_pass(const Model& m, Data& d, Eigen::Ref<const VecX> qd, Eigen::Ref<const VecX> qdd,
+                  const Vec3& o) {
+  Data::Derivatives& w = d.deriv;
+  rne_forward(m, d.kin, qd, qdd, d.rne);
+  for (int i = 0; i < m.nb; ++i) {
+    const BodyKin& k = d.kin[i];
+    const Vec3 c = k.x - o;
+    const Vec3& alpha = d.rne.alpha[i];
+    Vec6& V = w.V[i];
+    V << k.W, k.xd - k.W.cross(c);
+    Vec6& A = w.A[i];
+    A << alpha, d.rne.acc[i] - alpha.cross(c) - k.W.cross(k.xd) - m.gravity;
+    Mat6& Y = w.Yc[i];
+    spatial_inertia(m.bodies[i], k, o, Y);
+    const Vec6 h = Y * V;
+    w.Fc[i].noalias() = Y * A;
+    w.Fc[i] += fcross(V, h);
+    velocity_variation(Y, V, h, w.Bc[i]);
+  }
+  Vec6 ground_a;
+  ground_a << Vec3::Zero(), -m.gravity;
+  for (int ji : m.tree_order) {
+    const Joint& j = m.joints[ji];
+    if (j.dof0 < 0) continue;
+    const bool root = j.parent == kGround;
+    const Vec6 Vp = root ? Vec6::Zero() : w.V[j.parent];
+    const Vec6& Ap = root ? ground_a : w.A[j.parent];
+    const Vec6 Vpc = Vp + w.V[j.child];
+    for (int k = 0; k < joint_dofs(j.type); ++k) {
+      const int c = j.dof0 + k;
+      w.S[c] = dof_motion(j, k, d.kin[j.child], d.rne.point[ji], d.rne.axis[ji], o);
+      w.u[c] = mcross(Vp, w.S[c]);
+      w.w[c] = mcross(Ap, w.S[c]) + mcross(Vp, w.u[c]);
+      w.av[c] = mcross(Vpc, w.S[c]);
+    }
+  }
+}
+
+// backward, children first: the subtree sums and each degree of freedom's terms
+void backward_pass(const Model& m, Data& d) {
+  Data::Derivatives& w = d.deriv;
+  for (auto it = m.tree_order.rbegin(); it != m.tree_order.rend(); ++it) {
+    const Joint& j = m.joints[*it];
+    const int b = j.child;
+    const Mat6 &Y = w.Yc[b], &B = w.Bc[b];
+    for (int c = j.dof0; c < j.dof0 + joint_dofs(j.type); ++c) {
+      const Vec6& S = w.S[c];
+      w.YS[c].noalias() = Y * S;
+      w.BS[c].noalias() = B.transpose() * S;
+      w.dFq[c].noalias() = Y * w.w[c];
+      w.dFq[c].noalias() += B * w.u[c];
+      w.dFqx[c] = w.dFq[c] + fcross(S, w.Fc[b]);
+      w.dFv[c].noalias() = Y * w.av[c];
+      w.dFv[c].noalias() += B * S;
+    }
+    if (j.parent != kGround) {
+      w.Yc[j.parent] += Y;
+      w.Bc[j.parent] += B;
+      w.Fc[j.parent] += w.Fc[b];
+    }
+  }
+}
+
+// the entries: (j, k) for j's joint at or above k's, and (k, j) for j's strictly above
+void fill_matrices(const Model& m, Data& d) {
+  Data::Derivatives& w = d.deriv;
+  w.dq.setZero();
+  w.dqd.setZero();
+  for (int k = 0; k < d.n; ++k) {
+    const Joint& jk = m.joints[m.dof_joint[k]];
+    for (int r = jk.dof0; r < jk.dof0 + joint_dofs(jk.type); ++r) {
+      w.dq(r, k) = w.S[r].dot(w.dFq[k]);
+      w.dqd(r, k) = w.S[r].dot(w.dFv[k]);
+    }
+    for (int ja = jk.parent == kGround ? -1 : d.joint_of_body[jk.parent]; ja >= 0;) {
+      const Joint& j = m.joints[ja];
+      for (int r = j.dof0; r < j.dof0 + joint_dofs(j.type); ++r) {
+        w.dq(r, k) = w.S[r].dot(w.dFqx[k]);
+        w.dqd(r, k) = w.S[r].dot(w.dFv[k]);
+        w.dq(k, r) = w.YS[k].dot(w.w[r]) + w.BS[k].dot(w.u[r]);
+        w.dqd(k, r) = w.YS[k].dot(w.av[r]) + w.BS[k].dot(w.S[r]);
+      }
+      ja = j.parent == kGround ? -1 : d.joint_of_body[j.parent];
+    }
+  }
+}
+
+// the checks of inverse_dynamics / forward_dynamics (dynamics.cpp), naming fn
+void check_state(const Model& m, const Data& d, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
+                 Eigen::Ref<const VecX> x, double t, const char* fn, const char* xname) {
+  require_joint_space(m, fn, true);
+  check_data(m, d, fn);
+  check_joint_vector(q, d.niq, fn, "q");
+  check_joint_vector(qd, d.ni, fn, "qd");
+  check_joint_vector(x, d.ni, fn, xname);
+  if (!std::isfinite(t)) throw ModelError(msg(fn, ": t is not finite"));
+  check_base_quaternions(m, q, fn);
+}
+
+// d.deriv.dq, dqd at the loaded kinematics: the rigid-body derivatives less the force elements'
+// (tau = ... - F)
+void full_derivatives(const Model& m, Data& d, const double* q, Eigen::Ref<const VecX> qd,
+                      Eigen::Ref<const VecX> qdd, double t) {
+  rnea_derivatives_loaded(m, d, qd, qdd);
+  if (!has_force_elements(m)) return;
+  Data::Derivatives& w = d.deriv;
+  w.dq = -w.dq;
+  w.dqd = -w.dqd;
+  add_force_element_derivatives(m, d, q, qd.data(), t, w.dq, w.dqd);
+  w.dq = -w.dq;
+  w.dqd = -w.dqd;
+}
+
+// the public (independent) results from the full ones: G^T X G (a copy without couplings)
+void reduce_pair(const Model& m, const Data& d, const MatX& a, const MatX& b, MatX& ar, MatX& br) {
+  if (d.ni == d.n) {
+    ar = a;
+    br = b;
+    return;
+  }
+  m.independent.reduce(a, ar);
+  m.independent.reduce(b, br);
+}
+
+}  // namespace derivatives_detail
+
+using namespace derivatives_detail;
+
+void ensure_derivatives(const Model& m, Data& d) {
+  Data::Derivatives& w = d.deriv;
+  if (w.sized) return;
+  const size_t nb = static_cast<size_t>(m.nb), n = static_cast<size_t>(d.n);
+  w.Yc.assign(nb, Mat6::Zero());
+  w.Bc.assign(nb, Mat6::Zero());
+  for (auto* v : {&w.V, &w.A, &w.Fc}) v->assign(nb, Vec6::Zero());
+  for (auto* v : {&w.S, &w.u, &w.w, &w.av, &w.YS, &w.BS, &w.dFq, &w.dFqx, &w.dFv})
+    v->assign(n, Vec6::Zero());
+  w.dq = MatX::Zero(d.n, d.n);
+  w.dqd = MatX::Zero(d.n, d.n);
+  for (MatX* x : {&w.tau_q, &w.tau_qd, &w.qdd_q, &w.qdd_qd, &w.qdd_tau})
+    *x = MatX::Zero(d.ni, d.ni);
+  w.qdd_full = VecX::Zero(d.n);
+  w.qdd = VecX::Zero(d.ni);
+  w.sized = true;
+}
+
+void rnea_derivatives_loaded(const Model& m, Data& d, Eigen::Ref<const VecX> qd,
+                             Eigen::Ref<const VecX> qdd) {
+  const Vec3 o = about_point(m, d);
+  forward_pass(m, d, qd, qdd, o);
+  backward_pass(m, d);
+  fill_matrices(m, d);
+}
+
+void inverse_dynamics_derivatives(const Model& m, Data& d, Eigen::Ref<const VecX> q,
+                                  Eigen::Ref<const VecX> qd, Eigen::Ref<const VecX> qdd, double t) {
+  constexpr const char* fn = "inverse_dynamics_derivatives";
+  check_state(m, d, q, qd, qdd, t, fn, "qdd");
+  ensure_derivatives(m, d);
+  Data::Derivatives& w = d.deriv;
+  if (d.ni != d.n) {
+    // a coupled model: the full coordinates (Model::independent)
+    Data::Coupled& c = d.coupled;
+    m.independent.expand_q(q.data(), c.q.data());
+    m.independent.expand_v(qd.data(), c.qd.data());
+    m.independent.expand_v(qdd.data(), c.qdd.data());
+    joint_space_kinematics(m, c.q, c.qd, d.kin, d.rne);
+    full_derivatives(m, d, c.q.data(), c.qd, c.qdd, t);
+  } else {
+    joint_space_kinematics(m, q, qd, d.kin, d.rne);
+    full_derivatives(m, d, q.data(), qd, qdd, t);
+  }
+  reduce_pair(m, d, w.dq, w.dqd, w.tau_q, w.tau_qd);
+}
+
+void forward_dynamics_derivatives(const Model& m, Data& d, Eigen::Ref<const VecX> q,
+                                  Eigen::Ref<const VecX> qd, Eigen::Ref<const VecX> tau, double t) {
+  constexpr const char* fn = "forward_dynamics_derivatives";
+  check_state(m, d, q, qd, tau, t, fn, "tau");
+  if (const LightBodies& light = light_bodies(m); !light.joint_space.empty())
+    throw ModelError(msg(fn,
+                         ": needs the mass matrix (CRBA about the world origin), which loses the "
+                         "accelerations of light bodies: ",
+                         light.joint_space_note));
+  ensure_derivatives(m, d);
+  ensure_mass_matrix(d);
+  Data::Derivatives& w = d.deriv;
+  const bool coupled = d.ni != d.n;
+  Data::Coupled& c = d.coupled;
+  if (coupled) {
+    m.independent.expand_q(q.data(), c.q.data());
+    m.independent.expand_v(qd.data(), c.qd.data());
+  }
+  const double* qf = coupled ? c.q.data() : q.data();
+  const Eigen::Map<const VecX> qdf(coupled ? c.qd.data() : qd.data(), d.n);
+  // M qdd = tau + Q - b (joint_space_equations: CRBA, and the Newton-Euler residual at qdd = 0)
+  joint_space_equations(m, d, qf, qdf.data(), nullptr, nullptr, t);
+  MatX& M = coupled ? c.M : d.M;
+  MatX& L = coupled ? c.L : d.L;
+  if (coupled) {
+    m.independent.reduce(d.rhs.data(), w.qdd.data());
+    m.independent.reduce(d.M, c.M);
+  } else {
+    w.qdd = d.rhs;
+  }
+  w.qdd += tau;
+  if (!cholesky_factor(M, L))
+    throw SolverError(msg(fn, ": the joint-space mass matrix is not positive definite at t=", t,
+                          " (a massless subtree?)"));
+  cholesky_solve(L, w.qdd);
+  if (coupled)
+    m.independent.expand_v(w.qdd.data(), w.qdd_full.data());
+  else
+    w.qdd_full = w.qdd;
+  // dtau/dq, dtau/dqd at (q, qd, qdd), then M^-1 applied
+  full_derivatives(m, d, qf, qdf, w.qdd_full, t);
+  reduce_pair(m, d, w.dq, w.dqd, w.tau_q, w.tau_qd);
+  w.qdd_tau.setIdentity();
+  w.qdd_q = -w.tau_q;
+  w.qdd_qd = -w.tau_qd;
+  for (MatX* x : {&w.qdd_tau, &w.qdd_q, &w.qdd_qd}) {
+    L.triangularView<Eigen::Lower>().solveInPlace(*x);
+    L.transpose().triangularView<Eigen::Upper>().solveInPlace(*x);
+  }
+}
+
+}  // namespace armdyn
