@@ -6,6 +6,9 @@ thermal limits), and the least-energy motion. Every planner returns a :class:`Tr
 take) or a :class:`Path` (geometric, timed by :func:`time_optimal`).
 """
 
+from armdyn.motion.cartesian import CartesianPath, arc_move, linear_move
+from armdyn.motion.energy import least_energy
+from armdyn.motion.ik import IKResult, inverse_kinematics, manipulability
 from armdyn.motion.profiles import (
     drive_profile,
     point_to_point,
@@ -13,14 +16,24 @@ from armdyn.motion.profiles import (
     through_waypoints,
     waypoint_path,
 )
+from armdyn.motion.timing import shortest_cycle, time_optimal
 from armdyn.motion.trajectory import Path, Trajectory
 
 __all__ = [
+    "CartesianPath",
+    "IKResult",
     "Path",
     "Trajectory",
+    "arc_move",
     "drive_profile",
+    "inverse_kinematics",
+    "least_energy",
+    "linear_move",
+    "manipulability",
     "point_to_point",
+    "shortest_cycle",
     "spline",
     "through_waypoints",
+    "time_optimal",
     "waypoint_path",
 ]
