@@ -1138,6 +1138,7 @@ CASES = [
         ME,
         "hinge",
     ),
+<<<<<<< HEAD
     # ---- motion: joint trajectories
     (
         "p2p-start-nan",
@@ -1218,6 +1219,63 @@ CASES = [
         lambda: _motion().waypoint_path([[0.0, 1.0], [0.0, 1.0], [1.0, 1.0]]),
         ME,
         r"waypoints\[0\] and waypoints\[1\] are equal",
+=======
+    (
+        "topp-torque-negative",
+        "motion",
+        "time_optimal with a negative torque limit",
+        lambda: ad.motion.time_optimal(_pendulum(), _swing(), max_torque=-1.0),
+        ME,
+        r"max_torque\[0\] \(joint 'hinge'\)",
+    ),
+    (
+        "topp-grid-one",
+        "motion",
+        "time_optimal on a grid of one interval",
+        lambda: ad.motion.time_optimal(_pendulum(), _swing(), max_torque=5.0, grid=1),
+        ME,
+        "grid must be",
+    ),
+    (
+        "topp-path-array",
+        "motion",
+        "time_optimal of an array instead of a Path",
+        lambda: ad.motion.time_optimal(_pendulum(), np.zeros((2, 1))),
+        ME,
+        "path must be an armdyn.motion.Path",
+    ),
+    (
+        "topp-unbounded",
+        "motion",
+        "time_optimal with no limit on the moving joint",
+        lambda: ad.motion.time_optimal(_pendulum(), _swing(), max_torque=np.inf),
+        ME,
+        "nothing limits the path speed",
+    ),
+    (
+        "topp-static-torque",
+        "motion",
+        "time_optimal from a pose whose holding torque exceeds the limit",
+        lambda: ad.motion.time_optimal(_pendulum(), _swing(np.pi / 2, 2.5), max_torque=2.0),
+        SE,
+        r"s = 0 .*torque 'hinge' at rest is 4\.905",
+    ),
+    (
+        "cycle-time-no-motor",
+        "motion",
+        "shortest_cycle of a model without a motor",
+        lambda: ad.motion.shortest_cycle(_pendulum(), _swing(), dwell=1.0, max_torque=5.0),
+        ME,
+        "no actuator with a motor",
+    ),
+    (
+        "cycle-time-dwell-negative",
+        "motion",
+        "shortest_cycle with a negative dwell",
+        lambda: ad.motion.shortest_cycle(_pendulum(), _swing(), dwell=-1.0),
+        ME,
+        "dwell",
+>>>>>>> i34-topp
     ),
 ]
 
@@ -1228,6 +1286,11 @@ def _motion():
     import armdyn.motion
 
     return armdyn.motion
+
+
+def _swing(q0=0.0, q1=1.0):
+    """A straight joint-space path of the pendulum's hinge from q0 to q1."""
+    return ad.motion.Path([0.0, 1.0], [[q0], [q1]])
 
 
 def _cli():
