@@ -1139,6 +1139,7 @@ CASES = [
         "hinge",
     ),
 <<<<<<< HEAD
+<<<<<<< HEAD
     # ---- motion: joint trajectories
     (
         "p2p-start-nan",
@@ -1276,6 +1277,39 @@ CASES = [
         ME,
         "dwell",
 >>>>>>> i34-topp
+=======
+    (
+        "least-energy-duration-nan",
+        "motion",
+        "least_energy with a NaN duration",
+        lambda: _least_energy(duration=np.nan),
+        ME,
+        "least_energy: duration must be a positive number",
+    ),
+    (
+        "least-energy-start-shape",
+        "motion",
+        "least_energy from a start of two coordinates on a one-joint model",
+        lambda: _least_energy(start=[0.0, 0.0]),
+        ME,
+        r"least_energy: start must have shape \(1,\)",
+    ),
+    (
+        "least-energy-copper-no-motor",
+        "motion",
+        "least_energy's copper loss on a joint without a motor's torque constant and resistance",
+        lambda: _least_energy(objective="copper"),
+        ME,
+        "joint 'hinge' has none",
+    ),
+    (
+        "least-energy-infeasible",
+        "motion",
+        "least_energy in less time than any motion within the torque limit takes",
+        lambda: _least_energy(duration=0.2, max_torque=0.5),
+        SE,
+        "most exceeded limit is torque of joint 'hinge'",
+>>>>>>> i34-energy
     ),
 ]
 
@@ -1291,6 +1325,14 @@ def _motion():
 def _swing(q0=0.0, q1=1.0):
     """A straight joint-space path of the pendulum's hinge from q0 to q1."""
     return ad.motion.Path([0.0, 1.0], [[q0], [q1]])
+
+
+def _least_energy(**change):
+    from armdyn.motion import least_energy
+
+    args = dict(start=[0.0], goal=[1.0], duration=1.0, objective="rms_torque")
+    args.update(change)
+    return least_energy(_pendulum(), **args)
 
 
 def _cli():
