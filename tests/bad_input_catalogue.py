@@ -1138,8 +1138,6 @@ CASES = [
         ME,
         "hinge",
     ),
-<<<<<<< HEAD
-<<<<<<< HEAD
     # ---- motion: joint trajectories
     (
         "p2p-start-nan",
@@ -1220,7 +1218,7 @@ CASES = [
         lambda: _motion().waypoint_path([[0.0, 1.0], [0.0, 1.0], [1.0, 1.0]]),
         ME,
         r"waypoints\[0\] and waypoints\[1\] are equal",
-=======
+    ),
     (
         "topp-torque-negative",
         "motion",
@@ -1276,8 +1274,7 @@ CASES = [
         lambda: ad.motion.shortest_cycle(_pendulum(), _swing(), dwell=-1.0),
         ME,
         "dwell",
->>>>>>> i34-topp
-=======
+    ),
     (
         "least-energy-duration-nan",
         "motion",
@@ -1309,7 +1306,6 @@ CASES = [
         lambda: _least_energy(duration=0.2, max_torque=0.5),
         SE,
         "most exceeded limit is torque of joint 'hinge'",
->>>>>>> i34-energy
     ),
 ]
 
