@@ -192,7 +192,9 @@ def test_motion_notebook_executes(tmp_path):
     cycle of jerk-limited joint moves and straight approach moves of tool0, the drivetrains
     chosen for it, its time-optimal timing for those motors, the shortest thermal cycle, the
     least-energy joint moves, the verdict of each). Its own checks, independent of the planners:
-    the tool on its lines by forward kinematics (1e-9 m); the time-optimal torques by an
+    the jerk-limited joint moves on their joint-space lines (the geometric path time_optimal
+    times), the tool on its lines by forward kinematics (1e-9 m); the chosen motors' torques on
+    the arm rebuilt with them equal to the selection's closed form; the time-optimal torques by an
     independent inverse dynamics within the joint and motor peak limits (1e-6), and its cycle
     time that of each leg timed on its own (the same geometric path, another parametrisation:
     the grids' discretisation apart); the shortest cycle's binding check at margin 1 in a
@@ -213,10 +215,12 @@ def test_motion_notebook_executes(tmp_path):
     # (1) jerk-limited joint legs within their speed limit, the lines straight, no singularity
     assert "phase-synchronised joint legs: True" in out
     assert _number(r"largest joint speed / limit on the joint legs: (\S+)", out) <= 1.0 + 1e-9
+    assert _number(r"joint moves off their straight line \[rad\]: (\S+)", out) <= 1e-12
     assert _number(r"line error of the jerk-limited cycle \[m\]: (\S+)", out) <= 1e-9
     assert _number(r"manipulability along the cycle: min (\S+),", out) > 0.05
     # (2) the drivetrains for that cycle
     assert "selection: converged: True, every joint ok: True" in out
+    assert _number(r"rebuilt vs closed form: (\S+)", out) <= 1e-9
     # (3) time-optimal: limits by an independent inverse dynamics, the same path leg by leg
     assert _number(r"time-optimal joint torque / limit, max: (\S+)", out) <= 1.0 + 1e-6
     assert _number(r"time-optimal motor torque / peak torque, max: (\S+)", out) <= 1.0 + 1e-6
