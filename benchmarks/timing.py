@@ -3,8 +3,13 @@ solved otherwise, in one run: toppra alone (its own two passes on the same const
 the convex formulation of Verscheure et al. 2009 in cvxpy (Clarabel) on the same grid. Per
 grid size: the CPU time of each (median of warm calls), the durations and their relative
 differences, and the worst torque limit ratio of each answer recomputed by
-armdyn.inverse_dynamics on its (u, x) pairs (toppra's own forward pass shrinks x by 0.01 % per
-step, so its pairs are not consistent: the reason time_optimal does its own forward pass).
+armdyn.inverse_dynamics on its (u, x) pairs, and through its x alone (toppra's own forward pass
+lowers each x by 1e-8, so its u are not exactly those of its x), and time_optimal's between
+its samples too (its exact evaluator, 20 points per interval: collocation meets the limits at
+the grid points only, between them to first order in the grid step). Then
+armdyn.motion.shortest_cycle on the UR5 with a geared motor on every joint (datasheets with
+thermal data), over the path there and back, for two dwells: CPU time, the slowdown found and
+the check that binds.
 
     python -m benchmarks.timing [--grids N ...] [--out DIR]
 """
@@ -133,8 +138,13 @@ def measure(model, path, grid: int) -> dict:
     )
     lin = _timing._linearised(prob, np.ones(len(s)))
     t_sets, _, _ = cpu_time(lambda: _timing._scaled_controllable(s, *lin, prob.xmax), 5)
+    # between the samples (the exact evaluator, 20 points per interval): collocation holds the
+    # limits at the grid points only, between them to first order in the grid step
+    fine = traj.sample(dt=traj.duration / (20 * grid))
+    tau_fine = ad.inverse_dynamics(model, fine.q, fine.qd, fine.qdd)
     row = {
         "grid": grid,
+        "worst_torque_ratio_time_optimal_between_samples": float(np.max(np.abs(tau_fine) / TORQUE)),
         "duration_time_optimal_s": traj.duration,
         "duration_cvxpy_s": d_cvx,
         "duration_toppra_alone_s": d_toppra,
@@ -155,7 +165,8 @@ def measure(model, path, grid: int) -> dict:
         f"{row['time_optimal_vs_cvxpy']:+.2e}; toppra alone {d_toppra:.6f}); CPU "
         f"time_optimal {t_ours * 1e3:.1f} ms (toppra's sets {t_sets * 1e3:.1f} ms), toppra "
         f"alone {t_toppra * 1e3:.1f} ms, cvxpy {t_cvx * 1e3:.1f} ms; worst |tau|/limit: "
-        f"{row['worst_torque_ratio_time_optimal_samples']:.9f} (ours, on the samples), "
+        f"{row['worst_torque_ratio_time_optimal_samples']:.9f} (ours, on the samples; "
+        f"{row['worst_torque_ratio_time_optimal_between_samples']:.4f} between them), "
         f"{row['worst_torque_ratio_toppra_alone']:.6f} (toppra's pairs), "
         f"{row['worst_torque_ratio_toppra_alone_through_its_x']:.6f} (toppra's x), "
         f"{row['worst_torque_ratio_cvxpy']:.6f} (cvxpy)"
@@ -163,9 +174,58 @@ def measure(model, path, grid: int) -> dict:
     return row
 
 
+MOTORS = (
+    dict(torque_constant=0.1, resistance=0.5, voltage=48.0, peak_torque=1.5,
+         continuous_torque=0.5, thermal_resistance=1.5, thermal_time_constant=30.0,
+         max_winding_temperature=120.0, no_load_speed=450.0),
+    dict(torque_constant=0.05, resistance=1.0, voltage=24.0, peak_torque=0.4,
+         continuous_torque=0.15, thermal_resistance=3.0, thermal_time_constant=15.0,
+         max_winding_temperature=120.0, no_load_speed=450.0),
+)  # fmt: skip
+
+
+def cycles(dwells=(0.2, 2.0), grid: int = 500) -> list[dict]:
+    """shortest_cycle of the UR5 with motors (N = 100, η = 0.85; the larger motor on the first
+    three joints) over the path there and back."""
+    from armdyn.motion import shortest_cycle
+
+    urdf = robot_urdf("ur5")
+    b = ad.urdf_builder(str(urdf))
+    for k, joint in enumerate(ad.load_urdf(urdf).dof_names):
+        b.add_actuator(
+            joint, gear_ratio=100.0, rotor_inertia=3e-5 if k < 3 else 1e-5, efficiency=0.85,
+            motor=ad.Motor(**MOTORS[0 if k < 3 else 1]),
+        )  # fmt: skip
+    model = b.finalize()
+    w = WAYPOINTS
+    loop = MotionPath([0.0, 0.25, 0.5, 0.75, 1.0], [w[0], w[1], w[2], w[1], w[0]])
+    out = []
+    for dwell in dwells:
+        cpu, _, c = cpu_time(
+            lambda dwell=dwell: shortest_cycle(model, loop, dwell=dwell, grid=grid), 3
+        )
+        row = {
+            "dwell_s": dwell,
+            "grid": grid,
+            "cpu_s": cpu,
+            "time_optimal_duration_s": c.info["time_optimal_duration"],
+            "slowdown": c.info["slowdown"],
+            "period_s": c.info["period"],
+            "binding": list(c.info["binding"]) if c.info["binding"] else None,
+        }
+        out.append(row)
+        motion, period = row["time_optimal_duration_s"], row["period_s"]
+        print(
+            f"shortest_cycle, dwell {dwell} s: time-optimal motion {motion:.4f} s, slowdown "
+            f"{row['slowdown']:.4f}, period {period:.4f} s, binding {row['binding']}; "
+            f"CPU {cpu:.2f} s"
+        )
+    return out
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--grids", type=int, nargs="+", default=[200, 1000])
+    p.add_argument("--grids", type=int, nargs="+", default=[200, 1000, 4000])
     p.add_argument("--out", default="benchmarks/results")
     args = p.parse_args(argv)
     model = ad.load_urdf(robot_urdf("ur5"))
@@ -176,6 +236,7 @@ def main(argv=None) -> int:
         "path": "UR5, natural cubic spline through 3 waypoints (benchmarks/timing.py WAYPOINTS)",
         "limits": "joint torques [60, 60, 40, 10, 10, 10] N m, the URDF's joint speeds",
         "rows": rows,
+        "shortest_cycle": cycles(),
         "machine": machine(),
         "load_average_1min": os.getloadavg()[0],
     }

@@ -1138,6 +1138,38 @@ CASES = [
         ME,
         "hinge",
     ),
+    (
+        "least-energy-duration-nan",
+        "motion",
+        "least_energy with a NaN duration",
+        lambda: _least_energy(duration=np.nan),
+        ME,
+        "least_energy: duration must be a positive number",
+    ),
+    (
+        "least-energy-start-shape",
+        "motion",
+        "least_energy from a start of two coordinates on a one-joint model",
+        lambda: _least_energy(start=[0.0, 0.0]),
+        ME,
+        r"least_energy: start must have shape \(1,\)",
+    ),
+    (
+        "least-energy-copper-no-motor",
+        "motion",
+        "least_energy's copper loss on a joint without a motor's torque constant and resistance",
+        lambda: _least_energy(objective="copper"),
+        ME,
+        "joint 'hinge' has none",
+    ),
+    (
+        "least-energy-infeasible",
+        "motion",
+        "least_energy in less time than any motion within the torque limit takes",
+        lambda: _least_energy(duration=0.2, max_torque=0.5),
+        SE,
+        "most exceeded limit is torque of joint 'hinge'",
+    ),
     # ---- motion: joint trajectories
     (
         "p2p-start-nan",
@@ -1276,36 +1308,74 @@ CASES = [
         "dwell",
     ),
     (
-        "least-energy-duration-nan",
+        "ik-target-nan",
         "motion",
-        "least_energy with a NaN duration",
-        lambda: _least_energy(duration=np.nan),
+        "inverse_kinematics with NaN in the target pose",
+        lambda: _motion().inverse_kinematics(_arm2(), "tip", _tip_pose(y=np.nan), [0.3, 0.5]),
         ME,
-        "least_energy: duration must be a positive number",
+        r"target\[1, 3\] = .*nan",
     ),
     (
-        "least-energy-start-shape",
+        "ik-target-not-rotation",
         "motion",
-        "least_energy from a start of two coordinates on a one-joint model",
-        lambda: _least_energy(start=[0.0, 0.0]),
+        "inverse_kinematics with a scaled rotation (|R^T R - I| = 0.02)",
+        lambda: _motion().inverse_kinematics(_arm2(), "tip", _tip_pose(scale=1.01), [0.3, 0.5]),
         ME,
-        r"least_energy: start must have shape \(1,\)",
+        r"target\[:3, :3\] is not a rotation matrix",
     ),
     (
-        "least-energy-copper-no-motor",
+        "ik-unknown-frame",
         "motion",
-        "least_energy's copper loss on a joint without a motor's torque constant and resistance",
-        lambda: _least_energy(objective="copper"),
+        "inverse_kinematics of a frame the model does not have",
+        lambda: _motion().inverse_kinematics(_arm2(), "hand", _tip_pose(), [0.3, 0.5]),
         ME,
-        "joint 'hinge' has none",
+        "unknown frame 'hand'",
     ),
     (
-        "least-energy-infeasible",
+        "ik-unreachable",
         "motion",
-        "least_energy in less time than any motion within the torque limit takes",
-        lambda: _least_energy(duration=0.2, max_torque=0.5),
+        "inverse_kinematics of a target beyond the arm's reach",
+        lambda: _motion().inverse_kinematics(
+            _arm2(), "tip", _tip_pose(x=5.0), [0.3, 0.5], mask=_XY
+        ),
         SE,
-        "most exceeded limit is torque of joint 'hinge'",
+        r"no solution for frame 'tip' at position \[5\.0",
+    ),
+    (
+        "move-start-outside-limits",
+        "motion",
+        "linear_move from a start outside a joint's limits",
+        lambda: _motion().linear_move(
+            _arm2(limit=1.0), "tip", [0.0, 1.5], [1.0, 0.5, 0.0], mask=_XY
+        ),
+        ME,
+        r"q_start\[1\] = 1\.5 is outside joint 'j1'",
+    ),
+    (
+        "move-rows-not-joints",
+        "motion",
+        "linear_move of a 2-joint arm along all six rows (q(s) not unique)",
+        lambda: _motion().linear_move(_arm2(), "tip", [0.3, 0.5], [1.0, 0.5, 0.0]),
+        ME,
+        r"moved by 2 joints but the move keeps 6 rows",
+    ),
+    (
+        "arc-collinear",
+        "motion",
+        "arc_move through three points on a line",
+        lambda: _motion().arc_move(
+            _arm2(), "tip", [0.0, 0.0], [1.4, 0.0, 0.0], [1.2, 0.0, 0.0], mask=_XY
+        ),
+        ME,
+        "collinear",
+    ),
+    (
+        "move-singular",
+        "motion",
+        "linear_move beyond the stretched arm (manipulability falls below its minimum)",
+        lambda: _motion().linear_move(_arm2(), "tip", [0.0, 1.0], [2.5, 0.0, 0.0], mask=_XY),
+        SE,
+        r"singularity at s = [0-9.]+ \(position \[",
     ),
 ]
 
@@ -1321,6 +1391,36 @@ def _motion():
 def _swing(q0=0.0, q1=1.0):
     """A straight joint-space path of the pendulum's hinge from q0 to q1."""
     return ad.motion.Path([0.0, 1.0], [[q0], [q1]])
+
+
+def _motion():
+    from armdyn import motion
+
+    return motion
+
+
+_XY = [1, 1, 0, 0, 0, 0]
+
+
+def _arm2(limit=None):
+    """A planar 2R arm (links 1 m and 0.8 m, axes z) with the frame 'tip' at its end; joint
+    'j1' limited to [-limit, limit] when given."""
+    b = ad.ModelBuilder()
+    b.add_body("l0", 1.0, I3, position=(0.5, 0.0, 0.0))
+    b.add_revolute("j0", "ground", "l0", (0.0, 0.0, 0.0), (0.0, 0.0, 1.0))
+    b.add_body("l1", 1.0, I3, position=(1.4, 0.0, 0.0))
+    b.add_revolute("j1", "l0", "l1", (1.0, 0.0, 0.0), (0.0, 0.0, 1.0))
+    b.add_frame("tip", "l1", position=(1.8, 0.0, 0.0))
+    if limit is not None:
+        b.set_joint_limits("j1", -limit, limit)
+    return b.finalize()
+
+
+def _tip_pose(x=1.2, y=0.5, scale=1.0):
+    t = np.eye(4)
+    t[:3, :3] *= scale
+    t[:2, 3] = (x, y)
+    return t
 
 
 def _least_energy(**change):

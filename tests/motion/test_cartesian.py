@@ -14,7 +14,7 @@ from armdyn.motion import (
     linear_move,
     manipulability,
 )
-from armdyn.motion.ik import Task
+from armdyn.motion.ik import Task, rotation_exp, rotation_log
 from scipy.spatial.transform import Rotation, Slerp
 
 from benchmarks.common import UR5_Q0, robot_urdf
@@ -139,7 +139,7 @@ def test_ik_respects_joint_limits():
 
 def test_jdot_qdot_equals_a_difference_of_the_jacobian(ur5):
     """The exact J̇ q̇ against a central difference of armdyn.frame_jacobian (h = 1e-5: error
-    about 1e-10), on the UR5 and on a chain with a prismatic joint."""
+    about 1e-10), on the UR5 and on a chain with prismatic and cylindrical joints."""
     b = ad.ModelBuilder()
     b.add_body("a", 1.0, np.eye(3) * 0.01, position=(0.2, 0.0, 0.0))
     b.add_revolute("r1", "ground", "a", (0, 0, 0), (0, 0, 1))
@@ -147,11 +147,12 @@ def test_jdot_qdot_equals_a_difference_of_the_jacobian(ur5):
     b.add_prismatic("p2", "a", "b", (0.4, 0, 0), (1, 0, 0.5))
     b.add_body("c", 1.0, np.eye(3) * 0.01, position=(0.8, 0.0, 0.1))
     b.add_revolute("r3", "b", "c", (0.7, 0, 0), (0, 1, 0))
-    b.add_frame("tip", "c", position=(0.9, 0.1, 0.2))
+    b.add_body("d", 1.0, np.eye(3) * 0.01, position=(0.9, 0.0, 0.3))
+    b.add_cylindrical("c4", "c", "d", (0.85, 0, 0.2), (0.3, 1, 0.2))
+    b.add_frame("tip", "d", position=(0.9, 0.1, 0.4))
     rng = np.random.default_rng(3)
     for model, frame in ((ur5, "tool0"), (b.finalize(), "tip")):
         task = Task("test", model, frame)
-        assert task.exact_jdot
         n = model.n_coords
         q, qd = rng.uniform(-2, 2, (4, n)), rng.normal(size=(4, n))
         h = 1e-5
@@ -160,6 +161,28 @@ def test_jdot_qdot_equals_a_difference_of_the_jacobian(ur5):
         want = np.einsum("rij,rj->ri", (jp - jm) / (2 * h), qd)
         got = task.jdot_qdot(q, ad.frame_jacobian(model, q, frame), qd)
         np.testing.assert_allclose(got, want, rtol=0, atol=1e-8 * np.abs(want).max())
+
+
+def test_rotation_log_and_exp_equal_scipys_at_every_angle():
+    """The IK's rotation error (log) and the slerp (exp) against scipy's rotation vectors, from
+    1e-15 rad to the half turn (where the log's axis comes from the symmetric part)."""
+    rng = np.random.default_rng(11)
+    axis = rng.normal(size=(4000, 3))
+    axis /= np.linalg.norm(axis, axis=1, keepdims=True)
+    angle = np.concatenate(
+        [
+            rng.uniform(0.0, np.pi, 1000),
+            10 ** rng.uniform(-15, -1, 1000),
+            np.pi - 10 ** rng.uniform(-12, -1, 1000),
+            rng.uniform(1.5, 1.7, 1000),
+        ]
+    )
+    w = axis * angle[:, None]
+    r = Rotation.from_rotvec(w).as_matrix()
+    np.testing.assert_allclose(rotation_log(r), w, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(rotation_exp(w), r, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(rotation_log(np.diag([-1.0, -1.0, 1.0])), [0, 0, np.pi], atol=1e-15)
+    assert not np.any(rotation_log(np.eye(3)))
 
 
 # ---- linear moves
@@ -192,7 +215,21 @@ def test_linear_move_stays_on_the_line_at_any_s(ur5):
     np.testing.assert_allclose(
         path.manipulability, np.abs(np.linalg.det(ad.frame_jacobian(ur5, path.q, "tool0")))
     )
-    assert path.info["min_manipulability"] == path.manipulability.min()
+    assert path.info["lowest_manipulability"] == path.manipulability.min()
+
+
+def test_a_path_evaluates_the_same_from_several_threads(ur5):
+    from concurrent.futures import ThreadPoolExecutor
+
+    q0, _, t1 = _ur5_move(ur5)
+    path = linear_move(ur5, "tool0", q0, t1)
+    grids = [np.linspace(0.0, 1.0, 301) ** k for k in (1, 2, 3, 4)]
+    serial = [path.evaluate(g) for g in grids]
+    with ThreadPoolExecutor(4) as pool:
+        parallel = list(pool.map(path.evaluate, grids * 3))
+    for got, want in zip(parallel, serial * 3, strict=True):
+        for a, b in zip(got, want, strict=True):
+            np.testing.assert_array_equal(a, b)
 
 
 def test_linear_move_derivatives_equal_finite_differences(ur5):
@@ -375,6 +412,23 @@ def test_a_move_blocked_by_a_joint_limit_names_the_first_unreachable_point():
     np.testing.assert_allclose([x, y, z], [1.5 - 0.6 * s, 0.0, 0.0], atol=1e-6)
 
 
+def test_a_limit_crossed_between_two_knots_is_caught_by_the_midpoint_check():
+    """A chord of the 2R arm's reach circle: |p| is smallest at s = 0.5, so the elbow bends
+    most there (q2 = 1.180 against 1.118 at the ends, closed form); with the only knots at the
+    ends (within j1's upper limit 1.15), the midpoint's exact evaluation finds the limit
+    crossed."""
+    model = _planar(2, limits={"j1": (-1.15, 1.15)})
+    q_start = _two_link(np.array([1.5, -0.3]), 1)
+    assert q_start[1] == pytest.approx(np.arccos((1.5**2 + 0.3**2 - L1**2 - L2**2) / 1.6))
+    with pytest.raises(ad.SolverError, match=r"at s = 0\.5 joint 'j1' leaves its limits") as err:
+        linear_move(model, "tip", q_start, [1.5, 0.3, 0.0], mask=XY, samples=2, max_joint_step=1.0)
+    q_mid = float(str(err.value).split("(q = ")[1].rstrip(")"))
+    assert q_mid == pytest.approx(np.arccos((1.5**2 - L1**2 - L2**2) / 1.6), abs=1e-8)
+    # up to y = -0.22 (|p|² = 2.2984 > L1² + L2² + 2 L1 L2 cos 1.15 = 2.2936): within the limit
+    ok = linear_move(model, "tip", q_start, [1.5, -0.22, 0.0], mask=XY)
+    assert 1.14 < ok.q[-1, 1] < 1.15
+
+
 def test_an_unreachable_ur5_target_is_refused_with_where(ur5):
     q0, t0, _ = _ur5_move(ur5)
     with pytest.raises(ad.SolverError, match=r"at s = 0\.[0-9]+.*position \["):
@@ -433,8 +487,10 @@ def test_bad_target_poses_are_refused(ur5, kind, pattern):
         (lambda m, t: manipulability(m, np.zeros((2, 5)), "tool0"), r"q must have shape"),
         (lambda m, t: linear_move(m, "tool0", [7.0, 0, 0, 0, 0, 0], t), r"outside joint"),
         (lambda m, t: linear_move(m, "tool0", UR5_Q0, t, samples=1), r"samples must be"),
+        (lambda m, t: linear_move(m, "tool0", UR5_Q0, t, samples=10**6), r"samples must be"),
+        (lambda m, t: linear_move(m, "tool0", UR5_Q0, [0, 0, 1e10]), r"farther than 1e\+09 m"),
         (lambda m, t: linear_move(m, "tool0", UR5_Q0, t, samples=3, max_step=0.1), r"at most one"),
-        (lambda m, t: linear_move(m, "tool0", UR5_Q0, t, max_step=1e-9), r"> 1e6"),
+        (lambda m, t: linear_move(m, "tool0", UR5_Q0, t, max_step=1e-9), r"at most 10000"),
         (lambda m, t: linear_move(m, "tool0", UR5_Q0, t, orientation="lerp"), r"orientation"),
         (lambda m, t: linear_move(m, "tool0", UR5_Q0, t, mask=XY), r"moved by 6 joints .* 2 rows"),
         (lambda m, t: linear_move(m, "tool0", UR5_Q0, t, min_manipulability=np.inf), "min_manip"),
@@ -446,6 +502,30 @@ def test_hostile_arguments_are_named(ur5, call, pattern):
     target = ad.frame_pose(ur5, np.array(UR5_Q0) + 0.05, "tool0")
     with pytest.raises(ad.ModelError, match=pattern):
         call(ur5, target)
+
+
+def test_panda_redundant_ik_round_trip_within_its_limits():
+    """7 joints for 6 rows: the least-norm steps reach the pose (within the Panda's tight
+    limits); a Cartesian path, which needs a unique q(s), is refused with what to change."""
+    path = robot_urdf("panda")
+    if path is None:
+        pytest.skip("example-robot-data is not installed")
+    panda = ad.load_urdf(path)
+    rng = np.random.default_rng(5)
+    lo, hi = panda.coord_lower, panda.coord_upper
+    for _ in range(6):
+        q = lo + (hi - lo) * rng.uniform(0.1, 0.9, panda.n_coords)
+        target = ad.frame_pose(panda, q, "panda_hand_tcp")
+        start = np.clip(q + rng.normal(0.0, 0.15, panda.n_coords), lo, hi)
+        r = inverse_kinematics(panda, "panda_hand_tcp", target, start)
+        np.testing.assert_allclose(
+            ad.frame_pose(panda, r.q, "panda_hand_tcp"), target, rtol=0, atol=1e-12
+        )
+        assert np.all(r.q >= lo) and np.all(r.q <= hi)
+        j = ad.frame_jacobian(panda, r.q, "panda_hand_tcp")
+        assert r.manipulability == pytest.approx(np.sqrt(np.linalg.det(j @ j.T)), rel=1e-10)
+    with pytest.raises(ad.ModelError, match=r"moved by 7 joints but the move keeps 6 rows"):
+        linear_move(panda, "panda_hand_tcp", r.q, target[:3, 3] + 0.01)
 
 
 def test_degenerate_moves_are_refused(ur5):
@@ -465,6 +545,21 @@ def test_degenerate_moves_are_refused(ur5):
         path.evaluate([0.5, 1.2])
     with pytest.raises(ad.ModelError, match="s"):
         path.evaluate([np.nan])
+
+
+def test_a_coupled_joint_on_the_chain_is_refused():
+    b = ad.ModelBuilder()
+    b.add_body("a", 1.0, np.eye(3) * 0.01, position=(0.5, 0.0, 0.0))
+    b.add_revolute("j0", "ground", "a", (0, 0, 0), (0, 0, 1))
+    b.add_body("b", 1.0, np.eye(3) * 0.01, position=(1.5, 0.0, 0.0))
+    b.add_revolute("j1", "a", "b", (1, 0, 0), (0, 0, 1))
+    b.add_coupling("c", "j1", "j0", 2.0)
+    b.add_frame("tip", "b", position=(2, 0, 0))
+    model = b.finalize()
+    with pytest.raises(
+        ad.ModelError, match=r"joint 'j1', which moves frame 'tip', follows joint 'j0'"
+    ):
+        inverse_kinematics(model, "tip", _pose([1.0, 1.0]), np.zeros(model.n_coords), mask=XY)
 
 
 def test_a_floating_model_is_refused():

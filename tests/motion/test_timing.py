@@ -194,6 +194,16 @@ def test_one_joint_constant_torque_limit_is_bang_bang(q_end):
     np.testing.assert_allclose(np.abs(tau[:-1, 0]), tau_max, rtol=1e-10)
 
 
+def test_a_given_uneven_grid_is_used_as_it_is():
+    """A cosine-spaced grid (denser at the ends, s = 1/2 on it): the samples are at those
+    path parameters and the bang-bang time is still exact."""
+    grid = 0.5 - 0.5 * np.cos(np.pi * np.arange(81) / 80)
+    grid[0], grid[-1] = 0.0, 1.0
+    traj = time_optimal(arm(), segment(1.5), max_torque=3.0, max_velocity=np.inf, grid=grid)
+    np.testing.assert_array_equal(traj.info["grid"], grid)
+    assert traj.duration == pytest.approx(2 * np.sqrt(1.5 * INERTIA / 3.0), rel=1e-12)
+
+
 def test_spring_torque_is_in_the_static_term_and_dampers_are_refused():
     """A joint spring (k = 4 N m/rad) adds k q to the torque: the limit holds with it, checked
     by an independent inverse dynamics, and binds; a damper (velocity-dependent) is refused."""
@@ -375,13 +385,30 @@ def test_shortest_cycle_winding_temperature_binds_as_in_closed_form():
 
 
 def test_shortest_cycle_is_the_time_optimal_one_when_the_thermal_limits_are_loose():
-    model = _geared(1.0, J_ROT, N_GEAR, peak_torque=T_PEAK, continuous_torque=1.0)
+    """η = 0.8: the arrival brakes through the gear's regenerating branch; the cycle's samples
+    keep it (a sample at rest with the braking torque would take the motoring branch and exceed
+    the peak by 1/η²)."""
+    model = _geared(0.8, J_ROT, N_GEAR, peak_torque=T_PEAK, continuous_torque=1.0)
     cycle = shortest_cycle(
         model, segment(Q_END), dwell=DWELL, max_torque=np.inf, max_velocity=np.inf, grid=200
     )
     assert cycle.info["slowdown"] == 1.0
     assert cycle.info["binding"] == ("j", "peak_torque")
     assert cycle.info["margins"][("j", "peak_torque")] == pytest.approx(1.0, rel=1e-9)
+
+
+def test_shortest_cycle_limited_by_a_joint_limit_has_no_motor_binding():
+    """A joint torque limit (0.5 N m) below what the motor gives: the time-optimal cycle is the
+    shortest, no motor check binds (binding None), every motor margin above 1."""
+    model = _geared(0.8, J_ROT, N_GEAR, peak_torque=T_PEAK, continuous_torque=1.0)
+    cycle = shortest_cycle(
+        model, segment(Q_END), dwell=DWELL, max_torque=0.5, max_velocity=np.inf, grid=200
+    )
+    assert cycle.info["slowdown"] == 1.0 and cycle.info["binding"] is None
+    assert np.nanmin(list(cycle.info["margins"].values())) > 1.0 + 1e-6
+    assert cycle.info["time_optimal_duration"] == pytest.approx(
+        2 * np.sqrt(Q_END * (INERTIA + N_GEAR**2 * J_ROT) / 0.5), rel=1e-12
+    )
 
 
 def test_shortest_cycle_that_cannot_hold_in_the_dwell_names_the_check():
@@ -429,6 +456,35 @@ def test_an_end_pose_that_cannot_be_held_is_infeasible_and_named():
         time_optimal(model, segment(0.5, -np.pi / 2 + 0.1), max_torque=8.0, grid=100)
 
 
+def test_holding_at_the_end_takes_the_motoring_branch_of_the_gear():
+    """Lifting the link to horizontal through a gear of η = 0.5: holding it there at rest takes
+    m g L / (N η) = 0.3924 N m from the motor (the gear drives the load: motoring, whatever the
+    sign), above the 0.9 × that peak torque, though the gear's other branch (m g L η / N) would
+    fit: infeasible, named at the end."""
+    n, eta = 50.0, 0.5
+    hold = MASS * 9.81 * ARM / (n * eta)
+    model = arm(
+        dict(
+            gear_ratio=n, rotor_inertia=1e-5, efficiency=eta, motor=ad.Motor(peak_torque=0.9 * hold)
+        ),
+        axis=(0, 1, 0),
+    )
+    with pytest.raises(ad.SolverError, match=r"s = 1 .*motor peak torque 'j' at rest is -?0\.3924"):
+        time_optimal(model, segment(0.0, -1.2), max_velocity=np.inf, max_torque=np.inf, grid=100)
+    # with the peak above the hold, the motion is feasible and the end sample holds within it
+    model = arm(
+        dict(
+            gear_ratio=n, rotor_inertia=1e-5, efficiency=eta, motor=ad.Motor(peak_torque=1.1 * hold)
+        ),
+        axis=(0, 1, 0),
+    )
+    traj = time_optimal(model, segment(0.0, -1.2), max_velocity=np.inf, max_torque=np.inf, grid=100)
+    tau = ad.inverse_dynamics(model, traj.q, traj.qd, traj.qdd)
+    side = motor_side(model.actuators[0], traj.t, traj.qd[:, 0], traj.qdd[:, 0], tau[:, 0])
+    assert np.max(np.abs(side.torque)) <= 1.1 * hold * (1 + 1e-6)
+    assert abs(side.torque[-1]) == pytest.approx(hold, rel=1e-9)
+
+
 def test_ur5_static_torque_above_the_limit_names_the_joint(ur5, ur5_path):
     q0 = UR5_WAYPOINTS[0]
     hold = ad.inverse_dynamics(ur5, q0, np.zeros(6), np.zeros(6))
@@ -472,6 +528,8 @@ def test_hostile_paths_and_models(ur5_path):
         time_optimal(model, np.zeros((2, 1)))
     with pytest.raises(ad.ModelError, match="the path has 6 joints, the model 1"):
         time_optimal(model, ur5_path)
+    with pytest.raises(ad.ModelError, match=r"the path's joints \['k'\] are not the model's"):
+        time_optimal(model, Path([0.0, 1.0], [[0.0], [1.0]], names=["k"]))
     with pytest.raises(ad.ModelError, match="does not move"):
         time_optimal(model, Path([0.0, 1.0], [[0.2], [0.2]]), max_torque=1.0)
     with pytest.raises(ad.ModelError, match=r"the path's dq/ds\[0, 0\]"):

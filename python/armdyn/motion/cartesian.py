@@ -13,13 +13,24 @@ from __future__ import annotations
 
 import numpy as np
 import numpy.typing as npt
-from scipy.spatial.transform import Rotation
 
 from armdyn import _checks, _core
-from armdyn.motion.ik import ROWS, Task, check_pose, pose_error, solve
+
+__all__ = ["CartesianPath", "arc_move", "linear_move"]
+from armdyn.motion.ik import (
+    ROWS,
+    Task,
+    check_pose,
+    check_position,
+    pose_error,
+    rotation_exp,
+    rotation_log,
+    solve,
+)
 from armdyn.motion.trajectory import Path
 
 _MIN_DS = 1e-7  # the smallest knot spacing the refinement tries before giving up
+_MAX_KNOTS = 10_000  # each costs about a millisecond of inverse kinematics
 
 
 class _Geometry:
@@ -29,7 +40,7 @@ class _Geometry:
 
     def __init__(self, r0: np.ndarray, r1: np.ndarray, who: str) -> None:
         self.r0 = r0
-        self.phi = Rotation.from_matrix(r1 @ r0.T).as_rotvec()
+        self.phi = rotation_log(r1 @ r0.T)
         if np.linalg.norm(self.phi) > np.pi - 1e-6:
             raise _core.ModelError(
                 f"{who}: the target's orientation is a half turn from the start's: the slerp "
@@ -48,7 +59,7 @@ class _Geometry:
         """``(p (r, 3), R (r, 3, 3), xi (r, 6), xi' (r, 6))``: the pose at ``s`` and the frame's
         twist per unit s ``[dp/ds; w]`` and its s-derivative."""
         p, dp, ddp = self.position(s)
-        r = Rotation.from_rotvec(s[:, None] * self.phi).as_matrix() @ self.r0
+        r = rotation_exp(s[:, None] * self.phi) @ self.r0
         w = np.broadcast_to(self.phi, p.shape)
         xi = np.concatenate([dp, w], axis=1)
         dxi = np.concatenate([ddp, np.zeros_like(ddp)], axis=1)
@@ -108,10 +119,12 @@ class CartesianPath(Path):
     """A joint :class:`~armdyn.motion.Path` that moves a frame along a Cartesian line or arc.
 
     Besides the knots ``s`` and their configurations ``q``: ``poses`` (m, 4, 4) the frame's
-    target pose at each knot (the frame is there to the solver's tolerance) and
+    target pose at each knot (the frame is there to the solver's tolerance in the rows the
+    ``mask`` keeps) and
     ``manipulability`` (m,) at each knot (over the kept rows). :meth:`evaluate` is exact at
-    any ``s`` (inverse kinematics there); ``info`` holds the method, frame, length [m],
-    rotation [rad], the lowest manipulability and the knots the step limiting added.
+    any ``s`` (inverse kinematics there). ``info``: ``method``, ``frame``, ``length`` [m],
+    ``rotation`` [rad], ``lowest_manipulability`` (over the knots), ``refined_knots`` (the
+    knots the step limiting added), ``mask`` (the rows followed), ``tol``, ``max_joint_step``.
     """
 
     __slots__ = ("_dq", "_geometry", "_min", "_task", "_tol", "manipulability", "poses")
@@ -155,7 +168,7 @@ def _newton_rows(task: Task, p, r, q0: np.ndarray, tol: float, s: np.ndarray) ->
     k = int(todo[0]) if len(todo) else 0
     raise _core.SolverError(
         f"{task.who}: the inverse kinematics at s = {s[k]:.9g} (position "
-        f"{np.round(p[k], 6).tolist()}) does not converge from the nearest knot"
+        f"{np.round(p[k], 6).tolist()}) does not converge to tol = {tol:g} from the nearest knot"
     )
 
 
@@ -209,14 +222,17 @@ def _grid(who: str, geo: _Geometry, samples, max_step, max_joint_step: float) ->
     if samples is not None and max_step is not None:
         raise _core.ModelError(f"{who}: give at most one of samples and max_step")
     if samples is not None:
-        count = _checks.integer(who, "samples", samples, lo=2, hi=1_000_000)
+        count = _checks.integer(who, "samples", samples, lo=2, hi=_MAX_KNOTS)
     else:
         step = _checks.number(
             who, "max_step", 0.01 if max_step is None else max_step, lo=0.0, lo_open=True
         )
         need = max(geo.length / step, geo.angle / max_joint_step)
-        if need > 1_000_000:
-            raise _core.ModelError(f"{who}: max_step = {step:g} m gives {need:.3g} knots (> 1e6)")
+        if need >= _MAX_KNOTS:
+            raise _core.ModelError(
+                f"{who}: max_step = {step:g} m (and max_joint_step = {max_joint_step:g} for the "
+                f"rotation) gives {need:.3g} knots (at most {_MAX_KNOTS})"
+            )
         count = max(2, int(np.ceil(need - 1e-9)) + 1)
     return np.linspace(0.0, 1.0, count)
 
@@ -252,7 +268,7 @@ class _Knots:
         self.det.append(float(det[0]))
 
 
-def _unreachable(task, geo, s, q, e, knots) -> _core.SolverError:
+def _unreachable(task, geo, s, q, e, knots, tol) -> _core.SolverError:
     p = geo.at(np.array([s]))[0][0]
     pos = np.linalg.norm(e[task.rows < 3]) if np.any(task.rows < 3) else 0.0
     rot = np.linalg.norm(e[task.rows >= 3]) if np.any(task.rows >= 3) else 0.0
@@ -261,8 +277,8 @@ def _unreachable(task, geo, s, q, e, knots) -> _core.SolverError:
     return _core.SolverError(
         f"{task.who}: the pose at s = {s:.9g} (position {np.round(p, 6).tolist()} m) is "
         f"unreachable from the path so far (inverse kinematics residual {pos:.3g} m, "
-        f"{rot:.3g} rad{held}; the last solved knot s = {knots.s[-1]:.9g} has manipulability "
-        f"{knots.m[-1]:.3g})"
+        f"{rot:.3g} rad, tol = {tol:g}{held}; the last solved knot s = {knots.s[-1]:.9g} has "
+        f"manipulability {knots.m[-1]:.3g})"
     )
 
 
@@ -294,7 +310,12 @@ def _solve_knots(task, geo, q_start, grid, *, tol, max_joint_step, min_manip):
                     f"m over ds = {s1 - s0:.3g}): the branch is lost near a singularity "
                     f"(manipulability {knots.m[-1]:.3g} at s = {s0:.9g})"
                 )
-            raise _unreachable(task, geo, s1, q, e, knots)
+            raise _unreachable(task, geo, s1, q, e, knots, tol)
+        if len(planned) + 1 >= _MAX_KNOTS:
+            raise _core.SolverError(
+                f"{task.who}: the step limiting needs more than {_MAX_KNOTS} knots (at s = "
+                f"{s0:.9g}, max_joint_step = {max_joint_step:g}): raise max_joint_step"
+            )
         planned.insert(k, 0.5 * (s0 + s1))
         added += 1
     return knots, added
@@ -329,7 +350,9 @@ def _build(who, model, frame, q_start, make_geometry, options) -> CartesianPath:
         frame=task.frame,
         length=geo.length,
         rotation=geo.angle,
-        min_manipulability=float(np.min(path.manipulability)),
+        lowest_manipulability=float(np.min(path.manipulability)),
+        tol=tol,
+        max_joint_step=max_joint_step,
         refined_knots=added,
         mask=[ROWS[i] for i in task.rows],
     )
@@ -364,8 +387,7 @@ def _target(who: str, target, r0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """A 4x4 pose, or a position (3,) that keeps the start's orientation."""
     a = _checks.array(who, "target", target)
     if a.shape == (3,):
-        _checks.finite_entries(who, "target", a)
-        return a.copy(), r0
+        return check_position(who, "target", a), r0
     return check_pose(who, "target", a)
 
 
@@ -392,20 +414,26 @@ def linear_move(
     axis), both linear in ``s``.
 
     Args:
-        model: a fixed-base :class:`armdyn.Model` (coordinates = rates, no couplings).
+        model: a fixed-base :class:`armdyn.Model` (coordinates = rates; no joint between the
+            frame and the ground may follow another through a coupling).
         frame: a name or an index of ``model.frame_names``.
         q_start: where the move starts (n_coords,), within the joint limits.
         target: the end pose (4, 4) ``[R p; 0 0 0 1]``, or a position (3,) keeping the start's
             orientation.
-        samples: the number of evenly spaced first knots (at least 2); or
+        samples: the number of evenly spaced first knots (2 to 10000); or
         max_step: the largest step of the frame between first knots [m] (default 0.01;
             rotations in steps of at most ``max_joint_step`` rad). Knots are then added where
-            the joints move more than ``max_joint_step`` between two (step limiting).
+            the joints move more than ``max_joint_step`` between two, or stray from the
+            previous knot's tangent by more than half that (step limiting; at most 10000
+            knots in all, SolverError beyond). Between the knots, each midpoint is evaluated
+            once more to check that it stays on the branch and within the joint limits.
         orientation: ``"slerp"`` (the only interpolation).
         max_joint_step: the largest joint step between knots [rad or m]: keeps the branch
             continuous (a larger step, or one far from the tangent prediction, is halved).
-        min_manipulability: SolverError at a knot whose manipulability is below this
-            (a singularity on the way, or the workspace's boundary).
+        min_manipulability: SolverError where the manipulability (``|det J|``, J the kept rows
+            and the moving joints) is below this, at a knot or wherever the path is evaluated
+            (a singularity on the way, or the workspace's boundary); and wherever det J changes
+            sign between two knots (a singularity crossed between them), whatever this is.
         tol: the inverse kinematics tolerance, at the knots and wherever the path is evaluated
             [m and rad].
         mask: the rows of ``[vx, vy, vz, wx, wy, wz]`` to follow (6 booleans), as many as
@@ -417,8 +445,9 @@ def linear_move(
 
     Raises:
         ModelError: a bad argument (named), a half-turn rotation (no unique slerp axis).
-        SolverError: the first unreachable pose (``s`` and position), a singularity (the first
-            knot below ``min_manipulability``) or the joint path jumping (branch lost).
+        SolverError: the first unreachable pose (``s`` and position), the first singularity
+            (``s`` and position, or the two knots around it) or the joint path jumping (the
+            branch lost).
     """
     who = "linear_move"
     _checks.choice(who, "orientation", orientation, ("slerp",))
@@ -465,7 +494,7 @@ def arc_move(
         v = _checks.array(who, "via", via)
         if v.shape != (3,):
             raise _core.ModelError(f"{who}: via must be a position (3,), got shape {v.shape}")
-        _checks.finite_entries(who, "via", v)
+        v = check_position(who, "via", v)
         p1, r1 = _target(who, target, r0)
         return _Arc(p0, v, p1, r0, r1, who)
 

@@ -18,10 +18,13 @@ import numpy.typing as npt
 
 from armdyn import _checks, _core
 
+__all__ = ["IKResult", "inverse_kinematics", "manipulability"]
+
 #: the rows of a frame Jacobian and of a pose error, in order
 ROWS = ("vx", "vy", "vz", "wx", "wy", "wz")
 _ROTATION_TOL = 1e-9  # |R^T R - I| a target's rotation may have (it is then projected)
-_ONE_DOF = ("revolute", "prismatic")
+_FAR = 1e9  # [m] no target position beyond this (the errors' squares would overflow long before)
+_COORDS = {"revolute": 1, "prismatic": 1, "cylindrical": 2}  # the joints frame_jacobian takes
 
 
 @dataclass(frozen=True)
@@ -40,8 +43,8 @@ class IKResult:
 
 
 def check_model(who: str, model) -> None:
-    """ModelError unless ``model`` is a fixed-base tree without couplings (its coordinates are
-    its rates: the only models whose joint paths ``q(s)`` are vectors)."""
+    """ModelError unless ``model`` is a fixed-base tree (its coordinates are its rates: the only
+    models whose joint paths ``q(s)`` are vectors)."""
     if not isinstance(model, _core.Model):
         raise _checks.ArgumentTypeError(
             f"{who}: model must be an armdyn.Model, got {type(model).__name__}"
@@ -52,10 +55,9 @@ def check_model(who: str, model) -> None:
             "floating base or a spherical joint's quaternion); Cartesian motion needs a model "
             "whose coordinates are its rates"
         )
-    if len(model.couplings) or not model.is_tree:
+    if not model.is_tree:
         raise _core.ModelError(
-            f"{who}: the model has couplings or closed loops; inverse kinematics needs a tree "
-            "of independent joints"
+            f"{who}: the model has closed loops; inverse kinematics needs a tree of joints"
         )
 
 
@@ -96,10 +98,20 @@ def check_mask(who: str, mask) -> np.ndarray:
     return rows
 
 
+def check_position(who: str, name: str, p: np.ndarray) -> np.ndarray:
+    """A position (3,): finite and within 1e9 m of the world origin."""
+    _checks.finite_entries(who, name, p)
+    if np.max(np.abs(p)) > _FAR:
+        raise _core.ModelError(
+            f"{who}: {name} = {p.tolist()} is farther than {_FAR:g} m from the world origin"
+        )
+    return p.copy()
+
+
 def check_pose(who: str, name: str, pose) -> tuple[np.ndarray, np.ndarray]:
     """``(p (3,), R (3, 3))`` of a homogeneous transform ``pose`` (4, 4): finite, last row
     ``[0, 0, 0, 1]``, ``R`` a rotation to 1e-9 (``|R^T R - I|``, det +1), projected onto the
-    nearest rotation."""
+    nearest rotation; ``p`` within 1e9 m of the origin."""
     a = _checks.array(who, name, pose)
     if a.shape != (4, 4):
         raise _core.ModelError(f"{who}: {name} must be a 4x4 pose [R p; 0 0 0 1], got {a.shape}")
@@ -116,7 +128,7 @@ def check_pose(who: str, name: str, pose) -> tuple[np.ndarray, np.ndarray]:
     if np.linalg.det(r) < 0.0:
         raise _core.ModelError(f"{who}: {name}[:3, :3] is a reflection (det = -1), not a rotation")
     u, _, vt = np.linalg.svd(r)
-    return a[:3, 3].copy(), u @ vt
+    return check_position(who, f"{name}[:3, 3]", a[:3, 3]), u @ vt
 
 
 def rotation_log(r: np.ndarray) -> np.ndarray:
@@ -147,6 +159,20 @@ def rotation_log(r: np.ndarray) -> np.ndarray:
     return w
 
 
+def rotation_exp(w: np.ndarray) -> np.ndarray:
+    """The rotation matrices (..., 3, 3) of rotation vectors ``w`` (..., 3) (Rodrigues: ``I +
+    sin(t)/t [w]x + (1 - cos(t))/t² [w]x²``, t = |w|, by their series below t = 1e-4)."""
+    t = np.linalg.norm(w, axis=-1)[..., None, None]
+    small = t < 1e-4
+    safe = np.where(small, 1.0, t)
+    a = np.where(small, 1.0 - t**2 / 6.0, np.sin(safe) / safe)
+    b = np.where(small, 0.5 - t**2 / 24.0, (1.0 - np.cos(safe)) / safe**2)
+    k = np.zeros((*w.shape[:-1], 3, 3))
+    k[..., 0, 1], k[..., 0, 2], k[..., 1, 2] = -w[..., 2], w[..., 1], -w[..., 0]
+    k[..., 1, 0], k[..., 2, 0], k[..., 2, 1] = w[..., 2], -w[..., 1], w[..., 0]
+    return np.eye(3) + a * k + b * (k @ k)
+
+
 def pose_error(poses: np.ndarray, p: np.ndarray, r: np.ndarray) -> np.ndarray:
     """``[p* - p; log(R* R^T)]`` (..., 6) of frame poses (..., 4, 4) against targets ``p``
     (..., 3) and ``R`` (..., 3, 3)."""
@@ -170,27 +196,35 @@ def _rotation_log_one(r: np.ndarray) -> np.ndarray:
     return np.array([scale * v[0], scale * v[1], scale * v[2]])
 
 
-def _chain_order(model, frame: str) -> list[int] | None:
-    """The coordinates of the joints between ground and ``frame``, root first, when every one
-    of them is a revolute or prismatic joint (None otherwise)."""
+def _chain_order(who: str, model, frame: str) -> list[int] | None:
+    """The coordinates of the joints between ground and ``frame``, root first (None when one of
+    them is not a revolute, prismatic, cylindrical or fixed joint); ModelError when one of them
+    follows another joint through a coupling (its motion is then in the leader's column)."""
     by_child = {}
     for name in model.joint_names:
         jf = model.joint_frame(name)
-        by_child[jf["child"]] = jf
+        by_child[jf["child"]] = (name, jf)
+    followers = {c["follower"]: c for c in model.couplings}
     body, order = model.frame(frame)["body"], []
     while body != "ground" and body in by_child:
-        jf = by_child[body]
+        name, jf = by_child[body]
+        if name in followers:
+            raise _core.ModelError(
+                f"{who}: joint {name!r}, which moves frame {frame!r}, follows joint "
+                f"{followers[name]['leader']!r} through a coupling; inverse kinematics needs "
+                "independent joints between the frame and the ground"
+            )
         if jf["coord"] >= 0:
-            if jf["type"] not in _ONE_DOF:
+            if jf["type"] not in _COORDS:
                 return None
-            order.append(int(jf["coord"]))
+            order += [int(jf["coord"]) + k for k in range(_COORDS[jf["type"]])][::-1]
         body = jf["parent"]
     return order[::-1]
 
 
 class Task:
-    """A frame of a model, checked once: its name, the error rows kept, the joint limits, the
-    coordinates that move it (``chain``, root first) and how ``J̇ q̇`` is computed."""
+    """A frame of a model, checked once: its name, the error rows kept, the joint limits and the
+    coordinates that move it (``chain``, root first)."""
 
     def __init__(self, who: str, model, frame, mask=None) -> None:
         check_model(who, model)
@@ -201,20 +235,28 @@ class Task:
         self.lower = np.asarray(model.coord_lower, dtype=float)
         self.upper = np.asarray(model.coord_upper, dtype=float)
         self.names = list(model.coord_names)
-        self.data = _core.Data(model)
-        j = self.jacobian(np.zeros(self.n))
+        try:
+            j = self.jacobian(np.zeros(self.n))
+        except _core.ModelError as err:
+            raise _core.ModelError(f"{who}: {err}") from None
         moved = np.flatnonzero(np.any(j != 0.0, axis=0))
-        order = _chain_order(model, self.frame)
-        self.exact_jdot = order is not None and sorted(order) == list(moved)
-        self.chain = np.asarray(order if self.exact_jdot else moved, dtype=int)
+        order = _chain_order(who, model, self.frame)
+        if order is None or sorted(order) != list(moved):  # pragma: no cover - frame_jacobian
+            raise _core.ModelError(  # refuses these models first
+                f"{who}: the joints that move frame {self.frame!r} are not a chain of revolute, "
+                "prismatic and cylindrical joints"
+            )
+        self.chain = np.asarray(order, dtype=int)
         if len(self.chain) == 0:
             raise _core.ModelError(f"{who}: frame {self.frame!r} is not moved by any joint")
 
+    # without data=: the core keeps one workspace per thread, so a path evaluates safely from
+    # several threads
     def pose(self, q: np.ndarray) -> np.ndarray:
-        return _core.frame_pose(self.model, q, self.frame, data=self.data)
+        return _core.frame_pose(self.model, q, self.frame)
 
     def jacobian(self, q: np.ndarray) -> np.ndarray:
-        return _core.frame_jacobian(self.model, q, self.frame, data=self.data)
+        return _core.frame_jacobian(self.model, q, self.frame)
 
     def at_limits(self, q: np.ndarray) -> tuple[str, ...]:
         hit = (q <= self.lower) | (q >= self.upper)
@@ -246,19 +288,17 @@ class Task:
 
     def jdot_qdot(self, q: np.ndarray, j: np.ndarray, qd: np.ndarray) -> np.ndarray:
         """``J̇ q̇`` (rows, 6) at configurations ``q`` (rows, n) with Jacobians ``j`` (rows, 6, n),
-        rates ``qd`` (rows, n): the frame's classical acceleration at ``q̈ = 0``.
+        rates ``qd`` (rows, n): the frame's classical acceleration at ``q̈ = 0``, exact.
 
-        Exact on a chain of revolute and prismatic joints (root first): column ``i``, ``[a_i;
-        w_i]`` (for a revolute joint ``a_i = w_i x (p - r_i)``; prismatic: ``a_i`` the axis,
-        ``w_i = 0``), moves with the body before the joint (angular velocity ``W_i = sum_{k<i} w_k
-        q̇_k``) while the frame's origin moves relative to the joint's axis point at ``W_i x (p -
-        r_i) + V_i``, ``V_i = sum_{k>=i} a_k q̇_k``; so ``ẇ_i = W_i x w_i`` and ``ȧ_i = W_i x
-        a_i + w_i x V_i`` (the Jacobi identity folds ``ẇ_i x (p - r_i) + w_i x (W_i x (p -
-        r_i))`` into ``W_i x a_i``). Other joints: the central difference of ``J`` along ``q̇``
-        with the step ``h = 6e-6 / |q̇|`` (``h |q̇| ≈ eps^(1/3)``, which balances the O(h²)
-        truncation against the O(eps / h) round-off: about 1e-11 relative)."""
-        if not self.exact_jdot:
-            return self._jdot_qdot_difference(q, qd)
+        Along the chain (root first), column ``i`` is ``[a_i; w_i]``: a rotation about the
+        unit axis ``w_i`` through the point ``r_i`` has ``a_i = w_i x (p - r_i)``, a slide
+        along ``a_i`` has ``w_i = 0`` (a cylindrical joint is both, about the same axis). The
+        axis turns with the body before the joint (angular velocity ``W_i = sum_{k<i} w_k
+        q̇_k``) and the frame's origin moves relative to the axis point at ``W_i x (p - r_i) +
+        V_i`` with ``V_i = sum_{k>=i} a_k q̇_k``; so ``ẇ_i = W_i x w_i`` and ``ȧ_i = W_i x a_i +
+        w_i x V_i`` (the Jacobi identity folds ``ẇ_i x (p - r_i) + w_i x (W_i x (p - r_i))``
+        into ``W_i x a_i``). The two columns of a cylindrical joint share their axis, so their
+        order does not matter (``w x w = 0``)."""
         c = self.chain
         jc, qc = j[:, :, c], qd[:, c][:, None, :]
         a, w = jc[:, :3, :], jc[:, 3:, :]
@@ -268,12 +308,6 @@ class Task:
         da = np.cross(before, a, axis=1) + np.cross(w, after, axis=1)
         dw = np.cross(before, w, axis=1)
         return np.concatenate([np.sum(da * qc, axis=2), np.sum(dw * qc, axis=2)], axis=1)
-
-    def _jdot_qdot_difference(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
-        size = np.max(np.abs(qd), axis=1, keepdims=True)
-        h = 6e-6 / np.where(size > 0.0, size, 1.0)
-        jp, jm = self.jacobian(q + h * qd), self.jacobian(q - h * qd)
-        return np.einsum("rij,rj->ri", (jp - jm) / (2.0 * h[:, :, None]), qd)
 
 
 def _damped_step(j: np.ndarray, e: np.ndarray, lam: float) -> np.ndarray:
@@ -369,7 +403,8 @@ def inverse_kinematics(
     descent reaches from ``q0`` (no restarts: give a ``q0`` near the branch you want).
 
     Args:
-        model: a fixed-base :class:`armdyn.Model` (coordinates = rates, no couplings).
+        model: a fixed-base :class:`armdyn.Model` (coordinates = rates; no joint between the
+            frame and the ground may follow another through a coupling).
         frame: a name or an index of ``model.frame_names``.
         target: the frame's world pose (4, 4) ``[R p; 0 0 0 1]``; ``R`` must be a rotation
             to 1e-9.
@@ -406,8 +441,8 @@ def inverse_kinematics(
         raise _core.SolverError(
             f"{who}: no solution for frame {task.frame!r} at position {np.round(p, 6).tolist()} "
             f"(stopped after {iterations} iterations at position error {pos:.3g} m, "
-            f"orientation error {rot:.3g} rad{held}); the pose may be out of reach, blocked by "
-            "the joint limits, or q0 too far from a solution"
+            f"orientation error {rot:.3g} rad, tol = {tol:g}{held}); the pose may be out of "
+            "reach, blocked by the joint limits, or q0 too far from a solution"
         )
     return IKResult(
         q=q,

@@ -30,8 +30,10 @@ constraints that imply them (conservative): ``√x`` by its tangent at the previ
 it tightens the constraint (concave: the tangent lies above), by the chord ``x/√X`` on the
 stage's speed bound ``[0, X]`` where it relaxes it (0 without a bound); the efficiency's two
 branches by both linear pieces on the side where their maximum (minimum) is the true value and
-by the regenerating piece alone on the other (exact wherever that branch holds); the Coulomb
-term by its saturated value ``±c`` on the side where it hurts and 0 on the other. The tangents
+by the regenerating piece alone on the other (exact wherever that branch holds), and at the
+path's ends, at rest, by the motoring piece on both sides (holding takes ``τ_gear/(N η)``
+whatever its sign); the Coulomb term by its saturated value ``±c`` on the side where it hurts
+and 0 on the other (0 at the ends: at rest it is exactly 0). The tangents
 are then moved to the new solution and the problem solved again (``envelope_iterations``,
 until the duration stops falling by more than 1e-9 relative): every iterate satisfies the true
 constraints at the grid points, the fastest is returned, and at convergence the speed terms are
@@ -53,9 +55,9 @@ largest coefficient.
 
 **The output.** The trajectory's samples are the grid points: ``ṡ_i = √x_i`` and ``s̈_i = u_i``
 (the acceleration over the next interval; at the last point 0: the arrival at rest, where the
-hold begins; ``info["qdd_arrival"]`` is the last interval's q̈ there), so the limits hold at
-every sample as above; between samples they hold to
-the discretisation error (refine ``grid``). ``evaluate(t)`` is exact between samples
+hold begins, checked against every limit; ``info["qdd_arrival"]`` is the last interval's q̈
+there), so the limits hold at every sample as above; between samples they hold to the
+discretisation error (refine ``grid``). ``evaluate(t)`` is exact between samples
 (``s = s_i + ṡ_i τ + u_i τ²/2``). Duration: ``Σ 2 Δ_i / (ṡ_i + ṡ_{i+1})``. The motion starts and
 ends at rest.
 """
@@ -75,7 +77,7 @@ from armdyn.motion.trajectory import Path, Trajectory
 #: grid intervals when ``grid`` is None
 DEFAULT_GRID = 1000
 #: the most grid intervals (memory: a few (grid, rows) arrays)
-MAX_GRID = 200_000
+MAX_GRID = 100_000
 #: an upper bound on x = ṡ² where nothing else bounds it (reached: ModelError)
 _X_CAP = 1e20
 #: toppra's Seidel solver bounds x at 1e8: its problem is x / scale, scale found by re-solving
@@ -146,6 +148,10 @@ def _model_path(who: str, model, path) -> list[str]:
     if path.n_joints != len(coords):
         raise _core.ModelError(
             f"{who}: the path has {path.n_joints} joints, the model {len(coords)} ({coords})"
+        )
+    if path.names is not None and list(path.names) != coords:
+        raise _core.ModelError(
+            f"{who}: the path's joints {list(path.names)} are not the model's {coords} (in order)"
         )
     return dofs
 
@@ -231,6 +237,7 @@ def _along(who: str, model, path: Path, s: np.ndarray) -> _Along:
         k, n = int(act.dof), float(act.gear_ratio)
         visc[:, k] += n * n * float(act.friction_viscous) * d1[:, k]
         coulomb[:, k] += abs(n) * float(act.friction_coulomb) * np.sign(d1[:, k])
+    coulomb[[0, -1]] = 0.0  # at rest at both ends: tanh(0) = 0
     return _Along(s, q, d1, d2, a, one, c, visc, coulomb)
 
 
@@ -291,7 +298,7 @@ def _speed_bound(p: _Problem, speed: np.ndarray, limit: float, label: str) -> No
         p.xmax_label[i] = label
 
 
-def _motor_rows(p: _Problem, act, model) -> None:
+def _motor_rows(p: _Problem, act) -> None:
     """The motor's speed, peak torque and envelope constraints of one actuator (module notes)."""
     from armdyn.sizing.motor import motor_envelope, speed_limit
 
@@ -312,8 +319,13 @@ def _motor_rows(p: _Problem, act, model) -> None:
     sigma = np.sign(d1)
     convex, zero = sigma * n > 0.0, sigma == 0.0
     concave = ~convex & ~zero
+    # at rest (q̇ = 0: the path's ends, where ṡ = 0) the motoring branch holds whatever the
+    # torque's sign (holding takes τ_gear / (N η)): its piece on both sides there
+    rest = zero.copy()
+    rest[[0, -1]] = True
     visc = float(act.friction_viscous) * n * d1
     coul = float(act.friction_coulomb) * np.sign(n * d1)
+    coul[[0, -1]] = 0.0  # at rest at both ends
     t0, w0 = motor_envelope(motor)
     limits = []
     if motor.peak_torque is not None:
@@ -322,7 +334,7 @@ def _motor_rows(p: _Problem, act, model) -> None:
         limits.append((f"motor envelope {name!r}", float(t0), t0 / w0 * n * d1))
     for label, limit, env in limits:
         for piece, up, lo in (
-            (1.0 / (n * eta), convex | zero, concave | zero),
+            (1.0 / (n * eta), convex | rest, concave | rest),
             (eta / n, ~zero, ~zero),
         ):
             a = j * n * d1 + piece * g_u
@@ -351,7 +363,7 @@ def _problem(model, along: _Along, names, v_max, a_max, tau_max, motors: bool) -
     if motors:
         for act in _actuators(model):
             if getattr(act, "motor", None) is not None:
-                _motor_rows(p, act, model)
+                _motor_rows(p, act)
     return p
 
 
@@ -359,6 +371,7 @@ def _linearised(p: _Problem, x_ref: np.ndarray):
     """(A, B, C) with the √x terms replaced by linear bounds (module notes): the tangent at
     ``x_ref`` where D > 0, the chord x/√X on [0, X] (X the stage's bound on x) where D < 0."""
     a, b, c, d = p.rows.arrays()
+    d[[0, -1]] = 0.0  # x = 0 at both ends: the √x terms vanish there exactly
     if not np.any(d):
         return a, b, c
     b, c = b.copy(), c.copy()
@@ -381,7 +394,6 @@ def _controllable(s: np.ndarray, a, b, c, xmax: np.ndarray) -> np.ndarray:
     import toppra.algorithm as algo
     from toppra.constraint import DiscretizationType, LinearConstraint
 
-    logging.getLogger("toppra").setLevel(logging.ERROR)
     m = a.shape[1]
 
     class _Stagewise(LinearConstraint):
@@ -400,8 +412,14 @@ def _controllable(s: np.ndarray, a, b, c, xmax: np.ndarray) -> np.ndarray:
         path_interval = np.array([0.0, 1.0])
         dof = 1
 
-    solver = algo.TOPPRA([_Stagewise()], _Interval(), gridpoints=s, solver_wrapper="seidel")
-    return np.asarray(solver.compute_controllable_sets(0.0, 0.0), dtype=float)
+    log = logging.getLogger("toppra")
+    level = log.level
+    log.setLevel(logging.ERROR)  # its warnings of an empty set: this module reports them
+    try:
+        solver = algo.TOPPRA([_Stagewise()], _Interval(), gridpoints=s, solver_wrapper="seidel")
+        return np.asarray(solver.compute_controllable_sets(0.0, 0.0), dtype=float)
+    finally:
+        log.setLevel(level)
 
 
 def _scaled_controllable(s: np.ndarray, a, b, c, xmax: np.ndarray) -> np.ndarray:
@@ -491,6 +509,9 @@ def _solve(who: str, p: _Problem, x_ref: np.ndarray):
         raise _fail(who, p, int(bad[-1]), "the limits admit no path speed from there to the end")
     if k_sets[0, 0] > 1e-9 * k_sets[0, 1]:  # above round-off
         raise _fail(who, p, 0, "the path cannot start from rest within the limits")
+    hold = p.rows.arrays()[2][-1]  # the last sample: at rest, s̈ = 0 (the hold)
+    if np.any(hold > 1e-12 * np.array([col[1] for col in p.rows.cols])):
+        raise _fail(who, p, len(s) - 1, "the end pose cannot be held at rest within the limits")
     x, u = _forward(s, a, b, c, k_sets)
     if np.max(x) >= 0.5 * _X_CAP:
         i = int(np.argmax(x))
@@ -536,18 +557,18 @@ def _active(p: _Problem, lin, x, u) -> list[str]:
     """Per sample, the constraint that binds (least slack within 1e-6 of its limit), the bound
     on x, or '' (the speed is set by a constraint further on)."""
     a, b, c = lin
-    out = []
-    values = _violation(a, b, c, x, u)
-    limits = np.array([max(col[1], 1e-300) for col in p.rows.cols])
-    for i in range(len(x)):
-        label = ""
-        if values.shape[1]:
-            r = int(np.argmax(values[i] / limits))
-            if values[i, r] >= -1e-6 * limits[r]:
-                label = f"{p.rows.cols[r][0]} {'upper' if p.rows.cols[r][2] > 0 else 'lower'}"
-        if not label and x[i] >= p.xmax[i] * (1.0 - 1e-9) and x[i] > 0.0:
-            label = p.xmax_label[i]
-        out.append(label)
+    out = [""] * len(x)
+    if a.shape[1]:
+        limits = np.array([max(col[1], 1e-300) for col in p.rows.cols])
+        ratio = _violation(a, b, c, x, u) / limits
+        worst = np.argmax(ratio, axis=1)
+        for i in np.flatnonzero(ratio[np.arange(len(x)), worst] >= -1e-6):
+            label, _, side = p.rows.cols[worst[i]][:3]
+            out[i] = f"{label} {'upper' if side > 0 else 'lower'}"
+    at_bound = (x >= p.xmax * (1.0 - 1e-9)) & (x > 0.0)
+    for i in np.flatnonzero(at_bound):
+        if not out[i]:
+            out[i] = p.xmax_label[i]
     return out
 
 
@@ -663,17 +684,25 @@ def _scaled(traj: Trajectory, k: float) -> Trajectory:
     )
 
 
-def _cycle_margins(model, traj: Trajectory, dwell: float, actuators, options, k: float) -> dict:
+def _cycle_margins(model, traj: Trajectory, dwell: float, actuators, options) -> dict:
     """{(joint, check): margin} of the repeated cycle (motion + dwell, periodic steady state).
-    The motion's last sample takes the arrival's acceleration (the last interval's, not the
-    hold's 0: the dwell's first sample holds), so the trapezoid rule of the RMS and the losses
-    keeps the last interval whole."""
+    A sample is added a millionth of the last interval before the end, with that interval's
+    motion (the arrival: still moving, the braking torque through the gear's branch of that
+    motion): the samples' trapezoid rule of the RMS and the losses then keeps the last interval
+    whole, and the end sample holds (s̈ = 0, the torque of the dwell)."""
     from armdyn.sizing.cycle import duty_cycle
     from armdyn.sizing.motor import motor_cycle_values
 
-    qdd = traj.qdd.copy()
-    qdd[-1] = traj.info["qdd_arrival"] / (k * k)
-    cycle = duty_cycle(model, (traj.t, traj.q, traj.qd, qdd), dwell=dwell, repeat=None)
+    t = traj.t
+    t_arrival = t[-1] - 1e-6 * (t[-1] - t[-2])
+    q_a, qd_a, qdd_a = traj._evaluate(np.array([t_arrival]))
+    samples = [
+        np.concatenate([x[:-1], extra, x[-1:]])
+        for x, extra in zip(
+            (t, traj.q, traj.qd, traj.qdd), ([t_arrival], q_a, qd_a, qdd_a), strict=True
+        )
+    ]
+    cycle = duty_cycle(model, tuple(samples), dwell=dwell, repeat=None)
     out = {}
     for act in actuators:
         load = cycle.joint_load(str(act.joint))
@@ -784,7 +813,7 @@ def shortest_cycle(
 
     def check(k: float):
         traj = _scaled(fastest, k) if k != 1.0 else fastest
-        return traj, _cycle_margins(model, traj, dwell, actuators, options, k)
+        return traj, _cycle_margins(model, traj, dwell, actuators, options)
 
     best, margins = check(1.0)
     k_best = 1.0

@@ -161,11 +161,12 @@ class Trajectory:
 
     def then_hold(self, dwell: float, *, samples: int = 2) -> Trajectory:
         """This motion followed by ``dwell`` seconds at rest at its last position (``samples``
-        extra samples; the motion must end at rest)."""
+        extra samples; the motion must end at rest: zero rates. An acceleration at the end, as
+        the least-energy motion's, steps to zero as the hold begins)."""
         who = "Trajectory.then_hold"
         dwell = _checks.number(who, "dwell", dwell, lo=0.0, lo_open=True)
         samples = _checks.integer(who, "samples", samples, lo=1)
-        if np.any(np.abs(self.qd[-1]) > 1e-9) or np.any(np.abs(self.qdd[-1]) > 1e-6):
+        if np.any(np.abs(self.qd[-1]) > 1e-9):
             raise _core.ModelError(f"{who}: the motion does not end at rest")
         extra = self.t[-1] + dwell * np.arange(1, samples + 1) / samples
         zeros = np.zeros((samples, self.qd.shape[1]))
