@@ -50,8 +50,11 @@ MAX_SAMPLES = 100_000
 #: and about ten times as many in the limits' Jacobian)
 MAX_ENTRIES = 2_000_000
 
-#: a solve takes the limits' sides used to at least this fraction (0: the side x has the sign of)
-SCREEN = 0.0
+#: the first solve's samples (every limit's side the motion leans to: the quintic is no guide
+#: to which limits bind) ...
+COARSE = 31
+#: ... then the solves on the samples take the limits' sides used to at least this fraction
+SCREEN = 0.5
 #: ... and resumes with those it left out that the motion came to use, at most this many times
 ROUNDS = 8
 
@@ -432,7 +435,7 @@ def least_energy(
     margin: float = 1e-3,
     check_factor: int = 8,
     max_iterations: int = 200,
-    tol: float = 1e-10,
+    tol: float = 1e-8,
 ) -> Trajectory:
     """The least-energy rest-to-rest motion from ``start`` to ``goal`` in ``duration`` seconds.
 
@@ -638,10 +641,11 @@ def _exceeded(problem: _Problem, p: np.ndarray, fine: np.ndarray, grid: np.ndarr
 def _solve(
     problem: _Problem, *, samples, margin, check_factor, max_iterations, tol, end
 ) -> Trajectory:
-    """SLSQP from the quintic, on the limits' sides used to at least :data:`SCREEN` (the
-    others are slack); after each solve, the sides the motion now uses that much join, and so
-    do the check grid's instants over a limit, and the solve resumes while a side left out is
-    exceeded (at most :data:`ROUNDS` solves)."""
+    """SLSQP from the quintic: first on :data:`COARSE` samples with every limit's side the
+    motion leans to, then on the ``samples`` with the sides used to at least :data:`SCREEN`
+    (the others are slack); after each solve the sides the motion now uses that much join, and
+    so do the check grid's instants over a limit, and the solve resumes while a side left out
+    is exceeded (at most :data:`ROUNDS` solves on the samples)."""
     u = np.linspace(0.0, 1.0, samples)
     w = _simpson(u, problem.duration)
     problem.set_grid(u, w)
@@ -657,30 +661,23 @@ def _solve(
             f"{problem.duration:g} s too short for the distance, or coordinates too large)"
         )
     problem.scale = baseline if baseline > 0.0 else 1.0
-    fine = np.linspace(0.0, 1.0, (samples - 1) * check_factor + 1)
-    grid, iterations, result = u, 0, None
-    mask = problem.screen(p, SCREEN)
     # unknowns z = Lᵀ p, L L' the cost's Gauss–Newton Hessian at the quintic: SLSQP's
     # quasi-Newton Hessian starts as the identity, which is then about right
     back = _preconditioner(problem, p)
-    constraint = {
-        "type": "ineq",
-        "fun": lambda z: problem.constraints(back @ z, margin),
-        "jac": lambda z: problem.constraints(back @ z, margin, jacobian=True) @ back,
-    }
+    iterations = 0
+    if samples > COARSE:
+        coarse = np.linspace(0.0, 1.0, COARSE)
+        problem.set_grid(coarse, _simpson(coarse, problem.duration))
+        problem.mask = problem.screen(p, 0.0)
+        p, result = _slsqp(problem, back, p, margin, max_iterations, tol)
+        iterations += int(result.nit)
+        problem.set_grid(u, w)
+    fine = np.linspace(0.0, 1.0, (samples - 1) * check_factor + 1)
+    grid, mask = u, problem.screen(p, SCREEN if samples > COARSE else 0.0)
     for _ in range(ROUNDS):
         problem.mask = mask
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)
-            result = _minimize(
-                lambda z: problem.value(back @ z),
-                np.linalg.solve(back, p),
-                jac=lambda z: back.T @ problem.gradient(back @ z),
-                method="SLSQP",
-                constraints=[constraint],
-                options={"maxiter": max_iterations, "ftol": tol},
-            )
-        p, iterations = back @ np.asarray(result.x, dtype=float), iterations + int(result.nit)
+        p, result = _slsqp(problem, back, p, margin, max_iterations, tol)
+        iterations += int(result.nit)
         if result.status not in (0, 9) and _worst(_usage(problem, p)).max() > 1.0:
             break
         left_out = _left_out(problem, p, mask, margin)
@@ -700,6 +697,27 @@ def _solve(
     problem.mask = None
     problem.set_grid(u, w)
     return _result(problem, p, result, iterations, fine, margin, end)
+
+
+def _slsqp(problem: _Problem, back: np.ndarray, p: np.ndarray, margin, max_iterations, tol):
+    """One SLSQP solve from ``p`` in the scaled unknowns z = back⁻¹ p on the problem's grid and
+    mask: (p, scipy's result)."""
+    constraint = {
+        "type": "ineq",
+        "fun": lambda z: problem.constraints(back @ z, margin),
+        "jac": lambda z: problem.constraints(back @ z, margin, jacobian=True) @ back,
+    }
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        result = _minimize(
+            lambda z: problem.value(back @ z),
+            np.linalg.solve(back, p),
+            jac=lambda z: back.T @ problem.gradient(back @ z),
+            method="SLSQP",
+            constraints=[constraint],
+            options={"maxiter": max_iterations, "ftol": tol},
+        )
+    return back @ np.asarray(result.x, dtype=float), result
 
 
 def _preconditioner(problem: _Problem, p: np.ndarray) -> np.ndarray:
