@@ -20,55 +20,58 @@ using ArrayPair = py::typing::Tuple<py::array_t<double>, py::array_t<double>>;
 using ArrayTriple =
     py::typing::Tuple<py::array_t<double>, py::array_t<double>, py::array_t<double>>;
 
-// the k matrices (n, n) of one state, or (rows, n, n) each of a batch, from their
-// concatenation (k, n, n) / (rows, k, n, n)
-py::tuple split_matrices(const py::array_t<double>& all, bool batch, int k, long n) {
-  const long rows = batch ? static_cast<long>(all.shape(0)) : 1;
-  std::vector<py::ssize_t> shape{n, n};
-  if (batch) shape.insert(shape.begin(), rows);
-  const long block = n * n;
-  py::tuple out(k);
-  for (int j = 0; j < k; ++j) {
-    py::array_t<double> a(shape);
-    double* dst = a.mutable_data();
-    for (long i = 0; i < rows; ++i)
-      std::copy(all.data() + (i * k + j) * block, all.data() + (i * k + j + 1) * block,
-                dst + i * block);
-    out[j] = a;
-  }
-  return out;
-}
-
-// k matrices row-major into out (k n n), each checked finite
+// k matrices row-major into out[j] + offset, each checked finite
 void write_matrices(const char* fn, std::initializer_list<std::pair<const char*, const MatX*>> ms,
-                    std::initializer_list<NamedInput> in, double* out) {
+                    std::initializer_list<NamedInput> in, double* const* out, long offset) {
   for (const auto& [name, x] : ms) {
     check_finite_output(fn, name, x->data(), x->size(), in);
-    copy_row_major(*x, out);
-    out += x->size();
+    copy_row_major(*x, *out++ + offset);
   }
 }
 
-// batch() with its Ctrl-C partial result split as the complete one
+// the k matrices (n, n) of one state, or (rows, n, n) each of one state per row, from
+// one(q_i, a_i, b_i, t_i, outputs, offset of row i): written straight into their arrays (batch()
+// then makes no output of its own); a Ctrl-C's partial result is the rows done
 template <class Fn>
 py::tuple matrices_call(const char* fn, Data& d, int k, const py::handle& q, const py::handle& a,
                         const char* an, const py::handle& b, const char* bn, const py::handle& t,
                         Fn&& one) {
   const long n = d.ni;
-  if (is_batch(q)) {
-    try {
-      return split_matrices(batch(fn, d.niq, n, q, a, an, b, bn, t, {k, n, n}, one), true, k, n);
-    } catch (PyInterrupted& e) {
-      const py::object err = e.err.value();
-      err.attr("result") =
-          split_matrices(err.attr("result").cast<py::array_t<double>>(), true, k, n);
-      throw;
-    }
+  std::vector<py::array_t<double>> outs;
+  std::vector<double*> ptrs;
+  const bool rows_given = is_batch(q);
+  const long rows =
+      rows_given ? static_cast<long>(py::reinterpret_borrow<py::array>(q).shape(0)) : 1;
+  std::vector<py::ssize_t> shape{n, n};
+  if (rows_given) shape.insert(shape.begin(), rows);
+  for (int j = 0; j < k; ++j) {
+    outs.emplace_back(shape);
+    ptrs.push_back(outs.back().mutable_data());
   }
-  const VecArg qa(q, "q", d.niq), aa(a, an, n), ba(b, bn, n);
-  py::array_t<double> all(std::vector<py::ssize_t>{k, n, n});
-  one(*qa, *aa, *ba, scalar_time(t, fn), all.mutable_data());
-  return split_matrices(all, false, k, n);
+  auto result = [&](long done) {
+    py::tuple r(k);
+    for (int j = 0; j < k; ++j)
+      r[j] = rows_given && done < rows ? py::object(outs[j][py::slice(0, done, 1)])
+                                       : py::object(outs[j]);
+    return r;
+  };
+  if (!rows_given) {
+    const VecArg qa(q, "q", d.niq), aa(a, an, n), ba(b, bn, n);
+    one(*qa, *aa, *ba, scalar_time(t, fn), ptrs.data(), 0);
+    return result(1);
+  }
+  long row = 0;
+  try {
+    batch(fn, d.niq, n, q, a, an, b, bn, t, {0},
+          [&](auto qi, auto ai, auto bi, double tt, double*) {
+            one(qi, ai, bi, tt, ptrs.data(), row * n * n);
+            ++row;
+          });
+  } catch (PyInterrupted& e) {
+    e.err.value().attr("result") = result(row);
+    throw;
+  }
+  return result(rows);
 }
 
 ArrayPair inverse_dynamics_derivatives_py(const ModelArg& model, const ArrayLike& q,
@@ -77,13 +80,15 @@ ArrayPair inverse_dynamics_derivatives_py(const ModelArg& model, const ArrayLike
   constexpr const char* fn = "inverse_dynamics_derivatives";
   const CallArgs a = call_args(model, data, fn);
   Data& d = a.data;
-  auto one = [&](const auto& qi, const auto& qdi, const auto& ai, double tt, double* out) {
+  auto one = [&](const auto& qi, const auto& qdi, const auto& ai, double tt, double* const* out,
+                 long offset) {
     const auto in = {named_input("q", qi), named_input("qd", qdi), named_input("qdd", ai)};
     naming_huge_inputs(fn, in, [&]() {
       inverse_dynamics_derivatives(a.model(), d, qi, qdi, ai, tt);
       return 0;
     });
-    write_matrices(fn, {{"dtau_dq", &d.deriv.tau_q}, {"dtau_dqd", &d.deriv.tau_qd}}, in, out);
+    write_matrices(fn, {{"dtau_dq", &d.deriv.tau_q}, {"dtau_dqd", &d.deriv.tau_qd}}, in, out,
+                   offset);
   };
   return matrices_call(fn, d, 2, q, qd, "qd", qdd, "qdd", t, one);
 }
@@ -94,7 +99,8 @@ ArrayTriple forward_dynamics_derivatives_py(const ModelArg& model, const ArrayLi
   constexpr const char* fn = "forward_dynamics_derivatives";
   const CallArgs a = call_args(model, data, fn);
   Data& d = a.data;
-  auto one = [&](const auto& qi, const auto& qdi, const auto& ti, double tt, double* out) {
+  auto one = [&](const auto& qi, const auto& qdi, const auto& ti, double tt, double* const* out,
+                 long offset) {
     const auto in = {named_input("q", qi), named_input("qd", qdi), named_input("tau", ti)};
     naming_huge_inputs(fn, in, [&]() {
       forward_dynamics_derivatives(a.model(), d, qi, qdi, ti, tt);
@@ -104,7 +110,7 @@ ArrayTriple forward_dynamics_derivatives_py(const ModelArg& model, const ArrayLi
                    {{"dqdd_dq", &d.deriv.qdd_q},
                     {"dqdd_dqd", &d.deriv.qdd_qd},
                     {"dqdd_dtau", &d.deriv.qdd_tau}},
-                   in, out);
+                   in, out, offset);
   };
   return matrices_call(fn, d, 3, q, qd, "qd", tau, "tau", t, one);
 }

@@ -134,7 +134,7 @@ def _check_model(model, seed=3, states=2):
 def test_arms_equal_finite_differences(robot, tmp_path):
     model = ad.load_urdf(_urdf(robot, tmp_path))
     if robot == "panda":
-        assert model.n_coords < len(model.coord_names) or model.n_dofs == 8  # the mimic finger
+        assert len(model.joint_coord_names) == model.n_coords + 1  # the mimic finger
     _check_model(model)
 
 
@@ -142,3 +142,146 @@ def test_floating_solo12_equals_finite_differences(tmp_path):
     model = ad.load_urdf(_urdf("solo12", tmp_path), fixed_base=False)
     assert model.n_coords == model.n_dofs + 1
     _check_model(model, states=1)
+
+
+def _box(b, name, mass, position, dims=(0.3, 0.2, 0.1)):
+    x, y, z = dims
+    inertia = mass / 12 * np.array([y * y + z * z, x * x + z * z, x * x + y * y])
+    b.add_body(name, mass, inertia, position)
+
+
+def _mixed(floating):
+    """A tree with every joint type the joint space takes: a base (floating or on a revolute),
+    a revolute, a cylindrical (turn and slide on one line), a prismatic, a fixed joint, and a
+    coupling with an offset (follower 'r3' = -0.7 'r1' + 0.2); gravity oblique."""
+    b = ad.ModelBuilder(gravity=(1.0, -2.0, -9.0))
+    _box(b, "base", 3.0, (0.1, 0.0, 0.5))
+    _box(b, "a", 1.2, (0.4, 0.1, 0.6))
+    _box(b, "c", 0.8, (0.7, 0.2, 0.5))
+    _box(b, "p", 0.5, (0.7, 0.5, 0.3))
+    _box(b, "f", 0.3, (0.9, 0.5, 0.3))
+    _box(b, "d", 0.6, (0.2, -0.3, 0.7))
+    if floating:
+        b.add_free("float", "base")
+    else:
+        b.add_revolute("r0", "ground", "base", (0.0, 0.0, 0.4), (0.2, 0.1, 1.0))
+    b.add_revolute("r1", "base", "a", (0.3, 0.05, 0.55), (0.0, 1.0, 0.3))
+    b.add_cylindrical("cyl", "a", "c", (0.55, 0.15, 0.55), (1.0, 0.2, -0.1))
+    b.add_prismatic("pr", "c", "p", (0.7, 0.35, 0.4), (0.1, 1.0, -0.5))
+    b.add_fixed("weld", "p", "f", (0.8, 0.5, 0.3))
+    b.add_revolute("r3", "base", "d", (0.15, -0.2, 0.6), (1.0, 0.0, 0.2))
+    b.add_coupling("link", "r3", "r1", -0.7, 0.2)
+    return b.finalize()
+
+
+@pytest.mark.parametrize("floating", [False, True])
+def test_every_joint_type_with_a_coupling_equals_finite_differences(floating):
+    model = _mixed(floating)
+    assert model.n_dofs == (6 if floating else 1) + 4  # r3 follows r1
+    _check_model(model, seed=11, states=2)
+
+
+@pytest.mark.parametrize("gyroscopic", [False, True])
+def test_arm_with_actuators_equals_finite_differences(gyroscopic, tmp_path):
+    # rotors on follower joints (coupled to their joints: q_rotor = N q), gear-reduced on ground
+    # or gyroscopic on the joint's parent body
+    b = ad.urdf_builder(_urdf("ur5", tmp_path))
+    for name, n, j in zip(
+        ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint"],
+        [100.0, -100.0, 80.0, 50.0],
+        [6e-5, 6e-5, 4e-5, 1.5e-5],
+        strict=True,
+    ):
+        b.add_actuator(name, n, j, gyroscopic=gyroscopic)
+    model = b.finalize()
+    assert model.n_dofs == 6 and len(model.joint_coord_names) == 10
+    _check_model(model, seed=5, states=1)
+
+
+def test_properties_without_differencing(tmp_path):
+    # at rest dtau/dqd vanishes (no velocity terms, no dampers); at rest and without
+    # acceleration dtau/dq is the Hessian of the potential energy on a fixed base: symmetric;
+    # dqdd/dtau is the inverse of mass_matrix
+    model = ad.load_urdf(_urdf("panda", tmp_path))
+    rng = np.random.default_rng(2)
+    q, _, _ = _state(model, rng)
+    zero = np.zeros(model.n_dofs)
+    dq, dqd = ad.inverse_dynamics_derivatives(model, q, zero, zero)
+    assert np.abs(dqd).max() == 0.0
+    assert np.abs(dq).max() > 1.0  # gravity's
+    assert _rel(dq, dq.T) <= 1e-13
+    _, _, minv = ad.forward_dynamics_derivatives(model, q, zero, rng.normal(size=model.n_dofs))
+    np.testing.assert_allclose(minv, np.linalg.inv(ad.mass_matrix(model, q)), rtol=1e-10)
+    np.testing.assert_allclose(minv, minv.T, rtol=1e-12)
+
+
+def test_batch_equals_single_states_and_takes_data_and_times(tmp_path):
+    model = ad.load_urdf(_urdf("ur5", tmp_path))
+    rng = np.random.default_rng(4)
+    rows = [_state(model, rng) for _ in range(3)]
+    q, qd, x = (np.array(a) for a in zip(*rows, strict=True))
+    data = ad.Data(model)
+    t = np.array([0.0, 0.5, 1.0])
+    dq, dqd = ad.inverse_dynamics_derivatives(model, q, qd, x, t=t, data=data)
+    fq, fqd, ftau = ad.forward_dynamics_derivatives(model, q, qd, x, t=t, data=data)
+    assert dq.shape == dqd.shape == fq.shape == ftau.shape == (3, 6, 6)
+    for i in range(3):
+        one = ad.inverse_dynamics_derivatives(model, q[i], qd[i], x[i], t=t[i])
+        np.testing.assert_array_equal(dq[i], one[0])
+        np.testing.assert_array_equal(dqd[i], one[1])
+        one = ad.forward_dynamics_derivatives(model, q[i], qd[i], x[i])
+        for a, b in zip((fq[i], fqd[i], ftau[i]), one, strict=True):
+            np.testing.assert_array_equal(a, b)
+    # the state's rows keep their order: row 1 differs from row 0
+    assert not np.array_equal(dq[0], dq[1])
+
+
+def _message(f, *args, **kw):
+    with pytest.raises(ad.ModelError) as err:
+        f(*args, **kw)
+    return str(err.value)
+
+
+def test_bad_inputs_get_the_messages_of_inverse_and_forward_dynamics(tmp_path):
+    # the same checks as inverse_dynamics / forward_dynamics, naming the argument (and the row)
+    model = ad.load_urdf(_urdf("ur5", tmp_path))
+    z, nan, rows = np.zeros(6), np.full(6, np.nan), np.zeros((2, 6))
+    bad_row = rows.copy()
+    bad_row[1, 2] = np.inf
+    cases = [
+        ((z[:5], z, z), {}, "has length 5|shape"),
+        ((z, nan, z), {}, "qd contains NaN"),
+        ((z, z, nan), {}, "contains NaN"),
+        ((z, z, z), {"t": np.inf}, "t is not finite"),
+        ((rows, bad_row, rows), {}, "row 1: .*qd contains NaN or inf"),
+        ((rows, rows, rows[:1]), {}, "must have shape"),
+        ((z, z, z), {"data": ad.Data(_mixed(False))}, "made for another model"),
+        ((None, z, z), {}, "None|q"),
+    ]
+    pairs = [
+        (ad.inverse_dynamics, ad.inverse_dynamics_derivatives),
+        (ad.forward_dynamics, ad.forward_dynamics_derivatives),
+    ]
+    for plain, deriv in pairs:
+        name = plain.__name__
+        for args, kw, pattern in cases:
+            want = _message(plain, model, *args, **kw)
+            got = _message(deriv, model, *args, **kw)
+            assert re.search(pattern, got), (got, pattern)
+            assert got == want.replace(name, name + "_derivatives"), (got, want)
+
+
+def test_forward_derivatives_refuse_light_bodies_inverse_take_them():
+    # a body of inertia 1e-9 its m l^2: the mass matrix about the world origin loses it
+    b = ad.ModelBuilder()
+    _box(b, "arm", 1.0, (0.3, 0.0, 0.0))
+    b.add_body("tip", 1.0, [1e-9] * 3, (0.6, 0.0, 0.0))
+    b.add_revolute("j0", "ground", "arm", (0.0, 0.0, 0.0), (0.0, 0.0, 1.0))
+    b.add_revolute("j1", "arm", "tip", (0.5, 0.0, 0.0), (0.0, 1.0, 0.0))
+    model = b.finalize()
+    z = np.array([0.3, -0.2])
+    with pytest.raises(ad.ModelError, match=r"light bodies.*'tip'"):
+        ad.forward_dynamics_derivatives(model, z, z, z)
+    dq, _ = ad.inverse_dynamics_derivatives(model, z, z, z)
+    fq, _ = _fd(model, lambda a, b, c: ad.inverse_dynamics(model, a, b, c), z, z, z)
+    assert _rel(dq, fq) <= 1e-7

@@ -161,11 +161,15 @@ class Data {
   // --- first-order derivatives of the dynamics (algorithm/derivatives), sized on first use
   // (ensure_derivatives: quadratic in the coordinates, never per call) ---
   struct Derivatives {
-    /// per body: its subtree's spatial inertia about the reference point o (angular rows first),
-    /// the inertia's velocity variation (dY/dt with the momentum's cross terms), and the
-    /// subtree's Newton-Euler wrench (gravity and gyroscopic terms, no force elements)
-    std::vector<Mat6> Yc, Bc;
-    std::vector<Vec6> V, A, Fc;  ///< per body: spatial velocity, acceleration (gravity offset)
+    /// per body: its subtree's spatial inertia about the reference point o, and the angular
+    /// block Bc and linear momentum Lc of the inertia's velocity variation B (B u = Y (u x V) +
+    /// u x* Y V + V x* Y u = (Bc u_w, -2 Lc x u_w): its other blocks vanish)
+    std::vector<Composite> Yc;
+    std::vector<Mat3> Bc;
+    std::vector<Vec3> Lc;
+    /// per body: spatial velocity, acceleration (gravity offset) and the subtree's Newton-Euler
+    /// wrench (gravity and gyroscopic terms, no force elements)
+    std::vector<Vec6> V, A, Fc;
     /// per degree of freedom (n): its motion S, the parent's terms u = V_p x S, w = A_p x S +
     /// V_p x u, a = (V_p + V_c) x S; the subtree's Yc S and Bc^T S; the subtree wrench's
     /// derivatives along q (without and with S x* Fc) and along qd

@@ -49,35 +49,62 @@ Vec3 about_point(const Model& m, const Data& d) {
   return Vec3::Zero();
 }
 
-// body b's spatial inertia about o: [I_o, [h]x; -[h]x, m 1], h = m (x - o)
-void spatial_inertia(const Body& b, const BodyKin& k, const Vec3& o, Mat6& Y) {
-  const Vec3 c = k.x - o;
-  const Vec3 h = b.mass * c;
-  Mat3 I;
-  I.noalias() = k.R * b.inertia * k.R.transpose();
-  I.noalias() -= h * c.transpose();
-  I.diagonal().array() += h.dot(c);
-  const Mat3 H = skew(h);
-  Y.topLeftCorner<3, 3>() = I;
-  Y.topRightCorner<3, 3>() = H;
-  Y.bottomLeftCorner<3, 3>() = -H;
-  Y.bottomRightCorner<3, 3>() = b.mass * Mat3::Identity();
+// a spatial inertia (m, h, I about o) times a motion x: (I x_w + h x x_v, m x_v - h x x_w)
+inline Vec6 inertia_times(const Data::Composite& Y, const Vec6& x) {
+  Vec6 r;
+  r.head<3>().noalias() = Y.I * x.head<3>();
+  r.head<3>() += Y.h.cross(x.tail<3>());
+  r.tail<3>() = Y.m * x.tail<3>() - Y.h.cross(x.head<3>());
+  return r;
 }
 
-// B = crf(V) Y - Y crm(V) + X(h), h = Y V: B u = Y (u x V) + u x* h + V x* (Y u), the
-// inertia's variation along V with the momentum's cross terms (crm(V) = -crf(V)^T)
-void velocity_variation(const Mat6& Y, const Vec6& V, const Vec6& h, Mat6& B) {
-  Mat6 C = Mat6::Zero();
-  const Mat3 W = skew(V.head<3>());
-  C.topLeftCorner<3, 3>() = W;
-  C.topRightCorner<3, 3>() = skew(V.tail<3>());
-  C.bottomRightCorner<3, 3>() = W;
-  B.noalias() = C * Y;
-  B.noalias() += Y * C.transpose();
-  const Mat3 Hn = skew(h.head<3>()), Hf = skew(h.tail<3>());
-  B.topLeftCorner<3, 3>() -= Hn;
-  B.topRightCorner<3, 3>() -= Hf;
-  B.bottomLeftCorner<3, 3>() -= Hf;
+// the velocity variation B u = (Bc u_w, -2 L x u_w) (Data::Derivatives)
+inline Vec6 variation_times(const Mat3& B, const Vec3& L, const Vec6& u) {
+  Vec6 r;
+  r.head<3>().noalias() = B * u.head<3>();
+  r.tail<3>() = -2.0 * L.cross(u.head<3>());
+  return r;
+}
+
+// B^T s = (Bc^T s_w + 2 L x s_v, 0)
+inline Vec6 variation_transpose_times(const Mat3& B, const Vec3& L, const Vec6& s) {
+  Vec6 r;
+  r.head<3>().noalias() = B.transpose() * s.head<3>();
+  r.head<3>() += 2.0 * L.cross(s.tail<3>());
+  r.tail<3>().setZero();
+  return r;
+}
+
+// body i's spatial inertia Y about o, velocity V = (W, v) and acceleration A = (alpha, a)
+// (gravity offset) give its Newton-Euler wrench f = Y A + V x* Y V and its velocity variation
+// B = crf(V) Y - Y crm(V) + X(Y V): with Y = [I, [h]; -[h], m] and the momentum (n, L) = Y V,
+// B = [[W, I] - ([v][h] + [h][v]) - [n], 0; -2 [L], 0] (W = [w]: its two right blocks cancel)
+void body_terms(const Body& b, const BodyKin& k, const Vec3& o, Data::Derivatives& w, int i) {
+  Data::Composite& Y = w.Yc[i];
+  const Vec3 c = k.x - o;
+  Y.m = b.mass;
+  Y.h = b.mass * c;
+  const Mat3 RJ = k.R * b.inertia;
+  Y.I.noalias() = RJ * k.R.transpose();
+  Y.I.noalias() -= Y.h * c.transpose();
+  Y.I.diagonal().array() += Y.h.dot(c);
+  const Vec6& V = w.V[i];
+  const Vec3 om = V.head<3>(), v = V.tail<3>();
+  const Vec6 hm = inertia_times(Y, V);
+  const Vec3 n = hm.head<3>(), L = hm.tail<3>();
+  Vec6& f = w.Fc[i];
+  f = inertia_times(Y, w.A[i]);
+  f.head<3>() += om.cross(n) + v.cross(L);
+  f.tail<3>() += om.cross(L);
+  Mat3& B = w.Bc[i];
+  const Mat3 W = skew(om);
+  B.noalias() = W * Y.I;
+  B.noalias() -= Y.I * W;
+  B.noalias() -= Y.h * v.transpose();
+  B.noalias() -= v * Y.h.transpose();
+  B.diagonal().array() += 2.0 * v.dot(Y.h);
+  B -= skew(n);
+  w.Lc[i] = L;
 }
 
 // degree of freedom k of joint j (the k-th of its own): its world motion about o (crba_loaded's)
@@ -114,12 +141,7 @@ void forward_pass(const Model& m, Data& d, Eigen::Ref<const VecX> qd, Eigen::Ref
     V << k.W, k.xd - k.W.cross(c);
     Vec6& A = w.A[i];
     A << alpha, d.rne.acc[i] - alpha.cross(c) - k.W.cross(k.xd) - m.gravity;
-    Mat6& Y = w.Yc[i];
-    spatial_inertia(m.bodies[i], k, o, Y);
-    const Vec6 h = Y * V;
-    w.Fc[i].noalias() = Y * A;
-    w.Fc[i] += fcross(V, h);
-    velocity_variation(Y, V, h, w.Bc[i]);
+    body_terms(m.bodies[i], k, o, w, i);
   }
   Vec6 ground_a;
   ground_a << Vec3::Zero(), -m.gravity;
@@ -146,20 +168,24 @@ void backward_pass(const Model& m, Data& d) {
   for (auto it = m.tree_order.rbegin(); it != m.tree_order.rend(); ++it) {
     const Joint& j = m.joints[*it];
     const int b = j.child;
-    const Mat6 &Y = w.Yc[b], &B = w.Bc[b];
+    const Data::Composite& Y = w.Yc[b];
+    const Mat3& B = w.Bc[b];
+    const Vec3& L = w.Lc[b];
     for (int c = j.dof0; c < j.dof0 + joint_dofs(j.type); ++c) {
       const Vec6& S = w.S[c];
-      w.YS[c].noalias() = Y * S;
-      w.BS[c].noalias() = B.transpose() * S;
-      w.dFq[c].noalias() = Y * w.w[c];
-      w.dFq[c].noalias() += B * w.u[c];
+      w.YS[c] = inertia_times(Y, S);
+      w.BS[c] = variation_transpose_times(B, L, S);
+      w.dFq[c] = inertia_times(Y, w.w[c]) + variation_times(B, L, w.u[c]);
       w.dFqx[c] = w.dFq[c] + fcross(S, w.Fc[b]);
-      w.dFv[c].noalias() = Y * w.av[c];
-      w.dFv[c].noalias() += B * S;
+      w.dFv[c] = inertia_times(Y, w.av[c]) + variation_times(B, L, S);
     }
     if (j.parent != kGround) {
-      w.Yc[j.parent] += Y;
+      Data::Composite& P = w.Yc[j.parent];
+      P.m += Y.m;
+      P.h += Y.h;
+      P.I += Y.I;
       w.Bc[j.parent] += B;
+      w.Lc[j.parent] += L;
       w.Fc[j.parent] += w.Fc[b];
     }
   }
@@ -234,8 +260,9 @@ void ensure_derivatives(const Model& m, Data& d) {
   Data::Derivatives& w = d.deriv;
   if (w.sized) return;
   const size_t nb = static_cast<size_t>(m.nb), n = static_cast<size_t>(d.n);
-  w.Yc.assign(nb, Mat6::Zero());
-  w.Bc.assign(nb, Mat6::Zero());
+  w.Yc.assign(nb, Data::Composite{});
+  w.Bc.assign(nb, Mat3::Zero());
+  w.Lc.assign(nb, Vec3::Zero());
   for (auto* v : {&w.V, &w.A, &w.Fc}) v->assign(nb, Vec6::Zero());
   for (auto* v : {&w.S, &w.u, &w.w, &w.av, &w.YS, &w.BS, &w.dFq, &w.dFqx, &w.dFv})
     v->assign(n, Vec6::Zero());
