@@ -206,8 +206,6 @@ def test_motion_notebook_executes(tmp_path):
         "DT": 0.005,
         "GRID": 700,
         "LEG_GRID": 100,
-        "ENERGY_KNOTS": 4,
-        "ENERGY_SAMPLES": 51,
         "ENERGY_LEGS": [3],
     }
     out = execute_notebook("motion_ur5.ipynb", tmp_path, parameters=coarse)
