@@ -50,8 +50,8 @@ MAX_SAMPLES = 100_000
 #: and about ten times as many in the limits' Jacobian)
 MAX_ENTRIES = 2_000_000
 
-#: the first solve's samples (every limit's side the motion leans to: the quintic is no guide
-#: to which limits bind) ...
+#: the first solve constrains about this many of the samples (every limit's side the motion
+#: leans to there: the quintic is no guide to which limits bind; the cost takes all) ...
 COARSE = 31
 #: ... then the solves on the samples take the limits' sides used to at least this fraction
 SCREEN = 0.5
@@ -641,11 +641,11 @@ def _exceeded(problem: _Problem, p: np.ndarray, fine: np.ndarray, grid: np.ndarr
 def _solve(
     problem: _Problem, *, samples, margin, check_factor, max_iterations, tol, end
 ) -> Trajectory:
-    """SLSQP from the quintic: first on :data:`COARSE` samples with every limit's side the
-    motion leans to, then on the ``samples`` with the sides used to at least :data:`SCREEN`
-    (the others are slack); after each solve the sides the motion now uses that much join, and
-    so do the check grid's instants over a limit, and the solve resumes while a side left out
-    is exceeded (at most :data:`ROUNDS` solves on the samples)."""
+    """SLSQP from the quintic: first with every limit's side the motion leans to at about
+    :data:`COARSE` of the samples, then at every sample with the sides used to at least
+    :data:`SCREEN` (the others are slack); after each solve the sides the motion now uses
+    that much join, and so do the check grid's instants over a limit, and the solve resumes
+    while a side left out is exceeded (at most :data:`ROUNDS` solves at every sample)."""
     u = np.linspace(0.0, 1.0, samples)
     w = _simpson(u, problem.duration)
     problem.set_grid(u, w)
@@ -666,12 +666,12 @@ def _solve(
     back = _preconditioner(problem, p)
     iterations = 0
     if samples > COARSE:
-        coarse = np.linspace(0.0, 1.0, COARSE)
-        problem.set_grid(coarse, _simpson(coarse, problem.duration))
-        problem.mask = problem.screen(p, 0.0)
+        rows = np.zeros(samples, dtype=bool)
+        rows[:: -(-(samples - 1) // (COARSE - 1))] = True
+        rows[-1] = True
+        problem.mask = {k: m & rows[:, None, None] for k, m in problem.screen(p, 0.0).items()}
         p, result = _slsqp(problem, back, p, margin, max_iterations, tol)
         iterations += int(result.nit)
-        problem.set_grid(u, w)
     fine = np.linspace(0.0, 1.0, (samples - 1) * check_factor + 1)
     grid, mask = u, problem.screen(p, SCREEN if samples > COARSE else 0.0)
     for _ in range(ROUNDS):
