@@ -97,9 +97,9 @@ void body_terms(const Body& b, const BodyKin& k, const Vec3& o, Data::Derivative
   f.head<3>() += om.cross(n) + v.cross(L);
   f.tail<3>() += om.cross(L);
   Mat3& B = w.Bc[i];
-  const Mat3 W = skew(om);
-  B.noalias() = W * Y.I;
-  B.noalias() -= Y.I * W;
+  // [W, I] = W I + (W I)^T (I symmetric, W skew), W I by columns w x I_k
+  for (int k = 0; k < 3; ++k) B.col(k) = om.cross(Y.I.col(k));
+  B += B.transpose().eval();
   B.noalias() -= Y.h * v.transpose();
   B.noalias() -= v * Y.h.transpose();
   B.diagonal().array() += 2.0 * v.dot(Y.h);
@@ -207,8 +207,9 @@ void fill_matrices(const Model& m, Data& d) {
       for (int r = j.dof0; r < j.dof0 + joint_dofs(j.type); ++r) {
         w.dq(r, k) = w.S[r].dot(w.dFqx[k]);
         w.dqd(r, k) = w.S[r].dot(w.dFv[k]);
-        w.dq(k, r) = w.YS[k].dot(w.w[r]) + w.BS[k].dot(w.u[r]);
-        w.dqd(k, r) = w.YS[k].dot(w.av[r]) + w.BS[k].dot(w.S[r]);
+        // (BS's linear half is zero)
+        w.dq(k, r) = w.YS[k].dot(w.w[r]) + w.BS[k].head<3>().dot(w.u[r].head<3>());
+        w.dqd(k, r) = w.YS[k].dot(w.av[r]) + w.BS[k].head<3>().dot(w.S[r].head<3>());
       }
       ja = j.parent == kGround ? -1 : d.joint_of_body[j.parent];
     }
@@ -242,10 +243,11 @@ void full_derivatives(const Model& m, Data& d, const double* q, Eigen::Ref<const
 }
 
 // the public (independent) results from the full ones: G^T X G (a copy without couplings)
-void reduce_pair(const Model& m, const Data& d, const MatX& a, const MatX& b, MatX& ar, MatX& br) {
+void reduce_pair(const Model& m, const Data& d, MatX& a, MatX& b, MatX& ar, MatX& br) {
   if (d.ni == d.n) {
-    ar = a;
-    br = b;
+    // the same sizes: the buffers trade places (no copy; fill_matrices rewrites a and b whole)
+    a.swap(ar);
+    b.swap(br);
     return;
   }
   m.independent.reduce(a, ar);
