@@ -1560,8 +1560,11 @@ def _tip_pose(x=1.2, y=0.5, scale=1.0):
     t[:3, :3] *= scale
     t[:2, 3] = (x, y)
     return t
+
+
 def _least_energy(**change):
     from armdyn.motion import least_energy
+
     args = dict(start=[0.0], goal=[1.0], duration=1.0, objective="rms_torque")
     args.update(change)
     return least_energy(_pendulum(), **args)
