@@ -1,9 +1,8 @@
 """The shared shapes of armdyn.motion: Trajectory (timed samples) and Path (geometric q(s))."""
 
+import armdyn as ad
 import numpy as np
 import pytest
-
-import armdyn as ad
 from armdyn.motion import Path, Trajectory
 
 
@@ -59,6 +58,7 @@ def test_path_timed_is_the_chain_rule():
     sd, sdd = np.full_like(t, 0.5), np.zeros_like(t)
     traj = path.timed(t, u, sd, sdd)
     q, d1, d2 = path.evaluate(u)
+    np.testing.assert_allclose(traj.q, q)
     np.testing.assert_allclose(traj.qd, d1 * 0.5)
     np.testing.assert_allclose(traj.qdd, d2 * 0.25)
     # the default spline interpolates the knots
