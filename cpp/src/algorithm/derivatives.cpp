@@ -349,13 +349,13 @@ void forward_dynamics_derivatives(const Model& m, Data& d, Eigen::Ref<const VecX
   // dtau/dq, dtau/dqd at (q, qd, qdd), then M^-1 applied
   full_derivatives(m, d, qf, qdf, w.qdd_full, t);
   reduce_pair(m, d, w.dq, w.dqd, w.tau_q, w.tau_qd);
+  // M^-1 by the Cholesky factor, then -M^-1 dtau/dq and -M^-1 dtau/dqd as products (small
+  // sizes: coefficient-wise, larger: blocked on the stack; no heap allocation either way)
   w.qdd_tau.setIdentity();
-  w.qdd_q = -w.tau_q;
-  w.qdd_qd = -w.tau_qd;
-  for (MatX* x : {&w.qdd_tau, &w.qdd_q, &w.qdd_qd}) {
-    L.triangularView<Eigen::Lower>().solveInPlace(*x);
-    L.transpose().triangularView<Eigen::Upper>().solveInPlace(*x);
-  }
+  L.triangularView<Eigen::Lower>().solveInPlace(w.qdd_tau);
+  L.transpose().triangularView<Eigen::Upper>().solveInPlace(w.qdd_tau);
+  w.qdd_q.noalias() = -w.qdd_tau * w.tau_q;
+  w.qdd_qd.noalias() = -w.qdd_tau * w.tau_qd;
 }
 
 }  // namespace armdyn
