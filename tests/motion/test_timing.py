@@ -204,9 +204,10 @@ def test_a_given_uneven_grid_is_used_as_it_is():
     assert traj.duration == pytest.approx(2 * np.sqrt(1.5 * INERTIA / 3.0), rel=1e-12)
 
 
-def test_spring_torque_is_in_the_static_term_and_dampers_are_refused():
+def test_spring_torque_is_in_the_static_term_and_joint_coulomb_friction_is_refused():
     """A joint spring (k = 4 N m/rad) adds k q to the torque: the limit holds with it, checked
-    by an independent inverse dynamics, and binds; a damper (velocity-dependent) is refused."""
+    by an independent inverse dynamics, and binds; a joint's smoothed Coulomb friction (not
+    linear in the rates, not an actuator's) is refused."""
     b = ad.ModelBuilder(gravity=(0.0, 0.0, -9.81))
     b.add_body("link", MASS, [0.01, I_C, I_C], position=(ARM, 0.0, 0.0))
     b.add_revolute("j", "ground", "link", point=(0, 0, 0), axis=(0, 0, 1))
@@ -217,9 +218,87 @@ def test_spring_torque_is_in_the_static_term_and_dampers_are_refused():
     assert np.max(np.abs(tau)) <= 3.0 * (1 + 1e-6)
     assert np.max(np.abs(tau)) >= 3.0 * (1 - 1e-6)
     np.testing.assert_allclose(tau[-1, 0], 4.0 * 0.5, rtol=1e-12)  # held by the motor at the end
-    b.add_joint_spring_damper("j", damping=0.5)
-    with pytest.raises(ad.ModelError, match="velocity-dependent forces"):
+    b.add_joint_friction("j", coulomb=0.5)
+    with pytest.raises(ad.ModelError, match=r"velocity-dependent forces .* joint 'j'"):
         time_optimal(b.finalize(), segment(0.5), max_torque=3.0)
+
+
+# --- dampers: torques a s̈ + b ṡ² + d ṡ + c --------------------------------------------------
+
+TAU_D, C_D = 3.0, 1.5  # the damped arm's torque limit and its damping (N m s/rad)
+
+
+def damped_arm():
+    """The arm about z with a joint damper (1 N m s/rad) and viscous joint friction (0.5):
+    I q̈ + C q̇ = τ, C = 1.5."""
+    b = ad.ModelBuilder(gravity=(0.0, 0.0, -9.81))
+    b.add_body("link", MASS, [0.01, I_C, I_C], position=(ARM, 0.0, 0.0))
+    b.add_revolute("j", "ground", "link", point=(0, 0, 0), axis=(0, 0, 1))
+    b.add_joint_spring_damper("j", damping=1.0)
+    b.add_joint_friction("j", viscous=C_D - 1.0)
+    return b.finalize()
+
+
+def damped_bang_bang(q_end):
+    """The time-optimal rest-to-rest move of I q̈ + C q̇ = τ, |τ| ≤ τ_max, by scipy's solve_ivp
+    in the speed ω: accelerating dθ/dω = I ω/(τ − C ω), dt/dω = I/(τ − C ω) from rest;
+    braking, integrated back from the end, dθ/dω = I ω/(τ + C ω), dt/dω = I/(τ + C ω); the
+    switch where the two angles add up to the move. Returns (duration, switch speed)."""
+    from scipy.integrate import solve_ivp
+
+    def rhs(w, y):
+        up, down = TAU_D - C_D * w, TAU_D + C_D * w
+        return [INERTIA * w / up, INERTIA / up, INERTIA * w / down, INERTIA / down]
+
+    def meet(w, y):
+        return y[0] + y[2] - q_end
+
+    meet.terminal = True
+    sol = solve_ivp(
+        rhs, [0.0, TAU_D / C_D * (1 - 1e-12)], [0.0] * 4, events=meet, rtol=1e-12, atol=1e-14
+    )
+    y = sol.y_events[0][0]
+    return y[1] + y[3], sol.t_events[0][0]
+
+
+def test_damped_inertia_bang_bang_converges_to_the_ode_solution():
+    """I q̈ + C q̇ = ±τ_max (a joint damper and viscous joint friction): the duration against
+    the bang-bang of :func:`damped_bang_bang` (solve_ivp): the collocation is first order in
+    the grid step (the damper makes the phase curves bend: x_{i+1} = x_i + 2Δ u(x_i) is
+    explicit Euler), so the error halves with the step (measured: −2.4e-3, −1.3e-3, −7.0e-4
+    at 1000, 2000, 4000 intervals); every sample but the switch and the arrival at rest is at
+    the torque limit to 1e-6 by an independent inverse dynamics (the damper's torque C q̇ there
+    is up to C ω*/τ_max = 93 % of the limit: ignoring it would fail by that much)."""
+    model = damped_arm()
+    exact, switch_speed = damped_bang_bang(1.5)
+    errors = []
+    for grid in (1000, 2000, 4000):
+        traj = time_optimal(model, segment(1.5), max_torque=TAU_D, max_velocity=np.inf, grid=grid)
+        errors.append(traj.duration / exact - 1.0)
+        tau = ad.inverse_dynamics(model, traj.q, traj.qd, traj.qdd)[:, 0]
+        assert np.max(np.abs(tau)) <= TAU_D * (1 + 1e-6)
+        off = np.flatnonzero(np.abs(np.abs(tau) / TAU_D - 1.0) > 1e-6)
+        assert len(off) <= 2 and off[-1] == grid  # the switch's sample and the arrival
+    assert abs(errors[-1]) < 1e-3
+    assert 1.6 < errors[1] / errors[2] < 2.4 and 1.6 < errors[0] / errors[1] < 2.4
+    assert np.max(traj.qd) == pytest.approx(switch_speed, rel=1e-4)
+    assert C_D * switch_speed / TAU_D > 0.9
+
+
+def test_damped_inertia_cruises_at_the_terminal_speed():
+    """A long move (40 rad, no speed limit): the damped arm accelerates at τ_max towards its
+    terminal speed τ_max / C, where the damper takes the whole torque: the samples reach it to
+    1e-9 (the discrete speed has the same fixed point), at the torque limit there."""
+    model = damped_arm()
+    traj = time_optimal(model, segment(40.0), max_torque=TAU_D, max_velocity=np.inf, grid=2000)
+    assert np.max(traj.qd) == pytest.approx(TAU_D / C_D, rel=1e-9)
+    cruise = np.abs(traj.qd[:, 0] / (TAU_D / C_D) - 1.0) < 1e-9
+    assert cruise.sum() > 500
+    tau = ad.inverse_dynamics(model, traj.q, traj.qd, traj.qdd)[:, 0]
+    switch = np.flatnonzero(cruise)[-1]  # the last sample at that speed begins the braking
+    np.testing.assert_allclose(tau[cruise][:-1], TAU_D, rtol=1e-6)
+    np.testing.assert_allclose(np.abs(np.delete(tau, [switch, 2000])), TAU_D, rtol=1e-6)
+    assert np.max(np.abs(tau)) <= TAU_D * (1 + 1e-6)
 
 
 def test_speed_and_acceleration_limits_give_the_trapezoid():
