@@ -9,11 +9,16 @@ points (collocation):
 
 - joint speed ``|q'_j| ṡ ≤ v_j``: a bound on x;
 - joint acceleration ``|q'_j u + q''_j x| ≤ α_j``;
-- joint torque ``τ = a(s) u + b(s) x + c(s)`` within ``±τ_max``, from ``armdyn.inverse_dynamics``
-  (batched over the grid): ``c = ID(q, 0, 0)`` (gravity, springs and the other force elements,
-  evaluated at t = 0), ``a = ID(q, 0, q') − c``, ``b = ID(q, q', q'') − c`` less the actuators'
-  friction. Velocity-dependent forces other than the actuators' friction (dampers) are not of
-  this form: the model is refused (the check: the remainder at ṡ = 1 and 2 must scale as ṡ²);
+- joint torque ``τ = a(s) u + b(s) x + d(s) √x + c(s)`` within ``±τ_max``, from
+  ``armdyn.inverse_dynamics`` (batched over the grid): ``c = ID(q, 0, 0)`` (gravity, springs
+  and the other force elements, evaluated at t = 0), ``a = ID(q, 0, q') − c``, and at ``u = 0``,
+  ``ṡ = k`` (``q̇ = k q'``, ``q̈ = k² q''``) the rest ``r_k = ID(q, k q', k² q'') − c`` less the
+  actuators' friction is ``b k² + d k``: the Coriolis and centrifugal terms are quadratic in
+  q̇, and the dampers (joint spring-dampers' and URDF ``<dynamics damping>``, viscous joint
+  friction, point-to-point dampers: forces linear in q̇ at fixed q) linear, so ``b = r_2/2 −
+  r_1`` and ``d = 2 r_1 − r_2/2`` (d = 0 without dampers). A third speed checks it (``r_3 = 9 b +
+  3 d`` to 1e-9 of the torques' scale): other velocity-dependent forces (a joint's Coulomb
+  friction, gear contact) are refused;
 - with actuators carrying an :class:`armdyn.Motor` (``motors=True``): each motor's speed
   ``|N q̇| ≤`` its maximum (else no-load) speed, its peak torque ``|T| ≤ T_peak`` and its
   speed–torque envelope ``|T + T0 ω/ω0| ≤ T0`` (:func:`armdyn.sizing.motor.motor_envelope`), with
@@ -22,23 +27,32 @@ points (collocation):
   drives it, ``τ_gear = τ − N T_rot`` (the link's share, exactly ``a u + b x + c`` without the
   rotor).
 
-**What is exact and what is conservative.** Joint speed, acceleration and torque limits are
-exact at the grid points. The motor constraints are not linear in (u, x): the speed terms (the
-envelope's ``T0 ω/ω0``, the viscous ``b ω``) go as ``ṡ = √x``, the gear's efficiency switches
-branch with the sign of the power, the Coulomb term is a tanh. They are replaced by linear
-constraints that imply them (conservative): ``√x`` by its tangent at the previous solution where
-it tightens the constraint (concave: the tangent lies above), by the chord ``x/√X`` on the
-stage's speed bound ``[0, X]`` where it relaxes it (0 without a bound); the efficiency's two
-branches by both linear pieces on the side where their maximum (minimum) is the true value and
-by the regenerating piece alone on the other (exact wherever that branch holds), and at the
-path's ends, at rest, by the motoring piece on both sides (holding takes ``τ_gear/(N η)``
-whatever its sign); the Coulomb term by its saturated value ``±c`` on the side where it hurts
-and 0 on the other (0 at the ends: at rest it is exactly 0). The tangents
-are then moved to the new solution and the problem solved again (``envelope_iterations``,
-until the duration stops falling by more than 1e-9 relative): every iterate satisfies the true
-constraints at the grid points, the fastest is returned, and at convergence the speed terms are
-exact where they bind (a tangent touches √x at its own point). Joint-torque rows get the
-same treatment for the actuators' friction (inverse dynamics includes it).
+**What is exact and what is conservative.** Joint speed and acceleration limits are exact at
+the grid points, and so are the joint torque limits without speed terms. The others are not
+linear in (u, x): the speed terms (the dampers' ``d ṡ``, the actuators' viscous ``b ω``, the
+envelope's ``T0 ω/ω0``) go as ``ṡ = √x``, the gear's efficiency switches branch with the sign of
+the power, the Coulomb term is a tanh. They are replaced by linear constraints that imply them
+(conservative): a term ``D √x`` by its tangent at a reference x where it tightens the constraint
+(D > 0: √x is concave, the tangent lies above), and where it relaxes it (D < 0: a damper
+helping to brake, ``D √x`` convex) by the secants of its piecewise-linear interpolant on the
+stage's speed bound [0, X] (X = 1e20 where nothing else bounds x), at nodes dense around the
+reference x (1 ± 1e-3, 1 ± 1e-2, ...; one row per secant: the interpolant of a convex function
+lies above it and is the largest of its pieces); the efficiency's two branches by both linear
+pieces on the side where their maximum (minimum) is the true value and by the regenerating
+piece alone on the other (exact wherever that branch holds), and at the path's ends, at rest,
+by the motoring piece on both sides (holding takes ``τ_gear/(N η)`` whatever its sign); the
+Coulomb term by its saturated value ``±c`` on the side where it hurts and 0 on the other (0 at
+the ends: at rest it is exactly 0). The first reference x is, per stage, where the tightening
+terms take half the slack at rest (at most the stage's bound; if that solve finds no timing, it
+is retried from references 100× lower, up to three times). The references are then moved to
+the new solution and the problem solved again (``envelope_iterations``, until the duration
+stops falling by more than 1e-9 relative): every iterate satisfies the true constraints at the
+grid points (each linear row is exact at its reference, so the previous solution stays
+feasible), the fastest is returned, and at convergence the speed terms are exact where they
+bind (a tangent touches √x at its own point, a secant's nodes hold it): a damped inertia at its
+torque limit meets it to 1e-6 at every sample but the switch's (tests/motion/test_timing.py).
+Joint-torque rows get the same treatment for the dampers and the actuators' friction (inverse
+dynamics includes both); with an actuator the dampers' torque is part of the gear's load.
 
 **Why toppra.** The ``toppra`` package (0.6) computes the controllable sets: the backward pass
 of TOPP-RA, 2N two-variable LPs by its Cython Seidel solver, the bulk of the solve; it is
@@ -82,7 +96,7 @@ MAX_GRID = 100_000
 _X_CAP = 1e20
 #: toppra's Seidel solver bounds x at 1e8: its problem is x / scale, scale found by re-solving
 _TOPPRA_X = 1e8
-#: the most tangent updates of the speed terms (envelope, viscous friction)
+#: the most tangent updates of the speed terms (dampers, envelope, viscous friction)
 MAX_ITERATIONS = 30
 #: stop updating the tangents when the duration changes less than this (relative)
 _ITERATION_TOL = 1e-9
@@ -696,8 +710,10 @@ def time_optimal(
         ``envelope_iterations``, ``motor_treatment``.
 
     Raises:
-        ModelError: a bad argument (named), a model that is not fixed-base or has dampers, a
-            path that does not move or whose speed nothing limits.
+        ModelError: a bad argument (named), a model that is not fixed-base or has
+            velocity-dependent forces other than dampers (linear in the rates) and the
+            actuators' friction (a joint's Coulomb friction, gear contact: named with the
+            joint), a path that does not move or whose speed nothing limits.
         SolverError: no feasible timing (naming the grid point, and the limit exceeded at rest
             there when one is).
     """
@@ -723,8 +739,9 @@ def time_optimal(
         "limits": {"max_velocity": v_max, "max_acceleration": a_max, "max_torque": tau_max},
         "envelope_iterations": iterations,
         "qdd_arrival": along.d1[-1] * u[-2],
-        "motor_treatment": "conservative: speed terms by tangents (exact at convergence where "
-        "they bind), gear efficiency branches and Coulomb friction by their worst case",
+        "motor_treatment": "conservative: speed terms (dampers, viscous friction, envelope) by "
+        "tangents and secants (exact at convergence where they bind), gear efficiency branches "
+        "and Coulomb friction by their worst case",
     }
     return _trajectory(path, t, s, sd, u, info, names)
 
