@@ -50,6 +50,12 @@ def _pendulum():
     return _hinged().finalize()
 
 
+def _coulomb_pendulum():
+    b = _hinged()
+    b.add_joint_friction("hinge", viscous=0.1, coulomb=0.5)
+    return b.finalize()
+
+
 def _heavy_pendulum():
     """10 kg at 0.5 m: I = 2.52 kg m², so I q̈ overflows for q̈ = 1.7e308."""
     b = ad.ModelBuilder()
@@ -1292,6 +1298,14 @@ CASES = [
         r"s = 0 .*torque 'hinge' at rest is 4\.905",
     ),
     (
+        "topp-joint-coulomb",
+        "motion",
+        "time_optimal of a model with a joint's Coulomb friction (dampers are accepted)",
+        lambda: ad.motion.time_optimal(_coulomb_pendulum(), _swing(), max_torque=5.0),
+        ME,
+        r"velocity-dependent forces .*joint 'hinge'",
+    ),
+    (
         "cycle-time-no-motor",
         "motion",
         "shortest_cycle of a model without a motor",
@@ -1421,8 +1435,11 @@ def _tip_pose(x=1.2, y=0.5, scale=1.0):
     t[:3, :3] *= scale
     t[:2, 3] = (x, y)
     return t
+
+
 def _least_energy(**change):
     from armdyn.motion import least_energy
+
     args = dict(start=[0.0], goal=[1.0], duration=1.0, objective="rms_torque")
     args.update(change)
     return least_energy(_pendulum(), **args)
