@@ -50,6 +50,12 @@ def _pendulum():
     return _hinged().finalize()
 
 
+def _coulomb_pendulum():
+    b = _hinged()
+    b.add_joint_friction("hinge", viscous=0.1, coulomb=0.5)
+    return b.finalize()
+
+
 def _heavy_pendulum():
     """10 kg at 0.5 m: I = 2.52 kg m², so I q̈ overflows for q̈ = 1.7e308."""
     b = ad.ModelBuilder()
@@ -1429,6 +1435,14 @@ CASES = [
         lambda: ad.motion.time_optimal(_pendulum(), _swing(np.pi / 2, 2.5), max_torque=2.0),
         SE,
         r"s = 0 .*torque 'hinge' at rest is 4\.905",
+    ),
+    (
+        "topp-joint-coulomb",
+        "motion",
+        "time_optimal of a model with a joint's Coulomb friction (dampers are accepted)",
+        lambda: ad.motion.time_optimal(_coulomb_pendulum(), _swing(), max_torque=5.0),
+        ME,
+        r"velocity-dependent forces .*joint 'hinge'",
     ),
     (
         "cycle-time-no-motor",

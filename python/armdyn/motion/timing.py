@@ -9,11 +9,16 @@ points (collocation):
 
 - joint speed ``|q'_j| ṡ ≤ v_j``: a bound on x;
 - joint acceleration ``|q'_j u + q''_j x| ≤ α_j``;
-- joint torque ``τ = a(s) u + b(s) x + c(s)`` within ``±τ_max``, from ``armdyn.inverse_dynamics``
-  (batched over the grid): ``c = ID(q, 0, 0)`` (gravity, springs and the other force elements,
-  evaluated at t = 0), ``a = ID(q, 0, q') − c``, ``b = ID(q, q', q'') − c`` less the actuators'
-  friction. Velocity-dependent forces other than the actuators' friction (dampers) are not of
-  this form: the model is refused (the check: the remainder at ṡ = 1 and 2 must scale as ṡ²);
+- joint torque ``τ = a(s) u + b(s) x + d(s) √x + c(s)`` within ``±τ_max``, from
+  ``armdyn.inverse_dynamics`` (batched over the grid): ``c = ID(q, 0, 0)`` (gravity, springs
+  and the other force elements, evaluated at t = 0), ``a = ID(q, 0, q') − c``, and at ``u = 0``,
+  ``ṡ = k`` (``q̇ = k q'``, ``q̈ = k² q''``) the rest ``r_k = ID(q, k q', k² q'') − c`` less the
+  actuators' friction is ``b k² + d k``: the Coriolis and centrifugal terms are quadratic in
+  q̇, and the dampers (joint spring-dampers' and URDF ``<dynamics damping>``, viscous joint
+  friction, point-to-point dampers: forces linear in q̇ at fixed q) linear, so ``b = r_2/2 −
+  r_1`` and ``d = 2 r_1 − r_2/2`` (d = 0 without dampers). A third speed checks it (``r_3 = 9 b +
+  3 d`` to 1e-9 of the torques' scale): other velocity-dependent forces (a joint's Coulomb
+  friction, gear contact) are refused;
 - with actuators carrying an :class:`armdyn.Motor` (``motors=True``): each motor's speed
   ``|N q̇| ≤`` its maximum (else no-load) speed, its peak torque ``|T| ≤ T_peak`` and its
   speed–torque envelope ``|T + T0 ω/ω0| ≤ T0`` (:func:`armdyn.sizing.motor.motor_envelope`), with
@@ -22,23 +27,32 @@ points (collocation):
   drives it, ``τ_gear = τ − N T_rot`` (the link's share, exactly ``a u + b x + c`` without the
   rotor).
 
-**What is exact and what is conservative.** Joint speed, acceleration and torque limits are
-exact at the grid points. The motor constraints are not linear in (u, x): the speed terms (the
-envelope's ``T0 ω/ω0``, the viscous ``b ω``) go as ``ṡ = √x``, the gear's efficiency switches
-branch with the sign of the power, the Coulomb term is a tanh. They are replaced by linear
-constraints that imply them (conservative): ``√x`` by its tangent at the previous solution where
-it tightens the constraint (concave: the tangent lies above), by the chord ``x/√X`` on the
-stage's speed bound ``[0, X]`` where it relaxes it (0 without a bound); the efficiency's two
-branches by both linear pieces on the side where their maximum (minimum) is the true value and
-by the regenerating piece alone on the other (exact wherever that branch holds), and at the
-path's ends, at rest, by the motoring piece on both sides (holding takes ``τ_gear/(N η)``
-whatever its sign); the Coulomb term by its saturated value ``±c`` on the side where it hurts
-and 0 on the other (0 at the ends: at rest it is exactly 0). The tangents
-are then moved to the new solution and the problem solved again (``envelope_iterations``,
-until the duration stops falling by more than 1e-9 relative): every iterate satisfies the true
-constraints at the grid points, the fastest is returned, and at convergence the speed terms are
-exact where they bind (a tangent touches √x at its own point). Joint-torque rows get the
-same treatment for the actuators' friction (inverse dynamics includes it).
+**What is exact and what is conservative.** Joint speed and acceleration limits are exact at
+the grid points, and so are the joint torque limits without speed terms. The others are not
+linear in (u, x): the speed terms (the dampers' ``d ṡ``, the actuators' viscous ``b ω``, the
+envelope's ``T0 ω/ω0``) go as ``ṡ = √x``, the gear's efficiency switches branch with the sign of
+the power, the Coulomb term is a tanh. They are replaced by linear constraints that imply them
+(conservative): a term ``D √x`` by its tangent at a reference x where it tightens the constraint
+(D > 0: √x is concave, the tangent lies above), and where it relaxes it (D < 0: a damper
+helping to brake, ``D √x`` convex) by the secants of its piecewise-linear interpolant on the
+stage's speed bound [0, X] (X = 1e20 where nothing else bounds x), at nodes dense around the
+reference x (1 ± 1e-3, 1 ± 1e-2, ...; one row per secant: the interpolant of a convex function
+lies above it and is the largest of its pieces); the efficiency's two branches by both linear
+pieces on the side where their maximum (minimum) is the true value and by the regenerating
+piece alone on the other (exact wherever that branch holds), and at the path's ends, at rest,
+by the motoring piece on both sides (holding takes ``τ_gear/(N η)`` whatever its sign); the
+Coulomb term by its saturated value ``±c`` on the side where it hurts and 0 on the other (0 at
+the ends: at rest it is exactly 0). The first reference x is, per stage, where the tightening
+terms take half the slack at rest (at most the stage's bound; if that solve finds no timing, it
+is retried from references 100× lower, up to three times). The references are then moved to
+the new solution and the problem solved again (``envelope_iterations``, until the duration
+stops falling by more than 1e-9 relative): every iterate satisfies the true constraints at the
+grid points (each linear row is exact at its reference, so the previous solution stays
+feasible), the fastest is returned, and at convergence the speed terms are exact where they
+bind (a tangent touches √x at its own point, a secant's nodes hold it): a damped inertia at its
+torque limit meets it to 1e-6 at every sample but the switch's (tests/motion/test_timing.py).
+Joint-torque rows get the same treatment for the dampers and the actuators' friction (inverse
+dynamics includes both); with an actuator the dampers' torque is part of the gear's load.
 
 **Why toppra.** The ``toppra`` package (0.6) computes the controllable sets: the backward pass
 of TOPP-RA, 2N two-variable LPs by its Cython Seidel solver, the bulk of the solve; it is
@@ -82,7 +96,7 @@ MAX_GRID = 100_000
 _X_CAP = 1e20
 #: toppra's Seidel solver bounds x at 1e8: its problem is x / scale, scale found by re-solving
 _TOPPRA_X = 1e8
-#: the most tangent updates of the speed terms (envelope, viscous friction)
+#: the most tangent updates of the speed terms (dampers, envelope, viscous friction)
 MAX_ITERATIONS = 30
 #: stop updating the tangents when the duration changes less than this (relative)
 _ITERATION_TOL = 1e-9
@@ -167,10 +181,11 @@ class _Along:
     q: np.ndarray
     d1: np.ndarray
     d2: np.ndarray
-    a: np.ndarray  # τ = a u + b x + c + visc √x + Coulomb (the actuators' friction)
+    a: np.ndarray  # τ = a u + b x + c + (visc + damp) √x + Coulomb (the actuators' friction)
     b: np.ndarray
     c: np.ndarray
-    visc: np.ndarray
+    visc: np.ndarray  # the actuators' viscous friction (joint side)
+    damp: np.ndarray  # the other forces linear in the rates (dampers): τ gets damp · ṡ
     coulomb: np.ndarray  # the saturated Coulomb term at each joint (signed)
 
 
@@ -201,13 +216,14 @@ def _along(who: str, model, path: Path, s: np.ndarray) -> _Along:
         raise _core.ModelError(f"{who}: the path does not move (dq/ds is zero everywhere)")
     zero = np.zeros_like(d1)
     rows = len(s)
+    speeds = (1.0, 2.0, 3.0)
     try:
         tau = np.asarray(
             _core.inverse_dynamics(
                 model,
-                np.concatenate([q, q, q, q]),
-                np.concatenate([zero, zero, d1, 2.0 * d1]),
-                np.concatenate([zero, d1, d2, 4.0 * d2]),
+                np.concatenate([q] * (2 + len(speeds))),
+                np.concatenate([zero, zero] + [k * d1 for k in speeds]),
+                np.concatenate([zero, d1] + [k * k * d2 for k in speeds]),
             ),
             dtype=float,
         )
@@ -220,16 +236,25 @@ def _along(who: str, model, path: Path, s: np.ndarray) -> _Along:
         ) from None
     c = tau[:rows]
     a = tau[rows : 2 * rows] - c
-    one = tau[2 * rows : 3 * rows] - c - _friction(model, d1, 1.0)
-    two = tau[3 * rows :] - c - _friction(model, d1, 2.0)
+    # at s̈ = 0 and ṡ = k: τ − c − (the actuators' friction) = b k² + d k (module notes)
+    r1, r2, r3 = (
+        tau[(2 + i) * rows : (3 + i) * rows] - c - _friction(model, d1, k)
+        for i, k in enumerate(speeds)
+    )
+    b = 0.5 * r2 - r1
+    damp = 2.0 * r1 - 0.5 * r2
+    # round-off of the differences (no damper at that joint, or not moving): exactly 0
+    raw = np.abs(tau[2 * rows : 3 * rows]) + np.abs(tau[3 * rows : 4 * rows]) + np.abs(c)
+    damp = np.where(np.abs(damp) <= 1e-12 * raw, 0.0, damp)
     scale = np.max(np.abs(tau)) + 1e-300
-    off = np.abs(two - 4.0 * one)
+    off = np.abs(r3 - 9.0 * b - 3.0 * damp)
     if np.max(off) > 1e-9 * scale:
         i, j = np.unravel_index(int(np.argmax(off)), off.shape)
         raise _core.ModelError(
-            f"{who}: the model has velocity-dependent forces other than the actuators' friction "
-            f"(dampers; at s = {s[i]:.6g}, joint {list(model.dof_names)[j]!r}): the joint "
-            "torques are not a(s) s̈ + b(s) ṡ² + c(s), which the timing needs"
+            f"{who}: the model has velocity-dependent forces that are neither linear in the "
+            "rates (dampers) nor the actuators' friction (e.g. Coulomb friction of a joint, "
+            f"gear contact; at s = {s[i]:.6g}, joint {list(model.dof_names)[j]!r}): the joint "
+            "torques are not a(s) s̈ + b(s) ṡ² + d(s) ṡ + c(s), which the timing needs"
         )
     visc = np.zeros_like(d1)
     coulomb = np.zeros_like(d1)
@@ -238,7 +263,7 @@ def _along(who: str, model, path: Path, s: np.ndarray) -> _Along:
         visc[:, k] += n * n * float(act.friction_viscous) * d1[:, k]
         coulomb[:, k] += abs(n) * float(act.friction_coulomb) * np.sign(d1[:, k])
     coulomb[[0, -1]] = 0.0  # at rest at both ends: tanh(0) = 0
-    return _Along(s, q, d1, d2, a, one, c, visc, coulomb)
+    return _Along(s, q, d1, d2, a, b, c, visc, damp, coulomb)
 
 
 # --- the constraint rows ----------------------------------------------------------------------
@@ -316,6 +341,7 @@ def _motor_rows(p: _Problem, act) -> None:
     _speed_bound(p, n * d1, w_max if np.isfinite(w_max) else np.inf, f"motor speed {name!r}")
     # the gear's load torque τ_gear = g_u u + g_x x + g_c (the rotor's N² J taken off)
     g_u, g_x, g_c = al.a[:, k] - n * n * j * d1, al.b[:, k] - n * n * j * d2, al.c[:, k]
+    g_d = al.damp[:, k]  # and the dampers' g_d √x
     sigma = np.sign(d1)
     convex, zero = sigma * n > 0.0, sigma == 0.0
     concave = ~convex & ~zero
@@ -340,7 +366,7 @@ def _motor_rows(p: _Problem, act) -> None:
             a = j * n * d1 + piece * g_u
             b = j * n * d2 + piece * g_x
             c = piece * g_c
-            d = visc + env
+            d = visc + env + piece * g_d
             p.rows.add(label, limit, 1, a, b, c + np.maximum(coul, 0.0), d, active=up)
             p.rows.add(label, limit, -1, a, b, c + np.minimum(coul, 0.0), d, active=lo)
 
@@ -357,7 +383,7 @@ def _problem(model, along: _Along, names, v_max, a_max, tau_max, motors: bool) -
             along.a[:, k],
             along.b[:, k],
             along.c[:, k],
-            along.visc[:, k],
+            along.visc[:, k] + along.damp[:, k],
             along.coulomb[:, k],
         )
     if motors:
@@ -367,22 +393,72 @@ def _problem(model, along: _Along, names, v_max, a_max, tau_max, motors: bool) -
     return p
 
 
+#: where the secants of the √x terms with D < 0 meet √x, as multiples of the reference x: dense
+#: around it (1 ± 1e-3: the interpolant is within 1.3e-7 √x of √x there), then the stage's
+#: bound on x (module notes)
+_SECANT_NODES = (0.0, 0.5, 0.9, 0.99, 0.999, 1.0, 1.001, 1.01, 1.1, 1.5, 2.0, 4.0)
+
+
+def _secants(x_ref: np.ndarray, xmax: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per stage, the lines ``k x + m`` (K columns) of √x's piecewise-linear interpolant at the
+    nodes ``x_ref · _SECANT_NODES`` below the stage's bound X, and X: for D < 0 the interpolant
+    of D √x (convex) lies above it on [0, X] and is the largest of its lines, so the rows
+    ``A u + B x + C + D (k x + m) ≤ 0``, one per line, imply the true one, exactly at the
+    nodes. Where nodes coincide (clipped at X) the stage's first line is repeated."""
+    xs = x_ref[:, None] * np.asarray(_SECANT_NODES)[None, :]
+    xs = np.concatenate([np.minimum(xs, xmax[:, None]), xmax[:, None]], axis=1)
+    x0, x1 = xs[:, :-1], xs[:, 1:]
+    gap = x1 > x0 * (1.0 + 1e-12)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        k = np.where(gap, 1.0 / (np.sqrt(x1) + np.sqrt(x0)), np.nan)
+    m = np.sqrt(x0) - k * x0
+    # a node repeated (clipped at X): use a real line of the stage instead (the first one)
+    first = np.argmax(gap, axis=1)
+    rows = np.arange(len(x_ref))
+    k = np.where(gap, k, k[rows, first][:, None])
+    m = np.where(gap, m, m[rows, first][:, None])
+    return np.nan_to_num(k), np.nan_to_num(m)  # X = 0: x = 0 there, the term vanishes
+
+
 def _linearised(p: _Problem, x_ref: np.ndarray):
-    """(A, B, C) with the √x terms replaced by linear bounds (module notes): the tangent at
-    ``x_ref`` where D > 0, the chord x/√X on [0, X] (X the stage's bound on x) where D < 0."""
+    """(A, B, C, cols) with the √x terms replaced by linear bounds (module notes): the tangent
+    at ``x_ref`` where D > 0; where D < 0 the secants of :func:`_secants` on [0, X] (X the
+    stage's bound on x), one row each: rows of the same constraint, ``cols`` names the
+    constraint (its column of ``p.rows``) of each row."""
     a, b, c, d = p.rows.arrays()
     d[[0, -1]] = 0.0  # x = 0 at both ends: the √x terms vanish there exactly
+    cols = np.arange(a.shape[1])
     if not np.any(d):
-        return a, b, c
+        return a, b, c, cols
     b, c = b.copy(), c.copy()
-    xr = np.maximum(x_ref, 1e-6 * max(float(np.max(x_ref)), 1e-300))[:, None]
+    xr = np.maximum(x_ref, 1e-6 * max(float(np.max(x_ref)), 1e-300))
     up = d > 0.0
-    b += np.where(up, d / (2.0 * np.sqrt(xr)), 0.0)
-    c += np.where(up, d * np.sqrt(xr) / 2.0, 0.0)
-    bounded = (p.xmax < _X_CAP)[:, None]
-    chord = (d < 0.0) & bounded
-    b += np.where(chord, d / np.sqrt(np.where(bounded, p.xmax[:, None], 1.0)), 0.0)
-    return a, b, c
+    b += np.where(up, d / (2.0 * np.sqrt(xr[:, None])), 0.0)
+    c += np.where(up, d * np.sqrt(xr[:, None]) / 2.0, 0.0)
+    down = d < 0.0
+    if not np.any(down):
+        return a, b, c, cols
+    k, m = _secants(np.minimum(xr, p.xmax), p.xmax)
+    neg = np.flatnonzero(np.any(down, axis=0))
+    out_a, out_b, out_c, out_cols = [a], [b], [c], [cols]
+    dn = np.where(down[:, neg], d[:, neg], 0.0)
+    b_neg, c_neg = b[:, neg], c[:, neg]  # copies (fancy indexing)
+    for line in range(k.shape[1]):
+        bb = b_neg + dn * k[:, line, None]
+        cc = c_neg + dn * m[:, line, None]
+        if line == 0:  # the first line replaces the term in the row itself
+            b[:, neg], c[:, neg] = bb, cc
+            continue
+        out_a.append(a[:, neg])
+        out_b.append(bb)
+        out_c.append(cc)
+        out_cols.append(neg)
+    return (
+        np.concatenate(out_a, axis=1),
+        np.concatenate(out_b, axis=1),
+        np.concatenate(out_c, axis=1),
+        np.concatenate(out_cols),
+    )
 
 
 # --- the solve --------------------------------------------------------------------------------
@@ -502,7 +578,7 @@ def _fail(who: str, p: _Problem, i: int, why: str):
 
 def _solve(who: str, p: _Problem, x_ref: np.ndarray):
     s = p.along.s
-    a, b, c = _linearised(p, x_ref)
+    a, b, c, _ = lin = _linearised(p, x_ref)
     k_sets = _scaled_controllable(s, a, b, c, p.xmax)
     bad = np.flatnonzero(np.isnan(k_sets).any(axis=1))
     if len(bad):
@@ -519,18 +595,46 @@ def _solve(who: str, p: _Problem, x_ref: np.ndarray):
             f"{who}: nothing limits the path speed at s = {s[i]:.6g}: give max_velocity, "
             "max_acceleration or max_torque (or a model with limits) for the joints that move"
         )
-    return x, u, (a, b, c)
+    return x, u, lin
+
+
+def _first_reference(p: _Problem) -> np.ndarray:
+    """The first tangent points: per stage, the x where the √x terms of the rows that tighten
+    (D > 0) take half the slack at rest (D √x = −C/2: the tangent there leaves 3/4 of it),
+    at most the stage's bound on x (1 where neither applies)."""
+    _, _, c, d = p.rows.arrays()
+    with np.errstate(divide="ignore", invalid="ignore"):
+        half = np.where((d > 0.0) & (c < 0.0), (c / (2.0 * d)) ** 2, np.inf)
+    x0 = np.minimum(np.min(half, axis=1, initial=np.inf), p.xmax)
+    return np.where(x0 < _X_CAP, x0, 1.0)
+
+
+#: the first solve is retried from tangent points this much lower when it finds no timing
+_RETRY_FACTOR, _RETRIES = 1e-2, 3
+
+
+def _first_solve(who: str, p: _Problem, x_ref: np.ndarray):
+    """The first solve; a tangent point above what a stage allows makes its linear rows
+    infeasible where the true ones are not: retried from lower points before failing."""
+    for attempt in range(_RETRIES + 1):
+        try:
+            return _solve(who, p, x_ref)
+        except _core.SolverError:
+            if attempt == _RETRIES or not np.any(p.rows.arrays()[3] > 0.0):
+                raise
+            x_ref = x_ref * _RETRY_FACTOR
+    raise AssertionError("unreachable")  # pragma: no cover
 
 
 def _iterate(who: str, p: _Problem):
-    """The solve, with the tangents of the √x terms moved to each solution until the duration
-    settles (module notes); every iterate is feasible."""
+    """The solve, with the tangents (secants) of the √x terms moved to each solution until the
+    duration settles (module notes); every iterate is feasible."""
     _, _, _, d = p.rows.arrays()
-    x_ref = np.where(p.xmax < _X_CAP, p.xmax, 1.0)
+    x_ref = _first_reference(p)
     best, duration, iterations = None, np.inf, 0
     while iterations < (MAX_ITERATIONS if np.any(d) else 1):
         iterations += 1
-        x, u, lin = _solve(who, p, x_ref)
+        x, u, lin = _solve(who, p, x_ref) if best is not None else _first_solve(who, p, x_ref)
         t = _times(who, p.along.s, x)
         if best is not None and t[-1] >= duration * (1.0 - _ITERATION_TOL):
             if t[-1] < duration:
@@ -556,14 +660,14 @@ def _times(who: str, s: np.ndarray, x: np.ndarray) -> np.ndarray:
 def _active(p: _Problem, lin, x, u) -> list[str]:
     """Per sample, the constraint that binds (least slack within 1e-6 of its limit), the bound
     on x, or '' (the speed is set by a constraint further on)."""
-    a, b, c = lin
+    a, b, c, cols = lin
     out = [""] * len(x)
     if a.shape[1]:
-        limits = np.array([max(col[1], 1e-300) for col in p.rows.cols])
+        limits = np.array([max(p.rows.cols[k][1], 1e-300) for k in cols])
         ratio = _violation(a, b, c, x, u) / limits
         worst = np.argmax(ratio, axis=1)
         for i in np.flatnonzero(ratio[np.arange(len(x)), worst] >= -1e-6):
-            label, _, side = p.rows.cols[worst[i]][:3]
+            label, _, side = p.rows.cols[cols[worst[i]]][:3]
             out[i] = f"{label} {'upper' if side > 0 else 'lower'}"
     at_bound = (x >= p.xmax * (1.0 - 1e-9)) & (x > 0.0)
     for i in np.flatnonzero(at_bound):
@@ -606,8 +710,10 @@ def time_optimal(
         ``envelope_iterations``, ``motor_treatment``.
 
     Raises:
-        ModelError: a bad argument (named), a model that is not fixed-base or has dampers, a
-            path that does not move or whose speed nothing limits.
+        ModelError: a bad argument (named), a model that is not fixed-base or has
+            velocity-dependent forces other than dampers (linear in the rates) and the
+            actuators' friction (a joint's Coulomb friction, gear contact: named with the
+            joint), a path that does not move or whose speed nothing limits.
         SolverError: no feasible timing (naming the grid point, and the limit exceeded at rest
             there when one is).
     """
@@ -633,8 +739,9 @@ def time_optimal(
         "limits": {"max_velocity": v_max, "max_acceleration": a_max, "max_torque": tau_max},
         "envelope_iterations": iterations,
         "qdd_arrival": along.d1[-1] * u[-2],
-        "motor_treatment": "conservative: speed terms by tangents (exact at convergence where "
-        "they bind), gear efficiency branches and Coulomb friction by their worst case",
+        "motor_treatment": "conservative: speed terms (dampers, viscous friction, envelope) by "
+        "tangents and secants (exact at convergence where they bind), gear efficiency branches "
+        "and Coulomb friction by their worst case",
     }
     return _trajectory(path, t, s, sd, u, info, names)
 
