@@ -137,7 +137,7 @@ def measure(model, path, grid: int) -> dict:
         model, along, list(model.dof_names), v_max, np.full(6, np.inf), TORQUE, True
     )
     lin = _timing._linearised(prob, np.ones(len(s)))
-    t_sets, _, _ = cpu_time(lambda: _timing._scaled_controllable(s, *lin, prob.xmax), 5)
+    t_sets, _, _ = cpu_time(lambda: _timing._scaled_controllable(s, *lin[:3], prob.xmax), 5)
     # between the samples (the exact evaluator, 20 points per interval): collocation holds the
     # limits at the grid points only, between them to first order in the grid step
     fine = traj.sample(dt=traj.duration / (20 * grid))
