@@ -10,18 +10,12 @@
 #include "armdyn/kernels/joint_space.hpp"
 #include "armdyn/kernels/kkt_factor.hpp"
 #include "armdyn/math/cholesky.hpp"
+#include "armdyn/math/quaternion.hpp"
 
 namespace armdyn {
 
 // (a named namespace: the algorithm sources share one unity translation unit)
 namespace derivatives_detail {
-
-// [a]x, the cross-product matrix
-inline Mat3 skew(const Vec3& a) {
-  Mat3 s;
-  s << 0.0, -a.z(), a.y(), a.z(), 0.0, -a.x(), -a.y(), a.x(), 0.0;
-  return s;
-}
 
 // motion cross product (w, v) x (w2, v2) = (w x w2, w x v2 + v x w2)
 inline Vec6 mcross(const Vec6& a, const Vec6& b) {
