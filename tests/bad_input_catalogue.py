@@ -50,11 +50,25 @@ def _pendulum():
     return _hinged().finalize()
 
 
+def _coulomb_pendulum():
+    b = _hinged()
+    b.add_joint_friction("hinge", viscous=0.1, coulomb=0.5)
+    return b.finalize()
+
+
 def _heavy_pendulum():
     """10 kg at 0.5 m: I = 2.52 kg m², so I q̈ overflows for q̈ = 1.7e308."""
     b = ad.ModelBuilder()
     b.add_body("link", 10.0, I3, position=(0.0, 0.0, -0.5))
     b.add_revolute("hinge", "ground", "link", (0, 0, 0), (0, 1, 0))
+    return b.finalize()
+
+
+def _two_links():
+    """Two links on parallel hinges: the mass matrix depends on the elbow angle."""
+    b = _hinged()
+    b.add_body("forearm", 1.0, I3, position=(0.0, 0.0, -1.5))
+    b.add_revolute("elbow", "link", "forearm", (0, 0, -1.0), (0, 1, 0))
     return b.finalize()
 
 
@@ -942,6 +956,137 @@ CASES = [
         SE,
         r"qdd\[0\].*overflow",
     ),
+    # ---- derivatives of the dynamics (issue 34)
+    (
+        "idd-q-length",
+        "derivatives",
+        "inverse_dynamics_derivatives with q of length 2 for 1 coordinate",
+        lambda: ad.inverse_dynamics_derivatives(_pendulum(), [0.0, 0.0], [0.0], [0.0]),
+        ME,
+        r"\bq\b",
+    ),
+    (
+        "idd-qdd-nan",
+        "derivatives",
+        "inverse_dynamics_derivatives with qdd NaN",
+        lambda: ad.inverse_dynamics_derivatives(_pendulum(), [0.0], [0.0], [np.nan]),
+        ME,
+        "qdd",
+    ),
+    (
+        "idd-rows",
+        "derivatives",
+        "inverse_dynamics_derivatives with 3 rows of q and 2 of qd",
+        lambda: ad.inverse_dynamics_derivatives(
+            _pendulum(), np.zeros((3, 1)), np.zeros((2, 1)), np.zeros((3, 1))
+        ),
+        ME,
+        r"\bqd\b",
+    ),
+    (
+        "idd-t-rows",
+        "derivatives",
+        "inverse_dynamics_derivatives with 2 times for 3 rows",
+        lambda: ad.inverse_dynamics_derivatives(
+            _pendulum(), np.zeros((3, 1)), np.zeros((3, 1)), np.zeros((3, 1)), t=[0.0, 1.0]
+        ),
+        ME,
+        r"\bt\b",
+    ),
+    (
+        "idd-model",
+        "derivatives",
+        "inverse_dynamics_derivatives of a ModelBuilder (not finalized)",
+        lambda: ad.inverse_dynamics_derivatives(_hinged(), [0.0], [0.0], [0.0]),
+        ME,
+        "model must be an armdyn.Model",
+    ),
+    (
+        "idd-data-other-model",
+        "derivatives",
+        "inverse_dynamics_derivatives with data made for another model",
+        lambda: ad.inverse_dynamics_derivatives(
+            _pendulum(), [0.0], [0.0], [0.0], data=ad.Data(_heavy_pendulum())
+        ),
+        ME,
+        "data.*another model",
+    ),
+    (
+        "idd-overflow",
+        "derivatives",
+        "inverse_dynamics_derivatives with qdd = 1e308 on a two-link arm (finite; overflows)",
+        lambda: ad.inverse_dynamics_derivatives(_two_links(), [0.0, 0.5], [0.0, 0.0], [1e308] * 2),
+        SE,
+        r"overflow.*qdd\[0\]",
+    ),
+    (
+        "fdd-tau-nan",
+        "derivatives",
+        "forward_dynamics_derivatives with tau NaN",
+        lambda: ad.forward_dynamics_derivatives(_pendulum(), [0.0], [0.0], [np.nan]),
+        ME,
+        "tau",
+    ),
+    (
+        "fdd-qd-inf",
+        "derivatives",
+        "forward_dynamics_derivatives with qd inf",
+        lambda: ad.forward_dynamics_derivatives(_pendulum(), [0.0], [np.inf], [0.0]),
+        ME,
+        r"\bqd\b",
+    ),
+    (
+        "fdd-q-3d",
+        "derivatives",
+        "forward_dynamics_derivatives with a 3-D q",
+        lambda: ad.forward_dynamics_derivatives(_pendulum(), np.zeros((2, 2, 1)), [0.0], [0.0]),
+        ME,
+        r"\bq\b",
+    ),
+    (
+        "fdd-model",
+        "derivatives",
+        "forward_dynamics_derivatives with model None",
+        lambda: ad.forward_dynamics_derivatives(None, [0.0], [0.0], [0.0]),
+        ME,
+        "model must be an armdyn.Model",
+    ),
+    (
+        "fdd-data-type",
+        "derivatives",
+        "forward_dynamics_derivatives with data a Model (not a Data)",
+        lambda: ad.forward_dynamics_derivatives(_pendulum(), [0.0], [0.0], [0.0], data=_pendulum()),
+        ME,
+        r"data must be an armdyn\.Data",
+    ),
+    (
+        "fdd-data-other-model",
+        "derivatives",
+        "forward_dynamics_derivatives with data made for another model",
+        lambda: ad.forward_dynamics_derivatives(
+            _pendulum(), [0.0], [0.0], [0.0], data=ad.Data(_two_links())
+        ),
+        ME,
+        "data.*another model",
+    ),
+    (
+        "fdd-on-loop",
+        "derivatives",
+        "forward_dynamics_derivatives on a closed loop",
+        lambda: ad.forward_dynamics_derivatives(
+            ad.scenes.four_bar(), np.zeros(4), np.zeros(4), np.zeros(4)
+        ),
+        ME,
+        "loop",
+    ),
+    (
+        "fdd-overflow",
+        "derivatives",
+        "forward_dynamics_derivatives with tau = 1.7e308 on a two-link arm (finite; overflows)",
+        lambda: ad.forward_dynamics_derivatives(_two_links(), [0.0, 0.5], [0.0, 0.0], [1.7e308, 0]),
+        SE,
+        r"overflow.*tau\[0\]",
+    ),
     (
         "lagrange-loop",
         "validators",
@@ -1138,7 +1283,305 @@ CASES = [
         ME,
         "hinge",
     ),
+    (
+        "least-energy-duration-nan",
+        "motion",
+        "least_energy with a NaN duration",
+        lambda: _least_energy(duration=np.nan),
+        ME,
+        "least_energy: duration must be a positive number",
+    ),
+    (
+        "least-energy-start-shape",
+        "motion",
+        "least_energy from a start of two coordinates on a one-joint model",
+        lambda: _least_energy(start=[0.0, 0.0]),
+        ME,
+        r"least_energy: start must have shape \(1,\)",
+    ),
+    (
+        "least-energy-copper-no-motor",
+        "motion",
+        "least_energy's copper loss on a joint without a motor's torque constant and resistance",
+        lambda: _least_energy(objective="copper"),
+        ME,
+        "joint 'hinge' has none",
+    ),
+    (
+        "least-energy-infeasible",
+        "motion",
+        "least_energy in less time than any motion within the torque limit takes",
+        lambda: _least_energy(duration=0.2, max_torque=0.5),
+        SE,
+        "most exceeded limit is torque of joint 'hinge'",
+    ),
+    # ---- motion: joint trajectories
+    (
+        "p2p-start-nan",
+        "motion",
+        "point-to-point move from a NaN joint position",
+        lambda: _motion().point_to_point([0.0, np.nan], [1.0, 1.0], **_LIMITS),
+        ME,
+        r"point_to_point: start\[1\] = .*nan.* is not finite",
+    ),
+    (
+        "p2p-velocity-limit-zero",
+        "motion",
+        "a zero velocity limit",
+        lambda: _motion().point_to_point(0.0, 1.0, **{**_LIMITS, "max_velocity": 0.0}),
+        ME,
+        r"max_velocity\[0\] = 0\.0 must be positive",
+    ),
+    (
+        "p2p-limit-shape",
+        "motion",
+        "three velocity limits for two joints",
+        lambda: _motion().point_to_point([0, 0], [1, 1], **{**_LIMITS, "max_velocity": [1, 2, 3]}),
+        ME,
+        r"max_velocity must be a scalar or have shape \(2,\)",
+    ),
+    (
+        "p2p-jerk-missing",
+        "motion",
+        "a jerk-limited profile without a jerk limit",
+        lambda: _motion().point_to_point(0.0, 1.0, max_velocity=1.0, max_acceleration=1.0),
+        ME,
+        "profile='double_s' needs max_jerk",
+    ),
+    (
+        "p2p-too-many-samples",
+        "motion",
+        "a 10 000 s move sampled every microsecond",
+        lambda: _motion().point_to_point(0.0, 1e4, **_LIMITS, dt=1e-6),
+        ME,
+        r"dt = 1e-06 s over .* samples \(> 10000000\)",
+    ),
+    (
+        "p2p-scales",
+        "motion",
+        "a move of 1e300 rad at 1 rad/s (ruckig finds no profile)",
+        lambda: _motion().point_to_point(0.0, 1e300, **_LIMITS),
+        SE,
+        r"segment 0 \(waypoint 0 to 1\) of joint 0",
+    ),
+    (
+        "via-one-waypoint",
+        "motion",
+        "a move through a single waypoint",
+        lambda: _motion().through_waypoints([[0.0, 1.0]], **_LIMITS),
+        ME,
+        "waypoints must hold at least two points, got 1",
+    ),
+    (
+        "spline-times-repeat",
+        "motion",
+        "a spline whose times repeat",
+        lambda: _motion().spline([0.0, 1.0, 1.0], [0.0, 1.0, 2.0]),
+        ME,
+        r"times must be strictly increasing \(times\[2\]",
+    ),
+    (
+        "spline-over-limit",
+        "motion",
+        "a spline too fast for its velocity limit",
+        lambda: _motion().spline([0.0, 0.5], [[0.0, 0.0], [0.1, 2.0]], max_velocity=[1.0, 3.0]),
+        SE,
+        r"joint 1 reaches velocity 7\.5 at t = 0\.25 s",
+    ),
+    (
+        "path-repeated-waypoint",
+        "motion",
+        "a waypoint path through the same point twice in a row",
+        lambda: _motion().waypoint_path([[0.0, 1.0], [0.0, 1.0], [1.0, 1.0]]),
+        ME,
+        r"waypoints\[0\] and waypoints\[1\] are equal",
+    ),
+    (
+        "topp-torque-negative",
+        "motion",
+        "time_optimal with a negative torque limit",
+        lambda: ad.motion.time_optimal(_pendulum(), _swing(), max_torque=-1.0),
+        ME,
+        r"max_torque\[0\] \(joint 'hinge'\)",
+    ),
+    (
+        "topp-grid-one",
+        "motion",
+        "time_optimal on a grid of one interval",
+        lambda: ad.motion.time_optimal(_pendulum(), _swing(), max_torque=5.0, grid=1),
+        ME,
+        "grid must be",
+    ),
+    (
+        "topp-path-array",
+        "motion",
+        "time_optimal of an array instead of a Path",
+        lambda: ad.motion.time_optimal(_pendulum(), np.zeros((2, 1))),
+        ME,
+        "path must be an armdyn.motion.Path",
+    ),
+    (
+        "topp-unbounded",
+        "motion",
+        "time_optimal with no limit on the moving joint",
+        lambda: ad.motion.time_optimal(_pendulum(), _swing(), max_torque=np.inf),
+        ME,
+        "nothing limits the path speed",
+    ),
+    (
+        "topp-static-torque",
+        "motion",
+        "time_optimal from a pose whose holding torque exceeds the limit",
+        lambda: ad.motion.time_optimal(_pendulum(), _swing(np.pi / 2, 2.5), max_torque=2.0),
+        SE,
+        r"s = 0 .*torque 'hinge' at rest is 4\.905",
+    ),
+    (
+        "topp-joint-coulomb",
+        "motion",
+        "time_optimal of a model with a joint's Coulomb friction (dampers are accepted)",
+        lambda: ad.motion.time_optimal(_coulomb_pendulum(), _swing(), max_torque=5.0),
+        ME,
+        r"velocity-dependent forces .*joint 'hinge'",
+    ),
+    (
+        "cycle-time-no-motor",
+        "motion",
+        "shortest_cycle of a model without a motor",
+        lambda: ad.motion.shortest_cycle(_pendulum(), _swing(), dwell=1.0, max_torque=5.0),
+        ME,
+        "no actuator with a motor",
+    ),
+    (
+        "cycle-time-dwell-negative",
+        "motion",
+        "shortest_cycle with a negative dwell",
+        lambda: ad.motion.shortest_cycle(_pendulum(), _swing(), dwell=-1.0),
+        ME,
+        "dwell",
+    ),
+    (
+        "ik-target-nan",
+        "motion",
+        "inverse_kinematics with NaN in the target pose",
+        lambda: _motion().inverse_kinematics(_arm2(), "tip", _tip_pose(y=np.nan), [0.3, 0.5]),
+        ME,
+        r"target\[1, 3\] = .*nan",
+    ),
+    (
+        "ik-target-not-rotation",
+        "motion",
+        "inverse_kinematics with a scaled rotation (|R^T R - I| = 0.02)",
+        lambda: _motion().inverse_kinematics(_arm2(), "tip", _tip_pose(scale=1.01), [0.3, 0.5]),
+        ME,
+        r"target\[:3, :3\] is not a rotation matrix",
+    ),
+    (
+        "ik-unknown-frame",
+        "motion",
+        "inverse_kinematics of a frame the model does not have",
+        lambda: _motion().inverse_kinematics(_arm2(), "hand", _tip_pose(), [0.3, 0.5]),
+        ME,
+        "unknown frame 'hand'",
+    ),
+    (
+        "ik-unreachable",
+        "motion",
+        "inverse_kinematics of a target beyond the arm's reach",
+        lambda: _motion().inverse_kinematics(
+            _arm2(), "tip", _tip_pose(x=5.0), [0.3, 0.5], mask=_XY
+        ),
+        SE,
+        r"no solution for frame 'tip' at position \[5\.0",
+    ),
+    (
+        "move-start-outside-limits",
+        "motion",
+        "linear_move from a start outside a joint's limits",
+        lambda: _motion().linear_move(
+            _arm2(limit=1.0), "tip", [0.0, 1.5], [1.0, 0.5, 0.0], mask=_XY
+        ),
+        ME,
+        r"q_start\[1\] = 1\.5 is outside joint 'j1'",
+    ),
+    (
+        "move-rows-not-joints",
+        "motion",
+        "linear_move of a 2-joint arm along all six rows (q(s) not unique)",
+        lambda: _motion().linear_move(_arm2(), "tip", [0.3, 0.5], [1.0, 0.5, 0.0]),
+        ME,
+        r"moved by 2 joints but the move keeps 6 rows",
+    ),
+    (
+        "arc-collinear",
+        "motion",
+        "arc_move through three points on a line",
+        lambda: _motion().arc_move(
+            _arm2(), "tip", [0.0, 0.0], [1.4, 0.0, 0.0], [1.2, 0.0, 0.0], mask=_XY
+        ),
+        ME,
+        "collinear",
+    ),
+    (
+        "move-singular",
+        "motion",
+        "linear_move beyond the stretched arm (manipulability falls below its minimum)",
+        lambda: _motion().linear_move(_arm2(), "tip", [0.0, 1.0], [2.5, 0.0, 0.0], mask=_XY),
+        SE,
+        r"singularity at s = [0-9.]+ \(position \[",
+    ),
 ]
+
+_LIMITS = {"max_velocity": 1.0, "max_acceleration": 2.0, "max_jerk": 10.0}
+
+
+def _motion():
+    import armdyn.motion
+
+    return armdyn.motion
+
+
+def _swing(q0=0.0, q1=1.0):
+    """A straight joint-space path of the pendulum's hinge from q0 to q1."""
+    return ad.motion.Path([0.0, 1.0], [[q0], [q1]])
+
+
+def _motion():
+    from armdyn import motion
+
+    return motion
+
+
+_XY = [1, 1, 0, 0, 0, 0]
+
+
+def _arm2(limit=None):
+    """A planar 2R arm (links 1 m and 0.8 m, axes z) with the frame 'tip' at its end; joint
+    'j1' limited to [-limit, limit] when given."""
+    b = ad.ModelBuilder()
+    b.add_body("l0", 1.0, I3, position=(0.5, 0.0, 0.0))
+    b.add_revolute("j0", "ground", "l0", (0.0, 0.0, 0.0), (0.0, 0.0, 1.0))
+    b.add_body("l1", 1.0, I3, position=(1.4, 0.0, 0.0))
+    b.add_revolute("j1", "l0", "l1", (1.0, 0.0, 0.0), (0.0, 0.0, 1.0))
+    b.add_frame("tip", "l1", position=(1.8, 0.0, 0.0))
+    if limit is not None:
+        b.set_joint_limits("j1", -limit, limit)
+    return b.finalize()
+
+
+def _tip_pose(x=1.2, y=0.5, scale=1.0):
+    t = np.eye(4)
+    t[:3, :3] *= scale
+    t[:2, 3] = (x, y)
+    return t
+
+
+def _least_energy(**change):
+    from armdyn.motion import least_energy
+
+    args = dict(start=[0.0], goal=[1.0], duration=1.0, objective="rms_torque")
+    args.update(change)
+    return least_energy(_pendulum(), **args)
 
 
 def _cli():

@@ -25,6 +25,7 @@ void bind_inverse_dynamics(py::module_& m);
 void bind_validate(py::module_& m);
 void bind_algorithm(py::module_& m);
 void bind_frames(py::module_& m);
+void bind_derivatives(py::module_& m);
 }  // namespace armdyn
 
 namespace {
@@ -223,5 +224,6 @@ PYBIND11_MODULE(_core, m) {
   armdyn::bind_validate(m);
   armdyn::bind_algorithm(m);
   armdyn::bind_frames(m);
+  armdyn::bind_derivatives(m);
   add_text_signatures(m, py::module_::import("ast").attr("literal_eval"));
 }

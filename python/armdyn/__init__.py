@@ -7,7 +7,7 @@ actuator efforts) come from the augmented system ``[Γ ζᵀ; ζ 0][v'; δ] = [�
 projection keeps the constraints satisfied to round-off.
 """
 
-from armdyn import actuators, scenes, validation
+from armdyn import actuators, motion, scenes, validation
 from armdyn._core import (
     Actuator,
     Data,
@@ -25,11 +25,13 @@ from armdyn._core import (
     energy,
     evaluate_constraints,
     forward_dynamics,
+    forward_dynamics_derivatives,
     frame_jacobian,
     frame_jacobian_cartesian,
     frame_pose,
     frame_pose_cartesian,
     inverse_dynamics,
+    inverse_dynamics_derivatives,
     joint_coordinates,
     joint_reactions,
     mass_matrix,
@@ -91,18 +93,21 @@ __all__ = [
     "energy",
     "evaluate_constraints",
     "forward_dynamics",
+    "forward_dynamics_derivatives",
     "frame_jacobian",
     "frame_jacobian_cartesian",
     "frame_pose",
     "frame_pose_cartesian",
     "gear_ratio_sweep",
     "inverse_dynamics",
+    "inverse_dynamics_derivatives",
     "joint_coordinates",
     "joint_reactions",
     "limit_violations",
     "load_catalog",
     "load_urdf",
     "mass_matrix",
+    "motion",
     "profiles",
     "rollout",
     "scenes",

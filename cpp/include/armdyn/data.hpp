@@ -60,6 +60,16 @@ class Data {
   // --- forces (body_forces, coordinate_forces, cartesian_forces) ---
   VecX eta;        ///< (nv) applied and gyroscopic forces on the bodies
   VecX coord_tau;  ///< (nco) joint-coordinate forces and gear contact forces (coordinate_forces)
+  /// add_force_element_derivatives (algorithm/force_derivatives.hpp), sized by its first call:
+  /// per degree of freedom its world twist (angular; velocity of the origin); per entry of a
+  /// body's chain or of a spring-damper's two chains: the degree of freedom, its joint's level
+  /// (1 at the body), and the terms of algorithm/force_derivatives.cpp (dd, fa, tc, g, dT)
+  struct ForceDerivScratch {
+    std::vector<Vec6> twist;
+    std::vector<int> dofs, level;
+    std::vector<Vec3> dd, fa, tc;
+    VecX g, dT;
+  } force_deriv;
   // --- recursive Newton-Euler (rnea) ---
   RneWork rne;
   VecX tau;  ///< (n) the last rnea's joint torques/forces
@@ -157,6 +167,29 @@ class Data {
   /// the joints joint_reactions sweeps (tree_sweep), made on its first call
   std::vector<std::pair<int, int>> reaction_sweep;
   bool reaction_sweep_made = false;
+
+  // --- first-order derivatives of the dynamics (algorithm/derivatives), sized on first use
+  // (ensure_derivatives: quadratic in the coordinates, never per call) ---
+  struct Derivatives {
+    /// per body: its subtree's spatial inertia about the reference point o, and the angular
+    /// block Bc and linear momentum Lc of the inertia's velocity variation B (B u = Y (u x V) +
+    /// u x* Y V + V x* Y u = (Bc u_w, -2 Lc x u_w): its other blocks vanish)
+    std::vector<Composite> Yc;
+    std::vector<Mat3> Bc;
+    std::vector<Vec3> Lc;
+    /// per body: spatial velocity, acceleration (gravity offset) and the subtree's Newton-Euler
+    /// wrench (gravity and gyroscopic terms, no force elements)
+    std::vector<Vec6> V, A, Fc;
+    /// per degree of freedom (n): its motion S, the parent's terms u = V_p x S, w = A_p x S +
+    /// V_p x u, a = (V_p + V_c) x S; the subtree's Yc S and Bc^T S; the subtree wrench's
+    /// derivatives along q (without and with S x* Fc) and along qd
+    std::vector<Vec6> S, u, w, av, YS, BS, dFq, dFqx, dFv;
+    MatX dq, dqd;  ///< (n, n) the rigid-body derivatives of tau_full, then the force elements'
+    /// the public results (ni, ni): dtau/dq and dtau/dqd; forward: dqdd/dq, dqdd/dqd, M^-1
+    MatX tau_q, tau_qd, qdd_q, qdd_qd, qdd_tau;
+    VecX qdd_full, qdd;  ///< (n) the forward derivatives' accelerations (full), (ni) independent
+    bool sized = false;
+  } deriv;
 
   // --- named frames (algorithm/frames) ---
   Mat4 frame_pose = Mat4::Identity();  ///< the last frame pose [R p; 0 1]

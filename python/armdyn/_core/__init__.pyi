@@ -7,7 +7,7 @@ import numpy
 import numpy.typing
 import typing
 from . import profiles
-__all__: list[str] = ['Actuator', 'Data', 'LagrangeValidator', 'Model', 'ModelBuilder', 'ModelError', 'Motor', 'Profile', 'SolverError', 'URDF_COULOMB_SMOOTHING', 'URDF_MAX_ATTRIBUTES', 'URDF_MAX_BYTES', 'UrdfError', 'body_accelerations', 'body_forces', 'body_mass_matrix', 'dynamics_cost', 'end_effector_position', 'energy', 'evaluate_constraints', 'forward_dynamics', 'frame_jacobian', 'frame_jacobian_cartesian', 'frame_pose', 'frame_pose_cartesian', 'inverse_dynamics', 'joint_coordinates', 'joint_reactions', 'mass_matrix', 'paper_3dof_torques', 'paper_5dof_end_effector', 'profiles', 'state_from_joints', 'torque_error_metrics', 'urdf_builder']
+__all__: list[str] = ['Actuator', 'Data', 'LagrangeValidator', 'Model', 'ModelBuilder', 'ModelError', 'Motor', 'Profile', 'SolverError', 'URDF_COULOMB_SMOOTHING', 'URDF_MAX_ATTRIBUTES', 'URDF_MAX_BYTES', 'UrdfError', 'body_accelerations', 'body_forces', 'body_mass_matrix', 'dynamics_cost', 'end_effector_position', 'energy', 'evaluate_constraints', 'forward_dynamics', 'forward_dynamics_derivatives', 'frame_jacobian', 'frame_jacobian_cartesian', 'frame_pose', 'frame_pose_cartesian', 'inverse_dynamics', 'inverse_dynamics_derivatives', 'joint_coordinates', 'joint_reactions', 'mass_matrix', 'paper_3dof_torques', 'paper_5dof_end_effector', 'profiles', 'state_from_joints', 'torque_error_metrics', 'urdf_builder']
 class ModelError(ValueError):
     """
     Bad input: a model, builder call, array shape or option that armdyn refuses, the message naming the culprit (the body, joint, argument and the expected shape). The model or builder is left as it was. A ValueError.
@@ -641,6 +641,10 @@ class Data:
         """
         The model this workspace serves.
         """
+def _force_element_derivatives(model: Model, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, t: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
+    """
+    (dF_dq, dF_dqd), each (n_dofs, n_dofs): the derivatives of the generalised force F of the model's force elements (body loads, spring-dampers, coordinate forces, gear pairs; F = inverse_dynamics of the model without them - inverse_dynamics with them) at (q, qd) and time t, q-derivatives along the rates (a floating base's along qd's base-frame velocity), integral states zero (a coupled model's in its independent coordinates: G^T dF G). Private: the tests' and part deriv's check of the C++ function.
+    """
 def _inverse_dynamics_driven(model: Model, t: numpy.typing.ArrayLike) -> dict:
     ...
 def _output_row_bytes(model: Model) -> int:
@@ -683,6 +687,10 @@ def forward_dynamics(model: Model, q: numpy.typing.ArrayLike, qd: numpy.typing.A
     """
     Joint accelerations qdd of a tree for joint torques/forces tau at (q, qd) and time t [s] (q: n_coords, the others n_dofs; a coupled model's independent coordinates, followers of couplings removed, as Pinocchio's mimic=True models; 2-D: one state per row). method: 'crba' (CRBA mass matrix, recursive Newton-Euler bias, Cholesky), 'aba' (articulated-body algorithm, O(n)), 'cartesian' (the constrained Newton-Euler KKT system of the bodies), 'joint' (the cheaper of crba and aba for this model), 'auto' (the cheapest of the three); the choice comes from a measured cost model (dynamics_cost). The model's force elements act; drives are ignored.
     """
+def forward_dynamics_derivatives(model: Model, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, tau: numpy.typing.ArrayLike, t: float | numpy.typing.ArrayLike = 0.0, data: Data | None = None) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
+    """
+    The first-order derivatives (dqdd_dq, dqdd_dqd, dqdd_dtau) of forward_dynamics at (q, qd, tau) and time t [s], each (n_dofs, n_dofs) for one state or (rows, n_dofs, n_dofs) for one state per row, as inverse_dynamics_derivatives takes them: qdd = M^-1 (tau - b) by the composite-rigid-body mass matrix and a Cholesky factor, then dqdd_dq = -M^-1 dtau_dq and dqdd_dqd = -M^-1 dtau_dqd at that qdd, dqdd_dtau = M^-1 (q-derivatives along the coordinates' rates, a floating base's along its qd block). ModelError for a model with light bodies, whose mass matrix about the world origin loses them.
+    """
 def frame_jacobian(model: Model, q: numpy.typing.ArrayLike, frame: str | int, data: Data | None = None) -> numpy.typing.NDArray[numpy.float64]:
     """
     The Jacobian (6, n_dofs) of a named frame at joint-space q (n_coords): linear rows then angular rows, world axes, at the frame's origin (Pinocchio's LOCAL_WORLD_ALIGNED), so that [v; omega] of the frame = J qd (a floating base's six columns first; a coupled model's independent coordinates, J G). 2-D q gives (rows, 6, n_dofs).
@@ -702,6 +710,10 @@ def frame_pose_cartesian(model: Model, u: numpy.typing.ArrayLike, frame: str | i
 def inverse_dynamics(model: Model, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike, t: float | numpy.typing.ArrayLike = 0.0, method: str = 'auto', data: Data | None = None) -> numpy.typing.NDArray[numpy.float64]:
     """
     Joint torques/forces tau realising qdd at (q, qd) and time t [s] (q: n_coords, the others n_dofs; a coupled model's independent coordinates, tau = G^T tau_full; 2-D: one state per row): what each joint's actuator applies to its child about/along the joint axis, gravity and the model's force elements included, drives ignored. method: 'joint' (recursive Newton-Euler), 'cartesian' (every coordinate driven, the drives' KKT multipliers), 'auto' (joint).
+    """
+def inverse_dynamics_derivatives(model: Model, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike, t: float | numpy.typing.ArrayLike = 0.0, data: Data | None = None) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
+    """
+    The first-order derivatives (dtau_dq, dtau_dqd) of inverse_dynamics at (q, qd, qdd) and time t [s], each (n_dofs, n_dofs) for one state (q: n_coords, qd and qdd: n_dofs; a coupled model's independent coordinates) or (rows, n_dofs, n_dofs) for one state per row (2-D arrays; t a number or one per row). Analytical (the recursive Newton-Euler derivatives of Carpentier & Mansard 2018), gravity, gyroscopic terms and the model's force elements included, drives ignored. q-derivatives are taken along the coordinates' rates: column k of dtau_dq is d tau(q + eps e_k) / d eps for a joint coordinate, and for a floating base's six columns the derivative along its qd block (the base frame moved by its own linear and angular velocity in its axes, Pinocchio's free-flyer convention). dtau/dqdd is mass_matrix(model, q).
     """
 def joint_coordinates(model: Model, u: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
     """

@@ -56,7 +56,11 @@ class TrajectoryRun:
 
 
 def trajectory_run(
-    model: _core.Model, t: npt.ArrayLike, q: npt.ArrayLike, qd: npt.ArrayLike, qdd: npt.ArrayLike
+    model: _core.Model,
+    t: npt.ArrayLike,
+    q: npt.ArrayLike | None = None,
+    qd: npt.ArrayLike | None = None,
+    qdd: npt.ArrayLike | None = None,
 ) -> TrajectoryRun:
     """The joint torques of a tree model along a planned motion: ``armdyn.inverse_dynamics``
     (recursive Newton–Euler, gravity, force elements and, with actuators, the reflected rotor
@@ -65,13 +69,22 @@ def trajectory_run(
 
     Args:
         model: a joint-space model (``model.joint_space``).
-        t: (n,) strictly increasing times [s].
+        t: (n,) strictly increasing times [s], or an ``armdyn.motion.Trajectory`` (then
+            without q, qd, qdd).
         q: (n, len(model.coord_names)); qd, qdd: (n, len(model.dof_names)).
 
     Raises:
         ModelError: shapes that do not match the model, non-increasing times, or a model the
             joint-space inverse dynamics does not cover.
     """
+    from armdyn.motion.trajectory import Trajectory
+
+    if isinstance(t, Trajectory):
+        if not (q is None and qd is None and qdd is None):
+            raise _core.ModelError("trajectory_run: give a Trajectory alone, or t, q, qd, qdd")
+        t, q, qd, qdd = t
+    elif q is None or qd is None or qdd is None:
+        raise _core.ModelError("trajectory_run: q, qd and qdd are required with times t")
     t = np.atleast_1d(_checks.array("trajectory_run", "t", t, finite=True))
     q, qd, qdd = (
         np.atleast_2d(_checks.array("trajectory_run", name, x, finite=True))
