@@ -7,34 +7,12 @@
 #include <atomic>
 #include <cstdlib>
 
+#include "alloc_counter.hpp"
 #include "armdyn/algorithm/force_derivatives.hpp"
 #include "armdyn/algorithm/rnea.hpp"
 #include "armdyn/builder/builder.hpp"
 #include "check.hpp"
 #include "models.hpp"
-
-// every heap allocation (operator new and Eigen's aligned_malloc both end in malloc): glibc's
-// malloc, counted
-extern "C" {
-void* __libc_malloc(std::size_t);
-void* __libc_calloc(std::size_t, std::size_t);
-void* __libc_realloc(void*, std::size_t);
-}
-namespace {
-std::atomic<long> g_allocations{0};
-}  // namespace
-extern "C" void* malloc(std::size_t n) {
-  ++g_allocations;
-  return __libc_malloc(n);
-}
-extern "C" void* calloc(std::size_t n, std::size_t size) {
-  ++g_allocations;
-  return __libc_calloc(n, size);
-}
-extern "C" void* realloc(void* p, std::size_t n) {
-  ++g_allocations;
-  return __libc_realloc(p, n);
-}
 
 using namespace armdyn;
 
