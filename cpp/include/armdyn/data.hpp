@@ -198,6 +198,8 @@ class Data {
     std::vector<int> anc0, anc;
     std::vector<double> lval;
     VecX ltd, ltd_inv;
+    /// (n, 3n) row-major: [M^-1, -M^-1 dtau/dq, -M^-1 dtau/dqd] as the factor's solves make them
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> solves;
     bool sized = false;
   } deriv;
 

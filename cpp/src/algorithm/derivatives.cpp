@@ -277,6 +277,7 @@ void dof_tree(const Model& m, const Data& d, Data::Derivatives& w) {
   w.lval.assign(w.anc.size(), 0.0);
   w.ltd = VecX::Zero(n);
   w.ltd_inv = VecX::Zero(n);
+  w.solves.setZero(n, 3 * n);
 }
 
 // whether M's entries off the tree's pattern (between dofs neither of which is the other's
@@ -407,17 +408,37 @@ bool solve_sparse(const Data& d, Data::Derivatives& w, const char* fn, double t)
   return true;
 }
 
-// M^-1, -M^-1 dtau/dq and -M^-1 dtau/dqd by the LTDL factor, column by column (the columns'
-// zeros, those of dofs on other branches, skipped)
+// M^-1, -M^-1 dtau/dq and -M^-1 dtau/dqd by the LTDL factor, the three right-hand sides side by
+// side in the rows of w.solves (each step of the two triangular solves one row update, 3n long)
 void inverse_products_sparse(Data::Derivatives& w, int n) {
-  w.qdd_tau.setIdentity();
-  w.qdd_q.noalias() = -w.tau_q;
-  w.qdd_qd.noalias() = -w.tau_qd;
-  for (int c = 0; c < n; ++c) {
-    ltdl_solve(w, w.qdd_tau.col(c).data(), n);
-    ltdl_solve(w, w.qdd_q.col(c).data(), n);
-    ltdl_solve(w, w.qdd_qd.col(c).data(), n);
+  auto& X = w.solves;
+  X.leftCols(n).setIdentity();
+  X.middleCols(n, n) = -w.tau_q;
+  X.rightCols(n) = -w.tau_qd;
+  const long cols = 3L * n;
+  const int* anc = w.anc.data();
+  const double* l = w.lval.data();
+  for (int k = n - 1; k >= 0; --k) {  // L^T Y = X, children first
+    const double* xk = X.row(k).data();
+    for (int p = w.anc0[k]; p < w.anc0[k + 1]; ++p) {
+      double* xi = X.row(anc[p]).data();
+      const double a = l[p];
+      for (long c = 0; c < cols; ++c) xi[c] -= a * xk[c];
+    }
   }
+  for (int k = 0; k < n; ++k) {  // L X = D^-1 Y, parents first
+    double* xk = X.row(k).data();
+    const double dinv = w.ltd_inv[k];
+    for (long c = 0; c < cols; ++c) xk[c] *= dinv;
+    for (int p = w.anc0[k]; p < w.anc0[k + 1]; ++p) {
+      const double* xi = X.row(anc[p]).data();
+      const double a = l[p];
+      for (long c = 0; c < cols; ++c) xk[c] -= a * xi[c];
+    }
+  }
+  w.qdd_tau = X.leftCols(n);
+  w.qdd_q = X.middleCols(n, n);
+  w.qdd_qd = X.rightCols(n);
 }
 
 // the same by the dense Cholesky factor L of M: M^-1 by two triangular solves, then the products
