@@ -235,6 +235,12 @@ def python_timings(pair: DerivativePair, number: int, repeat: int) -> dict:
         t, "armdyn_inverse_dynamics_derivatives", "armdyn_inverse_dynamics"
     )
     r["pin_rnea_derivatives_over_rnea"] = common.paired_ratio(t, "pin_rnea_derivatives", "pin_rnea")
+    # the reference implementation against the 4x-inverse-dynamics bar (each call's
+    # Python overhead included on both sides)
+    r["armdyn_fd_derivatives_over_id"] = common.paired_ratio(
+        t, "armdyn_forward_dynamics_derivatives", "armdyn_inverse_dynamics"
+    )
+    r["pin_aba_derivatives_over_rnea"] = common.paired_ratio(t, "pin_aba_derivatives", "pin_rnea")
     return r
 
 
@@ -317,6 +323,7 @@ def summary_line(name: str, rec: dict) -> str:
         f"{p['pin_rnea_derivatives_us']:.2f} us = {p['ratio_inverse_dynamics_derivatives']:.2f}x, "
         f"FD-deriv {p['armdyn_forward_dynamics_derivatives_us']:.2f} us / pin "
         f"{p['pin_aba_derivatives_us']:.2f} us = {p['ratio_forward_dynamics_derivatives']:.2f}x"
+        f" (pin ABA-deriv / pin rnea {p['pin_aba_derivatives_over_rnea']:.2f}x)"
         f"  |  C++ batch per row: ID {c['inverse_dynamics_us_per_row']:.2f} us, ID-deriv "
         f"{c['inverse_dynamics_derivatives_us_per_row']:.2f} us = "
         f"{c['ratio_inverse_dynamics_derivatives_to_inverse_dynamics']:.2f}x, FD-deriv "

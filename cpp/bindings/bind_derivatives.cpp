@@ -5,6 +5,10 @@
 // forward_dynamics take them (rows.hpp).
 #include <pybind11/stl.h>
 
+#include <cstdlib>
+#include <new>
+#include <vector>
+
 #include "armdyn/algorithm/derivatives.hpp"
 #include "common.hpp"
 #include "rows.hpp"
@@ -19,6 +23,77 @@ namespace {
 using ArrayPair = py::typing::Tuple<py::array_t<double>, py::array_t<double>>;
 using ArrayTriple =
     py::typing::Tuple<py::array_t<double>, py::array_t<double>, py::array_t<double>>;
+
+// The batch calls' output buffers, kept for the next call when their arrays are freed: a batch
+// on many rows writes megabytes of fresh memory, and the allocator hands large blocks back to
+// the system when they are freed (and trims the heap's top), so that each call paid the
+// kernel's zero-filling page faults again (on solo12 at 1000 rows, a third of the call). Only
+// this module's own arrays of at least kMinBytes; at most kMaxHeld bytes in kMaxBlocks blocks
+// are kept (the rest freed); a buffer is reused for a request between half its size and its
+// size. Touched only with the GIL held (array creation and destruction).
+class DerivativeOutputPool {
+ public:
+  static constexpr size_t kMinBytes = size_t{1} << 20, kMaxHeld = size_t{64} << 20;
+  static constexpr size_t kMaxBlocks = 6;
+
+  static DerivativeOutputPool& get() {
+    static auto* pool = new DerivativeOutputPool();  // never destroyed: arrays may outlive exit
+    return *pool;
+  }
+
+  /// a C-contiguous float64 array of this shape, its buffer from the pool when large
+  py::array_t<double> array(const std::vector<py::ssize_t>& shape) {
+    size_t bytes = sizeof(double);
+    for (py::ssize_t e : shape) bytes *= static_cast<size_t>(e);
+    if (bytes < kMinBytes) return py::array_t<double>(shape);
+    Block* b = take(bytes);
+    if (b == nullptr) {
+      b = new Block{bytes, static_cast<double*>(std::malloc(bytes))};
+      if (b->data == nullptr) {
+        delete b;
+        throw std::bad_alloc();
+      }
+    }
+    py::capsule owner(b, [](void* p) { get().give(static_cast<Block*>(p)); });
+    return py::array_t<double>(shape, b->data, owner);
+  }
+
+ private:
+  struct Block {
+    size_t bytes;
+    double* data;
+  };
+  std::vector<Block*> free_;
+  size_t held_ = 0;
+
+  Block* take(size_t bytes) {
+    for (size_t i = 0; i < free_.size(); ++i) {
+      Block* b = free_[i];
+      if (b->bytes >= bytes && b->bytes / 2 <= bytes) {
+        free_.erase(free_.begin() + static_cast<long>(i));
+        held_ -= b->bytes;
+        return b;
+      }
+    }
+    return nullptr;
+  }
+
+  void give(Block* b) {
+    while (!free_.empty() && (free_.size() >= kMaxBlocks || held_ + b->bytes > kMaxHeld)) {
+      held_ -= free_.front()->bytes;  // the oldest first
+      std::free(free_.front()->data);
+      delete free_.front();
+      free_.erase(free_.begin());
+    }
+    if (b->bytes > kMaxHeld) {
+      std::free(b->data);
+      delete b;
+      return;
+    }
+    free_.push_back(b);
+    held_ += b->bytes;
+  }
+};
 
 // k matrices row-major into out[j] + offset, each checked finite (vectorised; the element-wise
 // check names the entry)
@@ -46,7 +121,7 @@ py::tuple matrices_call(const char* fn, Data& d, int k, const py::handle& q, con
   std::vector<py::ssize_t> shape{n, n};
   if (rows_given) shape.insert(shape.begin(), rows);
   for (int j = 0; j < k; ++j) {
-    outs.emplace_back(shape);
+    outs.push_back(DerivativeOutputPool::get().array(shape));
     ptrs.push_back(outs.back().mutable_data());
   }
   auto result = [&](long done) {
@@ -140,7 +215,8 @@ void bind_derivatives(py::module_& m) {
         "The first-order derivatives (dqdd_dq, dqdd_dqd, dqdd_dtau) of forward_dynamics at (q, "
         "qd, tau) and time t [s], each (n_dofs, n_dofs) for one state or (rows, n_dofs, n_dofs) "
         "for one state per row, as inverse_dynamics_derivatives takes them: qdd = "
-        "M^-1 (tau - b) by the composite-rigid-body mass matrix and a Cholesky factor, then "
+        "M^-1 (tau - b) by the composite-rigid-body mass matrix and a factor of it (L^T D L "
+        "without fill-in on a model without couplings, else Cholesky), then "
         "dqdd_dq = -M^-1 dtau_dq and dqdd_dqd = -M^-1 dtau_dqd at that qdd, dqdd_dtau = M^-1 "
         "(q-derivatives along the coordinates' rates, a floating base's along its qd block). "
         "ModelError for a model with light bodies, whose mass matrix about the world origin "

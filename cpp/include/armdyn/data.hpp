@@ -188,6 +188,18 @@ class Data {
     /// the public results (ni, ni): dtau/dq and dtau/dqd; forward: dqdd/dq, dqdd/dqd, M^-1
     MatX tau_q, tau_qd, qdd_q, qdd_qd, qdd_tau;
     VecX qdd_full, qdd;  ///< (n) the forward derivatives' accelerations (full), (ni) independent
+    /// per degree of freedom: the one it moves on (the previous of its joint's, else the last of
+    /// the nearest ancestor joint's; -1: none); tree_sparse when each is below its child's
+    /// index, so that M = L^T D L factors without fill-in (Featherstone's LTDL)
+    std::vector<int> dof_parent;
+    bool tree_sparse = false;
+    /// the factor, by rows: dof k's ancestor dofs anc[anc0[k] .. anc0[k + 1]) (nearest first),
+    /// L's entries lval at the same places, D and 1 / D (n)
+    std::vector<int> anc0, anc;
+    std::vector<double> lval;
+    VecX ltd, ltd_inv;
+    /// (n, 3n) row-major: [M^-1, -M^-1 dtau/dq, -M^-1 dtau/dqd] as the factor's solves make them
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> solves;
     bool sized = false;
   } deriv;
 

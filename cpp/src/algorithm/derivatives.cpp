@@ -249,6 +249,96 @@ void reduce_pair(const Model& m, const Data& d, MatX& a, MatX& b, MatX& ar, MatX
   m.independent.reduce(b, br);
 }
 
+// each degree of freedom's parent and ancestors (Data::Derivatives::dof_parent, anc0, anc)
+void dof_tree(const Model& m, const Data& d, Data::Derivatives& w) {
+  const int n = d.n;
+  w.dof_parent.assign(static_cast<size_t>(n), -1);
+  for (const Joint& j : m.joints) {
+    if (j.dof0 < 0) continue;
+    int up = -1;
+    for (int b = j.parent; b != kGround && up < 0;) {
+      const int ja = d.joint_of_body[b];
+      if (ja < 0) break;
+      const Joint& a = m.joints[ja];
+      if (a.dof0 >= 0 && joint_dofs(a.type) > 0) up = a.dof0 + joint_dofs(a.type) - 1;
+      b = a.parent;
+    }
+    for (int k = 0; k < joint_dofs(j.type); ++k)
+      w.dof_parent[j.dof0 + k] = k == 0 ? up : j.dof0 + k - 1;
+  }
+  w.tree_sparse = true;
+  w.anc0.assign(1, 0);
+  w.anc.clear();
+  for (int k = 0; k < n; ++k) {
+    if (w.dof_parent[k] >= k) w.tree_sparse = false;
+    for (int i = w.dof_parent[k]; i >= 0 && w.tree_sparse; i = w.dof_parent[i]) w.anc.push_back(i);
+    w.anc0.push_back(static_cast<int>(w.anc.size()));
+  }
+  w.lval.assign(w.anc.size(), 0.0);
+  w.ltd = VecX::Zero(n);
+  w.ltd_inv = VecX::Zero(n);
+  w.solves.setZero(n, 3 * n);
+}
+
+// whether M's entries off the tree's pattern (between dofs neither of which is the other's
+// ancestor) are all zero: the LTDL factor (ltdl_factor) then has no fill-in
+bool tree_pattern(const MatX& M, const Data::Derivatives& w) {
+  if (!w.tree_sparse) return false;
+  for (long k = 0; k < M.rows(); ++k) {
+    int p = w.anc0[k];
+    for (long i = k - 1; i >= 0; --i) {
+      if (p < w.anc0[k + 1] && w.anc[p] == i)
+        ++p;
+      else if (M(k, i) != 0.0)
+        return false;
+    }
+  }
+  return true;
+}
+
+// M = L^T D L (Featherstone's LTDL, children first: no fill-in on a tree) into w.lval and w.ltd;
+// false when a pivot is not positive (M is not positive definite)
+bool ltdl_factor(const MatX& M, Data::Derivatives& w) {
+  const int n = static_cast<int>(M.rows());
+  for (int k = 0; k < n; ++k) {
+    w.ltd[k] = M(k, k);
+    for (int p = w.anc0[k]; p < w.anc0[k + 1]; ++p) w.lval[p] = M(k, w.anc[p]);
+  }
+  for (int k = n - 1; k >= 0; --k) {
+    const double dk = w.ltd[k];
+    if (!(dk > 0.0)) return false;
+    const int* a = w.anc.data() + w.anc0[k];
+    double* lk = w.lval.data() + w.anc0[k];
+    const int na = w.anc0[k + 1] - w.anc0[k];
+    for (int p = 0; p < na; ++p) {
+      const double alpha = lk[p] / dk;
+      w.ltd[a[p]] -= alpha * lk[p];
+      double* li = w.lval.data() + w.anc0[a[p]];  // a[p]'s ancestors are a[p + 1 ..]
+      for (int r = p + 1; r < na; ++r) li[r - p - 1] -= alpha * lk[r];
+      lk[p] = alpha;
+    }
+    w.ltd_inv[k] = 1.0 / dk;
+  }
+  return true;
+}
+
+// x <- M^-1 x by ltdl_factor's factor: L^T y = x (children first, zeros skipped), then
+// L x = D^-1 y (parents first)
+inline void ltdl_solve(const Data::Derivatives& w, double* x, int n) {
+  const int* anc = w.anc.data();
+  const double* l = w.lval.data();
+  for (int k = n - 1; k >= 0; --k) {
+    const double xk = x[k];
+    if (xk == 0.0) continue;
+    for (int p = w.anc0[k]; p < w.anc0[k + 1]; ++p) x[anc[p]] -= l[p] * xk;
+  }
+  for (int k = 0; k < n; ++k) {
+    double s = x[k] * w.ltd_inv[k];
+    for (int p = w.anc0[k]; p < w.anc0[k + 1]; ++p) s -= l[p] * x[anc[p]];
+    x[k] = s;
+  }
+}
+
 }  // namespace derivatives_detail
 
 using namespace derivatives_detail;
@@ -269,6 +359,7 @@ void ensure_derivatives(const Model& m, Data& d) {
     *x = MatX::Zero(d.ni, d.ni);
   w.qdd_full = VecX::Zero(d.n);
   w.qdd = VecX::Zero(d.ni);
+  dof_tree(m, d, w);
   w.sized = true;
 }
 
@@ -301,6 +392,67 @@ void inverse_dynamics_derivatives(const Model& m, Data& d, Eigen::Ref<const VecX
   reduce_pair(m, d, w.dq, w.dqd, w.tau_q, w.tau_qd);
 }
 
+namespace derivatives_detail {
+
+[[noreturn]] void not_positive_definite(const char* fn, double t) {
+  throw SolverError(msg(fn, ": the joint-space mass matrix is not positive definite at t=", t,
+                        " (a massless subtree?)"));
+}
+
+// w.qdd = M^-1 w.qdd by the LTDL factor of d.M when the model has no couplings and M the tree's
+// pattern (true; then w.ltdl holds the factor), else false (nothing done)
+bool solve_sparse(const Data& d, Data::Derivatives& w, const char* fn, double t) {
+  if (d.ni != d.n || !tree_pattern(d.M, w)) return false;
+  if (!ltdl_factor(d.M, w)) not_positive_definite(fn, t);
+  ltdl_solve(w, w.qdd.data(), d.n);
+  return true;
+}
+
+// M^-1, -M^-1 dtau/dq and -M^-1 dtau/dqd by the LTDL factor, the three right-hand sides side by
+// side in the rows of w.solves (each step of the two triangular solves one row update, 3n long)
+void inverse_products_sparse(Data::Derivatives& w, int n) {
+  auto& X = w.solves;
+  X.leftCols(n).setIdentity();
+  X.middleCols(n, n) = -w.tau_q;
+  X.rightCols(n) = -w.tau_qd;
+  const long cols = 3L * n;
+  const int* anc = w.anc.data();
+  const double* l = w.lval.data();
+  for (int k = n - 1; k >= 0; --k) {  // L^T Y = X, children first
+    const double* xk = X.row(k).data();
+    for (int p = w.anc0[k]; p < w.anc0[k + 1]; ++p) {
+      double* xi = X.row(anc[p]).data();
+      const double a = l[p];
+      for (long c = 0; c < cols; ++c) xi[c] -= a * xk[c];
+    }
+  }
+  for (int k = 0; k < n; ++k) {  // L X = D^-1 Y, parents first
+    double* xk = X.row(k).data();
+    const double dinv = w.ltd_inv[k];
+    for (long c = 0; c < cols; ++c) xk[c] *= dinv;
+    for (int p = w.anc0[k]; p < w.anc0[k + 1]; ++p) {
+      const double* xi = X.row(anc[p]).data();
+      const double a = l[p];
+      for (long c = 0; c < cols; ++c) xk[c] -= a * xi[c];
+    }
+  }
+  w.qdd_tau = X.leftCols(n);
+  w.qdd_q = X.middleCols(n, n);
+  w.qdd_qd = X.rightCols(n);
+}
+
+// the same by the dense Cholesky factor L of M: M^-1 by two triangular solves, then the products
+// (small sizes: coefficient-wise, larger: blocked on the stack; no heap allocation either way)
+void inverse_products_dense(Data::Derivatives& w, const MatX& L) {
+  w.qdd_tau.setIdentity();
+  L.triangularView<Eigen::Lower>().solveInPlace(w.qdd_tau);
+  L.transpose().triangularView<Eigen::Upper>().solveInPlace(w.qdd_tau);
+  w.qdd_q.noalias() = -w.qdd_tau * w.tau_q;
+  w.qdd_qd.noalias() = -w.qdd_tau * w.tau_qd;
+}
+
+}  // namespace derivatives_detail
+
 void forward_dynamics_derivatives(const Model& m, Data& d, Eigen::Ref<const VecX> q,
                                   Eigen::Ref<const VecX> qd, Eigen::Ref<const VecX> tau, double t) {
   constexpr const char* fn = "forward_dynamics_derivatives";
@@ -332,10 +484,11 @@ void forward_dynamics_derivatives(const Model& m, Data& d, Eigen::Ref<const VecX
     w.qdd = d.rhs;
   }
   w.qdd += tau;
-  if (!cholesky_factor(M, L))
-    throw SolverError(msg(fn, ": the joint-space mass matrix is not positive definite at t=", t,
-                          " (a massless subtree?)"));
-  cholesky_solve(L, w.qdd);
+  const bool sparse = solve_sparse(d, w, fn, t);
+  if (!sparse) {
+    if (!cholesky_factor(M, L)) not_positive_definite(fn, t);
+    cholesky_solve(L, w.qdd);
+  }
   if (coupled)
     m.independent.expand_v(w.qdd.data(), w.qdd_full.data());
   else
@@ -343,13 +496,10 @@ void forward_dynamics_derivatives(const Model& m, Data& d, Eigen::Ref<const VecX
   // dtau/dq, dtau/dqd at (q, qd, qdd), then M^-1 applied
   full_derivatives(m, d, qf, qdf, w.qdd_full, t);
   reduce_pair(m, d, w.dq, w.dqd, w.tau_q, w.tau_qd);
-  // M^-1 by the Cholesky factor, then -M^-1 dtau/dq and -M^-1 dtau/dqd as products (small
-  // sizes: coefficient-wise, larger: blocked on the stack; no heap allocation either way)
-  w.qdd_tau.setIdentity();
-  L.triangularView<Eigen::Lower>().solveInPlace(w.qdd_tau);
-  L.transpose().triangularView<Eigen::Upper>().solveInPlace(w.qdd_tau);
-  w.qdd_q.noalias() = -w.qdd_tau * w.tau_q;
-  w.qdd_qd.noalias() = -w.qdd_tau * w.tau_qd;
+  if (sparse)
+    inverse_products_sparse(w, d.n);
+  else
+    inverse_products_dense(w, L);
 }
 
 }  // namespace armdyn

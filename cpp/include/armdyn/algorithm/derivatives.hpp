@@ -22,8 +22,9 @@
 // The force elements' derivatives come from add_force_element_derivatives
 // (algorithm/force_derivatives.hpp) and are subtracted (tau = ... - F). A coupled model is taken
 // in its independent coordinates: G^T (d tau_full) G (Model::independent).
-// Forward dynamics: qdd = M^-1 (tau - b) by CRBA and Cholesky, then dqdd/dq = -M^-1 dtau/dq and
-// dqdd/dqd = -M^-1 dtau/dqd at that qdd, dqdd/dtau = M^-1.
+// Forward dynamics: qdd = M^-1 (tau - b) by CRBA and a factor of M (L^T D L without fill-in on a
+// model without couplings, Featherstone's LTDL; else Cholesky), then dqdd/dq = -M^-1 dtau/dq and
+// dqdd/dqd = -M^-1 dtau/dqd at that qdd, dqdd/dtau = M^-1, by the same factor.
 #pragma once
 
 #include "armdyn/data.hpp"
