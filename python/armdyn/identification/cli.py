@@ -96,7 +96,10 @@ def _out_dir(out: str) -> Path:
     """DIR, created if missing and checked writable (before the fit)."""
     _not_a_file(out)
     path = Path(out)
-    path.mkdir(parents=True, exist_ok=True)
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise _core.ModelError(f"--out {out!r}: cannot create the folder: {exc}") from None
     if not os.access(path, os.W_OK | os.X_OK):
         raise _core.ModelError(f"--out {out!r}: the folder is not writable")
     return path
@@ -164,16 +167,24 @@ def run(args, echo=print) -> int:
 
 
 def _logs(args, model, options):
-    from armdyn.identification.log import load_log
-
-    log = load_log(args.log, model, **options)
+    log = _read("--log", args.log, model, options)
     if args.validate is not None:
-        return log, load_log(args.validate, model, **options)
+        return log, _read("--validate", args.validate, model, options)
     if len(log.t) < 2:
         raise _core.ModelError(
             f"--log {args.log!r}: too few samples to split into fit and validation"
         )
     return log.split(FIT_FRACTION)
+
+
+def _read(option: str, path: str, model, options):
+    """load_log of ``path``; a failure names the option."""
+    from armdyn.identification.log import load_log
+
+    try:
+        return load_log(path, model, **options)
+    except (_core.ModelError, OSError) as exc:
+        raise _core.ModelError(f"{option}: {exc}") from None
 
 
 def _identify(model, log, args):
