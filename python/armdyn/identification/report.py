@@ -248,7 +248,7 @@ def torque_figure(validation: Validation, nominal: Validation | None = None):
     t = validation.t
     for j, name in enumerate(validation.joint_names):
         ax = axes[j]
-        ax.plot(t, validation.tau_measured[:, j], color="k", lw=1.4, label="measured")
+        ax.plot(t, validation.tau_measured[:, j], color="0.6", lw=2.2, label="measured")
         ax.plot(
             t,
             validation.tau_predicted[:, j],
@@ -268,7 +268,7 @@ def torque_figure(validation: Validation, nominal: Validation | None = None):
         ax.set_title(name, fontsize=10)
         ax.set_ylabel("torque [N m or N]", fontsize=8)
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=7, loc="upper right")
+        ax.legend(fontsize=7, loc="upper right", framealpha=0.7)
     for ax in axes[n:]:
         ax.set_visible(False)
     for ax in axes[max(0, n - cols) : n]:
