@@ -9,9 +9,14 @@ other data, and the identified model written back as a URDF and an armdyn model.
 """
 
 from armdyn._core import dynamic_parameter_names, dynamic_parameters, joint_torque_regressor
+from armdyn.identification.report import write_report
+from armdyn.identification.validate import Validation, validate
 
 __all__ = [
+    "Validation",
     "dynamic_parameter_names",
     "dynamic_parameters",
     "joint_torque_regressor",
+    "validate",
+    "write_report",
 ]
