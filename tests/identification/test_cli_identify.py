@@ -203,3 +203,28 @@ def test_identify_bad_input_exit_2(robot, tmp_path, capsys, case):
     assert "Traceback" not in printed.err
     assert re.search(culprit, lines[0]), lines[0]
     assert not (tmp_path / "out" / "report.html").exists()
+
+
+def test_unconstrained_estimate_not_a_urdf_exit_1(robot, tmp_path, capsys, monkeypatch):
+    """--no-physical: an estimate with a negative friction cannot be a URDF; the report is
+    written, identified.urdf is not, exit code 1 with one line saying why."""
+    from armdyn.identification import cli
+
+    real = cli._identify
+
+    def negative_friction(model, log, args):
+        ident = real(model, log, args)
+        ident.pi = ident.pi.copy()
+        ident.pi[ad.dynamic_parameter_names(model).index("elbow.fv")] = -0.5
+        return ident
+
+    monkeypatch.setattr(cli, "_identify", negative_friction)
+    out = tmp_path / "neg"
+    rc = main(["identify", robot["urdf"], "--log", robot["fit"], "--validate", robot["val"],
+               "--out", str(out), "--no-physical"])  # fmt: skip
+    printed = capsys.readouterr()
+    assert rc == 1
+    lines = printed.err.strip().splitlines()
+    assert len(lines) == 1 and "identified.urdf not written" in lines[0], printed.err
+    assert "elbow" in lines[0]
+    assert (out / "report.html").is_file() and not (out / "identified.urdf").exists()
