@@ -117,6 +117,7 @@ def test_identify_writes_urdf_report_parameters(robot, tmp_path, capsys):
     assert [(j, s) for j, s, _ in rows] == [("shoulder", "match"), ("elbow", "match")]
     page = (out / "report.html").read_text(encoding="utf-8")
     assert 'id="overall" data-status="match"' in page
+    assert "fit (--log)" in page and "validation (--validate)" in page
 
 
 def test_identify_splits_the_log_and_filters(robot, tmp_path, capsys):

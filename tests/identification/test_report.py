@@ -34,9 +34,13 @@ def _statuses(page: str) -> dict:
 
 def test_write_report_files(case, tmp_path):
     model, ident, v, nominal = case
-    page = report.write_report(ident, tmp_path / "out", validation=v, nominal_validation=nominal)
+    logs = {"fit": "q <filtered> at 5 Hz", "validation": "given"}
+    page = report.write_report(
+        ident, tmp_path / "out", validation=v, nominal_validation=nominal, logs=logs
+    )
     assert page == tmp_path / "out" / "report.html"
     text = page.read_text(encoding="utf-8")
+    assert "q &lt;filtered&gt; at 5 Hz" in text  # the logs' processing, escaped
     # identified: the error is the noise (0.05 N m), under 10 % of every joint's torque RMS
     assert _statuses(text) == {j: "match" for j in model.dof_names}
     assert 'data-status="match"' in text.split('id="verdict-table"')[0]

@@ -151,7 +151,8 @@ def run(args, echo=print) -> int:
     ident = _identify(model, fit_log, args)
     validation = validate(ident, val_log)
     nominal = validate(model, val_log)
-    files, no_urdf = _write(args, out, model, ident, validation, nominal)
+    logs = (fit_log, val_log)
+    files, no_urdf = _write(args, out, model, ident, logs, validation, nominal)
     statuses = joint_status(validation, ident.sigma)
     _summary(echo, ident, validation, nominal, statuses, fit_log, val_log, args)
     for f in files:
@@ -193,13 +194,29 @@ def _identify(model, log, args):
     return identify(model, log, method=args.method, physical=not args.no_physical)
 
 
-def _write(args, out: Path, model, ident, validation, nominal) -> tuple[list[Path], str]:
+def _log_notes(args, fit_log, val_log) -> dict[str, str]:
+    """The report's description of the two logs."""
+    if args.validate is not None:
+        return {"fit (--log)": fit_log.processing, "validation (--validate)": val_log.processing}
+    share = f"{FIT_FRACTION:.0%}"
+    return {
+        f"fit (--log, the first {share} in time)": fit_log.processing,
+        "validation (--log, the rest)": val_log.processing,
+    }
+
+
+def _write(args, out: Path, model, ident, logs, validation, nominal) -> tuple[list[Path], str]:
     """The report's files, then identified.urdf: ``(written, why the URDF is not)``."""
     from armdyn.identification.export import write_urdf
     from armdyn.identification.report import write_report
 
     page = write_report(
-        ident, out, validation=validation, nominal_validation=nominal, urdf=args.urdf
+        ident,
+        out,
+        validation=validation,
+        nominal_validation=nominal,
+        urdf=args.urdf,
+        logs=_log_notes(args, *logs),
     )
     names = ["torques.png", "parameters.csv", "base_parameters.csv"]
     written = [page, *(out / n for n in names if (out / n).exists())]

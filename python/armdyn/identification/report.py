@@ -32,8 +32,8 @@ The page, in order:
    parameters are identified: the rest of pi is the completion closest to the nominal
    (``BaseParameters.complete``), so a body's gap shows where the data moved the model, not a
    measurement of that body alone.
-5. The fit (method, solver, samples, outliers, fit RMSE and sigma per joint) and the validation's
-   largest errors with their times.
+5. The fit (method, solver, samples, outliers, the logs and how they were processed, fit RMSE
+   and sigma per joint) and the validation's largest errors with their times.
 """
 
 from __future__ import annotations
@@ -333,7 +333,7 @@ def _pct(x: float) -> str:
     return "\u221e" if np.isinf(x) else f"{100 * x:.3g} %"
 
 
-def _sections(ident, validation, nominal, figure: ReportFigure | None) -> list[Section]:
+def _sections(ident, validation, nominal, figure: ReportFigure | None, logs) -> list[Section]:
     import pandas as pd
 
     base = base_table(ident)
@@ -375,6 +375,12 @@ def _sections(ident, validation, nominal, figure: ReportFigure | None) -> list[S
         index=pd.Index(list(ident.model.dof_names), name="joint"),
     )
     tables = [("fit residuals", fit)]
+    if logs:
+        described = pd.DataFrame(
+            {"how q, qd, qdd and tau were obtained": [str(v) for v in logs.values()]},
+            index=pd.Index([str(k) for k in logs], name="log"),
+        )
+        tables.insert(0, ("the logs", described))
     if validation is not None:
         tables.append(
             (
@@ -396,10 +402,11 @@ def _sections(ident, validation, nominal, figure: ReportFigure | None) -> list[S
 
 
 def render_report(
-    identification, validation=None, nominal_validation=None, *, urdf=None, figure=None
+    identification, validation=None, nominal_validation=None, *, urdf=None, figure=None, logs=None
 ) -> str:
     """The HTML page (see the module notes); ``figure``: the torque figure's
-    :class:`~armdyn.sizing.html.ReportFigure` (None: no figure)."""
+    :class:`~armdyn.sizing.html.ReportFigure` (None: no figure); ``logs``: ``{role:
+    description}`` of the logs (as :func:`write_report`)."""
     ident = identification
     statuses = joint_status(validation, ident.sigma)
     title = "Identification report" + (f": {Path(os.fspath(urdf)).name}" if urdf else "")
@@ -416,7 +423,7 @@ def render_report(
         _verdict_block(ident, validation, nominal_validation, statuses, title, subtitle),
         *(
             _section_block(k, s)
-            for k, s in enumerate(_sections(ident, validation, nominal_validation, figure))
+            for k, s in enumerate(_sections(ident, validation, nominal_validation, figure, logs))
         ),
         "</body></html>",
     ]
@@ -430,14 +437,17 @@ def write_report(
     validation: Validation | None = None,
     nominal_validation: Validation | None = None,
     urdf=None,
+    logs=None,
 ) -> Path:
     """Write ``report.html``, ``torques.png`` (with a validation), ``parameters.csv`` and
     ``base_parameters.csv`` of ``identification`` into ``out_dir`` (created if missing; see
     the module notes); returns the page's path. ``validation``: the identified model's
     :func:`~armdyn.identification.validate.validate` on data the fit did not use;
     ``nominal_validation``: the nominal model's on the same data; ``urdf``: the nominal URDF's
-    path (named in the title). OSError when the folder cannot be written; ModelError when the
-    validations' joints are not the model's."""
+    path (named in the title); ``logs``: ``{role: description}`` shown in the fit section, e.g.
+    ``{"fit": fit_log.processing, "validation": val_log.processing}`` (how q, qd, qdd and tau
+    were obtained: :attr:`MotionLog.processing`). OSError when the folder cannot be written;
+    ModelError when the validations' joints are not the model's."""
     joints = list(identification.model.dof_names)
     for name, v in (("validation", validation), ("nominal_validation", nominal_validation)):
         if v is not None and list(v.joint_names) != joints:
@@ -456,7 +466,9 @@ def write_report(
     base_table(identification).to_csv(out / "base_parameters.csv")
     page = out / "report.html"
     page.write_text(
-        render_report(identification, validation, nominal_validation, urdf=urdf, figure=figure),
+        render_report(
+            identification, validation, nominal_validation, urdf=urdf, figure=figure, logs=logs
+        ),
         encoding="utf-8",
     )
     return page
