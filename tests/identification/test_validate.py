@@ -63,7 +63,7 @@ def _log(model, tau_extra=0.0, seed=0, n=400):
 
 def test_own_torques_rmse_zero():
     model = _model()
-    log = _log(model)
+    log = _log(model, n=2500)  # more than two CHUNKs of samples
     v = validate(model, log)
     scale = np.sqrt(np.mean(log.tau**2, axis=0))
     assert v.label == "nominal"

@@ -29,6 +29,9 @@ from armdyn import _core
 if TYPE_CHECKING:
     import pandas as pd
 
+#: samples predicted per call (the regressor of a block is CHUNK x n_dofs x n_params floats)
+CHUNK = 1024
+
 
 @dataclass(frozen=True)
 class Validation:
@@ -206,12 +209,22 @@ def validate(model_or_identification: Any, log: Any, *, pi=None) -> Validation:
             raise _core.ModelError(f"validate: pi has {pi.size} entries, the model {n_params}")
         if not np.all(np.isfinite(pi)):
             raise _core.ModelError(f"validate: pi[{int(np.argmin(np.isfinite(pi)))}] is not finite")
-        predicted = _core.joint_torque_regressor(model, q, qd, qdd) @ pi
+
+        def predict(*state):
+            return _core.joint_torque_regressor(model, *state) @ pi
+
         label = "pi"
     elif ident is not None:
-        predicted = np.asarray(ident.predict(q, qd, qdd), dtype=float).reshape(tau.shape)
-        label = "identified"
+        predict, label = ident.predict, "identified"
     else:
-        predicted = np.asarray(_core.inverse_dynamics(model, q, qd, qdd)).reshape(tau.shape)
+
+        def predict(*state):
+            return _core.inverse_dynamics(model, *state)
+
         label = "nominal"
+    predicted = np.empty_like(tau)
+    for start in range(0, t.size, CHUNK):  # bounded memory: Y is (rows, n_dofs, n_params)
+        rows = slice(start, start + CHUNK)
+        block = np.asarray(predict(q[rows], qd[rows], qdd[rows]), dtype=float)
+        predicted[rows] = block.reshape(predicted[rows].shape)
     return compare(t, tau, predicted, list(model.dof_names), label)
