@@ -139,6 +139,33 @@ def test_identify_splits_the_log_and_filters(robot, tmp_path, capsys):
     assert (out / "identified.urdf").is_file() and (out / "report.html").is_file()
 
 
+def test_identify_from_currents(robot, tmp_path, capsys):
+    """A log of motor currents (tau / (K N)) with --torque-constants K and --gear-ratios=N (a
+    negative N: the = form) identifies what the torque log does."""
+    model = robot["model"]
+    k, n = 0.08, [-50.0, 30.0]
+    for role in ("fit", "val"):
+        table = pd.read_csv(robot[role])
+        for j, c in enumerate(model.coord_names):
+            table[f"{c}.current"] = table.pop(f"{c}.tau") / (k * n[j])
+        table.to_csv(tmp_path / f"current_{role}.csv", index=False)
+    options = ["--method", "ols", "--no-physical"]
+    currents = ["--torque-constants", str(k), "--gear-ratios=-50,30"]
+    runs = {}
+    for name, fit, val, extra in (
+        ("tau", robot["fit"], robot["val"], []),
+        ("current", str(tmp_path / "current_fit.csv"), str(tmp_path / "current_val.csv"), currents),
+    ):
+        out = tmp_path / name
+        argv = [robot["urdf"], "--log", fit, "--validate", val, "--out", str(out), *options]
+        rc = main(["identify", *argv, *extra])
+        assert rc in (0, 1), capsys.readouterr().err
+        runs[name] = pd.read_csv(out / "parameters.csv")["identified"].to_numpy()
+    capsys.readouterr()
+    scale = np.abs(runs["tau"]).max()
+    np.testing.assert_allclose(runs["current"], runs["tau"], rtol=0, atol=1e-9 * scale)
+
+
 def _bad(tmp_path, robot):
     d = tmp_path
     empty = d / "empty.csv"
@@ -154,6 +181,8 @@ def _bad(tmp_path, robot):
     unknown.write_text("\n".join([text[0].replace("elbow.qdd", "wrist.qdd"), *text[1:]]) + "\n")
     afile = d / "afile"
     afile.write_text("x")
+    current = d / "current.csv"
+    current.write_text("\n".join([text[0].replace(".tau", ".current"), *text[1:]]) + "\n")
     fifo = d / "fifo.csv"
     os.mkfifo(fifo)
     fit, urdf = robot["fit"], robot["urdf"]
@@ -179,6 +208,10 @@ def _bad(tmp_path, robot):
         "cutoff": ([urdf, "--log", fit, "--cutoff", "-1"], "--cutoff"),
         "cutoff-nan": ([urdf, "--log", fit, "--cutoff", "nan"], "--cutoff"),
         "method": ([urdf, "--log", fit, "--method", "lasso"], "--method"),
+        "current-no-ratios": (
+            [urdf, "--log", str(current), "--torque-constants", "0.1"],
+            "--gear-ratios is required",
+        ),
         "torque-constants": ([urdf, "--log", fit, "--torque-constants", "a,b"], "'a'"),
         "gear-ratios-mixed": ([urdf, "--log", fit, "--gear-ratios", "elbow=2,3"], "none"),
     }
@@ -188,6 +221,7 @@ CASES = [
     "missing-urdf", "missing-log", "log-directory", "log-fifo", "log-device", "empty-csv",
     "header-only", "nan", "unknown-joint", "validate-directory", "out-is-a-file",
     "out-under-a-file", "cutoff", "cutoff-nan", "method", "torque-constants", "gear-ratios-mixed",
+    "current-no-ratios",
 ]  # fmt: skip
 
 

@@ -27,7 +27,9 @@ parameter — one line on stderr naming the command and the culprit.
 ``--torque-constants`` and ``--gear-ratios`` (for logs with ``<joint>.current`` columns; torque =
 gear ratio x torque constant x current [x efficiency]) take one number for every joint, one per
 joint in the model's order (``0.07,0.07,...``), or ``JOINT=VALUE`` pairs
-(``elbow_joint=0.07,wrist_1_joint=0.05``).
+(``elbow_joint=0.07,wrist_1_joint=0.05``); a list starting with a minus sign needs the ``=`` form
+(``--gear-ratios=-50,100``). They apply to both logs (the ``--validate`` log then has current
+columns too).
 """
 
 from __future__ import annotations
@@ -185,7 +187,10 @@ def _read(option: str, path: str, model, options):
     try:
         return load_log(path, model, **options)
     except (_core.ModelError, OSError) as exc:
-        raise _core.ModelError(f"{option}: {exc}") from None
+        text = str(exc)
+        for name in ("torque_constants", "gear_ratios"):  # load_log's keywords: the options
+            text = text.replace(name, "--" + name.replace("_", "-"))
+        raise _core.ModelError(f"{option}: {text}") from None
 
 
 def _identify(model, log, args):
