@@ -9,9 +9,12 @@ other data, and the identified model written back as a URDF and an armdyn model.
 """
 
 from armdyn._core import dynamic_parameter_names, dynamic_parameters, joint_torque_regressor
+from armdyn.identification.export import with_parameters, write_urdf
 
 __all__ = [
     "dynamic_parameter_names",
     "dynamic_parameters",
     "joint_torque_regressor",
+    "with_parameters",
+    "write_urdf",
 ]
