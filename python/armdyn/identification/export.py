@@ -17,6 +17,7 @@ import os
 import re
 import xml.etree.ElementTree as ET
 from pathlib import Path
+from xml.sax.saxutils import unescape as xml_unescape
 
 import numpy as np
 
@@ -114,7 +115,9 @@ def _urdf_text(urdf, fn: str) -> str:
             return urdf.decode("utf-8")
         except UnicodeDecodeError as e:
             raise armdyn.UrdfError(f"{fn}: urdf bytes are not UTF-8 ({e})") from None
-    if isinstance(urdf, os.PathLike) or (isinstance(urdf, str) and not urdf.lstrip().startswith("<")):
+    if isinstance(urdf, os.PathLike) or (
+        isinstance(urdf, str) and not urdf.lstrip().startswith("<")
+    ):
         path = Path(urdf)
         try:
             return path.read_text(encoding="utf-8")
@@ -127,62 +130,95 @@ def _urdf_text(urdf, fn: str) -> str:
     )
 
 
-def _root_span(text: str, fn: str) -> tuple[int, int]:
-    """Where the <robot> element starts and ends in text (outside comments)."""
-    comments = [m.span() for m in re.finditer(r"<!--.*?-->", text, re.S)]
-
-    def outside(i: int) -> bool:
-        return not any(a <= i < b for a, b in comments)
-
-    starts = [m.start() for m in re.finditer(r"<robot[\s>/]", text) if outside(m.start())]
-    ends = [m.end() for m in re.finditer(r"</robot\s*>", text) if outside(m.start())]
-    if not starts:
-        raise armdyn.UrdfError(f"{fn}: the URDF has no <robot> element")
-    end = ends[-1] if ends else None
-    if end is None:  # <robot .../> (empty) or no closing tag: the parser decides
-        end = len(text.rstrip())
-    return starts[0], end
+_TOKEN = re.compile(
+    r"<!--.*?-->|<!\[CDATA\[.*?\]\]>|<\?.*?\?>|<![A-Za-z][^>]*>"
+    r"|<(?P<close>/?)(?P<tag>[A-Za-z_][\w:.\-]*)(?P<attrs>(?:[^>\"']|\"[^\"]*\"|'[^']*')*?)"
+    r"(?P<empty>/?)>",
+    re.S,
+)
+_ATTR = re.compile(r"([A-Za-z_][\w:.\-]*)\s*=\s*(\"[^\"]*\"|'[^']*')")
 
 
-def _parse(text: str, fn: str) -> ET.Element:
-    """The <robot> element, comments kept, namespace prefixes registered as written."""
+class _Node:
+    """An element's place in the text: [start, end), its start tag [start, open_end), its
+    end tag [close, end) (close == end for an empty element <x/>), its attributes (escaped as
+    written) with their value spans, its child elements and comments."""
+
+    def __init__(self, tag: str, start: int, open_end: int, attrs: str, attrs_at: int) -> None:
+        self.tag, self.start, self.open_end = tag, start, open_end
+        self.close = self.end = open_end
+        self.attrs: dict[str, tuple[str, int, int]] = {}
+        for m in _ATTR.finditer(attrs):
+            v0, v1 = attrs_at + m.start(2) + 1, attrs_at + m.end(2) - 1
+            self.attrs[m.group(1)] = (xml_unescape(m.group(2)[1:-1], {"&quot;": '"'}), v0, v1)
+        self.children: list[_Node] = []
+        self.comments: list[tuple[int, int, str]] = []
+
+    def get(self, name: str, default: str | None = None) -> str | None:
+        return self.attrs[name][0] if name in self.attrs else default
+
+    def find(self, tag: str) -> _Node | None:
+        return next((c for c in self.children if c.tag == tag), None)
+
+
+def _scan(text: str, fn: str) -> _Node:
+    """The <robot> element of the URDF as _Nodes (positions in text), after xml.etree checked
+    that the text is well-formed."""
     try:
-        for _, (prefix, uri) in ET.iterparse(_StringSource(text), events=("start-ns",)):
-            if prefix:
-                ET.register_namespace(prefix, uri)
-        parser = ET.XMLParser(target=ET.TreeBuilder(insert_comments=True))
-        root = ET.fromstring(text, parser=parser)
+        ET.fromstring(text)
     except ET.ParseError as e:
         raise armdyn.UrdfError(f"{fn}: the URDF is not well-formed XML: {e}") from None
-    if root.tag != "robot":
-        raise armdyn.UrdfError(f"{fn}: the URDF's root element is <{root.tag}>, not <robot>")
+    stack: list[_Node] = []
+    root = None
+    for m in _TOKEN.finditer(text):
+        if m.group("tag") is None:
+            if stack and m.group(0).startswith("<!--"):
+                stack[-1].comments.append((m.start(), m.end(), m.group(0)[4:-3]))
+            continue
+        if m.group("close"):
+            node = stack.pop()
+            node.close, node.end = m.start(), m.end()
+            continue
+        node = _Node(m.group("tag"), m.start(), m.end(), m.group("attrs"), m.start("attrs"))
+        if stack:
+            stack[-1].children.append(node)
+        elif root is None:
+            root = node
+        if not m.group("empty"):
+            stack.append(node)
+    if root is None or root.tag != "robot":
+        tag = root.tag if root is not None else "none"
+        raise armdyn.UrdfError(f"{fn}: the URDF's root element is <{tag}>, not <robot>")
     return root
-
-
-class _StringSource:
-    """A file-like read() over a str (ET.iterparse takes a file)."""
-
-    def __init__(self, text: str) -> None:
-        self._data = text.encode("utf-8")
-        self._pos = 0
-
-    def read(self, n: int = -1) -> bytes:
-        end = len(self._data) if n < 0 else self._pos + n
-        chunk = self._data[self._pos : end]
-        self._pos += len(chunk)
-        return chunk
 
 
 def _num(x: float) -> str:
     """A float written to round-trip exactly (shortest repr)."""
-    return repr(float(x))
+    return repr(float(x) + 0.0)  # + 0.0: no "-0.0"
 
 
-def _indent_of(el: ET.Element) -> tuple[str, str]:
-    """(child indent, the element's own closing indent) from el's whitespace, or defaults."""
-    inner = el.text if el.text and not el.text.strip() else "\n    "
-    closing = el[-1].tail if len(el) and el[-1].tail and not el[-1].tail.strip() else "\n  "
-    return inner, closing
+def _line_indent(text: str, pos: int) -> str:
+    """The whitespace between the line's start and pos ("" when other text precedes pos)."""
+    line = text.rfind("\n", 0, pos) + 1
+    lead = text[line:pos]
+    return lead if not lead.strip() else ""
+
+
+def _child_indent(text: str, node: _Node) -> str:
+    """The indentation of node's children (its first child's, else node's own + 2 spaces)."""
+    if node.children:
+        return _line_indent(text, node.children[0].start)
+    return _line_indent(text, node.start) + "  "
+
+
+def _cut(text: str, start: int, end: int) -> tuple[int, int]:
+    """[start, end) widened to its whole line(s) when nothing else is on them."""
+    line = text.rfind("\n", 0, start) + 1
+    stop = text.find("\n", end)
+    stop = len(text) if stop < 0 else stop
+    if not text[line:start].strip() and not text[end:stop].strip():
+        return line, min(stop + 1, len(text))
+    return start, end
 
 
 def _inertial_of(p10: np.ndarray, body: str, fn: str) -> tuple[float, np.ndarray, np.ndarray]:
@@ -202,112 +238,133 @@ def _inertial_of(p10: np.ndarray, body: str, fn: str) -> tuple[float, np.ndarray
     return m, c, i_o - m * (c @ c * np.eye(3) - np.outer(c, c))
 
 
-def _set_inertial(link: ET.Element, m: float, c: np.ndarray, inertia: np.ndarray) -> None:
-    """Replace (or add, as the first child) link's <inertial>."""
-    inner, _ = _indent_of(link)
-    old = link.find("inertial")
-    new = ET.Element("inertial")
-    new.text = inner + "  "
-    origin = ET.SubElement(new, "origin", {"xyz": " ".join(_num(v) for v in c), "rpy": "0 0 0"})
-    origin.tail = inner + "  "
-    mass = ET.SubElement(new, "mass", {"value": _num(m)})
-    mass.tail = inner + "  "
-    keys = {"ixx": (0, 0), "ixy": (0, 1), "ixz": (0, 2), "iyy": (1, 1), "iyz": (1, 2), "izz": (2, 2)}
-    el = ET.SubElement(new, "inertia", {k: _num(inertia[ij]) for k, ij in keys.items()})
-    el.tail = inner
-    if old is not None:
-        new.tail = old.tail
-        index = list(link).index(old)
-        link.remove(old)
-        link.insert(index, new)
-    else:
-        new.tail = inner if len(link) else _indent_of(link)[1]
-        if not len(link):
-            link.text = inner
-        link.insert(0, new)
+def _inertial_xml(m: float, c: np.ndarray, inertia: np.ndarray, indent: str, inner: str) -> str:
+    """An <inertial> element, its first line unindented, its children at inner, its end tag at
+    indent."""
+    keys = {
+        "ixx": (0, 0),
+        "ixy": (0, 1),
+        "ixz": (0, 2),
+        "iyy": (1, 1),
+        "iyz": (1, 2),
+        "izz": (2, 2),
+    }
+    moments = " ".join(f'{k}="{_num(inertia[ij])}"' for k, ij in keys.items())
+    xyz = " ".join(_num(v) for v in c)
+    return (
+        f'<inertial>\n{inner}<origin xyz="{xyz}" rpy="0 0 0"/>\n{inner}<mass value="{_num(m)}"/>'
+        f"\n{inner}<inertia {moments}/>\n{indent}</inertial>"
+    )
 
 
-def _add_note(el: ET.Element, text: str) -> None:
-    """An XML comment as el's first child ("armdyn: ...")."""
-    inner, closing = _indent_of(el)
-    note = ET.Comment(f" {_NOTE} {text} ")
-    note.tail = inner if len(el) else closing
-    if not len(el):
-        el.text = inner
-    el.insert(0, note)
+Edit = tuple[int, int, str]  # replace text[start:end] by the string
 
 
-def _drop_notes(root: ET.Element) -> None:
-    """Remove the comments an earlier write_urdf added (a second export replaces them)."""
-    for parent in root.iter():
-        for child in list(parent):
-            if child.tag is ET.Comment and (child.text or "").strip().startswith(_NOTE):
-                _remove_keeping_layout(parent, child)
+def _insert_first(text: str, node: _Node, xml: str) -> list[Edit]:
+    """Edits that put xml (one line, unindented) as node's first child."""
+    indent = _child_indent(text, node)
+    if node.close == node.end and text[node.open_end - 2] == "/":  # <x .../>: open it
+        own = _line_indent(text, node.start)
+        head = text[node.start : node.open_end - 2].rstrip()
+        return [(node.start, node.end, f"{head}>\n{indent}{xml}\n{own}</{node.tag}>")]
+    return [(node.open_end, node.open_end, f"\n{indent}{xml}")]
 
 
-def _remove_keeping_layout(parent: ET.Element, child: ET.Element) -> None:
-    """Remove child, its whitespace with it (the previous sibling keeps its own tail)."""
-    kids = list(parent)
-    i = kids.index(child)
-    if i == len(kids) - 1:  # the last child: its tail is the parent's closing indent
-        if i > 0:
-            kids[i - 1].tail = child.tail
+def _insert_last(text: str, node: _Node, xml: str) -> list[Edit]:
+    """Edits that put xml (one line) as node's last child (node not empty: a joint)."""
+    indent = _child_indent(text, node)
+    if node.close == node.end:
+        return _insert_first(text, node, xml)
+    last = max([c.end for c in node.children] + [e for _, e, _ in node.comments] + [node.open_end])
+    return [(last, last, f"\n{indent}{xml}")]
+
+
+def _set_attrs(text: str, node: _Node, values: dict[str, str]) -> list[Edit]:
+    """Edits that set node's attributes (in place when present, appended otherwise)."""
+    edits: list[Edit] = []
+    new = []
+    for k, v in values.items():
+        if k in node.attrs:
+            _, v0, v1 = node.attrs[k]
+            edits.append((v0, v1, v))
         else:
-            parent.text = child.tail
-    parent.remove(child)
+            new.append(f' {k}="{v}"')
+    if new:
+        at = node.open_end - (2 if text[node.open_end - 2] == "/" else 1)
+        while text[at - 1].isspace():
+            at -= 1
+        edits.append((at, at, "".join(new)))
+    return edits
 
 
-def _mimic_sources(joints: dict[str, ET.Element], coords: list[str], fn: str):
+def _note(text: str) -> str:
+    return f"<!-- {_NOTE} {text} -->"
+
+
+def _drop_notes(text: str, joints: dict[str, _Node]) -> list[Edit]:
+    """Edits removing the joints' rotor-inertia comments of an earlier write_urdf (a new export
+    writes them again; a merged link's comment stays, its <inertial> being gone)."""
+    return [
+        (*_cut(text, a, b), "")
+        for joint in joints.values()
+        for a, b, body in joint.comments
+        if body.strip().startswith(_NOTE)
+    ]
+
+
+def _mimic_sources(joints: dict[str, _Node], coords: list[str]) -> dict[str, tuple[str, float]]:
     """Per URDF joint with a coordinate: (the independent coordinate it drives, its scale)."""
     out: dict[str, tuple[str, float]] = {}
     for name in joints:
         j, scale, seen = name, 1.0, set()
-        while j not in coords:
-            mimic = joints[j].find("mimic") if j in joints else None
-            if mimic is None or j in seen:
+        while j not in coords and j in joints and j not in seen:
+            mimic = joints[j].find("mimic")
+            if mimic is None:
                 break
             seen.add(j)
-            scale *= float(mimic.get("multiplier", "1"))
+            try:
+                scale *= float(mimic.get("multiplier", "1"))
+            except ValueError:
+                break
             j = mimic.get("joint", "")
         if j in coords:
             out[name] = (j, scale)
     return out
 
 
-def _set_friction(joints, sources, coord: str, fv: float, fc: float) -> None:
-    """Scale the <dynamics> of coord's joints (its own and its mimic followers') to fv, fc."""
-    mine = [(name, s) for name, (c, s) in sources.items() if c == coord]
-
-    def value(name: str, attr: str) -> float:
-        dyn = joints[name].find("dynamics")
+def _dynamics_value(joint: _Node, attr: str) -> float:
+    dyn = joint.find("dynamics")
+    try:
         return float(dyn.get(attr, "0")) if dyn is not None else 0.0
+    except ValueError:
+        return 0.0
 
+
+def _friction_edits(text, joints, sources, coord: str, fv: float, fc: float) -> list[Edit]:
+    """Edits scaling the <dynamics> of coord's joints (its own, its mimic followers') to fv, fc
+    (load_urdf reflects a follower's friction with its multiplier's square, resp. modulus)."""
+    mine = [(name, s) for name, (c, s) in sources.items() if c == coord]
+    values: dict[str, dict[str, str]] = {}
     for attr, target, power in (("damping", fv, 2), ("friction", fc, 1)):
-        total = sum(abs(s) ** power * value(n, attr) for n, s in mine)
+        total = sum(abs(s) ** power * _dynamics_value(joints[n], attr) for n, s in mine)
         for name, _ in mine:
-            joint = joints[name]
-            dyn = joint.find("dynamics")
             if total > 0.0:
-                new = value(name, attr) * (target / total)
+                new = _dynamics_value(joints[name], attr) * (target / total)
             elif name == coord:
                 new = target
             else:
                 continue
-            if dyn is None:
-                if new == 0.0:
-                    continue
-                inner, closing = _indent_of(joint)
-                dyn = ET.SubElement(joint, "dynamics")
-                if len(joint) > 1:
-                    joint[-2].tail = inner
-                dyn.tail = closing
-            dyn.set(attr, _num(new))
-
-
-def _check_friction(p: np.ndarray, names: list[str], start: int, fn: str) -> None:
-    for i in range(start, p.size):
-        if names[i].rsplit(".", 1)[1] in ("fv", "fc", "Ia") and p[i] < 0.0:
-            raise armdyn.ModelError(f"{fn}: '{names[i]}' must be >= 0, got {p[i]}")
+            if joints[name].find("dynamics") is not None or new != 0.0:
+                values.setdefault(name, {})[attr] = _num(new)
+    edits: list[Edit] = []
+    for name, attrs in values.items():
+        dyn = joints[name].find("dynamics")
+        if dyn is not None:
+            edits += _set_attrs(text, dyn, attrs)
+        else:
+            fields = " ".join(f'{k}="{v}"' for k, v in attrs.items())
+            edits += _insert_last(text, joints[name], f"<dynamics {fields}/>")
+    return edits
 
 
 def write_urdf(urdf, model, pi, path=None) -> str:
@@ -351,10 +408,9 @@ def write_urdf(urdf, model, pi, path=None) -> str:
     fn = "write_urdf"
     p, names = _checked_pi(model, pi, fn)
     text = _urdf_text(urdf, fn)
-    start, end = _root_span(text, fn)
-    root = _parse(text, fn)
-    links = {el.get("name"): el for el in root.findall("link")}
-    joints = {el.get("name"): el for el in root.findall("joint")}
+    root = _scan(text, fn)
+    links = {el.get("name"): el for el in root.children if el.tag == "link"}
+    joints = {el.get("name"): el for el in root.children if el.tag == "joint"}
     n_bodies = sum(n.endswith(".m") for n in names)  # only a body's mass entry ends so
     bodies = [names[_BODY * i][: -len(".m")] for i in range(n_bodies)]
     coords = list(model.coord_names)
@@ -366,31 +422,47 @@ def write_urdf(urdf, model, pi, path=None) -> str:
             raise armdyn.ModelError(
                 f"{fn}: the URDF has no joint '{c}' (a joint coordinate of the model)"
             )
-    n_body = _BODY * len(bodies)
+    n_body = _BODY * n_bodies
     _check_friction(p, names, n_body, fn)
     inertials = [_inertial_of(p[_BODY * i : _BODY * (i + 1)], b, fn) for i, b in enumerate(bodies)]
-    _drop_notes(root)
-    for b, (m, c, inertia) in zip(bodies, inertials):
-        _set_inertial(links[b], m, c, inertia)
-    _clear_merged(root, model, links, set(bodies))
-    sources = _mimic_sources(joints, coords, fn)
+    edits = _drop_notes(text, joints)
+    for b, (m, c, inertia) in zip(bodies, inertials, strict=True):
+        old = links[b].find("inertial")
+        if old is not None:
+            own = _line_indent(text, old.start)
+            xml = _inertial_xml(m, c, inertia, own, _child_indent(text, old))
+            edits.append((old.start, old.end, xml))
+        else:
+            indent = _child_indent(text, links[b])
+            xml = _inertial_xml(m, c, inertia, indent, indent + "  ")
+            edits += _insert_first(text, links[b], xml)
+    edits += _merged_edits(text, model, links, set(bodies))
+    sources = _mimic_sources(joints, coords)
     for k, c in enumerate(coords):
         o = n_body + _COORD * k
-        _set_friction(joints, sources, c, p[o], p[o + 1])
+        edits += _friction_edits(text, joints, sources, c, p[o], p[o + 1])
         if p[o + 3] != 0.0:
-            _add_note(
-                joints[c],
+            note = _note(
                 f"rotor inertia Ia = {_num(p[o + 3])} kg m^2 (reflected to the joint; no URDF "
-                "element: armdyn.identification.with_parameters adds it as an actuator)",
+                "element: armdyn.identification.with_parameters adds it as an actuator)"
             )
-    out = text[:start] + ET.tostring(root, encoding="unicode") + text[end:]
+            edits += _insert_first(text, joints[c], note)
+    out = _apply(text, edits)
     if path is not None:
         Path(path).write_text(out, encoding="utf-8")
     return out
 
 
-def _clear_merged(root: ET.Element, model, links: dict, bodies: set[str]) -> None:
-    """Drop the <inertial> of the links merged into a body through fixed joints."""
+def _check_friction(p: np.ndarray, names: list[str], start: int, fn: str) -> None:
+    for i in range(start, p.size):
+        if names[i].rsplit(".", 1)[1] in ("fv", "fc", "Ia") and p[i] < 0.0:
+            raise armdyn.ModelError(f"{fn}: '{names[i]}' must be >= 0, got {p[i]}")
+
+
+def _merged_edits(text: str, model, links: dict[str, _Node], bodies: set[str]) -> list[Edit]:
+    """Edits dropping the <inertial> of the links merged into a body through fixed joints (a
+    comment in its place)."""
+    edits: list[Edit] = []
     for name in model.frame_names:
         link = links.get(name)
         if link is None or name in bodies:
@@ -399,9 +471,23 @@ def _clear_merged(root: ET.Element, model, links: dict, bodies: set[str]) -> Non
         inertial = link.find("inertial")
         if body not in bodies or inertial is None:
             continue
-        _remove_keeping_layout(link, inertial)
-        _add_note(
-            link,
+        note = _note(
             f"inertial merged into link '{body}' (one armdyn body through fixed joints; the "
-            "identified parameters are there)",
+            "identified parameters are there)"
         )
+        a, b = _cut(text, inertial.start, inertial.end)
+        whole = a != inertial.start
+        edits.append((a, b, f"{_line_indent(text, inertial.start)}{note}\n" if whole else note))
+    return edits
+
+
+def _apply(text: str, edits: list[Edit]) -> str:
+    """text with the edits (non-overlapping) applied."""
+    out, at = [], 0
+    for a, b, new in sorted(edits, key=lambda e: (e[0], e[1])):
+        if a < at:
+            raise RuntimeError(f"write_urdf: overlapping edits at {a}")  # a bug, not an input
+        out += [text[at:a], new]
+        at = b
+    out.append(text[at:])
+    return "".join(out)
