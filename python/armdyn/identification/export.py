@@ -349,12 +349,13 @@ def _friction_edits(text, joints, sources, coord: str, fv: float, fc: float) -> 
         total = sum(abs(s) ** power * _dynamics_value(joints[n], attr) for n, s in mine)
         for name, _ in mine:
             if total > 0.0:
-                new = _dynamics_value(joints[name], attr) * (target / total)
+                new = target * (_dynamics_value(joints[name], attr) / total)  # 1 source: exact
             elif name == coord:
                 new = target
             else:
                 continue
-            if joints[name].find("dynamics") is not None or new != 0.0:
+            dyn = joints[name].find("dynamics")
+            if new != 0.0 or (dyn is not None and attr in dyn.attrs):
                 values.setdefault(name, {})[attr] = _num(new)
     edits: list[Edit] = []
     for name, attrs in values.items():
