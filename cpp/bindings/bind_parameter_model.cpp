@@ -1,9 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Binding of model_with_dynamic_parameters (armdyn/io/parameter_model.hpp): the model of an
 // identified parameter vector (armdyn.identification.with_parameters calls it).
-#include "armdyn/io/parameter_model.hpp"
-
 #include "armdyn/algorithm/regressor.hpp"
+#include "armdyn/io/parameter_model.hpp"
 #include "common.hpp"
 #include "rows.hpp"
 

@@ -15,6 +15,7 @@ ROBOTS = common.robots_dir()
 needs_robots = pytest.mark.skipif(ROBOTS is None, reason="example-robot-data not installed")
 UR5 = str(ROBOTS / "ur_description/urdf/ur5_robot.urdf") if ROBOTS else ""
 PANDA = str(ROBOTS / "panda_description/urdf/panda.urdf") if ROBOTS else ""
+SOLO = str(ROBOTS / "solo_description/robots/solo12.urdf") if ROBOTS else ""
 
 # a pendulum about y (link1) with a massive fixed child (tool, merged into link1's body), and a
 # second link (link2) about y: every parameter of link1 is in closed form below
@@ -68,11 +69,11 @@ PENDULUM = """<?xml version="1.0"?>
 
 
 def _state(model, rng):
-    return (
-        rng.uniform(-1.0, 1.0, model.n_coords),
-        rng.normal(size=model.n_dofs),
-        rng.normal(size=model.n_dofs),
-    )
+    q = rng.uniform(-1.0, 1.0, model.n_coords)
+    if model.n_free:
+        quat = rng.normal(size=4)
+        q = np.concatenate([rng.normal(size=3), quat / np.linalg.norm(quat), q[7:]])
+    return q, rng.normal(size=model.n_dofs), rng.normal(size=model.n_dofs)
 
 
 def _names(model):
@@ -136,22 +137,48 @@ def _check_model(model, new, pi, rng, frames=True):
 
 
 @needs_robots
-@pytest.mark.parametrize("path", [UR5, PANDA], ids=["ur5", "panda-mimic"])
-def test_with_parameters_gives_pi_and_its_dynamics(path):
-    model = ad.load_urdf(path)
+@pytest.mark.parametrize(
+    "path, fixed", [(UR5, True), (PANDA, True), (SOLO, False)], ids=["ur5", "panda-mimic", "solo12"]
+)
+def test_with_parameters_gives_pi_and_its_dynamics(path, fixed):
+    model = ad.load_urdf(path, fixed_base=fixed)
     before = ad.dynamic_parameters(model)
     pi = _identified(model)
     new = with_parameters(model, pi)
     _check_model(model, new, pi, np.random.default_rng(1))
     np.testing.assert_array_equal(ad.dynamic_parameters(model), before)  # nominal untouched
     # Ia on coordinates without actuator: a gear-ratio-1 armature each
+    coords = [n[: -len(".Ia")] for n in _names(model) if n.endswith(".Ia")]
     assert [b for b in new.body_names if b.endswith("_armature")] == [
-        f"{c}_armature" for c in model.coord_names
+        f"{c}_armature" for c in coords
     ]
     # the copy is a model the builder could have made: it pickles (the bytes are re-checked)
     np.testing.assert_array_equal(
         ad.dynamic_parameters(pickle.loads(pickle.dumps(new))), ad.dynamic_parameters(new)
     )
+
+
+@needs_robots
+def test_with_parameters_cartesian_state_and_simulation():
+    """The assembled Cartesian state has the new centres of mass (link frame pose at the build
+    pose times pi's c = h / m) and the Cartesian simulation (welded model, KKT plans made
+    afresh) follows the joint-space one."""
+    model = ad.load_urdf(UR5)
+    pi = _identified(model)
+    new = with_parameters(model, pi)
+    zero = np.zeros(model.n_coords)
+    for i, body in enumerate(model.body_names):
+        k = new.body_names.index(body)
+        c = pi[10 * i + 1 : 10 * i + 4] / pi[10 * i]
+        expected = ad.frame_pose(model, zero, body) @ np.r_[c, 1.0]
+        np.testing.assert_allclose(new.u0[7 * k : 7 * k + 3], expected[:3], atol=1e-12)
+    q0 = np.array([0.3, -1.0, 1.2, -0.5, 0.8, 0.2])
+    runs = [
+        ad.simulate(new, 0.2, q0=q0, coordinates=c, rtol=1e-9, atol=1e-11)
+        for c in ("cartesian", "joint")
+    ]
+    np.testing.assert_allclose(runs[0].q[-1], runs[1].q[-1], atol=1e-6)
+    assert np.abs(runs[0].q[-1][: q0.size] - q0).max() > 0.01  # it moved
 
 
 def test_with_parameters_closed_form_pendulum():

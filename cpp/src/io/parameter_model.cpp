@@ -68,12 +68,12 @@ BodyInertial body_inertial(const ParameterLayout& L, int i, const Eigen::Matrix<
   out.inertia = 0.5 * (out.inertia + out.inertia.transpose());
   const InertiaCheck ic = check_inertia(out.inertia, physical);
   if (!ic.problem.empty())
-    throw ModelError(msg(
-        who, ": the inertia about the centre of mass ", ic.problem, " (principal moments ",
-        ic.moments.transpose(), ")",
-        ic.kind == InertiaProblem::TriangleInequality
-            ? ": not physically consistent (physical_inertia=False accepts it)"
-            : ": not physically consistent (the pseudo-inertia is not positive semidefinite)"));
+    throw ModelError(
+        msg(who, ": the inertia about the centre of mass ", ic.problem, " (principal moments ",
+            ic.moments.transpose(), ")",
+            ic.kind == InertiaProblem::TriangleInequality
+                ? ": not physically consistent (physical_inertia=False accepts it)"
+                : ": not physically consistent (the pseudo-inertia is not positive semidefinite)"));
   out.inertia = ic.tensor;
   return out;
 }
@@ -96,12 +96,11 @@ void move_body_origin(Model& d, int b, const Vec3& shift) {
     if (l.body == b) l.point -= shift;
 }
 
-void set_bodies(const Model& m, const ParameterLayout& L, const VecX& pi, bool physical,
-                Model& d) {
+void set_bodies(const Model& m, const ParameterLayout& L, const VecX& pi, bool physical, Model& d) {
   std::vector<BodyInertial> news;
   for (int i = 0; i < static_cast<int>(L.bodies.size()); ++i)
-    news.push_back(body_inertial(L, i, pi.segment<10>(L.body_offset(i)),
-                                 m.bodies[L.bodies[i]].name, physical));
+    news.push_back(body_inertial(L, i, pi.segment<10>(L.body_offset(i)), m.bodies[L.bodies[i]].name,
+                                 physical));
   for (int i = 0; i < static_cast<int>(L.bodies.size()); ++i) {
     const int b = L.bodies[i];
     d.bodies[b].mass = news[i].mass;
@@ -133,7 +132,8 @@ int own_friction(const Model& d, int c) {
 /// Scale independent coordinate k's friction sources to pi's fv, fc (d's coord_forces are m's,
 /// same order); the friction a coordinate without sources needs goes to `added`.
 void set_friction(const Model& m, const ParameterLayout& L, const VecX& pi,
-                  const std::vector<std::string>& names, Model& d, std::vector<NewFriction>& added) {
+                  const std::vector<std::string>& names, Model& d,
+                  std::vector<NewFriction>& added) {
   for (int k = 0; k < m.independent.n; ++k) {
     const int o = L.coord_offset(k);
     const double fv = pi[o], fc = pi[o + 1];
