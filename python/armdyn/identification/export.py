@@ -21,7 +21,6 @@ from xml.sax.saxutils import unescape as xml_unescape
 
 import numpy as np
 
-import armdyn
 from armdyn import _core
 
 __all__ = ["with_parameters", "write_urdf"]
@@ -34,21 +33,21 @@ _NOTE = "armdyn:"  # the comments write_urdf adds start with it (replaced on a s
 def _checked_pi(model, pi, fn: str) -> tuple[np.ndarray, list[str]]:
     """pi as a finite float vector of the model's length, or a ModelError naming the culprit."""
     if not isinstance(model, _core.Model):
-        raise armdyn.ModelError(f"{fn}: model must be an armdyn.Model, got {type(model).__name__}")
-    names = armdyn.dynamic_parameter_names(model)
+        raise _core.ModelError(f"{fn}: model must be an armdyn.Model, got {type(model).__name__}")
+    names = _core.dynamic_parameter_names(model)
     try:
         p = np.array(pi, dtype=float)
     except (TypeError, ValueError) as e:
-        raise armdyn.ModelError(f"{fn}: pi must be an array of numbers ({e})") from None
+        raise _core.ModelError(f"{fn}: pi must be an array of numbers ({e})") from None
     if p.shape != (len(names),):
-        raise armdyn.ModelError(
+        raise _core.ModelError(
             f"{fn}: pi must have shape ({len(names)},) (dynamic_parameter_names(model)), "
             f"got {p.shape}"
         )
     bad = np.flatnonzero(~np.isfinite(p))
     if bad.size:
         i = int(bad[0])
-        raise armdyn.ModelError(f"{fn}: pi[{i}] ('{names[i]}') must be finite, got {p[i]}")
+        raise _core.ModelError(f"{fn}: pi[{i}] ('{names[i]}') must be finite, got {p[i]}")
     return p, names
 
 
@@ -99,7 +98,7 @@ def with_parameters(model, pi, *, urdf=None, physical_inertia: bool = True):
     fn = "with_parameters"
     p, _ = _checked_pi(model, pi, fn)
     if not isinstance(physical_inertia, (bool, np.bool_)):
-        raise armdyn.ModelError(f"{fn}: physical_inertia must be True or False")
+        raise _core.ModelError(f"{fn}: physical_inertia must be True or False")
     if urdf is not None:
         write_urdf(urdf, model, p)
     return _core.model_with_dynamic_parameters(model, p, bool(physical_inertia))
@@ -114,7 +113,7 @@ def _urdf_text(urdf, fn: str) -> str:
         try:
             return urdf.decode("utf-8")
         except UnicodeDecodeError as e:
-            raise armdyn.UrdfError(f"{fn}: urdf bytes are not UTF-8 ({e})") from None
+            raise _core.UrdfError(f"{fn}: urdf bytes are not UTF-8 ({e})") from None
     if isinstance(urdf, os.PathLike) or (
         isinstance(urdf, str) and not urdf.lstrip().startswith("<")
     ):
@@ -122,10 +121,10 @@ def _urdf_text(urdf, fn: str) -> str:
         try:
             return path.read_text(encoding="utf-8")
         except (OSError, UnicodeDecodeError) as e:
-            raise armdyn.UrdfError(f"{fn}: cannot read the URDF file '{path}': {e}") from None
+            raise _core.UrdfError(f"{fn}: cannot read the URDF file '{path}': {e}") from None
     if isinstance(urdf, str):
         return urdf
-    raise armdyn.UrdfError(
+    raise _core.UrdfError(
         f"{fn}: urdf must be a path or the XML text (str or bytes), got {type(urdf).__name__}"
     )
 
@@ -167,7 +166,7 @@ def _scan(text: str, fn: str) -> _Node:
     try:
         ET.fromstring(text)
     except ET.ParseError as e:
-        raise armdyn.UrdfError(f"{fn}: the URDF is not well-formed XML: {e}") from None
+        raise _core.UrdfError(f"{fn}: the URDF is not well-formed XML: {e}") from None
     stack: list[_Node] = []
     root = None
     for m in _TOKEN.finditer(text):
@@ -188,7 +187,7 @@ def _scan(text: str, fn: str) -> _Node:
             stack.append(node)
     if root is None or root.tag != "robot":
         tag = root.tag if root is not None else "none"
-        raise armdyn.UrdfError(f"{fn}: the URDF's root element is <{tag}>, not <robot>")
+        raise _core.UrdfError(f"{fn}: the URDF's root element is <{tag}>, not <robot>")
     return root
 
 
@@ -226,10 +225,10 @@ def _inertial_of(p10: np.ndarray, body: str, fn: str) -> tuple[float, np.ndarray
     m, h = float(p10[0]), np.asarray(p10[1:4], dtype=float)
     i_o = np.array([[p10[4], p10[5], p10[7]], [p10[5], p10[6], p10[8]], [p10[7], p10[8], p10[9]]])
     if m < 0.0:
-        raise armdyn.ModelError(f"{fn}: body '{body}': mass ('{body}.m') must be >= 0, got {m}")
+        raise _core.ModelError(f"{fn}: body '{body}': mass ('{body}.m') must be >= 0, got {m}")
     if m == 0.0:
         if np.any(h != 0.0):
-            raise armdyn.ModelError(
+            raise _core.ModelError(
                 f"{fn}: body '{body}': zero mass with a nonzero first moment {h}: no centre of "
                 "mass (not physically consistent)"
             )
@@ -417,10 +416,10 @@ def write_urdf(urdf, model, pi, path=None) -> str:
     coords = list(model.coord_names)
     for b in bodies:
         if b not in links:
-            raise armdyn.ModelError(f"{fn}: the URDF has no link '{b}' (a body of the model)")
+            raise _core.ModelError(f"{fn}: the URDF has no link '{b}' (a body of the model)")
     for c in coords:
         if c not in joints:
-            raise armdyn.ModelError(
+            raise _core.ModelError(
                 f"{fn}: the URDF has no joint '{c}' (a joint coordinate of the model)"
             )
     n_body = _BODY * n_bodies
@@ -457,7 +456,7 @@ def write_urdf(urdf, model, pi, path=None) -> str:
 def _check_friction(p: np.ndarray, names: list[str], start: int, fn: str) -> None:
     for i in range(start, p.size):
         if names[i].rsplit(".", 1)[1] in ("fv", "fc", "Ia") and p[i] < 0.0:
-            raise armdyn.ModelError(f"{fn}: '{names[i]}' must be >= 0, got {p[i]}")
+            raise _core.ModelError(f"{fn}: '{names[i]}' must be >= 0, got {p[i]}")
 
 
 def _merged_edits(text: str, model, links: dict[str, _Node], bodies: set[str]) -> list[Edit]:
