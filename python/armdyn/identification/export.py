@@ -80,7 +80,7 @@ def with_parameters(model, pi, *, urdf=None, physical_inertia: bool = True):
     consistent (its pseudo-inertia positive semidefinite: ``m >= 0`` and the inertia about the
     centre of mass positive semidefinite with the triangle inequality); False, the inertia
     about the centre of mass need only be positive semidefinite (published or identified sets
-    that violate the triangle inequality, e.g. Gaz et al.'s Panda). Either way ``m >= 0``, a
+    that violate the triangle inequality). Either way ``m >= 0``, a
     zero mass has a zero first moment and ``fv, fc, Ia >= 0``; a model cannot hold other
     values (a negative mass or a non-positive-semidefinite inertia has no dynamics to
     simulate).
@@ -100,7 +100,10 @@ def with_parameters(model, pi, *, urdf=None, physical_inertia: bool = True):
     if not isinstance(physical_inertia, (bool, np.bool_)):
         raise _core.ModelError(f"{fn}: physical_inertia must be True or False")
     if urdf is not None:
-        write_urdf(urdf, model, p)
+        try:
+            write_urdf(urdf, model, p)
+        except (_core.ModelError, _core.UrdfError) as e:
+            raise type(e)(f"{fn}: urdf: {e}") from None
     return _core.model_with_dynamic_parameters(model, p, bool(physical_inertia))
 
 
@@ -392,12 +395,12 @@ def write_urdf(urdf, model, pi, path=None) -> str:
 
     ``armdyn.load_urdf`` of the result gives ``dynamic_parameters`` equal to ``pi``'s body and
     friction entries (to round-off; with the options the model was loaded with). Everything
-    else is kept: the document is parsed by ``xml.etree`` with its comments, and the text
-    before and after ``<robot>`` (XML declaration, header comments) is copied byte for byte;
-    inside ``<robot>`` the unchanged elements are re-serialized by ``xml.etree`` (the same
-    elements, attributes, text and comments; quoting and empty-element spacing may differ,
-    unused namespace declarations are dropped). Comments from an earlier export
-    (``armdyn: ...``) are replaced.
+    else is kept byte for byte: ``xml.etree`` checks that the document is well-formed, and
+    the changes are spliced into the original text (the replaced ``<inertial>`` elements, the
+    ``damping``/``friction`` attribute values, the added elements and comments indented as
+    their neighbours); comments, attribute quoting, namespaces and layout elsewhere are
+    untouched. Comments from an earlier export (``armdyn: ...``) are replaced, so exporting
+    again gives the same text.
 
     ``path``: also written there (UTF-8). Returns the text. Raises ModelError naming the
     culprit on a ``pi`` of the wrong shape, a non-finite entry, a negative mass, friction or
