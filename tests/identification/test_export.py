@@ -225,6 +225,31 @@ def test_with_parameters_actuators_friction_and_smoothing():
         assert rotor in new.body_names and "j2_armature" in new.body_names
 
 
+def test_with_parameters_rotor_without_inertia_and_cylindrical():
+    """An actuator whose rotor inertia is 0 takes all of Ia (J = Ia / N^2); a cylindrical
+    joint's slide takes no actuator (ModelError naming the coordinate)."""
+    b = ad.urdf_builder(PENDULUM)
+    b.add_actuator("j2", 10.0, 0.0)
+    model = b.finalize()
+    pi = _identified(model, seed=6)
+    new = with_parameters(model, pi)
+    _check_model(model, new, pi, np.random.default_rng(7))
+    assert "j2_armature" in new.body_names and len(new.body_names) == 4  # + j1_armature
+    b = ad.ModelBuilder()
+    b.add_body("slider", 1.0, np.diag([0.01, 0.02, 0.03]), position=(0.0, 0.0, -0.5))
+    b.add_cylindrical("cyl", "ground", "slider", (0, 0, 0), (0, 0, 1))
+    model = b.finalize()
+    pi = ad.dynamic_parameters(model)
+    names = _names(model)
+    pi[names.index(names[-1])] = 0.1  # the slide's Ia
+    with pytest.raises(ad.ModelError, match=rf"'{re.escape(names[-1])}' = 0\.1\d*: .*cylindrical"):
+        with_parameters(model, pi)
+    pi[names.index(names[-1])] = 0.0
+    pi[names.index(names[-5])] = 0.1  # the angle's Ia: an actuator on a cylindrical joint
+    with pytest.raises(ad.ModelError, match="joint 'cyl' needs an actuator"):
+        with_parameters(model, pi)
+
+
 def test_with_parameters_zero_friction_and_massless():
     model = ad.load_urdf(PENDULUM)
     pi = ad.dynamic_parameters(model)
@@ -336,20 +361,24 @@ INERTIAL_LINE = re.compile(r"^\s*(<inertial>|</inertial>|<mass |<origin |<inerti
 
 
 @needs_robots
-@pytest.mark.parametrize("path", [UR5, PANDA], ids=["ur5-merged-tool0", "panda-mimic"])
-def test_write_urdf_round_trip(path, tmp_path):
-    model = ad.load_urdf(path)
+@pytest.mark.parametrize(
+    "path, fixed",
+    [(UR5, True), (PANDA, True), (SOLO, False)],
+    ids=["ur5-merged-tool0", "panda-mimic", "solo12-floating"],
+)
+def test_write_urdf_round_trip(path, fixed, tmp_path):
+    model = ad.load_urdf(path, fixed_base=fixed)
     pi = _identified(model)
     out = tmp_path / "identified.urdf"
     text = write_urdf(path, model, pi, path=out)
     assert out.read_text() == text
-    _check_round_trip(path, model, pi, str(out))
+    _check_round_trip(path, model, pi, str(out), fixed_base=fixed)
     original = open(path).read()
     # everything but the inertials and the joints' <dynamics> kept byte for byte
     assert text.startswith(original[: original.index("<robot")])
     assert all(INERTIAL_LINE.match(line) for line in _changed_lines(original, text))
     n_ia = text.count("armdyn: rotor inertia Ia")
-    assert n_ia == model.n_coords
+    assert n_ia == sum(n.endswith(".Ia") for n in _names(model))
     # a second export of the same pi changes nothing (its comments replaced, not added)
     assert write_urdf(text, model, pi) == text
 

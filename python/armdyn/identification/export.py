@@ -240,9 +240,11 @@ def _inertial_of(p10: np.ndarray, body: str, fn: str) -> tuple[float, np.ndarray
     return m, c, i_o - m * (c @ c * np.eye(3) - np.outer(c, c))
 
 
-def _inertial_xml(m: float, c: np.ndarray, inertia: np.ndarray, indent: str, inner: str) -> str:
-    """An <inertial> element, its first line unindented, its children at inner, its end tag at
-    indent."""
+def _inertial_xml(
+    m: float, c: np.ndarray, inertia: np.ndarray, indent: str, inner: str, notes=()
+) -> str:
+    """An <inertial> element, its first line unindented, its children at inner (the comments
+    `notes` first), its end tag at indent."""
     keys = {
         "ixx": (0, 0),
         "ixy": (0, 1),
@@ -253,9 +255,10 @@ def _inertial_xml(m: float, c: np.ndarray, inertia: np.ndarray, indent: str, inn
     }
     moments = " ".join(f'{k}="{_num(inertia[ij])}"' for k, ij in keys.items())
     xyz = " ".join(_num(v) for v in c)
+    kept = "".join(f"\n{inner}{note}" for note in notes)
     return (
-        f'<inertial>\n{inner}<origin xyz="{xyz}" rpy="0 0 0"/>\n{inner}<mass value="{_num(m)}"/>'
-        f"\n{inner}<inertia {moments}/>\n{indent}</inertial>"
+        f'<inertial>{kept}\n{inner}<origin xyz="{xyz}" rpy="0 0 0"/>'
+        f'\n{inner}<mass value="{_num(m)}"/>\n{inner}<inertia {moments}/>\n{indent}</inertial>'
     )
 
 
@@ -416,7 +419,7 @@ def write_urdf(urdf, model, pi, path=None) -> str:
     joints = {el.get("name"): el for el in root.children if el.tag == "joint"}
     n_bodies = sum(n.endswith(".m") for n in names)  # only a body's mass entry ends so
     bodies = [names[_BODY * i][: -len(".m")] for i in range(n_bodies)]
-    coords = list(model.coord_names)
+    coords = [n[: -len(".fv")] for n in names[_BODY * n_bodies :: _COORD]]  # no floating base
     for b in bodies:
         if b not in links:
             raise _core.ModelError(f"{fn}: the URDF has no link '{b}' (a body of the model)")
@@ -433,7 +436,8 @@ def write_urdf(urdf, model, pi, path=None) -> str:
         old = links[b].find("inertial")
         if old is not None:
             own = _line_indent(text, old.start)
-            xml = _inertial_xml(m, c, inertia, own, _child_indent(text, old))
+            notes = [text[a:b] for a, b, _ in old.comments]  # the old one's comments kept
+            xml = _inertial_xml(m, c, inertia, own, _child_indent(text, old), notes)
             edits.append((old.start, old.end, xml))
         else:
             indent = _child_indent(text, links[b])
