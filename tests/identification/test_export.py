@@ -280,7 +280,7 @@ def test_with_parameters_urdf_checked():
     np.testing.assert_allclose(
         ad.dynamic_parameters(new), ad.dynamic_parameters(with_parameters(model, pi)), atol=0
     )
-    with pytest.raises(ad.ModelError, match="no link 'shoulder_link'"):
+    with pytest.raises(ad.ModelError, match=r"with_parameters: urdf: .*no link 'shoulder_link'"):
         with_parameters(model, pi, urdf=PENDULUM)
 
 
@@ -407,12 +407,15 @@ def test_write_urdf_panda_mimic_friction():
     _check_round_trip(PANDA, model, pi, text)
 
 
-def test_write_urdf_fixed_child_with_mass():
+def test_write_urdf_fixed_child_with_mass(tmp_path):
     model = ad.load_urdf(PENDULUM)
     # the merged body's nominal parameters: link1's and the tool's, about link1's frame
     assert ad.dynamic_parameters(model)[0] == pytest.approx(2.5)
     pi = _identified(model)
     text = write_urdf(PENDULUM, model, pi)
+    assert write_urdf(PENDULUM.encode(), model, pi) == text  # XML as bytes
+    (tmp_path / "p.urdf").write_text(PENDULUM)
+    assert write_urdf(tmp_path / "p.urdf", model, pi) == text  # a PathLike
     tool = re.search(r'<link name="tool">.*?</link>', text, re.S).group(0)
     assert "<inertial>" not in tool and "merged into link 'link1'" in tool
     assert text.startswith('<?xml version="1.0"?>\n<!-- a hand-written test robot -->\n')
@@ -434,7 +437,7 @@ def test_write_urdf_adds_inertial_to_link_without_one(empty):
     _check_round_trip(urdf, model, pi, text)
 
 
-def test_write_urdf_hostile():
+def test_write_urdf_hostile(tmp_path):
     model = ad.load_urdf(PENDULUM)
     pi = ad.dynamic_parameters(model)
     for bad, match in _bad_pi(model):
@@ -448,6 +451,10 @@ def test_write_urdf_hostile():
         write_urdf(PENDULUM.replace('name="j2"', 'name="jx"'), model, pi)
     with pytest.raises(ad.UrdfError, match="cannot read the URDF file"):
         write_urdf("/nonexistent/robot.urdf", model, pi)
+    with pytest.raises(ad.UrdfError, match="not a regular file"):
+        write_urdf(tmp_path, model, pi)
+    with pytest.raises(ad.UrdfError, match="urdf must be a path or the XML text"):
+        write_urdf(3, model, pi)
     with pytest.raises(ad.UrdfError, match="not well-formed"):
         write_urdf("<robot name='x'><link></robot>", model, pi)
     with pytest.raises(ad.UrdfError, match="root element is <sdf>"):

@@ -111,25 +111,33 @@ def with_parameters(model, pi, *, urdf=None, physical_inertia: bool = True):
 
 
 def _urdf_text(urdf, fn: str) -> str:
-    """The URDF's XML: a path (str or os.PathLike) to a file, or the XML itself (str, bytes)."""
+    """The URDF's XML: a path (str or os.PathLike) to a regular file of at most
+    armdyn._core.URDF_MAX_BYTES bytes, or the XML itself (str, UTF-8 bytes), as load_urdf."""
+    limit = _core.URDF_MAX_BYTES
     if isinstance(urdf, bytes):
         try:
-            return urdf.decode("utf-8")
+            urdf = urdf.decode("utf-8")
         except UnicodeDecodeError as e:
             raise _core.UrdfError(f"{fn}: urdf bytes are not UTF-8 ({e})") from None
     if isinstance(urdf, os.PathLike) or (
-        isinstance(urdf, str) and not urdf.lstrip().startswith("<")
+        isinstance(urdf, str) and not urdf.lstrip("\ufeff \t\r\n").startswith("<")
     ):
         path = Path(urdf)
         try:
+            if not path.is_file():
+                raise OSError("not a regular file")
+            if path.stat().st_size > limit:
+                raise OSError(f"larger than armdyn._core.URDF_MAX_BYTES = {limit} bytes")
             return path.read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError) as e:
+        except (OSError, UnicodeDecodeError, ValueError) as e:
             raise _core.UrdfError(f"{fn}: cannot read the URDF file '{path}': {e}") from None
-    if isinstance(urdf, str):
-        return urdf
-    raise _core.UrdfError(
-        f"{fn}: urdf must be a path or the XML text (str or bytes), got {type(urdf).__name__}"
-    )
+    if not isinstance(urdf, str):
+        raise _core.UrdfError(
+            f"{fn}: urdf must be a path or the XML text (str or bytes), got {type(urdf).__name__}"
+        )
+    if len(urdf) > limit:
+        raise _core.UrdfError(f"{fn}: the URDF text is longer than {limit} characters")
+    return urdf
 
 
 _TOKEN = re.compile(
@@ -303,7 +311,8 @@ def _set_attrs(text: str, node: _Node, values: dict[str, str]) -> list[Edit]:
 
 
 def _note(text: str) -> str:
-    return f"<!-- {_NOTE} {text} -->"
+    """An XML comment (a "--" inside a name would end it early: spaced out)."""
+    return f"<!-- {_NOTE} {text.replace('--', '- -')} -->"
 
 
 def _drop_notes(text: str, joints: dict[str, _Node]) -> list[Edit]:
