@@ -270,6 +270,8 @@ def test_with_parameters_physical_inertia_option():
         with_parameters(model, pi)
     new = with_parameters(model, pi, physical_inertia=False)
     _check_model(model, new, pi, np.random.default_rng(5))
+    copy = pickle.loads(pickle.dumps(new))  # the model bytes take such an inertia back
+    np.testing.assert_array_equal(ad.dynamic_parameters(copy), ad.dynamic_parameters(new))
 
 
 @needs_robots
