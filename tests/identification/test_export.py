@@ -225,6 +225,51 @@ def test_with_parameters_actuators_friction_and_smoothing():
         assert rotor in new.body_names and "j2_armature" in new.body_names
 
 
+def _quat(v):
+    """A unit quaternion (scalar first) of rotation vector v."""
+    angle = np.linalg.norm(v)
+    return np.r_[np.cos(angle / 2), np.sin(angle / 2) * np.asarray(v) / angle]
+
+
+def test_with_parameters_builder_model_body_frames():
+    """Bodies without a frame of their name: the parameter frame is the body frame (the
+    centre of mass, body axes, here rotated); its origin moves with pi's centre of mass, the
+    named frame 'tip' and the joints stay where they were, and the old body frame becomes a
+    frame of the body's name (pi's parameter frame)."""
+    b = ad.ModelBuilder(gravity=(0.3, -0.2, -9.81))
+    b.add_body(
+        "upper",
+        2.0,
+        [[0.05, 0.004, -0.002], [0.004, 0.06, 0.003], [-0.002, 0.003, 0.03]],
+        position=(0.0, 0.02, 0.2),
+        orientation=_quat([0.1, -0.3, 0.2]),
+    )
+    b.add_body(
+        "slide",
+        0.8,
+        [0.01, 0.02, 0.015],
+        position=(0.3, 0.05, 0.4),
+        orientation=_quat([-0.4, 0.2, 0.5]),
+    )
+    b.add_revolute("yaw", "ground", "upper", (0, 0, 0.1), (0.1, 0, 1))
+    b.add_prismatic("reach", "upper", "slide", (0.2, 0.03, 0.4), (1, 0.1, 0))
+    b.add_frame("tip", "slide", (0.5, 0.1, 0.45), _quat([0.2, 0.1, -0.3]))
+    b.add_joint_friction("reach", 0.4, 0.6, 0.02)
+    model = b.finalize()
+    pi = _identified(model, seed=8)
+    new = with_parameters(model, pi)
+    _check_model(model, new, pi, np.random.default_rng(9))
+    # pi's centre of mass of 'slide' is now its body frame's origin: in the old body frame
+    # (the old centre of mass, body axes) it sits at h / m
+    c_old = pi[11:14] / pi[10]
+    frame = model.frame("tip")
+    np.testing.assert_allclose(new.frame("tip")["point"], frame["point"] - c_old, atol=1e-15)
+    # ... and pi's parameter frame, the old body frame, is now a frame of its name
+    np.testing.assert_allclose(new.frame("slide")["point"], -c_old, atol=1e-15)
+    np.testing.assert_allclose(new.frame("slide")["rotation"], np.eye(3), atol=1e-15)
+    assert "slide" not in model.frame_names
+
+
 def test_with_parameters_rotor_without_inertia_and_cylindrical():
     """An actuator whose rotor inertia is 0 takes all of Ia (J = Ia / N^2); a cylindrical
     joint's slide takes no actuator (ModelError naming the coordinate)."""

@@ -96,17 +96,31 @@ void move_body_origin(Model& d, int b, const Vec3& shift) {
     if (l.body == b) l.point -= shift;
 }
 
-void set_bodies(const Model& m, const ParameterLayout& L, const VecX& pi, bool physical, Model& d) {
+/// A frame to add: the parameter frame of a body that had none of its name (the old body frame).
+struct NewFrame {
+  std::string name;
+  Vec3 position;  ///< world, build pose
+  Vec4 orientation;
+};
+
+/// Set the bodies from pi; a body whose parameter frame was its body frame (no frame of its
+/// name) gets a frame of its name at the old body frame, so that pi stays about the same frame.
+std::vector<NewFrame> set_bodies(const Model& m, const ParameterLayout& L, const VecX& pi,
+                                 bool physical, Model& d) {
   std::vector<BodyInertial> news;
   for (int i = 0; i < static_cast<int>(L.bodies.size()); ++i)
     news.push_back(body_inertial(L, i, pi.segment<10>(L.body_offset(i)), m.bodies[L.bodies[i]].name,
                                  physical));
+  std::vector<NewFrame> frames;
   for (int i = 0; i < static_cast<int>(L.bodies.size()); ++i) {
     const int b = L.bodies[i];
+    if (L.frame_name[i].empty())
+      frames.push_back({d.bodies[b].name, d.bodies[b].position, d.bodies[b].orientation});
     d.bodies[b].mass = news[i].mass;
     d.bodies[b].inertia = news[i].inertia;
     move_body_origin(d, b, news[i].shift);
   }
+  return frames;
 }
 
 /// Friction to add on a coordinate without a CoordForce of its own (add_joint_friction).
@@ -234,7 +248,7 @@ ModelPtr model_with_dynamic_parameters(const Model& m, const VecX& pi, bool phys
   if (draft.coord_forces.size() != m.coord_forces.size() ||
       draft.actuators.size() != m.actuators.size() || draft.bodies.size() != m.bodies.size())
     throw ModelError(msg(kFn, ": internal: the model's draft differs from the model"));
-  set_bodies(m, L, pi, physical_inertia, draft);
+  const std::vector<NewFrame> frames = set_bodies(m, L, pi, physical_inertia, draft);
   std::vector<NewFriction> frictions;
   set_friction(m, L, pi, names, draft, frictions);
   std::vector<std::pair<std::string, double>> actuators;
@@ -242,6 +256,7 @@ ModelPtr model_with_dynamic_parameters(const Model& m, const VecX& pi, bool phys
   const std::vector<std::string> warnings = std::move(draft.warnings);
   draft.warnings.clear();
   ModelBuilder b(std::move(draft), physical_inertia);
+  for (const NewFrame& f : frames) b.add_frame(f.name, f.name, f.position, f.orientation);
   for (const NewFriction& f : frictions)
     b.add_joint_friction(f.joint, f.viscous, f.coulomb, kRegressorCoulombSmoothing, f.sub);
   for (const auto& [joint, Ia] : actuators) {

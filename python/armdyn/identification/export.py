@@ -65,7 +65,9 @@ def with_parameters(model, pi, *, urdf=None, physical_inertia: bool = True):
       the parameter frame. An armdyn body's frame has its origin at its centre of mass, so
       the body frame moves with it (axes kept) and every point held in the body (joint
       points, named frames, ...) moves back: the geometry, frame poses and joint axes are
-      the model's;
+      the model's. A body without a frame of its name (a builder's model: its parameter frame
+      was its body frame) gets one at its old body frame, so that the new model's parameters
+      are about the same frames as ``pi``;
     - each joint coordinate's friction sources (its joint's, a mimic follower's, an
       actuator's motor side) are scaled to ``fv`` and ``fc`` (their smoothing kept); a
       coordinate without viscous or Coulomb friction gets it on its joint (Coulomb smoothing

@@ -19,7 +19,10 @@ namespace armdyn {
 ///    inertia about c (body axes). An armdyn body's frame has its origin at the centre of mass,
 ///    so the body frame moves by the centre of mass's shift (axes kept) and every point held in
 ///    it moves the other way (joint points, named frames, spring points, loads, Body::position):
-///    the geometry is unchanged. A massless body (m = 0, first moment 0) keeps its frame.
+///    the geometry is unchanged. A massless body (m = 0, first moment 0) keeps its frame. A body
+///    without a frame of its name (its parameter frame was its body frame: a builder's model)
+///    gets one, at its old body frame (old centre of mass, body axes), so that the result's
+///    parameters are about the same frames as pi.
 ///  - Friction fv, fc of an independent coordinate: every friction source reflected onto it (its
 ///    own, its followers', the actuators' motor-side) scaled by the ratio to pi's value (their
 ///    smoothing velocities kept: the regressor's column is then exact); a coordinate without
