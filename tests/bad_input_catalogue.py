@@ -1561,8 +1561,44 @@ CASES = [
         lambda: _identify_cli()._cutoff("-1"),
         ME,
         r"--cutoff '-1': the cutoff must be > 0 Hz",
+        "with-parameters-length",
+        "with_parameters with a pi one entry short",
+        lambda: _ident().with_parameters(_pendulum(), np.zeros(13)),
+        r"pi must have shape \(14,\)",
+        "with-parameters-nan",
+        "with_parameters with a NaN entry in pi",
+        lambda: _ident().with_parameters(_pendulum(), _pi_with(4, np.nan)),
+        r"pi\[4\] \('link.Ixx'\) must be finite",
+        "with-parameters-negative-mass",
+        "with_parameters with a negative body mass",
+        lambda: _ident().with_parameters(_pendulum(), _pi_with(0, -1.0)),
+        r"body 'link': mass \('link.m'\) must be >= 0",
+        "with-parameters-not-psd",
+        "with_parameters with a body inertia that is not positive semidefinite",
+        lambda: _ident().with_parameters(_pendulum(), _pi_with(4, -1.0)),
+        r"body 'link'.*not positive semidefinite",
+        "write-urdf-missing-link",
+        "write_urdf onto a URDF without one of the model's bodies",
+        lambda: _ident().write_urdf(
+            '<robot name="r"><link name="other"/></robot>', _pendulum(), _pi_with(0, 1.0)
+        ),
+        "the URDF has no link 'link'",
     ),
 ]
+
+
+def _ident():
+    from armdyn import identification
+
+    return identification
+
+
+def _pi_with(i, value):
+    """The pendulum's dynamic parameters with entry i set to value."""
+    pi = ad.dynamic_parameters(_pendulum())
+    pi[i] = value
+    return pi
+
 
 _LIMITS = {"max_velocity": 1.0, "max_acceleration": 2.0, "max_jerk": 10.0}
 

@@ -9,6 +9,7 @@ other data, and the identified model written back as a URDF and an armdyn model.
 """
 
 from armdyn._core import dynamic_parameter_names, dynamic_parameters, joint_torque_regressor
+from armdyn.identification.export import with_parameters, write_urdf
 from armdyn.identification.report import write_report
 from armdyn.identification.validate import Validation, validate
 
@@ -18,5 +19,7 @@ __all__ = [
     "dynamic_parameters",
     "joint_torque_regressor",
     "validate",
+    "with_parameters",
     "write_report",
+    "write_urdf",
 ]
