@@ -9,8 +9,11 @@ other data, and the identified model written back as a URDF and an armdyn model.
 """
 
 from armdyn._core import dynamic_parameter_names, dynamic_parameters, joint_torque_regressor
+from armdyn.identification.base import BaseParameters, base_parameters
 
 __all__ = [
+    "BaseParameters",
+    "base_parameters",
     "dynamic_parameter_names",
     "dynamic_parameters",
     "joint_torque_regressor",
