@@ -10,11 +10,21 @@ other data, and the identified model written back as a URDF and an armdyn model.
 
 from armdyn._core import dynamic_parameter_names, dynamic_parameters, joint_torque_regressor
 from armdyn.identification.base import BaseParameters, base_parameters
+from armdyn.identification.excitation import (
+    Excitation,
+    fourier_excitation,
+    fourier_series,
+    random_fourier,
+)
 
 __all__ = [
     "BaseParameters",
+    "Excitation",
     "base_parameters",
     "dynamic_parameter_names",
     "dynamic_parameters",
+    "fourier_excitation",
+    "fourier_series",
     "joint_torque_regressor",
+    "random_fourier",
 ]
