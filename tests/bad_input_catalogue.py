@@ -1561,28 +1561,84 @@ CASES = [
         lambda: _identify_cli()._cutoff("-1"),
         ME,
         r"--cutoff '-1': the cutoff must be > 0 Hz",
+    ),
+    (
         "with-parameters-length",
+        "identification",
         "with_parameters with a pi one entry short",
         lambda: _ident().with_parameters(_pendulum(), np.zeros(13)),
+        ME,
         r"pi must have shape \(14,\)",
+    ),
+    (
         "with-parameters-nan",
+        "identification",
         "with_parameters with a NaN entry in pi",
         lambda: _ident().with_parameters(_pendulum(), _pi_with(4, np.nan)),
+        ME,
         r"pi\[4\] \('link.Ixx'\) must be finite",
+    ),
+    (
         "with-parameters-negative-mass",
+        "identification",
         "with_parameters with a negative body mass",
         lambda: _ident().with_parameters(_pendulum(), _pi_with(0, -1.0)),
+        ME,
         r"body 'link': mass \('link.m'\) must be >= 0",
+    ),
+    (
         "with-parameters-not-psd",
+        "identification",
         "with_parameters with a body inertia that is not positive semidefinite",
         lambda: _ident().with_parameters(_pendulum(), _pi_with(4, -1.0)),
+        ME,
         r"body 'link'.*not positive semidefinite",
+    ),
+    (
         "write-urdf-missing-link",
+        "identification",
         "write_urdf onto a URDF without one of the model's bodies",
         lambda: _ident().write_urdf(
             '<robot name="r"><link name="other"/></robot>', _pendulum(), _pi_with(0, 1.0)
         ),
+        ME,
         "the URDF has no link 'link'",
+    ),
+    (
+        "base-parameters-samples-zero",
+        "identification",
+        "base_parameters with samples = 0",
+        lambda: _identification().base_parameters(_pendulum(), samples=0),
+        ME,
+        r"samples must be an integer in \[1, 1000000\], got 0",
+    ),
+    (
+        "excitation-floating-base",
+        "identification",
+        "fourier_excitation of a floating base",
+        lambda: _identification().fourier_excitation(_floating_box()),
+        ME,
+        "floating base",
+    ),
+    (
+        "excitation-period-nan",
+        "identification",
+        "fourier_excitation with period NaN",
+        lambda: _identification().fourier_excitation(
+            _pendulum(), period=float("nan"), max_velocity=1.0
+        ),
+        ME,
+        "period must be a positive number",
+    ),
+    (
+        "excitation-torque-infeasible",
+        "identification",
+        "fourier_excitation whose torque limit is below the gravity torque at q0",
+        lambda: _identification().fourier_excitation(
+            _pendulum(), q0=[1.0], max_velocity=1.0, max_torque=0.1, harmonics=2, samples=10
+        ),
+        SE,
+        "torque limit of joint 'hinge'",
     ),
 ]
 
@@ -1598,6 +1654,19 @@ def _pi_with(i, value):
     pi = ad.dynamic_parameters(_pendulum())
     pi[i] = value
     return pi
+
+
+def _identification():
+    import armdyn.identification
+
+    return armdyn.identification
+
+
+def _floating_box():
+    b = ad.ModelBuilder()
+    b.add_body("box", 1.0, I3)
+    b.add_free("float", "box")
+    return b.finalize()
 
 
 _LIMITS = {"max_velocity": 1.0, "max_acceleration": 2.0, "max_jerk": 10.0}

@@ -9,15 +9,28 @@ other data, and the identified model written back as a URDF and an armdyn model.
 """
 
 from armdyn._core import dynamic_parameter_names, dynamic_parameters, joint_torque_regressor
+from armdyn.identification.base import BaseParameters, base_parameters
+from armdyn.identification.excitation import (
+    Excitation,
+    fourier_excitation,
+    fourier_series,
+    random_fourier,
+)
 from armdyn.identification.export import with_parameters, write_urdf
 from armdyn.identification.report import write_report
 from armdyn.identification.validate import Validation, validate
 
 __all__ = [
+    "BaseParameters",
+    "Excitation",
     "Validation",
+    "base_parameters",
     "dynamic_parameter_names",
     "dynamic_parameters",
+    "fourier_excitation",
+    "fourier_series",
     "joint_torque_regressor",
+    "random_fourier",
     "validate",
     "with_parameters",
     "write_report",
