@@ -9,9 +9,14 @@ other data, and the identified model written back as a URDF and an armdyn model.
 """
 
 from armdyn._core import dynamic_parameter_names, dynamic_parameters, joint_torque_regressor
+from armdyn.identification.log import MotionLog, differentiate, load_log, log_from_arrays
 
 __all__ = [
+    "MotionLog",
+    "differentiate",
     "dynamic_parameter_names",
     "dynamic_parameters",
     "joint_torque_regressor",
+    "load_log",
+    "log_from_arrays",
 ]
