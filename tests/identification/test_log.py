@@ -214,6 +214,21 @@ def test_current_to_torque():
     np.testing.assert_allclose(log.tau, cur * [10.0, 1.0], rtol=1e-15)
 
 
+def test_model_with_actuators_is_taken():
+    """A model with a gear-reduced actuator (its rotor a body of the model, so not a
+    joint-space tree for the simulator) logs its coordinates as any fixed-base model."""
+    b = ad.ModelBuilder()
+    b.add_body("link", 1.0, I3, position=(0.0, 0.0, -0.5))
+    b.add_revolute("hinge", "ground", "link", (0, 0, 0), (0, 1, 0))
+    b.add_body("forearm", 1.0, I3, position=(0.0, 0.0, -1.5))
+    b.add_revolute("elbow", "link", "forearm", (0, 0, -1.0), (0, 1, 0))
+    b.add_actuator("elbow", 50.0, 1e-4)
+    geared = b.finalize()
+    assert not geared.joint_space and geared.coord_names == JOINTS
+    frame, q, _, _ = _log_frame()
+    np.testing.assert_array_equal(load_log(frame, geared).q, q)
+
+
 def test_floating_base_is_refused():
     floating = ad.urdf_builder(str(DATA / "arm6.urdf"), fixed_base=False).finalize()
     frame, _, _, _ = _log_frame()

@@ -302,11 +302,6 @@ def _fixed_base(who: str, model: Any) -> list[str]:
             f"{who}: the model has a floating base; logs and identification take fixed-base "
             "models only"
         )
-    if not model.joint_space:
-        raise _ME(
-            f"{who}: the model is not a joint-space model (a tree of revolute, prismatic, "
-            "cylindrical and fixed joints), which logs need"
-        )
     return list(model.coord_names)
 
 
