@@ -220,6 +220,12 @@ def test_split_and_select():
         log.select(np.zeros(100, dtype=bool))
     with pytest.raises(ad.ModelError, match="mask has shape"):
         log.select(np.ones(5, dtype=bool))
+    with pytest.raises(ad.ModelError, match=r"at least 4 samples, got 2"):
+        log.select(slice(0, 2))
+    with pytest.raises(ad.ModelError, match=r"tau must have shape \(100, 2\)"):
+        MotionLog(log.t, log.q, log.qd, log.qdd, log.tau[:, :1], JOINTS, "by hand")
+    with pytest.raises(ad.ModelError, match=r"t must be strictly increasing"):
+        MotionLog(log.t[::-1], log.q, log.qd, log.qdd, log.tau, JOINTS, "by hand")
 
 
 def test_current_to_torque():

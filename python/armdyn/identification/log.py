@@ -106,18 +106,27 @@ class MotionLog:
     processing: str
 
     def __post_init__(self) -> None:
-        for name in ("t", "q", "qd", "qdd", "tau"):
-            a = np.array(getattr(self, name), dtype=float)  # a copy: the log owns its arrays
-            a.setflags(write=False)
+        names = [str(n) for n in self.joint_names]
+        t = _times("MotionLog", self.t)
+        object.__setattr__(self, "t", t)
+        for name in ("q", "qd", "qdd", "tau"):
+            a = _array("MotionLog", name, getattr(self, name), 2)  # a copy: the log owns it
+            if a.shape != (len(t), len(names)):
+                raise _ME(
+                    f"MotionLog: {name} must have shape ({len(t)}, {len(names)}) (samples, "
+                    f"joint_names), got {a.shape}"
+                )
             object.__setattr__(self, name, a)
-        object.__setattr__(self, "joint_names", list(self.joint_names))
+        for name in ("t", "q", "qd", "qdd", "tau"):
+            getattr(self, name).setflags(write=False)
+        object.__setattr__(self, "joint_names", names)
 
     def __len__(self) -> int:
         return len(self.t)
 
     def select(self, mask_or_slice: Any) -> MotionLog:
         """The samples picked by a slice, a boolean mask (N,) or increasing row indices; at least
-        one sample must remain (ModelError otherwise)."""
+        four samples must remain (ModelError otherwise)."""
         mask = np.asarray(mask_or_slice) if isinstance(mask_or_slice, np.ndarray | list) else None
         if mask is not None and mask.dtype == bool and mask.shape != self.t.shape:
             raise _ME(
