@@ -17,19 +17,24 @@ from armdyn.identification.excitation import (
     random_fourier,
 )
 from armdyn.identification.export import with_parameters, write_urdf
+from armdyn.identification.log import MotionLog, differentiate, load_log, log_from_arrays
 from armdyn.identification.report import write_report
 from armdyn.identification.validate import Validation, validate
 
 __all__ = [
     "BaseParameters",
     "Excitation",
+    "MotionLog",
     "Validation",
     "base_parameters",
+    "differentiate",
     "dynamic_parameter_names",
     "dynamic_parameters",
     "fourier_excitation",
     "fourier_series",
     "joint_torque_regressor",
+    "load_log",
+    "log_from_arrays",
     "random_fourier",
     "validate",
     "with_parameters",
