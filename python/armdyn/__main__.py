@@ -19,12 +19,12 @@
   the choice and writes its report to DIR; exit code 0 when every joint has a drivetrain that
   passes, 1 when some has none, 2 for bad input.
 * ``armdyn identify ROBOT.urdf --log FILE.csv --out DIR [--validate FILE.csv] [--cutoff HZ]
-  [--trim SECONDS] [--no-physical] [--method ols|wls] [--torque-constants K] [--gear-ratios N]
-  [--efficiency E]`` identifies the robot's inertial, friction, offset and rotor parameters from a
-  measured log (``armdyn.identification``), validates them on data the fit did not use, and
-  writes DIR/identified.urdf, DIR/report.html and DIR/parameters.csv; exit code 0 when it ran,
-  1 when the unconstrained (``--no-physical``) estimate cannot be written as a URDF, 2 for bad
-  input. Details: ``armdyn.identification.cli``.
+  [--trim SECONDS] [--filter-tau] [--no-physical] [--method ols|wls] [--torque-constants K]
+  [--gear-ratios N] [--efficiency E]`` identifies the robot's inertial, friction, offset and
+  rotor parameters from a measured log (``armdyn.identification``), validates them on data the
+  fit did not use, and writes DIR/identified.urdf, DIR/report.html and DIR/parameters.csv; exit
+  code 0 when it ran, 1 when the unconstrained (``--no-physical``) estimate cannot be written as
+  a URDF, 2 for bad input. Details: ``armdyn.identification.cli``.
 * ``armdyn verify`` prints the solver's accuracy figures: pendulum period, energy and momentum
   conservation, constraint drift, and forward dynamics against the Euler–Lagrange equations.
 
@@ -160,9 +160,15 @@ def _identify_arguments(sub) -> None:
     p.add_argument(
         "--cutoff",
         metavar="HZ",
-        help="low-pass q and tau (zero-phase Butterworth) before differentiating",
+        help="low-pass q (zero-phase Butterworth) before differentiating",
     )
     p.add_argument("--trim", metavar="SECONDS", help="drop this much of each log at each end")
+    p.add_argument(
+        "--filter-tau",
+        action="store_true",
+        help="with --cutoff, filter the torques too (default: q only; a filtered Coulomb "
+        "friction step biases the fit)",
+    )
     p.add_argument(
         "--no-physical",
         action="store_true",

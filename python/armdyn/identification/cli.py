@@ -1,11 +1,14 @@
 """``armdyn identify ROBOT.urdf --log FILE.csv --out DIR [--validate FILE.csv] [--cutoff HZ]
-[--trim SECONDS] [--no-physical] [--method ols|wls] [--torque-constants K] [--gear-ratios N]
-[--efficiency E]``: identify a robot's parameters from a measured log, from the command line.
+[--trim SECONDS] [--filter-tau] [--no-physical] [--method ols|wls] [--torque-constants K]
+[--gear-ratios N] [--efficiency E]``: identify a robot's parameters from a measured log, from
+the command line.
 
 The steps: load the URDF (:func:`armdyn.load_urdf`; a fixed-base robot), read the log
 (:func:`armdyn.identification.load_log`: a CSV with ``t``, one position column per joint named
 as the joint, and ``<joint>.tau`` torques or ``<joint>.current`` currents; ``--cutoff`` low-pass
-filters q and tau before differentiating, ``--trim`` drops that many seconds at each end),
+filters q before differentiating, and tau too with ``--filter-tau`` — by default tau is left as
+logged, which :mod:`armdyn.identification.log` measures to bias a fit less, a filtered Coulomb
+step being smeared; ``--trim`` drops that many seconds at each end),
 identify (:func:`armdyn.identification.identify`, ``--method`` wls by default, physically
 consistent unless ``--no-physical``), validate on data the fit did not use (the ``--validate``
 log, read like the fit log; without it the log is split in time: the first
@@ -139,6 +142,7 @@ def run(args, echo=print) -> int:
         "torque_constants": per_joint("--torque-constants", args.torque_constants),
         "gear_ratios": per_joint("--gear-ratios", args.gear_ratios),
         "efficiency": per_joint("--efficiency", args.efficiency),
+        "filter_tau": bool(args.filter_tau),
     }
     _not_a_file(args.out)
     model = load_urdf(args.urdf)
