@@ -3,6 +3,7 @@
 The identification is the stand-in of identification_standin.py (QR base + ordinary least
 squares) on a synthetic log of a perturbed arm6 with known noise, until the fit part is merged."""
 
+import html
 import re
 from pathlib import Path
 
@@ -122,6 +123,18 @@ def test_body_and_joint_gap(case):
     joints = report.joint_gap(fake)
     assert joints.loc["elbow_joint", "fv identified"] == 0.25
     assert joints.loc["elbow_joint", "fv nominal"] == 0.0
+
+
+def test_solver_note(case, tmp_path):
+    """A physically consistent identification's info (status, cost, cost_ls) in the fit
+    section: the cost ratio."""
+    _, ident, v, _ = case
+    fake = StandIn(**{**ident.__dict__, "physical": True})
+    fake.info = {"status": "optimal", "cost": 5.0, "cost_ls": 4.0}
+    text = report.write_report(fake, tmp_path, validation=v).read_text(encoding="utf-8")
+    text = html.unescape(text)
+    assert "Solver status: optimal." in text
+    assert "consistent estimate: 1.25 times the least squares'" in text
 
 
 def test_write_report_bad_inputs(case, tmp_path):

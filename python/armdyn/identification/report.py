@@ -394,11 +394,25 @@ def _sections(ident, validation, nominal, figure: ReportFigure | None, logs) -> 
             "Fit",
             text=f"method {ident.method}, solver {ident.solver}, physically consistent "
             f"estimate: {'yes' if ident.physical else 'no'}; {ident.n_samples} samples, "
-            f"{outliers} rejected as outliers.",
+            f"{outliers} rejected as outliers.{_solver_note(ident)}",
             tables=tables,
         )
     )
     return sections
+
+
+def _solver_note(ident) -> str:
+    """The consistent estimate's solver status and its cost against the least squares' (from
+    ``Identification.info`` when it has them)."""
+    info = getattr(ident, "info", None) or {}
+    note = f" Solver status: {info['status']}." if "status" in info else ""
+    cost, cost_ls = info.get("cost"), info.get("cost_ls")
+    if ident.physical and cost is not None and cost_ls:
+        note += (
+            f" Weighted residual cost of the consistent estimate: {cost / cost_ls:.4g} times the "
+            "least squares' (1: the constraints cost nothing)."
+        )
+    return note
 
 
 def render_report(
