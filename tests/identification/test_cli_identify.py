@@ -113,6 +113,7 @@ def test_identify_writes_urdf_report_parameters(robot, tmp_path, capsys):
     )
     assert np.all(nominal > 10 * NOISE)
     # the printed verdict and the report's
+    assert re.search(r"^\s+verdict\s+rmse\s+rel_rmse\s+ls_rmse\s+nominal_rmse", printed.out, re.M)
     rows = re.findall(r"^(shoulder|elbow)\s+(\w+)\s+(\S+)", printed.out, re.M)
     assert [(j, s) for j, s, _ in rows] == [("shoulder", "match"), ("elbow", "match")]
     page = (out / "report.html").read_text(encoding="utf-8")

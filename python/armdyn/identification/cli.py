@@ -157,10 +157,15 @@ def run(args, echo=print) -> int:
     ident = _identify(model, fit_log, args)
     validation = validate(ident, val_log)
     nominal = validate(model, val_log)
+    least_squares = None
+    if ident.physical:  # what the consistency costs: the unconstrained estimate's validation
+        pi_ls = ident.base.complete(ident.beta_ls, _core.dynamic_parameters(model))
+        least_squares = validate(model, val_log, pi=pi_ls)
     logs = (fit_log, val_log)
-    files, no_urdf = _write(args, out, model, ident, logs, validation, nominal)
+    validations = (validation, nominal, least_squares)
+    files, no_urdf = _write(args, out, model, ident, logs, validations)
     statuses = joint_status(validation, ident.sigma)
-    _summary(echo, ident, validation, nominal, statuses, fit_log, val_log, args)
+    _summary(echo, ident, validations, statuses, fit_log, val_log, args)
     for f in files:
         echo(f"wrote {f}")
     if no_urdf:
@@ -214,8 +219,9 @@ def _log_notes(args, fit_log, val_log) -> dict[str, str]:
     }
 
 
-def _write(args, out: Path, model, ident, logs, validation, nominal) -> tuple[list[Path], str]:
+def _write(args, out: Path, model, ident, logs, validations) -> tuple[list[Path], str]:
     """The report's files, then identified.urdf: ``(written, why the URDF is not)``."""
+    validation, nominal, least_squares = validations
     from armdyn.identification.export import write_urdf
     from armdyn.identification.report import write_report
 
@@ -226,6 +232,7 @@ def _write(args, out: Path, model, ident, logs, validation, nominal) -> tuple[li
         nominal_validation=nominal,
         urdf=args.urdf,
         logs=_log_notes(args, *logs),
+        ls_validation=least_squares,
     )
     names = ["torques.png", "parameters.csv", "base_parameters.csv"]
     written = [page, *(out / n for n in names if (out / n).exists())]
@@ -239,9 +246,10 @@ def _write(args, out: Path, model, ident, logs, validation, nominal) -> tuple[li
     return [urdf_out, *written], ""
 
 
-def _summary(echo, ident, validation, nominal, statuses, fit_log, val_log, args) -> None:
+def _summary(echo, ident, validations, statuses, fit_log, val_log, args) -> None:
     import pandas as pd
 
+    validation, nominal, least_squares = validations
     how = (
         "--validate log" if args.validate is not None else f"last {1 - FIT_FRACTION:.0%} of the log"
     )
@@ -255,6 +263,7 @@ def _summary(echo, ident, validation, nominal, statuses, fit_log, val_log, args)
             "verdict": statuses,
             "rmse": validation.rmse,
             "rel_rmse": validation.rel_rmse,
+            **({"ls_rmse": least_squares.rmse} if least_squares is not None else {}),
             "nominal_rmse": nominal.rmse,
             "nominal_rel_rmse": nominal.rel_rmse,
         },

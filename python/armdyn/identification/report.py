@@ -14,7 +14,8 @@
 The page, in order:
 
 1. **Verdict**, per joint, on the validation data (data the fit did not use): the identified
-   model's RMSE and relative RMSE (to the measured torque's RMS), the nominal model's, and the
+   model's RMSE and relative RMSE (to the measured torque's RMS), the unconstrained
+   least-squares estimate's RMSE (when given), the nominal model's, and the
    status: ``MATCH`` when the relative RMSE is at most :data:`MATCH_REL_RMSE` (10 %);
    ``AT NOISE LEVEL`` when it is larger but the RMSE is at most :data:`NOISE_FACTOR` (1.2) times
    the fit's residual noise ``sigma`` of that joint (the model predicts the new data as well as
@@ -280,7 +281,7 @@ def torque_figure(validation: Validation, nominal: Validation | None = None):
 # ------------------------------------------------------------------------------- the page
 
 
-def _verdict_block(ident, validation, nominal, statuses, title, subtitle) -> str:
+def _verdict_block(ident, validation, nominal, statuses, title, subtitle, ls=None) -> str:
     overall = overall_status(statuses)
     cls, word = _STATUS[overall]
     joints = list(ident.model.dof_names)
@@ -291,9 +292,10 @@ def _verdict_block(ident, validation, nominal, statuses, title, subtitle) -> str
         f'<p class="sub">{_esc(subtitle)}</p>' if subtitle else "",
         f'<div class="overall {cls}" id="overall" data-status="{overall}">Overall: {word}</div>',
         '<table class="verdict" id="verdict-table"><thead><tr><th>joint</th><th>verdict</th>'
-        "<th>RMSE identified</th><th>rel. RMSE identified</th><th>RMSE nominal</th>"
-        "<th>rel. RMSE nominal</th><th>fit noise \u03c3</th><th>largest error (at t)</th>"
-        "</tr></thead><tbody>",
+        "<th>RMSE identified</th><th>rel. RMSE identified</th>"
+        + ("<th>RMSE least squares</th>" if ls is not None else "")
+        + "<th>RMSE nominal</th><th>rel. RMSE nominal</th><th>fit noise \u03c3</th>"
+        "<th>largest error (at t)</th></tr></thead><tbody>",
     ]
     for j, joint in enumerate(joints):
         s = statuses[j]
@@ -306,6 +308,8 @@ def _verdict_block(ident, validation, nominal, statuses, title, subtitle) -> str
             worst = f"{_fmt(validation.max_error[j])} (t = {_fmt(validation.max_error_time[j])} s)"
         else:
             cells, worst = '<td class="num">\u2013</td><td class="num">\u2013</td>', "\u2013"
+        if ls is not None:
+            cells += f'<td class="num">{_fmt(ls.rmse[j])}</td>'
         if nominal is not None:
             cells += (
                 f'<td class="num">{_fmt(nominal.rmse[j])}</td>'
@@ -323,7 +327,14 @@ def _verdict_block(ident, validation, nominal, statuses, title, subtitle) -> str
         f'<p class="sub">On the validation data (not used by the fit). MATCH: the RMSE is at most '
         f"{MATCH_REL_RMSE:.0%} of the measured torque's RMS (rel. RMSE). AT NOISE LEVEL: larger, "
         f"but at most {NOISE_FACTOR:g} \u00d7 the fit's residual noise \u03c3 of the joint. "
-        "Torques in N m (revolute) or N (prismatic).</p>"
+        "Torques in N m (revolute) or N (prismatic)."
+        + (
+            " RMSE least squares: the unconstrained estimate's (the price of physical "
+            "consistency is the difference)."
+            if ls is not None
+            else ""
+        )
+        + "</p>"
     )
     out.append("</section>")
     return "\n".join(p for p in out if p)
@@ -402,21 +413,20 @@ def _sections(ident, validation, nominal, figure: ReportFigure | None, logs) -> 
 
 
 def _solver_note(ident) -> str:
-    """The consistent estimate's solver status and its cost against the least squares' (from
-    ``Identification.info`` when it has them)."""
+    """The consistent estimate's solver status (from ``Identification.info`` when it has one)."""
     info = getattr(ident, "info", None) or {}
-    note = f" Solver status: {info['status']}." if "status" in info else ""
-    cost, cost_ls = info.get("cost"), info.get("cost_ls")
-    if ident.physical and cost is not None and cost_ls:
-        note += (
-            f" Weighted residual cost of the consistent estimate: {cost / cost_ls:.4g} times the "
-            "least squares' (1: the constraints cost nothing)."
-        )
-    return note
+    return f" Solver status: {info['status']}." if "status" in info else ""
 
 
 def render_report(
-    identification, validation=None, nominal_validation=None, *, urdf=None, figure=None, logs=None
+    identification,
+    validation=None,
+    nominal_validation=None,
+    *,
+    urdf=None,
+    figure=None,
+    logs=None,
+    ls_validation=None,
 ) -> str:
     """The HTML page (see the module notes); ``figure``: the torque figure's
     :class:`~armdyn.sizing.html.ReportFigure` (None: no figure); ``logs``: ``{role:
@@ -434,7 +444,9 @@ def render_report(
         '<html lang="en"><head><meta charset="utf-8">',
         '<meta name="viewport" content="width=device-width, initial-scale=1">',
         f"<title>{html.escape(title)}</title><style>{_CSS}</style></head><body>",
-        _verdict_block(ident, validation, nominal_validation, statuses, title, subtitle),
+        _verdict_block(
+            ident, validation, nominal_validation, statuses, title, subtitle, ls_validation
+        ),
         *(
             _section_block(k, s)
             for k, s in enumerate(_sections(ident, validation, nominal_validation, figure, logs))
@@ -452,6 +464,7 @@ def write_report(
     nominal_validation: Validation | None = None,
     urdf=None,
     logs=None,
+    ls_validation: Validation | None = None,
 ) -> Path:
     """Write ``report.html``, ``torques.png`` (with a validation), ``parameters.csv`` and
     ``base_parameters.csv`` of ``identification`` into ``out_dir`` (created if missing; see
@@ -460,10 +473,16 @@ def write_report(
     ``nominal_validation``: the nominal model's on the same data; ``urdf``: the nominal URDF's
     path (named in the title); ``logs``: ``{role: description}`` shown in the fit section, e.g.
     ``{"fit": fit_log.processing, "validation": val_log.processing}`` (how q, qd, qdd and tau
-    were obtained: :attr:`MotionLog.processing`). OSError when the folder cannot be written;
+    were obtained: :attr:`MotionLog.processing`); ``ls_validation``: the unconstrained
+    least-squares estimate's validation on the same data (a column of the verdict table: what
+    physical consistency costs). OSError when the folder cannot be written;
     ModelError when the validations' joints are not the model's."""
     joints = list(identification.model.dof_names)
-    for name, v in (("validation", validation), ("nominal_validation", nominal_validation)):
+    for name, v in (
+        ("validation", validation),
+        ("nominal_validation", nominal_validation),
+        ("ls_validation", ls_validation),
+    ):
         if v is not None and list(v.joint_names) != joints:
             raise _core.ModelError(
                 f"write_report: {name}'s joints {list(v.joint_names)} are not the model's {joints}"
@@ -481,7 +500,13 @@ def write_report(
     page = out / "report.html"
     page.write_text(
         render_report(
-            identification, validation, nominal_validation, urdf=urdf, figure=figure, logs=logs
+            identification,
+            validation,
+            nominal_validation,
+            urdf=urdf,
+            figure=figure,
+            logs=logs,
+            ls_validation=ls_validation,
         ),
         encoding="utf-8",
     )
