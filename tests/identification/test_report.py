@@ -158,3 +158,10 @@ def test_write_report_bad_inputs(case, tmp_path):
     with pytest.raises(ad.ModelError, match="validation's joints"):
         report.write_report(ident, tmp_path / "w", validation=wrong)
     assert not (tmp_path / "w").exists()
+
+
+def test_round_off_shown_as_zero():
+    """Display only: 1e-17 beside 2 is a zero's round-off; the CSVs keep every digit."""
+    np.testing.assert_array_equal(report._clean([1e-17, -0.0, 2.0, -3e-11]), [0, 0, 2, -3e-11])
+    assert report._vec([1e-17, -0.0, 0.0254]) == "0, 0, 0.0254"
+    assert report._vec([0.0, 0.0, 0.0]) == "0, 0, 0"

@@ -167,8 +167,17 @@ def _com_inertia(p10) -> tuple[float, np.ndarray, np.ndarray]:
     return m, c, inertia - m * (c @ c * np.eye(3) - np.outer(c, c))
 
 
+def _clean(values, rel: float = 1e-12) -> np.ndarray:
+    """For display: entries below ``rel`` times the largest magnitude (round-off of a zero, such
+    as 1e-17 of a symmetric link's first moment) shown as 0."""
+    v = np.asarray(values, dtype=float)
+    finite = np.abs(v[np.isfinite(v)])
+    scale = finite.max() if finite.size else 0.0
+    return np.where(np.abs(v) < rel * scale, 0.0, v) + 0.0  # + 0.0: no "-0"
+
+
 def _vec(v) -> str:
-    return ", ".join(_fmt(float(x) + 0.0) for x in v)  # + 0.0: no "-0"
+    return ", ".join(_fmt(float(x)) for x in _clean(list(v)))
 
 
 def body_gap(identification) -> pd.DataFrame:
@@ -350,7 +359,14 @@ def _sections(ident, validation, nominal, figure: ReportFigure | None, logs) -> 
     base = base_table(ident)
     poor = int(base["poorly_identified"].sum())
     shown = base.assign(
-        poorly_identified=np.where(base["poorly_identified"], "\u2718 poorly identified", "")
+        poorly_identified=np.where(base["poorly_identified"], "\u2718 poorly identified", ""),
+        **{c: _clean(base[c].to_numpy()) for c in ("nominal", "identified", "least_squares")},
+    ).rename(
+        columns={
+            "least_squares": "least squares",
+            "rel_std": "std / |identified|",
+            "poorly_identified": "flag",
+        }
     )
     sections = []
     if figure is not None:
