@@ -8,7 +8,11 @@ least-squares and physically consistent estimates with their uncertainties, a va
 other data, and the identified model written back as a URDF and an armdyn model.
 """
 
-from armdyn._core import dynamic_parameter_names, dynamic_parameters, joint_torque_regressor
+from armdyn import _core
+
+dynamic_parameter_names = _core.dynamic_parameter_names
+dynamic_parameters = _core.dynamic_parameters
+joint_torque_regressor = _core.joint_torque_regressor
 
 __all__ = [
     "dynamic_parameter_names",
