@@ -13,9 +13,12 @@ from armdyn import _core
 dynamic_parameter_names = _core.dynamic_parameter_names
 dynamic_parameters = _core.dynamic_parameters
 joint_torque_regressor = _core.joint_torque_regressor
+from armdyn.identification.export import with_parameters, write_urdf
 
 __all__ = [
     "dynamic_parameter_names",
     "dynamic_parameters",
     "joint_torque_regressor",
+    "with_parameters",
+    "write_urdf",
 ]
