@@ -9,11 +9,11 @@ other data, and the identified model written back as a URDF and an armdyn model.
 """
 
 from armdyn import _core
+from armdyn.identification.export import with_parameters, write_urdf
 
 dynamic_parameter_names = _core.dynamic_parameter_names
 dynamic_parameters = _core.dynamic_parameters
 joint_torque_regressor = _core.joint_torque_regressor
-from armdyn.identification.export import with_parameters, write_urdf
 
 __all__ = [
     "dynamic_parameter_names",
