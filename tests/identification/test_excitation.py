@@ -155,6 +155,8 @@ def test_starts_and_ends_at_rest_and_csv(ur5_design, tmp_path):
         ({"max_velocity": [1.0, 2.0]}, ad.ModelError, "max_velocity must"),
         ({"max_acceleration": np.inf}, ad.ModelError, "max_acceleration"),
         ({"position_margin": 4.0}, ad.SolverError, "position limits of joint 'elbow_joint'"),
+        ({"position_margin": -0.1}, ad.ModelError, "position_margin must be"),
+        ({"position_margin": [0.1, 0.1]}, ad.ModelError, "position_margin must be"),
         ({"q0": [0, 0, 3.2, 0, 0, 0]}, ad.SolverError, "q0.*'elbow_joint'"),
         (
             {"max_torque": [150, 10, 150, 28, 28, 28]},
@@ -213,3 +215,16 @@ def test_unlimited_joint_with_given_velocity_and_excitation_type():
     t = np.linspace(0.0, 3.0, 2001)
     _, qd, qdd = exc.evaluate(t)
     assert np.abs(qd).max() <= 2.0 and np.abs(qdd).max() <= 10.0
+
+
+@needs_robots
+def test_panda_with_a_coupled_finger():
+    """The Panda (the second finger mimics the first): a per-joint margin for the finger's 4 cm;
+    the design improves on its start and keeps every limit."""
+    model = ad.load_urdf(str(ROBOTS / "panda_description/urdf/panda.urdf"))
+    margin = [0.05] * 7 + [0.002]
+    with pytest.raises(ad.SolverError, match="'panda_finger_joint1'"):
+        random_fourier(model, **SMALL)
+    exc = fourier_excitation(model, position_margin=margin, maxiter=15, starts=1, **SMALL)
+    assert exc.info["optimised"] and exc.cond < exc.info["start_conds"][0]
+    _check_limits(model, exc, np.asarray(model.coord_effort_limit), margin=np.array(margin))

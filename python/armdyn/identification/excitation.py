@@ -123,6 +123,7 @@ class Excitation:
 
     @property
     def harmonics(self) -> int:
+        """The number of harmonics per joint (the columns of ``a`` and ``b``)."""
         return int(self.a.shape[1])
 
     def evaluate(self, t: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -187,8 +188,19 @@ class _Problem:
         self.torque_times = self.times
         self.scale = _column_scale(model, base)
         self.evaluations = 0
+        # the decision variables in units of what each joint allows (a finger's centimetres and
+        # a shoulder's radians alike O(1)): a coefficient by the largest first-harmonic one
+        # its position room, velocity and acceleration limits allow, q0 by half its range
+        lim = limits
+        both = np.isfinite(lim.upper) & np.isfinite(lim.lower)
+        half = np.where(both, 0.5 * (lim.upper - lim.lower), np.inf)
+        amp = np.minimum(np.minimum(half * self.wf, lim.velocity), lim.acceleration / self.wf)
+        free = harmonics - 1 if at_rest else harmonics
+        parts = [] if q0 is not None else [np.where(both, half, 1.0)]
+        self.xscale = np.concatenate([*parts, np.repeat(amp, free), np.repeat(amp, free)])
 
     def unpack(self, x):
+        x = x * self.xscale
         k = 0
         if self.fixed_q0 is None:
             q0, k = x[: self.n], self.n
@@ -206,7 +218,7 @@ class _Problem:
     def pack(self, q0, a, b):
         cut = 1 if self.at_rest else 0
         parts = [] if self.fixed_q0 is not None else [q0]
-        return np.concatenate([*parts, a[:, cut:].ravel(), b[:, cut:].ravel()])
+        return np.concatenate([*parts, a[:, cut:].ravel(), b[:, cut:].ravel()]) / self.xscale
 
     def states(self, q0, a, b, t):
         return _series(t, q0, a, b, self.wf)
@@ -336,6 +348,18 @@ def _per_joint(who, name, value, default, n, names):
     return arr
 
 
+def _margin(who, value, n):
+    """position_margin: one number or one per joint, each finite and >= 0."""
+    arr = _checks.array(who, "position_margin", value, finite=True)
+    if arr.ndim == 0:
+        arr = np.full(n, float(arr))
+    if arr.shape != (n,) or np.any(arr < 0.0):
+        raise _core.ModelError(
+            f"{who}: position_margin must be a number >= 0 or {n} of them, got {value!r}"
+        )
+    return arr
+
+
 def _limits(who, model, max_velocity, max_acceleration, max_torque, margin):
     n, names = model.n_dofs, list(model.coord_names)
     vel_model = np.asarray(model.coord_velocity_limit, dtype=float)
@@ -365,7 +389,7 @@ def _limits(who, model, max_velocity, max_acceleration, max_torque, margin):
         if not upper[j] > lower[j]:
             raise _core.SolverError(
                 f"{who}: position limits of joint {names[j]!r} minus position_margin = "
-                f"{margin:g} leave no room: [{lower[j]:.6g}, {upper[j]:.6g}]"
+                f"{margin[j]:g} leave no room: [{lower[j]:.6g}, {upper[j]:.6g}]"
             )
     return _Limits(lower, upper, vel, acc, tau)
 
@@ -387,7 +411,7 @@ def _setup(who, model, period, harmonics, q0, limits, base, samples, at_rest):
         who, "harmonics", harmonics, lo=2 if at_rest else 1, hi=MAX_HARMONICS
     )
     samples = _checks.integer(who, "samples", samples, lo=1, hi=100_000)
-    margin = _checks.number(who, "position_margin", limits.pop("position_margin"), lo=0.0)
+    margin = _margin(who, limits.pop("position_margin"), model.n_dofs)
     lim = _limits(who, model, **limits, margin=margin)
     if base is None:
         base = base_parameters(model)
@@ -461,10 +485,11 @@ def _random_start(problem, rng, fill=0.9, per_joint=True):
 
 
 def _feasible(problem, x, grid):
-    """(q0, a, b) of x, shrunk by the first of 1, 0.999, 0.99, 0.95 that meets every limit on
-    the check grid (SLSQP meets its constraints only to its tolerance), or None."""
+    """(q0, a, b) of x, its oscillation about q0 shrunk by the first of 1, 0.999, ..., 0.5
+    that meets every limit on the check grid (SLSQP's iterates meet the constraints only at
+    convergence, and then to its tolerance), or None."""
     q0, a, b = problem.unpack(x)
-    for shrink in (1.0, 0.999, 0.99, 0.95):
+    for shrink in (1.0, 0.999, 0.99, 0.97, 0.94, 0.9, 0.85, 0.8, 0.7, 0.6, 0.5):
         if not _violations(problem, q0, shrink * a, shrink * b, grid):
             return q0, shrink * a, shrink * b
     return None
@@ -551,7 +576,7 @@ def fourier_excitation(
     max_velocity: npt.ArrayLike | None = None,
     max_acceleration: npt.ArrayLike | None = None,
     max_torque: npt.ArrayLike | None = None,
-    position_margin: float = 0.05,
+    position_margin: npt.ArrayLike = 0.05,
     base: BaseParameters | None = None,
     seed: int = 0,
     samples: int = 100,
@@ -590,7 +615,8 @@ def fourier_excitation(
         max_velocity: [rad/s or m/s] per joint or one number; default model.coord_velocity_limit.
         max_acceleration: default :data:`ACCELERATION_PER_VELOCITY` (5 / s) x max_velocity.
         max_torque: default model.coord_effort_limit (0 or inf: no torque limit).
-        position_margin: [rad or m] kept from each position limit.
+        position_margin: [rad or m] kept from each position limit: one number or one per joint
+            (a gripper finger's few centimetres need a smaller one).
         base: the model's BaseParameters (default base_parameters(model)).
         seed: the first random start's seed; samples: times per period in the condition number
             and the torque constraints; maxiter: SLSQP iterations per start; starts: how many.
@@ -658,7 +684,7 @@ def random_fourier(
     max_velocity: npt.ArrayLike | None = None,
     max_acceleration: npt.ArrayLike | None = None,
     max_torque: npt.ArrayLike | None = None,
-    position_margin: float = 0.05,
+    position_margin: npt.ArrayLike = 0.05,
     base: BaseParameters | None = None,
     seed: int = 0,
     samples: int = 100,
