@@ -50,7 +50,7 @@ _FRICTION = (".fv", ".fc")
 _OFFSET = (".offset",)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # arrays: compared by identity
 class BaseParameters:
     """The base parameters of a model (from :func:`base_parameters`).
 

@@ -97,7 +97,7 @@ def _series(t, q0, a, b, wf):
     return q, qd, qdd
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # arrays: compared by identity
 class Excitation:
     """A periodic excitation motion (from :func:`fourier_excitation` or :func:`random_fourier`).
 
