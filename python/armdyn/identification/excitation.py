@@ -443,8 +443,11 @@ def _centre(problem):
     if problem.fixed_q0 is not None:
         return problem.fixed_q0
     lo, hi = problem.limits.lower, problem.limits.upper
+    # mid-range; 0 without limits; 1 (rad or m) inside a one-sided limit (or 0 when inside)
     both = np.isfinite(lo) & np.isfinite(hi)
     mid = 0.5 * (np.where(both, lo, 0.0) + np.where(both, hi, 0.0))
+    mid = np.maximum(mid, np.where(np.isfinite(lo) & ~both, lo + 1.0, -np.inf))
+    mid = np.minimum(mid, np.where(np.isfinite(hi) & ~both, hi - 1.0, np.inf))
     return np.clip(mid, lo + 1e-9, hi - 1e-9)
 
 
