@@ -1571,6 +1571,25 @@ CASES = [
         ),
         ME,
         "the URDF has no link 'link'",
+        "base-parameters-samples-zero",
+        "base_parameters with samples = 0",
+        lambda: _identification().base_parameters(_pendulum(), samples=0),
+        r"samples must be an integer in \[1, 1000000\], got 0",
+        "excitation-floating-base",
+        "fourier_excitation of a floating base",
+        lambda: _identification().fourier_excitation(_floating_box()),
+        "floating base",
+        "excitation-period-nan",
+        "fourier_excitation with period NaN",
+        lambda: _identification().fourier_excitation(
+            _pendulum(), period=float("nan"), max_velocity=1.0
+        "period must be a positive number",
+        "excitation-torque-infeasible",
+        "fourier_excitation whose torque limit is below the gravity torque at q0",
+        lambda: _identification().fourier_excitation(
+            _pendulum(), q0=[1.0], max_velocity=1.0, max_torque=0.1, harmonics=2, samples=10
+        SE,
+        "torque limit of joint 'hinge'",
     ),
 ]
 
@@ -1586,6 +1605,14 @@ def _pi_with(i, value):
     pi = ad.dynamic_parameters(_pendulum())
     pi[i] = value
     return pi
+def _identification():
+    import armdyn.identification
+    return armdyn.identification
+def _floating_box():
+    b = ad.ModelBuilder()
+    b.add_body("box", 1.0, I3)
+    b.add_free("float", "box")
+    return b.finalize()
 
 
 _LIMITS = {"max_velocity": 1.0, "max_acceleration": 2.0, "max_jerk": 10.0}

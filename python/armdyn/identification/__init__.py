@@ -9,6 +9,13 @@ other data, and the identified model written back as a URDF and an armdyn model.
 """
 
 from armdyn import _core
+from armdyn.identification.base import BaseParameters, base_parameters
+from armdyn.identification.excitation import (
+    Excitation,
+    fourier_excitation,
+    fourier_series,
+    random_fourier,
+)
 from armdyn.identification.export import with_parameters, write_urdf
 
 dynamic_parameter_names = _core.dynamic_parameter_names
@@ -16,9 +23,15 @@ dynamic_parameters = _core.dynamic_parameters
 joint_torque_regressor = _core.joint_torque_regressor
 
 __all__ = [
+    "BaseParameters",
+    "Excitation",
+    "base_parameters",
     "dynamic_parameter_names",
     "dynamic_parameters",
+    "fourier_excitation",
+    "fourier_series",
     "joint_torque_regressor",
+    "random_fourier",
     "with_parameters",
     "write_urdf",
 ]
