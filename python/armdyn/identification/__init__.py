@@ -9,9 +9,16 @@ other data, and the identified model written back as a URDF and an armdyn model.
 """
 
 from armdyn._core import dynamic_parameter_names, dynamic_parameters, joint_torque_regressor
+from armdyn.identification.estimate import Identification, identify
+from armdyn.identification.physical import is_physical, physical_violations, pseudo_inertia
 
 __all__ = [
+    "Identification",
     "dynamic_parameter_names",
     "dynamic_parameters",
+    "identify",
+    "is_physical",
     "joint_torque_regressor",
+    "physical_violations",
+    "pseudo_inertia",
 ]
