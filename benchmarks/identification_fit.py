@@ -10,6 +10,8 @@ motion, constraint satisfaction.
 
     python -m benchmarks.identification_fit [--samples 10000] [--repeats 3]
         [--out benchmarks/results/identification_fit.json]
+    OPENBLAS_NUM_THREADS=1 python -m benchmarks.identification_fit \
+        --out benchmarks/results/identification_fit_1thread.json
 
 The helpers (the perturbed model, the Fourier motion, the synthetic log) are also those of
 tests/identification/test_estimate.py.
@@ -18,7 +20,9 @@ tests/identification/test_estimate.py.
 from __future__ import annotations
 
 import argparse
+import os
 import re
+import sys
 import time
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
@@ -270,7 +274,14 @@ def main(argv=None):
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--out", default=str(common.RESULTS / "identification_fit.json"))
     args = ap.parse_args(argv)
-    out = {"machine": common.machine(), "command": "python -m benchmarks.identification_fit"}
+    out = {
+        "machine": common.machine(),
+        "command": "python -m benchmarks.identification_fit " + " ".join(argv or sys.argv[1:]),
+        # OpenBLAS threads spin on an oversubscribed machine: QR and SVD of small matrices slow
+        # down 20-100x there; recorded so the times can be read
+        "OPENBLAS_NUM_THREADS": os.environ.get("OPENBLAS_NUM_THREADS", "(default)"),
+        "load_average_before": os.getloadavg(),
+    }
     for name in ("panda", "ur5"):
         out[name] = run_robot(name, args.samples, args.repeats)
         r = out[name]
@@ -281,6 +292,7 @@ def main(argv=None):
             f"(cost {r['log-cholesky']['cost']:.6g}, physical {r['log-cholesky']['is_physical']})"
             f"; LS cost {r['sdp']['cost_ls']:.6g}"
         )
+    out["load_average_after"] = os.getloadavg()
     print(common.write_json(args.out, out))
 
 

@@ -60,7 +60,9 @@ _RANK_TOL = 1e-10  # singular values of R below _RANK_TOL * the largest: rank de
 _MASS_FLOOR = 1e-6  # masses >= _MASS_FLOOR * the nominal total mass
 _GAMMA = 1e-4  # regulariser weight relative to the smallest curvature of the data
 _SOLVERS = ("sdp", "log-cholesky")
+_SDP_UNIT_CAP = 1e12  # SDP: objective scale at most this x the normalised one
 _LC_MAX_NFEV = 500  # log-Cholesky: least_squares evaluations at most
+_LC_TR_SOLVER = "lsmr"  # log-Cholesky: trust-region steps by LSMR (no SVD per step)
 _LC_EXP_MAX = 60.0  # log-Cholesky: |alpha|, |d_i| clipped there (exp finite, squared too)
 
 
@@ -82,6 +84,9 @@ class Identification:
     rmse: np.ndarray
     n_samples: int
     outliers: np.ndarray
+    #: details: ``weights`` (n_dofs,) of the final fit's rows, ``s2`` its weighted residual
+    #: variance; with ``physical``: the solver's ``status``, the compressed ``cost`` of pi and
+    #: ``cost_ls`` of the least-squares pi, the regulariser's ``gamma``
     info: dict = field(default_factory=dict)
 
     def predict(self, q, qd, qdd) -> np.ndarray:
@@ -300,25 +305,30 @@ class _Problem:
     fixed: np.ndarray  # bool (n_params,): coordinate parameters held at nominal
     nonneg: np.ndarray  # bool (n_params,): fv, fc, Ia
     mass_floor: float
+    unit: float  # cost() * unit: in units of the weighted noise variance
 
     def cost(self, pi):
         d = self.a @ pi - self.c
-        return float(d @ d + self.gamma * np.sum((pi - self.pi_nom) ** 2))
+        return float(d @ d + self.gamma * np.sum((pi - self.pi_nom) ** 2)) * self.unit
 
 
 def _problem(fit, base, pi_nom, n_bodies):
-    s = np.sqrt(fit.s2) if fit.s2 > 0 else 1.0
-    a = fit.r @ np.asarray(base.matrix, dtype=float) / s
-    c = fit.c / s
-    sv = np.linalg.svd(fit.r / s, compute_uv=False)
-    gamma = _GAMMA * float(sv[-1]) ** 2
+    # scaled so the solver sees O(1) numbers: a = R M / |R|_2 (a noise-free fit's s2 is ~0);
+    # the regulariser relative to the smallest curvature is scale-free, the costs reported in
+    # units of the weighted noise variance (chi-square) when there is noise
+    sv = np.linalg.svd(fit.r, compute_uv=False)
+    k = float(sv[0])
+    a = fit.r @ np.asarray(base.matrix, dtype=float) / k
+    c = fit.c / k
+    gamma = _GAMMA * float(sv[-1] / sv[0]) ** 2
+    unit = k * k / fit.s2 if fit.s2 > 0 else 1.0
     n = pi_nom.size
     coord = np.arange(n) >= 10 * n_bodies
     fixed = coord & ~np.any(np.asarray(base.matrix) != 0.0, axis=0)
     kind = (np.arange(n) - 10 * n_bodies) % 4
     nonneg = coord & ~fixed & (kind != 2)
     mass_floor = _MASS_FLOOR * float(sum(pi_nom[10 * k] for k in range(n_bodies)))
-    return _Problem(a, c, gamma, pi_nom, n_bodies, fixed, nonneg, max(mass_floor, 1e-12))
+    return _Problem(a, c, gamma, pi_nom, n_bodies, fixed, nonneg, max(mass_floor, 1e-12), unit)
 
 
 def _body_map():
@@ -358,7 +368,10 @@ def _solve_sdp(p: _Problem):
         cons.append(x[coord_nonneg] >= 0)
     if coord_fixed.size:
         cons.append(x[coord_fixed] == p.pi_nom[10 * nb :][coord_fixed])
-    obj = cp.sum_squares(p.a @ pi - p.c) + p.gamma * cp.sum_squares(pi - p.pi_nom)
+    # the objective in units of the noise variance (capped for a noise-free log): Clarabel's
+    # absolute gap tolerance (1e-8) is then far below a statistically meaningful change
+    f = np.sqrt(min(p.unit, _SDP_UNIT_CAP))
+    obj = cp.sum_squares(f * p.a @ pi - f * p.c) + f * f * p.gamma * cp.sum_squares(pi - p.pi_nom)
     prob = cp.Problem(cp.Minimize(obj), cons)
     prob.solve(solver=cp.CLARABEL)
     if prob.status not in ("optimal", "optimal_inaccurate") or pi.value is None:
@@ -453,17 +466,25 @@ def _solve_log_cholesky(p: _Problem, pi_start):
         pi, _ = pi_of(x)
         return np.concatenate([p.a @ pi - p.c, sg * (pi - p.pi_nom)])
 
+    a_bodies = p.a[:, : 10 * nb].reshape(p.a.shape[0], nb, 10)
+    a_free = p.a[:, free]
+
     def jac(x):
+        # pi is block diagonal in x (a body's 10 in its 10 theta, a coordinate's in itself):
+        # products per block (einsum), no dense (n_params x n_x) product
         _, jb = pi_of(x)
-        dpi = np.zeros((n, x.size))
+        top = np.concatenate(
+            [np.einsum("rki,kij->rkj", a_bodies, jb).reshape(p.a.shape[0], -1), a_free], axis=1
+        )
+        low = np.zeros((n, x.size))
         for k in range(nb):
-            dpi[10 * k : 10 * k + 10, 10 * k : 10 * k + 10] = jb[k]
-        dpi[free, 10 * nb + np.arange(free.size)] = 1.0
-        return np.vstack([p.a @ dpi, sg * dpi])
+            low[10 * k : 10 * k + 10, 10 * k : 10 * k + 10] = sg * jb[k]
+        low[free, 10 * nb + np.arange(free.size)] = sg
+        return np.vstack([top, low])
 
     x0 = np.maximum(x0, lo)
     sol = least_squares(
-        fun, x0, jac=jac, bounds=(lo, np.inf), method="trf", x_scale="jac",
+        fun, x0, jac=jac, bounds=(lo, np.inf), method="trf", x_scale="jac", tr_solver=_LC_TR_SOLVER,
         ftol=1e-12, xtol=1e-12, gtol=1e-12, max_nfev=_LC_MAX_NFEV,
     )  # fmt: skip
     return pi_of(sol.x)[0], f"{sol.status}: {sol.message}"
@@ -555,15 +576,10 @@ def identify(
     fit, keep, _ = _least_squares(yb, tau_eff, method, outlier_threshold, base)
     beta_std = np.sqrt(fit.s2 * np.sum(np.linalg.inv(fit.r) ** 2, axis=1))
     pi_ls = _complete(base, fit.beta, pi_nom)
-    info = {}
+    info = {"weights": fit.w, "s2": fit.s2}
     if physical:
         pi, status, prob = _physical(fit, base, pi_nom, len(bodies), solver, pi_ls)
-        info = {
-            "status": status,
-            "cost": prob.cost(pi),
-            "cost_ls": prob.cost(pi_ls),
-            "gamma": prob.gamma,
-        }
+        info.update(status=status, cost=prob.cost(pi), cost_ls=prob.cost(pi_ls), gamma=prob.gamma)
     else:
         pi = pi_ls
     beta = matrix @ pi
