@@ -45,6 +45,7 @@ their torque is subtracted from the log's before the fit.
 
 from __future__ import annotations
 
+import contextlib
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -62,7 +63,7 @@ _GAMMA = 1e-4  # regulariser weight relative to the smallest curvature of the da
 _SOLVERS = ("sdp", "log-cholesky")
 _SDP_UNIT_CAP = 1e12  # SDP: objective scale at most this x the normalised one
 _LC_MAX_NFEV = 500  # log-Cholesky: least_squares evaluations at most
-_LC_TR_SOLVER = "lsmr"  # log-Cholesky: trust-region steps by LSMR (no SVD per step)
+_LC_TR_SOLVER = "exact"  # log-Cholesky: trust-region steps by SVD (LSMR measured slower)
 _LC_EXP_MAX = 60.0  # log-Cholesky: |alpha|, |d_i| clipped there (exp finite, squared too)
 
 
@@ -510,6 +511,18 @@ def _physical(fit, base, pi_nom, n_bodies, solver, pi_ls):
 
 
 # ------------------------------------------------------------------------------- identify
+def _single_threaded_blas():
+    """BLAS/LAPACK on one thread for the fit (threadpoolctl, when installed): its matrices are
+    small or tall and thin, where OpenBLAS's threads gain little and, on an oversubscribed
+    machine, spin: QR and SVD of them measured 20-100x slower there
+    (benchmarks/identification_fit.py records both)."""
+    try:
+        from threadpoolctl import threadpool_limits
+    except ImportError:  # pragma: no cover - threadpoolctl is a dependency
+        return contextlib.nullcontext()
+    return threadpool_limits(limits=1, user_api="blas")
+
+
 def _base_for(model, base, friction, offsets):
     if base is None:
         from armdyn.identification.base import base_parameters
@@ -563,6 +576,13 @@ def identify(
     """
     _check_options(method, solver, outlier_threshold)
     q, qd, qdd, tau = _check_log(model, log)
+    with _single_threaded_blas():
+        return _identify(model, (q, qd, qdd, tau), base, method, physical, solver,
+                         outlier_threshold, friction, offsets)  # fmt: skip
+
+
+def _identify(model, arrays, base, method, physical, solver, outlier_threshold, friction, offsets):
+    q, qd, qdd, tau = arrays
     base = _base_for(model, base, friction, offsets)
     pi_nom = np.asarray(_core.dynamic_parameters(model), dtype=float)
     bodies, _ = _phys.parameter_layout(list(base.param_names))
