@@ -9,16 +9,29 @@ other data, and the identified model written back as a URDF and an armdyn model.
 """
 
 from armdyn._core import dynamic_parameter_names, dynamic_parameters, joint_torque_regressor
+from armdyn.identification.base import BaseParameters, base_parameters
 from armdyn.identification.estimate import Identification, identify
+from armdyn.identification.excitation import (
+    Excitation,
+    fourier_excitation,
+    fourier_series,
+    random_fourier,
+)
 from armdyn.identification.physical import is_physical, physical_violations, pseudo_inertia
 
 __all__ = [
+    "BaseParameters",
+    "Excitation",
     "Identification",
+    "base_parameters",
     "dynamic_parameter_names",
     "dynamic_parameters",
+    "fourier_excitation",
+    "fourier_series",
     "identify",
     "is_physical",
     "joint_torque_regressor",
     "physical_violations",
     "pseudo_inertia",
+    "random_fourier",
 ]
