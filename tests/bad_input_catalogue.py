@@ -1566,6 +1566,84 @@ CASES = [
         SE,
         "torque limit of joint 'hinge'",
     ),
+    (
+        "log-unknown-column",
+        "identification",
+        "load_log with a column that is no coordinate of the model",
+        lambda: _load_log({**_log_columns(), "wrist": [0.0] * 6}),
+        ME,
+        r"unknown column 'wrist'",
+    ),
+    (
+        "log-missing-torque",
+        "identification",
+        "load_log with neither `<joint>.tau` nor `<joint>.current` for a joint",
+        lambda: _load_log({k: v for k, v in _log_columns().items() if k != "hinge.tau"}),
+        ME,
+        r"joint 'hinge' needs one of the columns 'hinge.tau' or 'hinge.current'",
+    ),
+    (
+        "log-nan-cell",
+        "identification",
+        "load_log with a NaN cell",
+        lambda: _load_log({**_log_columns(), "hinge": [0.0, 0.1, np.nan, 0.3, 0.4, 0.5]}),
+        ME,
+        r"column 'hinge', row 2 is 'nan', not finite",
+    ),
+    (
+        "log-time-order",
+        "identification",
+        "load_log with t not strictly increasing",
+        lambda: _load_log({**_log_columns(), "t": [0.0, 0.1, 0.1, 0.3, 0.4, 0.5]}),
+        ME,
+        r"t must be strictly increasing, but row 2",
+    ),
+    (
+        "log-current-constants",
+        "identification",
+        "load_log with a current column but no torque constants",
+        lambda: _load_log(
+            {("hinge.current" if k == "hinge.tau" else k): v for k, v in _log_columns().items()}
+        ),
+        ME,
+        r"torque_constants is required",
+    ),
+    (
+        "log-cutoff-nyquist",
+        "identification",
+        "log_from_arrays with a cutoff above the Nyquist frequency",
+        lambda: _identification().log_from_arrays(
+            _pendulum(), np.arange(40) * 0.1, np.zeros((40, 1)), np.zeros((40, 1)), cutoff=6.0
+        ),
+        ME,
+        r"cutoff 6.0 Hz is not below the Nyquist frequency 5 Hz",
+    ),
+    (
+        "log-device",
+        "identification",
+        "load_log of a device (/dev/zero)",
+        lambda: _identification().load_log("/dev/zero", _pendulum()),
+        ME,
+        r"'/dev/zero' is a character device, not a regular file",
+    ),
+    (
+        "log-directory",
+        "identification",
+        "load_log of a directory",
+        lambda: _identification().load_log(DATA, _pendulum()),
+        ME,
+        r"is a directory, not a regular file",
+    ),
+    (
+        "log-floating-base",
+        "identification",
+        "load_log with a floating-base model",
+        lambda: _identification().load_log(
+            _log_columns(), ad.urdf_builder(str(DATA / "arm6.urdf"), fixed_base=False).finalize()
+        ),
+        ME,
+        r"floating base",
+    ),
 ]
 
 
@@ -1580,6 +1658,16 @@ def _floating_box():
     b.add_body("box", 1.0, I3)
     b.add_free("float", "box")
     return b.finalize()
+
+
+def _log_columns():
+    """A six-sample log of the pendulum (coordinate 'hinge') as a dict of columns."""
+    t = [0.0, 0.1, 0.2, 0.3, 0.4, 0.5]
+    return {"t": t, "hinge": [0.1 * x for x in t], "hinge.tau": [1.0] * 6}
+
+
+def _load_log(columns):
+    return _identification().load_log(columns, _pendulum())
 
 
 _LIMITS = {"max_velocity": 1.0, "max_acceleration": 2.0, "max_jerk": 10.0}

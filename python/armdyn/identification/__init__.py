@@ -17,13 +17,16 @@ from armdyn.identification.excitation import (
     fourier_series,
     random_fourier,
 )
+from armdyn.identification.log import MotionLog, differentiate, load_log, log_from_arrays
 from armdyn.identification.physical import is_physical, physical_violations, pseudo_inertia
 
 __all__ = [
     "BaseParameters",
     "Excitation",
     "Identification",
+    "MotionLog",
     "base_parameters",
+    "differentiate",
     "dynamic_parameter_names",
     "dynamic_parameters",
     "fourier_excitation",
@@ -31,6 +34,8 @@ __all__ = [
     "identify",
     "is_physical",
     "joint_torque_regressor",
+    "load_log",
+    "log_from_arrays",
     "physical_violations",
     "pseudo_inertia",
     "random_fourier",
