@@ -1644,6 +1644,48 @@ CASES = [
         ME,
         r"floating base",
     ),
+    (
+        "with-parameters-length",
+        "identification",
+        "with_parameters with a pi one entry short",
+        lambda: _ident().with_parameters(_pendulum(), np.zeros(13)),
+        ME,
+        r"pi must have shape \(14,\)",
+    ),
+    (
+        "with-parameters-nan",
+        "identification",
+        "with_parameters with a NaN entry in pi",
+        lambda: _ident().with_parameters(_pendulum(), _pi_with(4, np.nan)),
+        ME,
+        r"pi\[4\] \('link.Ixx'\) must be finite",
+    ),
+    (
+        "with-parameters-negative-mass",
+        "identification",
+        "with_parameters with a negative body mass",
+        lambda: _ident().with_parameters(_pendulum(), _pi_with(0, -1.0)),
+        ME,
+        r"body 'link': mass \('link.m'\) must be >= 0",
+    ),
+    (
+        "with-parameters-not-psd",
+        "identification",
+        "with_parameters with a body inertia that is not positive semidefinite",
+        lambda: _ident().with_parameters(_pendulum(), _pi_with(4, -1.0)),
+        ME,
+        r"body 'link'.*not positive semidefinite",
+    ),
+    (
+        "write-urdf-missing-link",
+        "identification",
+        "write_urdf onto a URDF without one of the model's bodies",
+        lambda: _ident().write_urdf(
+            '<robot name="r"><link name="other"/></robot>', _pendulum(), _pi_with(0, 1.0)
+        ),
+        ME,
+        "the URDF has no link 'link'",
+    ),
 ]
 
 
@@ -1668,6 +1710,19 @@ def _log_columns():
 
 def _load_log(columns):
     return _identification().load_log(columns, _pendulum())
+
+
+def _ident():
+    from armdyn import identification
+
+    return identification
+
+
+def _pi_with(i, value):
+    """The pendulum's dynamic parameters with entry i set to value."""
+    pi = ad.dynamic_parameters(_pendulum())
+    pi[i] = value
+    return pi
 
 
 _LIMITS = {"max_velocity": 1.0, "max_acceleration": 2.0, "max_jerk": 10.0}

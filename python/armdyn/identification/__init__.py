@@ -11,6 +11,7 @@ other data, and the identified model written back as a URDF and an armdyn model.
 from armdyn._core import dynamic_parameter_names, dynamic_parameters, joint_torque_regressor
 from armdyn.identification.base import BaseParameters, base_parameters
 from armdyn.identification.estimate import Identification, identify
+from armdyn.identification.export import with_parameters, write_urdf
 from armdyn.identification.excitation import (
     Excitation,
     fourier_excitation,
@@ -39,4 +40,6 @@ __all__ = [
     "physical_violations",
     "pseudo_inertia",
     "random_fourier",
+    "with_parameters",
+    "write_urdf",
 ]
