@@ -11,13 +11,13 @@ other data, and the identified model written back as a URDF and an armdyn model.
 from armdyn._core import dynamic_parameter_names, dynamic_parameters, joint_torque_regressor
 from armdyn.identification.base import BaseParameters, base_parameters
 from armdyn.identification.estimate import Identification, identify
-from armdyn.identification.export import with_parameters, write_urdf
 from armdyn.identification.excitation import (
     Excitation,
     fourier_excitation,
     fourier_series,
     random_fourier,
 )
+from armdyn.identification.export import with_parameters, write_urdf
 from armdyn.identification.log import MotionLog, differentiate, load_log, log_from_arrays
 from armdyn.identification.physical import is_physical, physical_violations, pseudo_inertia
 
