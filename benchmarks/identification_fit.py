@@ -10,8 +10,6 @@ motion, constraint satisfaction.
 
     python -m benchmarks.identification_fit [--samples 10000] [--repeats 3]
         [--out benchmarks/results/identification_fit.json]
-    OPENBLAS_NUM_THREADS=1 python -m benchmarks.identification_fit \
-        --out benchmarks/results/identification_fit_1thread.json
 
 The helpers (the perturbed model, the Fourier motion, the synthetic log) are also those of
 tests/identification/test_estimate.py.
@@ -36,7 +34,8 @@ from benchmarks import common
 # ------------------------------------------------------------------------ the synthetic robot
 @dataclass(frozen=True)
 class SyntheticLog:
-    """The fields of armdyn.identification.MotionLog that identify reads."""
+    """The fields of armdyn.identification.MotionLog that identify reads, unvalidated (the
+    tests' hostile logs: NaN, wrong shapes, that MotionLog itself refuses)."""
 
     t: np.ndarray
     q: np.ndarray
@@ -131,78 +130,16 @@ def synthetic_log(true, limits, coords, n: int, *, seed: int, noise=None, period
     tau = tau0.copy()
     if noise is not None:
         tau += np.random.default_rng(seed + 7).normal(size=tau.shape) * noise
-    return SyntheticLog(t, q, qd, qdd, tau, list(coords)), tau0
+    from armdyn.identification import MotionLog
 
-
-# --------------------------------------------------------------- stand-in base parameters
-@dataclass(frozen=True)
-class QRBase:
-    """A stand-in for armdyn.identification.BaseParameters (same fields and methods) by QR
-    with column pivoting of Y stacked over random states, until i35-base-params is merged."""
-
-    param_names: list
-    independent: np.ndarray
-    matrix: np.ndarray
-    names: list
-    rank: int
-
-    def regressor(self, y):
-        return np.asarray(y)[..., self.independent]
-
-    def beta(self, pi):
-        return self.matrix @ np.asarray(pi)
-
-    def complete(self, beta, pi_ref):
-        m = self.matrix
-        return pi_ref + np.linalg.lstsq(m, beta - m @ pi_ref, rcond=None)[0]
-
-
-def qr_base(model, *, samples=200, seed=0, friction=True, offsets=True) -> QRBase:
-    import scipy.linalg as sla
-
-    names = list(ad.dynamic_parameter_names(model))
-    rng = np.random.default_rng(seed)
-    n = samples
-    q = rng.uniform(-np.pi, np.pi, (n, model.n_coords))
-    y = ad.joint_torque_regressor(
-        model, q, rng.normal(size=(n, model.n_dofs)), rng.normal(size=(n, model.n_dofs))
-    ).reshape(-1, len(names))
-    cols = np.ones(len(names), bool)
-    for k, nm in enumerate(names):
-        if (not friction and nm.endswith((".fv", ".fc", ".Ia"))) or (
-            not offsets and nm.endswith(".offset")
-        ):
-            cols[k] = False
-    idx = np.flatnonzero(cols)
-    _, r, piv = sla.qr(y[:, idx], mode="economic", pivoting=True)
-    d = np.abs(np.diag(r))
-    rank = int(np.sum(d > 1e-10 * d[0]))
-    ind, dep = piv[:rank], piv[rank:]
-    k = sla.solve_triangular(r[:rank, :rank], r[:rank, rank:])
-    k[np.abs(k) < 1e-10] = 0.0
-    order = np.argsort(idx[ind])
-    matrix = np.zeros((rank, len(names)))
-    matrix[np.arange(rank), idx[ind]] = 1.0
-    matrix[:, idx[dep]] = k
-    matrix = matrix[order]
-    independent = idx[ind][order]
-    labels = [
-        " + ".join(f"{v:.4g} {names[j]}" if j != i else names[j] for j, v in _terms(row, i))
-        for row, i in zip(matrix, independent, strict=True)
-    ]
-    return QRBase(names, independent, matrix, labels, rank)
-
-
-def _terms(row, i):
-    return [(j, row[j]) for j in np.flatnonzero(row)]
+    log = MotionLog(t, q, qd, qdd, tau, list(coords), SyntheticLog.processing)
+    return log, tau0
 
 
 def base_for(model, **kw):
-    """base_parameters from armdyn.identification when merged, else the stand-in."""
-    try:
-        from armdyn.identification import base_parameters
-    except ImportError:
-        return qr_base(model, **kw)
+    """armdyn.identification.base_parameters (the tests' and this benchmark's one call)."""
+    from armdyn.identification import base_parameters
+
     return base_parameters(model, **kw)
 
 
@@ -277,8 +214,8 @@ def main(argv=None):
     out = {
         "machine": common.machine(),
         "command": "python -m benchmarks.identification_fit " + " ".join(argv or sys.argv[1:]),
-        # OpenBLAS threads spin on an oversubscribed machine: QR and SVD of small matrices slow
-        # down 20-100x there; recorded so the times can be read
+        # identify runs OpenBLAS on one thread (base.one_blas_thread); the machine's load is
+        # recorded so the times can be read
         "OPENBLAS_NUM_THREADS": os.environ.get("OPENBLAS_NUM_THREADS", "(default)"),
         "load_average_before": os.getloadavg(),
     }

@@ -165,7 +165,7 @@ def test_physical_estimate_enforces_the_constraints():
     pi_bad[k] = -0.5
     log, _ = r.log(400, seed=1)
     y = ad.joint_torque_regressor(r.nominal, log.q, log.qd, log.qdd)
-    bad = F.SyntheticLog(log.t, log.q, log.qd, log.qdd, y @ pi_bad, log.joint_names)
+    bad = _log_with(log, tau=y @ pi_bad)
     ls = identify(r.nominal, bad, base=r.base, physical=False)
     assert "elbow_joint.fv = -0.5 is negative" in physical_violations(r.nominal, ls.pi)
     for solver in ("sdp", "log-cholesky"):
@@ -181,7 +181,7 @@ def test_outliers_removed_and_reported():
     spikes = np.array([100, 555, 1203])
     tau = log.tau.copy()
     tau[spikes, 2] += 200.0 * r.noise[2]
-    spiked = F.SyntheticLog(log.t, log.q, log.qd, log.qdd, tau, log.joint_names)
+    spiked = _log_with(log, tau=tau)
     clean = identify(r.nominal, log, base=r.base, physical=False)
     fit = identify(r.nominal, spiked, base=r.base, physical=False)
     raw = identify(r.nominal, spiked, base=r.base, physical=False, outlier_threshold=None)
@@ -197,8 +197,8 @@ def test_outliers_removed_and_reported():
 
 
 def test_without_friction_and_offsets_columns():
-    # a truth without friction or rotors: base parameters of the inertial columns only;
-    # friction, offsets and Ia stay at the nominal model's (zero)
+    # a truth without friction or rotors: base parameters without the friction and offset
+    # columns (Ia stays: an inertia); fv, fc and the offsets stay at the nominal model's (zero)
     r = _robot("ur5")
     b = ad.urdf_builder(F.perturbed_urdf(common.robot_urdf("ur5"), 0))
     true = b.finalize()
@@ -206,8 +206,9 @@ def test_without_friction_and_offsets_columns():
     log, _ = F.synthetic_log(true, r.limits, r.coords, 300, seed=4)
     fit = identify(r.nominal, log, base=base, physical=False, friction=False, offsets=False)
     assert _rel(fit.beta_ls, base.beta(ad.dynamic_parameters(true))) < 1e-8
-    joint = np.arange(fit.pi.size) >= fit.pi.size - 4 * len(r.coords)
-    np.testing.assert_array_equal(fit.pi[joint], 0.0)
+    held = [n.endswith((".fv", ".fc", ".offset")) for n in base.param_names]
+    assert sum(held) == 3 * len(r.coords)
+    np.testing.assert_array_equal(fit.pi[held], 0.0)
 
 
 def test_tables():

@@ -45,13 +45,13 @@ their torque is subtracted from the log's before the fit.
 
 from __future__ import annotations
 
-import contextlib
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from armdyn import _core
 from armdyn.identification import physical as _phys
+from armdyn.identification.base import one_blas_thread
 
 __all__ = ["Identification", "identify"]
 
@@ -511,18 +511,6 @@ def _physical(fit, base, pi_nom, n_bodies, solver, pi_ls):
 
 
 # ------------------------------------------------------------------------------- identify
-def _single_threaded_blas():
-    """BLAS/LAPACK on one thread for the fit (threadpoolctl, when installed): its matrices are
-    small or tall and thin, where OpenBLAS's threads gain little and, on an oversubscribed
-    machine, spin: QR and SVD of them measured 20-100x slower there
-    (benchmarks/identification_fit.py records both)."""
-    try:
-        from threadpoolctl import threadpool_limits
-    except ImportError:  # pragma: no cover - threadpoolctl is a dependency
-        return contextlib.nullcontext()
-    return threadpool_limits(limits=1, user_api="blas")
-
-
 def _base_for(model, base, friction, offsets):
     if base is None:
         from armdyn.identification.base import base_parameters
@@ -576,7 +564,7 @@ def identify(
     """
     _check_options(method, solver, outlier_threshold)
     q, qd, qdd, tau = _check_log(model, log)
-    with _single_threaded_blas():
+    with one_blas_thread():  # small / tall matrices: OpenBLAS threads only spin (base.py)
         return _identify(model, (q, qd, qdd, tau), base, method, physical, solver,
                          outlier_threshold, friction, offsets)  # fmt: skip
 
