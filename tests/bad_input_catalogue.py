@@ -1686,6 +1686,30 @@ CASES = [
         ME,
         "the URDF has no link 'link'",
     ),
+    (
+        "identify-log-of-another-model",
+        "identification",
+        "identify with a log whose joint names are not the model's coordinates",
+        lambda: _ident().identify(_pendulum(), _swing_log(names=["elbow"])),
+        ME,
+        r"log.joint_names \['elbow'\] do not match the model's coord_names \['hinge'\]",
+    ),
+    (
+        "identify-too-few-samples",
+        "identification",
+        "identify with four samples (fewer rows than base parameters)",
+        lambda: _ident().identify(_pendulum(), _swing_log(n=4)),
+        SE,
+        r"rank deficient: the log excites only",
+    ),
+    (
+        "identify-outlier-threshold",
+        "identification",
+        "identify with outlier_threshold 0",
+        lambda: _ident().identify(_pendulum(), _swing_log(), outlier_threshold=0.0),
+        ME,
+        r"outlier_threshold must be a number > 0",
+    ),
 ]
 
 
@@ -1716,6 +1740,15 @@ def _ident():
     from armdyn import identification
 
     return identification
+
+
+def _swing_log(n=50, names=("hinge",)):
+    """A log of the pendulum swinging (torques by its inverse dynamics)."""
+    model = _pendulum()
+    t = np.linspace(0.0, 2.0, n)
+    q, qd, qdd = np.sin(3 * t)[:, None], 3 * np.cos(3 * t)[:, None], -9 * np.sin(3 * t)[:, None]
+    tau = np.array([ad.inverse_dynamics(model, *x) for x in zip(q, qd, qdd, strict=True)])
+    return _ident().MotionLog(t, q, qd, qdd, tau, list(names), "synthetic")
 
 
 def _pi_with(i, value):

@@ -9,7 +9,9 @@
    deviation of that joint's residual after an ordinary fit, re-estimated once from the
    weighted fit's residuals and refitted (two weighted solves). A joint whose residual is zero
    to round-off would get an infinite weight: every ``sigma_j`` is floored at ``1e-3`` times
-   the largest (and a log fitted exactly to round-off keeps unit weights);
+   the largest (and a log fitted exactly to round-off keeps unit weights). Each joint's rows
+   are compressed once (the R factor of ``[Y_b,j  tau_j]``, Q not formed), so a reweighting
+   costs a QR of n_dofs small triangles, not of the log;
 2. **outliers**: the samples (rows of the log) where any joint's weighted residual exceeds
    ``outlier_threshold`` times the weighted residual's standard deviation are removed, and step
    1 is redone once on the rest (``Identification.outliers`` lists them). A fit exact to
@@ -21,17 +23,20 @@
    mass ``>= 1e-6`` times the model's total mass, ``fv, fc, Ia >= 0``; in the compressed form
    ``|R M pi - Q^T b_w|^2`` (``A_w = Q R``, so the solver sees n_base rows, not the log's), plus
    a regulariser ``gamma |pi - pi_nominal|^2`` that fixes the non-identifiable directions at
-   the nominal model's, ``gamma = 1e-4 s_min^2`` (``s_min`` the smallest singular value of the
-   (noise-scaled) compressed regressor ``R M / s``: it moves no identifiable direction by more
-   than ~1e-4 of its own curvature). Two solvers, the same problem:
+   the nominal model's: ``gamma = 1e-4 s_min^2``, ``s_min`` the smallest singular value of R
+   (the data's smallest curvature along a base parameter: the regulariser pulls no
+   identifiable direction by more than ~1e-4 of its own curvature). Two solvers, the same
+   problem:
 
    - ``solver="sdp"``: a semidefinite program through cvxpy (Clarabel), the pseudo-inertias
-     as 4x4 PSD variables (cvxpy is then a runtime dependency of this option only; it is
-     imported on first use);
+     as 4x4 PSD variables, the objective in units of the noise variance (so Clarabel's
+     absolute tolerance is far below a meaningful change); cvxpy is a runtime dependency
+     (imported on first use);
    - ``solver="log-cholesky"``: the log-Cholesky parametrisation (Rucker & Wensing 2022:
      ``J = U U^T``, U upper triangular with ``exp`` on its diagonal, so every J is positive
-     definite) with ``scipy.optimize.least_squares`` (friction bounds as box bounds), started
-     at the least-squares estimate projected onto the consistent set, analytic Jacobian.
+     definite) with ``scipy.optimize.least_squares`` (trust region, friction bounds as box
+     bounds, analytic Jacobian, at most 500 evaluations), started at the least-squares
+     estimate projected onto the consistent set.
 
    The default is chosen by the measurement of ``benchmarks/identification_fit.py`` (see
    :func:`identify`). The result is clipped onto the constraints (eigenvalues at 0, masses at
