@@ -6,7 +6,8 @@ noise on the torques. Per robot: the wall time of the whole fit (regressor batch
 outliers, standard deviations) without and with the physically consistent estimate, and the
 two physically consistent solvers compared on the same problem (SDP through cvxpy/Clarabel and
 log-Cholesky with scipy.optimize.least_squares): time, weighted cost, validation RMSE on another
-motion, constraint satisfaction.
+motion, constraint satisfaction. Each robot twice: with Coulomb friction in the truth, and
+without (the truth on the boundary fc = 0, where the constraints are active).
 
     python -m benchmarks.identification_fit [--samples 10000] [--repeats 3]
         [--out benchmarks/results/identification_fit.json]
@@ -82,18 +83,21 @@ def joint_limits(path, coords) -> tuple[np.ndarray, np.ndarray]:
     return lo, hi
 
 
-def robot(name: str, seed: int = 0):
+def robot(name: str, seed: int = 0, coulomb: bool = True):
     """(nominal model, true model, true pi in the nominal's layout, (lower, upper)).
 
-    The true model: the perturbed URDF, viscous and Coulomb friction on every coordinate, a
-    gear-reduced rotor (ratio 100) on every revolute coordinate."""
+    The true model: the perturbed URDF, viscous and Coulomb friction on every coordinate (no
+    Coulomb friction with coulomb=False: the truth on the boundary fc = 0 of the consistent
+    set, so that noise puts half the least-squares fc below zero), a gear-reduced rotor
+    (ratio 100) on every revolute coordinate."""
     path = common.robot_urdf(name)
     nominal = ad.load_urdf(str(path))
     rng = np.random.default_rng(seed + 1000)
     b = ad.urdf_builder(perturbed_urdf(path, seed))
     coords = list(nominal.coord_names)
     for c in coords:
-        b.add_joint_friction(c, rng.uniform(0.05, 0.5), rng.uniform(0.1, 1.0))
+        fc = rng.uniform(0.1, 1.0)
+        b.add_joint_friction(c, rng.uniform(0.05, 0.5), fc if coulomb else 0.0)
         if not re.search("finger", c):
             b.add_actuator(c, 100.0, rng.uniform(1e-5, 5e-5))
     true = b.finalize()
@@ -153,17 +157,23 @@ def _timed(fn, repeats):
     return float(np.median(times)), out
 
 
-def run_robot(name, n, repeats):
+def run_robot(name, n, repeats, coulomb=True):
     from armdyn.identification import identify, is_physical
 
-    nominal, true, pi_true, limits = robot(name)
+    nominal, true, pi_true, limits = robot(name, coulomb=coulomb)
     coords = list(nominal.coord_names)
     _, clean = synthetic_log(true, limits, coords, 400, seed=11)
     noise = 0.02 * np.sqrt(np.mean(clean**2, axis=0)) + 0.01
     log, _ = synthetic_log(true, limits, coords, n, seed=1, noise=noise)
     val, _ = synthetic_log(true, limits, coords, 2000, seed=2, noise=noise)
     base = base_for(nominal)
-    row = {"n_samples": n, "n_dofs": nominal.n_dofs, "n_params": pi_true.size, "n_base": base.rank}
+    row = {
+        "coulomb_friction": coulomb,
+        "n_samples": n,
+        "n_dofs": nominal.n_dofs,
+        "n_params": pi_true.size,
+        "n_base": base.rank,
+    }
     row["noise"] = noise.tolist()
     t_ls, ls = _timed(lambda: identify(nominal, log, base=base, physical=False), repeats)
     row["least_squares"] = {"seconds": t_ls, **_quality(ls, val, base, pi_true, noise)}
@@ -219,11 +229,13 @@ def main(argv=None):
         "OPENBLAS_NUM_THREADS": os.environ.get("OPENBLAS_NUM_THREADS", "(default)"),
         "load_average_before": os.getloadavg(),
     }
-    for name in ("panda", "ur5"):
-        out[name] = run_robot(name, args.samples, args.repeats)
-        r = out[name]
+    cases = [(name, name, True) for name in ("panda", "ur5")]
+    cases += [(name + "_no_coulomb", name, False) for name in ("panda", "ur5")]
+    for key, name, coulomb in cases:
+        out[key] = run_robot(name, args.samples, args.repeats, coulomb)
+        r = out[key]
         print(
-            f"{name}: n_base {r['n_base']}, LS {r['least_squares']['seconds']:.2f} s, "
+            f"{key}: n_base {r['n_base']}, LS {r['least_squares']['seconds']:.2f} s, "
             f"SDP {r['sdp']['seconds']:.2f} s (cost {r['sdp']['cost']:.6g}, physical "
             f"{r['sdp']['is_physical']}), log-Cholesky {r['log-cholesky']['seconds']:.2f} s "
             f"(cost {r['log-cholesky']['cost']:.6g}, physical {r['log-cholesky']['is_physical']})"

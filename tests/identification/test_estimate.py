@@ -304,6 +304,9 @@ def test_a_joint_with_zero_residual():
     [
         ({"outlier_threshold": 0.0}, "outlier_threshold must be a number > 0"),
         ({"outlier_threshold": -3}, "outlier_threshold must be a number > 0"),
+        ({"outlier_threshold": float("nan")}, "outlier_threshold must be a number > 0"),
+        ({"outlier_threshold": "3"}, "outlier_threshold must be a number > 0"),
+        ({"outlier_threshold": True}, "outlier_threshold must be a number > 0"),
         ({"method": "ridge"}, "method must be 'ols' or 'wls'"),
         ({"solver": "cvx"}, "solver must be one of"),
     ],
