@@ -240,6 +240,15 @@ def test_identified_model_has_the_identified_parameters():
     np.testing.assert_allclose(ad.dynamic_parameters(model), pi, rtol=1e-12, atol=1e-12)
 
 
+def test_default_base_is_base_parameters():
+    r = _robot("ur5")
+    log, _ = r.log(300, seed=1)
+    fit = identify(r.nominal, log, physical=False, friction=False)
+    assert fit.base.names == identification.base_parameters(r.nominal, friction=False).names
+    assert not any(n.endswith((".fv", ".fc")) for n in fit.base.names)
+    assert fit.base.names != r.base.names
+
+
 # ------------------------------------------------------------------------- hostile inputs
 def _log_with(log, **kw):
     fields = {k: getattr(log, k) for k in ("t", "q", "qd", "qdd", "tau", "joint_names")}
@@ -252,6 +261,13 @@ def test_log_of_another_model():
     log, _ = ur5.log(50, seed=1)
     with pytest.raises(ad.ModelError, match=r"log.joint_names .* do not match .*panda_joint1"):
         identify(panda.nominal, log, base=panda.base)
+
+
+def test_base_of_another_model():
+    ur5, panda = _robot("ur5"), _robot("panda")
+    log, _ = ur5.log(50, seed=1)
+    with pytest.raises(ad.ModelError, match="base parameters of another model"):
+        identify(ur5.nominal, log, base=panda.base)
 
 
 def test_too_few_samples_names_the_rank_deficiency():
