@@ -273,7 +273,11 @@ def test_base_of_another_model():
 def test_too_few_samples_names_the_rank_deficiency():
     r = _robot("ur5")
     log, _ = r.log(5, seed=1)  # 5 samples x 6 joints = 30 rows < n_base
-    with pytest.raises(ad.SolverError, match=r"rank deficient.*fourier_excitation"):
+    with pytest.raises(
+        ad.SolverError,
+        match=rf"rank deficient: the log excites only 30 of the {r.base.rank} base parameters"
+        r" \(.* over 5 samples, 30 rows; .*\)\; the least excited: .*fourier_excitation",
+    ):
         identify(r.nominal, log, base=r.base)
     log, _ = r.log(12, seed=1)  # enough rows, not enough distinct states
     with pytest.raises(ad.SolverError, match=r"excites only \d+ of the 5\d base parameters"):

@@ -244,12 +244,12 @@ def _solve(yb, tau, tri, w, base):
 
     n_samples, n_dofs, n_base = yb.shape
     rows = n_samples * n_dofs
-    if rows < n_base:
-        raise _rank_error(np.array([1.0, 0.0]), None, base, rows, n_samples)
     stack = np.vstack([wj * t for wj, t in zip(w, tri, strict=True)])
+    if stack.shape[0] < n_base:  # fewer rows than base parameters
+        _, sv, vt = np.linalg.svd(stack[:, :n_base])
+        sv = np.concatenate([sv, np.zeros(n_base - sv.size)])
+        raise _rank_error(sv, vt, base, rows, n_samples)
     raug = sla.qr(stack, mode="r", check_finite=False)[0]
-    if raug.shape[0] < n_base:
-        raise _rank_error(np.array([1.0, 0.0]), None, base, rows, n_samples)
     r, c = raug[:n_base, :n_base], raug[:n_base, n_base]
     sv = np.linalg.svd(r, compute_uv=False)
     if sv[0] == 0.0 or sv[-1] <= _RANK_TOL * sv[0]:
@@ -577,7 +577,8 @@ def identify(
     log-Cholesky's 12.9 / 3.0 / 4.6 / 2.8 s, which stopped at its 500-evaluation cap in 3 of
     the 4: the optima lie on the boundary (the SDP's smallest pseudo-inertia eigenvalue is
     <= 5e-7 in all four), which log-Cholesky's exp-parametrised interior only creeps toward.
-    log-Cholesky needs no cvxpy. friction, offsets: for the default base (a given ``base`` has its own columns).
+    log-Cholesky needs no cvxpy. friction, offsets: for the default base (a given ``base`` has
+    its own columns).
     outlier_threshold: residual sigmas (> 0), or None for no outlier rejection.
 
     Raises ModelError on a log of another model (joint names), of the wrong shapes, not finite
