@@ -1531,6 +1531,120 @@ CASES = [
         r"singularity at s = [0-9.]+ \(position \[",
     ),
     (
+        "base-parameters-samples-zero",
+        "identification",
+        "base_parameters with samples = 0",
+        lambda: _identification().base_parameters(_pendulum(), samples=0),
+        ME,
+        r"samples must be an integer in \[1, 1000000\], got 0",
+    ),
+    (
+        "excitation-floating-base",
+        "identification",
+        "fourier_excitation of a floating base",
+        lambda: _identification().fourier_excitation(_floating_box()),
+        ME,
+        "floating base",
+    ),
+    (
+        "excitation-period-nan",
+        "identification",
+        "fourier_excitation with period NaN",
+        lambda: _identification().fourier_excitation(
+            _pendulum(), period=float("nan"), max_velocity=1.0
+        ),
+        ME,
+        "period must be a positive number",
+    ),
+    (
+        "excitation-torque-infeasible",
+        "identification",
+        "fourier_excitation whose torque limit is below the gravity torque at q0",
+        lambda: _identification().fourier_excitation(
+            _pendulum(), q0=[1.0], max_velocity=1.0, max_torque=0.1, harmonics=2, samples=10
+        ),
+        SE,
+        "torque limit of joint 'hinge'",
+    ),
+    (
+        "log-unknown-column",
+        "identification",
+        "load_log with a column that is no coordinate of the model",
+        lambda: _load_log({**_log_columns(), "wrist": [0.0] * 6}),
+        ME,
+        r"unknown column 'wrist'",
+    ),
+    (
+        "log-missing-torque",
+        "identification",
+        "load_log with neither `<joint>.tau` nor `<joint>.current` for a joint",
+        lambda: _load_log({k: v for k, v in _log_columns().items() if k != "hinge.tau"}),
+        ME,
+        r"joint 'hinge' needs one of the columns 'hinge.tau' or 'hinge.current'",
+    ),
+    (
+        "log-nan-cell",
+        "identification",
+        "load_log with a NaN cell",
+        lambda: _load_log({**_log_columns(), "hinge": [0.0, 0.1, np.nan, 0.3, 0.4, 0.5]}),
+        ME,
+        r"column 'hinge', row 2 is 'nan', not finite",
+    ),
+    (
+        "log-time-order",
+        "identification",
+        "load_log with t not strictly increasing",
+        lambda: _load_log({**_log_columns(), "t": [0.0, 0.1, 0.1, 0.3, 0.4, 0.5]}),
+        ME,
+        r"t must be strictly increasing, but row 2",
+    ),
+    (
+        "log-current-constants",
+        "identification",
+        "load_log with a current column but no torque constants",
+        lambda: _load_log(
+            {("hinge.current" if k == "hinge.tau" else k): v for k, v in _log_columns().items()}
+        ),
+        ME,
+        r"torque_constants is required",
+    ),
+    (
+        "log-cutoff-nyquist",
+        "identification",
+        "log_from_arrays with a cutoff above the Nyquist frequency",
+        lambda: _identification().log_from_arrays(
+            _pendulum(), np.arange(40) * 0.1, np.zeros((40, 1)), np.zeros((40, 1)), cutoff=6.0
+        ),
+        ME,
+        r"cutoff 6.0 Hz is not below the Nyquist frequency 5 Hz",
+    ),
+    (
+        "log-device",
+        "identification",
+        "load_log of a device (/dev/zero)",
+        lambda: _identification().load_log("/dev/zero", _pendulum()),
+        ME,
+        r"'/dev/zero' is a character device, not a regular file",
+    ),
+    (
+        "log-directory",
+        "identification",
+        "load_log of a directory",
+        lambda: _identification().load_log(DATA, _pendulum()),
+        ME,
+        r"is a directory, not a regular file",
+    ),
+    (
+        "log-floating-base",
+        "identification",
+        "load_log with a floating-base model",
+        lambda: _identification().load_log(
+            _log_columns(), ad.urdf_builder(str(DATA / "arm6.urdf"), fixed_base=False).finalize()
+        ),
+        ME,
+        r"floating base",
+    ),
+    (
         "with-parameters-length",
         "identification",
         "with_parameters with a pi one entry short",
@@ -1571,27 +1685,55 @@ CASES = [
         ),
         ME,
         "the URDF has no link 'link'",
-        "base-parameters-samples-zero",
-        "base_parameters with samples = 0",
-        lambda: _identification().base_parameters(_pendulum(), samples=0),
-        r"samples must be an integer in \[1, 1000000\], got 0",
-        "excitation-floating-base",
-        "fourier_excitation of a floating base",
-        lambda: _identification().fourier_excitation(_floating_box()),
-        "floating base",
-        "excitation-period-nan",
-        "fourier_excitation with period NaN",
-        lambda: _identification().fourier_excitation(
-            _pendulum(), period=float("nan"), max_velocity=1.0
-        "period must be a positive number",
-        "excitation-torque-infeasible",
-        "fourier_excitation whose torque limit is below the gravity torque at q0",
-        lambda: _identification().fourier_excitation(
-            _pendulum(), q0=[1.0], max_velocity=1.0, max_torque=0.1, harmonics=2, samples=10
+    ),
+    (
+        "identify-log-of-another-model",
+        "identification",
+        "identify with a log whose joint names are not the model's coordinates",
+        lambda: _ident().identify(_pendulum(), _swing_log(names=["elbow"])),
+        ME,
+        r"log.joint_names \['elbow'\] do not match the model's coord_names \['hinge'\]",
+    ),
+    (
+        "identify-too-few-samples",
+        "identification",
+        "identify with four samples (fewer rows than base parameters)",
+        lambda: _ident().identify(_pendulum(), _swing_log(n=4)),
         SE,
-        "torque limit of joint 'hinge'",
+        r"rank deficient: the log excites only",
+    ),
+    (
+        "identify-outlier-threshold",
+        "identification",
+        "identify with outlier_threshold 0",
+        lambda: _ident().identify(_pendulum(), _swing_log(), outlier_threshold=0.0),
+        ME,
+        r"outlier_threshold must be a number > 0",
     ),
 ]
+
+
+def _identification():
+    import armdyn.identification
+
+    return armdyn.identification
+
+
+def _floating_box():
+    b = ad.ModelBuilder()
+    b.add_body("box", 1.0, I3)
+    b.add_free("float", "box")
+    return b.finalize()
+
+
+def _log_columns():
+    """A six-sample log of the pendulum (coordinate 'hinge') as a dict of columns."""
+    t = [0.0, 0.1, 0.2, 0.3, 0.4, 0.5]
+    return {"t": t, "hinge": [0.1 * x for x in t], "hinge.tau": [1.0] * 6}
+
+
+def _load_log(columns):
+    return _identification().load_log(columns, _pendulum())
 
 
 def _ident():
@@ -1600,19 +1742,20 @@ def _ident():
     return identification
 
 
+def _swing_log(n=50, names=("hinge",)):
+    """A log of the pendulum swinging (torques by its inverse dynamics)."""
+    model = _pendulum()
+    t = np.linspace(0.0, 2.0, n)
+    q, qd, qdd = np.sin(3 * t)[:, None], 3 * np.cos(3 * t)[:, None], -9 * np.sin(3 * t)[:, None]
+    tau = np.array([ad.inverse_dynamics(model, *x) for x in zip(q, qd, qdd, strict=True)])
+    return _ident().MotionLog(t, q, qd, qdd, tau, list(names), "synthetic")
+
+
 def _pi_with(i, value):
     """The pendulum's dynamic parameters with entry i set to value."""
     pi = ad.dynamic_parameters(_pendulum())
     pi[i] = value
     return pi
-def _identification():
-    import armdyn.identification
-    return armdyn.identification
-def _floating_box():
-    b = ad.ModelBuilder()
-    b.add_body("box", 1.0, I3)
-    b.add_free("float", "box")
-    return b.finalize()
 
 
 _LIMITS = {"max_velocity": 1.0, "max_acceleration": 2.0, "max_jerk": 10.0}
