@@ -1531,80 +1531,6 @@ CASES = [
         r"singularity at s = [0-9.]+ \(position \[",
     ),
     (
-        "validate-log-joints",
-        "identification",
-        "validate with a log of other joints than the model's",
-        lambda: _validate(joint_names=["other"]),
-        ME,
-        r"the log's joints \['other'\] are not the model's \['hinge'\]",
-    ),
-    (
-        "validate-pi-length",
-        "identification",
-        "validate with a pi of the wrong length",
-        lambda: _validate(pi=np.ones(3)),
-        ME,
-        r"pi has 3 entries, the model 14",
-    ),
-    (
-        "identify-cli-per-joint",
-        "identification",
-        "`armdyn identify --gear-ratios elbow=2,3` (named and unnamed entries mixed)",
-        lambda: _identify_cli().per_joint("--gear-ratios", "elbow=2,3"),
-        ME,
-        r"--gear-ratios 'elbow=2,3': either every entry is JOINT=VALUE or none is",
-    ),
-    (
-        "identify-cli-cutoff",
-        "identification",
-        "`armdyn identify --cutoff -1` (not a positive frequency)",
-        lambda: _identify_cli()._cutoff("-1"),
-        ME,
-        r"--cutoff '-1': the cutoff must be > 0 Hz",
-    ),
-    (
-        "with-parameters-length",
-        "identification",
-        "with_parameters with a pi one entry short",
-        lambda: _ident().with_parameters(_pendulum(), np.zeros(13)),
-        ME,
-        r"pi must have shape \(14,\)",
-    ),
-    (
-        "with-parameters-nan",
-        "identification",
-        "with_parameters with a NaN entry in pi",
-        lambda: _ident().with_parameters(_pendulum(), _pi_with(4, np.nan)),
-        ME,
-        r"pi\[4\] \('link.Ixx'\) must be finite",
-    ),
-    (
-        "with-parameters-negative-mass",
-        "identification",
-        "with_parameters with a negative body mass",
-        lambda: _ident().with_parameters(_pendulum(), _pi_with(0, -1.0)),
-        ME,
-        r"body 'link': mass \('link.m'\) must be >= 0",
-    ),
-    (
-        "with-parameters-not-psd",
-        "identification",
-        "with_parameters with a body inertia that is not positive semidefinite",
-        lambda: _ident().with_parameters(_pendulum(), _pi_with(4, -1.0)),
-        ME,
-        r"body 'link'.*not positive semidefinite",
-    ),
-    (
-        "write-urdf-missing-link",
-        "identification",
-        "write_urdf onto a URDF without one of the model's bodies",
-        lambda: _ident().write_urdf(
-            '<robot name="r"><link name="other"/></robot>', _pendulum(), _pi_with(0, 1.0)
-        ),
-        ME,
-        "the URDF has no link 'link'",
-    ),
-    (
         "base-parameters-samples-zero",
         "identification",
         "base_parameters with samples = 0",
@@ -1718,20 +1644,105 @@ CASES = [
         ME,
         r"floating base",
     ),
+    (
+        "with-parameters-length",
+        "identification",
+        "with_parameters with a pi one entry short",
+        lambda: _ident().with_parameters(_pendulum(), np.zeros(13)),
+        ME,
+        r"pi must have shape \(14,\)",
+    ),
+    (
+        "with-parameters-nan",
+        "identification",
+        "with_parameters with a NaN entry in pi",
+        lambda: _ident().with_parameters(_pendulum(), _pi_with(4, np.nan)),
+        ME,
+        r"pi\[4\] \('link.Ixx'\) must be finite",
+    ),
+    (
+        "with-parameters-negative-mass",
+        "identification",
+        "with_parameters with a negative body mass",
+        lambda: _ident().with_parameters(_pendulum(), _pi_with(0, -1.0)),
+        ME,
+        r"body 'link': mass \('link.m'\) must be >= 0",
+    ),
+    (
+        "with-parameters-not-psd",
+        "identification",
+        "with_parameters with a body inertia that is not positive semidefinite",
+        lambda: _ident().with_parameters(_pendulum(), _pi_with(4, -1.0)),
+        ME,
+        r"body 'link'.*not positive semidefinite",
+    ),
+    (
+        "write-urdf-missing-link",
+        "identification",
+        "write_urdf onto a URDF without one of the model's bodies",
+        lambda: _ident().write_urdf(
+            '<robot name="r"><link name="other"/></robot>', _pendulum(), _pi_with(0, 1.0)
+        ),
+        ME,
+        "the URDF has no link 'link'",
+    ),
+    (
+        "identify-log-of-another-model",
+        "identification",
+        "identify with a log whose joint names are not the model's coordinates",
+        lambda: _ident().identify(_pendulum(), _swing_log(names=["elbow"])),
+        ME,
+        r"log.joint_names \['elbow'\] do not match the model's coord_names \['hinge'\]",
+    ),
+    (
+        "identify-too-few-samples",
+        "identification",
+        "identify with four samples (fewer rows than base parameters)",
+        lambda: _ident().identify(_pendulum(), _swing_log(n=4)),
+        SE,
+        r"rank deficient: the log excites only",
+    ),
+    (
+        "identify-outlier-threshold",
+        "identification",
+        "identify with outlier_threshold 0",
+        lambda: _ident().identify(_pendulum(), _swing_log(), outlier_threshold=0.0),
+        ME,
+        r"outlier_threshold must be a number > 0",
+    ),
+    (
+        "validate-log-joints",
+        "identification",
+        "validate with a log of other joints than the model's",
+        lambda: _validate(joint_names=["other"]),
+        ME,
+        r"the log's joints \['other'\] are not the model's \['hinge'\]",
+    ),
+    (
+        "validate-pi-length",
+        "identification",
+        "validate with a pi of the wrong length",
+        lambda: _validate(pi=np.ones(3)),
+        ME,
+        r"pi has 3 entries, the model 14",
+    ),
+    (
+        "identify-cli-per-joint",
+        "identification",
+        "`armdyn identify --gear-ratios elbow=2,3` (named and unnamed entries mixed)",
+        lambda: _identify_cli().per_joint("--gear-ratios", "elbow=2,3"),
+        ME,
+        r"--gear-ratios 'elbow=2,3': either every entry is JOINT=VALUE or none is",
+    ),
+    (
+        "identify-cli-cutoff",
+        "identification",
+        "`armdyn identify --cutoff -1` (not a positive frequency)",
+        lambda: _identify_cli()._cutoff("-1"),
+        ME,
+        r"--cutoff '-1': the cutoff must be > 0 Hz",
+    ),
 ]
-
-
-def _ident():
-    from armdyn import identification
-
-    return identification
-
-
-def _pi_with(i, value):
-    """The pendulum's dynamic parameters with entry i set to value."""
-    pi = ad.dynamic_parameters(_pendulum())
-    pi[i] = value
-    return pi
 
 
 def _identification():
@@ -1755,6 +1766,28 @@ def _log_columns():
 
 def _load_log(columns):
     return _identification().load_log(columns, _pendulum())
+
+
+def _ident():
+    from armdyn import identification
+
+    return identification
+
+
+def _swing_log(n=50, names=("hinge",)):
+    """A log of the pendulum swinging (torques by its inverse dynamics)."""
+    model = _pendulum()
+    t = np.linspace(0.0, 2.0, n)
+    q, qd, qdd = np.sin(3 * t)[:, None], 3 * np.cos(3 * t)[:, None], -9 * np.sin(3 * t)[:, None]
+    tau = np.array([ad.inverse_dynamics(model, *x) for x in zip(q, qd, qdd, strict=True)])
+    return _ident().MotionLog(t, q, qd, qdd, tau, list(names), "synthetic")
+
+
+def _pi_with(i, value):
+    """The pendulum's dynamic parameters with entry i set to value."""
+    pi = ad.dynamic_parameters(_pendulum())
+    pi[i] = value
+    return pi
 
 
 _LIMITS = {"max_velocity": 1.0, "max_acceleration": 2.0, "max_jerk": 10.0}

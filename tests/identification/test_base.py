@@ -109,16 +109,19 @@ def test_options_drop_friction_and_offsets():
 )
 def test_rank_equals_svd_rank_and_is_stable(urdf, fixed):
     """The rank (QR with pivoting on unit-norm columns) equals an independent SVD rank of the
-    raw stacked regressor, for several seeds and sample counts, with a wide gap: the smallest
-    kept pivot is > 1e-4 of the largest and the next < 1e-12."""
+    raw stacked regressor, for several seeds and sample counts (from the fewest allowed, rows =
+    parameters, to 6x that; the default 200 in test_ur5_base_count), with a wide gap: the
+    singular values fall from > 1e-6 to < 1e-12 of the largest at the rank."""
     model = ad.load_urdf(str(ROBOTS / urdf), fixed_base=fixed)
     p = len(ad.dynamic_parameter_names(model))
+    least = -(-p // model.n_dofs)
     ranks = {
-        base_parameters(model, seed=s, samples=n).rank for s, n in [(0, 200), (1, 40), (7, 300)]
+        base_parameters(model, seed=s, samples=n).rank
+        for s, n in [(0, least), (1, 2 * least), (7, 6 * least)]
     }
     assert len(ranks) == 1
     rank = ranks.pop()
-    q, qd, qdd = random_states(model, 100, np.random.default_rng(11))
+    q, qd, qdd = random_states(model, 2 * least, np.random.default_rng(11))
     y = ad.joint_torque_regressor(model, q, qd, qdd).reshape(-1, p)
     s = np.linalg.svd(y, compute_uv=False)  # raw columns: the SVD rank is unit dependent,
     assert np.sum(s > 1e-9 * s[0]) == rank  # but the gap here is wide enough for both
@@ -238,6 +241,7 @@ def test_regressor_selects_columns_on_batches():
     ("kwargs", "match"),
     [
         ({"samples": 0}, "samples"),
+        ({"samples": 13}, "26 regressor rows for 28 parameters: the rank needs at least 14"),
         ({"samples": 2.5}, "samples"),
         ({"seed": -1}, "seed"),
         ({"tol": 0.0}, "tol"),

@@ -64,10 +64,12 @@ def test_fourier_series_closed_form_and_derivatives():
 @needs_robots
 def test_design_beats_random_fourier(ur5_design):
     """The designed motion's condition number against random Fourier motions within the same
-    limits (3 seeds each, both scalings). Measured (this configuration, also in
-    benchmarks/identification_excitation.py): the design ~3x lower than the per-joint scaled
-    random motions, ~3-60x lower than the common-scaled ones: the issue's 10x is not met against
-    the per-joint baseline (see the docstring of fourier_excitation)."""
+    limits (3 seeds each, both scalings): lower than all, and half the median and the start or
+    less. Measured with the same sizes but the UR5's own torque limits and random seeds 100-104
+    (python -m benchmarks.identification_excitation --quick): cond 9.6 (a 40-iteration design
+    is not converged: other round-off, e.g. threaded BLAS, ends elsewhere), 2.7-3.4x below the
+    per-joint scaled random motions, 4.8-143x below the common-scaled ones: the issue's 10x is
+    not met against the per-joint baseline (see fourier_excitation's docstring)."""
     model, base, design = ur5_design
     assert design.info["optimised"]
     assert design.cond < design.info["start_conds"][0]
@@ -76,7 +78,8 @@ def test_design_beats_random_fourier(ur5_design):
         for s in (10, 11, 12)
         for sc in ("joint", "common")
     ]
-    assert design.cond * 2.0 < min(rand)
+    assert design.cond < min(rand)
+    assert design.cond * 2.0 < min(np.median(rand), design.info["start_conds"][0])
     # the cond is the documented one: an independent recomputation
     t = design.period * np.arange(40) / 40
     y = base.regressor(ad.joint_torque_regressor(model, *design.evaluate(t))).reshape(-1, base.rank)
@@ -152,6 +155,8 @@ def test_starts_and_ends_at_rest_and_csv(ur5_design, tmp_path):
         ({"max_velocity": [1.0, 2.0]}, ad.ModelError, "max_velocity must"),
         ({"max_acceleration": np.inf}, ad.ModelError, "max_acceleration"),
         ({"position_margin": 4.0}, ad.SolverError, "position limits of joint 'elbow_joint'"),
+        ({"position_margin": -0.1}, ad.ModelError, "position_margin must be"),
+        ({"position_margin": [0.1, 0.1]}, ad.ModelError, "position_margin must be"),
         ({"q0": [0, 0, 3.2, 0, 0, 0]}, ad.SolverError, "q0.*'elbow_joint'"),
         (
             {"max_torque": [150, 10, 150, 28, 28, 28]},
@@ -198,15 +203,31 @@ def test_fourier_series_bad_inputs():
 
 
 def test_unlimited_joint_with_given_velocity_and_excitation_type():
-    """A joint without position limits: the velocity bound alone bounds the motion."""
+    """Joints without position limits: the velocity bound alone bounds the motion; q0 given."""
     b = ad.ModelBuilder(gravity=(0.0, 0.0, -9.81))
     b.add_body("l1", 1.0, (0.01, 0.01, 0.01), (0.2, 0.0, 0.0))
     b.add_revolute("j1", "ground", "l1", (0.0, 0.0, 0.0), (0.0, 0.0, 1.0))
     b.add_body("l2", 0.5, (0.005, 0.005, 0.005), (0.5, 0.0, 0.0))
     b.add_revolute("j2", "l1", "l2", (0.4, 0.0, 0.0), (0.0, 1.0, 0.0))
     model = b.finalize()
-    exc = fourier_excitation(model, max_velocity=2.0, period=3.0, maxiter=20, starts=1, **SMALL)
+    exc = fourier_excitation(
+        model, max_velocity=2.0, period=3.0, q0=[0.3, -0.2], maxiter=20, starts=1, **SMALL
+    )
     assert isinstance(exc, Excitation)
+    np.testing.assert_array_equal(exc.q0, [0.3, -0.2])  # a given q0 stays fixed
     t = np.linspace(0.0, 3.0, 2001)
     _, qd, qdd = exc.evaluate(t)
     assert np.abs(qd).max() <= 2.0 and np.abs(qdd).max() <= 10.0
+
+
+@needs_robots
+def test_panda_with_a_coupled_finger():
+    """The Panda (the second finger mimics the first): a per-joint margin for the finger's 4 cm;
+    the design improves on its start and keeps every limit."""
+    model = ad.load_urdf(str(ROBOTS / "panda_description/urdf/panda.urdf"))
+    margin = [0.05] * 7 + [0.002]
+    with pytest.raises(ad.SolverError, match="'panda_finger_joint1'"):
+        random_fourier(model, **SMALL)
+    exc = fourier_excitation(model, position_margin=margin, maxiter=15, starts=1, **SMALL)
+    assert exc.info["optimised"] and exc.cond < exc.info["start_conds"][0]
+    _check_limits(model, exc, np.asarray(model.coord_effort_limit), margin=np.array(margin))

@@ -256,7 +256,14 @@ ModelPtr model_with_dynamic_parameters(const Model& m, const VecX& pi, bool phys
   const std::vector<std::string> warnings = std::move(draft.warnings);
   draft.warnings.clear();
   ModelBuilder b(std::move(draft), physical_inertia);
-  for (const NewFrame& f : frames) b.add_frame(f.name, f.name, f.position, f.orientation);
+  for (const NewFrame& f : frames) {
+    try {
+      b.add_frame(f.name, f.name, f.position, f.orientation);
+    } catch (const ModelError& e) {
+      throw ModelError(msg(kFn, ": body '", f.name, "' needs a frame of its name (pi's parameter ",
+                           "frame, its old centre of mass): ", e.what()));
+    }
+  }
   for (const NewFriction& f : frictions)
     b.add_joint_friction(f.joint, f.viscous, f.coulomb, kRegressorCoulombSmoothing, f.sub);
   for (const auto& [joint, Ia] : actuators) {

@@ -16,11 +16,14 @@ columns ``b`` and the dependent ones ``d`` with ``Y_d = Y_b K``, ``K = R11^-1 R1
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
 import scipy.linalg
+import threadpoolctl
 
 from armdyn import _checks, _core
 
@@ -34,11 +37,12 @@ ZERO_COLUMN = 1e-10
 #: entries of K (on unit-norm columns: dimensionless) below this are round-off, set to 0
 K_ZERO = 1e-10
 
+#: (get, set) symbol pairs of the OpenBLAS builds numpy and scipy ship or link
 _FRICTION = (".fv", ".fc")
 _OFFSET = (".offset",)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # arrays: compared by identity
 class BaseParameters:
     """The base parameters of a model (from :func:`base_parameters`).
 
@@ -95,6 +99,16 @@ class BaseParameters:
 
     def __repr__(self) -> str:
         return f"<BaseParameters {self.rank} of {len(self.param_names)} parameters>"
+
+
+@contextlib.contextmanager
+def one_blas_thread() -> Iterator[None]:
+    """Run the block with the BLAS libraries on one thread (threadpoolctl; restored after). The
+    identification's matrices are small (hundreds of rows): BLAS threads gain nothing there and,
+    on a loaded machine, wait for each other: a QR of a 1080 x 178 regressor took 5 s with
+    OpenBLAS's threads on the shared 2-core machine at load 16, milliseconds on one."""
+    with threadpoolctl.threadpool_limits(limits=1, user_api="blas"):
+        yield
 
 
 def random_states(
@@ -164,7 +178,8 @@ def base_parameters(
 
     Args:
         model: any model the regressor takes (fixed or floating base).
-        samples: random states stacked (>= 1; the rows are ``samples * n_dofs``).
+        samples: random states stacked (the rows are ``samples * n_dofs``: at least as many
+            as the parameters kept, so that the rank is not capped by the rows).
         seed: the random generator's seed.
         tol: the relative rank tolerance (0 < tol < 1), default :data:`RANK_TOL`.
         friction: keep the joints' viscous and Coulomb friction parameters (``fv``, ``fc``);
@@ -190,9 +205,17 @@ def base_parameters(
             f"{who}: samples = {samples} gives a {samples * model.n_dofs} x {len(names)} "
             "regressor (> 5e7 entries); use fewer samples"
         )
+    kept = _kept_columns(names, friction, offsets)
+    need = -(-int(kept.sum()) // model.n_dofs)
+    if samples < need:
+        raise _core.ModelError(
+            f"{who}: samples = {samples} gives {samples * model.n_dofs} regressor rows for "
+            f"{int(kept.sum())} parameters: the rank needs at least {need} samples"
+        )
     q, qd, qdd = random_states(model, samples, np.random.default_rng(seed))
     y = _core.joint_torque_regressor(model, q, qd, qdd).reshape(-1, len(names))
-    return _from_stack(names, y, tol, _kept_columns(names, friction, offsets))
+    with one_blas_thread():
+        return _from_stack(names, y, tol, kept)
 
 
 def _from_stack(names: list[str], y: np.ndarray, tol: float, kept: np.ndarray) -> BaseParameters:
@@ -211,6 +234,10 @@ def _from_stack(names: list[str], y: np.ndarray, tol: float, kept: np.ndarray) -
     norms = norms.copy()
     norms[cols] /= weight
     ys = y[:, cols] / norms[cols]
+    # the pivoted QR of the tall matrix equals that of its triangular factor (same column norms
+    # and inner products): an unpivoted QR first, then the pivoted one on a (p, p) matrix
+    if ys.shape[0] > ys.shape[1]:
+        ys = np.linalg.qr(ys, mode="r")
     _, r, perm = scipy.linalg.qr(ys, mode="economic", pivoting=True)
     diag = np.abs(np.diag(r))
     rank = int(np.sum(diag > tol * diag[0]))

@@ -20,6 +20,7 @@ Starting from rest: by default (``at_rest=True``) the coefficients satisfy
 
 from __future__ import annotations
 
+import functools
 import time
 from dataclasses import dataclass, field
 from typing import Any
@@ -29,7 +30,12 @@ import numpy.typing as npt
 import scipy.optimize
 
 from armdyn import _checks, _core
-from armdyn.identification.base import BaseParameters, base_parameters, random_states
+from armdyn.identification.base import (
+    BaseParameters,
+    base_parameters,
+    one_blas_thread,
+    random_states,
+)
 from armdyn.motion.trajectory import Trajectory
 
 __all__ = ["Excitation", "fourier_excitation", "fourier_series", "random_fourier"]
@@ -44,6 +50,17 @@ ACCELERATION_PER_VELOCITY = 5.0
 CHECK_PER_CYCLE = 40
 TORQUE_CHECK = 0.999
 MAX_HARMONICS = 50
+
+
+def _single_blas_thread(fn):
+    """``fn`` run under :func:`armdyn.identification.base.one_blas_thread`."""
+
+    @functools.wraps(fn)
+    def run(*args, **kwargs):
+        with one_blas_thread():
+            return fn(*args, **kwargs)
+
+    return run
 
 
 def fourier_series(
@@ -80,7 +97,7 @@ def _series(t, q0, a, b, wf):
     return q, qd, qdd
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # arrays: compared by identity
 class Excitation:
     """A periodic excitation motion (from :func:`fourier_excitation` or :func:`random_fourier`).
 
@@ -106,6 +123,7 @@ class Excitation:
 
     @property
     def harmonics(self) -> int:
+        """The number of harmonics per joint (the columns of ``a`` and ``b``)."""
         return int(self.a.shape[1])
 
     def evaluate(self, t: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -170,8 +188,19 @@ class _Problem:
         self.torque_times = self.times
         self.scale = _column_scale(model, base)
         self.evaluations = 0
+        # the decision variables in units of what each joint allows (a finger's centimetres and
+        # a shoulder's radians alike O(1)): a coefficient by the largest first-harmonic one
+        # its position room, velocity and acceleration limits allow, q0 by half its range
+        lim = limits
+        both = np.isfinite(lim.upper) & np.isfinite(lim.lower)
+        half = np.where(both, 0.5 * (lim.upper - lim.lower), np.inf)
+        amp = np.minimum(np.minimum(half * self.wf, lim.velocity), lim.acceleration / self.wf)
+        free = harmonics - 1 if at_rest else harmonics
+        parts = [] if q0 is not None else [np.where(both, half, 1.0)]
+        self.xscale = np.concatenate([*parts, np.repeat(amp, free), np.repeat(amp, free)])
 
     def unpack(self, x):
+        x = x * self.xscale
         k = 0
         if self.fixed_q0 is None:
             q0, k = x[: self.n], self.n
@@ -189,7 +218,7 @@ class _Problem:
     def pack(self, q0, a, b):
         cut = 1 if self.at_rest else 0
         parts = [] if self.fixed_q0 is not None else [q0]
-        return np.concatenate([*parts, a[:, cut:].ravel(), b[:, cut:].ravel()])
+        return np.concatenate([*parts, a[:, cut:].ravel(), b[:, cut:].ravel()]) / self.xscale
 
     def states(self, q0, a, b, t):
         return _series(t, q0, a, b, self.wf)
@@ -242,7 +271,18 @@ def _cond(problem, q0, a, b, t):
     y = problem.base.regressor(
         _core.joint_torque_regressor(problem.model, *problem.states(q0, a, b, t))
     )
-    s = np.linalg.svd(y.reshape(-1, problem.base.rank) / problem.scale, compute_uv=False)
+    return scaled_cond(y.reshape(-1, problem.base.rank) / problem.scale)
+
+
+def scaled_cond(y: np.ndarray) -> float:
+    """The 2-norm condition number of ``y`` (rows >= columns): from the eigenvalues of
+    ``y^T y`` (a small symmetric eigenproblem, cheaper than the tall matrix's SVD) while that is
+    accurate (cond < 1e6: the
+    squared cond keeps ~1e-4 relative), else from the SVD."""
+    lam = np.linalg.eigvalsh(y.T @ y)
+    if lam[0] > 1e-12 * lam[-1]:
+        return float(np.sqrt(lam[-1] / lam[0]))
+    s = np.linalg.svd(y, compute_uv=False)
     return float(s[0] / s[-1]) if s[-1] > 0.0 else float("inf")
 
 
@@ -308,6 +348,18 @@ def _per_joint(who, name, value, default, n, names):
     return arr
 
 
+def _margin(who, value, n):
+    """position_margin: one number or one per joint, each finite and >= 0."""
+    arr = _checks.array(who, "position_margin", value, finite=True)
+    if arr.ndim == 0:
+        arr = np.full(n, float(arr))
+    if arr.shape != (n,) or np.any(arr < 0.0):
+        raise _core.ModelError(
+            f"{who}: position_margin must be a number >= 0 or {n} of them, got {value!r}"
+        )
+    return arr
+
+
 def _limits(who, model, max_velocity, max_acceleration, max_torque, margin):
     n, names = model.n_dofs, list(model.coord_names)
     vel_model = np.asarray(model.coord_velocity_limit, dtype=float)
@@ -337,7 +389,7 @@ def _limits(who, model, max_velocity, max_acceleration, max_torque, margin):
         if not upper[j] > lower[j]:
             raise _core.SolverError(
                 f"{who}: position limits of joint {names[j]!r} minus position_margin = "
-                f"{margin:g} leave no room: [{lower[j]:.6g}, {upper[j]:.6g}]"
+                f"{margin[j]:g} leave no room: [{lower[j]:.6g}, {upper[j]:.6g}]"
             )
     return _Limits(lower, upper, vel, acc, tau)
 
@@ -359,7 +411,7 @@ def _setup(who, model, period, harmonics, q0, limits, base, samples, at_rest):
         who, "harmonics", harmonics, lo=2 if at_rest else 1, hi=MAX_HARMONICS
     )
     samples = _checks.integer(who, "samples", samples, lo=1, hi=100_000)
-    margin = _checks.number(who, "position_margin", limits.pop("position_margin"), lo=0.0)
+    margin = _margin(who, limits.pop("position_margin"), model.n_dofs)
     lim = _limits(who, model, **limits, margin=margin)
     if base is None:
         base = base_parameters(model)
@@ -391,8 +443,11 @@ def _centre(problem):
     if problem.fixed_q0 is not None:
         return problem.fixed_q0
     lo, hi = problem.limits.lower, problem.limits.upper
+    # mid-range; 0 without limits; 1 (rad or m) inside a one-sided limit (or 0 when inside)
     both = np.isfinite(lo) & np.isfinite(hi)
     mid = 0.5 * (np.where(both, lo, 0.0) + np.where(both, hi, 0.0))
+    mid = np.maximum(mid, np.where(np.isfinite(lo) & ~both, lo + 1.0, -np.inf))
+    mid = np.minimum(mid, np.where(np.isfinite(hi) & ~both, hi - 1.0, np.inf))
     return np.clip(mid, lo + 1e-9, hi - 1e-9)
 
 
@@ -433,10 +488,11 @@ def _random_start(problem, rng, fill=0.9, per_joint=True):
 
 
 def _feasible(problem, x, grid):
-    """(q0, a, b) of x, shrunk by the first of 1, 0.999, 0.99, 0.95 that meets every limit on
-    the check grid (SLSQP meets its constraints only to its tolerance), or None."""
+    """(q0, a, b) of x, its oscillation about q0 shrunk by the first of 1, 0.999, ..., 0.5
+    that meets every limit on the check grid (SLSQP's iterates meet the constraints only at
+    convergence, and then to its tolerance), or None."""
     q0, a, b = problem.unpack(x)
-    for shrink in (1.0, 0.999, 0.99, 0.95):
+    for shrink in (1.0, 0.999, 0.99, 0.97, 0.94, 0.9, 0.85, 0.8, 0.7, 0.6, 0.5):
         if not _violations(problem, q0, shrink * a, shrink * b, grid):
             return q0, shrink * a, shrink * b
     return None
@@ -513,6 +569,7 @@ def _info(problem, samples):
     }
 
 
+@_single_blas_thread
 def fourier_excitation(
     model: _core.Model,
     *,
@@ -522,7 +579,7 @@ def fourier_excitation(
     max_velocity: npt.ArrayLike | None = None,
     max_acceleration: npt.ArrayLike | None = None,
     max_torque: npt.ArrayLike | None = None,
-    position_margin: float = 0.05,
+    position_margin: npt.ArrayLike = 0.05,
     base: BaseParameters | None = None,
     seed: int = 0,
     samples: int = 100,
@@ -542,8 +599,10 @@ def fourier_excitation(
     hide a parameter the motion leaves unexcited. A fixed scale per column keeps the criterion
     unit-free and still rewards exciting every column.
 
-    SLSQP (scipy) minimises ``log cond`` from ``starts`` feasible random starts
-    (:func:`random_fourier`, seeds ``seed``, ``seed + 1``, ...), the best result kept. The
+    SLSQP (scipy; gradients by finite differences) minimises ``log cond`` from ``starts``
+    feasible random starts (:func:`random_fourier` with per-joint scaling, seeds ``seed``,
+    ``seed + 1``, ...), the best result kept; the variables are scaled per joint by what its
+    limits allow, so a gripper's centimetres and a shoulder's radians weigh alike. The
     constraints: ``|q - q0| <= sum_l |c_l| / (w_f l)``, ``|qd| <= sum_l |c_l|`` and
     ``|qdd| <= sum_l w_f l |c_l|`` (``|c_l| = sqrt(a_l^2 + b_l^2)``; conservative bounds for all
     t) within the position limits minus ``position_margin``, ``max_velocity`` and
@@ -551,8 +610,11 @@ def fourier_excitation(
     :data:`TORQUE_MARGIN` (0.95) of ``max_torque``. Every result is checked on a grid of
     :data:`CHECK_PER_CYCLE` (40) samples per cycle of the highest harmonic (at least 200), the
     torques within :data:`TORQUE_CHECK` (0.999) of their limits there; an optimum that breaks a
-    torque limit there gets those times as constraints and is solved again;
-    if none passes, the best feasible start is returned (``info["optimised"]`` False).
+    torque limit there gets those times as constraints and is solved again. An SLSQP result
+    (or the best iterate that met the constraints) that misses a limit has its oscillation about
+    ``q0`` shrunk by the first factor of 1, 0.999, ..., 0.5 that meets them all; if no start
+    gives a feasible result better than the best start, that start is returned
+    (``info["optimised"]`` False).
 
     Args:
         model: a fixed-base model (no quaternion coordinates).
@@ -561,7 +623,8 @@ def fourier_excitation(
         max_velocity: [rad/s or m/s] per joint or one number; default model.coord_velocity_limit.
         max_acceleration: default :data:`ACCELERATION_PER_VELOCITY` (5 / s) x max_velocity.
         max_torque: default model.coord_effort_limit (0 or inf: no torque limit).
-        position_margin: [rad or m] kept from each position limit.
+        position_margin: [rad or m] kept from each position limit: one number or one per joint
+            (a gripper finger's few centimetres need a smaller one).
         base: the model's BaseParameters (default base_parameters(model)).
         seed: the first random start's seed; samples: times per period in the condition number
             and the torque constraints; maxiter: SLSQP iterations per start; starts: how many.
@@ -571,8 +634,15 @@ def fourier_excitation(
         ModelError: a bad argument, a floating base, a model without joints.
         SolverError: limits no motion can meet (naming the limit and the joint).
 
-    Runtime: the defaults (5 harmonics, 100 samples, 3 starts of 100 iterations) take about a
-    minute on the UR5 (benchmarks/identification_excitation.py).
+    Runtime and result on the UR5 with its own limits, period 10 s
+    (``python -m benchmarks.identification_excitation``,
+    benchmarks/results/identification_excitation.json): the defaults (5 harmonics, 100
+    samples, 3 starts of 100 SLSQP iterations, ~17,600 condition numbers) take 36 s of CPU
+    (111 s wall on the shared 2-core machine) and reach cond 6.1, against 12-41 for random
+    motions scaled per joint (1.9-6.6x higher) and 25-68 for random motions scaled by one
+    common factor (4.0-11x), 5 seeds each: the issue's 10x holds only against part of the
+    common-scaled ones. ``--quick`` (3 harmonics, 40 samples, 1 start of 40 iterations, as the
+    tests): 1.9 s CPU, cond 9.6, 2.7-3.4x below per-joint random, 4.8-143x below common.
     """
     who = "fourier_excitation"
     limits = {
@@ -613,6 +683,7 @@ def fourier_excitation(
     return _excitation(problem, *chosen, info)
 
 
+@_single_blas_thread
 def random_fourier(
     model: _core.Model,
     *,
@@ -622,7 +693,7 @@ def random_fourier(
     max_velocity: npt.ArrayLike | None = None,
     max_acceleration: npt.ArrayLike | None = None,
     max_torque: npt.ArrayLike | None = None,
-    position_margin: float = 0.05,
+    position_margin: npt.ArrayLike = 0.05,
     base: BaseParameters | None = None,
     seed: int = 0,
     samples: int = 100,
