@@ -1,7 +1,7 @@
 """``armdyn identify``: the CLI run in-process on a small synthetic log (issue 35).
 
 The log is "measured" on a two-joint arm whose parameters were perturbed (bodies scaled,
-friction, offsets and rotor inertias added: identification_standin.true_parameters), with
+friction, offsets and rotor inertias added: identification_synthetic.true_parameters), with
 Gaussian noise of known level; the CLI must write the identified URDF (its parameters those of
 parameters.csv), the report and parameters.csv, exit 0, and refuse hostile inputs with one line
 and exit code 2."""
@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 import pytest
 from armdyn.__main__ import main
-from identification_standin import synthetic_log, true_parameters
+from identification_synthetic import synthetic_log, true_parameters
 
 pytest.importorskip("armdyn.identification.estimate", reason="needs the fit part (i35-fit)")
 pytest.importorskip("armdyn.identification.log", reason="needs the log part (i35-log)")

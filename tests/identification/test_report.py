@@ -1,8 +1,9 @@
 """armdyn.identification.report: the identification report's page, figure and tables (issue 35).
 
-The identification is the stand-in of identification_standin.py (QR base + ordinary least
-squares) on a synthetic log of a perturbed arm6 with known noise, until the fit part is merged."""
+The identification is identify()'s on a synthetic log of a perturbed arm6 with known noise
+(identification_synthetic.py)."""
 
+import dataclasses
 import html
 import re
 from pathlib import Path
@@ -11,9 +12,9 @@ import armdyn as ad
 import numpy as np
 import pandas as pd
 import pytest
-from armdyn.identification import report
+from armdyn.identification import identify, report
 from armdyn.identification.validate import compare, validate
-from identification_standin import StandIn, ols_standin, synthetic_log, true_parameters
+from identification_synthetic import synthetic_log, true_parameters
 
 ARM6 = Path(__file__).resolve().parents[1] / "data" / "urdf" / "arm6.urdf"
 NOISE = 0.05
@@ -25,7 +26,7 @@ def case():
     pi_true = true_parameters(model)
     fit = synthetic_log(model, pi_true, noise=NOISE, seed=1)
     val = synthetic_log(model, pi_true, noise=NOISE, seed=2)
-    ident = ols_standin(model, fit)
+    ident = identify(model, fit)
     return model, ident, validate(ident, val), validate(model, val)
 
 
@@ -125,7 +126,7 @@ def test_body_and_joint_gap(case):
     k = names.index("forearm_link.m")
     pi[k : k + 10] *= 1.5
     pi[names.index("elbow_joint.fv")] = 0.25
-    fake = StandIn(**{**ident.__dict__, "pi": pi})
+    fake = dataclasses.replace(ident, pi=pi)
     gap = report.body_gap(fake)
     assert gap.loc["forearm_link", "mass change [%]"] == pytest.approx(50.0, rel=1e-12)
     assert gap.loc["forearm_link", "com shift [m]"] == pytest.approx(0.0, abs=1e-15)
@@ -141,8 +142,7 @@ def test_body_and_joint_gap(case):
 def test_solver_note(case, tmp_path):
     """A physically consistent identification's solver status in the fit section."""
     _, ident, v, _ = case
-    fake = StandIn(**{**ident.__dict__, "physical": True})
-    fake.info = {"status": "optimal"}
+    fake = dataclasses.replace(ident, physical=True, info={"status": "optimal"})
     text = report.write_report(fake, tmp_path, validation=v).read_text(encoding="utf-8")
     text = html.unescape(text)
     assert "Solver status: optimal." in text
