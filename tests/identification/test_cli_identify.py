@@ -182,6 +182,8 @@ def _bad(tmp_path, robot):
     unknown.write_text("\n".join([text[0].replace("elbow.qdd", "wrist.qdd"), *text[1:]]) + "\n")
     afile = d / "afile"
     afile.write_text("x")
+    short = d / "short.csv"
+    short.write_text("\n".join(text[:7]) + "\n")  # 6 samples: 4 to fit, 2 to validate
     current = d / "current.csv"
     current.write_text("\n".join([text[0].replace(".tau", ".current"), *text[1:]]) + "\n")
     fifo = d / "fifo.csv"
@@ -209,6 +211,7 @@ def _bad(tmp_path, robot):
         "cutoff": ([urdf, "--log", fit, "--cutoff", "-1"], "--cutoff"),
         "cutoff-nan": ([urdf, "--log", fit, "--cutoff", "nan"], "--cutoff"),
         "method": ([urdf, "--log", fit, "--method", "lasso"], "--method"),
+        "short-to-split": ([urdf, "--log", str(short)], r"6 samples cannot be split.*--validate"),
         "current-no-ratios": (
             [urdf, "--log", str(current), "--torque-constants", "0.1"],
             "--gear-ratios is required",
@@ -222,7 +225,7 @@ CASES = [
     "missing-urdf", "missing-log", "log-directory", "log-fifo", "log-device", "empty-csv",
     "header-only", "nan", "unknown-joint", "validate-directory", "out-is-a-file",
     "out-under-a-file", "cutoff", "cutoff-nan", "method", "torque-constants", "gear-ratios-mixed",
-    "current-no-ratios",
+    "current-no-ratios", "short-to-split",
 ]  # fmt: skip
 
 

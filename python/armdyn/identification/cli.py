@@ -182,11 +182,13 @@ def _logs(args, model, options):
     log = _read("--log", args.log, model, options)
     if args.validate is not None:
         return log, _read("--validate", args.validate, model, options)
-    if len(log.t) < 2:
+    try:
+        return log.split(FIT_FRACTION)
+    except _core.ModelError as exc:
         raise _core.ModelError(
-            f"--log {args.log!r}: too few samples to split into fit and validation"
-        )
-    return log.split(FIT_FRACTION)
+            f"--log {args.log!r}: {len(log.t)} samples cannot be split into a fit part (the first "
+            f"{FIT_FRACTION:.0%}) and a validation part ({exc}); give a longer log or --validate"
+        ) from None
 
 
 def _read(option: str, path: str, model, options):
