@@ -47,6 +47,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from armdyn import _core
+from armdyn.identification.physical import pseudo_inertia
 from armdyn.identification.validate import Validation
 from armdyn.sizing.html import _CSS, ReportFigure, Section, _esc, _fmt, _section_block, figure_png
 
@@ -140,18 +141,6 @@ def parameter_table(identification) -> pd.DataFrame:
             "identified": np.asarray(identification.pi, dtype=float),
         }
     )
-
-
-def pseudo_inertia(p10) -> np.ndarray:
-    """The 4x4 pseudo-inertia ``[[0.5 tr(I) 1 - I, h], [h^T, m]]`` of a body's 10 parameters
-    (``m, mcx, mcy, mcz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz``)."""
-    m, hx, hy, hz, xx, xy, yy, xz, yz, zz = (float(v) for v in p10)
-    inertia = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
-    j = np.empty((4, 4))
-    j[:3, :3] = 0.5 * np.trace(inertia) * np.eye(3) - inertia
-    j[:3, 3] = j[3, :3] = (hx, hy, hz)
-    j[3, 3] = m
-    return j
 
 
 def _com_inertia(p10) -> tuple[float, np.ndarray, np.ndarray]:
