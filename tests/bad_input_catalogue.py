@@ -1710,6 +1710,38 @@ CASES = [
         ME,
         r"outlier_threshold must be a number > 0",
     ),
+    (
+        "validate-log-joints",
+        "identification",
+        "validate with a log of other joints than the model's",
+        lambda: _validate(joint_names=["other"]),
+        ME,
+        r"the log's joints \['other'\] are not the model's \['hinge'\]",
+    ),
+    (
+        "validate-pi-length",
+        "identification",
+        "validate with a pi of the wrong length",
+        lambda: _validate(pi=np.ones(3)),
+        ME,
+        r"pi has 3 entries, the model 14",
+    ),
+    (
+        "identify-cli-per-joint",
+        "identification",
+        "`armdyn identify --gear-ratios elbow=2,3` (named and unnamed entries mixed)",
+        lambda: _identify_cli().per_joint("--gear-ratios", "elbow=2,3"),
+        ME,
+        r"--gear-ratios 'elbow=2,3': either every entry is JOINT=VALUE or none is",
+    ),
+    (
+        "identify-cli-cutoff",
+        "identification",
+        "`armdyn identify --cutoff -1` (not a positive frequency)",
+        lambda: _identify_cli()._cutoff("-1"),
+        ME,
+        r"--cutoff '-1': the cutoff must be > 0 Hz",
+    ),
 ]
 
 
@@ -1808,6 +1840,24 @@ def _least_energy(**change):
     args = dict(start=[0.0], goal=[1.0], duration=1.0, objective="rms_torque")
     args.update(change)
     return least_energy(_pendulum(), **args)
+
+
+def _validate(pi=None, **log_fields):
+    """validate(pendulum, a three-sample log of it, pi=pi), the log's fields overridden."""
+    from types import SimpleNamespace
+
+    from armdyn.identification import validate
+
+    z = np.zeros((3, 1))
+    fields = dict(t=np.arange(3.0), q=z, qd=z, qdd=z, tau=z, joint_names=["hinge"])
+    fields.update(log_fields)
+    return validate(_pendulum(), SimpleNamespace(**fields), pi=pi)
+
+
+def _identify_cli():
+    from armdyn.identification import cli
+
+    return cli
 
 
 def _cli():

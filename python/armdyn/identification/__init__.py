@@ -20,6 +20,8 @@ from armdyn.identification.excitation import (
 from armdyn.identification.export import with_parameters, write_urdf
 from armdyn.identification.log import MotionLog, differentiate, load_log, log_from_arrays
 from armdyn.identification.physical import is_physical, physical_violations, pseudo_inertia
+from armdyn.identification.report import write_report
+from armdyn.identification.validate import Validation, validate
 
 dynamic_parameter_names = _core.dynamic_parameter_names
 dynamic_parameters = _core.dynamic_parameters
@@ -30,6 +32,7 @@ __all__ = [
     "Excitation",
     "Identification",
     "MotionLog",
+    "Validation",
     "base_parameters",
     "differentiate",
     "dynamic_parameter_names",
@@ -44,6 +47,8 @@ __all__ = [
     "physical_violations",
     "pseudo_inertia",
     "random_fourier",
+    "validate",
     "with_parameters",
+    "write_report",
     "write_urdf",
 ]
