@@ -83,9 +83,17 @@ void bind_regressor(py::module_& m) {
         "(per body: m, m c, the inertia about its parameter frame -- its URDF link frame; per "
         "joint coordinate: viscous and Coulomb friction, a torque offset, the rotor's reflected "
         "inertia; dynamic_parameter_names names them). q: n_coords, qd and qdd: n_dofs (a "
-        "coupled model's independent coordinates); 2-D arrays (one state per row) give (rows, "
-        "n_dofs, n_params). ModelError for a model with a force element that is not a "
-        "parameter (springs, loads, inputs, motors), named.");
+        "coupled model's independent coordinates, Y = G^T Y_full); 2-D arrays (one state per "
+        "row) give (rows, n_dofs, n_params), computed in C++ without the GIL. A floating base's "
+        "six rows come first: the force on the base frame, then the moment about its origin, in "
+        "its axes (as inverse_dynamics). By the recursive Newton-Euler algorithm: per body its "
+        "6 x 10 unit-wrench block F in its parameter frame, then one row block S^T F per degree "
+        "of freedom on its path to the root. Pinocchio's computeJointTorqueRegressor is the same "
+        "matrix reordered: rows by joint name (a free flyer's six first), body B's 10 columns "
+        "those of the joint whose child link is B (Pinocchio's joint frame is the URDF link "
+        "frame), armdyn's friction, offset and rotor columns added. ModelError for a model with "
+        "a force element that is not a parameter (springs, loads, inputs, motors), named; "
+        "SolverError when finite inputs overflow.");
   m.def("energy_regressor", &energy_regressor_py, py::arg("model"), py::arg("q"), py::arg("qd"),
         py::arg("data") = py::none(),
         "The energy regressor h (n_params,) at (q, qd): the kinetic plus potential energy of the "

@@ -121,15 +121,13 @@ void layout_coordinates(const Model& m, ParameterLayout& L, const char* fn) {
 
 }  // namespace regressor_detail
 
-using namespace regressor_detail;
-
 ParameterLayout dynamic_parameter_layout(const Model& m) {
   constexpr const char* fn = "dynamic_parameter_layout";
   require_joint_space(m, fn, true);
-  refuse_non_parameters(m, fn);
+  regressor_detail::refuse_non_parameters(m, fn);
   ParameterLayout L;
-  layout_bodies(m, L);
-  layout_coordinates(m, L, fn);
+  regressor_detail::layout_bodies(m, L);
+  regressor_detail::layout_coordinates(m, L, fn);
   L.n_params = L.coord_offset(m.independent.n);
   for (int k = 0; k < m.independent.n; ++k)
     for (int a : L.actuators[k]) {
@@ -138,7 +136,7 @@ ParameterLayout dynamic_parameter_layout(const Model& m) {
       ParameterLayout::Rotor r;
       r.body = m.joints[act.rotor_joint].child;
       r.column = L.coord_offset(k) + 3;
-      r.weights = rotor_weights(m, act);
+      r.weights = regressor_detail::rotor_weights(m, act);
       L.rotors.push_back(r);
     }
   return L;
@@ -433,29 +431,34 @@ void energy_into(const Model& m, Data& d, const ParameterLayout& L, Eigen::Ref<c
 void joint_torque_regressor(const Model& m, Data& d, Eigen::Ref<const VecX> q,
                             Eigen::Ref<const VecX> qd, Eigen::Ref<const VecX> qdd, MatX& Y) {
   // the checks first: a refused call leaves Y as it was
-  const ParameterLayout& L = checked_layout(m, d, q, qd, &qdd, "joint_torque_regressor");
+  const ParameterLayout& L =
+      regressor_detail::checked_layout(m, d, q, qd, &qdd, "joint_torque_regressor");
   Y.resize(d.ni, L.n_params);
-  regressor_into(m, d, L, q, qd, qdd, Out{Y.data(), 1, Y.rows()});
+  regressor_detail::regressor_into(m, d, L, q, qd, qdd,
+                                   regressor_detail::Out{Y.data(), 1, Y.rows()});
 }
 
 void joint_torque_regressor_into(const Model& m, Data& d, Eigen::Ref<const VecX> q,
                                  Eigen::Ref<const VecX> qd, Eigen::Ref<const VecX> qdd,
                                  double* out) {
-  const ParameterLayout& L = checked_layout(m, d, q, qd, &qdd, "joint_torque_regressor");
-  regressor_into(m, d, L, q, qd, qdd, Out{out, L.n_params, 1});
+  const ParameterLayout& L =
+      regressor_detail::checked_layout(m, d, q, qd, &qdd, "joint_torque_regressor");
+  regressor_detail::regressor_into(m, d, L, q, qd, qdd, regressor_detail::Out{out, L.n_params, 1});
 }
 
 void energy_regressor(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
                       VecX& h) {
-  const ParameterLayout& L = checked_layout(m, d, q, qd, nullptr, "energy_regressor");
+  const ParameterLayout& L =
+      regressor_detail::checked_layout(m, d, q, qd, nullptr, "energy_regressor");
   h.resize(L.n_params);
-  energy_into(m, d, L, q, qd, h.data());
+  regressor_detail::energy_into(m, d, L, q, qd, h.data());
 }
 
 void energy_regressor_into(const Model& m, Data& d, Eigen::Ref<const VecX> q,
                            Eigen::Ref<const VecX> qd, double* out) {
-  const ParameterLayout& L = checked_layout(m, d, q, qd, nullptr, "energy_regressor");
-  energy_into(m, d, L, q, qd, out);
+  const ParameterLayout& L =
+      regressor_detail::checked_layout(m, d, q, qd, nullptr, "energy_regressor");
+  regressor_detail::energy_into(m, d, L, q, qd, out);
 }
 
 }  // namespace armdyn

@@ -7,7 +7,7 @@ import numpy
 import numpy.typing
 import typing
 from . import profiles
-__all__: list[str] = ['Actuator', 'Data', 'LagrangeValidator', 'Model', 'ModelBuilder', 'ModelError', 'Motor', 'Profile', 'SolverError', 'URDF_COULOMB_SMOOTHING', 'URDF_MAX_ATTRIBUTES', 'URDF_MAX_BYTES', 'UrdfError', 'body_accelerations', 'body_forces', 'body_mass_matrix', 'dynamic_parameter_names', 'dynamic_parameters', 'dynamics_cost', 'end_effector_position', 'energy', 'evaluate_constraints', 'forward_dynamics', 'forward_dynamics_derivatives', 'frame_jacobian', 'frame_jacobian_cartesian', 'frame_pose', 'frame_pose_cartesian', 'inverse_dynamics', 'inverse_dynamics_derivatives', 'joint_coordinates', 'joint_reactions', 'joint_torque_regressor', 'mass_matrix', 'paper_3dof_torques', 'paper_5dof_end_effector', 'profiles', 'state_from_joints', 'torque_error_metrics', 'urdf_builder']
+__all__: list[str] = ['Actuator', 'Data', 'LagrangeValidator', 'Model', 'ModelBuilder', 'ModelError', 'Motor', 'Profile', 'SolverError', 'URDF_COULOMB_SMOOTHING', 'URDF_MAX_ATTRIBUTES', 'URDF_MAX_BYTES', 'UrdfError', 'body_accelerations', 'body_forces', 'body_mass_matrix', 'dynamic_parameter_names', 'dynamic_parameters', 'dynamics_cost', 'end_effector_position', 'energy', 'energy_regressor', 'evaluate_constraints', 'forward_dynamics', 'forward_dynamics_derivatives', 'frame_jacobian', 'frame_jacobian_cartesian', 'frame_pose', 'frame_pose_cartesian', 'inverse_dynamics', 'inverse_dynamics_derivatives', 'joint_coordinates', 'joint_reactions', 'joint_torque_regressor', 'mass_matrix', 'paper_3dof_torques', 'paper_5dof_end_effector', 'profiles', 'state_from_joints', 'torque_error_metrics', 'urdf_builder']
 class ModelError(ValueError):
     """
     Bad input: a model, builder call, array shape or option that armdyn refuses, the message naming the culprit (the body, joint, argument and the expected shape). The model or builder is left as it was. A ValueError.
@@ -687,6 +687,10 @@ def energy(model: Model, u: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike) -
     """
     (kinetic, potential) energy [J] at the Cartesian state u (nq,), v (nv,); the potential includes gravity and springs. ModelError on wrong shapes.
     """
+def energy_regressor(model: Model, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, data: Data | None = None) -> numpy.typing.NDArray[numpy.float64]:
+    """
+    The energy regressor h (n_params,) at (q, qd): the kinetic plus potential energy of the model's bodies and actuator rotors is h @ dynamic_parameters(model) (potential -m g . c about the world origin, as energy(); the friction and offset entries are 0). Identification from energy needs no accelerations: h(t1) - h(t0) is the integral of (tau - friction) . qd dt along a motion. q: n_coords, qd: n_dofs; 2-D arrays (one state per row) give (rows, n_params). ModelError as joint_torque_regressor.
+    """
 def evaluate_constraints(model: Model, u: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, t: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> dict:
     """
     The constraints at the Cartesian state u (nq,), v (nv,) and time t [s]: a dict of float64 arrays f (nc,) (the residuals, [m or rad]), zeta (nc, nv) (the Jacobian), xi (nc,) and rhs (nc,), with zeta v = rhs and zeta v' = -xi. ModelError on wrong shapes.
@@ -733,7 +737,7 @@ def joint_reactions(model: Model, q: numpy.typing.ArrayLike, qd: numpy.typing.Ar
     """
 def joint_torque_regressor(model: Model, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike, data: Data | None = None) -> numpy.typing.NDArray[numpy.float64]:
     """
-    The joint torque regressor Y (n_dofs, n_params) at (q, qd, qdd): inverse_dynamics(model, q, qd, qdd) = Y @ dynamic_parameters(model), linear in the model's dynamic parameters (per body: m, m c, the inertia about its parameter frame -- its URDF link frame; per joint coordinate: viscous and Coulomb friction, a torque offset, the rotor's reflected inertia; dynamic_parameter_names names them). q: n_coords, qd and qdd: n_dofs (a coupled model's independent coordinates); 2-D arrays (one state per row) give (rows, n_dofs, n_params). ModelError for a model with a force element that is not a parameter (springs, loads, inputs, motors), named.
+    The joint torque regressor Y (n_dofs, n_params) at (q, qd, qdd): inverse_dynamics(model, q, qd, qdd) = Y @ dynamic_parameters(model), linear in the model's dynamic parameters (per body: m, m c, the inertia about its parameter frame -- its URDF link frame; per joint coordinate: viscous and Coulomb friction, a torque offset, the rotor's reflected inertia; dynamic_parameter_names names them). q: n_coords, qd and qdd: n_dofs (a coupled model's independent coordinates, Y = G^T Y_full); 2-D arrays (one state per row) give (rows, n_dofs, n_params), computed in C++ without the GIL. A floating base's six rows come first: the force on the base frame, then the moment about its origin, in its axes (as inverse_dynamics). By the recursive Newton-Euler algorithm: per body its 6 x 10 unit-wrench block F in its parameter frame, then one row block S^T F per degree of freedom on its path to the root. Pinocchio's computeJointTorqueRegressor is the same matrix reordered: rows by joint name (a free flyer's six first), body B's 10 columns those of the joint whose child link is B (Pinocchio's joint frame is the URDF link frame), armdyn's friction, offset and rotor columns added. ModelError for a model with a force element that is not a parameter (springs, loads, inputs, motors), named; SolverError when finite inputs overflow.
     """
 def mass_matrix(model: Model, q: numpy.typing.ArrayLike, data: Data | None = None) -> numpy.typing.NDArray[numpy.float64]:
     """

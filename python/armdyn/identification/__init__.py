@@ -10,12 +10,14 @@ estimates with their uncertainties, a validation on other data, and the identifi
 back as a URDF and an armdyn model.
 """
 
-from armdyn._core import (
-    dynamic_parameter_names,
-    dynamic_parameters,
-    energy_regressor,
-    joint_torque_regressor,
-)
+# (the compiled module as a leaf: `from armdyn._core import ...` would read as an import of the
+# armdyn package, a cycle with armdyn's own import of this package; tests/docs/test_layout.py)
+from armdyn import _core
+
+dynamic_parameter_names = _core.dynamic_parameter_names
+dynamic_parameters = _core.dynamic_parameters
+energy_regressor = _core.energy_regressor
+joint_torque_regressor = _core.joint_torque_regressor
 
 __all__ = [
     "dynamic_parameter_names",
