@@ -245,8 +245,9 @@ void body_terms(const Model& m, const Data& d, int b, const Vec3& point, const M
 }
 
 // the row S^T F of body terms t for the motion S = (sw, sv) about t.p (world axes)
+// (inlined: called once per degree of freedom and body, the recursion's inner loop)
 template <bool Turns>
-Row10 unit_row(const BodyTerms& t, const Vec3& sw, const Vec3& sv) {
+EIGEN_STRONG_INLINE Row10 unit_row(const BodyTerms& t, const Vec3& sw, const Vec3& sv) {
   Row10 row;
   row[0] = t.a.dot(sv);
   Vec3 u = sv.cross(t.al) + t.W.dot(sv) * t.W - t.W2 * sv;
@@ -274,7 +275,8 @@ struct Out {
 // Adds the rows of the degrees of freedom on body b's path to the root: row(dof, sw, sv, turns)
 // gives each one's entries for its motion (sw, sv) about t.p in world axes.
 template <class RowFn>
-void path_rows(const Model& m, const Data& d, int b, const Vec3& p, RowFn&& row) {
+EIGEN_STRONG_INLINE void path_rows(const Model& m, const Data& d, int b, const Vec3& p,
+                                   RowFn&& row) {
   for (int ja = d.joint_of_body[b]; ja >= 0;) {
     const Joint& j = m.joints[ja];
     const Vec3& P = d.rne.point[ja];
@@ -351,7 +353,10 @@ void body_columns(const Model& m, const Data& d, const ParameterLayout& L, const
       const Row10 row = unit_row<decltype(turns)::value>(t, sw, sv);
       const double s = L.dof_scale[dof];
       double* o = &out.at(L.dof_row[dof], col);
-      for (int k = 0; k < 10; ++k) o[k * out.cs] += s * row[k];
+      if (out.cs == 1)
+        Eigen::Map<Row10>(o) += s * row;
+      else
+        for (int k = 0; k < 10; ++k) o[k * out.cs] += s * row[k];
     });
   }
   for (const ParameterLayout::Rotor& r : L.rotors) {
