@@ -5,6 +5,8 @@
 // dynamic_parameters and dynamic_parameter_names.
 #include <pybind11/stl.h>
 
+#include <cmath>
+
 #include "armdyn/algorithm/regressor.hpp"
 #include "common.hpp"
 #include "rows.hpp"
@@ -22,11 +24,14 @@ long n_params_of(const Model& m, Data& d) {
   return d.parameter_layout->n_params;
 }
 
-// out (size entries) finite, else a SolverError naming the entry and the largest input
-// (vectorised first; the element-wise pass only on failure)
+// out (size entries) finite, else a SolverError naming the entry and the largest input: first
+// the vectorised sum of out * 0 (NaN exactly when an entry is inf or NaN; Eigen's allFinite
+// tests entry by entry, a quarter of a batch row's time on solo12), the element-wise pass only
+// on failure
 void check_out(const char* fn, const char* name, const double* out, long size,
                std::initializer_list<NamedInput> in) {
-  if (!Eigen::Map<const VecX>(out, size).allFinite()) check_finite_output(fn, name, out, size, in);
+  if (!std::isfinite((Eigen::Map<const VecX>(out, size).array() * 0.0).sum()))
+    check_finite_output(fn, name, out, size, in);
 }
 
 py::array_t<double> joint_torque_regressor_py(const ModelArg& model, const ArrayLike& q,
