@@ -222,6 +222,7 @@ struct BodyTerms {
   Mat3 R;                         // frame -> world
   Vec3 p, a, al, W;               // world
   double W2 = 0.0;                // |W|^2
+  Vec3 wl, all, al_;              // W, al and a in the frame's axes
   Eigen::Matrix<double, 3, 6> N;  // frame axes
 };
 
@@ -235,7 +236,10 @@ void body_terms(const Model& m, const Data& d, int b, const Vec3& point, const M
   t.W2 = k.W.squaredNorm();
   t.al = d.rne.alpha[b];
   t.a = d.rne.acc[b] + t.al.cross(r) + k.W.cross(k.W.cross(r)) - m.gravity;
-  const Vec3 w = t.R.transpose() * k.W, al = t.R.transpose() * t.al;
+  t.wl.noalias() = t.R.transpose() * k.W;
+  t.all.noalias() = t.R.transpose() * t.al;
+  t.al_.noalias() = t.R.transpose() * t.a;
+  const Vec3 &w = t.wl, &al = t.all;
   const double xx = w[0] * w[0], yy = w[1] * w[1], zz = w[2] * w[2];
   const double xy = w[0] * w[1], xz = w[0] * w[2], yz = w[1] * w[2];
   // U al + w x (U w) for Ixx, Ixy, Iyy, Ixz, Iyz, Izz
@@ -272,11 +276,31 @@ struct Out {
   double& at(int row, int col) const { return data[row * rs + col * cs]; }
 };
 
+// The six rows of a free joint (base frame B, origin P) at once: its translations' (sv = B_k,
+// sw = 0) and rotations' (sw = B_k, sv = B_k x (p - P)) rows of unit_row, in the frame's axes
+// with Bl = R^T B: the mass column B^T a and B^T ((p - P) x a); the first moments' Fh^T Bl and
+// ([a]x - Fh^T [r]x) Bl (Fh^T v = v x al + w (w . v) - |w|^2 v); the inertias' Bl^T N.
+EIGEN_ALWAYS_INLINE void free_rows(const BodyTerms& t, const Mat3& B, const Vec3& P,
+                                   Eigen::Matrix<double, 6, 10>& F) {
+  const Mat3 Bl = t.R.transpose() * B;
+  const Vec3 rl = t.R.transpose() * (t.p - P);
+  Mat3 FhT = t.wl * t.wl.transpose() - skew(t.all);  // Fh^T = -[al]x + w w^T - |w|^2 1
+  FhT.diagonal().array() -= t.W2;
+  F.block<3, 1>(0, 0).noalias() = Bl.transpose() * t.al_;
+  F.block<3, 1>(3, 0).noalias() = Bl.transpose() * rl.cross(t.al_);
+  F.block<3, 3>(0, 1).noalias() = (FhT * Bl).transpose();
+  const Mat3 K = skew(t.al_) - FhT * skew(rl);
+  F.block<3, 3>(3, 1).noalias() = (K * Bl).transpose();
+  F.block<3, 6>(0, 4).setZero();
+  F.block<3, 6>(3, 4).noalias() = Bl.transpose() * t.N;
+}
+
 // Adds the rows of the degrees of freedom on body b's path to the root: row(dof, sw, sv, turns)
-// gives each one's entries for its motion (sw, sv) about t.p in world axes.
-template <class RowFn>
-EIGEN_STRONG_INLINE void path_rows(const Model& m, const Data& d, int b, const Vec3& p,
-                                   RowFn&& row) {
+// gives each one's entries for its motion (sw, sv) about t.p in world axes, free(dof0, B, P) a
+// free joint's six (free_rows).
+template <class RowFn, class FreeFn>
+EIGEN_STRONG_INLINE void path_rows(const Model& m, const Data& d, int b, const Vec3& p, RowFn&& row,
+                                   FreeFn&& free) {
   for (int ja = d.joint_of_body[b]; ja >= 0;) {
     const Joint& j = m.joints[ja];
     const Vec3& P = d.rne.point[ja];
@@ -292,15 +316,9 @@ EIGEN_STRONG_INLINE void path_rows(const Model& m, const Data& d, int b, const V
         row(j.dof0, z, z.cross(p - P), std::true_type{});
         row(j.dof0 + 1, Vec3::Zero(), z, std::false_type{});
         break;
-      case JointType::Free: {
-        const Mat3 B = free_frame(j, d.kin[j.child]);
-        const Vec3 r = p - P;
-        for (int k = 0; k < 3; ++k) {
-          row(j.dof0 + k, Vec3::Zero(), B.col(k), std::false_type{});
-          row(j.dof0 + 3 + k, B.col(k), B.col(k).cross(r), std::true_type{});
-        }
+      case JointType::Free:
+        free(j.dof0, free_frame(j, d.kin[j.child]), P);
         break;
-      }
       default:
         break;
     }
@@ -346,25 +364,41 @@ void load_state(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen::Ref<co
 // degree of freedom on its path to the root (into the row G^T reduces it to)
 void body_columns(const Model& m, const Data& d, const ParameterLayout& L, const Out& out) {
   BodyTerms t;
+  Eigen::Matrix<double, 6, 10> F;
   for (int i = 0; i < static_cast<int>(L.bodies.size()); ++i) {
     const int b = L.bodies[i], col = L.body_offset(i);
     body_terms(m, d, b, L.frame_point[i], L.frame_rotation[i], t);
-    path_rows(m, d, b, t.p, [&](int dof, const Vec3& sw, const Vec3& sv, auto turns) {
-      const Row10 row = unit_row<decltype(turns)::value>(t, sw, sv);
+    auto write = [&](int dof, const auto& row) {
       const double s = L.dof_scale[dof];
       double* o = &out.at(L.dof_row[dof], col);
       if (out.cs == 1)
         Eigen::Map<Row10>(o) += s * row;
       else
         for (int k = 0; k < 10; ++k) o[k * out.cs] += s * row[k];
-    });
+    };
+    path_rows(
+        m, d, b, t.p,
+        [&](int dof, const Vec3& sw, const Vec3& sv, auto turns) {
+          write(dof, unit_row<decltype(turns)::value>(t, sw, sv));
+        },
+        [&](int dof0, const Mat3& B, const Vec3& P) {
+          free_rows(t, B, P, F);
+          for (int k = 0; k < 6; ++k) write(dof0 + k, F.row(k));
+        });
   }
   for (const ParameterLayout::Rotor& r : L.rotors) {
     body_terms(m, d, r.body, Vec3::Zero(), Mat3::Identity(), t);
-    path_rows(m, d, r.body, t.p, [&](int dof, const Vec3& sw, const Vec3& sv, auto turns) {
-      const Row10 row = unit_row<decltype(turns)::value>(t, sw, sv);
-      out.at(L.dof_row[dof], r.column) += L.dof_scale[dof] * row.dot(r.weights);
-    });
+    path_rows(
+        m, d, r.body, t.p,
+        [&](int dof, const Vec3& sw, const Vec3& sv, auto turns) {
+          const Row10 row = unit_row<decltype(turns)::value>(t, sw, sv);
+          out.at(L.dof_row[dof], r.column) += L.dof_scale[dof] * row.dot(r.weights);
+        },
+        [&](int dof0, const Mat3& B, const Vec3& P) {
+          free_rows(t, B, P, F);
+          const Vec6 Fw = F * r.weights;
+          for (int k = 0; k < 6; ++k) out.at(L.dof_row[dof0 + k], r.column) += Fw[k];
+        });
   }
 }
 

@@ -31,7 +31,8 @@ ModelPtr actuated_arm() {
   return b.finalize();
 }
 
-// the spatial arm's links on a floating base (a free joint instead of the yaw hinge)
+// the spatial arm's links on a floating base (a free joint instead of the yaw hinge), with a
+// gyroscopic rotor
 ModelPtr floating_arm() {
   ModelBuilder b(Vec3(0.3, -0.2, -9.81));
   Mat3 i1;
@@ -42,6 +43,8 @@ ModelPtr floating_arm() {
   b.add_free("float", "base");
   b.add_revolute("pitch", "base", "upper", Vec3(0.0, 0.03, 0.4), Vec3(0.1, 1, 0).normalized());
   b.add_prismatic("reach", "upper", "slide", Vec3(0.4, 0.08, 0.5), Vec3(1, 0.1, 0).normalized());
+  // a gyroscopic rotor on the floating base: its column's rows on the free joint too
+  b.add_actuator("pitch", 25.0, 3e-4, 1.0, 0.0, 0.0, nullptr, true);
   return b.finalize();
 }
 
@@ -96,7 +99,7 @@ TEST_CASE(y_pi_equals_rnea_with_rotors_friction_and_a_coupling) {
 
 TEST_CASE(y_pi_equals_rnea_on_a_floating_base) {
   const ModelPtr mp = floating_arm();
-  CHECK(mp->n_free == 1 && mp->independent.nv() == 8);
+  CHECK(mp->n_free == 1 && mp->independent.nv() == 8 && mp->actuators.size() == 1);
   check_regressor(*mp);
 }
 
