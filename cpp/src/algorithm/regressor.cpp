@@ -222,7 +222,7 @@ struct BodyTerms {
   Mat3 R;                         // frame -> world
   Vec3 p, a, al, W;               // world
   double W2 = 0.0;                // |W|^2
-  Vec3 wl, all, al_;              // W, al and a in the frame's axes
+  Vec3 w_f, al_f, a_f;            // W, al and a in the frame's axes
   Eigen::Matrix<double, 3, 6> N;  // frame axes
 };
 
@@ -236,10 +236,10 @@ void body_terms(const Model& m, const Data& d, int b, const Vec3& point, const M
   t.W2 = k.W.squaredNorm();
   t.al = d.rne.alpha[b];
   t.a = d.rne.acc[b] + t.al.cross(r) + k.W.cross(k.W.cross(r)) - m.gravity;
-  t.wl.noalias() = t.R.transpose() * k.W;
-  t.all.noalias() = t.R.transpose() * t.al;
-  t.al_.noalias() = t.R.transpose() * t.a;
-  const Vec3 &w = t.wl, &al = t.all;
+  t.w_f.noalias() = t.R.transpose() * k.W;
+  t.al_f.noalias() = t.R.transpose() * t.al;
+  t.a_f.noalias() = t.R.transpose() * t.a;
+  const Vec3 &w = t.w_f, &al = t.al_f;
   const double xx = w[0] * w[0], yy = w[1] * w[1], zz = w[2] * w[2];
   const double xy = w[0] * w[1], xz = w[0] * w[2], yz = w[1] * w[2];
   // U al + w x (U w) for Ixx, Ixy, Iyy, Ixz, Iyz, Izz
@@ -284,12 +284,12 @@ EIGEN_ALWAYS_INLINE void free_rows(const BodyTerms& t, const Mat3& B, const Vec3
                                    Eigen::Matrix<double, 6, 10>& F) {
   const Mat3 Bl = t.R.transpose() * B;
   const Vec3 rl = t.R.transpose() * (t.p - P);
-  Mat3 FhT = t.wl * t.wl.transpose() - skew(t.all);  // Fh^T = -[al]x + w w^T - |w|^2 1
+  Mat3 FhT = t.w_f * t.w_f.transpose() - skew(t.al_f);  // Fh^T = -[al]x + w w^T - |w|^2 1
   FhT.diagonal().array() -= t.W2;
-  F.block<3, 1>(0, 0).noalias() = Bl.transpose() * t.al_;
-  F.block<3, 1>(3, 0).noalias() = Bl.transpose() * rl.cross(t.al_);
+  F.block<3, 1>(0, 0).noalias() = Bl.transpose() * t.a_f;
+  F.block<3, 1>(3, 0).noalias() = Bl.transpose() * rl.cross(t.a_f);
   F.block<3, 3>(0, 1).noalias() = (FhT * Bl).transpose();
-  const Mat3 K = skew(t.al_) - FhT * skew(rl);
+  const Mat3 K = skew(t.a_f) - FhT * skew(rl);
   F.block<3, 3>(3, 1).noalias() = (K * Bl).transpose();
   F.block<3, 6>(0, 4).setZero();
   F.block<3, 6>(3, 4).noalias() = Bl.transpose() * t.N;

@@ -95,11 +95,11 @@ VecX dynamic_parameters(const Model& m);
 ///
 /// The recursion (Atkeson, An, Hollerbach 1986; Pinocchio's computeJointTorqueRegressor): the
 /// forward Newton-Euler sweep gives every body's velocity and acceleration; then per body its
-/// 6 x 10 block F of the Newton-Euler wrench per unit parameter, in its parameter frame (about
-/// its origin, in its axes), and for each degree of freedom of the joints on its path to the
-/// root one row block S^T F (S that degree of freedom's motion in the same frame). O(n d) for n
-/// bodies at depth d; no allocation once Y has its size and the Data its layout (the first
-/// call).
+/// 6 x 10 block F of the Newton-Euler wrench per unit parameter, about its parameter frame's
+/// origin (kept in factors, in the frame's axes), and for each degree of freedom of the joints
+/// on its path to the root one row block S^T F (S that degree of freedom's motion about the same
+/// origin; a free joint's six rows as one block). O(n d) for n bodies at depth d; no allocation
+/// once Y has its size and the Data its layout (the first call).
 /// @throws ModelError as inverse_dynamics (model, sizes, non-finite inputs, quaternions) and
 ///   as dynamic_parameter_layout.
 void joint_torque_regressor(const Model& m, Data& d, Eigen::Ref<const VecX> q,
