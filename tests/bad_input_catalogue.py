@@ -56,6 +56,12 @@ def _coulomb_pendulum():
     return b.finalize()
 
 
+def _sprung_pendulum():
+    b = _hinged()
+    b.add_joint_spring_damper("hinge", 10.0, 0.0)
+    return b.finalize()
+
+
 def _heavy_pendulum():
     """10 kg at 0.5 m: I = 2.52 kg m², so I q̈ overflows for q̈ = 1.7e308."""
     b = ad.ModelBuilder()
@@ -1018,6 +1024,57 @@ CASES = [
         lambda: ad.inverse_dynamics_derivatives(_two_links(), [0.0, 0.5], [0.0, 0.0], [1e308] * 2),
         SE,
         r"overflow.*qdd\[0\]",
+    ),
+    # ---- dynamic-parameter regressors (issue 35)
+    (
+        "reg-qdd-nan",
+        "identification",
+        "joint_torque_regressor with qdd NaN",
+        lambda: ad.joint_torque_regressor(_pendulum(), [0.0], [0.0], [np.nan]),
+        ME,
+        r"joint_torque_regressor: qdd contains NaN",
+    ),
+    (
+        "reg-rows",
+        "identification",
+        "joint_torque_regressor with 3 rows of q and 2 of qdd",
+        lambda: ad.joint_torque_regressor(
+            _pendulum(), np.zeros((3, 1)), np.zeros((3, 1)), np.zeros((2, 1))
+        ),
+        ME,
+        r"\bqdd\b must have shape \(3, 1\)",
+    ),
+    (
+        "reg-spring",
+        "identification",
+        "joint_torque_regressor of a model with a joint spring (not a dynamic parameter)",
+        lambda: ad.joint_torque_regressor(_sprung_pendulum(), [0.0], [0.0], [0.0]),
+        ME,
+        r"joint coordinate 'hinge' has a spring",
+    ),
+    (
+        "reg-overflow",
+        "identification",
+        "joint_torque_regressor with qd = 1e200 (finite; its square overflows)",
+        lambda: ad.joint_torque_regressor(_pendulum(), [0.3], [1e200], [0.0]),
+        SE,
+        r"overflow.*qd\[0\]",
+    ),
+    (
+        "ereg-qd-inf",
+        "identification",
+        "energy_regressor with qd inf",
+        lambda: ad.energy_regressor(_pendulum(), [0.0], [np.inf]),
+        ME,
+        r"energy_regressor: qd contains NaN or inf",
+    ),
+    (
+        "ereg-overflow",
+        "identification",
+        "energy_regressor with qd = 1e200 (finite; the kinetic energy overflows)",
+        lambda: ad.energy_regressor(_pendulum(), [0.3], [1e200]),
+        SE,
+        r"overflow.*qd\[0\]",
     ),
     (
         "fdd-tau-nan",
