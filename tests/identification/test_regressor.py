@@ -220,3 +220,34 @@ def test_refused_call_leaves_later_results_intact():
     with pytest.raises(ad.ModelError):
         ad.joint_torque_regressor(model, q, qd, [np.nan] * 6, data=data)
     np.testing.assert_array_equal(ad.joint_torque_regressor(model, q, qd, qdd, data=data), y)
+
+
+@pytest.mark.parametrize("gyroscopic", [False, True])
+def test_actuator_on_a_coupling_follower_of_scale_two(gyroscopic):
+    """A rotor on a follower q_b = 2 q_a: its reflected inertia on the independent coordinate is
+    s^2 N^2 J for a gear-reduced rotor (tau_a = s tau_b, qdd_b = s qdd_a); the model rebuilt by
+    with_parameters from a changed Ia has that Ia and the regressor's torques."""
+    b = ad.ModelBuilder(gravity=(0, 0, -9.81))
+    b.add_body("a", mass=1.0, inertia=[0.01, 0.02, 0.03], position=(0.3, 0, 0))
+    b.add_body("b", mass=0.5, inertia=[0.01, 0.01, 0.02], position=(0.3, 0.2, 0.1))
+    b.add_revolute("ja", "ground", "a", point=(0, 0, 0), axis=(0, 1, 0))
+    b.add_revolute("jb", "a", "b", point=(0.3, 0.1, 0), axis=(1, 0, 0))
+    b.add_coupling("jb", "jb", "ja", 2.0)
+    b.add_actuator("jb", 10.0, 1e-3, gyroscopic=gyroscopic)
+    model = b.finalize()
+    names = ad.dynamic_parameter_names(model)
+    pi = ad.dynamic_parameters(model)
+    if not gyroscopic:
+        assert pi[names.index("ja.Ia")] == pytest.approx(2.0**2 * 10.0**2 * 1e-3)
+    rng = np.random.default_rng(3)
+    pi2 = pi.copy()
+    pi2[names.index("ja.Ia")] *= 3.0
+    changed = ad.identification.with_parameters(model, pi2)
+    np.testing.assert_allclose(ad.dynamic_parameters(changed), pi2, rtol=1e-13, atol=1e-15)
+    for _ in range(3):
+        q, qd, qdd = _state(model, rng)
+        y = ad.joint_torque_regressor(model, q, qd, qdd)
+        tau = ad.inverse_dynamics(model, q, qd, qdd)
+        np.testing.assert_allclose(y @ pi, tau, rtol=0, atol=1e-12 * np.abs(tau).max())
+        tau2 = ad.inverse_dynamics(changed, q, qd, qdd)
+        np.testing.assert_allclose(y @ pi2, tau2, rtol=0, atol=1e-12 * np.abs(tau2).max())

@@ -96,7 +96,11 @@ void layout_coordinates(const Model& m, ParameterLayout& L, const char* fn) {
   for (int a = 0; a < static_cast<int>(m.actuators.size()); ++a) {
     const int c = actuated_coord(m, m.actuators[a].joint);
     if (c < 0) throw ModelError(msg(fn, ": actuator ", a, " acts on no joint coordinate"));
-    L.actuators[source_of(m, c).first].push_back(a);
+    const auto [k, scale] = source_of(m, c);
+    L.actuators[k].push_back(a);
+    const Actuator& act = m.actuators[a];
+    L.reflection.push_back(act.gear_ratio * act.gear_ratio *
+                           (act.gyroscopic ? 1.0 : scale * scale));
   }
   for (int k = 0; k < nc; ++k) {
     int gyro = 0;
@@ -179,7 +183,7 @@ VecX dynamic_parameters(const Model& m) {
     pi[o + 1] = L.coulomb_sum[k];
     for (int a : L.actuators[k]) {
       const Actuator& act = m.actuators[a];
-      pi[o + 3] += act.gear_ratio * act.gear_ratio * act.rotor_inertia;
+      pi[o + 3] += L.reflection[a] * act.rotor_inertia;
     }
   }
   return pi;

@@ -47,6 +47,10 @@ struct ParameterLayout {
   std::vector<double> viscous;
   /// per independent coordinate: the actuators (indices of Model::actuators) acting on it
   std::vector<std::vector<int>> actuators;
+  /// per actuator (Model::actuators): its Ia per unit rotor inertia J, N^2 (times s^2 for a
+  /// gear-reduced rotor on a coupling follower of scale s: reflected to the independent
+  /// coordinate)
+  std::vector<double> reflection;
   /// per independent coordinate: its actuators are gyroscopic (rotor bodies carry Ia; else the
   /// reflected inertia is Ia qdd)
   std::vector<char> gyroscopic;
