@@ -1576,7 +1576,7 @@ CASES = [
         "log-cutoff-nyquist",
         "identification",
         "log_from_arrays with a cutoff above the Nyquist frequency",
-        lambda: _identification().log_from_arrays(
+        lambda: _ident().log_from_arrays(
             _pendulum(), np.arange(40) * 0.1, np.zeros((40, 1)), np.zeros((40, 1)), cutoff=6.0
         ),
         ME,
@@ -1586,7 +1586,7 @@ CASES = [
         "log-device",
         "identification",
         "load_log of a device (/dev/zero)",
-        lambda: _identification().load_log("/dev/zero", _pendulum()),
+        lambda: _ident().load_log("/dev/zero", _pendulum()),
         ME,
         r"'/dev/zero' is a character device, not a regular file",
     ),
@@ -1594,7 +1594,7 @@ CASES = [
         "log-directory",
         "identification",
         "load_log of a directory",
-        lambda: _identification().load_log(DATA, _pendulum()),
+        lambda: _ident().load_log(DATA, _pendulum()),
         ME,
         r"is a directory, not a regular file",
     ),
@@ -1602,16 +1602,58 @@ CASES = [
         "log-floating-base",
         "identification",
         "load_log with a floating-base model",
-        lambda: _identification().load_log(
+        lambda: _ident().load_log(
             _log_columns(), ad.urdf_builder(str(DATA / "arm6.urdf"), fixed_base=False).finalize()
         ),
         ME,
         r"floating base",
     ),
+    (
+        "with-parameters-length",
+        "identification",
+        "with_parameters with a pi one entry short",
+        lambda: _ident().with_parameters(_pendulum(), np.zeros(13)),
+        ME,
+        r"pi must have shape \(14,\)",
+    ),
+    (
+        "with-parameters-nan",
+        "identification",
+        "with_parameters with a NaN entry in pi",
+        lambda: _ident().with_parameters(_pendulum(), _pi_with(4, np.nan)),
+        ME,
+        r"pi\[4\] \('link.Ixx'\) must be finite",
+    ),
+    (
+        "with-parameters-negative-mass",
+        "identification",
+        "with_parameters with a negative body mass",
+        lambda: _ident().with_parameters(_pendulum(), _pi_with(0, -1.0)),
+        ME,
+        r"body 'link': mass \('link.m'\) must be >= 0",
+    ),
+    (
+        "with-parameters-not-psd",
+        "identification",
+        "with_parameters with a body inertia that is not positive semidefinite",
+        lambda: _ident().with_parameters(_pendulum(), _pi_with(4, -1.0)),
+        ME,
+        r"body 'link'.*not positive semidefinite",
+    ),
+    (
+        "write-urdf-missing-link",
+        "identification",
+        "write_urdf onto a URDF without one of the model's bodies",
+        lambda: _ident().write_urdf(
+            '<robot name="r"><link name="other"/></robot>', _pendulum(), _pi_with(0, 1.0)
+        ),
+        ME,
+        "the URDF has no link 'link'",
+    ),
 ]
 
 
-def _identification():
+def _ident():
     from armdyn import identification
 
     return identification
@@ -1624,7 +1666,14 @@ def _log_columns():
 
 
 def _load_log(columns):
-    return _identification().load_log(columns, _pendulum())
+    return _ident().load_log(columns, _pendulum())
+
+
+def _pi_with(i, value):
+    """The pendulum's dynamic parameters with entry i set to value."""
+    pi = ad.dynamic_parameters(_pendulum())
+    pi[i] = value
+    return pi
 
 
 _LIMITS = {"max_velocity": 1.0, "max_acceleration": 2.0, "max_jerk": 10.0}

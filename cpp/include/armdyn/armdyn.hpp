@@ -68,7 +68,8 @@
 // validators independent of the Cartesian path
 #include "armdyn/validate/validators.hpp"
 
-// URDF import, model bytes, payloads
+// URDF import, model bytes, payloads, models of identified parameters
+#include "armdyn/io/parameter_model.hpp"
 #include "armdyn/io/payload.hpp"
 #include "armdyn/io/serialize.hpp"
 #include "armdyn/io/urdf.hpp"

@@ -7,7 +7,7 @@ import numpy
 import numpy.typing
 import typing
 from . import profiles
-__all__: list[str] = ['Actuator', 'Data', 'LagrangeValidator', 'Model', 'ModelBuilder', 'ModelError', 'Motor', 'Profile', 'SolverError', 'URDF_COULOMB_SMOOTHING', 'URDF_MAX_ATTRIBUTES', 'URDF_MAX_BYTES', 'UrdfError', 'body_accelerations', 'body_forces', 'body_mass_matrix', 'dynamic_parameter_names', 'dynamic_parameters', 'dynamics_cost', 'end_effector_position', 'energy', 'evaluate_constraints', 'forward_dynamics', 'forward_dynamics_derivatives', 'frame_jacobian', 'frame_jacobian_cartesian', 'frame_pose', 'frame_pose_cartesian', 'inverse_dynamics', 'inverse_dynamics_derivatives', 'joint_coordinates', 'joint_reactions', 'joint_torque_regressor', 'mass_matrix', 'paper_3dof_torques', 'paper_5dof_end_effector', 'profiles', 'state_from_joints', 'torque_error_metrics', 'urdf_builder']
+__all__: list[str] = ['Actuator', 'Data', 'LagrangeValidator', 'Model', 'ModelBuilder', 'ModelError', 'Motor', 'Profile', 'SolverError', 'URDF_COULOMB_SMOOTHING', 'URDF_MAX_ATTRIBUTES', 'URDF_MAX_BYTES', 'UrdfError', 'body_accelerations', 'body_forces', 'body_mass_matrix', 'dynamic_parameter_names', 'dynamic_parameters', 'dynamics_cost', 'end_effector_position', 'energy', 'evaluate_constraints', 'forward_dynamics', 'forward_dynamics_derivatives', 'frame_jacobian', 'frame_jacobian_cartesian', 'frame_pose', 'frame_pose_cartesian', 'inverse_dynamics', 'inverse_dynamics_derivatives', 'joint_coordinates', 'joint_reactions', 'joint_torque_regressor', 'mass_matrix', 'model_with_dynamic_parameters', 'paper_3dof_torques', 'paper_5dof_end_effector', 'profiles', 'state_from_joints', 'torque_error_metrics', 'urdf_builder']
 class ModelError(ValueError):
     """
     Bad input: a model, builder call, array shape or option that armdyn refuses, the message naming the culprit (the body, joint, argument and the expected shape). The model or builder is left as it was. A ValueError.
@@ -738,6 +738,10 @@ def joint_torque_regressor(model: Model, q: numpy.typing.ArrayLike, qd: numpy.ty
 def mass_matrix(model: Model, q: numpy.typing.ArrayLike, data: Data | None = None) -> numpy.typing.NDArray[numpy.float64]:
     """
     The joint-space mass matrix M(q) (n_dofs, n_dofs) of a tree, by the composite-rigid-body algorithm (a coupled model's in its independent coordinates, G^T M G); 2-D q (one state per row) gives (rows, n, n).
+    """
+def model_with_dynamic_parameters(model: Model, pi: numpy.typing.ArrayLike, physical_inertia: bool = True) -> Model:
+    """
+    A new model (this one unchanged) whose dynamic_parameters equal pi (n_params,), offsets aside (measurement biases, not dynamics: ignored): each body's mass, centre of mass and inertia from its 10 numbers (the body frame's origin moves with the centre of mass, every attachment point with it: the geometry is unchanged; a body without a frame of its name gets one at its old centre of mass, pi's parameter frame), each coordinate's friction sources scaled to fv, fc (created on its joint when it has none), its actuators' rotor inertias scaled to Ia (an actuator of gear ratio 1 added when it has none), then finalized again. physical_inertia=True: each body's parameters physically consistent (pseudo-inertia positive semidefinite); False: the inertia about the centre of mass positive semidefinite only (the triangle inequality not required). ModelError naming the entry or body on a wrong length, a non-finite entry, a negative mass, friction or Ia, an inertia outside those limits.
     """
 def paper_3dof_torques(L: numpy.typing.ArrayLike, M: numpy.typing.ArrayLike, g: typing.SupportsFloat | typing.SupportsIndex, theta: numpy.typing.ArrayLike, thetad: numpy.typing.ArrayLike) -> numpy.typing.NDArray[numpy.float64]:
     ...

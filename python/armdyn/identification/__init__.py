@@ -9,6 +9,7 @@ other data, and the identified model written back as a URDF and an armdyn model.
 """
 
 from armdyn._core import dynamic_parameter_names, dynamic_parameters, joint_torque_regressor
+from armdyn.identification.export import with_parameters, write_urdf
 from armdyn.identification.log import MotionLog, differentiate, load_log, log_from_arrays
 
 __all__ = [
@@ -19,4 +20,6 @@ __all__ = [
     "joint_torque_regressor",
     "load_log",
     "log_from_arrays",
+    "with_parameters",
+    "write_urdf",
 ]
