@@ -1650,6 +1650,40 @@ CASES = [
         ME,
         "the URDF has no link 'link'",
     ),
+    (
+        "base-parameters-samples-zero",
+        "identification",
+        "base_parameters with samples = 0",
+        lambda: _ident().base_parameters(_pendulum(), samples=0),
+        ME,
+        r"samples must be an integer in \[1, 1000000\], got 0",
+    ),
+    (
+        "excitation-floating-base",
+        "identification",
+        "fourier_excitation of a floating base",
+        lambda: _ident().fourier_excitation(_floating_box()),
+        ME,
+        "floating base",
+    ),
+    (
+        "excitation-period-nan",
+        "identification",
+        "fourier_excitation with period NaN",
+        lambda: _ident().fourier_excitation(_pendulum(), period=float("nan"), max_velocity=1.0),
+        ME,
+        "period must be a positive number",
+    ),
+    (
+        "excitation-torque-infeasible",
+        "identification",
+        "fourier_excitation whose torque limit is below the gravity torque at q0",
+        lambda: _ident().fourier_excitation(
+            _pendulum(), q0=[1.0], max_velocity=1.0, max_torque=0.1, harmonics=2, samples=10
+        ),
+        SE,
+        "torque limit of joint 'hinge'",
+    ),
 ]
 
 
@@ -1674,6 +1708,13 @@ def _pi_with(i, value):
     pi = ad.dynamic_parameters(_pendulum())
     pi[i] = value
     return pi
+
+
+def _floating_box():
+    b = ad.ModelBuilder()
+    b.add_body("box", 1.0, I3)
+    b.add_free("float", "box")
+    return b.finalize()
 
 
 _LIMITS = {"max_velocity": 1.0, "max_acceleration": 2.0, "max_jerk": 10.0}
