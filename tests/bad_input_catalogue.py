@@ -1531,6 +1531,42 @@ CASES = [
         r"singularity at s = [0-9.]+ \(position \[",
     ),
     (
+        "base-parameters-samples-zero",
+        "identification",
+        "base_parameters with samples = 0",
+        lambda: _identification().base_parameters(_pendulum(), samples=0),
+        ME,
+        r"samples must be an integer in \[1, 1000000\], got 0",
+    ),
+    (
+        "excitation-floating-base",
+        "identification",
+        "fourier_excitation of a floating base",
+        lambda: _identification().fourier_excitation(_floating_box()),
+        ME,
+        "floating base",
+    ),
+    (
+        "excitation-period-nan",
+        "identification",
+        "fourier_excitation with period NaN",
+        lambda: _identification().fourier_excitation(
+            _pendulum(), period=float("nan"), max_velocity=1.0
+        ),
+        ME,
+        "period must be a positive number",
+    ),
+    (
+        "excitation-torque-infeasible",
+        "identification",
+        "fourier_excitation whose torque limit is below the gravity torque at q0",
+        lambda: _identification().fourier_excitation(
+            _pendulum(), q0=[1.0], max_velocity=1.0, max_torque=0.1, harmonics=2, samples=10
+        ),
+        SE,
+        "torque limit of joint 'hinge'",
+    ),
+    (
         "log-unknown-column",
         "identification",
         "load_log with a column that is no coordinate of the model",
@@ -1576,7 +1612,7 @@ CASES = [
         "log-cutoff-nyquist",
         "identification",
         "log_from_arrays with a cutoff above the Nyquist frequency",
-        lambda: _ident().log_from_arrays(
+        lambda: _identification().log_from_arrays(
             _pendulum(), np.arange(40) * 0.1, np.zeros((40, 1)), np.zeros((40, 1)), cutoff=6.0
         ),
         ME,
@@ -1586,7 +1622,7 @@ CASES = [
         "log-device",
         "identification",
         "load_log of a device (/dev/zero)",
-        lambda: _ident().load_log("/dev/zero", _pendulum()),
+        lambda: _identification().load_log("/dev/zero", _pendulum()),
         ME,
         r"'/dev/zero' is a character device, not a regular file",
     ),
@@ -1594,7 +1630,7 @@ CASES = [
         "log-directory",
         "identification",
         "load_log of a directory",
-        lambda: _ident().load_log(DATA, _pendulum()),
+        lambda: _identification().load_log(DATA, _pendulum()),
         ME,
         r"is a directory, not a regular file",
     ),
@@ -1602,7 +1638,7 @@ CASES = [
         "log-floating-base",
         "identification",
         "load_log with a floating-base model",
-        lambda: _ident().load_log(
+        lambda: _identification().load_log(
             _log_columns(), ad.urdf_builder(str(DATA / "arm6.urdf"), fixed_base=False).finalize()
         ),
         ME,
@@ -1651,46 +1687,43 @@ CASES = [
         "the URDF has no link 'link'",
     ),
     (
-        "base-parameters-samples-zero",
+        "identify-log-of-another-model",
         "identification",
-        "base_parameters with samples = 0",
-        lambda: _ident().base_parameters(_pendulum(), samples=0),
+        "identify with a log whose joint names are not the model's coordinates",
+        lambda: _ident().identify(_pendulum(), _swing_log(names=["elbow"])),
         ME,
-        r"samples must be an integer in \[1, 1000000\], got 0",
+        r"log.joint_names \['elbow'\] do not match the model's coord_names \['hinge'\]",
     ),
     (
-        "excitation-floating-base",
+        "identify-too-few-samples",
         "identification",
-        "fourier_excitation of a floating base",
-        lambda: _ident().fourier_excitation(_floating_box()),
-        ME,
-        "floating base",
-    ),
-    (
-        "excitation-period-nan",
-        "identification",
-        "fourier_excitation with period NaN",
-        lambda: _ident().fourier_excitation(_pendulum(), period=float("nan"), max_velocity=1.0),
-        ME,
-        "period must be a positive number",
-    ),
-    (
-        "excitation-torque-infeasible",
-        "identification",
-        "fourier_excitation whose torque limit is below the gravity torque at q0",
-        lambda: _ident().fourier_excitation(
-            _pendulum(), q0=[1.0], max_velocity=1.0, max_torque=0.1, harmonics=2, samples=10
-        ),
+        "identify with four samples (fewer rows than base parameters)",
+        lambda: _ident().identify(_pendulum(), _swing_log(n=4)),
         SE,
-        "torque limit of joint 'hinge'",
+        r"rank deficient: the log excites only",
+    ),
+    (
+        "identify-outlier-threshold",
+        "identification",
+        "identify with outlier_threshold 0",
+        lambda: _ident().identify(_pendulum(), _swing_log(), outlier_threshold=0.0),
+        ME,
+        r"outlier_threshold must be a number > 0",
     ),
 ]
 
 
-def _ident():
-    from armdyn import identification
+def _identification():
+    import armdyn.identification
 
-    return identification
+    return armdyn.identification
+
+
+def _floating_box():
+    b = ad.ModelBuilder()
+    b.add_body("box", 1.0, I3)
+    b.add_free("float", "box")
+    return b.finalize()
 
 
 def _log_columns():
@@ -1700,7 +1733,22 @@ def _log_columns():
 
 
 def _load_log(columns):
-    return _ident().load_log(columns, _pendulum())
+    return _identification().load_log(columns, _pendulum())
+
+
+def _ident():
+    from armdyn import identification
+
+    return identification
+
+
+def _swing_log(n=50, names=("hinge",)):
+    """A log of the pendulum swinging (torques by its inverse dynamics)."""
+    model = _pendulum()
+    t = np.linspace(0.0, 2.0, n)
+    q, qd, qdd = np.sin(3 * t)[:, None], 3 * np.cos(3 * t)[:, None], -9 * np.sin(3 * t)[:, None]
+    tau = np.array([ad.inverse_dynamics(model, *x) for x in zip(q, qd, qdd, strict=True)])
+    return _ident().MotionLog(t, q, qd, qdd, tau, list(names), "synthetic")
 
 
 def _pi_with(i, value):
@@ -1708,13 +1756,6 @@ def _pi_with(i, value):
     pi = ad.dynamic_parameters(_pendulum())
     pi[i] = value
     return pi
-
-
-def _floating_box():
-    b = ad.ModelBuilder()
-    b.add_body("box", 1.0, I3)
-    b.add_free("float", "box")
-    return b.finalize()
 
 
 _LIMITS = {"max_velocity": 1.0, "max_acceleration": 2.0, "max_jerk": 10.0}

@@ -8,8 +8,9 @@ least-squares and physically consistent estimates with their uncertainties, a va
 other data, and the identified model written back as a URDF and an armdyn model.
 """
 
-from armdyn._core import dynamic_parameter_names, dynamic_parameters, joint_torque_regressor
+from armdyn import _core
 from armdyn.identification.base import BaseParameters, base_parameters
+from armdyn.identification.estimate import Identification, identify
 from armdyn.identification.excitation import (
     Excitation,
     fourier_excitation,
@@ -18,10 +19,16 @@ from armdyn.identification.excitation import (
 )
 from armdyn.identification.export import with_parameters, write_urdf
 from armdyn.identification.log import MotionLog, differentiate, load_log, log_from_arrays
+from armdyn.identification.physical import is_physical, physical_violations, pseudo_inertia
+
+dynamic_parameter_names = _core.dynamic_parameter_names
+dynamic_parameters = _core.dynamic_parameters
+joint_torque_regressor = _core.joint_torque_regressor
 
 __all__ = [
     "BaseParameters",
     "Excitation",
+    "Identification",
     "MotionLog",
     "base_parameters",
     "differentiate",
@@ -29,9 +36,13 @@ __all__ = [
     "dynamic_parameters",
     "fourier_excitation",
     "fourier_series",
+    "identify",
+    "is_physical",
     "joint_torque_regressor",
     "load_log",
     "log_from_arrays",
+    "physical_violations",
+    "pseudo_inertia",
     "random_fourier",
     "with_parameters",
     "write_urdf",

@@ -17,14 +17,13 @@ columns ``b`` and the dependent ones ``d`` with ``Y_d = Y_b K``, ``K = R11^-1 R1
 from __future__ import annotations
 
 import contextlib
-import ctypes
-import functools
 from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
 import scipy.linalg
+import threadpoolctl
 
 from armdyn import _checks, _core
 
@@ -39,18 +38,11 @@ ZERO_COLUMN = 1e-10
 K_ZERO = 1e-10
 
 #: (get, set) symbol pairs of the OpenBLAS builds numpy and scipy ship or link
-_OPENBLAS_SYMBOLS = (
-    ("openblas_get_num_threads", "openblas_set_num_threads"),
-    ("openblas_get_num_threads64_", "openblas_set_num_threads64_"),
-    ("scipy_openblas_get_num_threads", "scipy_openblas_set_num_threads"),
-    ("scipy_openblas_get_num_threads64_", "scipy_openblas_set_num_threads64_"),
-)
-
 _FRICTION = (".fv", ".fc")
 _OFFSET = (".offset",)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # arrays: compared by identity
 class BaseParameters:
     """The base parameters of a model (from :func:`base_parameters`).
 
@@ -109,47 +101,14 @@ class BaseParameters:
         return f"<BaseParameters {self.rank} of {len(self.param_names)} parameters>"
 
 
-@functools.cache
-def _openblas_controls() -> tuple:
-    """The (get, set) thread-count functions of every OpenBLAS loaded in this process (Linux:
-    from /proc/self/maps; elsewhere none)."""
-    controls = []
-    try:
-        with open("/proc/self/maps") as maps:
-            paths = {line.split()[-1] for line in maps if "openblas" in line.lower()}
-    except OSError:
-        return ()
-    for path in sorted(p for p in paths if ".so" in p):
-        try:
-            lib = ctypes.CDLL(path)
-        except OSError:
-            continue
-        for get, put in _OPENBLAS_SYMBOLS:
-            if hasattr(lib, get) and hasattr(lib, put):
-                controls.append((getattr(lib, get), getattr(lib, put)))
-                break
-    return tuple(controls)
-
-
 @contextlib.contextmanager
 def one_blas_thread() -> Iterator[None]:
-    """Run the block with OpenBLAS on one thread (restored after). The identification's matrices
-    are small (hundreds of rows): OpenBLAS's threads gain nothing there and, on a loaded
-    machine, wait for each other: a QR of a 1080 x 178 regressor took 5 s with threads on the
-    shared 2-core machine at load 16, milliseconds on one. What threadpoolctl does, without the
-    dependency; process-wide while it lasts."""
-    saved = []
-    for get, put in _openblas_controls():
-        try:
-            saved.append((put, int(get())))
-            put(1)
-        except (OSError, ValueError, TypeError):  # pragma: no cover - a foreign build
-            continue
-    try:
+    """Run the block with the BLAS libraries on one thread (threadpoolctl; restored after). The
+    identification's matrices are small (hundreds of rows): BLAS threads gain nothing there and,
+    on a loaded machine, wait for each other: a QR of a 1080 x 178 regressor took 5 s with
+    OpenBLAS's threads on the shared 2-core machine at load 16, milliseconds on one."""
+    with threadpoolctl.threadpool_limits(limits=1, user_api="blas"):
         yield
-    finally:
-        for put, count in saved:
-            put(count)
 
 
 def random_states(

@@ -97,7 +97,7 @@ def _series(t, q0, a, b, wf):
     return q, qd, qdd
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # arrays: compared by identity
 class Excitation:
     """A periodic excitation motion (from :func:`fourier_excitation` or :func:`random_fourier`).
 
@@ -443,8 +443,11 @@ def _centre(problem):
     if problem.fixed_q0 is not None:
         return problem.fixed_q0
     lo, hi = problem.limits.lower, problem.limits.upper
+    # mid-range; 0 without limits; 1 (rad or m) inside a one-sided limit (or 0 when inside)
     both = np.isfinite(lo) & np.isfinite(hi)
     mid = 0.5 * (np.where(both, lo, 0.0) + np.where(both, hi, 0.0))
+    mid = np.maximum(mid, np.where(np.isfinite(lo) & ~both, lo + 1.0, -np.inf))
+    mid = np.minimum(mid, np.where(np.isfinite(hi) & ~both, hi - 1.0, np.inf))
     return np.clip(mid, lo + 1e-9, hi - 1e-9)
 
 
@@ -596,8 +599,10 @@ def fourier_excitation(
     hide a parameter the motion leaves unexcited. A fixed scale per column keeps the criterion
     unit-free and still rewards exciting every column.
 
-    SLSQP (scipy) minimises ``log cond`` from ``starts`` feasible random starts
-    (:func:`random_fourier`, seeds ``seed``, ``seed + 1``, ...), the best result kept. The
+    SLSQP (scipy; gradients by finite differences) minimises ``log cond`` from ``starts``
+    feasible random starts (:func:`random_fourier` with per-joint scaling, seeds ``seed``,
+    ``seed + 1``, ...), the best result kept; the variables are scaled per joint by what its
+    limits allow, so a gripper's centimetres and a shoulder's radians weigh alike. The
     constraints: ``|q - q0| <= sum_l |c_l| / (w_f l)``, ``|qd| <= sum_l |c_l|`` and
     ``|qdd| <= sum_l w_f l |c_l|`` (``|c_l| = sqrt(a_l^2 + b_l^2)``; conservative bounds for all
     t) within the position limits minus ``position_margin``, ``max_velocity`` and
@@ -605,8 +610,11 @@ def fourier_excitation(
     :data:`TORQUE_MARGIN` (0.95) of ``max_torque``. Every result is checked on a grid of
     :data:`CHECK_PER_CYCLE` (40) samples per cycle of the highest harmonic (at least 200), the
     torques within :data:`TORQUE_CHECK` (0.999) of their limits there; an optimum that breaks a
-    torque limit there gets those times as constraints and is solved again;
-    if none passes, the best feasible start is returned (``info["optimised"]`` False).
+    torque limit there gets those times as constraints and is solved again. An SLSQP result
+    (or the best iterate that met the constraints) that misses a limit has its oscillation about
+    ``q0`` shrunk by the first factor of 1, 0.999, ..., 0.5 that meets them all; if no start
+    gives a feasible result better than the best start, that start is returned
+    (``info["optimised"]`` False).
 
     Args:
         model: a fixed-base model (no quaternion coordinates).
@@ -627,13 +635,14 @@ def fourier_excitation(
         SolverError: limits no motion can meet (naming the limit and the joint).
 
     Runtime and result on the UR5 with its own limits, period 10 s
-    (``python -m benchmarks.identification_excitation``): the defaults (5 harmonics, 100
-    samples, 3 starts of 100 SLSQP iterations, ~17,600 condition numbers) take 43 s of CPU
-    (109 s wall on the shared 2-core machine) and reach cond 6.3, against 12-41 for random
-    motions scaled per joint (1.9-6.5x higher) and 25-68 for random motions scaled by one
-    common factor (3.9-10.8x), 5 seeds each: the issue's 10x holds only against part of the
+    (``python -m benchmarks.identification_excitation``,
+    benchmarks/results/identification_excitation.json): the defaults (5 harmonics, 100
+    samples, 3 starts of 100 SLSQP iterations, ~17,600 condition numbers) take 36 s of CPU
+    (111 s wall on the shared 2-core machine) and reach cond 6.1, against 12-41 for random
+    motions scaled per joint (1.9-6.6x higher) and 25-68 for random motions scaled by one
+    common factor (4.0-11x), 5 seeds each: the issue's 10x holds only against part of the
     common-scaled ones. ``--quick`` (3 harmonics, 40 samples, 1 start of 40 iterations, as the
-    tests): 2.2 s CPU, cond 8.6, 3.0-3.8x below per-joint random, 5.3-159x below common.
+    tests): 1.9 s CPU, cond 9.6, 2.7-3.4x below per-joint random, 4.8-143x below common.
     """
     who = "fourier_excitation"
     limits = {
