@@ -270,7 +270,7 @@ def test_identification_notebook_executes(tmp_path):
     (the issue's target), the identified model's own error on the exact motion under a quarter
     of it, the nominal model's RMSE at least 5 times it; with tau filtered as well, fewer true
     parameters within 3 sigma (the bias log.py documents); the identified model's motor RMS
-    torques on the pick-and-place cycle within 3 % of the real arm's (measured: 1.5 %) and its
+    torques on the pick-and-place cycle within 3 % of the real arm's (measured: 1.0 %) and its
     verdict the real arm's, where the nominal model is off by more than 50 % (measured: 93 %, the
     wrist's friction). The designed excitation within its limits on a fine grid, by an
     independent inverse dynamics."""
