@@ -56,6 +56,12 @@ def _coulomb_pendulum():
     return b.finalize()
 
 
+def _sprung_pendulum():
+    b = _hinged()
+    b.add_joint_spring_damper("hinge", 10.0, 0.0)
+    return b.finalize()
+
+
 def _heavy_pendulum():
     """10 kg at 0.5 m: I = 2.52 kg m², so I q̈ overflows for q̈ = 1.7e308."""
     b = ad.ModelBuilder()
@@ -1019,6 +1025,57 @@ CASES = [
         SE,
         r"overflow.*qdd\[0\]",
     ),
+    # ---- dynamic-parameter regressors (issue 35)
+    (
+        "reg-qdd-nan",
+        "identification",
+        "joint_torque_regressor with qdd NaN",
+        lambda: ad.joint_torque_regressor(_pendulum(), [0.0], [0.0], [np.nan]),
+        ME,
+        r"joint_torque_regressor: qdd contains NaN",
+    ),
+    (
+        "reg-rows",
+        "identification",
+        "joint_torque_regressor with 3 rows of q and 2 of qdd",
+        lambda: ad.joint_torque_regressor(
+            _pendulum(), np.zeros((3, 1)), np.zeros((3, 1)), np.zeros((2, 1))
+        ),
+        ME,
+        r"\bqdd\b must have shape \(3, 1\)",
+    ),
+    (
+        "reg-spring",
+        "identification",
+        "joint_torque_regressor of a model with a joint spring (not a dynamic parameter)",
+        lambda: ad.joint_torque_regressor(_sprung_pendulum(), [0.0], [0.0], [0.0]),
+        ME,
+        r"joint coordinate 'hinge' has a spring",
+    ),
+    (
+        "reg-overflow",
+        "identification",
+        "joint_torque_regressor with qd = 1e200 (finite; its square overflows)",
+        lambda: ad.joint_torque_regressor(_pendulum(), [0.3], [1e200], [0.0]),
+        SE,
+        r"overflow.*qd\[0\]",
+    ),
+    (
+        "ereg-qd-inf",
+        "identification",
+        "energy_regressor with qd inf",
+        lambda: ad.energy_regressor(_pendulum(), [0.0], [np.inf]),
+        ME,
+        r"energy_regressor: qd contains NaN or inf",
+    ),
+    (
+        "ereg-overflow",
+        "identification",
+        "energy_regressor with qd = 1e200 (finite; the kinetic energy overflows)",
+        lambda: ad.energy_regressor(_pendulum(), [0.3], [1e200]),
+        SE,
+        r"overflow.*qd\[0\]",
+    ),
     (
         "fdd-tau-nan",
         "derivatives",
@@ -1710,6 +1767,38 @@ CASES = [
         ME,
         r"outlier_threshold must be a number > 0",
     ),
+    (
+        "validate-log-joints",
+        "identification",
+        "validate with a log of other joints than the model's",
+        lambda: _validate(joint_names=["other"]),
+        ME,
+        r"the log's joints \['other'\] are not the model's \['hinge'\]",
+    ),
+    (
+        "validate-pi-length",
+        "identification",
+        "validate with a pi of the wrong length",
+        lambda: _validate(pi=np.ones(3)),
+        ME,
+        r"pi has 3 entries, the model 14",
+    ),
+    (
+        "identify-cli-per-joint",
+        "identification",
+        "`armdyn identify --gear-ratios elbow=2,3` (named and unnamed entries mixed)",
+        lambda: _identify_cli().per_joint("--gear-ratios", "elbow=2,3"),
+        ME,
+        r"--gear-ratios 'elbow=2,3': either every entry is JOINT=VALUE or none is",
+    ),
+    (
+        "identify-cli-cutoff",
+        "identification",
+        "`armdyn identify --cutoff -1` (not a positive frequency)",
+        lambda: _identify_cli()._cutoff("-1"),
+        ME,
+        r"--cutoff '-1': the cutoff must be > 0 Hz",
+    ),
 ]
 
 
@@ -1808,6 +1897,24 @@ def _least_energy(**change):
     args = dict(start=[0.0], goal=[1.0], duration=1.0, objective="rms_torque")
     args.update(change)
     return least_energy(_pendulum(), **args)
+
+
+def _validate(pi=None, **log_fields):
+    """validate(pendulum, a three-sample log of it, pi=pi), the log's fields overridden."""
+    from types import SimpleNamespace
+
+    from armdyn.identification import validate
+
+    z = np.zeros((3, 1))
+    fields = dict(t=np.arange(3.0), q=z, qd=z, qdd=z, tau=z, joint_names=["hinge"])
+    fields.update(log_fields)
+    return validate(_pendulum(), SimpleNamespace(**fields), pi=pi)
+
+
+def _identify_cli():
+    from armdyn.identification import cli
+
+    return cli
 
 
 def _cli():

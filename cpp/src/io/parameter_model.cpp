@@ -208,7 +208,7 @@ void set_rotors(const Model& m, const ParameterLayout& L, const VecX& pi,
     double sum = 0.0;
     for (int a : L.actuators[k]) {
       const Actuator& act = m.actuators[a];
-      sum += act.gear_ratio * act.gear_ratio * act.rotor_inertia;
+      sum += L.reflection[a] * act.rotor_inertia;
     }
     for (int a : L.actuators[k]) {
       Actuator& act = d.actuators[a];
@@ -216,7 +216,7 @@ void set_rotors(const Model& m, const ParameterLayout& L, const VecX& pi,
       if (sum > 0.0)
         act.rotor_inertia *= Ia / sum;
       else
-        act.rotor_inertia = a == L.actuators[k].front() ? Ia / n2 : 0.0;
+        act.rotor_inertia = a == L.actuators[k].front() ? Ia / L.reflection[a] : 0.0;
       const Vec3 ax = d.joints[act.rotor_joint].frame_child.col(2);
       const double axial = act.gyroscopic ? act.rotor_inertia : n2 * act.rotor_inertia;
       d.bodies[d.joints[act.rotor_joint].child].inertia =

@@ -56,6 +56,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from armdyn import _core
+from armdyn.identification import export
 from armdyn.identification import physical as _phys
 from armdyn.identification.base import one_blas_thread
 
@@ -136,9 +137,7 @@ class Identification:
     def identified_model(self, *, urdf=None):
         """The model with the identified pi (``armdyn.identification.with_parameters``; the
         offsets, not a model parameter, are dropped)."""
-        from armdyn import identification
-
-        return identification.with_parameters(self.model, self.pi, urdf=urdf)
+        return export.with_parameters(self.model, self.pi, urdf=urdf)
 
 
 # ------------------------------------------------------------------------------ input checks

@@ -47,6 +47,26 @@ struct ParameterLayout {
   std::vector<double> viscous;
   /// per independent coordinate: the actuators (indices of Model::actuators) acting on it
   std::vector<std::vector<int>> actuators;
+  /// per actuator (Model::actuators): its Ia per unit rotor inertia J, N^2 (times s^2 for a
+  /// gear-reduced rotor on a coupling follower of scale s: reflected to the independent
+  /// coordinate)
+  std::vector<double> reflection;
+  /// per independent coordinate: its actuators are gyroscopic (rotor bodies carry Ia; else the
+  /// reflected inertia is Ia qdd)
+  std::vector<char> gyroscopic;
+  /// per independent coordinate: the sum of its Coulomb coefficients (0: no Coulomb friction)
+  std::vector<double> coulomb_sum;
+  /// per full degree of freedom (Model::nv_joint): the independent row it reduces to (G^T) and
+  /// its scale there (a coupling follower's; 1 otherwise)
+  std::vector<int> dof_row;
+  std::vector<double> dof_scale;
+  /// per gyroscopic actuator: (its rotor body, its coordinate's Ia column, the weights of the
+  /// rotor body's 10 parameters per unit Ia: a thin disc of axial inertia Ia / N^2)
+  struct Rotor {
+    int body = 0, column = 0;
+    Eigen::Matrix<double, 10, 1> weights = Eigen::Matrix<double, 10, 1>::Zero();
+  };
+  std::vector<Rotor> rotors;
   int n_params = 0;
   int body_offset(int k) const { return kBody * k; }  ///< k-th parameter body's first column
   int coord_offset(int c) const {                     ///< independent coordinate c's first column
@@ -59,6 +79,11 @@ struct ParameterLayout {
 ///   not a parameter (named).
 ParameterLayout dynamic_parameter_layout(const Model& m);
 
+/// dynamic_parameter_layout(m), made on the first request and kept with the model
+/// (Model::derived): what the regressors read per call (a Data keeps the pointer).
+/// @throws ModelError as dynamic_parameter_layout (then nothing is kept).
+const ParameterLayout& cached_parameter_layout(const Model& m);
+
 /// The names of pi: "<body>.m", "<body>.mcx", "<body>.mcy", "<body>.mcz", "<body>.Ixx",
 /// "<body>.Ixy", "<body>.Iyy", "<body>.Ixz", "<body>.Iyz", "<body>.Izz", then "<coord>.fv",
 /// "<coord>.fc", "<coord>.offset", "<coord>.Ia".
@@ -68,11 +93,42 @@ std::vector<std::string> dynamic_parameter_names(const Model& m);
 VecX dynamic_parameters(const Model& m);
 
 /// Y (n_dofs x n_params) at (q, qd, qdd): a coupled model's independent coordinates (Y = G^T
-/// Y_full), a floating base's six rows first. tau = Y pi equals inverse_dynamics(q, qd, qdd)
-/// (with pi's offsets zero). Into Y (resized when needed).
+/// Y_full), a floating base's six rows first (the base frame's force, then its moment about the
+/// frame's origin, in its axes: inverse_dynamics's rows). tau = Y pi equals inverse_dynamics(q,
+/// qd, qdd) (with pi's offsets zero). Into Y (resized when needed).
+///
+/// The recursion (Atkeson, An, Hollerbach 1986; Pinocchio's computeJointTorqueRegressor): the
+/// forward Newton-Euler sweep gives every body's velocity and acceleration; then per body its
+/// 6 x 10 block F of the Newton-Euler wrench per unit parameter, about its parameter frame's
+/// origin (kept in factors, in the frame's axes), and for each degree of freedom of the joints
+/// on its path to the root one row block S^T F (S that degree of freedom's motion about the same
+/// origin; a free joint's six rows as one block). O(n d) for n bodies at depth d; no allocation
+/// once Y has its size and the Data its layout (the first call).
 /// @throws ModelError as inverse_dynamics (model, sizes, non-finite inputs, quaternions) and
 ///   as dynamic_parameter_layout.
 void joint_torque_regressor(const Model& m, Data& d, Eigen::Ref<const VecX> q,
                             Eigen::Ref<const VecX> qd, Eigen::Ref<const VecX> qdd, MatX& Y);
+
+/// The same into out, row-major (n_dofs rows of n_params, every entry written): the bindings'
+/// arrays, a batch's rows straight into the output.
+void joint_torque_regressor_into(const Model& m, Data& d, Eigen::Ref<const VecX> q,
+                                 Eigen::Ref<const VecX> qd, Eigen::Ref<const VecX> qdd,
+                                 double* out);
+
+/// The energy regressor h (n_params) at (q, qd): the kinetic plus potential energy of the
+/// bodies and rotors is h . pi (the potential -m g . c about the world origin, as energy();
+/// friction and offset entries 0). Per body: 0.5 |v|^2, v x w, -g . p and -R^T g, 0.5 w^T U w
+/// for the unit inertias U (v, w the velocity of its parameter frame's origin and its angular
+/// velocity in the frame's axes, p and R the frame's world pose); per coordinate's Ia: 0.5 qd^2
+/// for a gear-reduced armature, the rotor's kinetic energy per unit Ia for a gyroscopic one.
+/// Identification from energy: h(t1) - h(t0) = integral of (tau - friction) . qd dt, without
+/// accelerations. Into h (resized when needed); no allocation once sized.
+/// @throws ModelError as joint_torque_regressor (qd as the rates).
+void energy_regressor(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
+                      VecX& h);
+
+/// The same into out (n_params entries, every one written).
+void energy_regressor_into(const Model& m, Data& d, Eigen::Ref<const VecX> q,
+                           Eigen::Ref<const VecX> qd, double* out);
 
 }  // namespace armdyn
