@@ -1,6 +1,7 @@
 """`armdyn reproduce` end to end: the command runs, writes the report, and its tables carry the
 paper's figures beside ours; the notebook walking through the 5-DOF validation executes."""
 
+import ast
 import re
 import subprocess
 import sys
@@ -269,13 +270,18 @@ def test_identification_notebook_executes(tmp_path):
     (the issue's target), the identified model's own error on the exact motion under a quarter
     of it, the nominal model's RMSE at least 5 times it; with tau filtered as well, fewer true
     parameters within 3 sigma (the bias log.py documents); the identified model's motor RMS
-    torques on the pick-and-place cycle within 2 % of the real arm's and its verdict the real
-    arm's, where the nominal model is off by more than 50 %. Two excitation periods (the
-    notebook: three)."""
-    out = execute_notebook("identification_ur5.ipynb", tmp_path, parameters={"PERIODS": 2})
+    torques on the pick-and-place cycle within 3 % of the real arm's (measured: 1.0 %) and its
+    verdict the real arm's, where the nominal model is off by more than 50 % (measured: 93 %, the
+    wrist's friction). The designed excitation within its limits on a fine grid, by an
+    independent inverse dynamics."""
+    out = execute_notebook("identification_ur5.ipynb", tmp_path)
     assert "real arm physically consistent: True" in out
-    cond = re.search(r"regressor condition number: designed (\S+), random (\S+) ", out)
+    cond = re.search(r"regressor condition number: designed (\S+), random (\S+)", out)
     assert float(cond.group(1)) < float(cond.group(2))
+    again = re.search(r"recomputed, one scaling: designed (\S+), random (\S+)", out)
+    assert float(again.group(1)) < float(again.group(2))
+    usage = re.search(r"largest use of each limit: (\{.*\})", out).group(1)
+    assert all(v <= 1.0 for v in ast.literal_eval(usage).values()), usage
     assert "physically consistent: True" in out
     inside = re.search(r"within 3 sigma of the least-squares estimate: (\d+) of (\d+)", out)
     n_in, n_base = int(inside.group(1)), int(inside.group(2))
@@ -287,7 +293,7 @@ def test_identification_notebook_executes(tmp_path):
     assert _number(r"exact motion / noise level, worst joint: (\S+)", out) <= 0.25
     verdicts = dict(re.findall(r"verdict \| (\w+) \| every joint ok: (\w+)", out))
     assert verdicts["identified"] == verdicts["real"]
-    assert _number(r"identified vs real, largest relative gap: (\S+)", out) <= 0.02
+    assert _number(r"identified vs real, largest relative gap: (\S+)", out) <= 0.03
     assert _number(r"nominal vs real, largest relative gap: (\S+)", out) >= 0.5
     out_dir = tmp_path / "ur5-identification"
     for name in ("excitation.csv", "measured_excitation.csv", "identified.urdf"):
