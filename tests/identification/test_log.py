@@ -111,7 +111,7 @@ def test_filter_is_zero_phase_and_trim_removes_edge_transients():
     lag = np.abs(q_f - q)[keep].max() / (np.abs(qd).max() * h)
     assert lag < 0.01
     # the same through log_from_arrays with trim
-    log = log_from_arrays(MODEL, t, q, q * 2.0, cutoff=cutoff, trim=3 / cutoff)
+    log = log_from_arrays(MODEL, t, q, q * 2.0, cutoff=cutoff, trim=3 / cutoff, filter_tau=True)
     np.testing.assert_array_equal(log.t, t[keep])
     np.testing.assert_allclose(log.qdd, qdd_n[keep], rtol=0, atol=1e-12)
     np.testing.assert_allclose(log.tau, 2.0 * q_f[keep], rtol=0, atol=1e-12)  # same filter
@@ -133,7 +133,7 @@ def test_filtering_reduces_the_noise_in_qdd():
     qn = q + rng.normal(0.0, 1e-4, q.shape)
     taun = tau + rng.normal(0.0, 0.5, tau.shape)
     raw = log_from_arrays(MODEL, t, qn, taun)
-    filt = log_from_arrays(MODEL, t, qn, taun, cutoff=5.0, trim=0.6)
+    filt = log_from_arrays(MODEL, t, qn, taun, cutoff=5.0, trim=0.6, filter_tau=True)
     keep = (t >= 0.6) & (t <= t[-1] - 0.6)
     rms_raw = np.sqrt(np.mean((raw.qdd[keep] - qdd[keep]) ** 2))
     rms_filt = np.sqrt(np.mean((filt.qdd - qdd[keep]) ** 2))

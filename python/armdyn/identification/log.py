@@ -42,9 +42,9 @@ velocity still steps, and the filtered noise is correlated from row to row, so l
 standard deviations that assume independent rows come out too small. Measured in
 ``tests/identification/test_log.py`` (a two-link arm with 2 and 1 N m of Coulomb friction,
 exact torques, cutoff 4 Hz at 100 Hz): a least-squares fit's residual is 0.33 and 0.17 N m
-with tau filtered, 0.0039 and 0.0015 N m with q alone filtered. For identification pass
-``filter_tau=False`` (q is still filtered; being zero-phase, the filter keeps q and the
-logged tau aligned in time).
+with tau filtered, 0.0039 and 0.0015 N m with q alone filtered. So by default
+(``filter_tau=False``) q alone is filtered (being zero-phase, the filter keeps q and the logged
+tau aligned in time); ``filter_tau=True`` filters tau too.
 
 **Edge transients.** A zero-phase filter still distorts the ends (``sosfiltfilt`` pads the
 signal by odd reflection, which keeps q and qd continuous but flips the sign of the curvature):
@@ -336,13 +336,13 @@ def log_from_arrays(
     cutoff: float | None = None,
     filter_order: int = 4,
     trim: float = 0.0,
-    filter_tau: bool = True,
+    filter_tau: bool = False,
     source: str = "arrays",
 ) -> MotionLog:
     """A :class:`MotionLog` from arrays: t (N,), q (N, n_coords), tau (N, n_dofs) joint-side,
     optional qd, qdd (N, n_dofs; given together or alone: a missing one is differentiated). With
-    ``cutoff`` every given signal is filtered alike (module docstring; ``filter_tau=False``
-    leaves tau as given, see there); ``trim`` [s] drops that much at each end afterwards.
+    ``cutoff`` q (and qd, qdd when given) are filtered, tau too with ``filter_tau=True`` (module
+    docstring: filtering tau biases a fit); ``trim`` [s] drops that much at each end afterwards.
     ModelError naming the culprit on bad input."""
     who = "log_from_arrays" if source == "arrays" else "load_log"
     names = _fixed_base(who, model)
@@ -440,7 +440,7 @@ def load_log(
     gear_ratios: Any = None,
     efficiency: Any = None,
     trim: float = 0.0,
-    filter_tau: bool = True,
+    filter_tau: bool = False,
 ) -> MotionLog:
     """A :class:`MotionLog` from a CSV file (path), a pandas DataFrame or a dict of arrays with
     the columns of the module docstring. Motor currents become joint torques with
