@@ -64,7 +64,8 @@ int main(int argc, char** argv) {
     if (std::strcmp(argv[i], "--rounds") == 0 && i + 1 < argc) rounds = std::atoi(argv[++i]);
   }
   const armdyn::ModelPtr model =
-      armdyn::urdf_builder(argv[1], !floating, armdyn::Vec3(0.0, 0.0, -9.81), true, mimic).finalize();
+      armdyn::urdf_builder(argv[1], !floating, armdyn::Vec3(0.0, 0.0, -9.81), true, mimic)
+          .finalize();
   const armdyn::Model& m = *model;
   armdyn::Data d(m);
   const States s = random_states(m, 256);
@@ -89,7 +90,7 @@ int main(int argc, char** argv) {
   std::printf(
       "%s%s n_dofs=%d n_params=%ld: inverse_dynamics %.3f us, joint_torque_regressor %.3f us "
       "(%.2fx inverse_dynamics), energy_regressor %.3f us (%.2fx inverse_dynamics)%s\n",
-      argv[1], floating ? " (floating)" : "", m.independent.nv(), static_cast<long>(Y.cols()),
-      t_id, t_reg, t_reg / t_id, t_en, t_en / t_id, sink == 0.123 ? " " : "");
+      argv[1], floating ? " (floating)" : "", m.independent.nv(), static_cast<long>(Y.cols()), t_id,
+      t_reg, t_reg / t_id, t_en, t_en / t_id, sink == 0.123 ? " " : "");
   return 0;
 }

@@ -38,11 +38,11 @@
 // dynamics with gears, driven inverse dynamics, frame poses and Jacobians
 #include "armdyn/algorithm/crba.hpp"
 #include "armdyn/algorithm/derivatives.hpp"
-#include "armdyn/algorithm/regressor.hpp"
 #include "armdyn/algorithm/driven_inverse_dynamics.hpp"
 #include "armdyn/algorithm/dynamics.hpp"
 #include "armdyn/algorithm/forces.hpp"
 #include "armdyn/algorithm/frames.hpp"
+#include "armdyn/algorithm/regressor.hpp"
 #include "armdyn/algorithm/rnea.hpp"
 #include "armdyn/algorithm/tree_dynamics.hpp"
 
