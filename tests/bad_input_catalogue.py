@@ -56,6 +56,12 @@ def _coulomb_pendulum():
     return b.finalize()
 
 
+def _sprung_pendulum():
+    b = _hinged()
+    b.add_joint_spring_damper("hinge", 10.0, 0.0)
+    return b.finalize()
+
+
 def _heavy_pendulum():
     """10 kg at 0.5 m: I = 2.52 kg m², so I q̈ overflows for q̈ = 1.7e308."""
     b = ad.ModelBuilder()
@@ -1019,6 +1025,57 @@ CASES = [
         SE,
         r"overflow.*qdd\[0\]",
     ),
+    # ---- dynamic-parameter regressors (issue 35)
+    (
+        "reg-qdd-nan",
+        "identification",
+        "joint_torque_regressor with qdd NaN",
+        lambda: ad.joint_torque_regressor(_pendulum(), [0.0], [0.0], [np.nan]),
+        ME,
+        r"joint_torque_regressor: qdd contains NaN",
+    ),
+    (
+        "reg-rows",
+        "identification",
+        "joint_torque_regressor with 3 rows of q and 2 of qdd",
+        lambda: ad.joint_torque_regressor(
+            _pendulum(), np.zeros((3, 1)), np.zeros((3, 1)), np.zeros((2, 1))
+        ),
+        ME,
+        r"\bqdd\b must have shape \(3, 1\)",
+    ),
+    (
+        "reg-spring",
+        "identification",
+        "joint_torque_regressor of a model with a joint spring (not a dynamic parameter)",
+        lambda: ad.joint_torque_regressor(_sprung_pendulum(), [0.0], [0.0], [0.0]),
+        ME,
+        r"joint coordinate 'hinge' has a spring",
+    ),
+    (
+        "reg-overflow",
+        "identification",
+        "joint_torque_regressor with qd = 1e200 (finite; its square overflows)",
+        lambda: ad.joint_torque_regressor(_pendulum(), [0.3], [1e200], [0.0]),
+        SE,
+        r"overflow.*qd\[0\]",
+    ),
+    (
+        "ereg-qd-inf",
+        "identification",
+        "energy_regressor with qd inf",
+        lambda: ad.energy_regressor(_pendulum(), [0.0], [np.inf]),
+        ME,
+        r"energy_regressor: qd contains NaN or inf",
+    ),
+    (
+        "ereg-overflow",
+        "identification",
+        "energy_regressor with qd = 1e200 (finite; the kinetic energy overflows)",
+        lambda: ad.energy_regressor(_pendulum(), [0.3], [1e200]),
+        SE,
+        r"overflow.*qd\[0\]",
+    ),
     (
         "fdd-tau-nan",
         "derivatives",
@@ -1530,7 +1587,265 @@ CASES = [
         SE,
         r"singularity at s = [0-9.]+ \(position \[",
     ),
+    (
+        "base-parameters-samples-zero",
+        "identification",
+        "base_parameters with samples = 0",
+        lambda: _identification().base_parameters(_pendulum(), samples=0),
+        ME,
+        r"samples must be an integer in \[1, 1000000\], got 0",
+    ),
+    (
+        "excitation-floating-base",
+        "identification",
+        "fourier_excitation of a floating base",
+        lambda: _identification().fourier_excitation(_floating_box()),
+        ME,
+        "floating base",
+    ),
+    (
+        "excitation-period-nan",
+        "identification",
+        "fourier_excitation with period NaN",
+        lambda: _identification().fourier_excitation(
+            _pendulum(), period=float("nan"), max_velocity=1.0
+        ),
+        ME,
+        "period must be a positive number",
+    ),
+    (
+        "excitation-torque-infeasible",
+        "identification",
+        "fourier_excitation whose torque limit is below the gravity torque at q0",
+        lambda: _identification().fourier_excitation(
+            _pendulum(), q0=[1.0], max_velocity=1.0, max_torque=0.1, harmonics=2, samples=10
+        ),
+        SE,
+        "torque limit of joint 'hinge'",
+    ),
+    (
+        "log-unknown-column",
+        "identification",
+        "load_log with a column that is no coordinate of the model",
+        lambda: _load_log({**_log_columns(), "wrist": [0.0] * 6}),
+        ME,
+        r"unknown column 'wrist'",
+    ),
+    (
+        "log-missing-torque",
+        "identification",
+        "load_log with neither `<joint>.tau` nor `<joint>.current` for a joint",
+        lambda: _load_log({k: v for k, v in _log_columns().items() if k != "hinge.tau"}),
+        ME,
+        r"joint 'hinge' needs one of the columns 'hinge.tau' or 'hinge.current'",
+    ),
+    (
+        "log-nan-cell",
+        "identification",
+        "load_log with a NaN cell",
+        lambda: _load_log({**_log_columns(), "hinge": [0.0, 0.1, np.nan, 0.3, 0.4, 0.5]}),
+        ME,
+        r"column 'hinge', row 2 is 'nan', not finite",
+    ),
+    (
+        "log-time-order",
+        "identification",
+        "load_log with t not strictly increasing",
+        lambda: _load_log({**_log_columns(), "t": [0.0, 0.1, 0.1, 0.3, 0.4, 0.5]}),
+        ME,
+        r"t must be strictly increasing, but row 2",
+    ),
+    (
+        "log-current-constants",
+        "identification",
+        "load_log with a current column but no torque constants",
+        lambda: _load_log(
+            {("hinge.current" if k == "hinge.tau" else k): v for k, v in _log_columns().items()}
+        ),
+        ME,
+        r"torque_constants is required",
+    ),
+    (
+        "log-cutoff-nyquist",
+        "identification",
+        "log_from_arrays with a cutoff above the Nyquist frequency",
+        lambda: _identification().log_from_arrays(
+            _pendulum(), np.arange(40) * 0.1, np.zeros((40, 1)), np.zeros((40, 1)), cutoff=6.0
+        ),
+        ME,
+        r"cutoff 6.0 Hz is not below the Nyquist frequency 5 Hz",
+    ),
+    (
+        "log-device",
+        "identification",
+        "load_log of a device (/dev/zero)",
+        lambda: _identification().load_log("/dev/zero", _pendulum()),
+        ME,
+        r"'/dev/zero' is a character device, not a regular file",
+    ),
+    (
+        "log-directory",
+        "identification",
+        "load_log of a directory",
+        lambda: _identification().load_log(DATA, _pendulum()),
+        ME,
+        r"is a directory, not a regular file",
+    ),
+    (
+        "log-floating-base",
+        "identification",
+        "load_log with a floating-base model",
+        lambda: _identification().load_log(
+            _log_columns(), ad.urdf_builder(str(DATA / "arm6.urdf"), fixed_base=False).finalize()
+        ),
+        ME,
+        r"floating base",
+    ),
+    (
+        "with-parameters-length",
+        "identification",
+        "with_parameters with a pi one entry short",
+        lambda: _ident().with_parameters(_pendulum(), np.zeros(13)),
+        ME,
+        r"pi must have shape \(14,\)",
+    ),
+    (
+        "with-parameters-nan",
+        "identification",
+        "with_parameters with a NaN entry in pi",
+        lambda: _ident().with_parameters(_pendulum(), _pi_with(4, np.nan)),
+        ME,
+        r"pi\[4\] \('link.Ixx'\) must be finite",
+    ),
+    (
+        "with-parameters-negative-mass",
+        "identification",
+        "with_parameters with a negative body mass",
+        lambda: _ident().with_parameters(_pendulum(), _pi_with(0, -1.0)),
+        ME,
+        r"body 'link': mass \('link.m'\) must be >= 0",
+    ),
+    (
+        "with-parameters-not-psd",
+        "identification",
+        "with_parameters with a body inertia that is not positive semidefinite",
+        lambda: _ident().with_parameters(_pendulum(), _pi_with(4, -1.0)),
+        ME,
+        r"body 'link'.*not positive semidefinite",
+    ),
+    (
+        "write-urdf-missing-link",
+        "identification",
+        "write_urdf onto a URDF without one of the model's bodies",
+        lambda: _ident().write_urdf(
+            '<robot name="r"><link name="other"/></robot>', _pendulum(), _pi_with(0, 1.0)
+        ),
+        ME,
+        "the URDF has no link 'link'",
+    ),
+    (
+        "identify-log-of-another-model",
+        "identification",
+        "identify with a log whose joint names are not the model's coordinates",
+        lambda: _ident().identify(_pendulum(), _swing_log(names=["elbow"])),
+        ME,
+        r"log.joint_names \['elbow'\] do not match the model's coord_names \['hinge'\]",
+    ),
+    (
+        "identify-too-few-samples",
+        "identification",
+        "identify with four samples (fewer rows than base parameters)",
+        lambda: _ident().identify(_pendulum(), _swing_log(n=4)),
+        SE,
+        r"rank deficient: the log excites only",
+    ),
+    (
+        "identify-outlier-threshold",
+        "identification",
+        "identify with outlier_threshold 0",
+        lambda: _ident().identify(_pendulum(), _swing_log(), outlier_threshold=0.0),
+        ME,
+        r"outlier_threshold must be a number > 0",
+    ),
+    (
+        "validate-log-joints",
+        "identification",
+        "validate with a log of other joints than the model's",
+        lambda: _validate(joint_names=["other"]),
+        ME,
+        r"the log's joints \['other'\] are not the model's \['hinge'\]",
+    ),
+    (
+        "validate-pi-length",
+        "identification",
+        "validate with a pi of the wrong length",
+        lambda: _validate(pi=np.ones(3)),
+        ME,
+        r"pi has 3 entries, the model 14",
+    ),
+    (
+        "identify-cli-per-joint",
+        "identification",
+        "`armdyn identify --gear-ratios elbow=2,3` (named and unnamed entries mixed)",
+        lambda: _identify_cli().per_joint("--gear-ratios", "elbow=2,3"),
+        ME,
+        r"--gear-ratios 'elbow=2,3': either every entry is JOINT=VALUE or none is",
+    ),
+    (
+        "identify-cli-cutoff",
+        "identification",
+        "`armdyn identify --cutoff -1` (not a positive frequency)",
+        lambda: _identify_cli()._cutoff("-1"),
+        ME,
+        r"--cutoff '-1': the cutoff must be > 0 Hz",
+    ),
 ]
+
+
+def _identification():
+    import armdyn.identification
+
+    return armdyn.identification
+
+
+def _floating_box():
+    b = ad.ModelBuilder()
+    b.add_body("box", 1.0, I3)
+    b.add_free("float", "box")
+    return b.finalize()
+
+
+def _log_columns():
+    """A six-sample log of the pendulum (coordinate 'hinge') as a dict of columns."""
+    t = [0.0, 0.1, 0.2, 0.3, 0.4, 0.5]
+    return {"t": t, "hinge": [0.1 * x for x in t], "hinge.tau": [1.0] * 6}
+
+
+def _load_log(columns):
+    return _identification().load_log(columns, _pendulum())
+
+
+def _ident():
+    from armdyn import identification
+
+    return identification
+
+
+def _swing_log(n=50, names=("hinge",)):
+    """A log of the pendulum swinging (torques by its inverse dynamics)."""
+    model = _pendulum()
+    t = np.linspace(0.0, 2.0, n)
+    q, qd, qdd = np.sin(3 * t)[:, None], 3 * np.cos(3 * t)[:, None], -9 * np.sin(3 * t)[:, None]
+    tau = np.array([ad.inverse_dynamics(model, *x) for x in zip(q, qd, qdd, strict=True)])
+    return _ident().MotionLog(t, q, qd, qdd, tau, list(names), "synthetic")
+
+
+def _pi_with(i, value):
+    """The pendulum's dynamic parameters with entry i set to value."""
+    pi = ad.dynamic_parameters(_pendulum())
+    pi[i] = value
+    return pi
+
 
 _LIMITS = {"max_velocity": 1.0, "max_acceleration": 2.0, "max_jerk": 10.0}
 
@@ -1582,6 +1897,24 @@ def _least_energy(**change):
     args = dict(start=[0.0], goal=[1.0], duration=1.0, objective="rms_torque")
     args.update(change)
     return least_energy(_pendulum(), **args)
+
+
+def _validate(pi=None, **log_fields):
+    """validate(pendulum, a three-sample log of it, pi=pi), the log's fields overridden."""
+    from types import SimpleNamespace
+
+    from armdyn.identification import validate
+
+    z = np.zeros((3, 1))
+    fields = dict(t=np.arange(3.0), q=z, qd=z, qdd=z, tau=z, joint_names=["hinge"])
+    fields.update(log_fields)
+    return validate(_pendulum(), SimpleNamespace(**fields), pi=pi)
+
+
+def _identify_cli():
+    from armdyn.identification import cli
+
+    return cli
 
 
 def _cli():

@@ -26,6 +26,8 @@ void bind_validate(py::module_& m);
 void bind_algorithm(py::module_& m);
 void bind_frames(py::module_& m);
 void bind_derivatives(py::module_& m);
+void bind_regressor(py::module_& m);
+void bind_parameter_model(py::module_& m);
 }  // namespace armdyn
 
 namespace {
@@ -225,5 +227,7 @@ PYBIND11_MODULE(_core, m) {
   armdyn::bind_algorithm(m);
   armdyn::bind_frames(m);
   armdyn::bind_derivatives(m);
+  armdyn::bind_regressor(m);
+  armdyn::bind_parameter_model(m);
   add_text_signatures(m, py::module_::import("ast").attr("literal_eval"));
 }

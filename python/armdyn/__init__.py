@@ -7,7 +7,7 @@ actuator efforts) come from the augmented system ``[Γ ζᵀ; ζ 0][v'; δ] = [�
 projection keeps the constraints satisfied to round-off.
 """
 
-from armdyn import actuators, motion, scenes, validation
+from armdyn import actuators, identification, motion, scenes, validation
 from armdyn._core import (
     Actuator,
     Data,
@@ -21,8 +21,11 @@ from armdyn._core import (
     body_accelerations,
     body_forces,
     body_mass_matrix,
+    dynamic_parameter_names,
+    dynamic_parameters,
     dynamics_cost,
     energy,
+    energy_regressor,
     evaluate_constraints,
     forward_dynamics,
     forward_dynamics_derivatives,
@@ -34,6 +37,7 @@ from armdyn._core import (
     inverse_dynamics_derivatives,
     joint_coordinates,
     joint_reactions,
+    joint_torque_regressor,
     mass_matrix,
     profiles,
     state_from_joints,
@@ -89,8 +93,11 @@ __all__ = [
     "body_mass_matrix",
     "driven_inverse_dynamics",
     "duty_cycle",
+    "dynamic_parameter_names",
+    "dynamic_parameters",
     "dynamics_cost",
     "energy",
+    "energy_regressor",
     "evaluate_constraints",
     "forward_dynamics",
     "forward_dynamics_derivatives",
@@ -99,10 +106,12 @@ __all__ = [
     "frame_pose",
     "frame_pose_cartesian",
     "gear_ratio_sweep",
+    "identification",
     "inverse_dynamics",
     "inverse_dynamics_derivatives",
     "joint_coordinates",
     "joint_reactions",
+    "joint_torque_regressor",
     "limit_violations",
     "load_catalog",
     "load_urdf",

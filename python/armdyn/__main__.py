@@ -18,6 +18,13 @@
   each joint's motor, gearbox and drive from the catalog (``armdyn.select_drivetrain``), prints
   the choice and writes its report to DIR; exit code 0 when every joint has a drivetrain that
   passes, 1 when some has none, 2 for bad input.
+* ``armdyn identify ROBOT.urdf --log FILE.csv --out DIR [--validate FILE.csv] [--cutoff HZ]
+  [--trim SECONDS] [--filter-tau] [--no-physical] [--method ols|wls] [--torque-constants K]
+  [--gear-ratios N] [--efficiency E]`` identifies the robot's inertial, friction, offset and
+  rotor parameters from a measured log (``armdyn.identification``), validates them on data the
+  fit did not use, and writes DIR/identified.urdf, DIR/report.html and DIR/parameters.csv; exit
+  code 0 when it ran, 1 when the unconstrained (``--no-physical``) estimate cannot be written as
+  a URDF, 2 for bad input. Details: ``armdyn.identification.cli``.
 * ``armdyn verify`` prints the solver's accuracy figures: pendulum period, energy and momentum
   conservation, constraint drift, and forward dynamics against the Euler–Lagrange equations.
 
@@ -86,6 +93,7 @@ def main(argv: list[str] | None = None) -> int:
         help="what the choice minimises (margin: maximises the least margin); default mass",
     )
     select.add_argument("--out", help="write the selection's report into this folder")
+    _identify_arguments(sub)
     args = parser.parse_args(argv)
     try:
         return _run(args)
@@ -129,6 +137,59 @@ def _motion_arguments(p: argparse.ArgumentParser) -> None:
     add_option_arguments(p)
 
 
+def _identify_arguments(sub) -> None:
+    """The ``identify`` subcommand's arguments (armdyn.identification.cli)."""
+    p = sub.add_parser(
+        "identify",
+        help="identify the robot's parameters from a measured log, validate them and write the "
+        "identified URDF and a report (exit 0: done, 2: bad input)",
+    )
+    p.add_argument("urdf", help="the robot's URDF file (fixed base)")
+    p.add_argument(
+        "--log",
+        required=True,
+        help="CSV: t, one position column per joint, <joint>.tau (or <joint>.current), optional "
+        "<joint>.qd/.qdd",
+    )
+    p.add_argument("--out", required=True, help="folder for identified.urdf and the report")
+    p.add_argument(
+        "--validate",
+        metavar="FILE.csv",
+        help="a second log to validate on (default: the last 30%% of --log; the fit uses the rest)",
+    )
+    p.add_argument(
+        "--cutoff",
+        metavar="HZ",
+        help="low-pass q (zero-phase Butterworth) before differentiating",
+    )
+    p.add_argument("--trim", metavar="SECONDS", help="drop this much of each log at each end")
+    p.add_argument(
+        "--filter-tau",
+        action="store_true",
+        help="with --cutoff, filter the torques too (default: q only; a filtered Coulomb "
+        "friction step biases the fit)",
+    )
+    p.add_argument(
+        "--no-physical",
+        action="store_true",
+        help="keep the least-squares estimate (no physical consistency constraint)",
+    )
+    p.add_argument(
+        "--method", default="wls", metavar="ols|wls", help="least squares: ordinary or weighted"
+    )
+    for flag, what in (
+        ("--torque-constants", "torque constants [N m/A]"),
+        ("--gear-ratios", "gear ratios"),
+        ("--efficiency", "gear efficiencies (0, 1]"),
+    ):
+        p.add_argument(
+            flag,
+            metavar="V|V1,V2,..|JOINT=V,..",
+            help=f"for <joint>.current logs: the {what}, one for all joints, one per joint or "
+            "by joint name",
+        )
+
+
 def _run(args: argparse.Namespace) -> int:
     if args.command == "size":
         from armdyn.size import main as size_main
@@ -138,6 +199,10 @@ def _run(args: argparse.Namespace) -> int:
         from armdyn.sizing.cli import select_main
 
         return select_main(args)
+    if args.command == "identify":
+        from armdyn.identification.cli import main as identify_main
+
+        return identify_main(args)
     if args.command == "verify":
         from armdyn.verify import main as verify_main
 

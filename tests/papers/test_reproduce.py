@@ -1,6 +1,7 @@
 """`armdyn reproduce` end to end: the command runs, writes the report, and its tables carry the
 paper's figures beside ours; the notebook walking through the 5-DOF validation executes."""
 
+import ast
 import re
 import subprocess
 import sys
@@ -256,3 +257,46 @@ def test_motion_notebook_executes(tmp_path):
     assert _number(r"least-energy joint torque / limit, max: (\S+)", out) <= 1.0
     assert _number(r"least-energy motor torque / peak torque, max: (\S+)", out) <= 1.0
     assert rows["least-energy joint legs"][0] == pytest.approx(rows["quintic joint legs"][0])
+
+
+def test_identification_notebook_executes(tmp_path):
+    """notebooks/identification_ur5.ipynb runs end to end (issue 35: the UR5 with drivetrains
+    from the catalog, a perturbed "real" arm simulated with sensor noise along the designed
+    excitation, the log read from its CSV, identified, validated on another motion, the sizing
+    verdict with the nominal, identified and real arm). Its checks against the real arm, which
+    the identification never sees: the true base parameters within three standard deviations
+    of the least-squares estimate (at most 2 of them outside: 58 at 3 sigma would put 0.16
+    outside on average); the validation RMSE within 10 % of the noise level on every joint
+    (the issue's target), the identified model's own error on the exact motion under a quarter
+    of it, the nominal model's RMSE at least 5 times it; with tau filtered as well, fewer true
+    parameters within 3 sigma (the bias log.py documents); the identified model's motor RMS
+    torques on the pick-and-place cycle within 3 % of the real arm's (measured: 1.0 %) and its
+    verdict the real arm's, where the nominal model is off by more than 50 % (measured: 93 %, the
+    wrist's friction). The designed excitation within its limits on a fine grid, by an
+    independent inverse dynamics."""
+    out = execute_notebook("identification_ur5.ipynb", tmp_path)
+    assert "real arm physically consistent: True" in out
+    cond = re.search(r"regressor condition number: designed (\S+), random (\S+)", out)
+    assert float(cond.group(1)) < float(cond.group(2))
+    again = re.search(r"recomputed, one scaling: designed (\S+), random (\S+)", out)
+    assert float(again.group(1)) < float(again.group(2))
+    usage = re.search(r"largest use of each limit: (\{.*\})", out).group(1)
+    assert all(v <= 1.0 for v in ast.literal_eval(usage).values()), usage
+    assert "physically consistent: True" in out
+    inside = re.search(r"within 3 sigma of the least-squares estimate: (\d+) of (\d+)", out)
+    n_in, n_base = int(inside.group(1)), int(inside.group(2))
+    assert n_in >= n_base - 2, out
+    filtered = re.search(r"tau filtered too: .* within 3 sigma: (\d+) of (\d+)", out)
+    assert int(filtered.group(1)) < n_in
+    assert _number(r"validation RMSE / noise level, worst joint: (\S+)", out) <= 1.1
+    assert _number(r"nominal RMSE / noise level, best joint: (\S+)", out) >= 5.0
+    assert _number(r"exact motion / noise level, worst joint: (\S+)", out) <= 0.25
+    verdicts = dict(re.findall(r"verdict \| (\w+) \| every joint ok: (\w+)", out))
+    assert verdicts["identified"] == verdicts["real"]
+    assert _number(r"identified vs real, largest relative gap: (\S+)", out) <= 0.03
+    assert _number(r"nominal vs real, largest relative gap: (\S+)", out) >= 0.5
+    out_dir = tmp_path / "ur5-identification"
+    for name in ("excitation.csv", "measured_excitation.csv", "identified.urdf"):
+        assert (out_dir / name).is_file(), name
+    assert (out_dir / "report" / "report.html").is_file()
+    assert (out_dir / "validation_torques.png").is_file()

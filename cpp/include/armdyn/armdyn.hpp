@@ -42,6 +42,7 @@
 #include "armdyn/algorithm/dynamics.hpp"
 #include "armdyn/algorithm/forces.hpp"
 #include "armdyn/algorithm/frames.hpp"
+#include "armdyn/algorithm/regressor.hpp"
 #include "armdyn/algorithm/rnea.hpp"
 #include "armdyn/algorithm/tree_dynamics.hpp"
 
@@ -67,7 +68,8 @@
 // validators independent of the Cartesian path
 #include "armdyn/validate/validators.hpp"
 
-// URDF import, model bytes, payloads
+// URDF import, model bytes, payloads, models of identified parameters
+#include "armdyn/io/parameter_model.hpp"
 #include "armdyn/io/payload.hpp"
 #include "armdyn/io/serialize.hpp"
 #include "armdyn/io/urdf.hpp"

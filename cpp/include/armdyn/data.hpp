@@ -19,6 +19,8 @@
 
 namespace armdyn {
 
+struct ParameterLayout;  // algorithm/regressor.hpp
+
 /// Counters of the Cartesian pipeline over a Data's life (a simulation reports them).
 struct PipelineStats {
   long position_projections = 0;  ///< position corrections that needed a factorisation
@@ -202,6 +204,11 @@ class Data {
     Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> solves;
     bool sized = false;
   } deriv;
+
+  // --- the dynamic-parameter regressors (algorithm/regressor) ---
+  /// the model's parameter layout (cached_parameter_layout), looked up by the first regressor
+  /// call on this Data (a model the regressor refuses leaves it nullptr)
+  const ParameterLayout* parameter_layout = nullptr;
 
   // --- named frames (algorithm/frames) ---
   Mat4 frame_pose = Mat4::Identity();  ///< the last frame pose [R p; 0 1]

@@ -7,7 +7,7 @@ import numpy
 import numpy.typing
 import typing
 from . import profiles
-__all__: list[str] = ['Actuator', 'Data', 'LagrangeValidator', 'Model', 'ModelBuilder', 'ModelError', 'Motor', 'Profile', 'SolverError', 'URDF_COULOMB_SMOOTHING', 'URDF_MAX_ATTRIBUTES', 'URDF_MAX_BYTES', 'UrdfError', 'body_accelerations', 'body_forces', 'body_mass_matrix', 'dynamics_cost', 'end_effector_position', 'energy', 'evaluate_constraints', 'forward_dynamics', 'forward_dynamics_derivatives', 'frame_jacobian', 'frame_jacobian_cartesian', 'frame_pose', 'frame_pose_cartesian', 'inverse_dynamics', 'inverse_dynamics_derivatives', 'joint_coordinates', 'joint_reactions', 'mass_matrix', 'paper_3dof_torques', 'paper_5dof_end_effector', 'profiles', 'state_from_joints', 'torque_error_metrics', 'urdf_builder']
+__all__: list[str] = ['Actuator', 'Data', 'LagrangeValidator', 'Model', 'ModelBuilder', 'ModelError', 'Motor', 'Profile', 'SolverError', 'URDF_COULOMB_SMOOTHING', 'URDF_MAX_ATTRIBUTES', 'URDF_MAX_BYTES', 'UrdfError', 'body_accelerations', 'body_forces', 'body_mass_matrix', 'dynamic_parameter_names', 'dynamic_parameters', 'dynamics_cost', 'end_effector_position', 'energy', 'energy_regressor', 'evaluate_constraints', 'forward_dynamics', 'forward_dynamics_derivatives', 'frame_jacobian', 'frame_jacobian_cartesian', 'frame_pose', 'frame_pose_cartesian', 'inverse_dynamics', 'inverse_dynamics_derivatives', 'joint_coordinates', 'joint_reactions', 'joint_torque_regressor', 'mass_matrix', 'model_with_dynamic_parameters', 'paper_3dof_torques', 'paper_5dof_end_effector', 'profiles', 'state_from_joints', 'torque_error_metrics', 'urdf_builder']
 class ModelError(ValueError):
     """
     Bad input: a model, builder call, array shape or option that armdyn refuses, the message naming the culprit (the body, joint, argument and the expected shape). The model or builder is left as it was. A ValueError.
@@ -669,6 +669,14 @@ def body_mass_matrix(model: Model) -> numpy.typing.NDArray[numpy.float64]:
     """
     The constant Cartesian mass matrix Gamma = blockdiag(m_i I3, J_i) (nv, nv) [kg, kg m^2] of the bodies (J_i about the CoM in body axes).
     """
+def dynamic_parameter_names(model: Model) -> list[str]:
+    """
+    The names of dynamic_parameters(model)' entries: '<body>.m', '<body>.mcx', ..., '<body>.Izz', then '<coordinate>.fv', '.fc', '.offset', '.Ia'.
+    """
+def dynamic_parameters(model: Model) -> numpy.typing.NDArray[numpy.float64]:
+    """
+    The model's dynamic parameters pi (n_params,) in joint_torque_regressor's order (dynamic_parameter_names): per body m, m c_x, m c_y, m c_z, I_xx, I_xy, I_yy, I_xz, I_yz, I_zz about its parameter frame (Pinocchio's order), then per joint coordinate fv, fc, offset (0), Ia.
+    """
 def dynamics_cost(model: Model) -> dict:
     """
     The measured cost model's prediction for a model (derived once per model): microseconds per forward_dynamics call by 'crba', 'aba' and 'cartesian', the algorithms method='joint' and method='auto' take, and the microseconds per right-hand side of simulate in joint space and in Cartesian coordinates with the formulation coordinates='auto' takes where both apply.
@@ -678,6 +686,10 @@ def end_effector_position(model: Model, body: str, point: numpy.typing.ArrayLike
 def energy(model: Model, u: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike) -> tuple[float, float]:
     """
     (kinetic, potential) energy [J] at the Cartesian state u (nq,), v (nv,); the potential includes gravity and springs. ModelError on wrong shapes.
+    """
+def energy_regressor(model: Model, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, data: Data | None = None) -> numpy.typing.NDArray[numpy.float64]:
+    """
+    The energy regressor h (n_params,) at (q, qd): the kinetic plus potential energy of the model's bodies and actuator rotors is h @ dynamic_parameters(model) (potential -m g . c about the world origin, as energy(); the friction and offset entries are 0). Identification from energy needs no accelerations: h(t1) - h(t0) is the integral of (tau - friction) . qd dt along a motion. q: n_coords, qd: n_dofs; 2-D arrays (one state per row) give (rows, n_params). ModelError as joint_torque_regressor.
     """
 def evaluate_constraints(model: Model, u: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, t: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> dict:
     """
@@ -723,9 +735,17 @@ def joint_reactions(model: Model, q: numpy.typing.ArrayLike, qd: numpy.typing.Ar
     """
     Every joint's reaction along a joint-space motion of a tree: (forces, torques), each (n_joints, 3) for one state (q: n_coords, qd and qdd: n_dofs; a coupled model's independent coordinates, as inverse_dynamics takes them) or (rows, n_joints, 3) for one state per row; t [s] a number, one per row, or None (0). The same quantity as SimulationResult.reaction_forces/reaction_torques: what the joint's constraint applies to its child at the joint point, in the child's joint frame, for every joint of the model (fixed joints included; zero for floating bases); the components about/along a joint's free axes are zero (the actuator's torque there is inverse_dynamics'). The joint torques are the inverse dynamics' (the motion is exactly the one given); gravity and the force elements act, drives are ignored.
     """
+def joint_torque_regressor(model: Model, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike, data: Data | None = None) -> numpy.typing.NDArray[numpy.float64]:
+    """
+    The joint torque regressor Y (n_dofs, n_params) at (q, qd, qdd): inverse_dynamics(model, q, qd, qdd) = Y @ dynamic_parameters(model), linear in the model's dynamic parameters (per body: m, m c, the inertia about its parameter frame -- its URDF link frame; per joint coordinate: viscous and Coulomb friction, a torque offset, the rotor's reflected inertia; dynamic_parameter_names names them). q: n_coords, qd and qdd: n_dofs (a coupled model's independent coordinates, Y = G^T Y_full); 2-D arrays (one state per row) give (rows, n_dofs, n_params), computed in C++ without the GIL. A floating base's six rows come first: the force on the base frame, then the moment about its origin, in its axes (as inverse_dynamics). By the recursive Newton-Euler algorithm: per body its 6 x 10 unit-wrench block F in its parameter frame, then one row block S^T F per degree of freedom on its path to the root. Pinocchio's computeJointTorqueRegressor is the same matrix reordered: rows by joint name (a free flyer's six first), body B's 10 columns those of the joint whose child link is B (Pinocchio's joint frame is the URDF link frame), armdyn's friction, offset and rotor columns added. ModelError for a model with a force element that is not a parameter (springs, loads, inputs, motors), named; SolverError when finite inputs overflow.
+    """
 def mass_matrix(model: Model, q: numpy.typing.ArrayLike, data: Data | None = None) -> numpy.typing.NDArray[numpy.float64]:
     """
     The joint-space mass matrix M(q) (n_dofs, n_dofs) of a tree, by the composite-rigid-body algorithm (a coupled model's in its independent coordinates, G^T M G); 2-D q (one state per row) gives (rows, n, n).
+    """
+def model_with_dynamic_parameters(model: Model, pi: numpy.typing.ArrayLike, physical_inertia: bool = True) -> Model:
+    """
+    A new model (this one unchanged) whose dynamic_parameters equal pi (n_params,), offsets aside (measurement biases, not dynamics: ignored): each body's mass, centre of mass and inertia from its 10 numbers (the body frame's origin moves with the centre of mass, every attachment point with it: the geometry is unchanged; a body without a frame of its name gets one at its old centre of mass, pi's parameter frame), each coordinate's friction sources scaled to fv, fc (created on its joint when it has none), its actuators' rotor inertias scaled to Ia (an actuator of gear ratio 1 added when it has none), then finalized again. physical_inertia=True: each body's parameters physically consistent (pseudo-inertia positive semidefinite); False: the inertia about the centre of mass positive semidefinite only (the triangle inequality not required). ModelError naming the entry or body on a wrong length, a non-finite entry, a negative mass, friction or Ia, an inertia outside those limits.
     """
 def paper_3dof_torques(L: numpy.typing.ArrayLike, M: numpy.typing.ArrayLike, g: typing.SupportsFloat | typing.SupportsIndex, theta: numpy.typing.ArrayLike, thetad: numpy.typing.ArrayLike) -> numpy.typing.NDArray[numpy.float64]:
     ...
