@@ -5,6 +5,7 @@
 // forward_dynamics take them (rows.hpp).
 #include <pybind11/stl.h>
 
+#include <array>
 #include <cstdlib>
 #include <new>
 #include <vector>
@@ -113,16 +114,18 @@ py::tuple matrices_call(const char* fn, Data& d, int k, const py::handle& q, con
                         const char* an, const py::handle& b, const char* bn, const py::handle& t,
                         Fn&& one) {
   const long n = d.ni;
-  std::vector<py::array_t<double>> outs;
-  std::vector<double*> ptrs;
+  // (at most 3 outputs: no vectors of them to allocate per call)
+  std::array<py::object, 3> outs;  // (py::object: no empty array made first)
+  std::array<double*, 3> ptrs{};
   const bool rows_given = is_batch(q);
   const long rows =
       rows_given ? static_cast<long>(py::reinterpret_borrow<py::array>(q).shape(0)) : 1;
-  std::vector<py::ssize_t> shape{n, n};
-  if (rows_given) shape.insert(shape.begin(), rows);
+  const std::vector<py::ssize_t> shape =
+      rows_given ? std::vector<py::ssize_t>{rows, n, n} : std::vector<py::ssize_t>{n, n};
   for (int j = 0; j < k; ++j) {
-    outs.push_back(DerivativeOutputPool::get().array(shape));
-    ptrs.push_back(outs.back().mutable_data());
+    py::array_t<double> out = DerivativeOutputPool::get().array(shape);
+    ptrs[j] = out.mutable_data();
+    outs[j] = std::move(out);
   }
   auto result = [&](long done) {
     py::tuple r(k);

@@ -186,6 +186,9 @@ class Data {
     /// V_p x u, a = (V_p + V_c) x S; the subtree's Yc S and Bc^T S; the subtree wrench's
     /// derivatives along q (without and with S x* Fc) and along qd
     std::vector<Vec6> S, u, w, av, YS, BS, dFq, dFqx, dFv;
+    /// per body, forward derivatives (the passes run at qdd = 0, then qdd added): the
+    /// acceleration qdd adds, and the sum of YS qdd over the degrees of freedom below the body
+    std::vector<Vec6> dA, dH;
     MatX dq, dqd;  ///< (n, n) the rigid-body derivatives of tau_full, then the force elements'
     /// the public results (ni, ni): dtau/dq and dtau/dqd; forward: dqdd/dq, dqdd/dqd, M^-1
     MatX tau_q, tau_qd, qdd_q, qdd_qd, qdd_tau;

@@ -6,6 +6,7 @@
 #include "armdyn/algorithm/crba.hpp"
 #include "armdyn/algorithm/dynamics.hpp"
 #include "armdyn/algorithm/force_derivatives.hpp"
+#include "armdyn/algorithm/forces.hpp"
 #include "armdyn/errors.hpp"
 #include "armdyn/kernels/joint_space.hpp"
 #include "armdyn/kernels/kkt_factor.hpp"
@@ -226,8 +227,11 @@ void check_state(const Model& m, const Data& d, Eigen::Ref<const VecX> q, Eigen:
 // d.deriv.dq, dqd at the loaded kinematics: the rigid-body derivatives less the force elements'
 // (tau = ... - F)
 void full_derivatives(const Model& m, Data& d, const double* q, Eigen::Ref<const VecX> qd,
-                      Eigen::Ref<const VecX> qdd, double t) {
-  rnea_derivatives_loaded(m, d, qd, qdd);
+                      Eigen::Ref<const VecX> qdd, double t);
+
+// the force elements' share of d.deriv.dq, dqd (tau = ... - F), after fill_matrices
+void element_derivatives(const Model& m, Data& d, const double* q, Eigen::Ref<const VecX> qd,
+                         double t) {
   if (!has_force_elements(m)) return;
   Data::Derivatives& w = d.deriv;
   w.dq = -w.dq;
@@ -235,6 +239,12 @@ void full_derivatives(const Model& m, Data& d, const double* q, Eigen::Ref<const
   add_force_element_derivatives(m, d, q, qd.data(), t, w.dq, w.dqd);
   w.dq = -w.dq;
   w.dqd = -w.dqd;
+}
+
+void full_derivatives(const Model& m, Data& d, const double* q, Eigen::Ref<const VecX> qd,
+                      Eigen::Ref<const VecX> qdd, double t) {
+  rnea_derivatives_loaded(m, d, qd, qdd);
+  element_derivatives(m, d, q, qd, t);
 }
 
 // the public (independent) results from the full ones: G^T X G (a copy without couplings)
@@ -350,7 +360,7 @@ void ensure_derivatives(const Model& m, Data& d) {
   w.Yc.assign(nb, Data::Composite{});
   w.Bc.assign(nb, Mat3::Zero());
   w.Lc.assign(nb, Vec3::Zero());
-  for (auto* v : {&w.V, &w.A, &w.Fc}) v->assign(nb, Vec6::Zero());
+  for (auto* v : {&w.V, &w.A, &w.Fc, &w.dA, &w.dH}) v->assign(nb, Vec6::Zero());
   for (auto* v : {&w.S, &w.u, &w.w, &w.av, &w.YS, &w.BS, &w.dFq, &w.dFqx, &w.dFv})
     v->assign(n, Vec6::Zero());
   w.dq = MatX::Zero(d.n, d.n);
@@ -393,6 +403,76 @@ void inverse_dynamics_derivatives(const Model& m, Data& d, Eigen::Ref<const VecX
 }
 
 namespace derivatives_detail {
+
+// whether the derivative passes give M qdd = tau + Q - b themselves (equations_from_passes):
+// without loads and spring-dampers, whose wrenches enter b only through joint_space_equations'
+// body forces
+bool passes_give_equations(const Model& m) { return m.body_loads.empty() && m.springs.empty(); }
+
+// M qdd = tau + Q - b (without tau) into d.M and d.rhs from the derivative passes at qdd = 0 on
+// the loaded kinematics, instead of joint_space_equations' CRBA and Newton-Euler residual:
+// M[r, k] = S_r . Yc S_k for r at or above k (crba_loaded's entries), b_k = S_k . Fc (the
+// subtree's wrench at qdd = 0), Q the joint-coordinate forces and gear pairs
+void equations_from_passes(const Model& m, Data& d, const double* q, const double* qd, double t) {
+  forward_pass(m, d, Eigen::Map<const VecX>(qd, d.n), d.zero, about_point(m, d));
+  backward_pass(m, d);
+  const Data::Derivatives& w = d.deriv;
+  for (int k = 0; k < d.n; ++k) {
+    d.rhs[k] = -w.S[k].dot(w.Fc[m.joints[m.dof_joint[k]].child]);
+    for (int ji = m.dof_joint[k]; ji >= 0;) {
+      const Joint& j = m.joints[ji];
+      for (int r = j.dof0; r < j.dof0 + joint_dofs(j.type); ++r)
+        d.M(r, k) = d.M(k, r) = w.S[r].dot(w.YS[k]);
+      ji = j.parent == kGround ? -1 : d.joint_of_body[j.parent];
+    }
+  }
+  if (!m.coord_forces.empty() || !m.gears.empty()) {
+    coordinate_forces(m, q + 7 * m.n_free, qd + 6 * m.n_free, nullptr, t, d.coord_tau);
+    d.rhs.tail(d.nco) += d.coord_tau;
+  }
+  if (!d.rhs.allFinite()) {
+    for (int c = 0; c < d.n; ++c)
+      if (!std::isfinite(d.rhs[c]))
+        throw SolverError(msg("non-finite generalised force on joint coordinate '", m.dof_names[c],
+                              "' at t=", t));
+  }
+}
+
+// the passes at qdd = 0 (equations_from_passes) brought to qdd (full): each body's acceleration
+// gains dA = dA_parent + S qdd over its joint, each dof's w and dFq their parent's dA x S terms,
+// each subtree wrench Yc dA + dH (YS qdd summed over the dofs below), and dFqx follows
+void add_accelerations(const Model& m, Data& d, const VecX& qdd) {
+  Data::Derivatives& w = d.deriv;
+  for (int ji : m.tree_order) {
+    const Joint& j = m.joints[ji];
+    const bool root = j.parent == kGround;
+    const Vec6 dAp = root ? Vec6::Zero() : w.dA[j.parent];
+    Vec6& dA = w.dA[j.child];
+    dA = dAp;
+    for (int c = j.dof0; c < j.dof0 + joint_dofs(j.type); ++c) {
+      if (!root) {
+        const Vec6 x = mcross(dAp, w.S[c]);
+        w.w[c] += x;
+        w.dFq[c] += inertia_times(w.Yc[j.child], x);
+      }
+      dA += w.S[c] * qdd[c];
+    }
+  }
+  for (Vec6& h : w.dH) h.setZero();
+  for (auto it = m.tree_order.rbegin(); it != m.tree_order.rend(); ++it) {
+    const Joint& j = m.joints[*it];
+    const int b = j.child;
+    Vec6& F = w.Fc[b];
+    F += inertia_times(w.Yc[b], w.dA[b]) + w.dH[b];
+    Vec6* up = j.parent == kGround ? nullptr : &w.dH[j.parent];
+    if (up) *up += w.dH[b];
+    for (int c = j.dof0; c < j.dof0 + joint_dofs(j.type); ++c) {
+      w.dFqx[c] = w.dFq[c] + fcross(w.S[c], F);
+      if (up) *up += w.YS[c] * qdd[c];
+    }
+  }
+  fill_matrices(m, d);
+}
 
 [[noreturn]] void not_positive_definite(const char* fn, double t) {
   throw SolverError(msg(fn, ": the joint-space mass matrix is not positive definite at t=", t,
@@ -473,8 +553,15 @@ void forward_dynamics_derivatives(const Model& m, Data& d, Eigen::Ref<const VecX
   }
   const double* qf = coupled ? c.q.data() : q.data();
   const Eigen::Map<const VecX> qdf(coupled ? c.qd.data() : qd.data(), d.n);
-  // M qdd = tau + Q - b (joint_space_equations: CRBA, and the Newton-Euler residual at qdd = 0)
-  joint_space_equations(m, d, qf, qdf.data(), nullptr, nullptr, t);
+  // M qdd = tau + Q - b: from the derivative passes at qdd = 0 where they give it, else by
+  // joint_space_equations (CRBA, and the Newton-Euler residual at qdd = 0)
+  const bool from_passes = passes_give_equations(m);
+  if (from_passes) {
+    joint_space_kinematics(m, Eigen::Map<const VecX>(qf, d.nq), qdf, d.kin, d.rne);
+    equations_from_passes(m, d, qf, qdf.data(), t);
+  } else {
+    joint_space_equations(m, d, qf, qdf.data(), nullptr, nullptr, t);
+  }
   MatX& M = coupled ? c.M : d.M;
   MatX& L = coupled ? c.L : d.L;
   if (coupled) {
@@ -494,7 +581,12 @@ void forward_dynamics_derivatives(const Model& m, Data& d, Eigen::Ref<const VecX
   else
     w.qdd_full = w.qdd;
   // dtau/dq, dtau/dqd at (q, qd, qdd), then M^-1 applied
-  full_derivatives(m, d, qf, qdf, w.qdd_full, t);
+  if (from_passes) {
+    add_accelerations(m, d, w.qdd_full);
+    element_derivatives(m, d, qf, qdf, t);
+  } else {
+    full_derivatives(m, d, qf, qdf, w.qdd_full, t);
+  }
   reduce_pair(m, d, w.dq, w.dqd, w.tau_q, w.tau_qd);
   if (sparse)
     inverse_products_sparse(w, d.n);
