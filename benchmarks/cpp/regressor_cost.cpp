@@ -1,55 +1,19 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The dynamic-parameter regressors' cost per call in C++ (benchmarks/cpp/CMakeLists.txt; the
 // C++ side of benchmarks/regressor.py): on one Data, over 256 random states of a URDF robot, the
-// median per-call time of inverse_dynamics, joint_torque_regressor (into a sized Y) and
+// median per-call CPU time of inverse_dynamics, joint_torque_regressor (into a sized Y) and
 // energy_regressor (rounds interleaved, each round every state once), and the ratio
 // (joint_torque_regressor / one inverse_dynamics call; target <= 3).
-#include <algorithm>
 #include <armdyn/armdyn.hpp>
-#include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
-#include <random>
 #include <string>
 #include <vector>
 
-namespace {
+#include "cost_harness.hpp"
 
-using Clock = std::chrono::steady_clock;
-
-struct States {
-  std::vector<armdyn::VecX> q, qd, qdd;
-};
-
-States random_states(const armdyn::Model& m, int count) {
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  States s;
-  const int nq = m.independent.nq(), nv = m.independent.nv();
-  for (int k = 0; k < count; ++k) {
-    armdyn::VecX q(nq), qd(nv), qdd(nv);
-    for (int i = 0; i < nq; ++i) q[i] = u(rng);
-    for (int f = 0; f < m.n_free; ++f) q.segment<4>(7 * f + 3).normalize();
-    for (int i = 0; i < nv; ++i) qd[i] = u(rng), qdd[i] = u(rng);
-    s.q.push_back(q), s.qd.push_back(qd), s.qdd.push_back(qdd);
-  }
-  return s;
-}
-
-template <class F>
-double round_us(const States& s, F&& f) {
-  const auto t0 = Clock::now();
-  for (std::size_t k = 0; k < s.q.size(); ++k) f(k);
-  const std::chrono::duration<double, std::micro> dt = Clock::now() - t0;
-  return dt.count() / static_cast<double>(s.q.size());
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
-}  // namespace
+using namespace cost_harness;
 
 int main(int argc, char** argv) {
   if (argc < 2) {

@@ -69,6 +69,7 @@
 #include "armdyn/validate/validators.hpp"
 
 // URDF import, model bytes, payloads, models of identified parameters
+#include "armdyn/io/model_copy.hpp"
 #include "armdyn/io/parameter_model.hpp"
 #include "armdyn/io/payload.hpp"
 #include "armdyn/io/serialize.hpp"

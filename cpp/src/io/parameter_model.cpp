@@ -12,7 +12,7 @@
 #include "armdyn/algorithm/regressor.hpp"
 #include "armdyn/builder/builder.hpp"
 #include "armdyn/errors.hpp"
-#include "armdyn/io/serialize.hpp"
+#include "armdyn/io/model_copy.hpp"
 #include "armdyn/math/quaternion.hpp"
 
 namespace armdyn {
@@ -225,17 +225,6 @@ void set_rotors(const Model& m, const ParameterLayout& L, const VecX& pi,
   }
 }
 
-/// The model's description as a builder's draft (its derived tables made afresh).
-Model draft_of(const Model& m) {
-  std::string bytes;
-  try {
-    bytes = serialize_draft(m);
-  } catch (const ModelError& e) {
-    throw ModelError(msg(kFn, ": the model cannot be copied (", e.what(), ")"));
-  }
-  return deserialize_draft(bytes);
-}
-
 }  // namespace parameter_model_detail
 
 using namespace parameter_model_detail;
@@ -244,7 +233,8 @@ ModelPtr model_with_dynamic_parameters(const Model& m, const VecX& pi, bool phys
   const ParameterLayout L = dynamic_parameter_layout(m);
   const std::vector<std::string> names = dynamic_parameter_names(m);
   check_vector(L, pi, names);
-  Model draft = draft_of(m);
+  std::vector<std::string> notes;
+  Model draft = model_draft(m, kFn, notes);
   if (draft.coord_forces.size() != m.coord_forces.size() ||
       draft.actuators.size() != m.actuators.size() || draft.bodies.size() != m.bodies.size())
     throw ModelError(msg(kFn, ": internal: the model's draft differs from the model"));
@@ -253,8 +243,6 @@ ModelPtr model_with_dynamic_parameters(const Model& m, const VecX& pi, bool phys
   set_friction(m, L, pi, names, draft, frictions);
   std::vector<std::pair<std::string, double>> actuators;
   set_rotors(m, L, pi, names, draft, actuators);
-  const std::vector<std::string> warnings = std::move(draft.warnings);
-  draft.warnings.clear();
   ModelBuilder b(std::move(draft), physical_inertia);
   for (const NewFrame& f : frames) {
     try {
@@ -274,18 +262,7 @@ ModelPtr model_with_dynamic_parameters(const Model& m, const VecX& pi, bool phys
                            "' needs an actuator, which the joint cannot take: ", e.what()));
     }
   }
-  std::shared_ptr<Model> out;
-  try {
-    out = std::const_pointer_cast<Model>(b.finalize(m.finalize_options));
-  } catch (const ModelError& e) {
-    throw ModelError(msg(kFn, ": the model with these parameters does not finalize: ", e.what()));
-  }
-  std::vector<std::string> notes = warnings;
-  for (const std::string& w : out->warnings)
-    if (std::find(notes.begin(), notes.end(), w) == notes.end()) notes.push_back(w);
-  out->warnings = std::move(notes);
-  out->force_dense_kkt = m.force_dense_kkt;
-  return out;
+  return finalize_like(b, m, std::move(notes), kFn, "these parameters");
 }
 
 }  // namespace armdyn

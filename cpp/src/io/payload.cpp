@@ -9,7 +9,7 @@
 
 #include "armdyn/builder/builder.hpp"
 #include "armdyn/errors.hpp"
-#include "armdyn/io/serialize.hpp"
+#include "armdyn/io/model_copy.hpp"
 #include "armdyn/math/quaternion.hpp"
 
 namespace armdyn {
@@ -110,44 +110,19 @@ void add_payload(ModelBuilder& b, const Payload& p, const std::string& who) {
   b.add_frame(p.name, p.name, com, orientation);
 }
 
-/// The model's description as a builder's draft (its derived tables made afresh).
-Model draft_of(const Model& m, const std::string& fn) {
-  std::string bytes;
-  try {
-    bytes = serialize_draft(m);
-  } catch (const ModelError& e) {
-    throw ModelError(msg(fn, ": the model cannot be copied (", e.what(),
-                         "); add the payload with the ModelBuilder instead"));
-  }
-  return deserialize_draft(bytes);
-}
-
 }  // namespace
 
 ModelPtr with_payloads(const Model& m, const std::vector<Payload>& payloads,
                        const std::string& fn) {
-  Model draft = draft_of(m, fn);
-  const std::vector<std::string> warnings = std::move(draft.warnings);
-  draft.warnings.clear();
+  std::vector<std::string> notes;
+  Model draft = model_draft(m, fn, notes, "; add the payload with the ModelBuilder instead");
   ModelBuilder b(std::move(draft), true);
   for (std::size_t k = 0; k < payloads.size(); ++k) {
     const std::string who =
         fn == "with_payload" ? fn : msg(fn, ": payloads[", k, "] '", payloads[k].name, "'");
     add_payload(b, payloads[k], who);
   }
-  std::shared_ptr<Model> out;
-  try {
-    out = std::const_pointer_cast<Model>(b.finalize(m.finalize_options));
-  } catch (const ModelError& e) {
-    throw ModelError(msg(fn, ": the model with the payload does not finalize: ", e.what()));
-  }
-  // the original's notes, then the new ones finalize made (not already among them)
-  std::vector<std::string> notes = warnings;
-  for (const std::string& w : out->warnings)
-    if (std::find(notes.begin(), notes.end(), w) == notes.end()) notes.push_back(w);
-  out->warnings = std::move(notes);
-  out->force_dense_kkt = m.force_dense_kkt;
-  return out;
+  return finalize_like(b, m, std::move(notes), fn, "the payload");
 }
 
 }  // namespace armdyn
