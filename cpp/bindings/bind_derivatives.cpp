@@ -12,6 +12,7 @@
 
 #include "armdyn/algorithm/derivatives.hpp"
 #include "common.hpp"
+#include "output_pool.hpp"
 #include "rows.hpp"
 
 namespace armdyn {
@@ -24,77 +25,6 @@ namespace {
 using ArrayPair = py::typing::Tuple<py::array_t<double>, py::array_t<double>>;
 using ArrayTriple =
     py::typing::Tuple<py::array_t<double>, py::array_t<double>, py::array_t<double>>;
-
-// The batch calls' output buffers, kept for the next call when their arrays are freed: a batch
-// on many rows writes megabytes of fresh memory, and the allocator hands large blocks back to
-// the system when they are freed (and trims the heap's top), so that each call paid the
-// kernel's zero-filling page faults again (on solo12 at 1000 rows, a third of the call). Only
-// this module's own arrays of at least kMinBytes; at most kMaxHeld bytes in kMaxBlocks blocks
-// are kept (the rest freed); a buffer is reused for a request between half its size and its
-// size. Touched only with the GIL held (array creation and destruction).
-class DerivativeOutputPool {
- public:
-  static constexpr size_t kMinBytes = size_t{1} << 20, kMaxHeld = size_t{64} << 20;
-  static constexpr size_t kMaxBlocks = 6;
-
-  static DerivativeOutputPool& get() {
-    static auto* pool = new DerivativeOutputPool();  // never destroyed: arrays may outlive exit
-    return *pool;
-  }
-
-  /// a C-contiguous float64 array of this shape, its buffer from the pool when large
-  py::array_t<double> array(const std::vector<py::ssize_t>& shape) {
-    size_t bytes = sizeof(double);
-    for (py::ssize_t e : shape) bytes *= static_cast<size_t>(e);
-    if (bytes < kMinBytes) return py::array_t<double>(shape);
-    Block* b = take(bytes);
-    if (b == nullptr) {
-      b = new Block{bytes, static_cast<double*>(std::malloc(bytes))};
-      if (b->data == nullptr) {
-        delete b;
-        throw std::bad_alloc();
-      }
-    }
-    py::capsule owner(b, [](void* p) { get().give(static_cast<Block*>(p)); });
-    return py::array_t<double>(shape, b->data, owner);
-  }
-
- private:
-  struct Block {
-    size_t bytes;
-    double* data;
-  };
-  std::vector<Block*> free_;
-  size_t held_ = 0;
-
-  Block* take(size_t bytes) {
-    for (size_t i = 0; i < free_.size(); ++i) {
-      Block* b = free_[i];
-      if (b->bytes >= bytes && b->bytes / 2 <= bytes) {
-        free_.erase(free_.begin() + static_cast<long>(i));
-        held_ -= b->bytes;
-        return b;
-      }
-    }
-    return nullptr;
-  }
-
-  void give(Block* b) {
-    while (!free_.empty() && (free_.size() >= kMaxBlocks || held_ + b->bytes > kMaxHeld)) {
-      held_ -= free_.front()->bytes;  // the oldest first
-      std::free(free_.front()->data);
-      delete free_.front();
-      free_.erase(free_.begin());
-    }
-    if (b->bytes > kMaxHeld) {
-      std::free(b->data);
-      delete b;
-      return;
-    }
-    free_.push_back(b);
-    held_ += b->bytes;
-  }
-};
 
 // k matrices row-major into out[j] + offset, each checked finite (vectorised; the element-wise
 // check names the entry)
@@ -123,7 +53,7 @@ py::tuple matrices_call(const char* fn, Data& d, int k, const py::handle& q, con
   const std::vector<py::ssize_t> shape =
       rows_given ? std::vector<py::ssize_t>{rows, n, n} : std::vector<py::ssize_t>{n, n};
   for (int j = 0; j < k; ++j) {
-    py::array_t<double> out = DerivativeOutputPool::get().array(shape);
+    py::array_t<double> out = OutputPool::get().array(shape);
     ptrs[j] = out.mutable_data();
     outs[j] = std::move(out);
   }

@@ -14,6 +14,7 @@
 #include "armdyn/algorithm/output_check.hpp"
 #include "armdyn/data.hpp"
 #include "common.hpp"
+#include "output_pool.hpp"
 
 namespace armdyn::py_helpers {
 
@@ -121,7 +122,7 @@ py::array_t<double> batch(const char* fn, long nq, long n, const py::handle& q, 
   long out_size = 1;
   for (auto s : out_shape) out_size *= static_cast<long>(s);
   out_shape.insert(out_shape.begin(), rows);
-  py::array_t<double> out(out_shape);
+  py::array_t<double> out = OutputPool::get().array(out_shape);
   const double *qp = Q.data(), *ap = A.data(), *bp = B.data();
   double* op = out.mutable_data();
   Poll poll = python_poll();  // Ctrl-C: KeyboardInterrupt with .result, the rows done
