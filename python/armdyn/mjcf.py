@@ -272,9 +272,10 @@ def _check_references(text: str, base: str, seen: set[str]) -> None:
 
 
 def _compile(source):
-    """(MjModel, the source as recorded, a label for messages): the source checked (type, size,
-    a regular file, the files it references), then MuJoCo's parser and compiler; MuJoCo's
-    refusal becomes a ModelError quoting its message (element and line)."""
+    """(MjModel, the source as recorded, a label for messages, MuJoCo's warnings): the source
+    checked (type, size, a regular file, the files it references), then MuJoCo's parser and
+    compiler (its warnings collected, not written to MUJOCO_LOG.TXT); MuJoCo's refusal becomes
+    a ModelError quoting its message (element and line)."""
     mujoco = _import_mujoco()
     kind, value = _source_kind(source)
     if kind == "xml":
@@ -302,12 +303,17 @@ def _compile(source):
         _check_references(text, os.path.dirname(os.path.abspath(value)), set())
         label, recorded = f"MJCF file {_shown_path(value)}", os.path.abspath(value)
         load = mujoco.MjModel.from_xml_path
+    said: list[str] = []
+    previous = mujoco.get_mju_user_warning()
+    mujoco.set_mju_user_warning(said.append)  # not MuJoCo's default: a MUJOCO_LOG.TXT in cwd
     try:
         mj = load(value)
     except (ValueError, mujoco.FatalError) as err:
         msg = " | ".join(line for line in str(err).splitlines() if line.strip())
         raise _core.ModelError(f"{label}: MuJoCo refused it: {msg}") from None
-    return mj, recorded, label
+    finally:
+        mujoco.set_mju_user_warning(previous)
+    return mj, recorded, label, [f"MuJoCo's compiler warned: {m.strip()}" for m in said]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -814,12 +820,13 @@ def load_mjcf(
     phys = _checks.flag("load_mjcf", "physical_inertia", physical_inertia)
     do_warn = _checks.flag("load_mjcf", "warn", warn)
     grav = _gravity(gravity)
-    mj, recorded, label = _compile(source)
+    mj, recorded, label, said = _compile(source)
     if grav is None and int(mj.opt.disableflags) & int(
         _import_mujoco().mjtDisableBit.mjDSBL_GRAVITY
     ):
         grav = np.zeros(3)
     mapper = _Mapper(mj, label, fixed, grav, phys)
+    mapper.unmapped.extend(said)
     mapper.add_bodies()
     mapper.add_joints()
     mapper.add_equalities()
