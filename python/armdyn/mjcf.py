@@ -221,6 +221,28 @@ def _is_xml(text: str) -> bool:
     return text.lstrip("\ufeff").lstrip().startswith("<")
 
 
+_PROLOG = re.compile(r"\s*(<\?.*?\?>|<!--.*?-->|<!DOCTYPE[^>]*>)", re.S)
+
+
+def _root_element(text: str) -> str:
+    """The name of the XML's first element (after a declaration, comments and a DOCTYPE)."""
+    pos = len(text) - len(text.lstrip("\ufeff"))
+    while (m := _PROLOG.match(text, pos)) is not None:
+        pos = m.end()
+    m = re.compile(r"\s*<([A-Za-z_][\w.:-]*)").match(text, pos)
+    return m.group(1) if m else ""
+
+
+def _check_root(text: str, label: str) -> None:
+    """MuJoCo also reads URDF (its own import): load_mjcf takes MJCF only (<mujoco>)."""
+    root = _root_element(text)
+    if root != "mujoco":
+        hint = "; for a URDF use armdyn.load_urdf" if root == "robot" else ""
+        raise _core.ModelError(
+            f"{label}: the root element is <{root[:40]}>, not <mujoco>: not MJCF{hint}"
+        )
+
+
 def _too_large(what: str, size: int) -> str:
     return (
         f"{what} is {size} bytes, more than the limit of {MJCF_MAX_BYTES} bytes "
@@ -285,6 +307,7 @@ def _compile(source):
             raise _core.ModelError(
                 f"MJCF string: contains a NUL byte at offset {value.index(chr(0))}"
             )
+        _check_root(value, "MJCF string")
         _check_references(value, os.getcwd(), set())
         label, recorded = "MJCF string", value
         load = mujoco.MjModel.from_xml_string
@@ -300,6 +323,7 @@ def _compile(source):
             raise _core.ModelError(
                 f"MJCF file {_shown_path(value)} does not hold XML (it does not start with '<')"
             )
+        _check_root(text, f"MJCF file {_shown_path(value)}")
         _check_references(text, os.path.dirname(os.path.abspath(value)), set())
         label, recorded = f"MJCF file {_shown_path(value)}", os.path.abspath(value)
         load = mujoco.MjModel.from_xml_path
