@@ -171,10 +171,10 @@ def _mat_to_quat(mat) -> np.ndarray:
 def _import_mujoco():
     try:
         import mujoco
-    except ImportError as err:  # pragma: no cover - mujoco is in the test extra
+    except ImportError as err:
         raise ImportError(
-            "armdyn.load_mjcf needs the 'mujoco' package (pip install mujoco): MJCF is read by "
-            "MuJoCo's own parser and compiler"
+            "armdyn.load_mjcf needs the 'mujoco' package (pip install mujoco, or armdyn[mjcf]): "
+            "MJCF is read by MuJoCo's own parser and compiler"
         ) from err
     return mujoco
 

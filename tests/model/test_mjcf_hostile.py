@@ -5,6 +5,8 @@ MuJoCo's global warning handler is left as it was; mutated files never crash."""
 from __future__ import annotations
 
 import os
+import subprocess
+import sys
 import warnings
 
 import armdyn as ad
@@ -155,3 +157,14 @@ def test_mutated_files_never_crash():
         q = np.zeros(model.n_coords)
         assert np.all(np.isfinite(ad.forward_dynamics(model, q, q, q)))
     assert loaded >= 20
+
+
+def test_without_mujoco_the_import_error_says_how_to_install_it():
+    code = (
+        "import sys; sys.modules['mujoco'] = None\n"
+        "import armdyn\n"
+        "try:\n    armdyn.load_mjcf('<mujoco/>')\n"
+        "except ImportError as e:\n    print(e)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert "needs the 'mujoco' package (pip install mujoco, or armdyn[mjcf])" in out.stdout
