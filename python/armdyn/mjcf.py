@@ -390,6 +390,10 @@ class _TreeMapper:
         self.followers: dict[int, tuple[int, float]] = {}  # joint id -> (leader id, multiplier)
         self.welded_free: list[int] = []
         self.extent = max(float(mj.stat.extent), 1.0)
+        flags, off = int(mj.opt.disableflags), mujoco.mjtDisableBit
+        self.no_spring = bool(flags & int(off.mjDSBL_SPRING))
+        self.no_damper = bool(flags & int(off.mjDSBL_DAMPER))
+        self.no_equality = bool(flags & (int(off.mjDSBL_EQUALITY) | int(off.mjDSBL_CONSTRAINT)))
 
     # -- helpers ------------------------------------------------------------------------------
     def _finite(self, what: str, values) -> None:
@@ -534,9 +538,9 @@ class _TreeMapper:
             lo, hi = (float(v) - q0 for v in mj.jnt_range[j])
             self._finite(f"{what}: range", [lo, hi])
             self._call(what, self.b.set_joint_limits, name, lo, hi)
-        if damping[0] != 0:
+        if damping[0] != 0 and not self.no_damper:
             self._call(what, self.b.add_joint_friction, name, viscous=float(damping[0]))
-        if stiffness != 0:
+        if stiffness != 0 and not self.no_spring:
             rest = float(mj.qpos_spring[qadr]) - q0
             self._finite(f"{what}: springref", [rest])
             self._call(what, self.b.add_joint_spring_damper, name, stiffness=stiffness, rest=rest)
@@ -581,6 +585,12 @@ class _Mapper(_TreeMapper):
     # -- equalities ---------------------------------------------------------------------------
     def add_equalities(self) -> None:
         mj, obj = self.mj, self.mujoco.mjtObj
+        if mj.neq and self.no_equality:
+            self.unmapped.append(
+                f"{mj.neq} equalities: the MJCF disables them (option flag equality or "
+                "constraint), as MuJoCo"
+            )
+            return
         residual = self._equality_residuals()
         for e in range(mj.neq):
             kind = _EQ_KINDS.get(int(mj.eq_type[e]), f"type {int(mj.eq_type[e])}")
@@ -754,6 +764,9 @@ class _Mapper(_TreeMapper):
         ]  # fmt: skip
         if visual:
             u.append("visual elements (no effect on the dynamics): " + ", ".join(visual))
+        for off, what in ((self.no_spring, "stiffness"), (self.no_damper, "damping")):
+            if off and np.any((mj.jnt_stiffness if what == "stiffness" else mj.dof_damping) != 0):
+                u.append(f"joint {what}: the MJCF disables it (option flag), as MuJoCo")
         if not self.fixed_base and not np.any(mj.jnt_type == 0):
             u.append("fixed_base=False: the MJCF has no free joint, so nothing floats")
 

@@ -79,8 +79,11 @@ def test_ranges_armature_and_actuator_gears_as_compiled():
     assert np.array_equal(jaco.reflected_inertia, mj.dof_armature)
 
 
-def test_spring_with_ref_and_springref_matches_mujoco():
-    xml = """<mujoco><compiler angle="radian"/><worldbody><body name="a">
+@pytest.mark.parametrize(
+    "flags", ["", '<option><flag spring="disable" damper="disable"/></option>']
+)
+def test_spring_with_ref_and_springref_matches_mujoco(flags):
+    xml = f"""<mujoco>{flags}<compiler angle="radian"/><worldbody><body name="a">
       <geom type="capsule" fromto="0 0 0 0.4 0 0"
       size="0.05"/><joint name="h" type="hinge" axis="0 1 0" ref="0.3" springref="0.5"
       stiffness="2" damping="0.4" armature="0.02" range="-1 2"/>
@@ -89,6 +92,8 @@ def test_spring_with_ref_and_springref_matches_mujoco():
       </body></worldbody></mujoco>"""
     model = load(xml)
     info = mjcf_info(model)
+    if flags:
+        assert "joint stiffness: the MJCF disables it (option flag), as MuJoCo" in info.unmapped
     assert model.coord_lower[0] == -1 - 0.3 and model.coord_upper[0] == 2 - 0.3
     m = mujoco.MjModel.from_xml_string(xml)
     m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT)
