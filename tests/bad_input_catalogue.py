@@ -26,6 +26,15 @@ def _b(name="link"):
     return b
 
 
+def _mjcf(mass="1", pos="0 0 0", site="", world=""):
+    """A one-hinge MJCF arm with the given body mass and position."""
+    return (
+        f'<mujoco><worldbody><body name="link" pos="{pos}"><joint name="hinge" type="hinge"/>'
+        f'<inertial pos="0 0 0.5" mass="{mass}" diaginertia="0.1 0.1 0.1"/>{site}</body>'
+        f"{world}</worldbody></mujoco>"
+    )
+
+
 def _hinged():
     b = _b("link")
     b.add_revolute("hinge", "ground", "link", (0, 0, 0), (0, 1, 0))
@@ -694,6 +703,79 @@ CASES = [
         ),
         UE,
         "40001 attributes, more than the limit of 1000",
+    ),
+    # ---- MJCF (issue 36; armdyn.load_mjcf through MuJoCo's parser, docs/mjcf.md)
+    (
+        "mjcf-missing-file",
+        "mjcf",
+        "a path that does not exist",
+        lambda: ad.load_mjcf(DATA / "no_such_robot.xml"),
+        ME,
+        r"MJCF file '.*no_such_robot\.xml' does not exist",
+    ),
+    (
+        "mjcf-device",
+        "mjcf",
+        "/dev/zero as the file",
+        lambda: ad.load_mjcf("/dev/zero"),
+        ME,
+        r"'/dev/zero' is a character device, not a regular file",
+    ),
+    (
+        "mjcf-truncated",
+        "mjcf",
+        "truncated XML",
+        lambda: ad.load_mjcf("<mujoco><worldbody><body><joint type='hin"),
+        ME,
+        r"MJCF string: MuJoCo refused it: XML parse error",
+    ),
+    (
+        "mjcf-urdf-root",
+        "mjcf",
+        "a URDF given to load_mjcf",
+        lambda: ad.load_mjcf("<robot name='r'/>"),
+        ME,
+        r"root element is <robot>, not <mujoco>",
+    ),
+    (
+        "mjcf-nan-position",
+        "mjcf",
+        "a body position of NaN (MuJoCo accepts it)",
+        lambda: ad.load_mjcf(_mjcf(pos="nan 0 0"), warn=False),
+        ME,
+        r"body 'link': position at qpos0 is not finite",
+    ),
+    (
+        "mjcf-mass-overflow",
+        "mjcf",
+        "a body mass of 1e300 (finalize)",
+        lambda: ad.load_mjcf(_mjcf(mass="1e300"), warn=False),
+        ME,
+        r"body 'link': mass = 1e\+300",
+    ),
+    (
+        "mjcf-open-loop",
+        "mjcf",
+        "a connect between sites apart at qpos0",
+        lambda: ad.load_mjcf(
+            _mjcf(
+                site='<site name="s1" pos="0.5 0 0"/>', world='<site name="s2" pos="0.7 0 0"/>'
+            ).replace(
+                "</mujoco>",
+                '<equality><connect name="hold" site1="s1" site2="s2"/></equality></mujoco>',
+            ),
+            warn=False,
+        ),
+        ME,
+        r"equality connect 'hold': not satisfied at qpos0",
+    ),
+    (
+        "mjcf-fixed-base-type",
+        "mjcf",
+        "fixed_base='yes'",
+        lambda: ad.load_mjcf(_mjcf(), fixed_base="yes"),
+        ME,
+        r"load_mjcf: fixed_base must be True or False, got 'yes'",
     ),
     # ---- arrays and joint-space calls
     (
