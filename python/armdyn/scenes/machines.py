@@ -136,7 +136,7 @@ class PalletizerMasses:
 def palletizer(
     *,
     payload: float = 20.0,
-    closure: str = "revolute",
+    closure: str = "inline",
     drives=None,
     geometry: PalletizerGeometry | None = None,
     masses: PalletizerMasses | None = None,
@@ -159,11 +159,12 @@ def palletizer(
     at E), ``level_pin`` (turret → level rod 1 at T), ``bell_rod`` (bell crank → level rod 2 at
     B2), ``wrist_pin`` (upper arm → wrist at W) and three loop closures, ``rear_pin`` (elbow
     rod → upper arm at R), ``bell_link`` (level rod 1 → bell crank at B1), ``wrist_link`` (level
-    rod 2 → wrist at W2). ``closure="revolute"`` closes them with revolutes (3 redundant rows
-    each, as real pins), ``"inline"`` with inline joints (2 rows each, no redundancy); the
-    motion is the same. Mobility 4. Points: :meth:`PalletizerGeometry.points`; frame ``tool``
-    on the flange, ``payload`` [kg] a point mass at it. Rods are offset along the pin axes
-    (elbow rod at y = -0.15, level rods at y = +0.15). ``drives``: a trajectory of the four
+    rod 2 → wrist at W2). ``closure="inline"`` (the default) closes them with inline joints (2
+    rows each: no redundant row, the sparse KKT path), ``"revolute"`` with revolutes (5 rows, 3 of
+    them redundant, as real pins; dense minimum-norm multipliers); the motion and the actuator
+    torques are the same. Mobility 4. Points: :meth:`PalletizerGeometry.points`; frame
+    ``tool`` on the flange, ``payload`` [kg] a point mass at it. Rods are offset along the pin
+    axes (elbow rod at y = -0.15, level rods at y = +0.15). ``drives``: a trajectory of the four
     actuated coordinates (``pick_and_place("palletizer")``) or ``{joint: profile}``."""
     if closure not in ("revolute", "inline"):
         raise _core.ModelError(
