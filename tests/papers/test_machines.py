@@ -111,3 +111,24 @@ def test_machines_refuse_bad_drives():
         mc.delta_robot(drives=mc.pick_and_place("palletizer"))
     with pytest.raises(ad.ModelError, match="machine must be one of"):
         mc.pick_and_place("scara")
+
+
+@pytest.mark.parametrize("machine", ["palletizer", "delta"])
+def test_cycle_profiles_are_the_exact_motion(machine):
+    """The C++ splines the drives run equal the cycle's closed form (and its derivatives equal
+    finite differences of its positions), within the per-joint limits, at rest at both ends."""
+    traj = mc.pick_and_place(machine)
+    t = np.linspace(0.0, traj.duration, 20001)
+    q, qd, qdd = traj.sample(t=t).q, traj.sample(t=t).qd, traj.sample(t=t).qdd
+    for i, name in enumerate(traj.names):
+        y, yd, ydd = traj.info["profiles"][name].eval(t)
+        np.testing.assert_allclose(y, q[:, i], atol=1e-13)
+        np.testing.assert_allclose(yd, qd[:, i], atol=1e-12)
+        np.testing.assert_allclose(ydd, qdd[:, i], atol=1e-10)
+    h, inner = 1e-6, t[1:-1]  # truncation: jerk h²/6 < 1e-9
+    fd = (traj.sample(t=inner + h).q - traj.sample(t=inner - h).q) / (2 * h)
+    np.testing.assert_allclose(fd, traj.sample(t=inner).qd, atol=1e-8)
+    v, a, _ = traj.info["limits"]
+    assert np.abs(qd).max() <= v * (1 + 1e-12) and np.abs(qdd).max() <= a * (1 + 1e-12)
+    np.testing.assert_allclose(q[[0, -1]], 0.0, atol=1e-15)
+    np.testing.assert_allclose(qd[[0, -1]], 0.0, atol=1e-15)

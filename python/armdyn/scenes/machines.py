@@ -68,7 +68,11 @@ def _add_drives(b: _core.ModelBuilder, drives, actuated) -> None:
                 f"drives: a trajectory of {drives.q.shape[1]} columns; the machine has "
                 f"{len(actuated)} actuated joints {list(actuated)}"
             )
-        drives = {j: drive_profile(drives, i) for i, j in enumerate(actuated)}
+        fast = drives.info.get("profiles")
+        if isinstance(fast, Mapping) and tuple(fast) == tuple(actuated):
+            drives = fast  # a pick_and_place cycle: its exact splines
+        else:
+            drives = {j: drive_profile(drives, i) for i, j in enumerate(actuated)}
     if not isinstance(drives, Mapping):
         raise _core.ModelError("drives must be None, an armdyn.motion.Trajectory or a dict")
     for joint, profile in drives.items():
@@ -380,47 +384,88 @@ def delta_ik(plate: npt.ArrayLike, geometry: DeltaGeometry | None = None) -> np.
 
 _CYCLES = {
     # tool points (world) above the pick, at the pick, above the place, at the place; flange
-    # yaw at the pick and at the place; limits (velocity, acceleration, jerk) per joint
+    # yaw at the pick and at the place; limits (velocity, acceleration, jerk) per joint; the
+    # dwell [s] at the pick and at the place
     "palletizer": dict(
         above_pick=(1.3, -0.6, 0.9), pick=(1.3, -0.6, 0.6), above_place=(0.8, 1.2, 0.9),
-        place=(0.8, 1.2, 0.5), yaw=(0.0, np.pi / 2), limits=(2.0, 6.0, 40.0),
+        place=(0.8, 1.2, 0.5), yaw=(0.0, np.pi / 2), limits=(2.0, 6.0, 40.0), dwell=0.3,
     ),
     "delta": dict(
         above_pick=(-0.1525, 0.0, -0.825), pick=(-0.1525, 0.0, -0.85),
-        above_place=(0.1525, 0.0, -0.825), place=(0.1525, 0.0, -0.85), limits=(10.0, 150.0, 4000.0),
+        above_place=(0.1525, 0.0, -0.825), place=(0.1525, 0.0, -0.85),
+        limits=(10.0, 150.0, 4000.0), dwell=0.05,
     ),
 }  # fmt: skip
 
+# the peaks of s_curve's velocity, acceleration and jerk (per unit move and duration)
+_S_PEAKS = (2.0, 8.0, 32.0)
 
-def pick_and_place(
-    machine: str,
-    *,
-    max_velocity: float | None = None,
-    max_acceleration: float | None = None,
-    max_jerk: float | None = None,
-    dt: float = 1e-3,
-):
-    """One pick-and-place cycle of `machine` (``"palletizer"`` or ``"delta"``) in its actuated
-    coordinates: from rest at the assembly pose (all coordinates 0: the home), to above the
-    pick, down to the pick, up, across to above the place, down to the place, up, and back
-    home, stopping at each of these eight waypoints
-    (``armdyn.motion.through_waypoints`` with ``stop_at_waypoints=True``: jerk-limited,
-    synchronised, each segment a straight line in joint space). The waypoints come from the
-    closed-form inverse kinematics of the default geometry (``palletizer_ik``: the palletizer's
-    tool from (1.3, -0.6, 0.6) m to (0.8, 1.2, 0.5) m, 0.3 m / 0.4 m lifts, the flange turned
-    by 90°; ``delta_ik``: the plate through the Adept-style cycle, 25 mm up, 305 mm across at
-    z = -0.825 m, 25 mm down). Limits per joint (rad/s, rad/s², rad/s³): palletizer 2, 6, 40;
-    delta 10, 150, 4000, or those given.
 
-    Returns an :class:`armdyn.motion.Trajectory` whose ``names`` are the actuated joints
-    (``PALLETIZER_ACTUATED`` / ``DELTA_ACTUATED``), with ``info["tool"]`` the (8, 3) tool (plate)
-    waypoints; ``palletizer(drives=traj)`` / ``delta_robot(drives=traj)`` drive it."""
-    from armdyn.motion import through_waypoints
+def s_curve(tau: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The cycles' rest-to-rest shape s(tau), s'(tau), s''(tau) for tau in [0, 1] (clipped): a
+    piecewise cubic with constant jerk +32, -32, +32 on [0, 1/4], [1/4, 3/4], [3/4, 1], from
+    s = 0 to 1 with zero velocity and acceleration at both ends (peaks |s'| = 2, |s''| = 8).
+    s'' is continuous, so the natural cubic spline through its values at the quarter points
+    reproduces it exactly."""
+    tau = np.clip(np.asarray(tau, float), 0.0, 1.0)
+    h = tau - 0.25
+    r = 1.0 - tau
+    first, last = tau <= 0.25, tau >= 0.75
+    middle = 1 / 12 + h + 4 * h**2 - 16 / 3 * h**3
+    pos = np.where(first, 16 / 3 * tau**3, np.where(last, 1 - 16 / 3 * r**3, middle))
+    vel = np.where(first, 16 * tau**2, np.where(last, 16 * r**2, 1 + 8 * h - 16 * h**2))
+    acc = np.where(first, 32 * tau, np.where(last, -32 * r, 8 - 32 * h))
+    return pos, vel, acc
 
-    if machine not in _CYCLES:
-        raise _core.ModelError(
-            f"pick_and_place: machine must be one of {sorted(_CYCLES)}, got {machine!r}"
-        )
+
+@dataclass(frozen=True)
+class _Moves:
+    """Rest-to-rest straight moves in joint space between waypoints (m, n), each of its own
+    duration (a dwell: a move of zero length), shaped by :func:`s_curve`."""
+
+    points: np.ndarray
+    durations: np.ndarray
+
+    @property
+    def starts(self) -> np.ndarray:
+        return np.concatenate([[0.0], np.cumsum(self.durations)])
+
+    def evaluate(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        t = np.atleast_1d(np.asarray(t, float))
+        starts = self.starts
+        k = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(self.durations) - 1)
+        span = self.durations[k][:, None]
+        step = self.points[k + 1] - self.points[k]
+        pos, vel, acc = s_curve((t - starts[k]) / self.durations[k])
+        q = self.points[k] + pos[:, None] * step
+        return q, vel[:, None] * step / span, acc[:, None] * step / span**2
+
+    def knots(self) -> np.ndarray:
+        """Every time where the jerk may change (the moves' ends and quarter points)."""
+        starts = self.starts
+        inner = starts[:-1, None] + self.durations[:, None] * np.array([0.25, 0.5, 0.75])
+        return np.union1d(starts, inner.ravel())
+
+
+def _timed(points: np.ndarray, limits, dwell_after: dict) -> _Moves:
+    """The moves through `points`, each as short as the per-joint limits (velocity,
+    acceleration, jerk) allow for the shape, with a dwell after the waypoints in `dwell_after`
+    (index -> seconds)."""
+    v, a, j = limits
+    peak_v, peak_a, peak_j = _S_PEAKS
+    pts, durations = [points[0]], []
+    for k in range(len(points) - 1):
+        d = np.abs(points[k + 1] - points[k]).max()
+        durations.append(max(peak_v * d / v, np.sqrt(peak_a * d / a), np.cbrt(peak_j * d / j)))
+        pts.append(points[k + 1])
+        if k + 1 in dwell_after:
+            durations.append(dwell_after[k + 1])
+            pts.append(points[k + 1])
+    return _Moves(np.array(pts), np.array(durations))
+
+
+def _waypoints(machine: str):
+    """(names, joint waypoints (8, n) from home to home, tool waypoints (8, 3))."""
     c = _CYCLES[machine]
     order = ["above_pick", "pick", "above_pick", "above_place", "place", "above_place"]
     tool = np.array([c[k] for k in order], float)
@@ -434,14 +479,58 @@ def pick_and_place(
         home = np.array([0.0, 0.0, DeltaGeometry().plate_z()])
         names = DELTA_ACTUATED
     zero = np.zeros((1, len(names)))
-    waypoints = np.vstack([zero, inner, zero])
-    tool = np.vstack([home, tool, home])
-    v, a, j = c["limits"]
-    traj = through_waypoints(
-        waypoints, max_velocity=max_velocity or v, max_acceleration=max_acceleration or a,
-        max_jerk=max_jerk or j, stop_at_waypoints=True, dt=dt,
+    return names, np.vstack([zero, inner, zero]), np.vstack([home, tool, home])
+
+
+def pick_and_place(
+    machine: str,
+    *,
+    max_velocity: float | None = None,
+    max_acceleration: float | None = None,
+    max_jerk: float | None = None,
+    dwell: float | None = None,
+    dt: float = 1e-3,
+):
+    """One pick-and-place cycle of `machine` (``"palletizer"`` or ``"delta"``) in its actuated
+    coordinates: from rest at the assembly pose (all coordinates 0: the home), to above the
+    pick, down to the pick, a `dwell` (the gripper), up, across to above the place, down to the
+    place, a dwell, up, and back home, stopping at each waypoint. Each move is a straight line in
+    joint space shaped by :func:`s_curve` (jerk-limited, constant jerk per quarter), as short as
+    the per-joint limits allow (rad/s, rad/s², rad/s³; default: palletizer 2, 6, 40 with a 0.3 s
+    dwell; delta 10, 150, 4000 with 0.05 s). The waypoints come from the closed-form inverse
+    kinematics of the default geometry (``palletizer_ik``: the tool from above (1.3, -0.6, 0.6)
+    m to above (0.8, 1.2, 0.5) m, 0.3 m / 0.4 m lifts, the flange turned by 90°; ``delta_ik``:
+    the plate through the Adept-style cycle, 25 mm up, 305 mm across at z = -0.825 m, 25 mm
+    down).
+
+    Returns an :class:`armdyn.motion.Trajectory` on a `dt` grid with the exact ``evaluate``,
+    ``names`` the actuated joints (``PALLETIZER_ACTUATED`` / ``DELTA_ACTUATED``) and in ``info``:
+    ``tool`` (8, 3) the tool (plate) waypoints, ``waypoint_times`` (8,) when the cycle arrives
+    at them (the dwells follow), ``knots`` and ``profiles``: per actuated joint an
+    ``armdyn.profiles.spline`` through the knots, which is the motion exactly (a C2 piecewise
+    cubic with zero end accelerations is the natural spline through its knots) and runs in
+    C++; ``palletizer(drives=traj)`` / ``delta_robot(drives=traj)`` drive them."""
+    from armdyn.motion import Trajectory
+
+    if machine not in _CYCLES:
+        raise _core.ModelError(
+            f"pick_and_place: machine must be one of {sorted(_CYCLES)}, got {machine!r}"
+        )
+    names, points, tool = _waypoints(machine)
+    v, a, j = _CYCLES[machine]["limits"]
+    limits = (max_velocity or v, max_acceleration or a, max_jerk or j)
+    rest = _CYCLES[machine]["dwell"] if dwell is None else dwell
+    moves = _timed(points, limits, {2: rest, 5: rest} if rest > 0 else {})
+    starts = moves.starts
+    moving = np.any(moves.points[1:] != moves.points[:-1], axis=1)
+    arrive = np.concatenate([[0.0], starts[1:][moving]])
+    grid = np.append(np.arange(0.0, starts[-1], dt), starts[-1])
+    q, qd, qdd = moves.evaluate(grid)
+    knots = moves.knots()
+    at_knots = moves.evaluate(knots)[0]
+    profiles = {n: _core.profiles.spline(knots, at_knots[:, i]) for i, n in enumerate(names)}
+    info = dict(
+        method="pick_and_place", machine=machine, tool=tool, waypoint_times=arrive,
+        knots=knots, profiles=profiles, limits=limits, dwell=rest,
     )  # fmt: skip
-    traj.names = tuple(names)
-    traj.info["tool"] = tool
-    traj.info["machine"] = machine
-    return traj
+    return Trajectory(grid, q, qd, qdd, names=names, info=info, evaluate=moves.evaluate)
