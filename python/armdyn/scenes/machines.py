@@ -57,6 +57,17 @@ def _add(b: _core.ModelBuilder, name: str, parts) -> None:
     b.add_body(name, m, inertia, position=c)
 
 
+def _add_torques(b: _core.ModelBuilder, torques, actuated) -> None:
+    if torques is None:
+        return
+    if not isinstance(torques, Mapping):
+        raise _core.ModelError("torques must be None or a dict {actuated joint: profile}")
+    for joint, profile in torques.items():
+        if joint not in actuated:
+            raise _core.ModelError(f"torques: {joint!r} is not an actuated joint {list(actuated)}")
+        b.add_joint_torque(joint, profile)
+
+
 def _add_drives(b: _core.ModelBuilder, drives, actuated) -> None:
     if drives is None:
         return
@@ -142,6 +153,7 @@ def palletizer(
     payload: float = 20.0,
     closure: str = "inline",
     drives=None,
+    torques=None,
     geometry: PalletizerGeometry | None = None,
     masses: PalletizerMasses | None = None,
     gravity: float = 9.81,
@@ -169,7 +181,8 @@ def palletizer(
     torques are the same. Mobility 4. Points: :meth:`PalletizerGeometry.points`; frame
     ``tool`` on the flange, ``payload`` [kg] a point mass at it. Rods are offset along the pin
     axes (elbow rod at y = -0.15, level rods at y = +0.15). ``drives``: a trajectory of the four
-    actuated coordinates (``pick_and_place("palletizer")``) or ``{joint: profile}``."""
+    actuated coordinates (``pick_and_place("palletizer")``) or ``{joint: profile}``; ``torques``:
+    ``{actuated joint: profile}`` applied as ``add_joint_torque`` (a forward run)."""
     if closure not in ("revolute", "inline"):
         raise _core.ModelError(
             f"palletizer: closure must be 'revolute' or 'inline', got {closure!r}"
@@ -226,6 +239,7 @@ def palletizer(
     close("wrist_link", "level_rod2", "wrist", point=p["W2"] + side_l, axis=ey)
     b.add_frame("tool", "flange", position=p["tool"])
     _add_drives(b, drives, PALLETIZER_ACTUATED)
+    _add_torques(b, torques, PALLETIZER_ACTUATED)
     return b.finalize()
 
 
@@ -297,7 +311,7 @@ class DeltaGeometry:
 
     def arm_inertia(self) -> float:
         """Moment of inertia [kg m²] of an upper arm (with its elbow mass) about its pivot."""
-        rod = self.arm_mass * (3 * self.radius**2 / 4 + self.arm**2 / 3)
+        rod = self.arm_mass * (self.radius**2 / 4 + self.arm**2 / 3)
         return rod + self.elbow_mass * self.arm**2
 
     def arm_moment(self) -> float:
@@ -306,7 +320,11 @@ class DeltaGeometry:
 
 
 def delta_robot(
-    *, drives=None, geometry: DeltaGeometry | None = None, gravity: float = 9.81
+    *,
+    drives=None,
+    torques=None,
+    geometry: DeltaGeometry | None = None,
+    gravity: float = 9.81,
 ) -> _core.Model:
     """A three-arm delta robot (Clavel): three upper arms on revolutes ``arm1``..``arm3`` (the
     actuated joints, added first: ground → upper arm ``arm<i>`` at the base pivot
@@ -319,7 +337,7 @@ def delta_robot(
     body ``plate`` is held by the rods alone; frame ``tool`` at its centre. Assembly: upper arms
     ``theta0`` below the horizontal, the plate centred under the base at ``plate_z()``.
     ``drives``: a trajectory of the three arm angles (``pick_and_place("delta")``) or
-    ``{joint: profile}``."""
+    ``{joint: profile}``; ``torques``: ``{arm joint: profile}`` applied as ``add_joint_torque``."""
     g = geometry or DeltaGeometry()
     radial, axis = g.directions()
     down = np.array([0.0, 0.0, -1.0])
@@ -351,6 +369,7 @@ def delta_robot(
             )  # fmt: skip
     b.add_frame("tool", "plate", position=plate)
     _add_drives(b, drives, DELTA_ACTUATED)
+    _add_torques(b, torques, DELTA_ACTUATED)
     return b.finalize()
 
 
