@@ -94,9 +94,11 @@ def crank_motion(t):
 
     Driven by torques alone the four-bar is unstable along slow motions (gravity tips the
     linkage like an inverted pendulum): along a crank swinging at 0.4 Hz, or turning at a
-    quarter turn per second, a 1e-12 difference grows to 1e-3 / 1e-7 within 5 s whatever the
-    integrator's tolerance (rtol 1e-12 to 1e-14 give the same growth), so no forward run can
-    follow those to 1e-8. One turn per second keeps the motion inertia-dominated."""
+    quarter turn per second, the forward run ends 6e-3 / 9e-8 rad away from the motion after
+    5 s whatever the integrator's tolerance (rtol 1e-12 and 1e-14 alike: the round-off grows,
+    not the truncation error), so no forward run can follow those to 1e-8. One turn per second
+    keeps the motion inertia-dominated (1e-11). Figures: ``python
+    tests/papers/test_machines_dynamics.py``."""
     t = np.asarray(t, float)
     w = np.pi
     q = 2 * np.pi * t + 0.3 * np.sin(w * t)
@@ -259,3 +261,41 @@ def test_delta_forward_run_follows_the_motion(delta_run):
     assert res.t[-1] == pytest.approx(T_END)
     want = np.array([arm_motion(ti)[0] for ti in res.t])
     np.testing.assert_allclose(res.q[:, :3], want, rtol=0, atol=1e-8)
+
+
+def _open_loop_growth():
+    """The four-bar driven by its reference torques along three crank motions, at two
+    tolerances: the largest deviation from the motion over 5 s (the figures of crank_motion's
+    docstring and docs/mechanisms.md)."""
+    w = 2 * np.pi * 0.4
+    motions = {
+        "swing 1.2 sin(2 pi 0.4 t)": lambda t: (
+            1.2 * np.sin(w * t), 1.2 * w * np.cos(w * t), -1.2 * w**2 * np.sin(w * t),
+        ),
+        "quarter turn per second": lambda t: (
+            np.pi / 2 * t + 0.3 * np.sin(np.pi * t), np.pi / 2 + 0.3 * np.pi * np.cos(np.pi * t),
+            -0.3 * np.pi**2 * np.sin(np.pi * t),
+        ),
+        "one turn per second (the test's)": crank_motion,
+    }  # fmt: skip
+    for name, motion in motions.items():
+        start = ad.driven_inverse_dynamics(four_bar(crank_drive=lambda t, m=motion: m(t)), [0.0])
+        for tol in (1e-12, 1e-14):
+            ref, cache = FourBarReference(), {}
+
+            def torque(t, ref=ref, cache=cache, motion=motion):
+                if t not in cache:
+                    cache.clear()
+                    cache[t] = ref.torque(*motion(t))
+                return cache[t], 0.0, 0.0
+
+            res = ad.simulate(
+                four_bar(crank_torque=torque), T_END, u0=start.u[0], v0=start.v[0],
+                integrator="dop853", rtol=tol, atol=tol, output_dt=0.05,
+            )  # fmt: skip
+            err = np.abs(res.q[:, 0] - motion(res.t)[0]).max()
+            print(f"{name}: rtol {tol:g}: largest deviation over {T_END:g} s {err:.1e} rad")
+
+
+if __name__ == "__main__":  # python tests/papers/test_machines_dynamics.py
+    _open_loop_growth()
