@@ -240,20 +240,24 @@ def test_delta_torques_equal_virtual_work(delta_run):
     np.testing.assert_allclose(idr.drive_forces, tau, rtol=0, atol=1e-10)
 
 
+def _reference_torque(ref, k, cache):
+    """Arm k's reference torque as a profile (the three share `cache`: one solve per time)."""
+
+    def profile(t):
+        if t not in cache:
+            cache.clear()
+            cache[t] = ref.torques(*arm_motion(t))
+        return float(cache[t][k]), 0.0, 0.0
+
+    return profile
+
+
 def test_delta_forward_run_follows_the_motion(delta_run):
     _, _, idr, _, ref = delta_run
     cache = {}
-
-    def torque(k):
-        def profile(t):
-            if t not in cache:
-                cache.clear()
-                cache[t] = ref.torques(*arm_motion(t))
-            return float(cache[t][k]), 0.0, 0.0
-
-        return profile
-
-    free = mc.delta_robot(torques={n: torque(k) for k, n in enumerate(mc.DELTA_ACTUATED)})
+    free = mc.delta_robot(
+        torques={n: _reference_torque(ref, k, cache) for k, n in enumerate(mc.DELTA_ACTUATED)}
+    )
     res = ad.simulate(
         free, T_END, u0=idr.u[0], v0=idr.v[0], integrator="dop853", rtol=1e-12, atol=1e-12,
         output_dt=0.05,
@@ -297,5 +301,39 @@ def _open_loop_growth():
             print(f"{name}: rtol {tol:g}: largest deviation over {T_END:g} s {err:.1e} rad")
 
 
+def _agreement():
+    """The largest differences the tests assert (torques, forward runs), printed."""
+    t = np.linspace(0.0, T_END, 101)
+    idr = ad.driven_inverse_dynamics(four_bar(crank_drive=lambda x: crank_motion(x)), t)
+    ref = FourBarReference()
+    tau = np.array([ref.torque(*crank_motion(ti)) for ti in t])
+    print(
+        "four-bar: crank torque vs SymPy's constrained Lagrange equations: largest difference "
+        f"{np.abs(idr.drive_forces[:, 0] - tau).max():.1e} N m "
+        f"(|tau| up to {np.abs(tau).max():.1f})"
+    )
+    drives = dict(
+        zip(mc.DELTA_ACTUATED, map(ad.profiles.sine, AMPLITUDES, FREQUENCIES), strict=True)
+    )
+    idr = ad.driven_inverse_dynamics(mc.delta_robot(drives=drives), t)
+    ref = DeltaReference(mc.DeltaGeometry())
+    tau = np.array([ref.torques(*arm_motion(ti)) for ti in t])
+    print(
+        f"delta: arm torques vs virtual work: largest difference "
+        f"{np.abs(idr.drive_forces - tau).max():.1e} N m (|tau| up to {np.abs(tau).max():.1f})"
+    )
+    cache = {}
+    torques = {n: _reference_torque(ref, k, cache) for k, n in enumerate(mc.DELTA_ACTUATED)}
+    res = ad.simulate(
+        mc.delta_robot(torques=torques), T_END, u0=idr.u[0], v0=idr.v[0], integrator="dop853",
+        rtol=1e-12, atol=1e-12, output_dt=0.05,
+    )  # fmt: skip
+    want = np.array([arm_motion(ti)[0] for ti in res.t])
+    print(
+        f"delta: forward run's largest deviation over 5 s {np.abs(res.q[:, :3] - want).max():.1e}"
+    )
+
+
 if __name__ == "__main__":  # python tests/papers/test_machines_dynamics.py
+    _agreement()
     _open_loop_growth()
