@@ -3,6 +3,7 @@
 
 #include <algorithm>
 
+#include "armdyn/algorithm/loop_coordinates.hpp"
 #include "armdyn/errors.hpp"
 
 namespace armdyn {
