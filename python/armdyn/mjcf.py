@@ -68,8 +68,8 @@ class MjcfInfo:
     name. ``actuators``: :class:`MjcfActuator` per MuJoCo actuator, in MuJoCo's order.
     ``unmapped``: every item the warning listed (what armdyn does not represent).
     ``qpos0``: MuJoCo's reference configuration (armdyn's joint coordinates are 0 there).
-    Use :meth:`q_from_qpos`, :meth:`qd_from_qvel`, :meth:`velocity_map` and
-    :meth:`qacc_from` to move states between the two."""
+    Use :meth:`q_from_qpos`, :meth:`qpos_from_q`, :meth:`qd_from_qvel`, :meth:`velocity_map`
+    and :meth:`qacc_from` to move states between the two."""
 
     source: str
     bodies: tuple[str, ...]
@@ -83,6 +83,23 @@ class MjcfInfo:
     # per armdyn independent coordinate / dof: where it comes from in MuJoCo's qpos / qvel
     _q_src: tuple = field(repr=False, default=())
     _dof_cols: tuple = field(repr=False, default=())
+    _followers: tuple = field(repr=False, default=())
+
+    def qpos_from_q(self, q) -> np.ndarray:
+        """MuJoCo's ``qpos`` at armdyn's ``q`` (the inverse of :meth:`q_from_qpos`): ``qpos0``
+        where armdyn has no coordinate (a free joint welded by ``fixed_base=True``), each
+        coupling follower from its leader (``multiplier * q_leader + offset``)."""
+        q = np.asarray(q, dtype=float)
+        qpos, k = self.qpos0.copy(), 0
+        for kind, adr in self._q_src:
+            if kind == "free":
+                qpos[adr : adr + 7], k = q[k : k + 7], k + 7
+            else:
+                qpos[adr], k = self.qpos0[adr] + q[k], k + 1
+        for _ in self._followers:  # enough passes for any chain of couplings
+            for fol, lead, mult, offset in self._followers:
+                qpos[fol] = self.qpos0[fol] + mult * (qpos[lead] - self.qpos0[lead]) + offset
+        return qpos
 
     def q_from_qpos(self, qpos) -> np.ndarray:
         """armdyn's ``q`` (``model.coord_names``) at MuJoCo's ``qpos``: a hinge's or slide's
@@ -605,6 +622,8 @@ class _Mapper(_TreeMapper):
                 self.add_loop(e, kind, what, name, residual.get(e, 0.0))
             elif kind == "joint":
                 self.add_joint_equality(e, what, name)
+            elif kind == "tendon":
+                self.add_tendon_equality(e, what, name)
             else:
                 self.unmapped.append(f"{what}: {kind} equalities are not mapped")
 
@@ -681,6 +700,34 @@ class _Mapper(_TreeMapper):
         self._call(
             what, self.b.add_coupling, name, self.jname[j1], self.jname[j2],
             float(coef[1]), float(coef[0]),
+        )  # fmt: skip
+
+    def add_tendon_equality(self, e: int, what: str, name: str) -> None:
+        """A ``tendon`` equality on one fixed tendon of two joints ``c1 q1 + c2 q2`` (MuJoCo:
+        ``L - L0 = a0``, L0 the length at qpos0) is the coupling ``q2 = -(c1/c2) q1 + a0/c2``
+        (the tendon's second joint follows its first); any other is listed."""
+        mj = self.mj
+        t1, t2 = int(mj.eq_obj1id[e]), int(mj.eq_obj2id[e])
+        adr, num = int(mj.tendon_adr[t1]), int(mj.tendon_num[t1])
+        wraps = range(adr, adr + num)
+        joints = [int(mj.wrap_objid[w]) for w in wraps]
+        coef = [float(mj.wrap_prm[w]) for w in wraps]
+        why = None
+        if t2 >= 0:
+            why = "between two tendons"
+        elif num != 2 or any(int(mj.wrap_type[w]) != 1 for w in wraps):  # 1: mjWRAP_JOINT
+            why = "not a fixed tendon of exactly two joints"
+        elif any(j not in self.jname for j in joints) or coef[0] == 0 or coef[1] == 0:
+            why = "a joint welded by fixed_base=True, not a hinge or slide, or a zero coef"
+        elif mj.jnt_type[joints[0]] != mj.jnt_type[joints[1]] or joints[0] == joints[1]:
+            why = "the tendon's two joints are not both hinges or both slides"
+        if why is not None:
+            self.unmapped.append(f"{what}: {why}")
+            return
+        a0 = float(mj.eq_data[e, 0])
+        self._call(
+            what, self.b.add_coupling, name, self.jname[joints[1]], self.jname[joints[0]],
+            -coef[0] / coef[1], a0 / coef[1],
         )  # fmt: skip
 
     # -- actuators ----------------------------------------------------------------------------
@@ -794,6 +841,12 @@ class _Mapper(_TreeMapper):
                 if lead in dofs:
                     cols[dofs.index(lead)].append(("dof", dadr, mult, qadr))
         q_src.sort()
+        adr_of = {name: int(mj.jnt_qposadr[j]) for j, name in self.jname.items()}
+        followers = tuple(
+            (adr_of[c["follower"]], adr_of[c["leader"]], c["multiplier"], c["offset"])
+            for c in model.couplings
+            if c["follower"] in adr_of and c["leader"] in adr_of
+        )
         return MjcfInfo(
             source=recorded,
             bodies=tuple(self.bodies),
@@ -806,6 +859,7 @@ class _Mapper(_TreeMapper):
             nv_mujoco=int(mj.nv),
             _q_src=tuple(src for _, src in q_src),
             _dof_cols=tuple(tuple(c) for c in cols),
+            _followers=followers,
         )
 
 
@@ -834,7 +888,8 @@ def load_mjcf(
       inertia ``armature`` (the gear-reduced model: exactly MuJoCo's ``M + diag(armature)``);
     - ``<equality>``: ``connect`` -> a spherical joint and ``weld`` -> a fixed joint between the
       two bodies at the anchor (closing loops; they must hold at qpos0), a ``joint`` equality
-      with a linear ``polycoef`` -> ``add_coupling(name, joint1, joint2, a1, a0)``;
+      with a linear ``polycoef`` -> ``add_coupling(name, joint1, joint2, a1, a0)``, a
+      ``tendon`` equality on a fixed tendon of two joints -> a coupling likewise;
     - actuators apply no force: :func:`mjcf_info` lists their transmissions and gears.
 
     ``fixed_base=True`` welds every free joint to the world at its qpos0 pose; ``False`` keeps

@@ -205,3 +205,45 @@ def test_joint_equality_is_a_coupling_as_mujoco_projected():
         tau = ad.inverse_dynamics(model, q, qd, qdd)
         expect = t.T @ d.qfrc_inverse
         assert np.abs(tau - expect).max() < 1e-10 * np.abs(expect).max()
+
+
+TENDON = """
+<mujoco model="tendon">
+  <compiler angle="radian"/>
+  <worldbody>
+    <body name="l1">
+      <joint name="j1" type="hinge" axis="0 0 1" ref="0.2"/>
+      <geom type="capsule" fromto="0 0 0 0.4 0 0" size="0.03"/>
+      <body name="l2" pos="0.4 0 0">
+        <joint name="j2" type="hinge" axis="0 1 0" ref="-0.1"/>
+        <geom type="capsule" fromto="0 0 0 0.3 0 0.1" size="0.03"/>
+      </body>
+    </body>
+  </worldbody>
+  <tendon><fixed name="tie"><joint joint="j1" coef="0.7"/><joint joint="j2" coef="-0.4"/></fixed>
+  </tendon>
+  <equality><tendon name="tied" tendon1="tie" polycoef="0.05 0 0 0 0"/></equality>
+</mujoco>
+"""
+
+
+@pytest.mark.parametrize(("xml", "name"), [(COUPLED, "follow"), (TENDON, "tied")])
+def test_equality_couplings_hold_mujocos_own_constraint(xml, name):
+    """At qpos_from_q(q) for any q, MuJoCo's residual of the equality (efc_pos) is zero: the
+    coupling's multiplier and offset are MuJoCo's definition (ref, a0, the tendon's coefs)."""
+    model = load(xml)
+    assert any(c["name"] == name for c in model.couplings)
+    info = mjcf_info(model)
+    m = mujoco.MjModel.from_xml_string(xml)
+    d = mujoco.MjData(m)
+    rng = np.random.default_rng(11)
+    for _ in range(3):
+        d.qpos[:] = info.qpos_from_q(rng.uniform(-1, 1, model.n_coords))
+        mujoco.mj_forward(m, d)
+        rows = d.efc_type == int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
+        assert rows.sum() == 1 and abs(d.efc_pos[rows][0]) < 1e-14
+        # and off the coupling, MuJoCo sees the violation
+        d.qpos[1] += 0.01
+        mujoco.mj_forward(m, d)
+        rows = d.efc_type == int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
+        assert abs(d.efc_pos[rows][0]) > 1e-3
