@@ -5,7 +5,8 @@
   assembled state (qpos0, at rest, gravity and a spring loading it) equal the rigid constrained
   dynamics of MuJoCo's own quantities: ``[M J'; J 0] [qacc; -f] = [qfrc_smooth; 0]`` with
   ``M = mj_fullM`` and ``J`` the equality rows of ``efc_J`` (MuJoCo itself solves them softly),
-  mapped to bodies by MuJoCo's Jacobians (``mj_jacBodyCom``).
+  mapped to bodies by MuJoCo's Jacobians (``mj_jacBodyCom``); and in motion (a velocity the
+  loops allow), with the loops' rows and their ``Jdot qvel`` from ``mj_jac`` / ``mj_jacDot``.
 - A ball joint (spherical pendulum with a hinged second link) at random states with velocity:
   ``body_accelerations`` equal MuJoCo's ``qacc`` mapped the same way (plus ``mj_jacDot``).
 - A ``<joint>`` equality with a linear polycoef is a coupling: ``mass_matrix`` and
@@ -247,3 +248,53 @@ def test_equality_couplings_hold_mujocos_own_constraint(xml, name):
         mujoco.mj_forward(m, d)
         rows = d.efc_type == int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
         assert abs(d.efc_pos[rows][0]) > 1e-3
+
+
+def loop_rows(m, d):
+    """The loops' velocity rows J and their J' qvel terms, from MuJoCo's point Jacobians and
+    mj_jacDot: the connect's anchor on the coupler and on the rocker move together; the weld's
+    two bodies share a point's velocity and their angular velocity."""
+    rows, dots = [], []
+
+    def jac(body, point):
+        jp, jr, jpd, jrd = (np.zeros((3, m.nv)) for _ in range(4))
+        mujoco.mj_jac(m, d, jp, jr, point, body)
+        mujoco.mj_jacDot(m, d, jpd, jrd, point, body)
+        return jp, jr, jpd, jrd
+
+    ids = {n: m.body(n).id for n in ("coupler", "rocker", "left", "right")}
+    anchor = d.xpos[ids["coupler"]] + d.xmat[ids["coupler"]].reshape(3, 3) @ [0.6, 0, 0.1]
+    a, b = jac(ids["coupler"], anchor), jac(ids["rocker"], anchor)
+    rows.append(a[0] - b[0])
+    dots.append((a[2] - b[2]) @ d.qvel)
+    point = d.xpos[ids["right"]].copy()
+    a, b = jac(ids["left"], point), jac(ids["right"], point)
+    rows += [a[0] - b[0], a[1] - b[1]]
+    dots += [(a[2] - b[2]) @ d.qvel, (a[3] - b[3]) @ d.qvel]
+    return np.vstack(rows), np.concatenate(dots)
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_loops_in_motion_match_mujocos_rigid_dynamics(seed):
+    """At qpos0 with a random velocity that the loops allow (the null space of their rows):
+    ``[M J'; J 0] [qacc; -f] = [qfrc_smooth; -Jdot qvel]`` from MuJoCo's quantities."""
+    model = load(LOOPS)
+    m = mujoco.MjModel.from_xml_string(LOOPS)
+    d = mujoco.MjData(m)
+    mujoco.mj_forward(m, d)
+    jac, _ = loop_rows(m, d)
+    _, sing, vt = np.linalg.svd(jac)
+    null = vt[np.sum(sing > 1e-10 * sing[0]) :].T
+    assert null.shape[1] == 2  # the four-bar's and the welded pair's one dof each
+    d.qvel[:] = null @ np.random.default_rng(seed).normal(scale=5.0, size=2)
+    mujoco.mj_forward(m, d)
+    jac, dot = loop_rows(m, d)
+    assert np.abs(jac @ d.qvel).max() < 1e-13
+    full = np.zeros((m.nv, m.nv))
+    mujoco.mj_fullM(m, d, full)
+    kkt = np.block([[full, jac.T], [jac, np.zeros((len(jac), len(jac)))]])
+    qacc = np.linalg.lstsq(kkt, np.r_[d.qfrc_smooth, -dot], rcond=None)[0][: m.nv]
+    u, v, jacs = cartesian_state(model, m, d, mjcf_info(model))
+    vdot, _ = ad.body_accelerations(model, u, v)
+    expect = body_accelerations_of(m, d, jacs, qacc, model.nv)
+    assert np.abs(vdot - expect).max() < 1e-10 * np.abs(expect).max()
