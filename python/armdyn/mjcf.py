@@ -11,7 +11,6 @@ list of what is not mapped, the info), then one ``UserWarning`` listing what was
 from __future__ import annotations
 
 import os
-import re
 import warnings
 import weakref
 from dataclasses import dataclass, field
@@ -22,6 +21,9 @@ from armdyn import _checks, _core
 
 #: largest MJCF file or XML string (and file it references) load_mjcf reads [bytes]: 64 MiB
 MJCF_MAX_BYTES = 64 << 20
+
+#: most attributes one XML element may have (MuJoCo's XML parser is quadratic in them)
+MJCF_MAX_ATTRIBUTES = 1000
 
 #: how far apart (in metres, relative to the model's extent) two points a connect or weld joins
 #: may be at MuJoCo's qpos0 for the loop to count as assembled there
@@ -238,25 +240,57 @@ def _is_xml(text: str) -> bool:
     return text.lstrip("\ufeff").lstrip().startswith("<")
 
 
-_PROLOG = re.compile(r"\s*(<\?.*?\?>|<!--.*?-->|<!DOCTYPE[^>]*>)", re.S)
+class _Scan:
+    """One linear pass of Python's expat over the XML before MuJoCo sees it: the root element,
+    the ``file=`` references and asset folders, and the refusals MuJoCo's tinyxml2 cannot make
+    cheaply (it is quadratic in the attributes of one element: 40000 take it 10 s) or at all
+    (a DOCTYPE, whose entities MJCF never uses)."""
 
+    REFS = ("file", "meshdir", "texturedir", "assetdir")
 
-def _root_element(text: str) -> str:
-    """The name of the XML's first element (after a declaration, comments and a DOCTYPE)."""
-    pos = len(text) - len(text.lstrip("\ufeff"))
-    while (m := _PROLOG.match(text, pos)) is not None:
-        pos = m.end()
-    m = re.compile(r"\s*<([A-Za-z_][\w.:-]*)").match(text, pos)
-    return m.group(1) if m else ""
+    def __init__(self, text: str, label: str):
+        import xml.parsers.expat
 
+        self.label, self.root, self.refs = label, "", []
+        parser = xml.parsers.expat.ParserCreate()
+        parser.ordered_attributes = True
+        parser.StartElementHandler = self._element
+        parser.StartDoctypeDeclHandler = self._doctype
+        self.parser = parser
+        try:
+            parser.Parse(text, True)
+        except xml.parsers.expat.ExpatError as err:
+            raise _core.ModelError(
+                f"{label}: not well-formed XML: {xml.parsers.expat.ErrorString(err.code)} "
+                f"(line {err.lineno}, column {err.offset + 1})"
+            ) from None
 
-def _check_root(text: str, label: str) -> None:
-    """MuJoCo also reads URDF (its own import): load_mjcf takes MJCF only (<mujoco>)."""
-    root = _root_element(text)
-    if root != "mujoco":
-        hint = "; for a URDF use armdyn.load_urdf" if root == "robot" else ""
+    def _element(self, name: str, attrs: list) -> None:
+        if not self.root:
+            self.root = name
+        if len(attrs) > 2 * MJCF_MAX_ATTRIBUTES:
+            raise _core.ModelError(
+                f"{self.label}: element <{name[:40]}> on line {self.parser.CurrentLineNumber} "
+                f"has {len(attrs) // 2} attributes, more than the limit of "
+                f"{MJCF_MAX_ATTRIBUTES} (armdyn.mjcf.MJCF_MAX_ATTRIBUTES)"
+            )
+        for key, value in zip(attrs[::2], attrs[1::2], strict=True):
+            if key in self.REFS and value:
+                self.refs.append((key, value))
+
+    def _doctype(self, name, *_args) -> None:
         raise _core.ModelError(
-            f"{label}: the root element is <{root[:40]}>, not <mujoco>: not MJCF{hint}"
+            f"{self.label}: has a DOCTYPE (<!DOCTYPE {str(name)[:40]}>, line "
+            f"{self.parser.CurrentLineNumber}): MJCF uses none, and its entities are refused"
+        )
+
+
+def _check_root(scan: _Scan) -> None:
+    """MuJoCo also reads URDF (its own import): load_mjcf takes MJCF only (<mujoco>)."""
+    if scan.root != "mujoco":
+        hint = "; for a URDF use armdyn.load_urdf" if scan.root == "robot" else ""
+        raise _core.ModelError(
+            f"{scan.label}: the root element is <{scan.root[:40]}>, not <mujoco>: not MJCF{hint}"
         )
 
 
@@ -284,17 +318,14 @@ def _check_file(path: str, what: str) -> bytes:
         ) from None
 
 
-_FILE_ATTR = re.compile(r"""\b(file|meshdir|texturedir|assetdir)\s*=\s*(["'])(.*?)\2""", re.S)
-
-
-def _check_references(text: str, base: str, seen: set[str]) -> None:
+def _check_references(scan: _Scan, base: str, seen: set[str]) -> None:
     """Every ``file=`` the XML (and the files it includes) names that exists must be a regular
-    file of at most MJCF_MAX_BYTES: checked before MuJoCo opens it (a FIFO would block it).
-    Paths are tried relative to ``base`` and to the <compiler>'s asset directories."""
-    attrs = [(m.group(1), m.group(3)) for m in _FILE_ATTR.finditer(text)]
-    dirs = [base] + [os.path.join(base, v) for k, v in attrs if k != "file"]
-    for kind, value in attrs:
-        if kind != "file" or not value:
+    file of at most MJCF_MAX_BYTES: checked before MuJoCo opens it (a FIFO would block it); an
+    included XML file is scanned as the model is. Paths are tried relative to ``base`` and to
+    the <compiler>'s asset folders."""
+    dirs = [base] + [os.path.join(base, v) for k, v in scan.refs if k != "file"]
+    for kind, value in scan.refs:
+        if kind != "file":
             continue
         for d in dirs if not os.path.isabs(value) else [""]:
             cand = os.path.normpath(os.path.join(d, value))
@@ -307,7 +338,8 @@ def _check_references(text: str, base: str, seen: set[str]) -> None:
                     sub = data.decode("utf-8")
                 except UnicodeDecodeError:
                     continue  # MuJoCo reports it
-                _check_references(sub, base, seen)
+                what = f"MJCF included file {_shown_path(cand)}"
+                _check_references(_Scan(sub, what), base, seen)
 
 
 def _compile(source):
@@ -324,8 +356,9 @@ def _compile(source):
             raise _core.ModelError(
                 f"MJCF string: contains a NUL byte at offset {value.index(chr(0))}"
             )
-        _check_root(value, "MJCF string")
-        _check_references(value, os.getcwd(), set())
+        scan = _Scan(value, "MJCF string")
+        _check_root(scan)
+        _check_references(scan, os.getcwd(), set())
         label, recorded = "MJCF string", value
         load = mujoco.MjModel.from_xml_string
     else:
@@ -340,8 +373,9 @@ def _compile(source):
             raise _core.ModelError(
                 f"MJCF file {_shown_path(value)} does not hold XML (it does not start with '<')"
             )
-        _check_root(text, f"MJCF file {_shown_path(value)}")
-        _check_references(text, os.path.dirname(os.path.abspath(value)), set())
+        scan = _Scan(text, f"MJCF file {_shown_path(value)}")
+        _check_root(scan)
+        _check_references(scan, os.path.dirname(os.path.abspath(value)), set())
         label, recorded = f"MJCF file {_shown_path(value)}", os.path.abspath(value)
         load = mujoco.MjModel.from_xml_path
     said: list[str] = []

@@ -46,9 +46,13 @@ def test_a_good_arm_loads():
 def test_malformed_and_truncated_xml():
     refused(
         "<mujoco><worldbody><body><joint type='hin",
-        r"MJCF string: MuJoCo refused it.*Line number=1.*joint",
+        r"MJCF string: not well-formed XML: unclosed token \(line 1, column 26\)",
     )
-    refused("<mujoco><worldbody><body></mujoco>", r"MuJoCo refused it")
+    refused("<mujoco><worldbody><body></mujoco>", r"not well-formed XML: mismatched tag")
+    refused(
+        "<mujoco><worldbody><body><joint type='bad'/></body></worldbody></mujoco>",
+        r"MuJoCo refused it: XML Error: invalid keyword: 'bad' \| Element 'joint', line 1",
+    )
     refused("<robot name='urdf'/>", r"root element is <robot>, not <mujoco>.*load_urdf")
     refused("<?xml version='1.0'?><!-- c --><mujocox/>", r"root element is <mujocox>")
     refused("<mujoco>\x00</mujoco>", r"NUL byte at offset 8")
@@ -168,3 +172,14 @@ def test_without_mujoco_the_import_error_says_how_to_install_it():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert "needs the 'mujoco' package (pip install mujoco, or armdyn[mjcf])" in out.stdout
+
+
+def test_many_attributes_doctype_and_ill_formed_xml_are_refused_before_mujoco():
+    many = " ".join(f'a{i}="1"' for i in range(40_000))
+    refused(
+        f"<mujoco><worldbody><body {many}/></worldbody></mujoco>",
+        r"element <body> on line 1 has 40000 attributes, more than the limit of 1000",
+    )
+    lol = '<!DOCTYPE m [<!ENTITY a "aaaaaaaa"><!ENTITY b "&a;&a;&a;&a;">]><mujoco model="&b;"/>'
+    refused(lol, r"has a DOCTYPE \(<!DOCTYPE m>, line 1\)")
+    refused('<mujoco model="&x;"/>', r"not well-formed XML: undefined entity \(line 1, column 1\)")
