@@ -243,7 +243,7 @@ def _is_xml(text: str) -> bool:
 class _Scan:
     """One linear pass of Python's expat over the XML before MuJoCo sees it: the root element,
     the ``file=`` references and asset folders, and the refusals MuJoCo's tinyxml2 cannot make
-    cheaply (it is quadratic in the attributes of one element: 40000 take it 10 s) or at all
+    cheaply (it is quadratic in the attributes of one element) or at all
     (a DOCTYPE, whose entities MJCF never uses)."""
 
     REFS = ("file", "meshdir", "texturedir", "assetdir")
