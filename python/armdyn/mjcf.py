@@ -440,6 +440,7 @@ class _TreeMapper:
         self.body_frames: dict[str, str] = {}
         self.followers: dict[int, tuple[int, float]] = {}  # joint id -> (leader id, multiplier)
         self.welded_free: list[int] = []
+        self.frictionloss: list[str] = []  # "'name' value" per joint that has one
         self.extent = max(float(mj.stat.extent), 1.0)
         flags, off = int(mj.opt.disableflags), mujoco.mjtDisableBit
         self.no_spring = bool(flags & int(off.mjDSBL_SPRING))
@@ -571,7 +572,7 @@ class _TreeMapper:
             self._finite(f"{what}: {label}", vals)
         floss = mj.dof_frictionloss[dof : dof + ndof]
         if np.any(floss != 0):
-            self.unmapped.append(f"{what}: frictionloss {float(np.max(floss)):g} (dry friction)")
+            self.frictionloss.append(f"{what.removeprefix('joint ')} {float(np.max(floss)):g}")
         if kind in ("ball", "free"):
             for label, vals in (
                 ("damping", damping),
@@ -804,6 +805,11 @@ class _Mapper(_TreeMapper):
     # -- what is not mapped -------------------------------------------------------------------
     def collect_unmapped(self) -> None:
         mj, u = self.mj, self.unmapped
+        if self.frictionloss:
+            u.append(
+                "frictionloss (dry friction, a constraint in MuJoCo) of joints "
+                + ", ".join(self.frictionloss)
+            )
         n_coll = int(np.count_nonzero((mj.geom_contype != 0) | (mj.geom_conaffinity != 0)))
         if n_coll or mj.npair:
             u.append(f"contacts: {n_coll} colliding geoms, {mj.npair} explicit contact pairs")

@@ -80,6 +80,10 @@ def test_ranges_armature_and_actuator_gears_as_compiled():
     jaco = load(JACO)
     mj = mujoco.MjModel.from_xml_path(JACO)
     assert np.array_equal(jaco.reflected_inertia, mj.dof_armature)
+    # frictionloss (MuJoCo's dry friction, a constraint) is listed with every joint's value
+    (item,) = [u for u in mjcf_info(jaco).unmapped if u.startswith("frictionloss")]
+    for j in range(mj.njnt):
+        assert f"'{mj.joint(j).name}' {mj.dof_frictionloss[mj.jnt_dofadr[j]]:g}" in item
 
 
 @pytest.mark.parametrize(
