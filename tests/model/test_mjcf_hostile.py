@@ -37,10 +37,17 @@ def refused(source, pattern, exc=ad.ModelError, **kw):
     assert mujoco.get_mju_user_warning() is before
 
 
-def test_a_good_arm_loads():
+def test_a_good_arm_loads_from_text_bytes_and_paths(tmp_path, monkeypatch):
     model = ad.load_mjcf(arm(), warn=False)
     assert model.coord_names == ["hinge"]
     assert mjcf.mjcf_info(model).unmapped == ()
+    assert mjcf.mjcf_info(model).source == arm()
+    (tmp_path / "arm.xml").write_text(arm())
+    monkeypatch.chdir(tmp_path)
+    for source in (arm().encode(), "arm.xml", tmp_path / "arm.xml"):
+        again = ad.load_mjcf(source, warn=False)
+        assert np.array_equal(again.u0, model.u0) and again.coord_names == ["hinge"]
+    assert mjcf.mjcf_info(again).source == str(tmp_path / "arm.xml")
 
 
 def test_malformed_and_truncated_xml():
