@@ -429,6 +429,7 @@ class _TreeMapper:
         mujoco.mj_kinematics(mj, self.d)
         grav = np.array(mj.opt.gravity, dtype=float) if gravity is None else gravity
         self.b = _core.ModelBuilder(gravity=grav, physical_inertia=physical_inertia)
+        self.gravity = np.asarray(grav, dtype=float)
         self.unmapped: list[str] = []
         self.body_names = _Names({"ground"})
         self.joint_names = _Names()
@@ -493,6 +494,23 @@ class _TreeMapper:
             self.bodies[i] = name
             if mj.body_mocapid[i] >= 0:
                 self.unmapped.append(f"mocap {what}: welded to the world at its qpos0 pose")
+
+    def add_gravcomp(self) -> None:
+        """``<body gravcomp>``: MuJoCo's passive force ``-gravcomp * mass * gravity`` at the
+        centre of mass is a constant world force on the body (``add_body_force``), exact; when
+        a joint routes it through actuators (``actuatorgravcomp``) it is listed instead."""
+        mj = self.mj
+        bodies = np.flatnonzero(mj.body_gravcomp != 0)
+        if len(bodies) == 0:
+            return
+        if np.any(mj.jnt_actgravcomp != 0):
+            self.unmapped.append("body gravcomp routed through actuators (actuatorgravcomp)")
+            return
+        for i in bodies:
+            self._finite(f"{self.body_label(i)}: gravcomp", [mj.body_gravcomp[i]])
+            force = -float(mj.body_gravcomp[i]) * float(mj.body_mass[i]) * self.gravity
+            if self.bodies[i] != "ground":
+                self._call(self.body_label(i), self.b.add_body_force, self.bodies[i], force)
 
     # -- joints -------------------------------------------------------------------------------
     def add_joints(self) -> None:
@@ -832,8 +850,6 @@ class _Mapper(_TreeMapper):
             u.append("joint actuatorfrcrange (limits on the actuators' total force)")
         if mj.opt.density or mj.opt.viscosity or np.any(mj.opt.wind != 0):
             u.append("fluid forces (option density, viscosity, wind)")
-        if np.any(mj.body_gravcomp != 0):
-            u.append("body gravcomp (gravity compensation forces)")
         for count, what in (
             (mj.nsensor, "sensors"),
             (mj.nkey, "keyframes (convert their qpos with mjcf_info(model).q_from_qpos)"),
@@ -930,6 +946,8 @@ def load_mjcf(
       two bodies at the anchor (closing loops; they must hold at qpos0), a ``joint`` equality
       with a linear ``polycoef`` -> ``add_coupling(name, joint1, joint2, a1, a0)``, a
       ``tendon`` equality on a fixed tendon of two joints -> a coupling likewise;
+    - ``<body gravcomp>`` -> a constant world force ``-gravcomp * mass * gravity`` at the
+      body's centre of mass (MuJoCo's gravity compensation);
     - actuators apply no force: :func:`mjcf_info` lists their transmissions and gears.
 
     ``fixed_base=True`` welds every free joint to the world at its qpos0 pose; ``False`` keeps
@@ -961,6 +979,7 @@ def load_mjcf(
     mapper.unmapped.extend(said)
     mapper.add_bodies()
     mapper.add_joints()
+    mapper.add_gravcomp()
     mapper.add_equalities()
     mapper.add_frames()
     mapper.collect_unmapped()

@@ -112,3 +112,23 @@ def test_spring_with_ref_and_springref_matches_mujoco(flags):
         q, qd = info.q_from_qpos(d.qpos), info.qd_from_qvel(d.qpos, d.qvel)
         qdd = ad.forward_dynamics(model, q, qd, np.zeros(2))
         assert np.abs(qdd - d.qacc).max() < 1e-10 * np.abs(d.qacc).max()
+
+
+def test_gravcomp_is_a_body_force_as_in_mujoco():
+    xml = """<mujoco><worldbody><body name="a" gravcomp="0.7"><joint type="hinge" axis="0 1 0"/>
+      <geom type="capsule" fromto="0 0 0 0.4 0 0.1" size="0.05"/>
+      <body name="b" pos="0.4 0 0.1" gravcomp="1"><joint type="hinge" axis="1 0 0"/>
+      <geom type="box" size="0.05 0.1 0.02" pos="0 0.1 0"/></body></body></worldbody></mujoco>"""
+    model = load(xml)
+    info = mjcf_info(model)
+    assert not any("gravcomp" in u for u in info.unmapped)
+    m = mujoco.MjModel.from_xml_string(xml)
+    m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT)
+    d = mujoco.MjData(m)
+    rng = np.random.default_rng(9)
+    for _ in range(3):
+        d.qpos[:], d.qvel[:] = rng.uniform(-1, 1, 2), rng.normal(size=2)
+        mujoco.mj_forward(m, d)
+        assert np.abs(d.qfrc_gravcomp).max() > 0.1
+        qdd = ad.forward_dynamics(model, d.qpos.copy(), d.qvel.copy(), np.zeros(2))
+        assert np.abs(qdd - d.qacc).max() < 1e-10 * np.abs(d.qacc).max()

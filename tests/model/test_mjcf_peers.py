@@ -2,9 +2,8 @@
 against MuJoCo itself (issue 36): the mass matrix equals ``mj_fullM`` and the forward dynamics
 MuJoCo's ``qacc`` (constraints, contacts and actuation disabled) to 1e-10 relative at seeded
 random states, with damping, stiffness and armature in both. MuJoCo's terms that armdyn does not
-map (tendon springs and dampers, fluid forces, gravity compensation, a free joint's damping or
-armature) are switched off on MuJoCo's side, and the test checks that load_mjcf's warning lists
-each of them.
+map (tendon springs and dampers, fluid forces, a free joint's damping or armature) are switched
+off on MuJoCo's side, and the test checks that load_mjcf's warning lists each of them.
 
 Coordinates: ``mjcf_info(model).q_from_qpos`` / ``qd_from_qvel`` / ``velocity_map`` /
 ``qacc_from`` (a free joint's linear velocity is in world axes in MuJoCo, in the body's axes in
@@ -88,14 +87,11 @@ def mujoco_peer(path: str, info) -> mujoco.MjModel:
         assert "tendons" in listed
     if m.opt.density or m.opt.viscosity:
         assert "fluid forces" in listed
-    if np.any(m.body_gravcomp):
-        assert "gravcomp" in listed
     if m.nu:
         assert f"{m.nu} actuators apply no force" in listed
     m.tendon_stiffness[:] = 0
     m.tendon_damping[:] = 0
     m.opt.density = m.opt.viscosity = 0.0
-    m.body_gravcomp[:] = 0
     for j in np.flatnonzero(m.jnt_type <= 1):  # free and ball joints
         a, n = m.jnt_dofadr[j], 6 if m.jnt_type[j] == 0 else 3
         for arr in (m.dof_damping, m.dof_armature):
