@@ -132,3 +132,31 @@ def test_gravcomp_is_a_body_force_as_in_mujoco():
         assert np.abs(d.qfrc_gravcomp).max() > 0.1
         qdd = ad.forward_dynamics(model, d.qpos.copy(), d.qvel.copy(), np.zeros(2))
         assert np.abs(qdd - d.qacc).max() < 1e-10 * np.abs(d.qacc).max()
+
+
+def test_unnamed_and_clashing_names_get_the_documented_names():
+    xml = """<mujoco><worldbody><site name="world"/>
+      <body name="ground" pos="0 0 1"><joint type="hinge" axis="0 1 0"/>
+        <geom type="sphere" size="0.1" pos="0.3 0 0"/><site name="ground" pos="0.3 0 0"/>
+        <body pos="0.3 0 0"><joint name="j" type="hinge" axis="0 0 1"/>
+          <joint type="slide" axis="1 0 0"/><geom type="sphere" size="0.05" pos="0.2 0 0"/>
+          <site name="body2"/><site/>
+        </body>
+      </body></worldbody>
+      <equality><weld body1="ground" active="false"/></equality></mujoco>"""
+    model = load(xml)
+    info = mjcf_info(model)
+    # a body named 'ground' (armdyn's world) and an unnamed body get body<id>
+    assert info.bodies == ("ground", "body1", "body2")
+    assert model.body_names == ["body1", "body2", "body2__j"]  # massless, between 2 joints
+    assert model.joint_names[:3] == ["joint0", "j", "joint2"]
+    assert info.joints == {"joint0": "joint0", "j": "j", "joint2": "joint2"}
+    assert info.body_frames == {"world": "world", "ground": "body1", "body2": "body2"}
+    # a site keeps its name unless a frame has it already: then site:<name>
+    assert info.sites == {
+        "world": "site:world",
+        "ground": "ground",
+        "body2": "site:body2",
+        "site3": "site3",
+    }
+    assert "equality weld 0 (unnamed): inactive at the start (eq active='false')" in info.unmapped
