@@ -727,7 +727,7 @@ CASES = [
         "truncated XML",
         lambda: ad.load_mjcf("<mujoco><worldbody><body><joint type='hin"),
         ME,
-        r"MJCF string: MuJoCo refused it: XML parse error",
+        r"MJCF string: not well-formed XML: unclosed token",
     ),
     (
         "mjcf-urdf-root",

@@ -11,7 +11,6 @@ list of what is not mapped, the info), then one ``UserWarning`` listing what was
 from __future__ import annotations
 
 import os
-import re
 import warnings
 import weakref
 from dataclasses import dataclass, field
@@ -22,6 +21,9 @@ from armdyn import _checks, _core
 
 #: largest MJCF file or XML string (and file it references) load_mjcf reads [bytes]: 64 MiB
 MJCF_MAX_BYTES = 64 << 20
+
+#: most attributes one XML element may have (MuJoCo's XML parser is quadratic in them)
+MJCF_MAX_ATTRIBUTES = 1000
 
 #: how far apart (in metres, relative to the model's extent) two points a connect or weld joins
 #: may be at MuJoCo's qpos0 for the loop to count as assembled there
@@ -68,8 +70,8 @@ class MjcfInfo:
     name. ``actuators``: :class:`MjcfActuator` per MuJoCo actuator, in MuJoCo's order.
     ``unmapped``: every item the warning listed (what armdyn does not represent).
     ``qpos0``: MuJoCo's reference configuration (armdyn's joint coordinates are 0 there).
-    Use :meth:`q_from_qpos`, :meth:`qd_from_qvel`, :meth:`velocity_map` and
-    :meth:`qacc_from` to move states between the two."""
+    Use :meth:`q_from_qpos`, :meth:`qpos_from_q`, :meth:`qd_from_qvel`, :meth:`velocity_map`
+    and :meth:`qacc_from` to move states between the two."""
 
     source: str
     bodies: tuple[str, ...]
@@ -83,6 +85,23 @@ class MjcfInfo:
     # per armdyn independent coordinate / dof: where it comes from in MuJoCo's qpos / qvel
     _q_src: tuple = field(repr=False, default=())
     _dof_cols: tuple = field(repr=False, default=())
+    _followers: tuple = field(repr=False, default=())
+
+    def qpos_from_q(self, q) -> np.ndarray:
+        """MuJoCo's ``qpos`` at armdyn's ``q`` (the inverse of :meth:`q_from_qpos`): ``qpos0``
+        where armdyn has no coordinate (a free joint welded by ``fixed_base=True``), each
+        coupling follower from its leader (``multiplier * q_leader + offset``)."""
+        q = np.asarray(q, dtype=float)
+        qpos, k = self.qpos0.copy(), 0
+        for kind, adr in self._q_src:
+            if kind == "free":
+                qpos[adr : adr + 7], k = q[k : k + 7], k + 7
+            else:
+                qpos[adr], k = self.qpos0[adr] + q[k], k + 1
+        for _ in self._followers:  # enough passes for any chain of couplings
+            for fol, lead, mult, offset in self._followers:
+                qpos[fol] = self.qpos0[fol] + mult * (qpos[lead] - self.qpos0[lead]) + offset
+        return qpos
 
     def q_from_qpos(self, qpos) -> np.ndarray:
         """armdyn's ``q`` (``model.coord_names``) at MuJoCo's ``qpos``: a hinge's or slide's
@@ -221,25 +240,57 @@ def _is_xml(text: str) -> bool:
     return text.lstrip("\ufeff").lstrip().startswith("<")
 
 
-_PROLOG = re.compile(r"\s*(<\?.*?\?>|<!--.*?-->|<!DOCTYPE[^>]*>)", re.S)
+class _Scan:
+    """One linear pass of Python's expat over the XML before MuJoCo sees it: the root element,
+    the ``file=`` references and asset folders, and the refusals MuJoCo's tinyxml2 cannot make
+    cheaply (it is quadratic in the attributes of one element) or at all
+    (a DOCTYPE, whose entities MJCF never uses)."""
 
+    REFS = ("file", "meshdir", "texturedir", "assetdir")
 
-def _root_element(text: str) -> str:
-    """The name of the XML's first element (after a declaration, comments and a DOCTYPE)."""
-    pos = len(text) - len(text.lstrip("\ufeff"))
-    while (m := _PROLOG.match(text, pos)) is not None:
-        pos = m.end()
-    m = re.compile(r"\s*<([A-Za-z_][\w.:-]*)").match(text, pos)
-    return m.group(1) if m else ""
+    def __init__(self, text: str, label: str):
+        import xml.parsers.expat
 
+        self.label, self.root, self.refs = label, "", []
+        parser = xml.parsers.expat.ParserCreate()
+        parser.ordered_attributes = True
+        parser.StartElementHandler = self._element
+        parser.StartDoctypeDeclHandler = self._doctype
+        self.parser = parser
+        try:
+            parser.Parse(text, True)
+        except xml.parsers.expat.ExpatError as err:
+            raise _core.ModelError(
+                f"{label}: not well-formed XML: {xml.parsers.expat.ErrorString(err.code)} "
+                f"(line {err.lineno}, column {err.offset + 1})"
+            ) from None
 
-def _check_root(text: str, label: str) -> None:
-    """MuJoCo also reads URDF (its own import): load_mjcf takes MJCF only (<mujoco>)."""
-    root = _root_element(text)
-    if root != "mujoco":
-        hint = "; for a URDF use armdyn.load_urdf" if root == "robot" else ""
+    def _element(self, name: str, attrs: list) -> None:
+        if not self.root:
+            self.root = name
+        if len(attrs) > 2 * MJCF_MAX_ATTRIBUTES:
+            raise _core.ModelError(
+                f"{self.label}: element <{name[:40]}> on line {self.parser.CurrentLineNumber} "
+                f"has {len(attrs) // 2} attributes, more than the limit of "
+                f"{MJCF_MAX_ATTRIBUTES} (armdyn.mjcf.MJCF_MAX_ATTRIBUTES)"
+            )
+        for key, value in zip(attrs[::2], attrs[1::2], strict=True):
+            if key in self.REFS and value:
+                self.refs.append((key, value))
+
+    def _doctype(self, name, *_args) -> None:
         raise _core.ModelError(
-            f"{label}: the root element is <{root[:40]}>, not <mujoco>: not MJCF{hint}"
+            f"{self.label}: has a DOCTYPE (<!DOCTYPE {str(name)[:40]}>, line "
+            f"{self.parser.CurrentLineNumber}): MJCF uses none, and its entities are refused"
+        )
+
+
+def _check_root(scan: _Scan) -> None:
+    """MuJoCo also reads URDF (its own import): load_mjcf takes MJCF only (<mujoco>)."""
+    if scan.root != "mujoco":
+        hint = "; for a URDF use armdyn.load_urdf" if scan.root == "robot" else ""
+        raise _core.ModelError(
+            f"{scan.label}: the root element is <{scan.root[:40]}>, not <mujoco>: not MJCF{hint}"
         )
 
 
@@ -267,17 +318,14 @@ def _check_file(path: str, what: str) -> bytes:
         ) from None
 
 
-_FILE_ATTR = re.compile(r"""\b(file|meshdir|texturedir|assetdir)\s*=\s*(["'])(.*?)\2""", re.S)
-
-
-def _check_references(text: str, base: str, seen: set[str]) -> None:
+def _check_references(scan: _Scan, base: str, seen: set[str]) -> None:
     """Every ``file=`` the XML (and the files it includes) names that exists must be a regular
-    file of at most MJCF_MAX_BYTES: checked before MuJoCo opens it (a FIFO would block it).
-    Paths are tried relative to ``base`` and to the <compiler>'s asset directories."""
-    attrs = [(m.group(1), m.group(3)) for m in _FILE_ATTR.finditer(text)]
-    dirs = [base] + [os.path.join(base, v) for k, v in attrs if k != "file"]
-    for kind, value in attrs:
-        if kind != "file" or not value:
+    file of at most MJCF_MAX_BYTES: checked before MuJoCo opens it (a FIFO would block it); an
+    included XML file is scanned as the model is. Paths are tried relative to ``base`` and to
+    the <compiler>'s asset folders."""
+    dirs = [base] + [os.path.join(base, v) for k, v in scan.refs if k != "file"]
+    for kind, value in scan.refs:
+        if kind != "file":
             continue
         for d in dirs if not os.path.isabs(value) else [""]:
             cand = os.path.normpath(os.path.join(d, value))
@@ -290,7 +338,8 @@ def _check_references(text: str, base: str, seen: set[str]) -> None:
                     sub = data.decode("utf-8")
                 except UnicodeDecodeError:
                     continue  # MuJoCo reports it
-                _check_references(sub, base, seen)
+                what = f"MJCF included file {_shown_path(cand)}"
+                _check_references(_Scan(sub, what), base, seen)
 
 
 def _compile(source):
@@ -307,8 +356,9 @@ def _compile(source):
             raise _core.ModelError(
                 f"MJCF string: contains a NUL byte at offset {value.index(chr(0))}"
             )
-        _check_root(value, "MJCF string")
-        _check_references(value, os.getcwd(), set())
+        scan = _Scan(value, "MJCF string")
+        _check_root(scan)
+        _check_references(scan, os.getcwd(), set())
         label, recorded = "MJCF string", value
         load = mujoco.MjModel.from_xml_string
     else:
@@ -323,8 +373,9 @@ def _compile(source):
             raise _core.ModelError(
                 f"MJCF file {_shown_path(value)} does not hold XML (it does not start with '<')"
             )
-        _check_root(text, f"MJCF file {_shown_path(value)}")
-        _check_references(text, os.path.dirname(os.path.abspath(value)), set())
+        scan = _Scan(text, f"MJCF file {_shown_path(value)}")
+        _check_root(scan)
+        _check_references(scan, os.path.dirname(os.path.abspath(value)), set())
         label, recorded = f"MJCF file {_shown_path(value)}", os.path.abspath(value)
         load = mujoco.MjModel.from_xml_path
     said: list[str] = []
@@ -378,6 +429,7 @@ class _TreeMapper:
         mujoco.mj_kinematics(mj, self.d)
         grav = np.array(mj.opt.gravity, dtype=float) if gravity is None else gravity
         self.b = _core.ModelBuilder(gravity=grav, physical_inertia=physical_inertia)
+        self.gravity = np.asarray(grav, dtype=float)
         self.unmapped: list[str] = []
         self.body_names = _Names({"ground"})
         self.joint_names = _Names()
@@ -389,6 +441,7 @@ class _TreeMapper:
         self.body_frames: dict[str, str] = {}
         self.followers: dict[int, tuple[int, float]] = {}  # joint id -> (leader id, multiplier)
         self.welded_free: list[int] = []
+        self.frictionloss: list[str] = []  # "'name' value" per joint that has one
         self.extent = max(float(mj.stat.extent), 1.0)
         flags, off = int(mj.opt.disableflags), mujoco.mjtDisableBit
         self.no_spring = bool(flags & int(off.mjDSBL_SPRING))
@@ -441,6 +494,23 @@ class _TreeMapper:
             self.bodies[i] = name
             if mj.body_mocapid[i] >= 0:
                 self.unmapped.append(f"mocap {what}: welded to the world at its qpos0 pose")
+
+    def add_gravcomp(self) -> None:
+        """``<body gravcomp>``: MuJoCo's passive force ``-gravcomp * mass * gravity`` at the
+        centre of mass is a constant world force on the body (``add_body_force``), exact; when
+        a joint routes it through actuators (``actuatorgravcomp``) it is listed instead."""
+        mj = self.mj
+        bodies = np.flatnonzero(mj.body_gravcomp != 0)
+        if len(bodies) == 0:
+            return
+        if np.any(mj.jnt_actgravcomp != 0):
+            self.unmapped.append("body gravcomp routed through actuators (actuatorgravcomp)")
+            return
+        for i in bodies:
+            self._finite(f"{self.body_label(i)}: gravcomp", [mj.body_gravcomp[i]])
+            force = -float(mj.body_gravcomp[i]) * float(mj.body_mass[i]) * self.gravity
+            if self.bodies[i] != "ground":
+                self._call(self.body_label(i), self.b.add_body_force, self.bodies[i], force)
 
     # -- joints -------------------------------------------------------------------------------
     def add_joints(self) -> None:
@@ -520,7 +590,7 @@ class _TreeMapper:
             self._finite(f"{what}: {label}", vals)
         floss = mj.dof_frictionloss[dof : dof + ndof]
         if np.any(floss != 0):
-            self.unmapped.append(f"{what}: frictionloss {float(np.max(floss)):g} (dry friction)")
+            self.frictionloss.append(f"{what.removeprefix('joint ')} {float(np.max(floss)):g}")
         if kind in ("ball", "free"):
             for label, vals in (
                 ("damping", damping),
@@ -605,6 +675,8 @@ class _Mapper(_TreeMapper):
                 self.add_loop(e, kind, what, name, residual.get(e, 0.0))
             elif kind == "joint":
                 self.add_joint_equality(e, what, name)
+            elif kind == "tendon":
+                self.add_tendon_equality(e, what, name)
             else:
                 self.unmapped.append(f"{what}: {kind} equalities are not mapped")
 
@@ -683,6 +755,34 @@ class _Mapper(_TreeMapper):
             float(coef[1]), float(coef[0]),
         )  # fmt: skip
 
+    def add_tendon_equality(self, e: int, what: str, name: str) -> None:
+        """A ``tendon`` equality on one fixed tendon of two joints ``c1 q1 + c2 q2`` (MuJoCo:
+        ``L - L0 = a0``, L0 the length at qpos0) is the coupling ``q2 = -(c1/c2) q1 + a0/c2``
+        (the tendon's second joint follows its first); any other is listed."""
+        mj = self.mj
+        t1, t2 = int(mj.eq_obj1id[e]), int(mj.eq_obj2id[e])
+        adr, num = int(mj.tendon_adr[t1]), int(mj.tendon_num[t1])
+        wraps = range(adr, adr + num)
+        joints = [int(mj.wrap_objid[w]) for w in wraps]
+        coef = [float(mj.wrap_prm[w]) for w in wraps]
+        why = None
+        if t2 >= 0:
+            why = "between two tendons"
+        elif num != 2 or any(int(mj.wrap_type[w]) != 1 for w in wraps):  # 1: mjWRAP_JOINT
+            why = "not a fixed tendon of exactly two joints"
+        elif any(j not in self.jname for j in joints) or coef[0] == 0 or coef[1] == 0:
+            why = "a joint welded by fixed_base=True, not a hinge or slide, or a zero coef"
+        elif mj.jnt_type[joints[0]] != mj.jnt_type[joints[1]] or joints[0] == joints[1]:
+            why = "the tendon's two joints are not both hinges or both slides"
+        if why is not None:
+            self.unmapped.append(f"{what}: {why}")
+            return
+        a0 = float(mj.eq_data[e, 0])
+        self._call(
+            what, self.b.add_coupling, name, self.jname[joints[1]], self.jname[joints[0]],
+            -coef[0] / coef[1], a0 / coef[1],
+        )  # fmt: skip
+
     # -- actuators ----------------------------------------------------------------------------
     def actuators(self) -> tuple[MjcfActuator, ...]:
         mujoco, mj = self.mujoco, self.mj
@@ -723,6 +823,11 @@ class _Mapper(_TreeMapper):
     # -- what is not mapped -------------------------------------------------------------------
     def collect_unmapped(self) -> None:
         mj, u = self.mj, self.unmapped
+        if self.frictionloss:
+            u.append(
+                "frictionloss (dry friction, a constraint in MuJoCo) of joints "
+                + ", ".join(self.frictionloss)
+            )
         n_coll = int(np.count_nonzero((mj.geom_contype != 0) | (mj.geom_conaffinity != 0)))
         if n_coll or mj.npair:
             u.append(f"contacts: {n_coll} colliding geoms, {mj.npair} explicit contact pairs")
@@ -745,8 +850,6 @@ class _Mapper(_TreeMapper):
             u.append("joint actuatorfrcrange (limits on the actuators' total force)")
         if mj.opt.density or mj.opt.viscosity or np.any(mj.opt.wind != 0):
             u.append("fluid forces (option density, viscosity, wind)")
-        if np.any(mj.body_gravcomp != 0):
-            u.append("body gravcomp (gravity compensation forces)")
         for count, what in (
             (mj.nsensor, "sensors"),
             (mj.nkey, "keyframes (convert their qpos with mjcf_info(model).q_from_qpos)"),
@@ -794,6 +897,12 @@ class _Mapper(_TreeMapper):
                 if lead in dofs:
                     cols[dofs.index(lead)].append(("dof", dadr, mult, qadr))
         q_src.sort()
+        adr_of = {name: int(mj.jnt_qposadr[j]) for j, name in self.jname.items()}
+        followers = tuple(
+            (adr_of[c["follower"]], adr_of[c["leader"]], c["multiplier"], c["offset"])
+            for c in model.couplings
+            if c["follower"] in adr_of and c["leader"] in adr_of
+        )
         return MjcfInfo(
             source=recorded,
             bodies=tuple(self.bodies),
@@ -806,6 +915,7 @@ class _Mapper(_TreeMapper):
             nv_mujoco=int(mj.nv),
             _q_src=tuple(src for _, src in q_src),
             _dof_cols=tuple(tuple(c) for c in cols),
+            _followers=followers,
         )
 
 
@@ -834,7 +944,10 @@ def load_mjcf(
       inertia ``armature`` (the gear-reduced model: exactly MuJoCo's ``M + diag(armature)``);
     - ``<equality>``: ``connect`` -> a spherical joint and ``weld`` -> a fixed joint between the
       two bodies at the anchor (closing loops; they must hold at qpos0), a ``joint`` equality
-      with a linear ``polycoef`` -> ``add_coupling(name, joint1, joint2, a1, a0)``;
+      with a linear ``polycoef`` -> ``add_coupling(name, joint1, joint2, a1, a0)``, a
+      ``tendon`` equality on a fixed tendon of two joints -> a coupling likewise;
+    - ``<body gravcomp>`` -> a constant world force ``-gravcomp * mass * gravity`` at the
+      body's centre of mass (MuJoCo's gravity compensation);
     - actuators apply no force: :func:`mjcf_info` lists their transmissions and gears.
 
     ``fixed_base=True`` welds every free joint to the world at its qpos0 pose; ``False`` keeps
@@ -866,6 +979,7 @@ def load_mjcf(
     mapper.unmapped.extend(said)
     mapper.add_bodies()
     mapper.add_joints()
+    mapper.add_gravcomp()
     mapper.add_equalities()
     mapper.add_frames()
     mapper.collect_unmapped()

@@ -37,18 +37,29 @@ def refused(source, pattern, exc=ad.ModelError, **kw):
     assert mujoco.get_mju_user_warning() is before
 
 
-def test_a_good_arm_loads():
+def test_a_good_arm_loads_from_text_bytes_and_paths(tmp_path, monkeypatch):
     model = ad.load_mjcf(arm(), warn=False)
     assert model.coord_names == ["hinge"]
     assert mjcf.mjcf_info(model).unmapped == ()
+    assert mjcf.mjcf_info(model).source == arm()
+    (tmp_path / "arm.xml").write_text(arm())
+    monkeypatch.chdir(tmp_path)
+    for source in (arm().encode(), "arm.xml", tmp_path / "arm.xml"):
+        again = ad.load_mjcf(source, warn=False)
+        assert np.array_equal(again.u0, model.u0) and again.coord_names == ["hinge"]
+    assert mjcf.mjcf_info(again).source == str(tmp_path / "arm.xml")
 
 
 def test_malformed_and_truncated_xml():
     refused(
         "<mujoco><worldbody><body><joint type='hin",
-        r"MJCF string: MuJoCo refused it.*Line number=1.*joint",
+        r"MJCF string: not well-formed XML: unclosed token \(line 1, column 26\)",
     )
-    refused("<mujoco><worldbody><body></mujoco>", r"MuJoCo refused it")
+    refused("<mujoco><worldbody><body></mujoco>", r"not well-formed XML: mismatched tag")
+    refused(
+        "<mujoco><worldbody><body><joint type='bad'/></body></worldbody></mujoco>",
+        r"MuJoCo refused it: XML Error: invalid keyword: 'bad' \| Element 'joint', line 1",
+    )
     refused("<robot name='urdf'/>", r"root element is <robot>, not <mujoco>.*load_urdf")
     refused("<?xml version='1.0'?><!-- c --><mujocox/>", r"root element is <mujocox>")
     refused("<mujoco>\x00</mujoco>", r"NUL byte at offset 8")
@@ -168,3 +179,14 @@ def test_without_mujoco_the_import_error_says_how_to_install_it():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert "needs the 'mujoco' package (pip install mujoco, or armdyn[mjcf])" in out.stdout
+
+
+def test_many_attributes_doctype_and_ill_formed_xml_are_refused_before_mujoco():
+    many = " ".join(f'a{i}="1"' for i in range(40_000))
+    refused(
+        f"<mujoco><worldbody><body {many}/></worldbody></mujoco>",
+        r"element <body> on line 1 has 40000 attributes, more than the limit of 1000",
+    )
+    lol = '<!DOCTYPE m [<!ENTITY a "aaaaaaaa"><!ENTITY b "&a;&a;&a;&a;">]><mujoco model="&b;"/>'
+    refused(lol, r"has a DOCTYPE \(<!DOCTYPE m>, line 1\)")
+    refused('<mujoco model="&x;"/>', r"not well-formed XML: undefined entity \(line 1, column 1\)")

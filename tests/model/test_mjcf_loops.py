@@ -5,7 +5,8 @@
   assembled state (qpos0, at rest, gravity and a spring loading it) equal the rigid constrained
   dynamics of MuJoCo's own quantities: ``[M J'; J 0] [qacc; -f] = [qfrc_smooth; 0]`` with
   ``M = mj_fullM`` and ``J`` the equality rows of ``efc_J`` (MuJoCo itself solves them softly),
-  mapped to bodies by MuJoCo's Jacobians (``mj_jacBodyCom``).
+  mapped to bodies by MuJoCo's Jacobians (``mj_jacBodyCom``); and in motion (a velocity the
+  loops allow), with the loops' rows and their ``Jdot qvel`` from ``mj_jac`` / ``mj_jacDot``.
 - A ball joint (spherical pendulum with a hinged second link) at random states with velocity:
   ``body_accelerations`` equal MuJoCo's ``qacc`` mapped the same way (plus ``mj_jacDot``).
 - A ``<joint>`` equality with a linear polycoef is a coupling: ``mass_matrix`` and
@@ -205,3 +206,95 @@ def test_joint_equality_is_a_coupling_as_mujoco_projected():
         tau = ad.inverse_dynamics(model, q, qd, qdd)
         expect = t.T @ d.qfrc_inverse
         assert np.abs(tau - expect).max() < 1e-10 * np.abs(expect).max()
+
+
+TENDON = """
+<mujoco model="tendon">
+  <compiler angle="radian"/>
+  <worldbody>
+    <body name="l1">
+      <joint name="j1" type="hinge" axis="0 0 1" ref="0.2"/>
+      <geom type="capsule" fromto="0 0 0 0.4 0 0" size="0.03"/>
+      <body name="l2" pos="0.4 0 0">
+        <joint name="j2" type="hinge" axis="0 1 0" ref="-0.1"/>
+        <geom type="capsule" fromto="0 0 0 0.3 0 0.1" size="0.03"/>
+      </body>
+    </body>
+  </worldbody>
+  <tendon><fixed name="tie"><joint joint="j1" coef="0.7"/><joint joint="j2" coef="-0.4"/></fixed>
+  </tendon>
+  <equality><tendon name="tied" tendon1="tie" polycoef="0.05 0 0 0 0"/></equality>
+</mujoco>
+"""
+
+
+@pytest.mark.parametrize(("xml", "name"), [(COUPLED, "follow"), (TENDON, "tied")])
+def test_equality_couplings_hold_mujocos_own_constraint(xml, name):
+    """At qpos_from_q(q) for any q, MuJoCo's residual of the equality (efc_pos) is zero: the
+    coupling's multiplier and offset are MuJoCo's definition (ref, a0, the tendon's coefs)."""
+    model = load(xml)
+    assert any(c["name"] == name for c in model.couplings)
+    info = mjcf_info(model)
+    m = mujoco.MjModel.from_xml_string(xml)
+    d = mujoco.MjData(m)
+    rng = np.random.default_rng(11)
+    for _ in range(3):
+        d.qpos[:] = info.qpos_from_q(rng.uniform(-1, 1, model.n_coords))
+        mujoco.mj_forward(m, d)
+        rows = d.efc_type == int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
+        assert rows.sum() == 1 and abs(d.efc_pos[rows][0]) < 1e-14
+        # and off the coupling, MuJoCo sees the violation
+        d.qpos[1] += 0.01
+        mujoco.mj_forward(m, d)
+        rows = d.efc_type == int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
+        assert abs(d.efc_pos[rows][0]) > 1e-3
+
+
+def loop_rows(m, d):
+    """The loops' velocity rows J and their J' qvel terms, from MuJoCo's point Jacobians and
+    mj_jacDot: the connect's anchor on the coupler and on the rocker move together; the weld's
+    two bodies share a point's velocity and their angular velocity."""
+    rows, dots = [], []
+
+    def jac(body, point):
+        jp, jr, jpd, jrd = (np.zeros((3, m.nv)) for _ in range(4))
+        mujoco.mj_jac(m, d, jp, jr, point, body)
+        mujoco.mj_jacDot(m, d, jpd, jrd, point, body)
+        return jp, jr, jpd, jrd
+
+    ids = {n: m.body(n).id for n in ("coupler", "rocker", "left", "right")}
+    anchor = d.xpos[ids["coupler"]] + d.xmat[ids["coupler"]].reshape(3, 3) @ [0.6, 0, 0.1]
+    a, b = jac(ids["coupler"], anchor), jac(ids["rocker"], anchor)
+    rows.append(a[0] - b[0])
+    dots.append((a[2] - b[2]) @ d.qvel)
+    point = d.xpos[ids["right"]].copy()
+    a, b = jac(ids["left"], point), jac(ids["right"], point)
+    rows += [a[0] - b[0], a[1] - b[1]]
+    dots += [(a[2] - b[2]) @ d.qvel, (a[3] - b[3]) @ d.qvel]
+    return np.vstack(rows), np.concatenate(dots)
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_loops_in_motion_match_mujocos_rigid_dynamics(seed):
+    """At qpos0 with a random velocity that the loops allow (the null space of their rows):
+    ``[M J'; J 0] [qacc; -f] = [qfrc_smooth; -Jdot qvel]`` from MuJoCo's quantities."""
+    model = load(LOOPS)
+    m = mujoco.MjModel.from_xml_string(LOOPS)
+    d = mujoco.MjData(m)
+    mujoco.mj_forward(m, d)
+    jac, _ = loop_rows(m, d)
+    _, sing, vt = np.linalg.svd(jac)
+    null = vt[np.sum(sing > 1e-10 * sing[0]) :].T
+    assert null.shape[1] == 2  # the four-bar's and the welded pair's one dof each
+    d.qvel[:] = null @ np.random.default_rng(seed).normal(scale=5.0, size=2)
+    mujoco.mj_forward(m, d)
+    jac, dot = loop_rows(m, d)
+    assert np.abs(jac @ d.qvel).max() < 1e-13
+    full = np.zeros((m.nv, m.nv))
+    mujoco.mj_fullM(m, d, full)
+    kkt = np.block([[full, jac.T], [jac, np.zeros((len(jac), len(jac)))]])
+    qacc = np.linalg.lstsq(kkt, np.r_[d.qfrc_smooth, -dot], rcond=None)[0][: m.nv]
+    u, v, jacs = cartesian_state(model, m, d, mjcf_info(model))
+    vdot, _ = ad.body_accelerations(model, u, v)
+    expect = body_accelerations_of(m, d, jacs, qacc, model.nv)
+    assert np.abs(vdot - expect).max() < 1e-10 * np.abs(expect).max()
