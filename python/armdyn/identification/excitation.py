@@ -50,6 +50,8 @@ ACCELERATION_PER_VELOCITY = 5.0
 CHECK_PER_CYCLE = 40
 TORQUE_CHECK = 0.999
 MAX_HARMONICS = 50
+#: the exponent k of the optimiser's smooth surrogate of log cond (:meth:`_Problem.surrogate`)
+SMOOTHING = 20.0
 
 
 def _single_blas_thread(fn):
@@ -188,6 +190,7 @@ class _Problem:
         self.torque_times = self.times
         self.scale = _column_scale(model, base)
         self.evaluations = 0
+        self._maps = {}
         # the decision variables in units of what each joint allows (a finger's centimetres and
         # a shoulder's radians alike O(1)): a coefficient by the largest first-harmonic one
         # its position room, velocity and acceleration limits allow, q0 by half its range
@@ -227,6 +230,97 @@ class _Problem:
         self.evaluations += 1
         return np.log(_cond(self, *self.unpack(x), self.times))
 
+    def maps(self, t):
+        """The states are affine in x: (Jq, Jqd, Jqdd), each (len(t), n, len(x)), the
+        derivatives of q, qd, qdd at the times t (exact: differences of unit vectors)."""
+        key = ("states", t.size, float(t[-1]) if t.size else 0.0)
+        if key not in self._maps:
+            dim = self.xscale.size
+            zero = self.states(*self.unpack(np.zeros(dim)), t)
+            cols = [np.empty((t.size, self.n, dim)) for _ in range(3)]
+            for i in range(dim):
+                unit = np.zeros(dim)
+                unit[i] = 1.0
+                for col, s, s0 in zip(cols, self.states(*self.unpack(unit), t), zero, strict=True):
+                    col[:, :, i] = s - s0
+            self._maps[key] = cols
+        return self._maps[key]
+
+    def coefficient_maps(self):
+        """(Uq0, Ua, Ub): q0 (n, len(x)), a and b (n, h, len(x)) are linear in x."""
+        if "coefficients" not in self._maps:
+            dim = self.xscale.size
+            q00, a0, b0 = self.unpack(np.zeros(dim))
+            uq = np.zeros((self.n, dim))
+            ua, ub = np.zeros((self.n, self.h, dim)), np.zeros((self.n, self.h, dim))
+            for i in range(dim):
+                unit = np.zeros(dim)
+                unit[i] = 1.0
+                q0, a, b = self.unpack(unit)
+                uq[:, i], ua[:, :, i], ub[:, :, i] = q0 - q00, a - a0, b - b0
+            self._maps["coefficients"] = (uq, ua, ub)
+        return self._maps["coefficients"]
+
+    def surrogate(self, x):
+        """The smooth surrogate of log cond the optimiser follows and its gradient in x:
+        ``(log sum s_i^k + log sum s_i^-k) / k`` over the singular values s_i of the scaled
+        stacked base regressor Z (k = :data:`SMOOTHING`; it bounds log cond from above, within
+        ``2 log(rank) / k``). Its differential is ``<Z M, dZ>`` with ``M = V diag(c) V^T``
+        (V, the eigenvectors of Z^T Z); dZ by the chain rule through the states: Y's
+        derivatives in each joint's q and qd (central differences of step 1e-6) and qdd (Y is
+        linear in it: one difference), then the Fourier series' exact derivatives in x
+        (:meth:`maps`)."""
+        self.evaluations += 1
+        q, qd, qdd = self.states(*self.unpack(x), self.times)
+        z = self._z(q, qd, qdd)
+        flat = z.reshape(-1, self.base.rank)
+        lam, v = np.linalg.eigh(flat.T @ flat)
+        lam = np.maximum(lam, 1e-300 + 1e-24 * lam[-1])
+        logs = 0.5 * np.log(lam)
+        k = SMOOTHING
+        up, down = k * logs, -k * logs
+        wu, wd = np.exp(up - up.max()), np.exp(down - down.max())
+        f = (up.max() + np.log(wu.sum()) + down.max() + np.log(wd.sum())) / k
+        c = (wu / wu.sum() - wd / wd.sum()) / (2.0 * lam)  # df/dlam_i
+        adj = 2.0 * (z @ ((v * c) @ v.T))  # df/dZ: (S, n, p)
+        grads = self._state_gradients(q, qd, qdd, z, adj)
+        jac = self.maps(self.times)
+        grad = sum(np.einsum("kj,kjd->d", g, m) for g, m in zip(grads, jac, strict=True))
+        return f, grad
+
+    def _z(self, q, qd, qdd):
+        y = _core.joint_torque_regressor(self.model, q, qd, qdd)
+        return y[..., self.base.independent] / self.scale
+
+    def _state_gradients(self, q, qd, qdd, z, adj):
+        """(gq, gqd, gqdd), each (S, n): the objective's derivative in each sample's state."""
+        s, n = q.shape
+        step = 1e-6
+        eye = np.eye(n)
+        # one batch: per joint q +- step, qd +- step, qdd + 1
+        qs = np.concatenate([q + step * eye[j] * sign for j in range(n) for sign in (1, -1)])
+        rows = [
+            (qs, np.tile(qd, (2 * n, 1)), np.tile(qdd, (2 * n, 1))),
+            (
+                np.tile(q, (2 * n, 1)),
+                np.concatenate([qd + step * eye[j] * sign for j in range(n) for sign in (1, -1)]),
+                np.tile(qdd, (2 * n, 1)),
+            ),
+            (
+                np.tile(q, (n, 1)),
+                np.tile(qd, (n, 1)),
+                np.concatenate([qdd + eye[j] for j in range(n)]),
+            ),
+        ]
+        big = self._z(*(np.concatenate(parts) for parts in zip(*rows, strict=True)))
+        zq = big[: 2 * n * s].reshape(n, 2, s, n, -1)
+        zd = big[2 * n * s : 4 * n * s].reshape(n, 2, s, n, -1)
+        za = big[4 * n * s :].reshape(n, s, n, -1)
+        dq = (zq[:, 0] - zq[:, 1]) / (2.0 * step)
+        dqd = (zd[:, 0] - zd[:, 1]) / (2.0 * step)
+        dqdd = za - z
+        return tuple(np.einsum("knp,jknp->kj", adj, d) for d in (dq, dqd, dqdd))
+
     def bounds(self, q0, a, b):
         """Analytic bounds over all t: |q - q0|, |qd|, |qdd| per joint (amplitude sums)."""
         amp = np.sqrt(a**2 + b**2 + 1e-30)
@@ -257,6 +351,43 @@ class _Problem:
                 (1.0 - np.abs(tau[:, limited]) / (TORQUE_MARGIN * lim.torque[limited])).ravel()
             )
         return np.concatenate(g)
+
+    def constraints_jacobian(self, x):
+        """The derivative of :meth:`constraints` in x: the amplitude bounds' analytically
+        (``d|c_l| = (a_l da_l + b_l db_l) / |c_l|``), the torques' by the chain rule through
+        the states (:func:`armdyn.inverse_dynamics_derivatives`; the mass matrix for qdd, from
+        one difference: tau is linear in qdd) and the series' exact derivatives in x."""
+        q0, a, b = self.unpack(x)
+        uq, ua, ub = self.coefficient_maps()
+        amp = np.sqrt(a**2 + b**2 + 1e-30)
+        damp = (a[:, :, None] * ua + b[:, :, None] * ub) / amp[:, :, None]  # (n, h, dim)
+        lw = self.wf * self.harm
+        dpos = np.einsum("jhd,h->jd", damp, 1.0 / lw)
+        lim = self.limits
+        both = np.isfinite(lim.upper) & np.isfinite(lim.lower)
+        room = np.where(both, np.maximum(lim.upper - lim.lower, 1e-9), 1.0)[:, None]
+        rows = [
+            np.where(np.isfinite(lim.upper)[:, None], (-uq - dpos) / room, 0.0),
+            np.where(np.isfinite(lim.lower)[:, None], (uq - dpos) / room, 0.0),
+            -damp.sum(axis=1) / lim.velocity[:, None],
+            -np.einsum("jhd,h->jd", damp, lw) / lim.acceleration[:, None],
+        ]
+        limited = np.isfinite(lim.torque)
+        if limited.any():
+            t = self.torque_times
+            q, qd, qdd = self.states(q0, a, b, t)
+            tau = _core.inverse_dynamics(self.model, q, qd, qdd)
+            dq, dqd = _core.inverse_dynamics_derivatives(self.model, q, qd, qdd)
+            jq, jqd, jqdd = self.maps(t)
+            dtau = np.einsum("kij,kjd->kid", dq, jq) + np.einsum("kij,kjd->kid", dqd, jqd)
+            for j in range(self.n):  # + M jqdd, M's column j = tau(qdd + e_j) - tau
+                step = np.zeros(self.n)
+                step[j] = 1.0
+                col = _core.inverse_dynamics(self.model, q, qd, qdd + step) - tau
+                dtau += col[:, :, None] * jqdd[:, j, None, :]
+            scale = np.sign(tau[:, limited]) / (TORQUE_MARGIN * lim.torque[limited])
+            rows.append((-scale[:, :, None] * dtau[:, limited, :]).reshape(-1, x.size))
+        return np.vstack(rows)
 
 
 def _column_scale(model, base):
@@ -516,11 +647,18 @@ def _optimise(problem, start, maxiter):
                     kept.update(x=np.array(xk), f=f)
 
         res = scipy.optimize.minimize(
-            problem.log_cond,
+            problem.surrogate,
             x,
+            jac=True,
             method="SLSQP",
-            constraints=[{"type": "ineq", "fun": problem.constraints}],
-            options={"maxiter": maxiter, "ftol": 1e-6},
+            constraints=[
+                {
+                    "type": "ineq",
+                    "fun": problem.constraints,
+                    "jac": problem.constraints_jacobian,
+                }
+            ],
+            options={"maxiter": maxiter, "ftol": 1e-9},
             callback=keep,
         )
         iterations += int(res.nit)
