@@ -231,3 +231,37 @@ def test_panda_with_a_coupled_finger():
     exc = fourier_excitation(model, position_margin=margin, maxiter=15, starts=1, **SMALL)
     assert exc.info["optimised"] and exc.cond < exc.info["start_conds"][0]
     _check_limits(model, exc, np.asarray(model.coord_effort_limit), margin=np.array(margin))
+
+
+@needs_robots
+def test_objective_and_constraint_gradients_match_finite_differences():
+    """The optimiser's gradients (chain rule through the regressor's state derivatives and the
+    series' exact maps; the constraints' through inverse_dynamics_derivatives) against central
+    differences of the objective and the constraints themselves, along random directions, at a
+    random feasible start whose samples avoid t = 0 (where qd = 0 up to round-off would put
+    the smoothed Coulomb column's steep slope into the differences)."""
+    from armdyn.identification import excitation as ex
+
+    model = _ur5()
+    limits = {
+        "max_velocity": None,
+        "max_acceleration": None,
+        "max_torque": TORQUES,
+        "position_margin": 0.05,
+    }
+    problem = ex._setup("t", model, 10.0, 3, None, limits, None, 40, True, "scaled")
+    problem.times = problem.times + 0.05
+    x = problem.pack(*ex._random_start(problem, np.random.default_rng(1)))
+    f, grad = problem.surrogate(x)
+    # the surrogate bounds log cond from above, within 2 log(rank) / SMOOTHING
+    log_cond = problem.log_cond(x)
+    assert log_cond <= f <= log_cond + 2 * np.log(problem.base.rank) / ex.SMOOTHING
+    jac = problem.constraints_jacobian(x)
+    rng = np.random.default_rng(2)
+    h = 1e-6
+    for _ in range(3):
+        d = rng.normal(size=x.size)
+        fd = (problem.surrogate(x + h * d)[0] - problem.surrogate(x - h * d)[0]) / (2 * h)
+        assert grad @ d == pytest.approx(fd, rel=1e-5, abs=1e-6)
+        cfd = (problem.constraints(x + h * d) - problem.constraints(x - h * d)) / (2 * h)
+        np.testing.assert_allclose(jac @ d, cfd, rtol=0, atol=1e-6 * np.abs(cfd).max())

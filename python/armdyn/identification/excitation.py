@@ -50,6 +50,9 @@ ACCELERATION_PER_VELOCITY = 5.0
 CHECK_PER_CYCLE = 40
 TORQUE_CHECK = 0.999
 MAX_HARMONICS = 50
+#: the condition numbers fourier_excitation can minimise: "scaled" (each base regressor column
+#: divided by its RMS over random states) or "raw" (the base regressor as it is, SI units)
+CRITERIA = ("scaled", "raw")
 #: the exponent k of the optimiser's smooth surrogate of log cond (:meth:`_Problem.surrogate`)
 SMOOTHING = 20.0
 
@@ -188,6 +191,7 @@ class _Problem:
         self.fixed_q0 = q0
         self.times = period * np.arange(samples) / samples
         self.torque_times = self.times
+        self.criterion = "scaled"
         self.scale = _column_scale(model, base)
         self.evaluations = 0
         self._maps = {}
@@ -525,7 +529,7 @@ def _limits(who, model, max_velocity, max_acceleration, max_torque, margin):
     return _Limits(lower, upper, vel, acc, tau)
 
 
-def _setup(who, model, period, harmonics, q0, limits, base, samples, at_rest):
+def _setup(who, model, period, harmonics, q0, limits, base, samples, at_rest, criterion):
     """Check the model and arguments; the design problem."""
     if not isinstance(model, _core.Model):
         raise _core.ModelError(f"{who}: model must be an armdyn.Model, got {type(model).__name__}")
@@ -567,6 +571,9 @@ def _setup(who, model, period, harmonics, q0, limits, base, samples, at_rest):
                 )
     problem = _Problem(model, base, period, harmonics, q0, lim, samples, at_rest)
     problem.who = who
+    problem.criterion = _checks.choice(who, "criterion", criterion, CRITERIA)
+    if problem.criterion == "raw":
+        problem.scale = np.ones(base.rank)
     return problem
 
 
@@ -703,7 +710,12 @@ def _info(problem, samples):
             "acceleration": lim.acceleration.copy(),
             "torque": lim.torque.copy(),
         },
-        "cond_scaling": "columns divided by their RMS over 200 random states",
+        "criterion": problem.criterion,
+        "cond_scaling": (
+            "columns divided by their RMS over 200 random states"
+            if problem.criterion == "scaled"
+            else "none (the base regressor in SI units)"
+        ),
     }
 
 
@@ -724,6 +736,7 @@ def fourier_excitation(
     maxiter: int = 100,
     starts: int = 3,
     at_rest: bool = True,
+    criterion: str = "scaled",
 ) -> Excitation:
     """The periodic excitation (finite Fourier series per joint, :func:`fourier_series`) that
     minimises the condition number of the stacked base regressor, within the limits.
@@ -789,7 +802,7 @@ def fourier_excitation(
         "max_torque": max_torque,
         "position_margin": position_margin,
     }
-    problem = _setup(who, model, period, harmonics, q0, limits, base, samples, at_rest)
+    problem = _setup(who, model, period, harmonics, q0, limits, base, samples, at_rest, criterion)
     seed = _checks.integer(who, "seed", seed, lo=0, hi=2**63 - 1)
     maxiter = _checks.integer(who, "maxiter", maxiter, lo=1, hi=100_000)
     starts = _checks.integer(who, "starts", starts, lo=1, hi=1000)
@@ -837,6 +850,7 @@ def random_fourier(
     samples: int = 100,
     at_rest: bool = True,
     scaling: str = "joint",
+    criterion: str = "scaled",
 ) -> Excitation:
     """A random Fourier excitation within the same limits as :func:`fourier_excitation` (the
     comparison, and its starting points): standard normal coefficients (with ``at_rest``, the
@@ -854,7 +868,7 @@ def random_fourier(
         "max_torque": max_torque,
         "position_margin": position_margin,
     }
-    problem = _setup(who, model, period, harmonics, q0, limits, base, samples, at_rest)
+    problem = _setup(who, model, period, harmonics, q0, limits, base, samples, at_rest, criterion)
     seed = _checks.integer(who, "seed", seed, lo=0, hi=2**63 - 1)
     scaling = _checks.choice(who, "scaling", scaling, ("joint", "common"))
     start = _random_start(problem, np.random.default_rng(seed), per_joint=scaling == "joint")
