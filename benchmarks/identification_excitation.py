@@ -11,8 +11,9 @@ iterations, objective evaluations and time.
 The three condition numbers of the stacked base regressor over one period (``samples`` equally
 spaced times):
 
-- ``scaled``: each column divided by its RMS over 200 random states (fourier_excitation's
-  default criterion: unit-free, fixed per model);
+- ``scaled``: each column divided by its RMS over 200 random states within the limits
+  (fourier_excitation's default criterion: fixed per model and limits, independent of each
+  joint's units);
 - ``raw``: the base regressor as it is, in SI units (what the literature reports: Swevers et al.
   1997, Gautier and Khalil, Presse and Gautier; it changes with the units);
 - ``equilibrated``: each column divided by its own norm over this motion (unit-free and within
@@ -42,7 +43,6 @@ import time
 import armdyn as ad
 import numpy as np
 from armdyn.identification import base_parameters, fourier_excitation, random_fourier
-from armdyn.identification.base import random_states
 
 from benchmarks import common
 
@@ -58,15 +58,27 @@ def _timed(fn):
     return out, time.perf_counter() - wall, time.process_time() - cpu
 
 
+def limit_scale(model, base, limits) -> np.ndarray:
+    """The "scaled" criterion's column scale, recomputed: each base regressor column's RMS over
+    200 random states within the limits (seed 0; q, qd, qdd uniform within the position limits
+    minus the margin, +-velocity, +-acceleration; every joint of these robots has finite
+    position limits)."""
+    rng = np.random.default_rng(0)
+    q = rng.uniform(limits["lower"], limits["upper"], size=(200, model.n_dofs))
+    qd = rng.uniform(-1.0, 1.0, size=(200, model.n_dofs)) * limits["velocity"]
+    qdd = rng.uniform(-1.0, 1.0, size=(200, model.n_dofs)) * limits["acceleration"]
+    yr = base.regressor(ad.joint_torque_regressor(model, q, qd, qdd)).reshape(-1, base.rank)
+    return np.sqrt(np.mean(yr**2, axis=0))
+
+
 def conds(model, base, motion, samples: int) -> dict[str, float]:
     """The three condition numbers of ``motion``'s stacked base regressor (see the module)."""
     t = motion.period * np.arange(samples) / samples
     y = base.regressor(ad.joint_torque_regressor(model, *motion.evaluate(t)))
     y = y.reshape(-1, base.rank)
-    q, qd, qdd = random_states(model, 200, np.random.default_rng(0))
-    yr = base.regressor(ad.joint_torque_regressor(model, q, qd, qdd)).reshape(-1, base.rank)
+    scale = limit_scale(model, base, motion.info["limits"])
     return {
-        "scaled": float(np.linalg.cond(y / np.sqrt(np.mean(yr**2, axis=0)))),
+        "scaled": float(np.linalg.cond(y / scale)),
         "raw": float(np.linalg.cond(y)),
         "equilibrated": float(np.linalg.cond(y / np.linalg.norm(y, axis=0))),
     }

@@ -11,7 +11,6 @@ from armdyn.identification import (
     fourier_series,
     random_fourier,
 )
-from armdyn.identification.base import random_states
 
 from benchmarks import common
 
@@ -83,7 +82,13 @@ def test_design_beats_random_fourier(ur5_design):
     # the cond is the documented one: an independent recomputation
     t = design.period * np.arange(40) / 40
     y = base.regressor(ad.joint_torque_regressor(model, *design.evaluate(t))).reshape(-1, base.rank)
-    q, qd, qdd = random_states(model, 200, np.random.default_rng(0))
+    rng = np.random.default_rng(0)  # 200 states within the limits (5 / s x velocity)
+    lower = np.asarray(model.coord_lower) + 0.05
+    upper = np.asarray(model.coord_upper) - 0.05
+    vel = np.asarray(model.coord_velocity_limit)
+    q = rng.uniform(lower, upper, size=(200, 6))
+    qd = rng.uniform(-1.0, 1.0, size=(200, 6)) * vel
+    qdd = rng.uniform(-1.0, 1.0, size=(200, 6)) * 5.0 * vel
     yr = base.regressor(ad.joint_torque_regressor(model, q, qd, qdd)).reshape(-1, base.rank)
     scaled = y / np.sqrt((yr**2).mean(axis=0))
     assert design.cond == pytest.approx(np.linalg.cond(scaled), rel=1e-9)
@@ -158,6 +163,7 @@ def test_starts_and_ends_at_rest_and_csv(ur5_design, tmp_path):
         ({"position_margin": -0.1}, ad.ModelError, "position_margin must be"),
         ({"position_margin": [0.1, 0.1]}, ad.ModelError, "position_margin must be"),
         ({"q0": [0, 0, 3.2, 0, 0, 0]}, ad.SolverError, "q0.*'elbow_joint'"),
+        ({"criterion": "log-det"}, ad.ModelError, "criterion"),
         (
             {"max_torque": [150, 10, 150, 28, 28, 28]},
             ad.SolverError,

@@ -34,7 +34,6 @@ from armdyn.identification.base import (
     BaseParameters,
     base_parameters,
     one_blas_thread,
-    random_states,
 )
 from armdyn.motion.trajectory import Trajectory
 
@@ -110,7 +109,7 @@ class Excitation:
         period: [s]; q0: (n,) the offsets; a, b: (n, harmonics) the coefficients
             (:func:`fourier_series`).
         cond: the condition number of the stacked base regressor over one period (its columns
-            scaled as :func:`fourier_excitation` says).
+            scaled or not by ``info["criterion"]``, as :func:`fourier_excitation` says).
         base: the base parameters it was designed for.
         joint_names: the model's coordinate names (the CSV's columns).
         info: what the design reports: the limits, the samples, the random starts' and the
@@ -192,7 +191,7 @@ class _Problem:
         self.times = period * np.arange(samples) / samples
         self.torque_times = self.times
         self.criterion = "scaled"
-        self.scale = _column_scale(model, base)
+        self.scale = _column_scale(model, base, limits)
         self.evaluations = 0
         self._maps = {}
         # the decision variables in units of what each joint allows (a finger's centimetres and
@@ -394,10 +393,19 @@ class _Problem:
         return np.vstack(rows)
 
 
-def _column_scale(model, base):
-    """The RMS of each base regressor column over 200 random states (seed 0, the distribution
-    base_parameters samples): a fixed, unit-carrying scale per column."""
-    q, qd, qdd = random_states(model, 200, np.random.default_rng(0))
+def _column_scale(model, base, limits):
+    """The RMS of each base regressor column over 200 random states within the limits (seed 0):
+    positions uniform within the position limits minus the margin ([-pi, pi] where one is
+    infinite), velocities and accelerations uniform within +-max_velocity and
+    +-max_acceleration: a fixed scale per column, independent of each joint's units."""
+    rng = np.random.default_rng(0)
+    finite = np.isfinite(limits.lower) & np.isfinite(limits.upper)
+    lo = np.where(finite, limits.lower, -np.pi)
+    hi = np.where(finite, limits.upper, np.pi)
+    count = 200
+    q = rng.uniform(lo, hi, size=(count, lo.size))
+    qd = rng.uniform(-1.0, 1.0, size=(count, lo.size)) * limits.velocity
+    qdd = rng.uniform(-1.0, 1.0, size=(count, lo.size)) * limits.acceleration
     y = base.regressor(_core.joint_torque_regressor(model, q, qd, qdd))
     return np.sqrt(np.mean(y.reshape(-1, base.rank) ** 2, axis=0))
 
@@ -712,7 +720,7 @@ def _info(problem, samples):
         },
         "criterion": problem.criterion,
         "cond_scaling": (
-            "columns divided by their RMS over 200 random states"
+            "columns divided by their RMS over 200 random states within the limits"
             if problem.criterion == "scaled"
             else "none (the base regressor in SI units)"
         ),
@@ -741,20 +749,32 @@ def fourier_excitation(
     """The periodic excitation (finite Fourier series per joint, :func:`fourier_series`) that
     minimises the condition number of the stacked base regressor, within the limits.
 
-    The condition number is that of ``Y_b`` stacked over ``samples`` equally spaced times of one
-    period, each column divided by a fixed scale: its RMS over 200 random states within the
-    limits (:func:`armdyn.identification.base.random_states`, seed 0). The raw ``cond(Y_b)``
-    depends on the units (a mass column in N/kg against an inertia column in 1/s^2: metres to
-    millimetres changes it) and scaling by the nominal parameters fails where they are zero (a
-    URDF has no friction or offsets); scaling each column by the motion's own column norm would
-    hide a parameter the motion leaves unexcited. A fixed scale per column keeps the criterion
-    unit-free and still rewards exciting every column.
+    The condition number (``criterion``) is that of ``Y_b`` stacked over ``samples`` equally
+    spaced times of one period, with ``"scaled"`` (the default) each column divided by a fixed
+    scale: its RMS over 200 random states within the limits (seed 0: positions uniform within
+    the position limits minus the margin, velocities and accelerations uniform within
+    +-``max_velocity`` and +-``max_acceleration``). ``"raw"``: ``cond(Y_b)`` as it is, in SI
+    units, the figure the literature reports (Swevers et al. 1997; Gautier and Khalil; Presse
+    and Gautier); it depends on the units (a mass column in N/kg against an inertia column in
+    1/s^2: metres to millimetres changes it).
+    Scaling by the nominal parameters fails where they are zero (a URDF has no friction or
+    offsets), and scaling each column by the motion's own norm (equilibration) measures only
+    the columns' collinearity, not how strongly the motion excites each: a fixed scale per
+    column from what the limits allow keeps the criterion independent of each joint's units (a
+    finger's m/s and a shoulder's rad/s) and still rewards exciting every column.
 
-    SLSQP (scipy; gradients by finite differences) minimises ``log cond`` from ``starts``
-    feasible random starts (:func:`random_fourier` with per-joint scaling, seeds ``seed``,
-    ``seed + 1``, ...), the best result kept; the variables are scaled per joint by what its
-    limits allow, so a gripper's centimetres and a shoulder's radians weigh alike. The
-    constraints: ``|q - q0| <= sum_l |c_l| / (w_f l)``, ``|qd| <= sum_l |c_l|`` and
+    SLSQP (scipy) minimises a smooth upper bound of ``log cond``,
+    ``(log sum s_i^k + log sum s_i^-k) / k`` over the singular values (k =
+    :data:`SMOOTHING`, 20: within ``2 log(rank) / k`` of it; log cond itself is not
+    differentiable where the smallest singular values meet, and the optimum gathers them), with
+    its gradient by the chain rule: the eigenvectors of ``Y_b^T Y_b``, the regressor's
+    derivatives in each joint's q, qd (central differences) and qdd (exact), the series' exact
+    derivatives in the coefficients; the constraints' Jacobian analytically (the torques' by
+    :func:`armdyn.inverse_dynamics_derivatives`). From ``starts`` feasible random starts
+    (:func:`random_fourier` with per-joint scaling, seeds ``seed``, ``seed + 1``, ...), the
+    lowest condition number kept; the variables are scaled per joint by what its limits allow,
+    so a gripper's centimetres and a shoulder's radians weigh alike. The constraints:
+    ``|q - q0| <= sum_l |c_l| / (w_f l)``, ``|qd| <= sum_l |c_l|`` and
     ``|qdd| <= sum_l w_f l |c_l|`` (``|c_l| = sqrt(a_l^2 + b_l^2)``; conservative bounds for all
     t) within the position limits minus ``position_margin``, ``max_velocity`` and
     ``max_acceleration``; the inverse-dynamics torques at the samples within
@@ -780,6 +800,7 @@ def fourier_excitation(
         seed: the first random start's seed; samples: times per period in the condition number
             and the torque constraints; maxiter: SLSQP iterations per start; starts: how many.
         at_rest: start (and end every period) at rest: qd = qdd = 0 at t = 0.
+        criterion: ``"scaled"`` or ``"raw"`` (above).
 
     Raises:
         ModelError: a bad argument, a floating base, a model without joints.
@@ -859,8 +880,9 @@ def random_fourier(
     torques hold on the check grid; ``q0`` mid-range unless given. ``scaling="joint"`` scales
     each joint's coefficients to its own limits (the stronger baseline, and the optimiser's
     starts); ``"common"`` scales all by one factor, until the first limit binds (the other
-    joints then move less). ``cond`` as :func:`fourier_excitation` computes it. Same arguments
-    and errors (``scaling`` neither: ModelError)."""
+    joints then move less). ``cond`` as :func:`fourier_excitation` computes it (by
+    ``criterion``). Same arguments and errors (``scaling`` or ``criterion`` neither:
+    ModelError)."""
     who = "random_fourier"
     limits = {
         "max_velocity": max_velocity,
