@@ -62,23 +62,27 @@ def test_fourier_series_closed_form_and_derivatives():
 
 @needs_robots
 def test_design_beats_random_fourier(ur5_design):
-    """The designed motion's condition number against random Fourier motions within the same
-    limits (3 seeds each, both scalings): lower than all, and half the median and the start or
-    less. Measured with the same sizes but the UR5's own torque limits and random seeds 100-104
-    (python -m benchmarks.identification_excitation --quick): cond 9.6 (a 40-iteration design
-    is not converged: other round-off, e.g. threaded BLAS, ends elsewhere), 2.7-3.4x below the
-    per-joint scaled random motions, 4.8-143x below the common-scaled ones: the issue's 10x is
-    not met against the per-joint baseline (see fourier_excitation's docstring)."""
+    """The designed motion's condition number against 20 random Fourier motions within the
+    same limits per scaling (seeds 10-29): 1.5x below every one, 2.5x below the per-joint median
+    and 10x below the common-scaled median (margins: a 40-iteration design is not converged,
+    other round-off ends elsewhere). Measured (this small design: 3 harmonics, 40 samples,
+    one start of 40 iterations, tighter torques): cond 16.9 against 36-338 per joint (2.2x
+    below the best, 3.4x below the median) and 69-1457 common (4.1x, 16.8x): the issue's 10x
+    is not met on the UR5 against the per-joint baseline (docs/identification.md says why)."""
     model, base, design = ur5_design
     assert design.info["optimised"]
     assert design.cond < design.info["start_conds"][0]
-    rand = [
-        random_fourier(model, base=base, max_torque=TORQUES, seed=s, scaling=sc, **SMALL).cond
-        for s in (10, 11, 12)
-        for sc in ("joint", "common")
-    ]
-    assert design.cond < min(rand)
-    assert design.cond * 2.0 < min(np.median(rand), design.info["start_conds"][0])
+    for scaling, median in (("joint", 2.5), ("common", 10.0)):
+        rand = np.array(
+            [
+                random_fourier(
+                    model, base=base, max_torque=TORQUES, seed=s, scaling=scaling, **SMALL
+                ).cond
+                for s in range(10, 30)
+            ]
+        )
+        assert design.cond * 1.5 < rand.min()
+        assert design.cond * median < np.median(rand)
     # the cond is the documented one: an independent recomputation
     t = design.period * np.arange(40) / 40
     y = base.regressor(ad.joint_torque_regressor(model, *design.evaluate(t))).reshape(-1, base.rank)

@@ -806,15 +806,14 @@ def fourier_excitation(
         ModelError: a bad argument, a floating base, a model without joints.
         SolverError: limits no motion can meet (naming the limit and the joint).
 
-    Runtime and result on the UR5 with its own limits, period 10 s
-    (``python -m benchmarks.identification_excitation``,
-    benchmarks/results/identification_excitation.json): the defaults (5 harmonics, 100
-    samples, 3 starts of 100 SLSQP iterations, ~17,600 condition numbers) take 36 s of CPU
-    (111 s wall on the shared 2-core machine) and reach cond 6.1, against 12-41 for random
-    motions scaled per joint (1.9-6.6x higher) and 25-68 for random motions scaled by one
-    common factor (4.0-11x), 5 seeds each: the issue's 10x holds only against part of the
-    common-scaled ones. ``--quick`` (3 harmonics, 40 samples, 1 start of 40 iterations, as the
-    tests): 1.9 s CPU, cond 9.6, 2.7-3.4x below per-joint random, 4.8-143x below common.
+    Runtime and result with the robots' own limits, period 10 s, the defaults (5 harmonics, 100
+    samples, 3 starts of 100 SLSQP iterations; ``python -m
+    benchmarks.identification_excitation --seeds 20``,
+    benchmarks/results/identification_excitation.json; CPU time on the shared 2-core machine):
+    the UR5, 23 s CPU, cond 9.3 against 25-117 (median 39) for 20 random motions scaled per
+    joint: 2.7x below the best draw, 4.1x below the median; the Panda, 44 s CPU, cond 49.7
+    against 680-3504 (median 1236): 13.7x and 24.9x. The UR5's random motions are already well
+    conditioned (docs/identification.md, "Excitation", says why the 10x cannot hold there).
     """
     who = "fourier_excitation"
     limits = {
