@@ -1696,6 +1696,16 @@ CASES = [
         "period must be a positive number",
     ),
     (
+        "excitation-unknown-criterion",
+        "identification",
+        "fourier_excitation with a criterion it does not know",
+        lambda: _identification().fourier_excitation(
+            _pendulum(), max_velocity=1.0, criterion="log-det"
+        ),
+        ME,
+        "criterion",
+    ),
+    (
         "excitation-torque-infeasible",
         "identification",
         "fourier_excitation whose torque limit is below the gravity torque at q0",
