@@ -174,13 +174,15 @@ void set_independent(Model& m, const std::vector<int>& chosen) {
 
 void choose_loop_coordinates(Model& m) {
   m.loop_coordinates = false;
-  const bool loops = !m.is_tree || has_ideal_gear(m);
-  if (!loops) {
+  // a tree with ideal gears keeps every coordinate (its joint-space simulation, TreeDynamics,
+  // takes them all): the joint-level functions take loop models
+  if (m.is_tree) {
     if (!m.independent_request.empty())
-      throw ModelError(
-          "finalize: set_independent_coordinates applies to models with closed loops or ideal "
-          "gears; this model is a tree (its joint coordinates are independent; a coupling's "
-          "follower is dependent by construction)");
+      throw ModelError(msg(
+          "finalize: set_independent_coordinates applies to models with closed loops; this model "
+          "is a tree (its joint coordinates are independent; a coupling's follower is dependent "
+          "by construction", has_ideal_gear(m) ? "; an ideal gear's tree is simulated in all its "
+          "coordinates" : "", ")"));
     return;
   }
   if (m.n_free > 0) {
