@@ -181,8 +181,11 @@ void choose_loop_coordinates(Model& m) {
       throw ModelError(msg(
           "finalize: set_independent_coordinates applies to models with closed loops; this model "
           "is a tree (its joint coordinates are independent; a coupling's follower is dependent "
-          "by construction", has_ideal_gear(m) ? "; an ideal gear's tree is simulated in all its "
-          "coordinates" : "", ")"));
+          "by construction",
+          has_ideal_gear(m) ? "; an ideal gear's tree is simulated in all its "
+                              "coordinates"
+                            : "",
+          ")"));
     return;
   }
   if (m.n_free > 0) {
@@ -242,6 +245,9 @@ LoopWork::LoopWork(const Model& m) {
   dd = std::make_unique<Data>(*driven);
   ref = VecX::Zero(3 * n);
   dd->ce.drive_ref = ref.data();
+  // positions to round-off (one Newton step past the pipeline's 1e-13): the results then do not
+  // depend on the state Newton started from (the Data's history)
+  dd->tol_f = 1e-15 * std::max(1.0, m.length_scale);
   for (VecX* x : {&u, &u_start, &u_save, &u_pred, &u_step, &ud}) *x = VecX::Zero(m.nq);
   for (VecX* x : {&v, &vd, &v_start, &v_save, &zero_v}) *x = VecX::Zero(m.nv);
   for (VecX* x : {&q_last, &q_from, &dq, &out, &qs, &unit, &zero_n}) *x = VecX::Zero(n);

@@ -560,6 +560,10 @@ class ModelBuilder:
         """
         Validate, analyse topology and rank, assemble; returns an immutable Model.
         """
+    def set_independent_coordinates(self, names: typing.Any) -> None:
+        """
+        The independent coordinates of a model with closed loops or ideal gears: names from joint_coord_names, as many as the model's mobility, in the order q, qd, qdd and tau take them. finalize() checks them (ModelError naming an unknown or repeated name, a wrong count, a coordinate the others determine at the assembled state, or a tree). An empty list restores armdyn's default: the joint coordinates in model order, each taken when independent of those taken before (add the actuated joints first).
+        """
     def set_joint_limits(self, joint: str, lower: typing.SupportsFloat | typing.SupportsIndex, upper: typing.SupportsFloat | typing.SupportsIndex, effort: typing.SupportsFloat | typing.SupportsIndex = 0.0, velocity: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> None:
         """
         Set a joint's limits (of its first coordinate): position lower <= q <= upper [rad or m] (stops enforced by simulate(limits=True)), effort [N m or N] and velocity [rad/s or m/s] (informative, 0 = none; read by the sizing). ModelError on an unknown joint, lower > upper, NaN, or negative effort/velocity.
