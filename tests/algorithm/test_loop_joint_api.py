@@ -450,3 +450,57 @@ def test_trajectory_run_and_sizing_of_a_loop_mechanism(crank_motion):
     rep = ad.sizing_report(run)
     assert list(rep.table.index) == ["A"]
     assert abs(rep.table.loc["A", "peak_torque"] - np.max(np.abs(res.drive_forces[:, 0]))) < 1e-9
+
+
+def _geared_four_bar(drive=None):
+    """The four-bar's crank turned by a pinion through an ideal gear (pitch radii 0.05 and
+    0.15: q_A = -q_P / 3), the pinion's angle the independent coordinate."""
+    bld = four_bar_builder()
+    bld.add_body("pinion", 0.5, [1e-3, 1e-3, 2e-3], position=(-0.2, 0.0, 0.0))
+    bld.add_revolute("P", "ground", "pinion", point=(-0.2, 0.0, 0.0), axis=(0, 0, 1))
+    bld.add_gear("mesh", "P", "A", 0.05, 0.15)
+    bld.set_independent_coordinates(["P"])
+    if drive is not None:
+        bld.add_drive("P", drive)
+    return bld.finalize()
+
+
+def test_geared_loop():
+    """An ideal gear in a loop model: against the Cartesian path (the pinion driven) and against
+    the four-bar alone by virtual work, tau_P = J_P qdd_P - tau_A / 3."""
+    m, fb = _geared_four_bar(), four_bar()
+    assert list(m.coord_names) == ["P"] and m.mobility == 1
+    drv = _geared_four_bar(ad.profiles.spline([0.0, 1.0, 2.0], [0.0, 2.0, -1.0]))
+    ts = np.linspace(0.1, 1.9, 12)
+    res = ad.driven_inverse_dynamics(drv, ts)
+    i = list(drv.joint_coord_names).index("P")
+    q, qd, qdd = res.q[:, [i]], res.qd[:, [i]], res.qdd[:, [i]]
+    tau = ad.inverse_dynamics(m, q, qd, qdd, t=ts)
+    assert rel_err(tau[:, 0], res.drive_forces[:, 0]) < 1e-10
+    assert rel_err(ad.forward_dynamics(m, q, qd, tau, t=ts), qdd) < 1e-10
+    tau_a = ad.inverse_dynamics(fb, -q / 3, -qd / 3, -qdd / 3)
+    assert rel_err(tau[:, 0], 2e-3 * qdd[:, 0] - tau_a[:, 0] / 3) < 1e-10
+    for k in (0, 6):
+        assert rel_err(ad.mass_matrix(m, q[k]), 2e-3 + ad.mass_matrix(fb, -q[k] / 3) / 9) < 1e-10
+
+
+def test_select_drivetrain_takes_a_loop_mechanism():
+    """A rest-to-rest crank motion of the four-bar through trajectory_run into
+    select_drivetrain: a selection for the crank, whose cycle torque is the loop's."""
+    import importlib.util
+    import pathlib
+
+    spec = importlib.util.spec_from_file_location(
+        "_sel", pathlib.Path(__file__).parents[1] / "validate" / "test_select_drivetrain.py"
+    )
+    sel_mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(sel_mod)
+    m = four_bar()
+    t = np.linspace(0.0, 2.0, 81)
+    q = 0.5 * (1 - np.cos(np.pi * t))[:, None]
+    qd = 0.5 * np.pi * np.sin(np.pi * t)[:, None]
+    qdd = 0.5 * np.pi**2 * np.cos(np.pi * t)[:, None]
+    run = ad.trajectory_run(m, t, q, qd, qdd)
+    sel = ad.select_drivetrain(m, run, sel_mod.catalog(), drives=False)
+    assert sel.converged and list(sel.table.index) == ["A"]
+    assert sel.table.loc["A", "motor"] in sel_mod.MOTORS.index
