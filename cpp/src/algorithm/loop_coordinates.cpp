@@ -263,7 +263,7 @@ LoopWork::LoopWork(const Model& m) {
 namespace {
 
 LoopWork& loop_work(const Model& m, Data& d) {
-  if (!d.loop) d.loop = std::make_unique<LoopWork>(m);
+  if (!d.loop) d.loop = std::make_shared<LoopWork>(m);
   return *d.loop;
 }
 
