@@ -96,13 +96,17 @@ py::array_t<double> body_mass_matrix_py(const Model& md) {
 }  // namespace
 
 void bind_dynamics(py::module_& m) {
-  m.def("state_from_joints", &state_from_joints_py, py::arg("model"), py::arg("q"),
-        py::arg("qd") = py::none(),
-        "Cartesian state (u, v) of a joint-space tree model from joint-space q (n_coords) and qd "
-        "(n_dofs; default zero): a coupled model's independent coordinates, the followers set by "
-        "their couplings. Returns (u (nq,), v (nv,)) float64 arrays: per body CoM [m] and unit "
-        "Euler parameters; CoM velocity [m/s, world] and angular velocity [rad/s, body]. "
-        "ModelError on a model without a joint space or wrong shapes.");
+  m.def(
+      "state_from_joints", &state_from_joints_py, py::arg("model"), py::arg("q"),
+      py::arg("qd") = py::none(),
+      "Cartesian state (u, v) of a joint-space tree model from joint-space q (n_coords) and qd "
+      "(n_dofs; default zero): a coupled model's independent coordinates, the followers set by "
+      "their couplings. Returns (u (nq,), v (nv,)) float64 arrays: per body CoM [m] and unit "
+      "Euler parameters; CoM velocity [m/s, world] and angular velocity [rad/s, body]. "
+      "ModelError on a model without a joint space or wrong shapes. A model with closed loops: its "
+      "independent coordinates, the others solved from the loop constraints (Newton from this "
+      "thread's last solution: the assembly branch kept; SolverError at a singular "
+      "configuration).");
 
   m.def("joint_coordinates", &joint_coordinates_py, py::arg("model"), py::arg("u"), py::arg("v"),
         "Joint-space q (n_coords: floating bases' poses, then joint coordinates with angles in "

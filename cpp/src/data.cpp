@@ -3,7 +3,6 @@
 
 #include <algorithm>
 
-#include "armdyn/algorithm/loop_coordinates.hpp"
 #include "armdyn/errors.hpp"
 
 namespace armdyn {

@@ -174,13 +174,18 @@ void set_independent(Model& m, const std::vector<int>& chosen) {
 
 void choose_loop_coordinates(Model& m) {
   m.loop_coordinates = false;
-  const bool loops = !m.is_tree || has_ideal_gear(m);
-  if (!loops) {
+  // a tree with ideal gears keeps every coordinate (its joint-space simulation, TreeDynamics,
+  // takes them all): the joint-level functions take loop models
+  if (m.is_tree) {
     if (!m.independent_request.empty())
-      throw ModelError(
-          "finalize: set_independent_coordinates applies to models with closed loops or ideal "
-          "gears; this model is a tree (its joint coordinates are independent; a coupling's "
-          "follower is dependent by construction)");
+      throw ModelError(msg(
+          "finalize: set_independent_coordinates applies to models with closed loops; this model "
+          "is a tree (its joint coordinates are independent; a coupling's follower is dependent "
+          "by construction",
+          has_ideal_gear(m) ? "; an ideal gear's tree is simulated in all its "
+                              "coordinates"
+                            : "",
+          ")"));
     return;
   }
   if (m.n_free > 0) {
@@ -240,6 +245,9 @@ LoopWork::LoopWork(const Model& m) {
   dd = std::make_unique<Data>(*driven);
   ref = VecX::Zero(3 * n);
   dd->ce.drive_ref = ref.data();
+  // positions to round-off (one Newton step past the pipeline's 1e-13): the results then do not
+  // depend on the state Newton started from (the Data's history)
+  dd->tol_f = 1e-15 * std::max(1.0, m.length_scale);
   for (VecX* x : {&u, &u_start, &u_save, &u_pred, &u_step, &ud}) *x = VecX::Zero(m.nq);
   for (VecX* x : {&v, &vd, &v_start, &v_save, &zero_v}) *x = VecX::Zero(m.nv);
   for (VecX* x : {&q_last, &q_from, &dq, &out, &qs, &unit, &zero_n}) *x = VecX::Zero(n);
@@ -255,7 +263,7 @@ LoopWork::LoopWork(const Model& m) {
 namespace {
 
 LoopWork& loop_work(const Model& m, Data& d) {
-  if (!d.loop) d.loop = std::make_unique<LoopWork>(m);
+  if (!d.loop) d.loop = std::make_shared<LoopWork>(m);
   return *d.loop;
 }
 
