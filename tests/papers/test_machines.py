@@ -132,3 +132,21 @@ def test_cycle_profiles_are_the_exact_motion(machine):
     assert np.abs(qd).max() <= v * (1 + 1e-12) and np.abs(qdd).max() <= a * (1 + 1e-12)
     np.testing.assert_allclose(q[[0, -1]], 0.0, atol=1e-15)
     np.testing.assert_allclose(qd[[0, -1]], 0.0, atol=1e-15)
+
+
+def test_delta_geometry_moments_are_the_models():
+    """DeltaGeometry.arm_inertia / arm_moment (the reference's I and S) equal the model's upper
+    arms' inertia about their pivot axes and first moment, from the model's own bodies."""
+    g = mc.DeltaGeometry()
+    model = mc.delta_robot()
+    radial, axis = g.directions()
+    for i in range(3):
+        k = model.body_names.index(f"upper_arm{i + 1}")
+        x, e = _body_pose(model, model.u0, f"upper_arm{i + 1}")
+        r = x - g.base * radial[i]
+        rot = quat_to_rot(e)
+        inertia = rot @ model.inertias[k] @ rot.T + model.masses[k] * (
+            r @ r * np.eye(3) - np.outer(r, r)
+        )
+        assert axis[i] @ inertia @ axis[i] == pytest.approx(g.arm_inertia(), rel=1e-14)
+        assert model.masses[k] * np.linalg.norm(r) == pytest.approx(g.arm_moment(), rel=1e-14)

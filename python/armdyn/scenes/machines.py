@@ -5,8 +5,8 @@ Each machine adds its ACTUATED joints first, so the default independent coordina
 model (the first independent joint coordinates in model order) are the actuated ones, and
 ``model.joint_names[:n]`` lists them (``PALLETIZER_ACTUATED``, ``DELTA_ACTUATED``). Joint
 coordinates are 0 at the assembly pose documented per machine. ``palletizer_ik`` and
-``delta_ik`` / ``delta_fk`` are the machines' closed-form kinematics (no armdyn call), which the
-cycles and the tests' independent references use. ``pick_and_place(machine)`` gives a cycle of
+``delta_ik`` are the machines' closed-form inverse kinematics (no armdyn call), which the
+cycles and the tests use. ``pick_and_place(machine)`` gives a cycle of
 the actuated coordinates as an :class:`armdyn.motion.Trajectory`; ``drives=`` of each machine
 takes it (or a dict of profiles per actuated joint) to build the fully driven model that
 ``armdyn.driven_inverse_dynamics`` and ``armdyn.simulate`` take."""
@@ -15,11 +15,16 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
 
 from armdyn import _core
+
+if TYPE_CHECKING:
+    from armdyn.motion import Trajectory
+
 
 PALLETIZER_ACTUATED = ("yaw", "shoulder", "elbow", "wrist")
 DELTA_ACTUATED = ("arm1", "arm2", "arm3")
@@ -57,7 +62,7 @@ def _add(b: _core.ModelBuilder, name: str, parts) -> None:
     b.add_body(name, m, inertia, position=c)
 
 
-def _add_torques(b: _core.ModelBuilder, torques, actuated) -> None:
+def _add_torques(b: _core.ModelBuilder, torques: Any, actuated: tuple[str, ...]) -> None:
     if torques is None:
         return
     if not isinstance(torques, Mapping):
@@ -68,7 +73,7 @@ def _add_torques(b: _core.ModelBuilder, torques, actuated) -> None:
         b.add_joint_torque(joint, profile)
 
 
-def _add_drives(b: _core.ModelBuilder, drives, actuated) -> None:
+def _add_drives(b: _core.ModelBuilder, drives: Any, actuated: tuple[str, ...]) -> None:
     if drives is None:
         return
     from armdyn.motion import Trajectory, drive_profile
@@ -152,8 +157,8 @@ def palletizer(
     *,
     payload: float = 20.0,
     closure: str = "inline",
-    drives=None,
-    torques=None,
+    drives: Trajectory | Mapping[str, Any] | None = None,
+    torques: Mapping[str, Any] | None = None,
     geometry: PalletizerGeometry | None = None,
     masses: PalletizerMasses | None = None,
     gravity: float = 9.81,
@@ -321,8 +326,8 @@ class DeltaGeometry:
 
 def delta_robot(
     *,
-    drives=None,
-    torques=None,
+    drives: Trajectory | Mapping[str, Any] | None = None,
+    torques: Mapping[str, Any] | None = None,
     geometry: DeltaGeometry | None = None,
     gravity: float = 9.81,
 ) -> _core.Model:
@@ -509,7 +514,7 @@ def pick_and_place(
     max_jerk: float | None = None,
     dwell: float | None = None,
     dt: float = 1e-3,
-):
+) -> Trajectory:
     """One pick-and-place cycle of `machine` (``"palletizer"`` or ``"delta"``) in its actuated
     coordinates: from rest at the assembly pose (all coordinates 0: the home), to above the
     pick, down to the pick, a `dwell` (the gripper), up, across to above the place, down to the
