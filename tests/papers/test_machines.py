@@ -104,13 +104,37 @@ def test_delta_cycle_translates_the_plate_through_the_waypoints(delta_cycle):
     np.testing.assert_allclose(mc.delta_ik(plate), idr.q[:, :3], atol=1e-10)
 
 
-def test_machines_refuse_bad_drives():
+def test_machines_refuse_bad_inputs():
     with pytest.raises(ad.ModelError, match="not an actuated joint"):
         mc.delta_robot(drives={"rod1a": 0.0})
     with pytest.raises(ad.ModelError, match="3 actuated joints"):
         mc.delta_robot(drives=mc.pick_and_place("palletizer"))
-    with pytest.raises(ad.ModelError, match="machine must be one of"):
+    with pytest.raises(ad.ModelError, match="torques must be"):
+        mc.delta_robot(torques=[1.0, 2.0, 3.0])
+    with pytest.raises(ad.ModelError, match="machine must be"):
         mc.pick_and_place("scara")
+    with pytest.raises(ad.ModelError, match="max_velocity"):
+        mc.pick_and_place("delta", max_velocity=-1.0)
+    with pytest.raises(ad.ModelError, match="dwell"):
+        mc.pick_and_place("delta", dwell=float("nan"))
+    with pytest.raises(ad.ModelError, match="dt"):
+        mc.pick_and_place("delta", dt=1e-12)
+    with pytest.raises(ad.ModelError, match="payload"):
+        mc.palletizer(payload=-2.0)
+    with pytest.raises(ad.ModelError, match=r"geometry\.upper"):
+        mc.palletizer(geometry=mc.PalletizerGeometry(upper=float("inf")))
+    with pytest.raises(ad.ModelError, match=r"masses\.turret"):
+        mc.palletizer(masses=mc.PalletizerMasses(turret=0.0))
+    with pytest.raises(ad.ModelError, match=r"geometry\.rod"):
+        mc.delta_robot(geometry=mc.DeltaGeometry(rod=0.3))
+    with pytest.raises(ad.ModelError, match="tool"):
+        mc.palletizer_ik([np.nan, 0.0, 1.0])
+    with pytest.raises(ad.ModelError, match="plate"):
+        mc.delta_ik([0.0, 0.0])
+    with pytest.raises(ad.SolverError, match="tool point 1"):
+        mc.palletizer_ik([[1.3, 0.0, 0.6], [5.0, 0.0, 0.6]])
+    with pytest.raises(ad.SolverError, match=r"position 0 .* arm1"):
+        mc.delta_ik([0.0, 0.0, -3.0])
 
 
 @pytest.mark.parametrize("machine", ["palletizer", "delta"])
@@ -132,3 +156,21 @@ def test_cycle_profiles_are_the_exact_motion(machine):
     assert np.abs(qd).max() <= v * (1 + 1e-12) and np.abs(qdd).max() <= a * (1 + 1e-12)
     np.testing.assert_allclose(q[[0, -1]], 0.0, atol=1e-15)
     np.testing.assert_allclose(qd[[0, -1]], 0.0, atol=1e-15)
+
+
+def test_delta_geometry_moments_are_the_models():
+    """DeltaGeometry.arm_inertia / arm_moment (the reference's I and S) equal the model's upper
+    arms' inertia about their pivot axes and first moment, from the model's own bodies."""
+    g = mc.DeltaGeometry()
+    model = mc.delta_robot()
+    radial, axis = g.directions()
+    for i in range(3):
+        k = model.body_names.index(f"upper_arm{i + 1}")
+        x, e = _body_pose(model, model.u0, f"upper_arm{i + 1}")
+        r = x - g.base * radial[i]
+        rot = quat_to_rot(e)
+        inertia = rot @ model.inertias[k] @ rot.T + model.masses[k] * (
+            r @ r * np.eye(3) - np.outer(r, r)
+        )
+        assert axis[i] @ inertia @ axis[i] == pytest.approx(g.arm_inertia(), rel=1e-14)
+        assert model.masses[k] * np.linalg.norm(r) == pytest.approx(g.arm_moment(), rel=1e-14)

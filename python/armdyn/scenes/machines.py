@@ -5,8 +5,8 @@ Each machine adds its ACTUATED joints first, so the default independent coordina
 model (the first independent joint coordinates in model order) are the actuated ones, and
 ``model.joint_names[:n]`` lists them (``PALLETIZER_ACTUATED``, ``DELTA_ACTUATED``). Joint
 coordinates are 0 at the assembly pose documented per machine. ``palletizer_ik`` and
-``delta_ik`` / ``delta_fk`` are the machines' closed-form kinematics (no armdyn call), which the
-cycles and the tests' independent references use. ``pick_and_place(machine)`` gives a cycle of
+``delta_ik`` are the machines' closed-form inverse kinematics (no armdyn call), which the
+cycles and the tests use. ``pick_and_place(machine)`` gives a cycle of
 the actuated coordinates as an :class:`armdyn.motion.Trajectory`; ``drives=`` of each machine
 takes it (or a dict of profiles per actuated joint) to build the fully driven model that
 ``armdyn.driven_inverse_dynamics`` and ``armdyn.simulate`` take."""
@@ -15,11 +15,16 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
 
-from armdyn import _core
+from armdyn import _checks, _core
+
+if TYPE_CHECKING:
+    from armdyn.motion import Trajectory
+
 
 PALLETIZER_ACTUATED = ("yaw", "shoulder", "elbow", "wrist")
 DELTA_ACTUATED = ("arm1", "arm2", "arm3")
@@ -57,7 +62,29 @@ def _add(b: _core.ModelBuilder, name: str, parts) -> None:
     b.add_body(name, m, inertia, position=c)
 
 
-def _add_torques(b: _core.ModelBuilder, torques, actuated) -> None:
+def _check_fields(who: str, name: str, obj: Any, signed: tuple[str, ...] = ()) -> None:
+    """Every number of a geometry / masses dataclass finite, and positive unless in `signed`."""
+    from dataclasses import fields
+
+    for f in fields(obj):
+        values = getattr(obj, f.name)
+        for k, v in enumerate(values if isinstance(values, tuple) else (values,)):
+            label = f"{name}.{f.name}" + (f"[{k}]" if isinstance(values, tuple) else "")
+            if f.name in signed:
+                _checks.number(who, label, v)
+            else:
+                _checks.number(who, label, v, lo=0.0, lo_open=True)
+
+
+def _points(who: str, name: str, value: Any) -> np.ndarray:
+    """(n, 3) finite points from (3,) or (n, 3)."""
+    x = np.asarray(_checks.array(who, name, value, finite=True), float)
+    if x.shape[-1:] != (3,) or x.ndim not in (1, 2):
+        raise _core.ModelError(f"{who}: {name} must have shape (3,) or (n, 3), got {x.shape}")
+    return np.atleast_2d(x)
+
+
+def _add_torques(b: _core.ModelBuilder, torques: Any, actuated: tuple[str, ...]) -> None:
     if torques is None:
         return
     if not isinstance(torques, Mapping):
@@ -68,7 +95,7 @@ def _add_torques(b: _core.ModelBuilder, torques, actuated) -> None:
         b.add_joint_torque(joint, profile)
 
 
-def _add_drives(b: _core.ModelBuilder, drives, actuated) -> None:
+def _add_drives(b: _core.ModelBuilder, drives: Any, actuated: tuple[str, ...]) -> None:
     if drives is None:
         return
     from armdyn.motion import Trajectory, drive_profile
@@ -106,7 +133,8 @@ class PalletizerGeometry:
     pin); rear: the upper arm's rear lever |ER| behind E, driven by the elbow parallelogram;
     level_back: the wrist-level parallelogram's turret lever (along -x from S and from E);
     level_up: the bell crank's upper lever (along +z from E and from W); flange_drop: the flange
-    (wrist yaw joint) below W; tool_drop: the tool point below the flange."""
+    (wrist yaw joint) below W; tool_drop: the tool point below the flange. Every number
+    positive and finite (else a ModelError naming the field)."""
 
     shoulder: tuple[float, float] = (0.25, 0.65)
     lower: float = 1.0
@@ -134,7 +162,8 @@ class PalletizerGeometry:
 
 @dataclass(frozen=True)
 class PalletizerMasses:
-    """Masses [kg] of the palletizer's bodies (the links as solid cylinders of `radius` [m])."""
+    """Masses [kg] of the palletizer's bodies (the links as solid cylinders of `radius` [m]),
+    each positive and finite."""
 
     turret: float = 80.0
     lower: float = 30.0
@@ -152,8 +181,8 @@ def palletizer(
     *,
     payload: float = 20.0,
     closure: str = "inline",
-    drives=None,
-    torques=None,
+    drives: Trajectory | Mapping[str, Any] | None = None,
+    torques: Mapping[str, Any] | None = None,
     geometry: PalletizerGeometry | None = None,
     masses: PalletizerMasses | None = None,
     gravity: float = 9.81,
@@ -183,12 +212,14 @@ def palletizer(
     axes (elbow rod at y = -0.15, level rods at y = +0.15). ``drives``: a trajectory of the four
     actuated coordinates (``pick_and_place("palletizer")``) or ``{joint: profile}``; ``torques``:
     ``{actuated joint: profile}`` applied as ``add_joint_torque`` (a forward run)."""
-    if closure not in ("revolute", "inline"):
-        raise _core.ModelError(
-            f"palletizer: closure must be 'revolute' or 'inline', got {closure!r}"
-        )
+    closure = _checks.choice("palletizer", "closure", closure, ("inline", "revolute"))
+    who = "palletizer"
     g = geometry or PalletizerGeometry()
     m = masses or PalletizerMasses()
+    _check_fields(who, "geometry", g)
+    _check_fields(who, "masses", m)
+    payload = _checks.number(who, "payload", payload, lo=0.0)
+    gravity = _checks.number(who, "gravity", gravity)
     p = g.points()
     rad = m.radius
     b = _core.ModelBuilder(gravity=(0.0, 0.0, -gravity))
@@ -249,18 +280,23 @@ def palletizer_ik(
     """The actuated coordinates (yaw, shoulder, elbow, wrist) that put the tool point at `tool`
     (world, (3,) or (n, 3)) with the flange turned by `tool_yaw` [rad] about the vertical from
     its assembly heading (closed form: the wrist is level, so the wrist pin is `flange_drop +
-    tool_drop` above the tool; the elbow on the upper branch, as assembled). ValueError when
-    out of reach."""
+    tool_drop` above the tool; the elbow on the upper branch, as assembled). SolverError naming
+    the first row out of reach; ModelError for a point that is not finite."""
+    who = "palletizer_ik"
     g = geometry or PalletizerGeometry()
+    _check_fields(who, "geometry", g)
+    tool_yaw = _checks.number(who, "tool_yaw", tool_yaw)
     p = g.points()
-    x = np.atleast_2d(np.asarray(tool, float))
+    x = _points(who, "tool", tool)
     yaw = np.arctan2(x[:, 1], x[:, 0])
     r = np.hypot(x[:, 0], x[:, 1])
     wr = r - p["S"][0]
     wz = x[:, 2] + g.flange_drop + g.tool_drop - p["S"][2]
     d = np.hypot(wr, wz)
-    if np.any(d > g.lower + g.upper) or np.any(d < abs(g.lower - g.upper)):
-        raise ValueError("palletizer_ik: a tool point out of reach")
+    out = (d > g.lower + g.upper) | (d < abs(g.lower - g.upper)) | (d <= 0.0)
+    if np.any(out):
+        row = int(np.argmax(out))
+        raise _core.SolverError(f"{who}: tool point {row} {x[row].tolist()} is out of reach")
     along = (g.lower**2 - g.upper**2 + d**2) / (2 * d)
     h = np.sqrt(g.lower**2 - along**2)
     er = along * wr / d - h * wz / d  # the elbow, left of S -> W (the upper branch)
@@ -284,7 +320,8 @@ class DeltaGeometry:
     half the distance between a forearm's two parallel rods (along the pivot axis); theta0:
     the upper arms' assembly angle below the horizontal [rad]. arm_mass (a solid cylinder of
     `radius`), elbow_mass (a point mass at the elbow: the lumped share of the forearm), plate_mass
-    (a disc of radius `plate`, with the forearms' other share)."""
+    (a disc of radius `plate`, with the forearms' other share). Every number finite, all but
+    theta0 positive, and the rods longer than the elbows' horizontal reach beyond the plate."""
 
     base: float = 0.2
     plate: float = 0.05
@@ -319,10 +356,20 @@ class DeltaGeometry:
         return self.arm_mass * self.arm / 2 + self.elbow_mass * self.arm
 
 
+def _check_geometry(who: str, g: DeltaGeometry) -> None:
+    _check_fields(who, "geometry", g, signed=("theta0",))
+    if g.base + g.arm * np.cos(g.theta0) - g.plate >= g.rod:
+        raise _core.ModelError(
+            f"{who}: geometry.rod ({g.rod:g} m) must exceed the horizontal reach of the elbow "
+            f"beyond the plate, base + arm cos(theta0) - plate = "
+            f"{g.base + g.arm * np.cos(g.theta0) - g.plate:g} m"
+        )
+
+
 def delta_robot(
     *,
-    drives=None,
-    torques=None,
+    drives: Trajectory | Mapping[str, Any] | None = None,
+    torques: Mapping[str, Any] | None = None,
     geometry: DeltaGeometry | None = None,
     gravity: float = 9.81,
 ) -> _core.Model:
@@ -338,7 +385,10 @@ def delta_robot(
     ``theta0`` below the horizontal, the plate centred under the base at ``plate_z()``.
     ``drives``: a trajectory of the three arm angles (``pick_and_place("delta")``) or
     ``{joint: profile}``; ``torques``: ``{arm joint: profile}`` applied as ``add_joint_torque``."""
+    who = "delta_robot"
     g = geometry or DeltaGeometry()
+    _check_geometry(who, g)
+    gravity = _checks.number(who, "gravity", gravity)
     radial, axis = g.directions()
     down = np.array([0.0, 0.0, -1.0])
     b = _core.ModelBuilder(gravity=(0.0, 0.0, -gravity))
@@ -382,17 +432,24 @@ def _delta_branch(g: DeltaGeometry, k, rho, z) -> np.ndarray:
 def delta_ik(plate: npt.ArrayLike, geometry: DeltaGeometry | None = None) -> np.ndarray:
     """The arm coordinates (arm1, arm2, arm3) [rad] (0 at the assembly pose) that put the plate's
     centre at `plate` ((3,) or (n, 3), world), on the assembly's branch (elbows outward); closed
-    form. ValueError when out of reach."""
+    form. SolverError naming the first row out of reach; ModelError for a point that is not
+    finite."""
+    who = "delta_ik"
     g = geometry or DeltaGeometry()
+    _check_geometry(who, g)
     radial, _ = g.directions()
-    x = np.atleast_2d(np.asarray(plate, float))
+    x = _points(who, "plate", plate)
     q = np.empty((x.shape[0], 3))
     for i in range(3):
         d = x + g.plate * radial[i] - g.base * radial[i]
         rho, z = d @ radial[i], d[:, 2]
         k = (g.arm**2 + np.sum(d * d, axis=1) - g.rod**2) / (2 * g.arm)
-        if np.any(np.abs(k) > np.hypot(rho, z)):
-            raise ValueError("delta_ik: a plate position out of reach")
+        out = np.abs(k) > np.hypot(rho, z)
+        if np.any(out):
+            row = int(np.argmax(out))
+            raise _core.SolverError(
+                f"{who}: plate position {row} {x[row].tolist()} is out of reach of arm{i + 1}"
+            )
         # rho cos(t) - z sin(t) = k, t the angle below the horizontal
         q[:, i] = _delta_branch(g, k, rho, z) - g.theta0
     return q[0] if np.ndim(plate) == 1 else q
@@ -509,7 +566,7 @@ def pick_and_place(
     max_jerk: float | None = None,
     dwell: float | None = None,
     dt: float = 1e-3,
-):
+) -> Trajectory:
     """One pick-and-place cycle of `machine` (``"palletizer"`` or ``"delta"``) in its actuated
     coordinates: from rest at the assembly pose (all coordinates 0: the home), to above the
     pick, down to the pick, a `dwell` (the gripper), up, across to above the place, down to the
@@ -531,18 +588,28 @@ def pick_and_place(
     C++; ``palletizer(drives=traj)`` / ``delta_robot(drives=traj)`` drive them."""
     from armdyn.motion import Trajectory
 
-    if machine not in _CYCLES:
-        raise _core.ModelError(
-            f"pick_and_place: machine must be one of {sorted(_CYCLES)}, got {machine!r}"
+    who = "pick_and_place"
+    machine = _checks.choice(who, "machine", machine, sorted(_CYCLES))
+    given = [
+        _checks.number(who, name, value, lo=0.0, lo_open=True, none=True)
+        for name, value in (
+            ("max_velocity", max_velocity), ("max_acceleration", max_acceleration),
+            ("max_jerk", max_jerk),
         )
+    ]  # fmt: skip
+    rest = _checks.number(who, "dwell", dwell, lo=0.0, none=True)
+    dt = float(_checks.number(who, "dt", dt, lo=0.0, lo_open=True))  # type: ignore[arg-type]
     names, points, tool = _waypoints(machine)
-    v, a, j = _CYCLES[machine]["limits"]
-    limits = (max_velocity or v, max_acceleration or a, max_jerk or j)
-    rest = _CYCLES[machine]["dwell"] if dwell is None else dwell
+    limits = tuple(
+        d if x is None else x for x, d in zip(given, _CYCLES[machine]["limits"], strict=True)
+    )
+    rest = _CYCLES[machine]["dwell"] if rest is None else rest
     moves = _timed(points, limits, {2: rest, 5: rest} if rest > 0 else {})
     starts = moves.starts
     moving = np.any(moves.points[1:] != moves.points[:-1], axis=1)
     arrive = np.concatenate([[0.0], starts[1:][moving]])
+    if starts[-1] / dt > 1e7:
+        raise _core.ModelError(f"{who}: dt = {dt:g} s gives more than 1e7 samples of the cycle")
     grid = np.append(np.arange(0.0, starts[-1], dt), starts[-1])
     q, qd, qdd = moves.evaluate(grid)
     knots = moves.knots()
