@@ -56,7 +56,7 @@ POINT_LIKE = ("revolute", "inline", "spherical")
 # axes of the joint frame: the constrained axes of Exudyn's ObjectJointGeneric
 ROW_AXES = {
     "revolute": (0, 1, 2, 3, 4),
-    "prismatic": (0, 1, 3, 4, 5),
+    "prismatic": (3, 4, 5, 0, 1),  # armdyn: the rotation rows first
     "spherical": (0, 1, 2),
     "inline": (0, 1),
     "fixed": (0, 1, 2, 3, 4, 5),
@@ -176,10 +176,11 @@ class Topology:
             points.append((a, pa + ra[:, 2], b, pb + rb[:, 2]))
         return points
 
-    def observe_u(self, u: np.ndarray) -> np.ndarray:
+    @staticmethod
+    def observe_u(u: np.ndarray) -> np.ndarray:
         """armdyn Cartesian states (n, nq) -> CoM positions (n, 3 nb)."""
-        u = np.atleast_2d(u).reshape(len(np.atleast_2d(u)), -1, 7)
-        return u[:, :, :3].reshape(len(u), -1)
+        u = np.atleast_2d(np.asarray(u, dtype=float))
+        return u.reshape(len(u), -1, 7)[:, :, :3].reshape(len(u), -1)
 
 
 # -- MuJoCo -----------------------------------------------------------------------------------
@@ -213,7 +214,9 @@ def mujoco_xml(topo: Topology, h: float = 1e-4) -> str:
         else:
             point, frame = topo.side(joint, name)
             kind = "slide" if topo.joints[joint]["type"] == "prismatic" else "hinge"
-            jxml = f'<joint name="{joint}" type="{kind}" pos="{_v(point)}" axis="{_v(frame[:, 2])}"/>'
+            jxml = (
+                f'<joint name="{joint}" type="{kind}" pos="{_v(point)}" axis="{_v(frame[:, 2])}"/>'
+            )
         inner = "".join(body(c, jc, name) for jc, c in children.get(name, []))
         return (
             f'<body name="{name}" pos="{_v(rel_p)}" quat="{_v(rel_q)}">{jxml}'
@@ -319,6 +322,7 @@ class MujocoLoop(MujocoPeer):
             mujoco.mj_jac(m, data, jp, jr, data.xipos[b], b)
             lin_v.append(jp @ qvel)
             ang_v.append(jr @ qvel)
+
         # CoM accelerations: J a + (d/dt J) v, the latter by central differences
         def com_vel(s):
             d2 = mujoco.MjData(m)
@@ -346,7 +350,9 @@ class PinocchioLoop:
     """Pinocchio's model of a :class:`Topology` with ``pin.constraintDynamics`` (see the module
     docstring). ``baumgarte`` = (Kp, Kd) of the constraint models' corrector."""
 
-    def __init__(self, topo: Topology, baumgarte=(0.0, 0.0), prox=(1e-13, 1e-10, 50), extra_tau=None):
+    def __init__(
+        self, topo: Topology, baumgarte=(0.0, 0.0), prox=(1e-13, 1e-10, 50), extra_tau=None
+    ):
         import pinocchio as pin
 
         if topo.free:
@@ -360,11 +366,15 @@ class PinocchioLoop:
             p_in, r_in = topo.side(j, inner)
             p_out, r_out = topo.side(j, outer)
             placement = x_in * pin.SE3(r_in, p_in)
-            kind = pin.JointModelPZ() if topo.joints[j]["type"] == "prismatic" else pin.JointModelRZ()
+            kind = (
+                pin.JointModelPZ() if topo.joints[j]["type"] == "prismatic" else pin.JointModelRZ()
+            )
             jid = m.addJoint(jid_in, kind, placement, j)
             x_body = pin.SE3(r_out, p_out).inverse()
             r = x_body.rotation
-            inertia = pin.Inertia(topo.mass[outer], x_body.translation, r @ topo.inertia[outer] @ r.T)
+            inertia = pin.Inertia(
+                topo.mass[outer], x_body.translation, r @ topo.inertia[outer] @ r.T
+            )
             m.appendBodyToJoint(jid, inertia, pin.SE3.Identity())
             self.at[outer] = (jid, x_body)
         self.model, self.data = m, m.createData()
@@ -422,7 +432,9 @@ class PinocchioLoop:
         out = []
         for col in np.atleast_2d(y.T):
             pin.framesForwardKinematics(m, d, col[: self.nq])
-            out.append(np.concatenate([d.oMf[self.frames[b]].translation for b in self.topo.bodies]))
+            out.append(
+                np.concatenate([d.oMf[self.frames[b]].translation for b in self.topo.bodies])
+            )
         return np.array(out)
 
     def com_motion(self, q, v, a):
@@ -441,7 +453,10 @@ class PinocchioLoop:
         return np.array(lin_a), np.array(lin_v), np.array(ang_v)
 
     def constraint_jacobian(self, q) -> np.ndarray:
+        """The loop closures' Jacobian at q (the constraint datas updated by one
+        ``constraintDynamics`` call at rest first: getConstraintsJacobian reads them)."""
         pin = self.pin
+        self.accelerations(q, np.zeros(self.nv))
         pin.computeJointJacobians(self.model, self.data, q)
         return pin.getConstraintsJacobian(self.model, self.data, self.constraints, self.cdatas)
 
@@ -452,9 +467,11 @@ class PinocchioLoop:
 class ExudynLoop:
     """Exudyn's redundant-coordinate model of a :class:`Topology` (see the module docstring)."""
 
-    def __init__(self, topo: Topology, extra=None):
+    def __init__(self, topo: Topology, extra=None, velocities=None):
         self.topo = topo
         self.extra = extra  # (mbs, bodies: name -> object number) -> None: more loads
+        # initial (CoM velocity, angular velocity), both in world, per body; default at rest
+        self.velocities = velocities or {}
 
     def system(self):
         from exudyn.rigidBodyUtilities import RigidBodyInertia
@@ -466,6 +483,7 @@ class ExudynLoop:
         ground = mbs.AddObject(eii.ObjectGround(visualization=eii.VObjectGround(show=False)))
         objects, nodes = {"ground": ground}, {}
         g = [float(c) for c in topo.model.gravity]
+        zero = (np.zeros(3), np.zeros(3))
         for b in topo.bodies:
             res = mbs.CreateRigidBody(
                 inertia=RigidBodyInertia(
@@ -474,6 +492,8 @@ class ExudynLoop:
                 referencePosition=topo.pos[b],
                 referenceRotationMatrix=topo.rot[b],
                 gravity=g,
+                initialVelocity=list(map(float, self.velocities.get(b, zero)[0])),
+                initialAngularVelocity=list(map(float, self.velocities.get(b, zero)[1])),
                 nodeType=exu.NodeType.RotationEulerParameters,
                 show=False,
                 returnDict=True,
@@ -496,7 +516,9 @@ class ExudynLoop:
                 )
                 for b, p in ((f["parent"], f["point_parent"]), (f["child"], f["point_child"]))
             )
-            length = np.linalg.norm(topo.world_point(j, f["parent"]) - topo.world_point(j, f["child"]))
+            length = np.linalg.norm(
+                topo.world_point(j, f["parent"]) - topo.world_point(j, f["child"])
+            )
             mbs.AddObject(
                 eii.ObjectConnectorDistance(
                     markerNumbers=[ma, mb],
