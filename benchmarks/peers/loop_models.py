@@ -150,6 +150,19 @@ class Topology:
                 raise NotImplementedError(f"loop_models: a {kind} joint ({j}) closing a loop")
         return tree, closures, free
 
+    def depth_first(self) -> list:
+        """The tree joints ordered depth first from the ground."""
+        out = []
+
+        def visit(body):
+            for t in self.tree:
+                if t[1] == body:
+                    out.append(t)
+                    visit(t[2])
+
+        visit("ground")
+        return out
+
     def side(self, joint: str, body: str):
         """(point, frame) of a joint in one of its bodies' frames."""
         f = self.joints[joint]
@@ -361,7 +374,9 @@ class PinocchioLoop:
         m = pin.Model()
         m.gravity = pin.Motion(np.asarray(topo.model.gravity, dtype=float), np.zeros(3))
         self.at = {"ground": (0, pin.SE3.Identity())}  # body -> (joint id, CoM frame in it)
-        for j, inner, outer, _rev in topo.tree:
+        # depth first: Pinocchio's CRBA and constrained dynamics need every subtree's velocity
+        # indices contiguous
+        for j, inner, outer, _rev in topo.depth_first():
             jid_in, x_in = self.at[inner]
             p_in, r_in = topo.side(j, inner)
             p_out, r_out = topo.side(j, outer)
@@ -394,9 +409,9 @@ class PinocchioLoop:
                     pin.ContactType.CONTACT_3D,
                     m,
                     ja,
-                    xa * pin.SE3(np.eye(3), pa),
+                    xa * pin.SE3(topo.rot[a].T, pa),
                     jb,
-                    xb * pin.SE3(np.eye(3), pb),
+                    xb * pin.SE3(topo.rot[b].T, pb),
                     pin.ReferenceFrame.LOCAL,
                 )
                 cm.setBaumgarteCorrectorParameters(
