@@ -551,8 +551,9 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python -m benchmarks.closed_loop")
     parser.add_argument("problems", nargs="*", default=["all"], help=f"{', '.join(ALL)} or all")
     parser.add_argument("--quick", action="store_true", help="one point per curve")
+    parser.add_argument("--out", default=None, help="JSON path (default: benchmarks/results/)")
     args = parser.parse_args(argv)
-    run(args.problems, quick=args.quick)
+    run(args.problems, quick=args.quick, out=args.out)
     return 0
 
 
