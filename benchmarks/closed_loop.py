@@ -8,9 +8,12 @@ the table of docs/benchmarks.md ("Closed loops against the peers").
 Problems (each released at rest in its assembled configuration, no drives):
 
 - ``four_bar``: :func:`armdyn.scenes.four_bar` (crank 0.3, coupler 0.6, rocker 0.5, ground
-  0.7 m, crank at 60 deg, gravity -y), 1.5 s of free swinging.
+  0.7 m, crank at 60 deg, gravity -y), 1.5 s of free swinging, the loop closed by an inline
+  joint (``closure="inline"``: no redundant rows); ``four_bar_revolute``: the same closed by a
+  revolute (3 redundant rows: armdyn's minimum-norm dense KKT path, the peers' models alike).
 - ``slider_crank``: the slider-crank of :func:`armdyn.scenes.slider_crank` (crank 0.1, rod
-  0.35 m) with gravity -y and the crank released at 60 deg, 2 s.
+  0.35 m) with gravity -y and the crank released at 60 deg, 2 s; the loop closed at the
+  rod-slider pin by an inline joint.
 - ``squeezer``: Andrews' squeezer (:func:`armdyn.scenes.standard.andrews_squeezer`), 0.03 s.
 - ``palletizer``, ``delta``: :func:`armdyn.scenes.palletizer` and
   :func:`armdyn.scenes.delta_robot` (when the installed armdyn has them), 0.5 s and 1 s
@@ -82,10 +85,12 @@ class LoopProblem:
     special: object = None  # () -> {"mujoco": MujocoPeer-like, "exudyn": ExudynPeer-like, ...}
 
 
-def slider_crank_falling(angle: float = np.pi / 3) -> ad.Model:
+def slider_crank_falling(angle: float = np.pi / 3, closure: str = "inline") -> ad.Model:
     """The slider-crank of :func:`armdyn.scenes.slider_crank` (crank 0.1 m, 1 kg; rod 0.35 m,
     0.5 kg; slider 2 kg on a prismatic joint along x) with gravity -y and the crank released at
-    ``angle`` from +x."""
+    ``angle`` from +x. ``closure="inline"`` (default) closes the loop at the rod-slider pin with
+    an inline joint (2 rows: 17 independent rows, none redundant), ``"revolute"`` with a
+    revolute (20 rows of rank 17: 3 redundant), the same motion."""
     crank, rod = 0.1, 0.35
     b = ad.ModelBuilder(gravity=(0.0, -9.81, 0.0))
     a = crank * np.array([np.cos(angle), np.sin(angle), 0.0])
@@ -103,7 +108,10 @@ def slider_crank_falling(angle: float = np.pi / 3) -> ad.Model:
     b.add_body("slider", 2.0, [1e-3, 1e-3, 1e-3], position=s)
     b.add_revolute("crank_pin", "ground", "crank", point=(0, 0, 0), axis=ez)
     b.add_revolute("crank_rod", "crank", "rod", point=a, axis=ez)
-    b.add_revolute("rod_slider", "rod", "slider", point=s, axis=ez)
+    if closure == "inline":
+        b.add_inline("rod_slider", "rod", "slider", point=s, axis=ez)
+    else:
+        b.add_revolute("rod_slider", "rod", "slider", point=s, axis=ez)
     b.add_prismatic("guide", "ground", "slider", point=s, axis=(1, 0, 0))
     return b.finalize()
 
@@ -190,9 +198,16 @@ def _machine(name):
 PROBLEMS = {
     "four_bar": LoopProblem(
         "four_bar",
-        "Four-bar (armdyn.scenes.four_bar), free swing under gravity, 1.5 s",
+        "Four-bar (armdyn.scenes.four_bar, closure='inline'), free swing under gravity, 1.5 s",
         1.5,
-        basic.four_bar,
+        lambda: basic.four_bar(closure="inline"),
+        quick={"armdyn": (1e-8,), "mujoco": (1.25e-4,), "pin": (1e-8,), "exudyn": (2000,)},
+    ),
+    "four_bar_revolute": LoopProblem(
+        "four_bar_revolute",
+        "The same four-bar closed by a revolute (3 redundant rows), 1.5 s",
+        1.5,
+        lambda: basic.four_bar(closure="revolute"),
         quick={"armdyn": (1e-8,), "mujoco": (1.25e-4,), "pin": (1e-8,), "exudyn": (2000,)},
     ),
     "slider_crank": LoopProblem(
@@ -228,7 +243,7 @@ PROBLEMS = {
         quick={"armdyn": (1e-8,), "mujoco": (1.25e-4,), "pin": (1e-8,), "exudyn": (1000,)},
     ),
 }
-ALL = ("four_bar", "slider_crank", "squeezer", "palletizer", "delta")
+ALL = ("four_bar", "four_bar_revolute", "slider_crank", "squeezer", "palletizer", "delta")
 
 
 def _without_drives(model):

@@ -14,7 +14,7 @@ import pytest
 from benchmarks import closed_loop as cl
 from benchmarks.peers import loop_models as lm
 
-PROBLEMS = ("four_bar", "slider_crank", "squeezer", "palletizer")
+PROBLEMS = ("four_bar", "four_bar_revolute", "slider_crank", "squeezer", "palletizer")
 
 
 def _moving_state(problem):
@@ -62,7 +62,7 @@ def test_pinocchio_peer_is_the_same_mechanism(problem):
     assert np.abs(peer.com_motion(q, 0 * v, a0)[0] - ref).max() > 1e-4 * scale
 
 
-@pytest.mark.parametrize("problem", ("four_bar", "slider_crank", "palletizer"))
+@pytest.mark.parametrize("problem", ("four_bar", "four_bar_revolute", "slider_crank", "palletizer"))
 def test_mujoco_peer_is_the_same_mechanism(problem):
     pytest.importorskip("mujoco")
     model, topo, pin_peer, _q, v = _moving_state(problem)
@@ -78,7 +78,7 @@ def test_mujoco_peer_is_the_same_mechanism(problem):
     assert np.abs(lin_a - ref).max() < 1e-6 * np.abs(ref).max()
 
 
-@pytest.mark.parametrize("problem", ("four_bar", "slider_crank", "palletizer"))
+@pytest.mark.parametrize("problem", ("four_bar", "four_bar_revolute", "slider_crank", "palletizer"))
 def test_exudyn_peer_is_the_same_mechanism(problem):
     pytest.importorskip("exudyn")
     model, topo, pin_peer, q, v = _moving_state(problem)
