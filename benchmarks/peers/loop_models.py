@@ -215,6 +215,27 @@ def mujoco_xml(topo: Topology, h: float = 1e-4) -> str:
     for b in topo.free:
         children.setdefault("ground", []).append((None, b))
     imp = _v(SOLIMP)
+    soft = f'solref="{_f(TIMECONST_STEPS * h)} 1" solimp="{imp}"'
+    sites: dict[str, list[str]] = {}  # body -> its sites' MJCF (the rods' ends)
+    eq, tendons = [], []
+    for j in topo.closures:
+        f = topo.joints[j]
+        if f["type"] == "distance":
+            for end, body, point in (
+                ("a", f["parent"], f["point_parent"]),
+                ("b", f["child"], f["point_child"]),
+            ):
+                sites.setdefault(body, []).append(f'<site name="{j}_{end}" pos="{_v(point)}"/>')
+            tendons.append(
+                f'<spatial name="{j}"><site site="{j}_a"/><site site="{j}_b"/></spatial>'
+            )
+            eq.append(f'<tendon name="{j}" tendon1="{j}" {soft}/>')
+            continue
+        for k, (a, pa, b, _pb) in enumerate(topo.closure_points(j)):
+            b2 = "world" if b == "ground" else b
+            eq.append(
+                f'<connect name="{j}_{k}" body1="{a}" body2="{b2}" anchor="{_v(pa)}" {soft}/>'
+            )
 
     def body(name, joint, parent):
         r_p, p_p = topo.rot[parent], topo.pos[parent]
@@ -234,47 +255,19 @@ def mujoco_xml(topo: Topology, h: float = 1e-4) -> str:
         return (
             f'<body name="{name}" pos="{_v(rel_p)}" quat="{_v(rel_q)}">{jxml}'
             f'<inertial pos="0 0 0" mass="{_f(topo.mass[name])}" fullinertia="{_v(full)}"/>'
-            f"{inner}</body>"
+            f"{''.join(sites.get(name, []))}{inner}</body>"
         )
 
-    world = "".join(body(c, jc, "ground") for jc, c in children.get("ground", []))
-    eq, tendons = [], []
-    for j in topo.closures:
-        if topo.joints[j]["type"] == "distance":
-            f = topo.joints[j]
-            sa, sb = f"{j}_a", f"{j}_b"
-            world += ""  # sites are added inside bodies below through site_xml
-            topo_sites = topo.__dict__.setdefault("_sites", [])
-            topo_sites += [(f["parent"], sa, f["point_parent"]), (f["child"], sb, f["point_child"])]
-            tendons.append(f'<spatial name="{j}"><site site="{sa}"/><site site="{sb}"/></spatial>')
-            eq.append(
-                f'<tendon name="{j}" tendon1="{j}" solref="{_f(TIMECONST_STEPS * h)} 1" '
-                f'solimp="{imp}"/>'
-            )
-            continue
-        for k, (a, pa, b, _pb) in enumerate(topo.closure_points(j)):
-            b2 = "world" if b == "ground" else b
-            eq.append(
-                f'<connect name="{j}_{k}" body1="{a}" body2="{b2}" anchor="{_v(pa)}" '
-                f'solref="{_f(TIMECONST_STEPS * h)} 1" solimp="{imp}"/>'
-            )
-    xml = (
+    world = "".join(sites.get("ground", [])) + "".join(
+        body(c, jc, "ground") for jc, c in children.get("ground", [])
+    )
+    return (
         f'<mujoco model="loop"><compiler angle="radian" autolimits="true"/>'
         f'<option gravity="{_v(topo.model.gravity)}" integrator="RK4" timestep="{_f(h)}"/>'
         f"<worldbody>{world}</worldbody><equality>{''.join(eq)}</equality>"
         + (f"<tendon>{''.join(tendons)}</tendon>" if tendons else "")
         + "</mujoco>"
     )
-    for body_name, site, point in topo.__dict__.get("_sites", []):
-        tag = "<worldbody>" if body_name == "ground" else None
-        site_xml = f'<site name="{site}" pos="{_v(point)}"/>'
-        if tag:
-            xml = xml.replace(tag, tag + site_xml, 1)
-        else:
-            m = re.search(rf'<body name="{re.escape(body_name)}"[^>]*>', xml)
-            xml = xml[: m.end()] + site_xml + xml[m.end() :]
-    topo.__dict__.pop("_sites", None)
-    return xml
 
 
 class MujocoLoop(MujocoPeer):
