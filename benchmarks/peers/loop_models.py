@@ -407,9 +407,13 @@ class PinocchioLoop:
                     xb * pin.SE3(topo.rot[b].T, pb),
                     pin.ReferenceFrame.LOCAL,
                 )
-                cm.setBaumgarteCorrectorParameters(
-                    pin.BaumgarteCorrectorParameters(float(baumgarte[0]), float(baumgarte[1]))
-                )
+                if hasattr(cm, "setBaumgarteCorrectorParameters"):  # Pinocchio 4
+                    cm.setBaumgarteCorrectorParameters(
+                        pin.BaumgarteCorrectorParameters(float(baumgarte[0]), float(baumgarte[1]))
+                    )
+                else:  # Pinocchio 3: one gain per constraint row
+                    cm.corrector.Kp[:] = float(baumgarte[0])
+                    cm.corrector.Kd[:] = float(baumgarte[1])
                 self.constraints.append(cm)
         self.cdatas = pin.StdVec_RigidConstraintData()
         for cm in self.constraints:
