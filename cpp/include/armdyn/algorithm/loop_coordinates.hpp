@@ -80,6 +80,9 @@ void loop_state(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen::Ref<co
 /// independent dofs; LOCAL_WORLD_ALIGNED as frame_jacobian).
 const Mat4& loop_frame_pose(const Model& m, Data& d, Eigen::Ref<const VecX> q, int frame);
 const Mat6X& loop_frame_jacobian(const Model& m, Data& d, Eigen::Ref<const VecX> q, int frame);
+/// Every joint coordinate (Model::coords; nq_joint entries, no floating base) at the independent
+/// coordinates qi, those keeping qi's turns (simulate's q0 of a loop model). Allocates.
+VecX loop_full_coordinates(const Model& m, const VecX& qi);
 /// The independent coordinates and rates of a Cartesian state (u, v).
 void loop_joint_coordinates(const Model& m, const VecX& u, const VecX& v, VecX& q, VecX& qd);
 
