@@ -504,3 +504,14 @@ def test_select_drivetrain_takes_a_loop_mechanism():
     sel = ad.select_drivetrain(m, run, sel_mod.catalog(), drives=False)
     assert sel.converged and list(sel.table.index) == ["A"]
     assert sel.table.loc["A", "motor"] in sel_mod.MOTORS.index
+
+
+def test_simulate_from_independent_coordinates():
+    """simulate(q0=, qd0=) of a loop model takes its independent coordinates (turns kept): the
+    run starts at state_from_joints' state, the crank at 7 rad."""
+    m = four_bar()
+    res = ad.simulate(m, 0.01, q0=[7.0], qd0=[1.0], output_dt=0.005)
+    u, v = ad.state_from_joints(m, [7.0], [1.0])
+    ia = list(m.joint_coord_names).index("A")
+    assert abs(res.q[0, ia] - 7.0) < 1e-12 and abs(res.qd[0, ia] - 1.0) < 1e-12
+    assert np.max(np.abs(res.u[0] - u)) < 1e-12 and np.max(np.abs(res.v[0] - v)) < 1e-10

@@ -594,4 +594,20 @@ void loop_joint_coordinates(const Model& m, const VecX& u, const VecX& v, VecX& 
   }
 }
 
+VecX loop_full_coordinates(const Model& m, const VecX& qi) {
+  constexpr const char* fn = "simulate: q0";
+  Data d(m);
+  VecX u, v;
+  loop_state(m, d, qi, VecX::Zero(qi.size()), u, v, fn);
+  std::vector<BodyKin> kin;
+  body_kinematics(m, u.data(), nullptr, kin);
+  const int nf = static_cast<int>(m.coords.size());
+  VecX q(m.nq_joint);
+  for (int c = 0; c < nf; ++c) q[c] = coord_value(m, kin, c);
+  const IndependentCoords& ic = m.independent;
+  for (int k = 0; k < ic.n; ++k) q[ic.full[k]] = qi[k];
+  ic.align(m.coords, q.data());
+  return q;
+}
+
 }  // namespace armdyn

@@ -1,11 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The joint-level functions of a model with closed loops or ideal gears, in independent
+// The joint-level functions of a model with closed loops, in independent
 // coordinates, on the Cartesian formulation (methods.md's constrained Newton-Euler system).
 //
 // A model whose joints close loops (any joint closing a cycle, add_distance, bodies held only by
-// constraints) or that has ideal gears (add_gear) has `mobility` degrees of freedom but more joint
-// coordinates. finalize() chooses `mobility` of them as its independent coordinates
-// (Model::independent, Model::loop_coordinates): the user's (ModelBuilder::
+// constraints; ideal gears inside it included) has `mobility` degrees of freedom but more joint
+// coordinates (a tree with ideal gears keeps its convention: every coordinate, simulated in joint
+// space by the null space of the gear rows). finalize() chooses `mobility` of them as its
+// independent coordinates (Model::independent, Model::loop_coordinates): the user's (ModelBuilder::
 // set_independent_coordinates) or, by default, the joint coordinates in model order, each taken
 // when it is independent of those taken before at the assembled state (a pivoted rank test of the
 // coordinates' velocity rows on the null space of the joint rows). The joint-level functions then
@@ -34,8 +35,8 @@
 
 namespace armdyn {
 
-/// finalize's stage: Model::loop_coordinates and Model::independent for a model with loops or
-/// ideal gears (the user's Model::independent_request, or the default choice), else nothing.
+/// finalize's stage: Model::loop_coordinates and Model::independent for a model with loops (the
+/// user's Model::independent_request, or the default choice), else nothing.
 /// @throws ModelError on an invalid request (unknown or duplicate name, too few or too many, a
 ///   dependent coordinate, a model that is a tree), naming it.
 void choose_loop_coordinates(Model& m);
@@ -80,6 +81,9 @@ void loop_state(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen::Ref<co
 /// independent dofs; LOCAL_WORLD_ALIGNED as frame_jacobian).
 const Mat4& loop_frame_pose(const Model& m, Data& d, Eigen::Ref<const VecX> q, int frame);
 const Mat6X& loop_frame_jacobian(const Model& m, Data& d, Eigen::Ref<const VecX> q, int frame);
+/// Every joint coordinate (Model::coords; nq_joint entries, no floating base) at the independent
+/// coordinates qi, those keeping qi's turns (simulate's q0 of a loop model). Allocates.
+VecX loop_full_coordinates(const Model& m, const VecX& qi);
 /// The independent coordinates and rates of a Cartesian state (u, v).
 void loop_joint_coordinates(const Model& m, const VecX& u, const VecX& v, VecX& q, VecX& qd);
 

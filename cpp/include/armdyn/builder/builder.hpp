@@ -140,7 +140,7 @@ class ModelBuilder {
   ///   joint, the same joint twice, a joint without exactly one coordinate, joints of different
   ///   types, a non-finite or zero multiplier, a non-finite offset, a follower coupled twice or
   ///   a cycle of couplings.
-  /// The independent coordinates of a model with closed loops or ideal gears (by name, from
+  /// The independent coordinates of a model with closed loops (by name, from
   /// joint_coord_names; as many as its mobility, each independent of the others at the assembled
   /// state), checked by finalize (Model::loop_coordinates). An empty list: armdyn's default.
   void set_independent_coordinates(const std::vector<std::string>& names) {
