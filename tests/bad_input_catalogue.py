@@ -46,6 +46,24 @@ def _hinged_with(mass=1.0, position=(0.0, 0.0, -0.5), point=(0.0, 0.0, 0.0)):
     return b.finalize()
 
 
+def _four_bar_by_rocker(name="D"):
+    """A crank-rocker four-bar whose independent coordinate is `name` (the rocker D)."""
+    b = ad.ModelBuilder()
+    for body, pos in (
+        ("crank", (0.5, 0, 0)),
+        ("coupler", (1.0, 1.0, 0)),
+        ("rocker", (1.5, 1.0, 0)),
+    ):
+        b.add_body(body, 1.0, [0.01, 0.01, 0.01], position=pos)
+    z = (0, 0, 1)
+    b.add_revolute("A", "ground", "crank", (0, 0, 0), z)
+    b.add_revolute("B", "crank", "coupler", (1, 0, 0), z)
+    b.add_revolute("C", "coupler", "rocker", (1, 2, 0), z)
+    b.add_revolute("D", "rocker", "ground", (2, 0, 0), z)
+    b.set_independent_coordinates([name])
+    return b.finalize()
+
+
 def _pendulum():
     return _hinged().finalize()
 
@@ -731,10 +749,28 @@ CASES = [
     (
         "fd-on-loop",
         "arrays",
-        "forward_dynamics on a closed loop",
+        "forward_dynamics on a closed loop given every joint's coordinate (it takes the "
+        "independent ones, model.coord_names)",
         lambda: ad.forward_dynamics(ad.scenes.four_bar(), np.zeros(4), np.zeros(4), np.zeros(4)),
         ME,
-        "loop",
+        r"q: expected shape \(1,\)",
+    ),
+    (
+        "loop-beyond-reach",
+        "arrays",
+        "inverse_dynamics of a four-bar whose rocker (its independent coordinate) is turned "
+        "beyond the linkage's reach",
+        lambda: ad.inverse_dynamics(_four_bar_by_rocker(), [1.5], [0.0], [0.0]),
+        SE,
+        r"no configuration at the independent coordinates \(D = 1\.5\)",
+    ),
+    (
+        "loop-coordinate-unknown",
+        "arrays",
+        "set_independent_coordinates naming no joint coordinate",
+        lambda: _four_bar_by_rocker("E"),
+        ME,
+        r"unknown joint coordinate 'E'",
     ),
     # ---- solver options
     (
@@ -949,10 +985,11 @@ CASES = [
     (
         "jr-on-loop",
         "inverse dynamics",
-        "joint_reactions on a closed loop",
+        "joint_reactions on a closed loop given every joint's coordinate (it takes the "
+        "independent ones)",
         lambda: ad.joint_reactions(ad.scenes.four_bar(), np.zeros(4), np.zeros(4), np.zeros(4)),
         ME,
-        "loop",
+        r"q: expected shape \(1,\)",
     ),
     (
         "jr-overflow",
@@ -1131,7 +1168,7 @@ CASES = [
         "derivatives",
         "forward_dynamics_derivatives on a closed loop",
         lambda: ad.forward_dynamics_derivatives(
-            ad.scenes.four_bar(), np.zeros(4), np.zeros(4), np.zeros(4)
+            ad.scenes.four_bar(), np.zeros(1), np.zeros(1), np.zeros(1)
         ),
         ME,
         "loop",

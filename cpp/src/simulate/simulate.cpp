@@ -12,6 +12,7 @@
 #include "armdyn/algorithm/driven_inverse_dynamics.hpp"
 #include "armdyn/algorithm/forces.hpp"
 #include "armdyn/algorithm/kinematics.hpp"
+#include "armdyn/algorithm/loop_coordinates.hpp"
 #include "armdyn/algorithm/projection.hpp"
 #include "armdyn/builder/weld.hpp"
 #include "armdyn/data.hpp"
@@ -511,6 +512,7 @@ Metric projection_from_name(const std::string& name) {
 VecX q_start_from_independent(const Model& m, const VecX& qi) {
   if (qi.size() != m.independent.nq())
     throw ModelError(msg("q0 must have ", m.independent.nq(), " entries, got ", qi.size()));
+  if (m.loop_coordinates) return loop_full_coordinates(m, qi);
   VecX q(m.nq_joint);
   m.independent.expand_q(qi.data(), q.data());
   return q;
