@@ -267,6 +267,41 @@ def test_delta_forward_run_follows_the_motion(delta_run):
     np.testing.assert_allclose(res.q[:, :3], want, rtol=0, atol=1e-8)
 
 
+# ---------------------------------------------------------------------------------------------
+# the joint-level API on the loop models (independent coordinates: the actuated joints)
+
+
+def test_four_bar_inverse_dynamics_on_the_crank(four_bar_run):
+    """ad.inverse_dynamics of the undriven four-bar in its independent coordinate (the crank,
+    added first) gives the reference torque along the same motion."""
+    _, t, _, tau = four_bar_run
+    free = four_bar()
+    assert list(free.coord_names) == ["A"]
+    q, qd, qdd = (x[:, None] for x in crank_motion(t))
+    np.testing.assert_allclose(ad.inverse_dynamics(free, q, qd, qdd)[:, 0], tau, rtol=0, atol=1e-10)
+
+
+def test_delta_inverse_dynamics_on_the_arms(delta_run):
+    _, t, _, tau, _ = delta_run
+    free = mc.delta_robot()
+    assert tuple(free.coord_names) == mc.DELTA_ACTUATED
+    q, qd, qdd = (np.array([arm_motion(ti)[k] for ti in t]) for k in range(3))
+    np.testing.assert_allclose(ad.inverse_dynamics(free, q, qd, qdd), tau, rtol=0, atol=1e-10)
+
+
+@pytest.mark.parametrize("machine", ["palletizer", "delta"])
+def test_trajectory_run_of_a_cycle_is_the_driven_inverse_dynamics(machine):
+    """trajectory_run takes a machine's cycle in its actuated coordinates: the joint torques
+    are driven_inverse_dynamics' drive forces (so sizing_report and select_drivetrain take the
+    machines as they take serial arms)."""
+    cycle = mc.pick_and_place(machine).sample(dt=0.01)
+    build = mc.palletizer if machine == "palletizer" else mc.delta_robot
+    run = ad.trajectory_run(build(), cycle)
+    driven = ad.driven_inverse_dynamics(build(drives=cycle), run.t)
+    scale = np.abs(driven.drive_forces).max()
+    np.testing.assert_allclose(run.joint_torques, driven.drive_forces, rtol=0, atol=1e-12 * scale)
+
+
 def _open_loop_growth():
     """The four-bar driven by its reference torques along three crank motions, at two
     tolerances: the largest deviation from the motion over 5 s (the figures of crank_motion's
