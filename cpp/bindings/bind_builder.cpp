@@ -128,7 +128,7 @@ void def_builder_joints(BuilderClass& cls) {
 void def_builder_closures(BuilderClass& cls) {
   cls.def(
          "set_independent_coordinates",
-         [](ModelBuilder& b, const py::object& names) {
+         [](ModelBuilder& b, const StrSeq& names) {
            const char* fn = "ModelBuilder.set_independent_coordinates";
            if (PyUnicode_Check(names.ptr()) || !py::isinstance<py::sequence>(names))
              throw ModelError(msg(

@@ -560,7 +560,7 @@ class ModelBuilder:
         """
         Validate, analyse topology and rank, assemble; returns an immutable Model.
         """
-    def set_independent_coordinates(self, names: typing.Any) -> None:
+    def set_independent_coordinates(self, names: collections.abc.Sequence[str]) -> None:
         """
         The independent coordinates of a model with closed loops: names from joint_coord_names, as many as the model's mobility, in the order q, qd, qdd and tau take them. finalize() checks them (ModelError naming an unknown or repeated name, a wrong count, a coordinate the others determine at the assembled state, or a tree). An empty list restores armdyn's default: the joint coordinates in model order, each taken when independent of those taken before (add the actuated joints first).
         """
