@@ -17,43 +17,25 @@ std::string dependent_row_names(const Model& m, const Data& d) {
   return rows;
 }
 
-namespace {
-
-// block blk's rows: the largest |zeta_r vd + xi_r| / (sum_j |zeta_rj| vmax + |xi_r|) into worst
-// (R rows at compile time, 0: at run time), a slot's six columns at a time
-template <int R>
-void block_residual(const ConstraintBlock& blk, const double* xi, const VecX& vd, double vmax,
-                    double& worst) {
-  constexpr int kMax = R > 0 ? R : 6;
-  using Col = Eigen::Matrix<double, R == 0 ? Eigen::Dynamic : R, 1, 0, kMax, 1>;
-  const int n = R > 0 ? R : blk.nrows;
-  Col sum = Eigen::Map<const Col>(xi, n), zsum = Col::Zero(n);
-  for (int k = 0; k < blk.nbody; ++k) {
-    if (blk.body[k] == kGround) continue;
-    const auto z = blk.J.block<R == 0 ? Eigen::Dynamic : R, 6>(0, 6 * k, n, 6);
-    sum.noalias() += z * vd.segment<6>(6 * blk.body[k]);
-    zsum.noalias() += z.cwiseAbs().rowwise().sum();
-  }
-  for (int r = 0; r < n; ++r) {
-    const double size = zsum[r] * vmax + std::abs(xi[r]);
-    if (size > 0.0) worst = std::max(worst, std::abs(sum[r]) / size);
-  }
-}
-
-}  // namespace
-
 double constraint_residual(const ConstraintEval& ce, int nrows, const VecX& vd) {
   const double vmax = vd.cwiseAbs().maxCoeff();
   double worst = 0.0;
   for (const ConstraintBlock& blk : ce.blocks) {
     if (blk.row0 >= nrows) continue;
-    const double* xi = ce.xi.data() + blk.row0;
-    if (blk.nrows == 5)
-      block_residual<5>(blk, xi, vd, vmax, worst);
-    else if (blk.nrows == 1)
-      block_residual<1>(blk, xi, vd, vmax, worst);
-    else
-      block_residual<0>(blk, xi, vd, vmax, worst);
+    for (int r = 0; r < blk.nrows; ++r) {
+      const double xi = ce.xi[blk.row0 + r];
+      double sum = xi, zsum = 0.0;
+      for (int k = 0; k < blk.nbody; ++k) {
+        if (blk.body[k] == kGround) continue;
+        for (int c = 0; c < 6; ++c) {
+          const double z = blk.J(r, 6 * k + c);
+          sum += z * vd[6 * blk.body[k] + c];
+          zsum += std::abs(z);
+        }
+      }
+      const double size = zsum * vmax + std::abs(xi);
+      if (size > 0.0) worst = std::max(worst, std::abs(sum) / size);
+    }
   }
   return worst;
 }
