@@ -26,6 +26,15 @@ def _b(name="link"):
     return b
 
 
+def _mjcf(mass="1", pos="0 0 0", site="", world=""):
+    """A one-hinge MJCF arm with the given body mass and position."""
+    return (
+        f'<mujoco><worldbody><body name="link" pos="{pos}"><joint name="hinge" type="hinge"/>'
+        f'<inertial pos="0 0 0.5" mass="{mass}" diaginertia="0.1 0.1 0.1"/>{site}</body>'
+        f"{world}</worldbody></mujoco>"
+    )
+
+
 def _hinged():
     b = _b("link")
     b.add_revolute("hinge", "ground", "link", (0, 0, 0), (0, 1, 0))
@@ -43,6 +52,24 @@ def _hinged_with(mass=1.0, position=(0.0, 0.0, -0.5), point=(0.0, 0.0, 0.0)):
     b = ad.ModelBuilder()
     b.add_body("link", mass, I3, position=position)
     b.add_revolute("hinge", "ground", "link", point, (0, 1, 0))
+    return b.finalize()
+
+
+def _four_bar_by_rocker(name="D"):
+    """A crank-rocker four-bar whose independent coordinate is `name` (the rocker D)."""
+    b = ad.ModelBuilder()
+    for body, pos in (
+        ("crank", (0.5, 0, 0)),
+        ("coupler", (1.0, 1.0, 0)),
+        ("rocker", (1.5, 1.0, 0)),
+    ):
+        b.add_body(body, 1.0, [0.01, 0.01, 0.01], position=pos)
+    z = (0, 0, 1)
+    b.add_revolute("A", "ground", "crank", (0, 0, 0), z)
+    b.add_revolute("B", "crank", "coupler", (1, 0, 0), z)
+    b.add_revolute("C", "coupler", "rocker", (1, 2, 0), z)
+    b.add_revolute("D", "rocker", "ground", (2, 0, 0), z)
+    b.set_independent_coordinates([name])
     return b.finalize()
 
 
@@ -695,6 +722,79 @@ CASES = [
         UE,
         "40001 attributes, more than the limit of 1000",
     ),
+    # ---- MJCF (issue 36; armdyn.load_mjcf through MuJoCo's parser, docs/mjcf.md)
+    (
+        "mjcf-missing-file",
+        "mjcf",
+        "a path that does not exist",
+        lambda: ad.load_mjcf(DATA / "no_such_robot.xml"),
+        ME,
+        r"MJCF file '.*no_such_robot\.xml' does not exist",
+    ),
+    (
+        "mjcf-device",
+        "mjcf",
+        "/dev/zero as the file",
+        lambda: ad.load_mjcf("/dev/zero"),
+        ME,
+        r"'/dev/zero' is a character device, not a regular file",
+    ),
+    (
+        "mjcf-truncated",
+        "mjcf",
+        "truncated XML",
+        lambda: ad.load_mjcf("<mujoco><worldbody><body><joint type='hin"),
+        ME,
+        r"MJCF string: not well-formed XML: unclosed token",
+    ),
+    (
+        "mjcf-urdf-root",
+        "mjcf",
+        "a URDF given to load_mjcf",
+        lambda: ad.load_mjcf("<robot name='r'/>"),
+        ME,
+        r"root element is <robot>, not <mujoco>",
+    ),
+    (
+        "mjcf-nan-position",
+        "mjcf",
+        "a body position of NaN (MuJoCo accepts it)",
+        lambda: ad.load_mjcf(_mjcf(pos="nan 0 0"), warn=False),
+        ME,
+        r"body 'link': position at qpos0 is not finite",
+    ),
+    (
+        "mjcf-mass-overflow",
+        "mjcf",
+        "a body mass of 1e300 (finalize)",
+        lambda: ad.load_mjcf(_mjcf(mass="1e300"), warn=False),
+        ME,
+        r"body 'link': mass = 1e\+300",
+    ),
+    (
+        "mjcf-open-loop",
+        "mjcf",
+        "a connect between sites apart at qpos0",
+        lambda: ad.load_mjcf(
+            _mjcf(
+                site='<site name="s1" pos="0.5 0 0"/>', world='<site name="s2" pos="0.7 0 0"/>'
+            ).replace(
+                "</mujoco>",
+                '<equality><connect name="hold" site1="s1" site2="s2"/></equality></mujoco>',
+            ),
+            warn=False,
+        ),
+        ME,
+        r"equality connect 'hold': not satisfied at qpos0",
+    ),
+    (
+        "mjcf-fixed-base-type",
+        "mjcf",
+        "fixed_base='yes'",
+        lambda: ad.load_mjcf(_mjcf(), fixed_base="yes"),
+        ME,
+        r"load_mjcf: fixed_base must be True or False, got 'yes'",
+    ),
     # ---- arrays and joint-space calls
     (
         "fd-q-length",
@@ -731,10 +831,28 @@ CASES = [
     (
         "fd-on-loop",
         "arrays",
-        "forward_dynamics on a closed loop",
+        "forward_dynamics on a closed loop given every joint's coordinate (it takes the "
+        "independent ones, model.coord_names)",
         lambda: ad.forward_dynamics(ad.scenes.four_bar(), np.zeros(4), np.zeros(4), np.zeros(4)),
         ME,
-        "loop",
+        r"q: expected shape \(1,\)",
+    ),
+    (
+        "loop-beyond-reach",
+        "arrays",
+        "inverse_dynamics of a four-bar whose rocker (its independent coordinate) is turned "
+        "beyond the linkage's reach",
+        lambda: ad.inverse_dynamics(_four_bar_by_rocker(), [1.5], [0.0], [0.0]),
+        SE,
+        r"no configuration at the independent coordinates \(D = 1\.5\)",
+    ),
+    (
+        "loop-coordinate-unknown",
+        "arrays",
+        "set_independent_coordinates naming no joint coordinate",
+        lambda: _four_bar_by_rocker("E"),
+        ME,
+        r"unknown joint coordinate 'E'",
     ),
     # ---- solver options
     (
@@ -949,10 +1067,11 @@ CASES = [
     (
         "jr-on-loop",
         "inverse dynamics",
-        "joint_reactions on a closed loop",
+        "joint_reactions on a closed loop given every joint's coordinate (it takes the "
+        "independent ones)",
         lambda: ad.joint_reactions(ad.scenes.four_bar(), np.zeros(4), np.zeros(4), np.zeros(4)),
         ME,
-        "loop",
+        r"q: expected shape \(1,\)",
     ),
     (
         "jr-overflow",
@@ -1131,7 +1250,7 @@ CASES = [
         "derivatives",
         "forward_dynamics_derivatives on a closed loop",
         lambda: ad.forward_dynamics_derivatives(
-            ad.scenes.four_bar(), np.zeros(4), np.zeros(4), np.zeros(4)
+            ad.scenes.four_bar(), np.zeros(1), np.zeros(1), np.zeros(1)
         ),
         ME,
         "loop",
@@ -1371,6 +1490,55 @@ CASES = [
         lambda: _least_energy(duration=0.2, max_torque=0.5),
         SE,
         "most exceeded limit is torque of joint 'hinge'",
+    ),
+    # ---- example machines (issue 36)
+    (
+        "palletizer-closure",
+        "scenes",
+        "palletizer with closure='weld'",
+        lambda: ad.scenes.palletizer(closure="weld"),
+        ME,
+        "closure",
+    ),
+    (
+        "palletizer-payload",
+        "scenes",
+        "palletizer with a negative payload",
+        lambda: ad.scenes.palletizer(payload=-1.0),
+        ME,
+        "payload",
+    ),
+    (
+        "delta-rod-short",
+        "scenes",
+        "delta robot whose rods cannot reach the plate",
+        lambda: ad.scenes.delta_robot(geometry=ad.scenes.machines.DeltaGeometry(rod=0.3)),
+        ME,
+        r"geometry\.rod",
+    ),
+    (
+        "machine-drive-passive",
+        "scenes",
+        "delta robot driven on a rod",
+        lambda: ad.scenes.delta_robot(drives={"rod1a": 0.0}),
+        ME,
+        "rod1a",
+    ),
+    (
+        "cycle-machine",
+        "scenes",
+        "pick_and_place of an unknown machine",
+        lambda: ad.scenes.pick_and_place("scara"),
+        ME,
+        "machine",
+    ),
+    (
+        "delta-ik-reach",
+        "scenes",
+        "delta_ik of a plate position out of reach",
+        lambda: ad.scenes.machines.delta_ik([[0.0, 0.0, -0.8], [0.0, 0.0, -3.0]]),
+        SE,
+        "position 1",
     ),
     # ---- motion: joint trajectories
     (
@@ -1612,6 +1780,16 @@ CASES = [
         ),
         ME,
         "period must be a positive number",
+    ),
+    (
+        "excitation-unknown-criterion",
+        "identification",
+        "fourier_excitation with a criterion it does not know",
+        lambda: _identification().fourier_excitation(
+            _pendulum(), max_velocity=1.0, criterion="log-det"
+        ),
+        ME,
+        "criterion",
     ),
     (
         "excitation-torque-infeasible",

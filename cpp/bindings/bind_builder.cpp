@@ -127,20 +127,40 @@ void def_builder_joints(BuilderClass& cls) {
 
 void def_builder_closures(BuilderClass& cls) {
   cls.def(
-         "add_distance",
-         [](ModelBuilder& b, const StrArg& n_, const StrArg& ba_, const ArrayLike& pa,
-            const StrArg& bb_, const ArrayLike& pb) {
-           const char* fn = "ModelBuilder.add_distance";
-           const std::string n = str_arg(n_, fn, "name"), ba = str_arg(ba_, fn, "body_a"),
-                             bb = str_arg(bb_, fn, "body_b");
-           const std::string who = "joint '" + n + "'";
-           return b.add_distance(n, ba, to_vec3(pa, who + ": point_a"), bb,
-                                 to_vec3(pb, who + ": point_b"));
+         "set_independent_coordinates",
+         [](ModelBuilder& b, const StrSeq& names) {
+           const char* fn = "ModelBuilder.set_independent_coordinates";
+           if (PyUnicode_Check(names.ptr()) || !py::isinstance<py::sequence>(names))
+             throw ModelError(msg(
+                 fn, ": names must be a list of joint coordinate names (str), got ", shown(names)));
+           std::vector<std::string> v;
+           for (const py::handle h : py::reinterpret_borrow<py::sequence>(names))
+             v.push_back(str_arg(h, fn, "each name"));
+           b.set_independent_coordinates(v);
          },
-         py::arg("name"), py::arg("body_a"), py::arg("point_a"), py::arg("body_b"),
-         py::arg("point_b"),
-         "Distance joint, 1 row: a massless rod with ball ends between point_a of body_a and "
-         "point_b of body_b (world coordinates at assembly); it holds their assembly distance.")
+         py::arg("names"),
+         "The independent coordinates of a model with closed loops: names from "
+         "joint_coord_names, as many as the model's mobility, in the order q, qd, qdd and tau "
+         "take them. finalize() checks them (ModelError naming an unknown or repeated name, a "
+         "wrong count, a coordinate the others determine at the assembled state, or a tree). "
+         "An empty list restores armdyn's default: the joint coordinates in model order, each "
+         "taken when independent of those taken before (add the actuated joints first).")
+      .def(
+
+          "add_distance",
+          [](ModelBuilder& b, const StrArg& n_, const StrArg& ba_, const ArrayLike& pa,
+             const StrArg& bb_, const ArrayLike& pb) {
+            const char* fn = "ModelBuilder.add_distance";
+            const std::string n = str_arg(n_, fn, "name"), ba = str_arg(ba_, fn, "body_a"),
+                              bb = str_arg(bb_, fn, "body_b");
+            const std::string who = "joint '" + n + "'";
+            return b.add_distance(n, ba, to_vec3(pa, who + ": point_a"), bb,
+                                  to_vec3(pb, who + ": point_b"));
+          },
+          py::arg("name"), py::arg("body_a"), py::arg("point_a"), py::arg("body_b"),
+          py::arg("point_b"),
+          "Distance joint, 1 row: a massless rod with ball ends between point_a of body_a and "
+          "point_b of body_b (world coordinates at assembly); it holds their assembly distance.")
       .def(
           "add_spherical",
           [](ModelBuilder& b, const StrArg& n, const StrArg& p, const StrArg& c,

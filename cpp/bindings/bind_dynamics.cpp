@@ -9,9 +9,11 @@
 #include "armdyn/algorithm/forces.hpp"
 #include "armdyn/algorithm/kinematics.hpp"
 #include "armdyn/algorithm/kkt.hpp"
+#include "armdyn/algorithm/loop_coordinates.hpp"
 #include "armdyn/data.hpp"
 #include "armdyn/kernels/joint_space.hpp"
 #include "common.hpp"
+#include "rows.hpp"
 
 namespace armdyn {
 
@@ -20,7 +22,17 @@ using namespace py_helpers;
 
 namespace {
 
-auto state_from_joints_py(const Model& md, const ArrayLike& q, const OptArrayLike& qd) {
+auto state_from_joints_py(const ModelArg& model, const ArrayLike& q, const OptArrayLike& qd) {
+  const ModelHolder holder = model_of(model, "state_from_joints");
+  const Model& md = *holder;
+  if (md.loop_coordinates) {
+    // a model with loops: the position and velocity problems from this thread's last state
+    const long n = md.independent.n;
+    const VecX qi = to_vec(q, "q", n), qdi = qd.is_none() ? VecX::Zero(n) : to_vec(qd, "qd", n);
+    VecX u, v;
+    loop_state(md, cached_data(holder), qi, qdi, u, v, "state_from_joints");
+    return py::make_tuple(to_numpy(u), to_numpy(v));
+  }
   // the sizes below are the joint space's: refused first for a model without one
   require_joint_space(md, "state_from_joints", true);
   const long nq = md.independent.nq(), n = md.independent.nv();
@@ -32,6 +44,10 @@ auto state_from_joints_py(const Model& md, const ArrayLike& q, const OptArrayLik
 
 auto joint_coordinates_py(const Model& md, const ArrayLike& u, const ArrayLike& v) {
   VecX q, qd;
+  if (md.loop_coordinates) {
+    loop_joint_coordinates(md, to_vec(u, "u", md.nq), to_vec(v, "v", md.nv), q, qd);
+    return py::make_tuple(to_numpy(q), to_numpy(qd));
+  }
   independent_joint_coordinates(md, to_vec(u, "u", md.nq), to_vec(v, "v", md.nv), q, qd);
   return py::make_tuple(to_numpy(q), to_numpy(qd));
 }
@@ -80,13 +96,17 @@ py::array_t<double> body_mass_matrix_py(const Model& md) {
 }  // namespace
 
 void bind_dynamics(py::module_& m) {
-  m.def("state_from_joints", &state_from_joints_py, py::arg("model"), py::arg("q"),
-        py::arg("qd") = py::none(),
-        "Cartesian state (u, v) of a joint-space tree model from joint-space q (n_coords) and qd "
-        "(n_dofs; default zero): a coupled model's independent coordinates, the followers set by "
-        "their couplings. Returns (u (nq,), v (nv,)) float64 arrays: per body CoM [m] and unit "
-        "Euler parameters; CoM velocity [m/s, world] and angular velocity [rad/s, body]. "
-        "ModelError on a model without a joint space or wrong shapes.");
+  m.def(
+      "state_from_joints", &state_from_joints_py, py::arg("model"), py::arg("q"),
+      py::arg("qd") = py::none(),
+      "Cartesian state (u, v) of a joint-space tree model from joint-space q (n_coords) and qd "
+      "(n_dofs; default zero): a coupled model's independent coordinates, the followers set by "
+      "their couplings. Returns (u (nq,), v (nv,)) float64 arrays: per body CoM [m] and unit "
+      "Euler parameters; CoM velocity [m/s, world] and angular velocity [rad/s, body]. "
+      "ModelError on a model without a joint space or wrong shapes. A model with closed loops: its "
+      "independent coordinates, the others solved from the loop constraints (Newton from this "
+      "thread's last solution: the assembly branch kept; SolverError at a singular "
+      "configuration).");
 
   m.def("joint_coordinates", &joint_coordinates_py, py::arg("model"), py::arg("u"), py::arg("v"),
         "Joint-space q (n_coords: floating bases' poses, then joint coordinates with angles in "

@@ -17,7 +17,7 @@ py::array_t<double> frame_pose_py(const ModelArg& model, const ArrayLike& q, con
                                   const OptData& data) {
   constexpr const char* fn = "frame_pose";
   const CallArgs a = call_args(model, data, fn);
-  require_joint_space(a.model(), fn, true);
+  if (!a.model().loop_coordinates) require_joint_space(a.model(), fn, true);
   const int f = frame_arg(a.model(), frame, fn);
   return per_state(fn, "q", a.data.niq, q, {4, 4}, [&](const auto& qi, double* out) {
     copy_row_major(frame_pose(a.model(), a.data, qi, f), out);
@@ -28,7 +28,7 @@ py::array_t<double> frame_jacobian_py(const ModelArg& model, const ArrayLike& q,
                                       const FrameRef& frame, const OptData& data) {
   constexpr const char* fn = "frame_jacobian";
   const CallArgs a = call_args(model, data, fn);
-  require_joint_space(a.model(), fn, true);
+  if (!a.model().loop_coordinates) require_joint_space(a.model(), fn, true);
   const int f = frame_arg(a.model(), frame, fn);
   return per_state(fn, "q", a.data.niq, q, {6, a.data.ni}, [&](const auto& qi, double* out) {
     copy_row_major(frame_jacobian(a.model(), a.data, qi, f), out);

@@ -38,6 +38,7 @@ ARMDYN_HINTED_OBJECT(OptProfileLike)  // the same or None
 ARMDYN_HINTED_OBJECT(OptFloat)        // float | None
 ARMDYN_HINTED_OBJECT(OptStr)          // str | None
 ARMDYN_HINTED_OBJECT(StrArg)          // str (checked by str_arg: a ModelError, never a cast error)
+ARMDYN_HINTED_OBJECT(StrSeq)          // collections.abc.Sequence[str] (checked where it is taken)
 ARMDYN_HINTED_OBJECT(FloatArg)        // a real number (checked by float_arg)
 ARMDYN_HINTED_OBJECT(IntArg)          // an integer (checked by int_arg)
 ARMDYN_HINTED_OBJECT(BoolArg)         // bool (checked by bool_arg)
@@ -284,6 +285,7 @@ ARMDYN_TYPE_HINT(OptProfileLike, ARMDYN_PROFILE_HINT " | None")
 ARMDYN_TYPE_HINT(OptFloat, "float | None")
 ARMDYN_TYPE_HINT(OptStr, "str | None")
 ARMDYN_TYPE_HINT(StrArg, "str")
+ARMDYN_TYPE_HINT(StrSeq, "collections.abc.Sequence[str]")
 // the hints pybind11 prints for double and int arguments (the stubs unchanged)
 ARMDYN_TYPE_HINT(FloatArg, "typing.SupportsFloat | typing.SupportsIndex")
 ARMDYN_TYPE_HINT(IntArg, "typing.SupportsInt | typing.SupportsIndex")

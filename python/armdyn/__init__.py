@@ -45,6 +45,7 @@ from armdyn._core import (
 )
 from armdyn.animation import animate  # k3d and trimesh are imported when animate() runs
 from armdyn.dynamics import InverseDynamicsResult, driven_inverse_dynamics
+from armdyn.mjcf import load_mjcf  # mujoco is imported when load_mjcf runs
 from armdyn.simulation import SimulationResult, load_urdf, rollout, simulate
 from armdyn.sizing import (
     Catalog,
@@ -114,6 +115,7 @@ __all__ = [
     "joint_torque_regressor",
     "limit_violations",
     "load_catalog",
+    "load_mjcf",
     "load_urdf",
     "mass_matrix",
     "motion",

@@ -143,17 +143,23 @@ and joint, the fixed joints' reactions from their bodies' Newton–Euler balance
     ),
     RunOption(
         "coordinates",
-        "cartesian",
+        "auto",
         _choice(("cartesian", "joint", "auto")),
         _as_is,
-        """``"cartesian"`` (default): the bodies' Cartesian state with the
+        """``"auto"`` (default): the cheaper exact formulation for the scene: joint
+space where it applies (a tree without drives, no light bodies on a geared model),
+no joint limit stop is in play (``limits="enforce"`` with a limited joint: the
+Cartesian path holds a joint resting on its stop with far fewer events) and the
+measured cost model (:func:`armdyn.dynamics_cost`) predicts its right-hand side
+cheaper, else Cartesian. ``"cartesian"``: the bodies' Cartesian state with the
 constrained Newton–Euler equations and the topological projection (the paper's
 method; any mechanism). ``"joint"``: the joint coordinates and rates of a tree
 without drives, ideal gears allowed: the mass matrix by the composite-rigid-body
 algorithm, the bias and applied forces by recursive Newton–Euler, the gears
 eliminated by their null space (far fewer states and a cheaper right-hand side;
-the error control then acts on (q, qd)). Outputs are the same tables, built from
-(q, qd). ``"auto"``: joint space wherever it applies, else Cartesian.
+the error control then acts on (q, qd)). Outputs are the same tables either way
+(joint space builds them from (q, qd): reactions from the bodies' Newton–Euler
+balances, the constraint residuals of the Cartesian state it reports).
 ``stats["formulation"]`` names the path taken (and for ``"auto"`` why).""",
     ),
     RunOption(

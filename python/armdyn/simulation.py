@@ -192,7 +192,7 @@ def simulate(
     u0: npt.ArrayLike | None = None,
     v0: npt.ArrayLike | None = None,
     merge_welded: bool = True,
-    coordinates: str = "cartesian",
+    coordinates: str = "auto",
     limits: str = "enforce",
     restitution: float = 0.0,
     progress: _Progress = False,

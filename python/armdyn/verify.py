@@ -21,6 +21,10 @@ from armdyn import scenes
 from armdyn._rotation import quat_to_rot
 from armdyn.scenes.extreme import random_spatial_arm
 
+# the runs are of the paper's Cartesian formulation, whose accuracy the figures document
+# (simulate's default, coordinates="auto", may take joint space for the open trees)
+CART = "cartesian"
+
 
 def _crossing(t, y, k):
     """Root of y(t) in [t[k], t[k+1]] from a degree-6 polynomial through 7 samples around it."""
@@ -41,7 +45,7 @@ def pendulum_period(theta0, rtol=1e-12, length=1.0, mass=1.0, radius=1e-3, g=9.8
     omega0 = np.sqrt(mass * g * length / i_pivot)
     exact = 4.0 / omega0 * ellipk(np.sin(theta0 / 2) ** 2)
     dt = exact / 400
-    res = ad.simulate(model, 0.6 * exact, rtol=rtol, atol=rtol, output_dt=dt)
+    res = ad.simulate(model, 0.6 * exact, rtol=rtol, atol=rtol, output_dt=dt, coordinates=CART)
     # half a period: the angular velocity returns to zero at the opposite extreme
     qd = res.qd[:, 0]
     k = next(i for i in range(5, len(qd) - 1) if qd[i] * qd[i + 1] <= 0)
@@ -51,7 +55,7 @@ def pendulum_period(theta0, rtol=1e-12, length=1.0, mass=1.0, radius=1e-3, g=9.8
 def conservation(rtol=1e-10):
     out = {}
     dp = scenes.double_pendulum()
-    r = ad.simulate(dp, 10.0, rtol=rtol, atol=rtol, output_dt=0.01)
+    r = ad.simulate(dp, 10.0, rtol=rtol, atol=rtol, output_dt=0.01, coordinates=CART)
     e = r.total_energy
     out["double pendulum energy (rel. to peak kinetic)"] = (
         np.abs(e - e[0]).max() / r.kinetic_energy.max()
@@ -59,7 +63,7 @@ def conservation(rtol=1e-10):
     fb = scenes.free_body((1.0, 2.0, 3.0))
     v0 = fb.v0.copy()
     v0[3:6] = [0.3, 1.0, 0.2]
-    r = ad.simulate(fb, 10.0, rtol=rtol, atol=rtol, output_dt=0.01, v0=v0)
+    r = ad.simulate(fb, 10.0, rtol=rtol, atol=rtol, output_dt=0.01, v0=v0, coordinates=CART)
     e = r.total_energy
     out["free body energy (rel.)"] = np.abs(e - e[0]).max() / e[0]
     rots = np.array([quat_to_rot(u[3:7]) for u in r.u])
@@ -74,7 +78,7 @@ def drift(steps=10_000, dt=1e-3):
         ("double pendulum", scenes.double_pendulum()),
         ("slider-crank (closed loop, driven)", scenes.slider_crank()),
     ]:
-        r = ad.simulate(model, steps * dt, integrator="rk4", dt=dt, output_dt=dt)
+        r = ad.simulate(model, steps * dt, integrator="rk4", dt=dt, output_dt=dt, coordinates=CART)
         out[name] = (len(r.t) - 1, r.position_residual.max(), r.velocity_residual.max())
     return out
 

@@ -234,7 +234,7 @@ def test_jacobian_matches_finite_differences_and_body_velocities(rng):
 
 
 def test_cartesian_frames_on_a_closed_loop():
-    """frame_pose_cartesian works where the joint-space calls do not (a four-bar loop)."""
+    """frame_pose_cartesian on a four-bar loop, and frame_pose in its independent coordinate."""
     b = ad.ModelBuilder()
     b.add_body("crank", 1.0, [0.01, 0.01, 0.01], (0.5, 0, 0))
     b.add_body("coupler", 1.0, [0.01, 0.01, 0.01], (1.0, 1.0, 0))
@@ -251,8 +251,10 @@ def test_cartesian_frames_on_a_closed_loop():
     T = ad.frame_pose_cartesian(m, m.u0, "pin")
     np.testing.assert_allclose(T[:3, 3], [1.0, 2.0, 0.0], rtol=0, atol=1e-14)
     np.testing.assert_allclose(T[:3, :3], quat_to_rot(quat), rtol=0, atol=1e-14)
-    with pytest.raises(ad.ModelError, match="frame_pose: needs a tree"):
-        ad.frame_pose(m, np.zeros(m.n_coords), "pin")
+    # the joint-level call takes the loop's independent coordinate (j0): at its assembled
+    # value, the assembled pose
+    assert list(m.coord_names) == ["j0"]
+    np.testing.assert_allclose(ad.frame_pose(m, np.zeros(m.n_coords), "pin"), T, rtol=0, atol=1e-14)
 
 
 # ----------------------------------------------------------------------------------------------

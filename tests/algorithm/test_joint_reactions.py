@@ -285,7 +285,11 @@ def test_hostile_inputs_name_their_culprit():
         ((model, z, z, z, np.nan), r"\bt is not finite"),
         ((model, z, z, z, "x"), r"\bt must be a number"),
         ((model, rows, rows, rows, [0.0, 1.0]), r"\bt: expected shape \(3,\)"),
-        ((ad.scenes.four_bar(), np.zeros(4), np.zeros(4), np.zeros(4)), "closed loops"),
+        # a loop model takes its independent coordinates (the four-bar: the crank angle alone)
+        (
+            (ad.scenes.four_bar(), np.zeros(4), np.zeros(4), np.zeros(4)),
+            r"q: expected shape \(1,\)",
+        ),
     ]
     for args, pattern in cases:
         with pytest.raises(ad.ModelError, match=pattern):

@@ -11,7 +11,6 @@ from armdyn.identification import (
     fourier_series,
     random_fourier,
 )
-from armdyn.identification.base import random_states
 
 from benchmarks import common
 
@@ -63,29 +62,31 @@ def test_fourier_series_closed_form_and_derivatives():
 
 @needs_robots
 def test_design_beats_random_fourier(ur5_design):
-    """The designed motion's condition number against random Fourier motions within the same
-    limits (3 seeds each, both scalings): lower than all, and half the median and the start or
-    less. Measured with the same sizes but the UR5's own torque limits and random seeds 100-104
-    (python -m benchmarks.identification_excitation --quick): cond 9.6 (a 40-iteration design
-    is not converged: other round-off, e.g. threaded BLAS, ends elsewhere), 2.7-3.4x below the
-    per-joint scaled random motions, 4.8-143x below the common-scaled ones: the issue's 10x is
-    not met against the per-joint baseline (see fourier_excitation's docstring)."""
+    """The designed motion's condition number against 20 random Fourier motions within the
+    same limits per scaling (seeds 10-29): 1.5x below every one, 2.5x below the per-joint median
+    and 10x below the common-scaled median (margins: a 40-iteration design is not converged,
+    other round-off ends elsewhere). Measured (this small design: 3 harmonics, 40 samples,
+    one start of 40 iterations, tighter torques): cond 16.9 against 36-338 per joint (2.2x
+    below the best, 3.4x below the median) and 69-1457 common (4.1x, 16.8x): the issue's 10x
+    is not met on the UR5 against the per-joint baseline (docs/identification.md says why)."""
     model, base, design = ur5_design
     assert design.info["optimised"]
     assert design.cond < design.info["start_conds"][0]
-    rand = [
-        random_fourier(model, base=base, max_torque=TORQUES, seed=s, scaling=sc, **SMALL).cond
-        for s in (10, 11, 12)
-        for sc in ("joint", "common")
-    ]
-    assert design.cond < min(rand)
-    assert design.cond * 2.0 < min(np.median(rand), design.info["start_conds"][0])
+    for scaling, median in (("joint", 2.5), ("common", 10.0)):
+        rand = np.array(
+            [
+                random_fourier(
+                    model, base=base, max_torque=TORQUES, seed=s, scaling=scaling, **SMALL
+                ).cond
+                for s in range(10, 30)
+            ]
+        )
+        assert design.cond * 1.5 < rand.min()
+        assert design.cond * median < np.median(rand)
     # the cond is the documented one: an independent recomputation
     t = design.period * np.arange(40) / 40
     y = base.regressor(ad.joint_torque_regressor(model, *design.evaluate(t))).reshape(-1, base.rank)
-    q, qd, qdd = random_states(model, 200, np.random.default_rng(0))
-    yr = base.regressor(ad.joint_torque_regressor(model, q, qd, qdd)).reshape(-1, base.rank)
-    scaled = y / np.sqrt((yr**2).mean(axis=0))
+    scaled = y / _limit_scale(model, base, 0.05)
     assert design.cond == pytest.approx(np.linalg.cond(scaled), rel=1e-9)
 
 
@@ -158,6 +159,7 @@ def test_starts_and_ends_at_rest_and_csv(ur5_design, tmp_path):
         ({"position_margin": -0.1}, ad.ModelError, "position_margin must be"),
         ({"position_margin": [0.1, 0.1]}, ad.ModelError, "position_margin must be"),
         ({"q0": [0, 0, 3.2, 0, 0, 0]}, ad.SolverError, "q0.*'elbow_joint'"),
+        ({"criterion": "log-det"}, ad.ModelError, "criterion"),
         (
             {"max_torque": [150, 10, 150, 28, 28, 28]},
             ad.SolverError,
@@ -231,3 +233,83 @@ def test_panda_with_a_coupled_finger():
     exc = fourier_excitation(model, position_margin=margin, maxiter=15, starts=1, **SMALL)
     assert exc.info["optimised"] and exc.cond < exc.info["start_conds"][0]
     _check_limits(model, exc, np.asarray(model.coord_effort_limit), margin=np.array(margin))
+
+
+@needs_robots
+def test_objective_and_constraint_gradients_match_finite_differences():
+    """The optimiser's gradients (chain rule through the regressor's state derivatives and the
+    series' exact maps; the constraints' through inverse_dynamics_derivatives) against central
+    differences of the objective and the constraints themselves, along random directions, at a
+    random feasible start whose samples avoid t = 0 (where qd = 0 up to round-off would put
+    the smoothed Coulomb column's steep slope into the differences)."""
+    from armdyn.identification import excitation as ex
+
+    model = _ur5()
+    limits = {
+        "max_velocity": None,
+        "max_acceleration": None,
+        "max_torque": TORQUES,
+        "position_margin": 0.05,
+    }
+    problem = ex._setup("t", model, 10.0, 3, None, limits, None, 40, True, "scaled")
+    problem.times = problem.times + 0.05
+    x = problem.pack(*ex._random_start(problem, np.random.default_rng(1)))
+    f, grad = problem.surrogate(x)
+    # the surrogate bounds log cond from above, within 2 log(rank) / SMOOTHING
+    log_cond = problem.log_cond(x)
+    assert log_cond <= f <= log_cond + 2 * np.log(problem.base.rank) / ex.SMOOTHING
+    jac = problem.constraints_jacobian(x)
+    rng = np.random.default_rng(2)
+    h = 1e-6
+    for _ in range(3):
+        d = rng.normal(size=x.size)
+        fd = (problem.surrogate(x + h * d)[0] - problem.surrogate(x - h * d)[0]) / (2 * h)
+        assert grad @ d == pytest.approx(fd, rel=1e-5, abs=1e-6)
+        cfd = (problem.constraints(x + h * d) - problem.constraints(x - h * d)) / (2 * h)
+        np.testing.assert_allclose(jac @ d, cfd, rtol=0, atol=1e-6 * np.abs(cfd).max())
+
+
+@needs_robots
+def test_panda_design_ten_times_below_random_fourier():
+    """Issue 35's target on the Panda: the designed motion's condition number (the default
+    scaled criterion) at least 10x below the median of 20 random Fourier motions with the same
+    limits, period, harmonics and samples (per-joint scaling, the stronger baseline; seeds
+    10-29), and 5x below the best of them, each recomputed independently. A small design (5
+    harmonics, 50 samples, one start of 50 iterations, ~3.5 s CPU) measured cond 60.1 against
+    483-3062 (8.0x below the best, 17x below the median); the full one (the defaults, python
+    -m benchmarks.identification_excitation --seeds 20) 13.7x and 24.9x."""
+    model = ad.load_urdf(str(ROBOTS / "panda_description/urdf/panda.urdf"))
+    base = base_parameters(model)
+    kw = {"position_margin": [0.05] * 7 + [0.002], "harmonics": 5, "samples": 50}
+    design = fourier_excitation(model, base=base, maxiter=50, starts=1, seed=0, **kw)
+    rand = [random_fourier(model, base=base, seed=s, **kw) for s in range(10, 30)]
+    # the same column scale for all: the criterion's (one fixed scale per model and limits)
+    t = design.period * np.arange(50) / 50
+
+    def cond(motion):
+        y = base.regressor(ad.joint_torque_regressor(model, *motion.evaluate(t)))
+        s = np.linalg.svd(y.reshape(-1, base.rank) / scale, compute_uv=False)
+        return s[0] / s[-1]
+
+    scale = _limit_scale(model, base, np.array(kw["position_margin"]))
+    assert cond(design) == pytest.approx(design.cond, rel=1e-8)
+    ratios = np.array([cond(r) for r in rand]) / design.cond
+    assert np.median(ratios) >= 10.0
+    assert ratios.min() >= 5.0
+    _check_limits(
+        model, design, np.asarray(model.coord_effort_limit), margin=np.array(kw["position_margin"])
+    )
+
+
+def _limit_scale(model, base, margin):
+    """The scaled criterion's column scale, recomputed: the RMS over 200 random states (seed 0)
+    uniform within the position limits minus the margin, +-velocity and +-5/s x velocity."""
+    rng = np.random.default_rng(0)
+    lower = np.asarray(model.coord_lower) + margin
+    upper = np.asarray(model.coord_upper) - margin
+    vel = np.asarray(model.coord_velocity_limit)
+    q = rng.uniform(lower, upper, size=(200, model.n_dofs))
+    qd = rng.uniform(-1.0, 1.0, size=(200, model.n_dofs)) * vel
+    qdd = rng.uniform(-1.0, 1.0, size=(200, model.n_dofs)) * 5.0 * vel
+    y = base.regressor(ad.joint_torque_regressor(model, q, qd, qdd))
+    return np.sqrt((y.reshape(-1, base.rank) ** 2).mean(axis=0))

@@ -135,12 +135,12 @@ def test_format_2_bytes_still_load():
     assert np.array_equal(ad.mass_matrix(model, q), ad.mass_matrix(today, q))
     # it is written again in today's format, as today's model is
     assert model.__getstate__() == today.__getstate__()
-    assert struct.unpack_from("<I", model.__getstate__()[0], 8)[0] == 3
+    assert struct.unpack_from("<I", model.__getstate__()[0], 8)[0] == 4
     builder = ad.ModelBuilder.__new__(ad.ModelBuilder)
     builder.__setstate__(((DATA / "format2_draft.bin").read_bytes(), True))
     assert builder.finalize().__getstate__() == today.__getstate__()
     # other versions are refused, naming the range read
-    for version in (1, 4):
+    for version in (1, 5):
         other = old[:8] + struct.pack("<I", version) + old[12:]
         with pytest.raises(ad.ModelError, match=rf"format version {version}, this armdyn reads "):
             _load(other)

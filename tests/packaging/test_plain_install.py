@@ -37,6 +37,8 @@ OPTIONAL = {
     "k3d": ("viz", {"animation.py"}),
     "trimesh": ("viz", {"animation.py"}),
     "collada": ("viz", {"animation.py"}),
+    # armdyn.load_mjcf: MuJoCo's own MJCF parser and compiler
+    "mujoco": ("mjcf", {"mjcf.py"}),
 }
 
 

@@ -96,7 +96,7 @@ def test_four_bar_in_3d_moves_like_the_planar_reduced_model():
     assert model.mobility == 1 and len(model.redundant_rows) == 3
     res = ad.simulate(model, 1.0, rtol=1e-11, atol=1e-12, output_dt=0.1)
     ref = four_bar_reference(model, phi0, 1.0, res.t)
-    crank = phi0 + res.q[:, list(model.coord_names).index("A")]
+    crank = phi0 + res.q[:, list(model.joint_coord_names).index("A")]
     assert np.ptp(ref) > 0.5  # it swings
     assert np.max(np.abs(crank - ref)) <= 1e-7
 
@@ -118,7 +118,7 @@ def test_parallelogram_through_its_change_point_is_reported_and_stays_on_its_bra
     assert res.stats["singular_evaluations"] >= 1
     assert "singular configuration at t=0.5" in res.stats["singular_note"]
     assert "dependent rows" in res.stats["singular_note"]
-    names = list(model.coord_names)
+    names = list(model.joint_coord_names)
     qa, qb = res.q[:, names.index("A")], res.q[:, names.index("B")]
     assert np.max(np.abs(qa + qb)) <= 1e-9
     assert np.max(res.position_residual) <= 1e-12

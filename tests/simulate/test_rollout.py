@@ -161,10 +161,21 @@ def test_unknown_option_and_option_errors():
     with pytest.raises(ad.ModelError, match=r"every run failed to start.*dt"):
         ad.rollout(model, np.zeros((2, 6)), None, 0.1, integrator="rk4", limits="ignore")
     assert ad.rollout(model, np.zeros((0, 6)), None, 0.1) == []
-    # q0 rows for a closed loop (no joint coordinates): the model's fault, raised
-    loop = ad.scenes.four_bar()
+    # q0 rows for a model without a joint space (a ball-jointed link carrying a hinged one):
+    # the model's fault, raised
+    b = ad.ModelBuilder()
+    b.add_body("bob", 1.0, [0.01, 0.01, 0.01], position=(0, 0, -1))
+    b.add_body("tip", 1.0, [0.01, 0.01, 0.01], position=(0, 0, -2))
+    b.add_spherical("ball", "ground", "bob", (0, 0, 0))
+    b.add_revolute("hinge", "bob", "tip", (0, 0, -1.5), (0, 1, 0))
+    ball = b.finalize()
     with pytest.raises(ad.ModelError, match="every run failed to start"):
-        ad.rollout(loop, np.zeros((2, loop.n_coords)), None, 0.1)
+        ad.rollout(ball, np.zeros((2, ball.n_coords)), None, 0.1)
+    # a closed loop takes its independent coordinates (the four-bar's crank): the runs start
+    loop = ad.scenes.four_bar()
+    runs = ad.rollout(loop, np.array([[0.0], [0.3]]), None, 0.05)
+    assert [r.error for r in runs] == [None, None]
+    assert abs(runs[1].q[0, list(loop.joint_coord_names).index("A")] - 0.3) < 1e-12
 
 
 def test_interrupt_between_runs_keeps_the_finished_runs():

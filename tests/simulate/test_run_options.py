@@ -85,7 +85,7 @@ def test_core_options_are_what_the_run_takes():
         "max_steps": 10_000_000,
         "max_step": 0.0,
         "merge_welded": True,
-        "coordinates": "cartesian",
+        "coordinates": "auto",
         "limits": True,
         "restitution": 0.0,
     }

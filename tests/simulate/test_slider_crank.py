@@ -20,7 +20,6 @@ from conftest import (
     body_index,
     body_pose,
     body_vel,
-    coord_index,
     quat_to_rot,
     random_inertia,
     random_quat,
@@ -119,7 +118,9 @@ def test_driven_slider_crank(rng, closure):
     vs, ws = body_vel(res.v, ks)
 
     # drive: crank coordinate follows the profile exactly
-    iq = coord_index(model, "crank_pivot")
+    # res.q's columns: every joint coordinate (model.joint_coord_names; a loop model's
+    # coord_names are its independent coordinates)
+    iq = list(model.joint_coord_names).index("crank_pivot")
     np.testing.assert_allclose(res.q[:, iq], W * t, rtol=0, atol=tol(1e-9))
     np.testing.assert_allclose(res.qd[:, iq], W, rtol=0, atol=tol(1e-9))
     # slider kinematics
@@ -136,7 +137,7 @@ def test_driven_slider_crank(rng, closure):
     )
     # slider coordinate = displacement from assembly along +x
     np.testing.assert_allclose(
-        res.q[:, coord_index(model, "slide")],
+        res.q[:, list(model.joint_coord_names).index("slide")],
         slider_x(theta) - slider_x(THETA0),
         rtol=0,
         atol=tol(1e-9),

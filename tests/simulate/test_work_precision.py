@@ -170,6 +170,7 @@ def test_tightest_point_against_an_independent_lagrange_solution(arm, sweep):
         atol=row["atol"],
         output_dt=T_END / N_OUT,
         q0=Q0,
+        coordinates="cartesian",  # the sweep's formulation (its default)
         qd0=QD0,
     )
     independent = np.abs(res.q - lagrange).max()

@@ -20,6 +20,7 @@
 namespace armdyn {
 
 struct ParameterLayout;  // algorithm/regressor.hpp
+struct LoopWork;         // algorithm/loop_coordinates.hpp
 
 /// Counters of the Cartesian pipeline over a Data's life (a simulation reports them).
 struct PipelineStats {
@@ -164,6 +165,10 @@ class Data {
   std::unique_ptr<Model> driven;      ///< inverse dynamics: the model with every coordinate driven
   std::unique_ptr<Data> driven_data;  ///< made on first use, for *driven
   VecX drive_ref;                     ///< (3 n) drive values (q, qd, qdd) of driven_data
+  /// the joint-level functions of a model with loops (Model::loop_coordinates): the driven
+  /// model, its Data and the last solved state (branch continuity), made on first use (shared_ptr:
+  /// its deleter is made with it, so this layer needs not see the type)
+  std::shared_ptr<LoopWork> loop;
 
   // --- joint reactions along a joint-space motion (algorithm/reactions) ---
   /// the joints joint_reactions sweeps (tree_sweep), made on its first call

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "armdyn/algorithm/crba.hpp"
 
+#include "armdyn/algorithm/loop_coordinates.hpp"
+
 namespace armdyn {
 
 void ensure_mass_matrix(Data& d) {
@@ -97,6 +99,7 @@ void crba_loaded(const Model& m, Data& d) {
 }
 
 const MatX& crba(const Model& m, Data& d, Eigen::Ref<const VecX> q) {
+  if (m.loop_coordinates) return loop_mass_matrix(m, d, q);
   require_joint_space(m, "mass_matrix", true);
   check_data(m, d, "mass_matrix");
   check_joint_vector(q, d.niq, "mass_matrix", "q");

@@ -9,6 +9,7 @@
 #include "armdyn/algorithm/forces.hpp"
 #include "armdyn/algorithm/kinematics.hpp"
 #include "armdyn/algorithm/kkt.hpp"
+#include "armdyn/algorithm/loop_coordinates.hpp"
 #include "armdyn/algorithm/rnea.hpp"
 #include "armdyn/algorithm/tree_dynamics.hpp"
 #include "armdyn/errors.hpp"
@@ -203,6 +204,7 @@ DynamicsMethod dynamics_method(const std::string& name, const char* fn, bool for
 const VecX& forward_dynamics(const Model& m, Data& d, Eigen::Ref<const VecX> q,
                              Eigen::Ref<const VecX> qd, Eigen::Ref<const VecX> tau, double t,
                              DynamicsMethod method) {
+  if (m.loop_coordinates) return loop_forward_dynamics(m, d, q, qd, tau, t, method);
   check_inputs(m, d, q, qd, tau, t, "forward_dynamics", "tau");
   if (d.ni != d.n) return forward_coupled(m, d, q, qd, tau, t, method);
   switch (resolve_method(m, method)) {
@@ -228,6 +230,7 @@ const VecX& forward_dynamics(const Model& m, Data& d, Eigen::Ref<const VecX> q,
 const VecX& inverse_dynamics(const Model& m, Data& d, Eigen::Ref<const VecX> q,
                              Eigen::Ref<const VecX> qd, Eigen::Ref<const VecX> qdd, double t,
                              DynamicsMethod method) {
+  if (m.loop_coordinates) return loop_inverse_dynamics(m, d, q, qd, qdd, t, method);
   if (method != DynamicsMethod::Cartesian) return rnea(m, d, q, qd, qdd, t);
   check_inputs(m, d, q, qd, qdd, t, "inverse_dynamics", "qdd");
   refuse_floating_cartesian(m, "inverse_dynamics");

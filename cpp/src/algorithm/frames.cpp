@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "armdyn/algorithm/frames.hpp"
 
+#include "armdyn/algorithm/loop_coordinates.hpp"
 #include "armdyn/errors.hpp"
 #include "armdyn/math/quaternion.hpp"
 
@@ -97,11 +98,15 @@ const Mat6X& frame_jacobian_loaded(const Model& m, Data& d, int frame) {
 }
 
 const Mat4& frame_pose(const Model& m, Data& d, Eigen::Ref<const VecX> q, int frame) {
+  if (m.loop_coordinates)
+    return loop_frame_pose(m, d, q, (checked_frame(m, frame, "frame_pose"), frame));
   load_poses(m, d, q, frame, "frame_pose");
   return frame_pose_loaded(m, d, frame);
 }
 
 const Mat6X& frame_jacobian(const Model& m, Data& d, Eigen::Ref<const VecX> q, int frame) {
+  if (m.loop_coordinates)
+    return loop_frame_jacobian(m, d, q, (checked_frame(m, frame, "frame_jacobian"), frame));
   load_poses(m, d, q, frame, "frame_jacobian");
   const Mat6X& J = frame_jacobian_loaded(m, d, frame);
   if (d.ni == d.n) return J;

@@ -8,6 +8,7 @@
 #include "armdyn/algorithm/constraints.hpp"
 #include "armdyn/algorithm/forces.hpp"
 #include "armdyn/algorithm/kinematics.hpp"
+#include "armdyn/algorithm/loop_coordinates.hpp"
 #include "armdyn/errors.hpp"
 #include "armdyn/kernels/joint_space.hpp"
 
@@ -125,6 +126,7 @@ struct ReactionSettings {
 void joint_reactions(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
                      Eigen::Ref<const VecX> qdd, double t, double* forces, double* torques) {
   constexpr const char* fn = "joint_reactions";
+  if (m.loop_coordinates) return loop_joint_reactions(m, d, q, qd, qdd, t, forces, torques);
   require_joint_space(m, fn, true);
   check_data(m, d, fn);
   check_joint_vector(q, d.niq, fn, "q");

@@ -11,6 +11,7 @@
 #include <numeric>
 
 #include "armdyn/algorithm/kinematics.hpp"
+#include "armdyn/algorithm/loop_coordinates.hpp"
 #include "armdyn/algorithm/projection.hpp"
 #include "armdyn/builder/builder.hpp"
 #include "armdyn/data.hpp"
@@ -659,6 +660,7 @@ std::shared_ptr<Model> finalize_draft(const Model& draft, const FinalizeOptions&
   analyse_rank(m);
   reassemble_if_redundant(m, metric);
   check_inertia_of_motions(m);
+  choose_loop_coordinates(m);
   return mp;
 }
 

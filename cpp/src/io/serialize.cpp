@@ -23,9 +23,10 @@ namespace {
 
 constexpr char kMagic[8] = {'A', 'R', 'M', 'D', 'Y', 'N', 'M', '1'};
 // Format versions: 3 adds the motor's datasheet fields after the first nine (MotorSpec::fields);
+// 4 the independent coordinates the user chose (Model::independent_request, after the warnings);
 // this armdyn writes kFormat and reads every version from kOldestFormat (an older one's missing
 // fields load as not given).
-constexpr std::uint32_t kFormat = 3, kOldestFormat = 2;
+constexpr std::uint32_t kFormat = 4, kOldestFormat = 2;
 /// The motor fields the bytes of format 2 hold: the first nine of MotorSpec::fields().
 constexpr std::size_t kMotorFieldsFormat2 = 9;
 constexpr std::uint8_t kKindModel = 'M', kKindDraft = 'D';
@@ -58,7 +59,7 @@ static_assert(sizeof(NamedFrame) == 136,
               "NamedFrame changed: store the new field here, then update its size");
 static_assert(sizeof(IndependentCoords) == 112,
               "IndependentCoords changed: store the new field here, then update its size");
-static_assert(sizeof(Model) == 1016,
+static_assert(sizeof(Model) == 1048,
               "Model changed: store the new field here, then update its size");
 static_assert(sizeof(Profile) == 176,
               "Profile changed: store the new field here, then update its size");
@@ -240,6 +241,7 @@ void put_gears_actuators(Writer& w, const Model& m) {
     put_motor(w, x.motor);
   });
   w.list(m.warnings, [&](const std::string& x) { w.s(x); });
+  w.list(m.independent_request, [&](const std::string& x) { w.s(x); });
 }
 
 std::string write(const Model& m, std::uint8_t kind) {
@@ -710,6 +712,11 @@ void read_gears_actuators(Reader& r, Model& m) {
   r.at("");
   const std::size_t nw = r.count("warnings", 8);
   for (std::size_t k = 0; k < nw; ++k) m.warnings.push_back(r.s("warnings"));
+  if (r.format >= 4) {
+    const std::size_t ni = r.count("independent_request", 8);
+    for (std::size_t k = 0; k < ni; ++k)
+      m.independent_request.push_back(r.s("independent_request"));
+  }
 }
 
 /// The checked description (a draft, its derived tables made as the builder makes them).

@@ -136,7 +136,8 @@ void IndependentCoords::reduce(const MatX& M, MatX& Mr) const {
 void IndependentCoords::align(const std::vector<Coord>& coords, double* coord_q) const {
   const int nf = static_cast<int>(source.size());
   for (int c = 0; c < nf; ++c) {
-    if (full[source[c]] == c || !coords[c].angular) continue;
+    // (a loop model's dependent coordinates, source -1, follow no independent one)
+    if (source[c] < 0 || full[source[c]] == c || !coords[c].angular) continue;
     const double want = scale[c] * coord_q[full[source[c]]] + shift[c];
     coord_q[c] = want + wrap_angle(coord_q[c] - want);
   }

@@ -59,7 +59,9 @@ std::vector<std::string> independent_dof_names(const Model& m) {
 }
 
 int independent_dof(const Model& m, int coord) {
-  return m.independent.lead_v + m.independent.source[coord];
+  // a loop model's dependent coordinate (Model::loop_coordinates) has none: -1
+  const int s = m.independent.source[coord];
+  return s < 0 ? -1 : m.independent.lead_v + s;
 }
 
 VecX coord_limits(const Model& m, LimitKind which) {
@@ -98,7 +100,8 @@ VecX reflected_inertia(const Model& m) {
     // turns at N qdot carrying J
     const double j_el =
         a.gyroscopic ? a.rotor_inertia : a.gear_ratio * a.gear_ratio * a.rotor_inertia;
-    r[independent_dof(m, c)] += ic.scale[c] * ic.scale[c] * j_el;
+    // (a rotor on a dependent joint of a loop model reflects onto no single independent dof)
+    if (const int k = independent_dof(m, c); k >= 0) r[k] += ic.scale[c] * ic.scale[c] * j_el;
   }
   return r;
 }

@@ -21,15 +21,19 @@ from armdyn.scenes.extreme import (
     nan_force_pendulum,
     random_chain,
 )
+from armdyn.scenes.machines import delta_robot, palletizer, pick_and_place
 
 __all__ = [
     "bricard",
+    "delta_robot",
     "double_pendulum",
     "four_bar",
     "free_body",
     "heavy_top",
     "mass_ratio_chain",
     "nan_force_pendulum",
+    "palletizer",
+    "pick_and_place",
     "random_chain",
     "simple_pendulum",
     "slider_crank",

@@ -108,6 +108,7 @@ def four_bar(
     crank_drive: _core.Profile | float | None = None,
     gravity: float = 9.81,
     closure: str = "revolute",
+    crank_torque: _core.Profile | float | None = None,
 ) -> _core.Model:
     """Planar four-bar (crank a, coupler b, rocker c, ground d) modelled in 3-D with revolute
     joints, all axes along z, gravity along -y: 3 moving bodies, 4 revolutes = 20 rows of rank 17,
@@ -117,7 +118,11 @@ def four_bar(
     start angle) prescribes the crank. With a = c and b = d the linkage is a parallelogram whose
     links all become collinear at crank angles 0 and π (its change points). ``closure="inline"``
     closes the loop at D with an inline joint (2 rows) instead of a revolute: 17 independent
-    rows, no redundancy, the same motion."""
+    rows, no redundancy, the same motion. `crank_torque` (a profile, number or callable, as
+    ``add_joint_torque`` takes) applies a torque to the crank about z. The links are solid
+    cylinders of radius 0.01 m whose axes are along z (so each turns about its own axis):
+    crank 1 kg, coupler 2 kg, rocker 1.5 kg, centres of mass at the links' midpoints, moment of
+    inertia about z 0.5 m r²."""
     bld = _core.ModelBuilder(gravity=(0.0, -gravity, 0.0))
     pa = np.array([a * np.cos(crank_angle), a * np.sin(crank_angle), 0.0])
     pd = np.array([d, 0.0, 0.0])
@@ -142,6 +147,8 @@ def four_bar(
         bld.add_revolute("D", "rocker", "ground", point=pd, axis=z)
     if crank_drive is not None:
         bld.add_drive("A", crank_drive)
+    if crank_torque is not None:
+        bld.add_joint_torque("A", crank_torque)
     return bld.finalize()
 
 

@@ -140,6 +140,12 @@ class ModelBuilder {
   ///   joint, the same joint twice, a joint without exactly one coordinate, joints of different
   ///   types, a non-finite or zero multiplier, a non-finite offset, a follower coupled twice or
   ///   a cycle of couplings.
+  /// The independent coordinates of a model with closed loops (by name, from
+  /// joint_coord_names; as many as its mobility, each independent of the others at the assembled
+  /// state), checked by finalize (Model::loop_coordinates). An empty list: armdyn's default.
+  void set_independent_coordinates(const std::vector<std::string>& names) {
+    m_.independent_request = names;
+  }
   void add_coupling(const std::string& name, const std::string& follower, const std::string& leader,
                     double multiplier, double offset = 0.0);
   /// A gearbox and motor rotor on revolute or prismatic joint `joint` (see Actuator), as a

@@ -30,7 +30,8 @@ std::vector<int> independent_coord_indices(const Model& m);
 /// Names of the entries of the independent q (n_coords) and of qd (n_dofs).
 std::vector<std::string> independent_coord_names(const Model& m);
 std::vector<std::string> independent_dof_names(const Model& m);
-/// The independent degree of freedom (into the independent qd) that moves coordinate `coord`.
+/// The independent degree of freedom (into the independent qd) that moves coordinate `coord`
+/// (-1 for a dependent coordinate of a loop model, Model::loop_coordinates).
 int independent_dof(const Model& m, int coord);
 
 /// Which joint limit coord_limits() reports.
