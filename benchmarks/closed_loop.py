@@ -29,7 +29,8 @@ squeezer the seven-angle index-1 equations of the Test Set (:mod:`benchmarks.ref
 JSON records how far armdyn's DOP853 at rtol 1e-12 is from it (``reference_check``): a second,
 independent method.
 
-Curves (each point: the median CPU time of warm repeats of the whole run, and its error):
+Curves (each point: the median CPU time of warm repeats of the whole run, and its error; the
+sweep's times are consecutive, not interleaved):
 
 - armdyn: :func:`armdyn.work_precision` (``simulate``, Cartesian formulation) with DOP853 and
   DOPRI5 over tolerances (atol = rtol), one output interval;
@@ -44,7 +45,18 @@ the squeezer's MuJoCo and Exudyn models are :mod:`benchmarks.peers.closed_loops`
 to be the same mechanism in tests/peers/test_peer_closed_loop_bench.py (accelerations at a
 moving state against armdyn's).
 
-``ratio`` in the table: the peer's CPU time to reach 1e-6 over armdyn's (fastest curve each).
+``ratio`` in the 1e-6 table (``rounds_1e-6`` in the JSON): the sweep only picks each curve's
+cheapest point reaching 1e-6; those points are then re-timed in ``ROUNDS`` (9; 3 in --quick)
+interleaved rounds, each round running every chosen point once in a rotating order (a run
+under 30 ms repeated within its sample), on the process CPU clock (``time.process_time``: all
+peers run in this process). Per round a library's time is its fastest curve's, and the ratio
+peer / armdyn is taken within the round, so a load burst on this shared machine scales both
+sides of a ratio alike. The table gives the median time over the rounds and the median of the
+per-round ratios with their [min, max]. The median rather than the minimum: the CPU clock
+already excludes time spent descheduled, what load remains (cache and memory-bandwidth
+contention from the other processes) slows either side of a round, and the median of the
+paired ratios is the typical ratio, not the luckiest one. The 1e-3 table is the sweep's
+(fastest point each, one run, no spread).
 """
 
 from __future__ import annotations
