@@ -160,3 +160,18 @@ def test_quick_benchmark_runs_every_peer(tmp_path):
             assert point["error"] < 1e-4, key
     assert (tmp_path / "quick.json").is_file()
     assert "| four_bar |" in doc["table_1e-6"]
+    # the 1e-6 ratio: interleaved rounds of each curve's cheapest point reaching 1e-6, paired
+    rounds = r["rounds_1e-6"]
+    libs = rounds["libraries"]
+    assert "armdyn" in libs and "Pinocchio" in libs
+    for lib, rec in libs.items():
+        assert len(rec["round_cpu_s"]) == rounds["rounds"] == 3
+        assert all(t > 0 for t in rec["round_cpu_s"])
+        for key, setting in rec["points"].items():  # the chosen point reached 1e-6 in the sweep
+            point = next(q for q in r["curves"][key] if q["setting"] == setting)
+            assert point["error"] <= 1e-6, (lib, key)
+    for lib, q in rounds["ratios"].items():
+        per = np.array(libs[lib]["round_cpu_s"]) / np.array(libs["armdyn"]["round_cpu_s"])
+        np.testing.assert_allclose(q["per_round"], per, rtol=1e-12)
+        assert q["min"] <= q["median"] <= q["max"]
+        assert f"({q['median']:.1f}x [{q['min']:.1f}, {q['max']:.1f}])" in doc["table_1e-6"]
