@@ -186,6 +186,10 @@ void choose_loop_coordinates(Model& m) {
               has_ideal_gear(m) ? "has a floating base" : "is a tree without ideal gears",
               " (its joint coordinates are independent; a coupling's follower is dependent by "
               "construction)"));
+    if (has_ideal_gear(m))
+      m.joint_space_reason +=
+          " (and a floating base: the joint-level functions take ideal gears on fixed-base "
+          "trees only; use simulate and the Cartesian functions)";
     return;
   }
   if (m.n_free > 0) {
@@ -627,11 +631,15 @@ VecX loop_full_coordinates(const Model& m, const VecX& qi) {
   Data d(m);
   VecX u, v;
   loop_state(m, d, qi, VecX::Zero(qi.size()), u, v, fn);
-  std::vector<BodyKin> kin;
-  body_kinematics(m, u.data(), nullptr, kin);
+  // the angles as the continuation tracked them (a gear's turns: its rows hold in them)
+  Data& dd = *d.loop->dd;
+  load_kinematics(*d.loop->driven, dd, u.data(), nullptr);
   const int nf = static_cast<int>(m.coords.size());
   VecX q(m.nq_joint);
-  for (int c = 0; c < nf; ++c) q[c] = coord_value(m, kin, c);
+  for (int c = 0; c < nf; ++c) {
+    const double raw = coord_value(m, dd.kin, c);
+    q[c] = m.coords[c].angular ? tracked(dd, c, raw) : raw;
+  }
   const IndependentCoords& ic = m.independent;
   for (int k = 0; k < ic.n; ++k) q[ic.full[k]] = qi[k];
   ic.align(m.coords, q.data());
