@@ -23,7 +23,7 @@ using namespace py_helpers;
 namespace {
 
 auto state_from_joints_py(const ModelArg& model, const ArrayLike& q, const OptArrayLike& qd,
-                          const py::object& data) {
+                          const OptData& data) {
   const ModelHolder holder = model_of(model, "state_from_joints");
   const Model& md = *holder;
   Data& d = data_for(holder, data, "state_from_joints");

@@ -83,6 +83,9 @@ def test_many_turns_keep_the_gear_ratio():
         assert rel_err(tau, [tau_closed_form(qa, 1.0)]) < 1e-10
         fresh = ad.inverse_dynamics(m, [qa], [0.0], [1.0], data=ad.Data(m))
         assert rel_err(fresh, tau) < 1e-12
+        # held at rest: the gravity torque alone
+        hold = ad.inverse_dynamics(m, [qa], [0.0], [0.0], data=d)
+        assert rel_err(hold, [tau_closed_form(qa, 0.0)]) < 1e-10
         # the load's centre of mass: the wheel's axis plus L turned by q_b = -r q_a
         u, _ = ad.state_from_joints(m, [qa], data=ad.Data(m))
         qb = -R * qa

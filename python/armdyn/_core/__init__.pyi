@@ -755,9 +755,9 @@ def paper_3dof_torques(L: numpy.typing.ArrayLike, M: numpy.typing.ArrayLike, g: 
     ...
 def paper_5dof_end_effector(h: typing.SupportsFloat | typing.SupportsIndex, L1: typing.SupportsFloat | typing.SupportsIndex, L2: typing.SupportsFloat | typing.SupportsIndex, L34: typing.SupportsFloat | typing.SupportsIndex, theta: numpy.typing.ArrayLike) -> numpy.typing.NDArray[numpy.float64]:
     ...
-def state_from_joints(model: Model, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike | None = None) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
+def state_from_joints(model: Model, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike | None = None, data: Data | None = None) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
     """
-    Cartesian state (u, v) of a joint-space tree model from joint-space q (n_coords) and qd (n_dofs; default zero): a coupled model's independent coordinates, the followers set by their couplings. Returns (u (nq,), v (nv,)) float64 arrays: per body CoM [m] and unit Euler parameters; CoM velocity [m/s, world] and angular velocity [rad/s, body]. ModelError on a model without a joint space or wrong shapes. A model with closed loops: its independent coordinates, the others solved from the loop constraints (Newton from this thread's last solution: the assembly branch kept; SolverError at a singular configuration).
+    Cartesian state (u, v) of a joint-space tree model from joint-space q (n_coords) and qd (n_dofs; default zero): a coupled model's independent coordinates, the followers set by their couplings. Returns (u (nq,), v (nv,)) float64 arrays: per body CoM [m] and unit Euler parameters; CoM velocity [m/s, world] and angular velocity [rad/s, body]. ModelError on a model without a joint space or wrong shapes. A model with closed loops or a fixed-base tree with ideal gears: its independent coordinates (model.coord_names), the others solved from the loop and gear constraints (continuation from the last solution of data, an armdyn.Data, or this thread's when None: the assembly branch and the gears' turns kept; SolverError at a singular configuration).
     """
 def torque_error_metrics(a: numpy.typing.ArrayLike, ref: numpy.typing.ArrayLike) -> dict:
     ...
