@@ -249,3 +249,27 @@ def test_singular_configuration_of_a_geared_mechanism():
 def test_inverse_kinematics_refuses_a_geared_tree():
     with pytest.raises(ad.ModelError, match="inverse_kinematics: the model has ideal gears"):
         ad.motion.inverse_kinematics(pinion_wheel(), "tool", np.eye(4), [0.0])
+
+
+def test_forward_dynamics_equals_the_cartesian_simulation_over_turns():
+    """A Cartesian run released 10 turns out, spinning: at its outputs forward_dynamics in the
+    independent coordinate equals the run's qdd (the KKT system with every row), and the wheel
+    keeps q_b = -r q_a over the turns."""
+    m = pinion_wheel()
+    ia, ib = (list(m.joint_coord_names).index(n) for n in ("ja", "jb"))
+    res = ad.simulate(
+        m,
+        0.5,
+        q0=[20 * np.pi + 0.3],
+        qd0=[40.0],
+        output_dt=0.05,
+        rtol=1e-10,
+        coordinates="cartesian",
+    )
+    q, qd, qdd = res.q[:, [ia]], res.qd[:, [ia]], res.qdd[:, [ia]]
+    assert np.ptp(q) > 2 * np.pi
+    assert np.max(np.abs(res.q[:, ib] + R * res.q[:, ia])) < 1e-10
+    tau = np.zeros_like(q)
+    assert rel_err(ad.forward_dynamics(m, q, qd, tau, t=res.t), qdd) < 1e-10
+    # the closed form of the free pendulum-through-a-gear
+    assert rel_err(qdd[:, 0], R * ML * G * L * np.cos(-R * q[:, 0]) / M_RED) < 1e-10
