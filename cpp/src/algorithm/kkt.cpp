@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "armdyn/algorithm/kkt.hpp"
 
-#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 
@@ -18,8 +17,8 @@ std::string dependent_row_names(const Model& m, const Data& d) {
   return rows;
 }
 
-double constraint_residual(const ConstraintEval& ce, int nrows, const VecX& vd, double vd_scale) {
-  const double vmax = std::max(vd.cwiseAbs().maxCoeff(), vd_scale);
+double constraint_residual(const ConstraintEval& ce, int nrows, const VecX& vd) {
+  const double vmax = vd.cwiseAbs().maxCoeff();
   double worst = 0.0;
   for (const ConstraintBlock& blk : ce.blocks) {
     if (blk.row0 >= nrows) continue;
@@ -42,22 +41,6 @@ double constraint_residual(const ConstraintEval& ce, int nrows, const VecX& vd, 
 }
 
 namespace {
-
-// The largest acceleration the applied and gyroscopic forces eta alone give a body (Gamma^-1
-// eta): the size of the terms a solve cancels when the constraints hold the bodies still, so
-// that a model at rest (vd zero to round-off) is not judged by its round-off alone
-double free_acceleration_scale(const Model& m, const VecX& eta) {
-  double s = 0.0;
-  for (int i = 0; i < m.nb; ++i) {
-    const Body& b = m.bodies[i];
-    if (!(b.mass > 0.0)) continue;
-    const Vec3 lin = eta.segment<3>(6 * i) / b.mass;
-    const Vec3 ang = b.inertia.llt().solve(Vec3(eta.segment<3>(6 * i + 3)));
-    if (lin.allFinite() && ang.allFinite())
-      s = std::max({s, lin.cwiseAbs().maxCoeff(), ang.cwiseAbs().maxCoeff()});
-  }
-  return s;
-}
 
 // The augmented solve of d's loaded system (rows [0, nrows)), with a SolverError when it has no
 // finite solution; the first one of a Data says why in the stats.
@@ -159,8 +142,7 @@ void body_accelerations_loaded(const Model& m, Data& d, double t, double* vdot, 
   // augmented solve takes over for the rest of this Data's life. (Not near a singular
   // configuration, where the regularised factor leaves a residual on purpose.)
   if (!kkt.near_singular() && !kkt.used_pseudo_inverse()) {
-    const double res =
-        constraint_residual(d.ce, nrows, d.vd_work, free_acceleration_scale(m, d.eta));
+    const double res = constraint_residual(d.ce, nrows, d.vd_work);
     if (res > 1e-8) {
       d.augmented = true;
       solve_augmented(

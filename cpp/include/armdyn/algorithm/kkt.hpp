@@ -25,11 +25,9 @@ void body_accelerations(const Model& m, Data& d, double t, const double* u, cons
                         double* vdot, bool reuse_factor = false);
 
 /// The largest relative residual of zeta vd = -xi over rows [0, nrows), row by row:
-/// |sum_j zeta_rj vd_j + xi_r| / (sum_j |zeta_rj| max(max|vd|, vd_scale) + |xi_r|), round-off
-/// (1e-16) for an exact solve. vd_scale: the size of the accelerations the solve cancelled (a
-/// model held at rest has vd zero to round-off). O(rows).
-double constraint_residual(const ConstraintEval& ce, int nrows, const VecX& vd,
-                           double vd_scale = 0.0);
+/// |sum_j zeta_rj vd_j + xi_r| / (sum_j |zeta_rj| max|vd| + |xi_r|), round-off (1e-16) for an
+/// exact solve. O(rows).
+double constraint_residual(const ConstraintEval& ce, int nrows, const VecX& vd);
 
 /// body_accelerations at the kinematics already loaded in data.kin (load_kinematics or
 /// load_joint_kinematics).
