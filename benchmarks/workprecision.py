@@ -274,7 +274,7 @@ class _Geared(_BuiltOnce):
 
     @classmethod
     def observe(cls, model, res):
-        names = list(model.coord_names)
+        names = list(model.joint_coord_names)
         return res.q[:, [names.index(j) for j in cls.ARM]]
 
     def check(self, ref):

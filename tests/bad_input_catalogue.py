@@ -55,6 +55,20 @@ def _hinged_with(mass=1.0, position=(0.0, 0.0, -0.5), point=(0.0, 0.0, 0.0)):
     return b.finalize()
 
 
+def _gear_train(independent=None):
+    """Two wheels on ground joined by an ideal gear (q_b = -q_a / 2); `independent` given to
+    set_independent_coordinates when not None."""
+    b = ad.ModelBuilder()
+    b.add_body("pinion", 1.0, [0.01, 0.01, 0.01], position=(0, 0, 0))
+    b.add_body("wheel", 1.0, [0.01, 0.01, 0.01], position=(0.3, 0, 0))
+    b.add_revolute("ja", "ground", "pinion", (0, 0, 0), (0, 0, 1))
+    b.add_revolute("jb", "ground", "wheel", (0.3, 0, 0), (0, 0, 1))
+    b.add_gear("mesh", "ja", "jb", 0.1, 0.2)
+    if independent is not None:
+        b.set_independent_coordinates(independent)
+    return b.finalize()
+
+
 def _four_bar_by_rocker(name="D"):
     """A crank-rocker four-bar whose independent coordinate is `name` (the rocker D)."""
     b = ad.ModelBuilder()
@@ -853,6 +867,23 @@ CASES = [
         lambda: _four_bar_by_rocker("E"),
         ME,
         r"unknown joint coordinate 'E'",
+    ),
+    (
+        "gear-train-every-coordinate",
+        "arrays",
+        "inverse_dynamics of a geared tree given every joint's coordinate (it takes the "
+        "independent ones, model.coord_names)",
+        lambda: ad.inverse_dynamics(_gear_train(), np.zeros(2), np.zeros(2), np.zeros(2)),
+        ME,
+        r"q: expected shape \(1,\)",
+    ),
+    (
+        "gear-train-both-independent",
+        "arrays",
+        "set_independent_coordinates naming both coordinates a gear ties (mobility 1)",
+        lambda: _gear_train(["ja", "jb"]),
+        ME,
+        r"2 coordinate\(s\) given, the model's mobility is 1",
     ),
     # ---- solver options
     (

@@ -193,8 +193,8 @@ void bind_algorithm(py::module_& m) {
         "system of the bodies), 'joint' (the cheaper of crba and aba for this model), 'auto' "
         "(the cheapest of the three); the choice comes from a measured cost model "
         "(dynamics_cost). The model's force elements act; drives are ignored. A model with closed "
-        "loops: its independent coordinates (model.coord_names), on the Cartesian formulation "
-        "(method 'auto' or 'cartesian').");
+        "loops or a fixed-base tree with ideal gears: its independent coordinates "
+        "(model.coord_names), on the Cartesian formulation (method 'auto' or 'cartesian').");
 
   m.def("dynamics_cost", &dynamics_cost_py, py::arg("model"),
         "The measured cost model's prediction for a model (derived once per model): microseconds "
@@ -211,7 +211,8 @@ void bind_algorithm(py::module_& m) {
         "state per row): what each joint's actuator applies to its child about/along the joint "
         "axis, gravity and the model's force elements included, drives ignored. method: 'joint' "
         "(recursive Newton-Euler), 'cartesian' (every coordinate driven, the drives' KKT "
-        "multipliers), 'auto' (joint). A model with closed loops: the torques on its independent "
+        "multipliers), 'auto' (joint). A model with closed loops or a fixed-base tree with ideal "
+        "gears: the torques on its independent "
         "coordinates (model.coord_names), driven_inverse_dynamics' drive forces with them driven "
         "(method 'auto' or 'cartesian').");
 
@@ -228,12 +229,13 @@ void bind_algorithm(py::module_& m) {
         "joint torques are the inverse dynamics' (the motion is exactly the one given); gravity "
         "and the force elements act, drives are ignored.");
 
-  m.def(
-      "mass_matrix", &mass_matrix_py, py::arg("model"), py::arg("q"), py::arg("data") = py::none(),
-      "The joint-space mass matrix M(q) (n_dofs, n_dofs) of a tree, by the "
-      "composite-rigid-body algorithm (a coupled model's in its independent coordinates, "
-      "G^T M G; a model with closed loops' in its independent coordinates, T^T Gamma T with T the "
-      "loop's velocity map); 2-D q (one state per row) gives (rows, n, n).");
+  m.def("mass_matrix", &mass_matrix_py, py::arg("model"), py::arg("q"),
+        py::arg("data") = py::none(),
+        "The joint-space mass matrix M(q) (n_dofs, n_dofs) of a tree, by the "
+        "composite-rigid-body algorithm (a coupled model's in its independent coordinates, "
+        "G^T M G; a model with closed loops' or a fixed-base tree with ideal gears' in its "
+        "independent coordinates, T^T Gamma T with T the velocity map); 2-D q (one state per row) "
+        "gives (rows, n, n).");
 }
 
 }  // namespace armdyn

@@ -139,10 +139,11 @@ void def_builder_closures(BuilderClass& cls) {
            b.set_independent_coordinates(v);
          },
          py::arg("names"),
-         "The independent coordinates of a model with closed loops: names from "
-         "joint_coord_names, as many as the model's mobility, in the order q, qd, qdd and tau "
-         "take them. finalize() checks them (ModelError naming an unknown or repeated name, a "
-         "wrong count, a coordinate the others determine at the assembled state, or a tree). "
+         "The independent coordinates of a model with closed loops or of a fixed-base tree "
+         "with ideal gears: names from joint_coord_names, as many as the model's mobility, in "
+         "the order q, qd, qdd and tau take them. finalize() checks them (ModelError naming an "
+         "unknown or repeated name, a wrong count, a coordinate the others determine at the "
+         "assembled state, or a tree without ideal gears or with a floating base). "
          "An empty list restores armdyn's default: the joint coordinates in model order, each "
          "taken when independent of those taken before (add the actuated joints first).")
       .def(

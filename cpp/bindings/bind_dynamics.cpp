@@ -22,15 +22,18 @@ using namespace py_helpers;
 
 namespace {
 
-auto state_from_joints_py(const ModelArg& model, const ArrayLike& q, const OptArrayLike& qd) {
+auto state_from_joints_py(const ModelArg& model, const ArrayLike& q, const OptArrayLike& qd,
+                          const OptData& data) {
   const ModelHolder holder = model_of(model, "state_from_joints");
   const Model& md = *holder;
+  Data& d = data_for(holder, data, "state_from_joints");
   if (md.loop_coordinates) {
-    // a model with loops: the position and velocity problems from this thread's last state
+    // a model with loops or ideal gears: the position and velocity problems from the Data's
+    // last state (this thread's by default)
     const long n = md.independent.n;
     const VecX qi = to_vec(q, "q", n), qdi = qd.is_none() ? VecX::Zero(n) : to_vec(qd, "qd", n);
     VecX u, v;
-    loop_state(md, cached_data(holder), qi, qdi, u, v, "state_from_joints");
+    loop_state(md, d, qi, qdi, u, v, "state_from_joints");
     return py::make_tuple(to_numpy(u), to_numpy(v));
   }
   // the sizes below are the joint space's: refused first for a model without one
@@ -98,15 +101,16 @@ py::array_t<double> body_mass_matrix_py(const Model& md) {
 void bind_dynamics(py::module_& m) {
   m.def(
       "state_from_joints", &state_from_joints_py, py::arg("model"), py::arg("q"),
-      py::arg("qd") = py::none(),
+      py::arg("qd") = py::none(), py::arg("data") = py::none(),
       "Cartesian state (u, v) of a joint-space tree model from joint-space q (n_coords) and qd "
       "(n_dofs; default zero): a coupled model's independent coordinates, the followers set by "
       "their couplings. Returns (u (nq,), v (nv,)) float64 arrays: per body CoM [m] and unit "
       "Euler parameters; CoM velocity [m/s, world] and angular velocity [rad/s, body]. "
-      "ModelError on a model without a joint space or wrong shapes. A model with closed loops: its "
-      "independent coordinates, the others solved from the loop constraints (Newton from this "
-      "thread's last solution: the assembly branch kept; SolverError at a singular "
-      "configuration).");
+      "ModelError on a model without a joint space or wrong shapes. A model with closed loops or a "
+      "fixed-base tree with ideal gears: its independent coordinates (model.coord_names), the "
+      "others solved from the loop and gear constraints (continuation from the last solution of "
+      "data, an armdyn.Data, or this thread's when None: the assembly branch and the gears' "
+      "turns kept; SolverError at a singular configuration).");
 
   m.def("joint_coordinates", &joint_coordinates_py, py::arg("model"), py::arg("u"), py::arg("v"),
         "Joint-space q (n_coords: floating bases' poses, then joint coordinates with angles in "

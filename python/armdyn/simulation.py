@@ -264,7 +264,9 @@ def simulate(
             raise _core.ModelError("simulate: give either q0/qd0 or u0/v0, not both")
         if q0 is None:
             raise _core.ModelError("simulate: qd0 given without q0")
-        u0, v0 = _core.state_from_joints(model, q0, qd0)
+        # on a fresh workspace: the start does not depend on earlier calls (a loop or geared
+        # model's dependent coordinates are solved by continuation from the Data's last state)
+        u0, v0 = _core.state_from_joints(model, q0, qd0, data=_core.Data(model))
         q_start = q0
     else:
         q_start = None
@@ -542,8 +544,8 @@ def _initial_rows(model, q0, qd0, u0, v0):
         us, vs, errors = np.empty((n, model.nq)), np.empty((n, model.nv)), [""] * n
         for k in range(n):
             try:
-                us[k], vs[k] = _core.state_from_joints(model, q[k], qd[k])
-            except _core.ModelError as err:  # this run cannot start; the others can
+                us[k], vs[k] = _core.state_from_joints(model, q[k], qd[k], data=_core.Data(model))
+            except (_core.ModelError, _core.SolverError) as err:  # this run cannot start alone
                 us[k], vs[k], errors[k] = model.u0, model.v0, str(err)
         return us, vs, q, errors
     if u0 is not None:

@@ -166,8 +166,8 @@ def _angular_mask(model) -> np.ndarray:
     mask = []
     for jt in model.joint_types:
         mask.extend(per_type.get(str(jt).split(".")[-1].lower(), ()))
-    if len(mask) != model.n_coords:  # a joint type this map does not know: wrap nothing
-        return np.zeros(model.n_coords, dtype=bool)
+    if len(mask) != model.n_joint_coords:  # a joint type this map does not know: wrap nothing
+        return np.zeros(model.n_joint_coords, dtype=bool)
     return np.array(mask, dtype=bool)
 
 
@@ -237,10 +237,10 @@ def _reference_on_grid(reference, t: np.ndarray, model, observe_default: bool):
         vals = vals[:, None]
     if vals.shape[0] != len(t):
         raise _bad(f"reference has {vals.shape[0]} rows for {len(t)} output times")
-    if observe_default and vals.shape[1] != model.n_coords:
+    if observe_default and vals.shape[1] != model.n_joint_coords:
         raise _bad(
-            f"reference has {vals.shape[1]} columns; the error compares the {model.n_coords} "
-            "joint coordinates"
+            f"reference has {vals.shape[1]} columns; the error compares the "
+            f"{model.n_joint_coords} joint coordinates (model.joint_coord_names)"
         )
     if not np.all(np.isfinite(vals)):
         raise _bad("reference has non-finite values")
@@ -293,7 +293,7 @@ def work_precision(
             below. Or the user's own: a callable ``t -> (len(t), k)`` values, a tuple
             ``(t, values)`` on the output grid, or a result with ``t`` and ``q`` on the grid
             (e.g. a :class:`SimulationResult` run with ``output_dt = t_end / n_out``); the
-            values are the joint coordinates (``k = model.n_coords``), or what ``observe``
+            values are the joint coordinates (``k = model.n_joint_coords``), or what ``observe``
             returns.
         dts: RK4's fixed steps; default: the output spacing ``t_end / n_out`` divided by 1, 2,
             4, 8, 16, 32.
@@ -459,7 +459,7 @@ def _check_start(model, q0, qd0, u0, v0, observe, reference) -> dict[str, Any]:
         raise _bad("qd0 given without q0")
     if (q0 is not None) and (u0 is not None or v0 is not None):
         raise _bad("give either q0/qd0 or u0/v0, not both")
-    if observe is None and model.n_coords == 0:
+    if observe is None and model.n_joint_coords == 0:
         raise _bad(
             "the model has no joint coordinates to compare (spherical, universal or free joints "
             "only); pass observe= and reference="
@@ -521,7 +521,7 @@ def _observation(model, n_out: int, observe, angular, error_measure) -> _Observa
         mask = _angular_mask(model) if angular is None else angular
         observe_fn = lambda res: res.q  # noqa: E731
         measure = error_measure or (
-            f"max |q - q_ref| of the {model.n_coords} joint coordinates over {n_out + 1} "
+            f"max |q - q_ref| of the {model.n_joint_coords} joint coordinates over {n_out + 1} "
             "outputs [rad for angles (wrapped), m for displacements]"
         )
     else:

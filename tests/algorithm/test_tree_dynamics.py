@@ -123,10 +123,10 @@ def test_geared_arm_joint_path_equals_the_reference_and_the_cartesian_run():
     model = geared_arm_6dof(backlash=0.0, **QUICK_GEARED_ARM)
     ref = GearedArmReference(**QUICK_GEARED_ARM)
     f, _ = ref.rhs()
-    perm = [list(ref.tree.coord_names).index(c) for c in model.coord_names]
+    perm = [list(ref.tree.coord_names).index(c) for c in model.joint_coord_names]
     td = _core._TreeDynamics(model)
     assert td.dof == 6
-    n = model.n_coords
+    n = model.n_joint_coords
     rng = np.random.default_rng(2)
     worst = 0.0
     for t in (0.05, 0.4, 0.9):  # before the motion and during it (the references' terms)

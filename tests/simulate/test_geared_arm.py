@@ -43,7 +43,7 @@ def test_backlash_run_has_tooth_impacts_and_holds_the_arm():
     res = ad.simulate(m, 0.3, rtol=1e-6, atol=1e-8, output_dt=0.05)
     assert res.stats["events"] > 0
     assert all(g.endswith("stage_2") for g in res.events["gear"])
-    names = list(m.coord_names)
+    names = list(m.joint_coord_names)
     shoulder = res.q[:, names.index("shoulder")]
     assert np.max(np.abs(shoulder)) < 0.02  # held near its start under gravity
     assert np.max(res.position_residual) <= 1e-12
@@ -58,7 +58,7 @@ def test_welded_run_reports_gear_residuals_over_many_rotor_turns():
     m = geared_arm_6dof(backlash=0.0)
     res = ad.simulate(m, 5.0, integrator="dopri5", rtol=1e-6, atol=1e-6, output_dt=0.05)
     assert res.stats["solver_bodies"] < 44  # the welded path
-    names = list(m.coord_names)
+    names = list(m.joint_coord_names)
     rotor = res.q[:, names.index("shoulder_motor")]
     assert np.max(np.abs(rotor)) > 4 * np.pi  # N = 25 times 0.6 rad: 15 rad, over two turns
     assert np.max(res.position_residual) <= 1e-10  # measured 9.5e-14

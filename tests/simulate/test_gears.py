@@ -180,7 +180,7 @@ def test_ideal_gear_on_a_moving_carrier_conserves_energy(coordinates):
         v0=v0,
         coordinates=coordinates,
     )
-    names = list(model.coord_names)
+    names = list(model.joint_coord_names)
     qa, qb = res.q[:, names.index("ja")], res.q[:, names.index("jb")]
     assert np.max(np.abs(RA * qa + RB * qb)) <= 1e-11
     assert np.ptp(qa) > 10.0  # several turns

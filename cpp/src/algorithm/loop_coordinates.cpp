@@ -174,18 +174,22 @@ void set_independent(Model& m, const std::vector<int>& chosen) {
 
 void choose_loop_coordinates(Model& m) {
   m.loop_coordinates = false;
-  // a tree with ideal gears keeps every coordinate (its joint-space simulation, TreeDynamics,
-  // takes them all): the joint-level functions take loop models
-  if (m.is_tree) {
+  // a tree without ideal gears has independent joint coordinates (a coupling's follower is
+  // dependent by construction); a fixed-base tree with ideal gears takes the loop functions (the
+  // gear rows are constraint rows like loop closures), simulated in joint space over all its
+  // coordinates by TreeDynamics
+  if (m.is_tree && !(has_ideal_gear(m) && m.n_free == 0)) {
     if (!m.independent_request.empty())
-      throw ModelError(msg(
-          "finalize: set_independent_coordinates applies to models with closed loops; this model "
-          "is a tree (its joint coordinates are independent; a coupling's follower is dependent "
-          "by construction",
-          has_ideal_gear(m) ? "; an ideal gear's tree is simulated in all its "
-                              "coordinates"
-                            : "",
-          ")"));
+      throw ModelError(
+          msg("finalize: set_independent_coordinates applies to models with closed loops or ideal "
+              "gears (fixed base); this model ",
+              has_ideal_gear(m) ? "has a floating base" : "is a tree without ideal gears",
+              " (its joint coordinates are independent; a coupling's follower is dependent by "
+              "construction)"));
+    if (has_ideal_gear(m))
+      m.joint_space_reason +=
+          " (and a floating base: the joint-level functions take ideal gears on fixed-base "
+          "trees only; use simulate and the Cartesian functions)";
     return;
   }
   if (m.n_free > 0) {
@@ -310,15 +314,35 @@ void coordinates_of(const Model& m, LoopWork& w, VecX& q) {
   }
 }
 
+// The largest motion of a body per unit of the path parameter along the tangent v (per body
+// max(|CoM velocity| / length scale, |angular velocity|)) [rad]
+double tangent_size(const Model& m, const VecX& v) {
+  double r = 0.0;
+  for (int i = 0; i < m.nb; ++i)
+    r = std::max({r, v.segment<3>(6 * i).norm() / m.length_scale, v.segment<3>(6 * i + 3).norm()});
+  return r;
+}
+
+// The longest step of the continuation: at most this rotation of a body per step [rad] (so the
+// tracked angles, gear rows included, keep their turns)
+constexpr double kMaxStep = 0.5;
+
 // one step of the continuation from the state at q_from + s dq to q_from + s1 dq: the predictor
-// along the path's tangent, then Newton; an empty string on success
-std::string path_step(LoopWork& w, double t, double s, double s1, VecX& qs) {
+// along the path's tangent, then Newton; an empty string on success. `too_long` (> 0) when the
+// step would move a body more than kMaxStep: the factor it is too long by (nothing solved)
+std::string path_step(LoopWork& w, double t, double s, double s1, VecX& qs, double& too_long) {
   const Model& dm = *w.driven;
   Data& dd = *w.dd;
+  too_long = 0.0;
   // the tangent at s: the velocity problem with the rates dq
   qs = w.q_from + s * w.dq;
   set_ref(w, qs, w.dq, 0.0, nullptr);
   project(dm, dd, t, w.u.data(), w.v.data(), Metric::Mass);
+  const double size = tangent_size(dm, w.v) * (s1 - s);
+  if (size > kMaxStep) {
+    too_long = size / kMaxStep;
+    return "";
+  }
   udot(dm, w.u.data(), w.v.data(), w.ud.data());
   w.u_pred = w.u + (s1 - s) * w.ud;
   w.u_save = w.u;
@@ -378,26 +402,34 @@ void solve_state(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen::Ref<c
   w.v_start = w.v;
   w.track_start = dd.track_ref;
   w.q_from = w.q_last;
+  // an ideal gear's coordinates keep their turns (a turn of a gear is not a turn of its mate):
+  // the path goes the whole way; without gears a loop's angles are taken modulo a turn
+  const bool turns = has_ideal_gear(m);
   for (int k = 0; k < ic.n; ++k) {
     const double diff = q[k] - w.q_from[k];
-    w.dq[k] = m.coords[ic.full[k]].angular ? wrap_angle(diff) : diff;
+    w.dq[k] = m.coords[ic.full[k]].angular && !turns ? wrap_angle(diff) : diff;
   }
   std::string failure;
-  double s = 0.0, h = 1.0;
+  double s = 0.0, h = 1.0, h_len = 1.0;  // h_len: the step the length cap allowed
   VecX& qs = w.qs;
-  while (s < 1.0 && w.dq.cwiseAbs().maxCoeff() > 0.0) {
+  while (s < 1.0 && ic.n > 0 && w.dq.cwiseAbs().maxCoeff() > 0.0) {
     const double s1 = std::min(s + h, 1.0);
     w.track_save = dd.track_ref;
     w.u_step = w.u;
-    failure = path_step(w, t, s, s1, qs);
-    if (failure.empty()) {
+    double too_long = 0.0;
+    failure = path_step(w, t, s, s1, qs, too_long);
+    if (failure.empty() && too_long == 0.0) {
       s = s1;
       continue;
     }
     w.u = w.u_step;
     dd.track_ref = w.track_save;
+    if (too_long > 0.0) {  // shorter steps, not a failure
+      h = h_len = 0.9 * (s1 - s) / too_long;
+      continue;
+    }
     h *= 0.5;
-    if (h < 1.0 / 1024) break;
+    if (h < h_len / 1024) break;
   }
   try {
     if (failure.empty()) {
@@ -599,11 +631,15 @@ VecX loop_full_coordinates(const Model& m, const VecX& qi) {
   Data d(m);
   VecX u, v;
   loop_state(m, d, qi, VecX::Zero(qi.size()), u, v, fn);
-  std::vector<BodyKin> kin;
-  body_kinematics(m, u.data(), nullptr, kin);
+  // the angles as the continuation tracked them (a gear's turns: its rows hold in them)
+  Data& dd = *d.loop->dd;
+  load_kinematics(*d.loop->driven, dd, u.data(), nullptr);
   const int nf = static_cast<int>(m.coords.size());
   VecX q(m.nq_joint);
-  for (int c = 0; c < nf; ++c) q[c] = coord_value(m, kin, c);
+  for (int c = 0; c < nf; ++c) {
+    const double raw = coord_value(m, dd.kin, c);
+    q[c] = m.coords[c].angular ? tracked(dd, c, raw) : raw;
+  }
   const IndependentCoords& ic = m.independent;
   for (int k = 0; k < ic.n; ++k) q[ic.full[k]] = qi[k];
   ic.align(m.coords, q.data());

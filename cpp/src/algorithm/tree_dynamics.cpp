@@ -109,7 +109,8 @@ std::string TreeDynamics::description() const {
                aba_ ? "articulated-body algorithm" : "mass matrix by CRBA, Cholesky", " (",
                c.forward_summary(), ")");
   }
-  const bool couplings = m_.independent.n != n_;
+  bool couplings = false;
+  for (const GearConstraint& g : m_.gear_constraints) couplings = couplings || g.coupling;
   return msg("joint space: ", n_, " coordinates, ", m_.gear_constraints.size(),
              couplings ? " ideal-gear and coupling rows (rank " : " ideal-gear rows (rank ", rank_,
              ") eliminated by their null space: ", dof_,

@@ -87,7 +87,14 @@ std::vector<SimResult> simulate_batch(const Model& m, double t_end, const SimOpt
   check_runs(runs, threads);
   const long n = static_cast<long>(runs.u0.size());
   for (long k = 0; k < static_cast<long>(runs.q_start.size()); ++k)
-    if (runs.errors[k].empty()) runs.q_start[k] = q_start_from_independent(m, runs.q_start[k]);
+    if (runs.errors[k].empty()) {
+      // a loop or geared model's start solved alone: a run that does not assemble fails alone
+      try {
+        runs.q_start[k] = q_start_from_independent(m, runs.q_start[k]);
+      } catch (const SolverError& e) {
+        runs.errors[k] = e.what();
+      }
+    }
   std::vector<SimResult> results(n);
   const int nt = static_cast<int>(std::min<long>(threads, std::max<long>(n, 1)));
   BatchQueue q;

@@ -562,7 +562,7 @@ class ModelBuilder:
         """
     def set_independent_coordinates(self, names: collections.abc.Sequence[str]) -> None:
         """
-        The independent coordinates of a model with closed loops: names from joint_coord_names, as many as the model's mobility, in the order q, qd, qdd and tau take them. finalize() checks them (ModelError naming an unknown or repeated name, a wrong count, a coordinate the others determine at the assembled state, or a tree). An empty list restores armdyn's default: the joint coordinates in model order, each taken when independent of those taken before (add the actuated joints first).
+        The independent coordinates of a model with closed loops or of a fixed-base tree with ideal gears: names from joint_coord_names, as many as the model's mobility, in the order q, qd, qdd and tau take them. finalize() checks them (ModelError naming an unknown or repeated name, a wrong count, a coordinate the others determine at the assembled state, or a tree without ideal gears or with a floating base). An empty list restores armdyn's default: the joint coordinates in model order, each taken when independent of those taken before (add the actuated joints first).
         """
     def set_joint_limits(self, joint: str, lower: typing.SupportsFloat | typing.SupportsIndex, upper: typing.SupportsFloat | typing.SupportsIndex, effort: typing.SupportsFloat | typing.SupportsIndex = 0.0, velocity: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> None:
         """
@@ -701,7 +701,7 @@ def evaluate_constraints(model: Model, u: numpy.typing.ArrayLike, v: numpy.typin
     """
 def forward_dynamics(model: Model, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, tau: numpy.typing.ArrayLike, t: float | numpy.typing.ArrayLike = 0.0, method: str = 'auto', data: Data | None = None) -> numpy.typing.NDArray[numpy.float64]:
     """
-    Joint accelerations qdd of a tree for joint torques/forces tau at (q, qd) and time t [s] (q: n_coords, the others n_dofs; a coupled model's independent coordinates, followers of couplings removed, as Pinocchio's mimic=True models; 2-D: one state per row). method: 'crba' (CRBA mass matrix, recursive Newton-Euler bias, Cholesky), 'aba' (articulated-body algorithm, O(n)), 'cartesian' (the constrained Newton-Euler KKT system of the bodies), 'joint' (the cheaper of crba and aba for this model), 'auto' (the cheapest of the three); the choice comes from a measured cost model (dynamics_cost). The model's force elements act; drives are ignored. A model with closed loops: its independent coordinates (model.coord_names), on the Cartesian formulation (method 'auto' or 'cartesian').
+    Joint accelerations qdd of a tree for joint torques/forces tau at (q, qd) and time t [s] (q: n_coords, the others n_dofs; a coupled model's independent coordinates, followers of couplings removed, as Pinocchio's mimic=True models; 2-D: one state per row). method: 'crba' (CRBA mass matrix, recursive Newton-Euler bias, Cholesky), 'aba' (articulated-body algorithm, O(n)), 'cartesian' (the constrained Newton-Euler KKT system of the bodies), 'joint' (the cheaper of crba and aba for this model), 'auto' (the cheapest of the three); the choice comes from a measured cost model (dynamics_cost). The model's force elements act; drives are ignored. A model with closed loops or a fixed-base tree with ideal gears: its independent coordinates (model.coord_names), on the Cartesian formulation (method 'auto' or 'cartesian').
     """
 def forward_dynamics_derivatives(model: Model, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, tau: numpy.typing.ArrayLike, t: float | numpy.typing.ArrayLike = 0.0, data: Data | None = None) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
     """
@@ -725,7 +725,7 @@ def frame_pose_cartesian(model: Model, u: numpy.typing.ArrayLike, frame: str | i
     """
 def inverse_dynamics(model: Model, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike, t: float | numpy.typing.ArrayLike = 0.0, method: str = 'auto', data: Data | None = None) -> numpy.typing.NDArray[numpy.float64]:
     """
-    Joint torques/forces tau realising qdd at (q, qd) and time t [s] (q: n_coords, the others n_dofs; a coupled model's independent coordinates, tau = G^T tau_full; 2-D: one state per row): what each joint's actuator applies to its child about/along the joint axis, gravity and the model's force elements included, drives ignored. method: 'joint' (recursive Newton-Euler), 'cartesian' (every coordinate driven, the drives' KKT multipliers), 'auto' (joint). A model with closed loops: the torques on its independent coordinates (model.coord_names), driven_inverse_dynamics' drive forces with them driven (method 'auto' or 'cartesian').
+    Joint torques/forces tau realising qdd at (q, qd) and time t [s] (q: n_coords, the others n_dofs; a coupled model's independent coordinates, tau = G^T tau_full; 2-D: one state per row): what each joint's actuator applies to its child about/along the joint axis, gravity and the model's force elements included, drives ignored. method: 'joint' (recursive Newton-Euler), 'cartesian' (every coordinate driven, the drives' KKT multipliers), 'auto' (joint). A model with closed loops or a fixed-base tree with ideal gears: the torques on its independent coordinates (model.coord_names), driven_inverse_dynamics' drive forces with them driven (method 'auto' or 'cartesian').
     """
 def inverse_dynamics_derivatives(model: Model, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike, t: float | numpy.typing.ArrayLike = 0.0, data: Data | None = None) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
     """
@@ -745,7 +745,7 @@ def joint_torque_regressor(model: Model, q: numpy.typing.ArrayLike, qd: numpy.ty
     """
 def mass_matrix(model: Model, q: numpy.typing.ArrayLike, data: Data | None = None) -> numpy.typing.NDArray[numpy.float64]:
     """
-    The joint-space mass matrix M(q) (n_dofs, n_dofs) of a tree, by the composite-rigid-body algorithm (a coupled model's in its independent coordinates, G^T M G; a model with closed loops' in its independent coordinates, T^T Gamma T with T the loop's velocity map); 2-D q (one state per row) gives (rows, n, n).
+    The joint-space mass matrix M(q) (n_dofs, n_dofs) of a tree, by the composite-rigid-body algorithm (a coupled model's in its independent coordinates, G^T M G; a model with closed loops' or a fixed-base tree with ideal gears' in its independent coordinates, T^T Gamma T with T the velocity map); 2-D q (one state per row) gives (rows, n, n).
     """
 def model_with_dynamic_parameters(model: Model, pi: numpy.typing.ArrayLike, physical_inertia: bool = True) -> Model:
     """
@@ -755,9 +755,9 @@ def paper_3dof_torques(L: numpy.typing.ArrayLike, M: numpy.typing.ArrayLike, g: 
     ...
 def paper_5dof_end_effector(h: typing.SupportsFloat | typing.SupportsIndex, L1: typing.SupportsFloat | typing.SupportsIndex, L2: typing.SupportsFloat | typing.SupportsIndex, L34: typing.SupportsFloat | typing.SupportsIndex, theta: numpy.typing.ArrayLike) -> numpy.typing.NDArray[numpy.float64]:
     ...
-def state_from_joints(model: Model, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike | None = None) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
+def state_from_joints(model: Model, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike | None = None, data: Data | None = None) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
     """
-    Cartesian state (u, v) of a joint-space tree model from joint-space q (n_coords) and qd (n_dofs; default zero): a coupled model's independent coordinates, the followers set by their couplings. Returns (u (nq,), v (nv,)) float64 arrays: per body CoM [m] and unit Euler parameters; CoM velocity [m/s, world] and angular velocity [rad/s, body]. ModelError on a model without a joint space or wrong shapes. A model with closed loops: its independent coordinates, the others solved from the loop constraints (Newton from this thread's last solution: the assembly branch kept; SolverError at a singular configuration).
+    Cartesian state (u, v) of a joint-space tree model from joint-space q (n_coords) and qd (n_dofs; default zero): a coupled model's independent coordinates, the followers set by their couplings. Returns (u (nq,), v (nv,)) float64 arrays: per body CoM [m] and unit Euler parameters; CoM velocity [m/s, world] and angular velocity [rad/s, body]. ModelError on a model without a joint space or wrong shapes. A model with closed loops or a fixed-base tree with ideal gears: its independent coordinates (model.coord_names), the others solved from the loop and gear constraints (continuation from the last solution of data, an armdyn.Data, or this thread's when None: the assembly branch and the gears' turns kept; SolverError at a singular configuration).
     """
 def torque_error_metrics(a: numpy.typing.ArrayLike, ref: numpy.typing.ArrayLike) -> dict:
     ...

@@ -59,6 +59,14 @@ def check_model(who: str, model) -> None:
         raise _core.ModelError(
             f"{who}: the model has closed loops; inverse kinematics needs a tree of joints"
         )
+    # a tree whose independent coordinates are fewer than its joint coordinates less the
+    # couplings' followers: ideal gears make the others dependent
+    if model.n_joint_coords - model.n_coords > len(model.couplings):
+        raise _core.ModelError(
+            f"{who}: the model has ideal gears (its independent coordinates "
+            f"{list(model.coord_names)} move the others through them); inverse kinematics needs "
+            "a tree of independent joints"
+        )
 
 
 def check_frame(who: str, model, frame) -> str:

@@ -1,11 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The joint-level functions of a model with closed loops, in independent
-// coordinates, on the Cartesian formulation (methods.md's constrained Newton-Euler system).
+// The joint-level functions of a model with closed loops or of a fixed-base tree with ideal
+// gears, in independent coordinates, on the Cartesian formulation (methods.md's constrained
+// Newton-Euler system).
 //
 // A model whose joints close loops (any joint closing a cycle, add_distance, bodies held only by
-// constraints; ideal gears inside it included) has `mobility` degrees of freedom but more joint
-// coordinates (a tree with ideal gears keeps its convention: every coordinate, simulated in joint
-// space by the null space of the gear rows). finalize() chooses `mobility` of them as its
+// constraints; ideal gears inside it included), or a fixed-base tree with ideal gears (each gear
+// row ties two coordinates as a loop closure does; simulate's joint space still integrates every
+// coordinate, the gear rows eliminated by their null space), has `mobility` degrees of freedom
+// but more joint coordinates. finalize() chooses `mobility` of them as its
 // independent coordinates (Model::independent, Model::loop_coordinates): the user's (ModelBuilder::
 // set_independent_coordinates) or, by default, the joint coordinates in model order, each taken
 // when it is independent of those taken before at the assembled state (a pivoted rank test of the
@@ -15,7 +17,9 @@
 //    (the model's joint rows plus one drive row per independent coordinate), by Newton from the
 //    Data's last solution with continuation along the straight path of q from its last value
 //    (so the assembly branch stays the one the Data was on; the first call starts from the
-//    assembled state), then the velocity problem;
+//    assembled state), in steps that turn no body more than 0.5 rad (the tracked angles, which
+//    the gear rows read, keep their turns; with ideal gears the path goes the whole way, without
+//    them a loop's angles are taken modulo a turn), then the velocity problem;
 //  - inverse dynamics: the acceleration problem with the independent coordinates driven to qdd,
 //    the torques tau = -delta of their drive rows (driven_inverse_dynamics' convention), every
 //    joint's reaction from the same multipliers;

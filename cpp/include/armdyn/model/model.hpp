@@ -350,11 +350,12 @@ class Model {
   /// dynamics, mass matrix, state_from_joints) take the independent coordinates
   /// (IndependentCoords); the others refuse such a model (joint_space_reason names the coupling)
   bool coupled_joint_space = false;
-  /// a model with closed loops (not a tree) whose joint-level functions (forward and inverse
-  /// dynamics, mass matrix, state_from_joints, joint_reactions, frame_pose, frame_jacobian)
-  /// take `mobility` independent joint coordinates (Model::independent: full lists them, source
-  /// -1 for the dependent ones), evaluated on the Cartesian formulation
-  /// (armdyn/algorithm/loop_coordinates.hpp; finalize's choose_loop_coordinates)
+  /// a model with closed loops (not a tree), or a fixed-base tree with ideal gears, whose
+  /// joint-level functions (forward and inverse dynamics, mass matrix, state_from_joints,
+  /// joint_reactions, frame_pose, frame_jacobian) take `mobility` independent joint coordinates
+  /// (Model::independent: full lists them, source -1 for the dependent ones), evaluated on the
+  /// Cartesian formulation (armdyn/algorithm/loop_coordinates.hpp; finalize's
+  /// choose_loop_coordinates)
   bool loop_coordinates = false;
   /// the independent coordinates the user chose (ModelBuilder::set_independent_coordinates, by
   /// name); empty: armdyn's default choice
