@@ -87,7 +87,9 @@ void ArticulatedSweep::plan(const Model& m, const ConstraintEval& ce) {
     const Joint& j = m.joints[ji];
     // parent -> child joints only (the tree order's parent is the joint's)
     if (j.child == kGround || !supported(j.type)) return;
-    Step s{ji, j.parent, j.child, -1, joint_rows(j.type), j.type};
+    Step s{ji, j.parent, j.child, -1, joint_rows(j.type), j.type, false};
+    s.point = j.type == JointType::Revolute || j.type == JointType::Universal ||
+              j.type == JointType::Spherical || j.type == JointType::Fixed;
     if (j.type == JointType::Free && j.parent != kGround) return;
     if (s.nk > 0) {
       s.block = block_at_row[j.row0];
@@ -102,8 +104,12 @@ void ArticulatedSweep::plan(const Model& m, const ConstraintEval& ce) {
     if (!joint_block[b]) extra_blocks_.push_back(b);
   const size_t n = steps_.size();
   tinv_.assign(n, Mat6::Identity());
-  a_.assign(n, Mat6::Zero());
+  s_.assign(n, Mat6::Zero());
   u_.assign(n, Mat6::Zero());
+  bm_.assign(n, Mat3::Zero());
+  ci_.assign(n, Mat3::Identity());
+  x_.assign(n, Mat3::Zero());
+  y_.assign(n, Mat3::Zero());
   dinv_.assign(n, Mat6::Zero());
   b_.assign(n, Vec6::Zero());
   ia_.assign(m.nb, Mat6::Zero());
@@ -116,47 +122,96 @@ void ArticulatedSweep::plan(const Model& m, const ConstraintEval& ce) {
   ok_ = true;
 }
 
-// T = [Z_c; C]: the joint's rows on the child, then its free directions (world axes of the joint
-// frames, in the child's velocity coordinates: linear in world, angular in the body frame)
+// T = [Z_c; C]: the joint's rows on the child, then its free directions (axes of the joint
+// frames, in the child's velocity coordinates: linear in world, angular in the body frame). Any
+// C that completes Z_c gives the same solution (s is free); the child's own axes cost least.
 bool ArticulatedSweep::complete_block(const Model& m, const std::vector<BodyKin>& kin,
                                       const ConstraintEval& ce, const Step& s, Mat6& T) const {
   T.setZero();
   if (s.nk > 0) T.topRows(s.nk) = ce.blocks[s.block].J.block(0, 6, s.nk, 6);
-  int r = s.nk;
   const Joint& j = m.joints[s.joint];
-  auto parent_axis = [&](int k) -> Vec3 {
-    const Vec3 a = j.frame_parent.col(k);
-    return j.parent == kGround ? a : Vec3(kin[j.parent].R * a);
-  };
-  const Mat3& Rc = kin[j.child].R;
+  const Vec3 z = kin[j.child].R * j.frame_child.col(2);
+  switch (s.type) {
+    case JointType::Prismatic:
+      T.row(5).head<3>() = z;
+      return true;
+    case JointType::Cylindrical:
+      T.row(4).tail<3>() = j.frame_child.col(2);
+      T.row(5).head<3>() = z;
+      return true;
+    case JointType::Free:
+      T.setIdentity();
+      return true;
+    default:
+      return false;
+  }
+}
+
+// A point joint's T = [I B; 0 C]: B (the point rows' angular columns) and C (the rotation rows'
+// angular columns, then the free rotations)
+void ArticulatedSweep::point_block(const Model& m, const std::vector<BodyKin>& kin,
+                                   const ConstraintEval& ce, const Step& s, Mat3& B,
+                                   Mat3& C) const {
+  const BlockMat& J = ce.blocks[s.block].J;
+  const Joint& j = m.joints[s.joint];
+  B = J.block<3, 3>(0, 9);
+  int r = 0;
+  for (; r < s.nk - 3; ++r) C.row(r) = J.row(3 + r).segment<3>(9);
   switch (s.type) {
     case JointType::Revolute:
-      T.row(r++).tail<3>() = Rc.transpose() * parent_axis(2);
+      C.row(2) = j.frame_child.col(2).transpose();
       break;
-    case JointType::Prismatic:
-      T.row(r++).head<3>() = parent_axis(2);
-      break;
-    case JointType::Cylindrical: {
-      const Vec3 z = parent_axis(2);
-      T.row(r++).tail<3>() = Rc.transpose() * z;
-      T.row(r++).head<3>() = z;
+    case JointType::Universal: {
+      const Vec3 za = j.parent == kGround ? Vec3(j.frame_parent.col(2))
+                                          : Vec3(kin[j.parent].R * j.frame_parent.col(2));
+      C.row(1) = (kin[j.child].R.transpose() * za).transpose();
+      C.row(2) = j.frame_child.col(2).transpose();
       break;
     }
-    case JointType::Universal:
-      T.row(r++).tail<3>() = Rc.transpose() * parent_axis(2);
-      T.row(r++).tail<3>() = j.frame_child.col(2);
-      break;
     case JointType::Spherical:
-      for (int k = 0; k < 3; ++k) T(r++, 3 + k) = 1.0;
-      break;
-    case JointType::Free:
-      for (int k = 0; k < 6; ++k) T(r++, k) = 1.0;
+      C.setIdentity();
       break;
     default:
       break;
   }
-  return r == 6;
 }
+
+namespace {
+
+// G = Ci[:, :K] W for the K rotation rows W (K x 3) of a point joint
+template <int K>
+Mat3 point_rows_product(const Mat3& Ci, const BlockMat& J, int col) {
+  if constexpr (K == 0) {
+    return Mat3::Zero();
+  } else {
+    return Ci.leftCols<K>() * J.block<K, 3>(3, col);
+  }
+}
+
+Mat3 point_product(int K, const Mat3& Ci, const BlockMat& J, int col) {
+  switch (K) {
+    case 1:
+      return point_rows_product<1>(Ci, J, col);
+    case 2:
+      return point_rows_product<2>(Ci, J, col);
+    case 3:
+      return point_rows_product<3>(Ci, J, col);
+    default:
+      return Mat3::Zero();
+  }
+}
+
+// M += A^T Ia A for A = [I X; 0 Y] (a point joint's transport)
+void add_congruence(const Mat6& Ia, const Mat3& X, const Mat3& Y, Mat6& M) {
+  const Mat3 N = Ia.topLeftCorner<3, 3>() * X + Ia.topRightCorner<3, 3>() * Y;
+  const Mat3 Q = Ia.bottomLeftCorner<3, 3>() * X + Ia.bottomRightCorner<3, 3>() * Y;
+  M.topLeftCorner<3, 3>() += Ia.topLeftCorner<3, 3>();
+  M.topRightCorner<3, 3>() += N;
+  M.bottomLeftCorner<3, 3>() += N.transpose();
+  M.bottomRightCorner<3, 3>().noalias() += X.transpose() * N + Y.transpose() * Q;
+}
+
+}  // namespace
 
 bool ArticulatedSweep::factor(const Model& m, const std::vector<BodyKin>& kin,
                               const ConstraintEval& ce) {
@@ -169,34 +224,82 @@ bool ArticulatedSweep::factor(const Model& m, const std::vector<BodyKin>& kin,
   Mat6 T, Ia;
   for (size_t k = steps_.size(); k-- > 0;) {
     const Step& s = steps_[k];
-    if (!complete_block(m, kin, ce, s, T) || !invert_block(T, tinv_[k])) return false;
     const int nf = 6 - s.nk;
+    Mat6& S = s_[k];
+    if (s.point) {
+      // T^-1 = [I, -B C^-1; 0, C^-1]
+      Mat3 C;
+      point_block(m, kin, ce, s, bm_[k], C);
+      if (!inverse3(C, ci_[k])) return false;
+      S.topLeftCorner(3, nf).noalias() = -bm_[k] * ci_[k].rightCols(nf);
+      S.bottomLeftCorner(3, nf) = ci_[k].rightCols(nf);
+    } else {
+      if (!complete_block(m, kin, ce, s, T) || !invert_block(T, tinv_[k])) return false;
+      S.leftCols(nf) = tinv_[k].rightCols(nf);
+      tinv_[k].rightCols(nf).setZero();  // P, padded to 6 x 6
+    }
     const Mat6& I = ia_[s.child];
-    const auto S = tinv_[k].rightCols(nf);
-    auto U = u_[k].leftCols(nf);
-    U.noalias() = I * S;
     Ia = I;
     if (nf == 1) {
-      const double D = S.col(0).dot(U.col(0));
+      u_[k].col(0).noalias() = I * S.col(0);
+      const double D = S.col(0).dot(u_[k].col(0));
       if (!(D > 0.0) || !std::isfinite(D)) return false;
       dinv_[k](0, 0) = 1.0 / D;
-      Ia.noalias() -= (U.col(0) / D) * U.col(0).transpose();
+      const Vec6 u = u_[k].col(0), w = u / D;
+      Ia.noalias() -= w.lazyProduct(u.transpose());
     } else if (nf > 1) {
-      SmallMat D = S.transpose() * U;
+      u_[k].leftCols(nf).noalias() = I * S.leftCols(nf);
+      SmallMat D = S.leftCols(nf).transpose() * u_[k].leftCols(nf);
       Eigen::LLT<SmallMat> llt(D);
       if (llt.info() != Eigen::Success) return false;
-      SmallMat Di = llt.solve(SmallMat::Identity(nf, nf));
+      const SmallMat Di = llt.solve(SmallMat::Identity(nf, nf));
       dinv_[k].topLeftCorner(nf, nf) = Di;
-      Ia.noalias() -= U * Di * U.transpose();
+      Ia.noalias() -= u_[k].leftCols(nf) * Di * u_[k].leftCols(nf).transpose();
     }
-    if (s.parent != kGround) {
-      // A = -P Z_p: the child's acceleration as the parent's moves it with the joint held
-      const ConstraintBlock& b = ce.blocks[s.block];
-      a_[k].noalias() = -tinv_[k].leftCols(s.nk) * b.J.block(0, 0, s.nk, 6);
-      ia_[s.parent].noalias() += a_[k].transpose() * Ia * a_[k];
+    if (s.parent == kGround) continue;
+    // A = -P Z_p moves the child with the parent, the joint held; A + S M for any M does as
+    // well (s absorbs it, and Ia S = 0): with M = C's linear columns, A = [I X; 0 Y] for every
+    // joint type (the rows' linear columns are opposite on parent and child), [X; Y] = -P Z_p's
+    // angular columns
+    const ConstraintBlock& b = ce.blocks[s.block];
+    if (s.point) {
+      // Z_p = [-I K; 0 W]: Y = -C^-1[:, :nk-3] W, X = -K - B Y
+      const Mat3 G = point_product(s.nk - 3, ci_[k], b.J, 3);
+      y_[k] = -G;
+      x_[k].noalias() = bm_[k] * G - b.J.block<3, 3>(0, 3);
+    } else if (s.nk > 0) {
+      Eigen::Matrix<double, 6, 3> Zp = Eigen::Matrix<double, 6, 3>::Zero();
+      Zp.topRows(s.nk) = b.J.block(0, 3, s.nk, 3);
+      const Eigen::Matrix<double, 6, 3> XY = -tinv_[k] * Zp;
+      x_[k] = XY.topRows<3>();
+      y_[k] = XY.bottomRows<3>();
+    } else {
+      x_[k].setZero();
+      y_[k].setZero();
     }
+    add_congruence(Ia, x_[k], y_[k], ia_[s.parent]);
   }
-  return ia_[steps_.empty() ? 0 : steps_.front().child].allFinite();
+  return true;
+}
+
+// b = -P xi_j: the child's acceleration with the parent at rest and the free directions still
+void ArticulatedSweep::bias(const ConstraintEval& ce, const VecX& xi, size_t k) {
+  const Step& s = steps_[k];
+  if (s.nk == 0) {
+    b_[k].setZero();
+    return;
+  }
+  const int r0 = ce.blocks[s.block].row0;
+  if (s.point) {
+    Vec3 g = Vec3::Zero();
+    for (int r = 3; r < s.nk; ++r) g.noalias() += xi[r0 + r] * ci_[k].col(r - 3);
+    b_[k].head<3>().noalias() = bm_[k] * g - xi.segment<3>(r0);
+    b_[k].tail<3>() = -g;
+  } else {
+    Vec6 x = Vec6::Zero();
+    x.head(s.nk) = xi.segment(r0, s.nk);
+    b_[k].noalias() = -tinv_[k] * x;
+  }
 }
 
 void ArticulatedSweep::sweep(const ConstraintEval& ce, const VecX& xi, const VecX& eta, VecX& vd,
@@ -207,40 +310,56 @@ void ArticulatedSweep::sweep(const ConstraintEval& ce, const VecX& xi, const Vec
   for (size_t k = steps_.size(); k-- > 0;) {
     const Step& s = steps_[k];
     const int nf = 6 - s.nk;
-    if (s.nk > 0)
-      b_[k].noalias() = -tinv_[k].leftCols(s.nk) * xi.segment(ce.blocks[s.block].row0, s.nk);
-    else
-      b_[k].setZero();
+    bias(ce, xi, k);
     if (s.parent == kGround) continue;
     // I^A b + p^A with the child's free directions taken out
     t.noalias() = ia_[s.child] * b_[k];
     t += pa_[s.child];
-    if (nf > 0) {
-      const auto S = tinv_[k].rightCols(nf);
-      t.noalias() -= u_[k].leftCols(nf) *
-                     (dinv_[k].topLeftCorner(nf, nf) * (S.transpose() * t).eval()).eval();
+    if (nf == 1) {
+      t.noalias() -= (dinv_[k](0, 0) * s_[k].col(0).dot(t)) * u_[k].col(0);
+    } else if (nf > 1) {
+      const SmallVec st = s_[k].leftCols(nf).transpose() * t;
+      const SmallVec w = dinv_[k].topLeftCorner(nf, nf) * st;
+      t.noalias() -= u_[k].leftCols(nf) * w;
     }
-    pa_[s.parent].noalias() += a_[k].transpose() * t;
+    Vec6& pp = pa_[s.parent];
+    pp.head<3>() += t.head<3>();
+    pp.tail<3>().noalias() += x_[k].transpose() * t.head<3>() + y_[k].transpose() * t.tail<3>();
   }
   Vec6 a;
   for (size_t k = 0; k < steps_.size(); ++k) {
     const Step& s = steps_[k];
     const int nf = 6 - s.nk;
     a = b_[k];
-    if (s.parent != kGround) a.noalias() += a_[k] * vd.segment<6>(6 * s.parent);
+    if (s.parent != kGround) {
+      const auto vp = vd.segment<6>(6 * s.parent);
+      a.head<3>().noalias() += vp.head<3>() + x_[k] * vp.tail<3>();
+      a.tail<3>().noalias() += y_[k] * vp.tail<3>();
+    }
     t.noalias() = ia_[s.child] * a;
     t += pa_[s.child];
-    if (nf > 0) {
-      const auto S = tinv_[k].rightCols(nf);
-      const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1> sv =
-          -(dinv_[k].topLeftCorner(nf, nf) * (S.transpose() * t));
-      a.noalias() += S * sv;
+    if (nf == 1) {
+      const double sv = -dinv_[k](0, 0) * s_[k].col(0).dot(t);
+      a.noalias() += sv * s_[k].col(0);
+      t.noalias() += sv * u_[k].col(0);
+    } else if (nf > 1) {
+      const SmallVec st = s_[k].leftCols(nf).transpose() * t;
+      const SmallVec sv = -(dinv_[k].topLeftCorner(nf, nf) * st);
+      a.noalias() += s_[k].leftCols(nf) * sv;
       t.noalias() += u_[k].leftCols(nf) * sv;
     }
     vd.segment<6>(6 * s.child) = a;
-    if (s.nk > 0)
-      delta.segment(ce.blocks[s.block].row0, s.nk).noalias() =
-          -tinv_[k].leftCols(s.nk).transpose() * t;
+    if (s.nk == 0) continue;
+    // delta = -P^T (I^A vdot + p^A)
+    const int r0 = ce.blocks[s.block].row0;
+    if (s.point) {
+      delta.segment<3>(r0) = -t.head<3>();
+      const Vec3 w = t.tail<3>() - bm_[k].transpose() * t.head<3>();
+      for (int r = 3; r < s.nk; ++r) delta[r0 + r] = -ci_[k].col(r - 3).dot(w);
+    } else {
+      const Vec6 d = -tinv_[k].transpose() * t;
+      delta.segment(r0, s.nk) = d.head(s.nk);
+    }
   }
 }
 

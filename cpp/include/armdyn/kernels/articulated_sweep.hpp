@@ -8,7 +8,8 @@
 // Each tree joint j (parent p, child c) has k rows Z_p vdot_p + Z_c vdot_c = -xi_j. Completed by
 // 6 - k rows C (the joint's free directions: its axis, its slide, ...) to the invertible
 //   T = [Z_c; C],   T^-1 = [P | S]   (P: 6 x k, S: 6 x (6 - k)),
-// the child's acceleration is vdot_c = A vdot_p + S s + b with A = -P Z_p, b = -P xi_j and s free.
+// the child's acceleration is vdot_c = A vdot_p + S s + b with A = -P Z_p, b = -P xi_j and s free
+// (any A + S M serves as well: the one used is [I X; 0 Y], 3 x 3 blocks, for every joint type).
 // The balance of the child's subtree, Z_c^T delta_j = -(I^A_c vdot_c + p^A_c), gives S^T (I^A_c
 // vdot_c + p^A_c) = 0 (Z_c S = 0), hence s, and passes I^A_c and p^A_c to the parent through A
 // (Z_p^T delta_j = A^T (I^A_c vdot_c + p^A_c)): Featherstone's articulated-body algorithm with the
@@ -54,11 +55,17 @@ class ArticulatedSweep {
   struct Step {
     int joint, parent, child, block, nk;  // block: the joint's row block (-1: free joint)
     JointType type;
+    // the joint's first rows make its points coincide and its free directions are rotations
+    // (revolute, universal, spherical, fixed): T = [I B; 0 C], A = [I X; 0 Y]
+    bool point;
   };
   std::vector<Step> steps_;
   std::vector<int> extra_blocks_;  // row blocks that are not tree joints' (gears, drives)
-  // per step: T^-1, the transport A = -P Z_p, U = I^A S, D^-1 = (S^T U)^-1, bias b
-  std::vector<Mat6> tinv_, a_, u_;
+  // per step: P (T^-1 with S's columns zero: general joints), B and C^-1 (point joints), the
+  // transport A = [I X; 0 Y], the free directions S, U = I^A S, D^-1 = (S^T U)^-1 (first
+  // 6 - k columns), bias b
+  std::vector<Mat6> tinv_, s_, u_;
+  std::vector<Mat3> bm_, ci_, x_, y_;
   std::vector<Mat6> dinv_;  // top-left (6 - k) square used
   std::vector<Vec6> b_;
   // per body: articulated inertia and bias force
@@ -75,8 +82,11 @@ class ArticulatedSweep {
   bool factor(const Model& m, const std::vector<BodyKin>& kin, const ConstraintEval& ce);
   bool complete_block(const Model& m, const std::vector<BodyKin>& kin, const ConstraintEval& ce,
                       const Step& s, Mat6& T) const;
+  void point_block(const Model& m, const std::vector<BodyKin>& kin, const ConstraintEval& ce,
+                   const Step& s, Mat3& B, Mat3& C) const;
   /// The bias pass and the forward pass for loads eta and row values xi (tree rows only).
   void sweep(const ConstraintEval& ce, const VecX& xi, const VecX& eta, VecX& vdot, VecX& delta);
+  void bias(const ConstraintEval& ce, const VecX& xi, size_t k);
   bool extra_rows(const ConstraintEval& ce, int nrows, VecX& vdot, VecX& delta);
 };
 
