@@ -30,6 +30,7 @@ struct PipelineStats {
   long velocity_projections = 0;
   long kkt_solves = 0;
   long factorizations = 0;
+  long articulated_solves = 0;  ///< of kkt_solves: by the articulated-body recursion
   /// body_accelerations evaluations where the constraint Jacobian had lower rank than at
   /// assembly (a singular configuration); the first one is described in singular_note.
   long singular_evaluations = 0;

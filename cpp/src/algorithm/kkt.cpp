@@ -123,8 +123,8 @@ void body_accelerations_loaded(const Model& m, Data& d, double t, double* vdot, 
     const bool reuse = reuse_factor && d.artic.factored(nrows, kkt.factor_count());
     if (d.artic.solve(m, d.kin, d.ce, nrows, d.eta, d.vd_work, d.delta, reuse,
                       kkt.factor_count())) {
-      if (!reuse) ++st.factorizations;
       ++st.kkt_solves;
+      ++st.articulated_solves;
       d.swept = true;
       kkt.mark_stale();
       vd = d.vd_work;
