@@ -39,6 +39,7 @@ Data::Data(const Model& m)
   ce.coord_cache = &jets;
   ce.track_ref = &track_ref;
   sweep.plan(m, ce);
+  artic.plan(m, ce);
   vd = VecX::Zero(m.nv);
   tau_in = VecX::Zero(n);
   tau_jets.resize(nco);
@@ -86,6 +87,7 @@ void reset_pipeline(Data& d) {
   d.augmented = false;
   d.stats = PipelineStats{};
   d.kkt.reset();
+  d.artic.mark_stale();
 }
 
 void check_data(const Model& m, const Data& d, const char* fn) {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "armdyn/integrate/integrators.hpp"
+#include "armdyn/kernels/articulated_sweep.hpp"
 #include "armdyn/kernels/constraint_rows.hpp"
 #include "armdyn/kernels/jets.hpp"
 #include "armdyn/kernels/joint_space.hpp"
@@ -29,6 +30,7 @@ struct PipelineStats {
   long velocity_projections = 0;
   long kkt_solves = 0;
   long factorizations = 0;
+  long articulated_solves = 0;  ///< of kkt_solves: by the articulated-body recursion
   /// body_accelerations evaluations where the constraint Jacobian had lower rank than at
   /// assembly (a singular configuration); the first one is described in singular_note.
   long singular_evaluations = 0;
@@ -126,6 +128,7 @@ class Data {
   VecX cq, cqd;                     ///< (nco) the coordinates the force laws read, from the jets
   KktSolver kkt;                    ///< the factor of the KKT system's Schur complement
   TreeSweep sweep;                  ///< the O(n) solve of a fully driven tree
+  ArticulatedSweep artic;           ///< the O(n) solve of a tree's KKT system (not fully driven)
   bool swept = false;               ///< the last body_accelerations took the sweep (kkt not used)
   /// the range-space solve lost accuracy once on this Data (its constraint residual): every later
   /// body_accelerations takes the augmented solve (reset_pipeline clears it)

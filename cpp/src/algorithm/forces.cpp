@@ -197,7 +197,9 @@ void cartesian_forces(const Model& m, Data& d, double t) {
   if (d.joint_torques) {
     const double* tau = d.joint_torques + 6 * m.n_free;
     for (int c = 0; c < static_cast<int>(m.coords.size()); ++c) {
-      const ScalarJet& q = d.tau_jets[c] = coord_jet(m, d.kin, c, false);
+      // (the coordinate forces' jet of this state when there is one: the same but its value)
+      const ScalarJet* cached = d.jets.cached(c);
+      const ScalarJet& q = d.tau_jets[c] = cached ? *cached : coord_jet(m, d.kin, c, false);
       if (tau[c] == 0.0) continue;
       const Joint& j = m.joints[m.coords[c].joint];
       add_pair(d.eta, tau[c] * q.J, j.parent, j.child);

@@ -78,7 +78,7 @@ void body_accelerations_loaded(const Model& m, Data& d, double t, double* vdot, 
     // refined against the exact system, O(n) per step; the augmented LU when it does not
     // converge (then for the rest of this Data's life)
     KktSolver& kkt = d.kkt;
-    if (!(reuse_factor && kkt.metric() == Metric::Mass && kkt.nrows() == nrows)) {
+    if (!(reuse_factor && kkt.reusable(nrows))) {
       kkt.factor(d.ce, nrows, Metric::Mass);
       ++st.factorizations;
     }
@@ -116,7 +116,22 @@ void body_accelerations_loaded(const Model& m, Data& d, double t, double* vdot, 
     }
   }
   KktSolver& kkt = d.kkt;
-  if (!(reuse_factor && kkt.metric() == Metric::Mass && kkt.nrows() == nrows)) {
+  const bool kkt_current = reuse_factor && kkt.reusable(nrows);
+  if (!kkt_current && d.artic.ok()) {
+    // a tree (ideal gears, couplings and a few drives as extra rows): the articulated-body
+    // recursions over the Cartesian coordinates, O(n), no KKT factorisation
+    const bool reuse = reuse_factor && d.artic.factored(nrows, kkt.factor_count());
+    if (d.artic.solve(m, d.kin, d.ce, nrows, d.eta, d.vd_work, d.delta, reuse,
+                      kkt.factor_count())) {
+      ++st.kkt_solves;
+      ++st.articulated_solves;
+      d.swept = true;
+      kkt.mark_stale();
+      vd = d.vd_work;
+      return;
+    }
+  }
+  if (!kkt_current) {
     kkt.factor(d.ce, nrows, Metric::Mass);
     ++st.factorizations;
   }

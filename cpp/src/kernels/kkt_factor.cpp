@@ -121,6 +121,8 @@ void KktSolver::ensure_dense() {
 }
 
 void KktSolver::factor_pivoted_at(const ConstraintEval& ce, int nrows, Metric metric, double tol) {
+  ++factor_count_;
+  stale_ = false;
   ensure_dense();
   assemble(ce, nrows, metric);
   if (nrows > 0) factor_pivoted(nrows, tol);
@@ -159,6 +161,8 @@ void KktSolver::assemble(const ConstraintEval& ce, int nrows, Metric metric) {
 }
 
 void KktSolver::factor(const ConstraintEval& ce, int nrows, Metric metric) {
+  ++factor_count_;
+  stale_ = false;
   BlockSparseSchur* sp = nullptr;
   if (nrows == m_.nc && sp_all_)
     sp = sp_all_.get();

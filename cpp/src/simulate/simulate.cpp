@@ -320,6 +320,7 @@ void finish(const Model& m, const Model& ms, const PipelineStats& st, SimResult&
   out.solver_rows = ms.nc;
   out.kkt_solves = st.kkt_solves;
   out.factorizations = st.factorizations;
+  out.articulated_solves = st.articulated_solves;
   out.position_projections = st.position_projections;
   out.newton_iterations = st.newton_iterations;
   out.singular_evaluations = st.singular_evaluations;

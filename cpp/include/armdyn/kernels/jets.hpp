@@ -118,6 +118,8 @@ class CoordJetCache {
     }
     return jet_[c];
   }
+  /// The jet of coordinate c when this state's is cached, else nullptr.
+  const ScalarJet* cached(int c) const { return stamp_[c] == now_ ? &jet_[c] : nullptr; }
 
  private:
   std::vector<ScalarJet> jet_;

@@ -82,6 +82,14 @@ class KktSolver {
 
   int nrows() const { return nrows_; }
   Metric metric() const { return metric_; }
+  /// Factorisations so far (factor and factor_pivoted_at): tells another solver's cached factor
+  /// whether the pose may have changed under it.
+  long factor_count() const { return factor_count_; }
+  /// The factor is of rows [0, nrows) with the mass metric, and no other solve of a later pose
+  /// (mark_stale) has come since: body_accelerations may reuse it at the same pose.
+  bool reusable(int nrows) const { return !stale_ && metric_ == Metric::Mass && nrows_ == nrows; }
+  /// Another solver answered at a pose this factor may not be of (the articulated sweep).
+  void mark_stale() { stale_ = true; }
   /// The last factorisation used the block-sparse path.
   bool used_sparse() const { return sparse_; }
   bool used_pseudo_inverse() const { return pinv_; }
@@ -163,6 +171,8 @@ class KktSolver {
   VecX rf_r1_, rf_r2_, rf_dv_, rf_dd_;  // accelerations_refined: residuals and corrections
   MatX DM_;                             // S1^2 M
   int nrows_ = 0, rank_ = 0;
+  long factor_count_ = 0;
+  bool stale_ = false;
   Metric metric_ = Metric::Mass;
   bool pinv_ = false;
 };

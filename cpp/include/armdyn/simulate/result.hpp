@@ -62,6 +62,8 @@ namespace armdyn {
   STEP(rhs_evals, rhs_evals, "right-hand side evaluations")                                   \
   OWN(kkt_solves, long, kkt_solves, "KKT systems solved")                                     \
   OWN(factorizations, long, factorizations, "KKT factorizations")                             \
+  OWN(articulated_solves, long, articulated_solves,                                           \
+      "KKT systems of a tree solved by the articulated-body recursion (no factorization)")    \
   OWN(position_projections, long, position_projections, "position projections")               \
   OWN(newton_iterations, long, newton_iterations, "Newton iterations of the projections")     \
   OWN(seconds, double, cpu_seconds, "CPU time of the run [s]")                                \

@@ -1,0 +1,93 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The KKT system of a tree in Cartesian coordinates,
+//   Gamma vdot + zeta^T delta = eta,   zeta vdot = -xi,
+// solved in O(n) by articulated-body recursions over the bodies' own coordinates (no KKT matrix,
+// no Schur complement, no fill), exact for the system as evaluated (off the constraint manifold
+// too).
+//
+// Each tree joint j (parent p, child c) has k rows Z_p vdot_p + Z_c vdot_c = -xi_j. Completed by
+// 6 - k rows C (the joint's free directions: its axis, its slide, ...) to the invertible
+//   T = [Z_c; C],   T^-1 = [P | S]   (P: 6 x k, S: 6 x (6 - k)),
+// the child's acceleration is vdot_c = A vdot_p + S s + b with A = -P Z_p, b = -P xi_j and s free
+// (any A + S M serves as well: the one used is [I X; 0 Y], 3 x 3 blocks, for every joint type).
+// The balance of the child's subtree, Z_c^T delta_j = -(I^A_c vdot_c + p^A_c), gives S^T (I^A_c
+// vdot_c + p^A_c) = 0 (Z_c S = 0), hence s, and passes I^A_c and p^A_c to the parent through A
+// (Z_p^T delta_j = A^T (I^A_c vdot_c + p^A_c)): Featherstone's articulated-body algorithm with the
+// constraint rows in place of the joint models. The multipliers follow from
+// delta_j = -P^T (I^A_c vdot_c + p^A_c).
+//
+// Rows outside the tree's joints (ideal gears, couplings, drives of some coordinates: at most
+// kMaxExtraRows) enter through their multipliers mu: the solution is linear in them, so one
+// response per row (the sweep with eta = -E_r^T, xi = 0) and a small dense solve give mu.
+#pragma once
+
+#include <Eigen/LU>
+#include <vector>
+
+#include "armdyn/kernels/constraint_rows.hpp"
+
+namespace armdyn {
+
+class ArticulatedSweep {
+ public:
+  static constexpr int kMaxExtraRows = 8;
+  /// The plan for model m with constraint blocks ce: ok() stays false unless m is a tree whose
+  /// bodies each hang from one joint of a supported type (revolute, prismatic, cylindrical,
+  /// universal, spherical, fixed, free), with no redundant rows and no forced dense KKT path.
+  void plan(const Model& m, const ConstraintEval& ce);
+  bool ok() const { return ok_; }
+  /// Forget the factor (the next solve factors).
+  void mark_stale() { factored_rows_ = -1; }
+  /// The factor is the one of rows [0, nrows) at the pose loaded when kkt_factors (the KKT
+  /// solver's factorisation count) was current.
+  bool factored(int nrows, long kkt_factors) const {
+    return factored_rows_ == nrows && kkt_factors_ == kkt_factors;
+  }
+  /// vdot and delta (rows [0, nrows)) from the evaluated constraints (with xi) and eta; when
+  /// reuse, the factor of the last call (same pose, same rows) is kept. Returns false, leaving
+  /// vdot and delta unspecified, when a joint's completed block is singular to working
+  /// precision, the extra rows are too many or dependent, or a result is not finite: the caller
+  /// then takes the KKT path, which diagnoses it.
+  bool solve(const Model& m, const std::vector<BodyKin>& kin, const ConstraintEval& ce, int nrows,
+             const VecX& eta, VecX& vdot, VecX& delta, bool reuse, long kkt_factors);
+
+ private:
+  struct Step {
+    int joint, parent, child, block, nk;  // block: the joint's row block (-1: free joint)
+    JointType type;
+    // the joint's first rows make its points coincide and its free directions are rotations
+    // (revolute, universal, spherical, fixed): T = [I B; 0 C], A = [I X; 0 Y]
+    bool point;
+  };
+  std::vector<Step> steps_;
+  std::vector<int> extra_blocks_;  // row blocks that are not tree joints' (gears, drives)
+  // per step: P (T^-1 with S's columns zero: general joints), B and C^-1 (point joints), the
+  // transport A = [I X; 0 Y], the free directions S, U = I^A S, D^-1 = (S^T U)^-1 (first
+  // 6 - k columns), bias b
+  std::vector<Mat6> tinv_, s_, u_;
+  std::vector<Mat3> bm_, ci_, x_, y_;
+  std::vector<Mat6> dinv_;  // top-left (6 - k) square used
+  std::vector<Vec6> b_;
+  // per body: articulated inertia and bias force
+  std::vector<Mat6> ia_;
+  std::vector<Vec6> pa_;
+  // the extra rows' responses: per extra row, vdot and delta
+  std::vector<VecX> resp_vd_, resp_delta_;
+  VecX load_, zero_xi_;
+  std::vector<int> extra_rows_;  // the extra rows in [0, nrows), this solve's
+  int factored_rows_ = -1;
+  long kkt_factors_ = -1;
+  bool ok_ = false;
+
+  bool factor(const Model& m, const std::vector<BodyKin>& kin, const ConstraintEval& ce);
+  bool complete_block(const Model& m, const std::vector<BodyKin>& kin, const ConstraintEval& ce,
+                      const Step& s, Mat6& T) const;
+  void point_block(const Model& m, const std::vector<BodyKin>& kin, const ConstraintEval& ce,
+                   const Step& s, Mat3& B, Mat3& C) const;
+  /// The bias pass and the forward pass for loads eta and row values xi (tree rows only).
+  void sweep(const ConstraintEval& ce, const VecX& xi, const VecX& eta, VecX& vdot, VecX& delta);
+  void bias(const ConstraintEval& ce, const VecX& xi, size_t k);
+  bool extra_rows(const ConstraintEval& ce, int nrows, VecX& vdot, VecX& delta);
+};
+
+}  // namespace armdyn

@@ -1,0 +1,444 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "armdyn/kernels/articulated_sweep.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace armdyn {
+
+namespace {
+
+using SmallMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 8, 8>;
+using SmallVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 8, 1>;
+
+bool supported(JointType t) {
+  switch (t) {
+    case JointType::Revolute:
+    case JointType::Prismatic:
+    case JointType::Cylindrical:
+    case JointType::Universal:
+    case JointType::Spherical:
+    case JointType::Fixed:
+    case JointType::Free:
+      return true;
+    default:
+      return false;
+  }
+}
+
+// closed-form inverse of a 3 x 3 block; false when it is singular to working precision (its
+// determinant below 1e-10 of the product of its row norms)
+inline bool inverse3(const Mat3& M, Mat3& Mi) {
+  const double det = M.determinant();
+  if (!(std::abs(det) > 1e-10 * M.row(0).norm() * M.row(1).norm() * M.row(2).norm())) return false;
+  Mi = M.inverse();
+  return true;
+}
+
+// T^-1 of a completed block whose rows split into three with linear columns and three without
+// (every supported joint type): with the rows so ordered, T = [L B; 0 C] and
+// T^-1 = [L^-1, -L^-1 B C^-1; 0, C^-1]. Other blocks: a pivoted LU. False when singular.
+bool invert_block(const Mat6& T, Mat6& Ti) {
+  int lin[6], ang[6], nl = 0, na = 0;
+  for (int r = 0; r < 6; ++r) {
+    if (T.row(r).head<3>().isZero(0.0))
+      ang[na++] = r;
+    else
+      lin[nl++] = r;
+  }
+  if (nl == 3 && na == 3) {
+    Mat3 L, B, C, Li, Ci;
+    for (int i = 0; i < 3; ++i) {
+      L.row(i) = T.row(lin[i]).head<3>();
+      B.row(i) = T.row(lin[i]).tail<3>();
+      C.row(i) = T.row(ang[i]).tail<3>();
+    }
+    if (!inverse3(L, Li) || !inverse3(C, Ci)) return false;
+    const Mat3 X = -Li * B * Ci;
+    for (int i = 0; i < 3; ++i) {
+      Ti.col(lin[i]).head<3>() = Li.col(i);
+      Ti.col(lin[i]).tail<3>().setZero();
+      Ti.col(ang[i]).head<3>() = X.col(i);
+      Ti.col(ang[i]).tail<3>() = Ci.col(i);
+    }
+    return true;
+  }
+  const Eigen::PartialPivLU<Mat6> lu(T);
+  const auto d = lu.matrixLU().diagonal().cwiseAbs();
+  if (!(d.minCoeff() > 1e-10 * d.maxCoeff())) return false;
+  Ti = lu.inverse();
+  return true;
+}
+
+}  // namespace
+
+void ArticulatedSweep::plan(const Model& m, const ConstraintEval& ce) {
+  ok_ = false;
+  factored_rows_ = -1;
+  steps_.clear();
+  extra_blocks_.clear();
+  if (!m.is_tree || m.redundant || m.force_dense_kkt || m.nb == 0) return;
+  if (static_cast<int>(m.tree_order.size()) != m.nb) return;
+  std::vector<int> block_at_row(m.nc + 1, -1);
+  for (int b = 0; b < static_cast<int>(ce.blocks.size()); ++b)
+    if (ce.blocks[b].row0 <= m.nc) block_at_row[ce.blocks[b].row0] = b;
+  std::vector<char> joint_block(ce.blocks.size(), 0);
+  for (int ji : m.tree_order) {
+    const Joint& j = m.joints[ji];
+    // parent -> child joints only (the tree order's parent is the joint's)
+    if (j.child == kGround || !supported(j.type)) return;
+    Step s{ji, j.parent, j.child, -1, joint_rows(j.type), j.type, false};
+    s.point = j.type == JointType::Revolute || j.type == JointType::Universal ||
+              j.type == JointType::Spherical || j.type == JointType::Fixed;
+    if (j.type == JointType::Free && j.parent != kGround) return;
+    if (s.nk > 0) {
+      s.block = block_at_row[j.row0];
+      if (s.block < 0) return;
+      const ConstraintBlock& b = ce.blocks[s.block];
+      if (b.nbody != 2 || b.body[0] != j.parent || b.body[1] != j.child || b.nrows != s.nk) return;
+      joint_block[s.block] = 1;
+    }
+    steps_.push_back(s);
+  }
+  for (int b = 0; b < static_cast<int>(ce.blocks.size()); ++b)
+    if (!joint_block[b]) extra_blocks_.push_back(b);
+  const size_t n = steps_.size();
+  tinv_.assign(n, Mat6::Identity());
+  s_.assign(n, Mat6::Zero());
+  u_.assign(n, Mat6::Zero());
+  bm_.assign(n, Mat3::Zero());
+  ci_.assign(n, Mat3::Identity());
+  x_.assign(n, Mat3::Zero());
+  y_.assign(n, Mat3::Zero());
+  dinv_.assign(n, Mat6::Zero());
+  b_.assign(n, Vec6::Zero());
+  ia_.assign(m.nb, Mat6::Zero());
+  pa_.assign(m.nb, Vec6::Zero());
+  resp_vd_.assign(kMaxExtraRows, VecX::Zero(m.nv));
+  resp_delta_.assign(kMaxExtraRows, VecX::Zero(m.nc));
+  load_ = VecX::Zero(m.nv);
+  zero_xi_ = VecX::Zero(m.nc);
+  extra_rows_.reserve(kMaxExtraRows);
+  ok_ = true;
+}
+
+// T = [Z_c; C]: the joint's rows on the child, then its free directions (axes of the joint
+// frames, in the child's velocity coordinates: linear in world, angular in the body frame). Any
+// C that completes Z_c gives the same solution (s is free); the child's own axes cost least.
+bool ArticulatedSweep::complete_block(const Model& m, const std::vector<BodyKin>& kin,
+                                      const ConstraintEval& ce, const Step& s, Mat6& T) const {
+  T.setZero();
+  if (s.nk > 0) T.topRows(s.nk) = ce.blocks[s.block].J.block(0, 6, s.nk, 6);
+  const Joint& j = m.joints[s.joint];
+  const Vec3 z = kin[j.child].R * j.frame_child.col(2);
+  switch (s.type) {
+    case JointType::Prismatic:
+      T.row(5).head<3>() = z;
+      return true;
+    case JointType::Cylindrical:
+      T.row(4).tail<3>() = j.frame_child.col(2);
+      T.row(5).head<3>() = z;
+      return true;
+    case JointType::Free:
+      T.setIdentity();
+      return true;
+    default:
+      return false;
+  }
+}
+
+// A point joint's T = [I B; 0 C]: B (the point rows' angular columns) and C (the rotation rows'
+// angular columns, then the free rotations)
+void ArticulatedSweep::point_block(const Model& m, const std::vector<BodyKin>& kin,
+                                   const ConstraintEval& ce, const Step& s, Mat3& B,
+                                   Mat3& C) const {
+  const BlockMat& J = ce.blocks[s.block].J;
+  const Joint& j = m.joints[s.joint];
+  B = J.block<3, 3>(0, 9);
+  int r = 0;
+  for (; r < s.nk - 3; ++r) C.row(r) = J.row(3 + r).segment<3>(9);
+  switch (s.type) {
+    case JointType::Revolute:
+      C.row(2) = j.frame_child.col(2).transpose();
+      break;
+    case JointType::Universal: {
+      const Vec3 za = j.parent == kGround ? Vec3(j.frame_parent.col(2))
+                                          : Vec3(kin[j.parent].R * j.frame_parent.col(2));
+      C.row(1) = (kin[j.child].R.transpose() * za).transpose();
+      C.row(2) = j.frame_child.col(2).transpose();
+      break;
+    }
+    case JointType::Spherical:
+      C.setIdentity();
+      break;
+    default:
+      break;
+  }
+}
+
+namespace {
+
+// G = Ci[:, :K] W for the K rotation rows W (K x 3) of a point joint
+template <int K>
+Mat3 point_rows_product(const Mat3& Ci, const BlockMat& J, int col) {
+  if constexpr (K == 0) {
+    return Mat3::Zero();
+  } else {
+    return Ci.leftCols<K>() * J.block<K, 3>(3, col);
+  }
+}
+
+Mat3 point_product(int K, const Mat3& Ci, const BlockMat& J, int col) {
+  switch (K) {
+    case 1:
+      return point_rows_product<1>(Ci, J, col);
+    case 2:
+      return point_rows_product<2>(Ci, J, col);
+    case 3:
+      return point_rows_product<3>(Ci, J, col);
+    default:
+      return Mat3::Zero();
+  }
+}
+
+// M += A^T Ia A for A = [I X; 0 Y] (a point joint's transport)
+void add_congruence(const Mat6& Ia, const Mat3& X, const Mat3& Y, Mat6& M) {
+  const Mat3 N = Ia.topLeftCorner<3, 3>() * X + Ia.topRightCorner<3, 3>() * Y;
+  const Mat3 Q = Ia.bottomLeftCorner<3, 3>() * X + Ia.bottomRightCorner<3, 3>() * Y;
+  M.topLeftCorner<3, 3>() += Ia.topLeftCorner<3, 3>();
+  M.topRightCorner<3, 3>() += N;
+  M.bottomLeftCorner<3, 3>() += N.transpose();
+  M.bottomRightCorner<3, 3>().noalias() += X.transpose() * N + Y.transpose() * Q;
+}
+
+}  // namespace
+
+bool ArticulatedSweep::factor(const Model& m, const std::vector<BodyKin>& kin,
+                              const ConstraintEval& ce) {
+  for (int i = 0; i < m.nb; ++i) {
+    Mat6& I = ia_[i];
+    I.setZero();
+    I.topLeftCorner<3, 3>().diagonal().setConstant(m.bodies[i].mass);
+    I.bottomRightCorner<3, 3>() = m.bodies[i].inertia;
+  }
+  Mat6 T, Ia;
+  for (size_t k = steps_.size(); k-- > 0;) {
+    const Step& s = steps_[k];
+    const int nf = 6 - s.nk;
+    Mat6& S = s_[k];
+    if (s.point) {
+      // T^-1 = [I, -B C^-1; 0, C^-1]
+      Mat3 C;
+      point_block(m, kin, ce, s, bm_[k], C);
+      if (!inverse3(C, ci_[k])) return false;
+      S.topLeftCorner(3, nf).noalias() = -bm_[k] * ci_[k].rightCols(nf);
+      S.bottomLeftCorner(3, nf) = ci_[k].rightCols(nf);
+    } else {
+      if (!complete_block(m, kin, ce, s, T) || !invert_block(T, tinv_[k])) return false;
+      S.leftCols(nf) = tinv_[k].rightCols(nf);
+      tinv_[k].rightCols(nf).setZero();  // P, padded to 6 x 6
+    }
+    const Mat6& I = ia_[s.child];
+    Ia = I;
+    if (nf == 1) {
+      u_[k].col(0).noalias() = I * S.col(0);
+      const double D = S.col(0).dot(u_[k].col(0));
+      if (!(D > 0.0) || !std::isfinite(D)) return false;
+      dinv_[k](0, 0) = 1.0 / D;
+      const Vec6 u = u_[k].col(0), w = u / D;
+      Ia.noalias() -= w.lazyProduct(u.transpose());
+    } else if (nf > 1) {
+      u_[k].leftCols(nf).noalias() = I * S.leftCols(nf);
+      SmallMat D = S.leftCols(nf).transpose() * u_[k].leftCols(nf);
+      Eigen::LLT<SmallMat> llt(D);
+      if (llt.info() != Eigen::Success) return false;
+      const SmallMat Di = llt.solve(SmallMat::Identity(nf, nf));
+      dinv_[k].topLeftCorner(nf, nf) = Di;
+      Ia.noalias() -= u_[k].leftCols(nf) * Di * u_[k].leftCols(nf).transpose();
+    }
+    if (s.parent == kGround) continue;
+    // A = -P Z_p moves the child with the parent, the joint held; A + S M for any M does as
+    // well (s absorbs it, and Ia S = 0): with M = C's linear columns, A = [I X; 0 Y] for every
+    // joint type (the rows' linear columns are opposite on parent and child), [X; Y] = -P Z_p's
+    // angular columns
+    const ConstraintBlock& b = ce.blocks[s.block];
+    if (s.point) {
+      // Z_p = [-I K; 0 W]: Y = -C^-1[:, :nk-3] W, X = -K - B Y
+      const Mat3 G = point_product(s.nk - 3, ci_[k], b.J, 3);
+      y_[k] = -G;
+      x_[k].noalias() = bm_[k] * G - b.J.block<3, 3>(0, 3);
+    } else if (s.nk > 0) {
+      Eigen::Matrix<double, 6, 3> Zp = Eigen::Matrix<double, 6, 3>::Zero();
+      Zp.topRows(s.nk) = b.J.block(0, 3, s.nk, 3);
+      const Eigen::Matrix<double, 6, 3> XY = -tinv_[k] * Zp;
+      x_[k] = XY.topRows<3>();
+      y_[k] = XY.bottomRows<3>();
+    } else {
+      x_[k].setZero();
+      y_[k].setZero();
+    }
+    add_congruence(Ia, x_[k], y_[k], ia_[s.parent]);
+  }
+  return true;
+}
+
+// b = -P xi_j: the child's acceleration with the parent at rest and the free directions still
+void ArticulatedSweep::bias(const ConstraintEval& ce, const VecX& xi, size_t k) {
+  const Step& s = steps_[k];
+  if (s.nk == 0) {
+    b_[k].setZero();
+    return;
+  }
+  const int r0 = ce.blocks[s.block].row0;
+  if (s.point) {
+    Vec3 g = Vec3::Zero();
+    for (int r = 3; r < s.nk; ++r) g.noalias() += xi[r0 + r] * ci_[k].col(r - 3);
+    b_[k].head<3>().noalias() = bm_[k] * g - xi.segment<3>(r0);
+    b_[k].tail<3>() = -g;
+  } else {
+    Vec6 x = Vec6::Zero();
+    x.head(s.nk) = xi.segment(r0, s.nk);
+    b_[k].noalias() = -tinv_[k] * x;
+  }
+}
+
+void ArticulatedSweep::sweep(const ConstraintEval& ce, const VecX& xi, const VecX& eta, VecX& vd,
+                             VecX& delta) {
+  const int nb = static_cast<int>(pa_.size());
+  for (int i = 0; i < nb; ++i) pa_[i] = -eta.segment<6>(6 * i);
+  Vec6 t;
+  for (size_t k = steps_.size(); k-- > 0;) {
+    const Step& s = steps_[k];
+    const int nf = 6 - s.nk;
+    bias(ce, xi, k);
+    if (s.parent == kGround) continue;
+    // I^A b + p^A with the child's free directions taken out
+    t.noalias() = ia_[s.child] * b_[k];
+    t += pa_[s.child];
+    if (nf == 1) {
+      t.noalias() -= (dinv_[k](0, 0) * s_[k].col(0).dot(t)) * u_[k].col(0);
+    } else if (nf > 1) {
+      const SmallVec st = s_[k].leftCols(nf).transpose() * t;
+      const SmallVec w = dinv_[k].topLeftCorner(nf, nf) * st;
+      t.noalias() -= u_[k].leftCols(nf) * w;
+    }
+    Vec6& pp = pa_[s.parent];
+    pp.head<3>() += t.head<3>();
+    pp.tail<3>().noalias() += x_[k].transpose() * t.head<3>() + y_[k].transpose() * t.tail<3>();
+  }
+  Vec6 a;
+  for (size_t k = 0; k < steps_.size(); ++k) {
+    const Step& s = steps_[k];
+    const int nf = 6 - s.nk;
+    a = b_[k];
+    if (s.parent != kGround) {
+      const auto vp = vd.segment<6>(6 * s.parent);
+      a.head<3>().noalias() += vp.head<3>() + x_[k] * vp.tail<3>();
+      a.tail<3>().noalias() += y_[k] * vp.tail<3>();
+    }
+    t.noalias() = ia_[s.child] * a;
+    t += pa_[s.child];
+    if (nf == 1) {
+      const double sv = -dinv_[k](0, 0) * s_[k].col(0).dot(t);
+      a.noalias() += sv * s_[k].col(0);
+      t.noalias() += sv * u_[k].col(0);
+    } else if (nf > 1) {
+      const SmallVec st = s_[k].leftCols(nf).transpose() * t;
+      const SmallVec sv = -(dinv_[k].topLeftCorner(nf, nf) * st);
+      a.noalias() += s_[k].leftCols(nf) * sv;
+      t.noalias() += u_[k].leftCols(nf) * sv;
+    }
+    vd.segment<6>(6 * s.child) = a;
+    if (s.nk == 0) continue;
+    // delta = -P^T (I^A vdot + p^A)
+    const int r0 = ce.blocks[s.block].row0;
+    if (s.point) {
+      delta.segment<3>(r0) = -t.head<3>();
+      const Vec3 w = t.tail<3>() - bm_[k].transpose() * t.head<3>();
+      for (int r = 3; r < s.nk; ++r) delta[r0 + r] = -ci_[k].col(r - 3).dot(w);
+    } else {
+      const Vec6 d = -tinv_[k].transpose() * t;
+      delta.segment(r0, s.nk) = d.head(s.nk);
+    }
+  }
+}
+
+namespace {
+// E_r v: row r of block b applied to the body velocities (or accelerations) v
+double row_times(const ConstraintBlock& b, int r, const VecX& v) {
+  double sum = 0.0;
+  for (int k = 0; k < b.nbody; ++k)
+    if (b.body[k] != kGround) sum += b.J.row(r).segment<6>(6 * k).dot(v.segment<6>(6 * b.body[k]));
+  return sum;
+}
+}  // namespace
+
+bool ArticulatedSweep::extra_rows(const ConstraintEval& ce, int nrows, VecX& vd, VecX& delta) {
+  const int ne = static_cast<int>(extra_rows_.size());
+  if (ne == 0) return true;
+  // E Vd mu = -xi_E - E vd0
+  SmallMat H(ne, ne);
+  SmallVec rhs(ne);
+  int i = 0;
+  for (int bi : extra_blocks_) {
+    const ConstraintBlock& b = ce.blocks[bi];
+    if (b.row0 >= nrows) continue;
+    for (int r = 0; r < b.nrows; ++r, ++i) {
+      for (int e = 0; e < ne; ++e) H(i, e) = row_times(b, r, resp_vd_[e]);
+      rhs[i] = -ce.xi[b.row0 + r] - row_times(b, r, vd);
+    }
+  }
+  const Eigen::PartialPivLU<SmallMat> lu(H);
+  const auto d = lu.matrixLU().diagonal().cwiseAbs();
+  if (!(d.minCoeff() > 1e-12 * d.maxCoeff())) return false;
+  const SmallVec mu = lu.solve(rhs);
+  for (int e = 0; e < ne; ++e) {
+    vd.noalias() += mu[e] * resp_vd_[e];
+    delta.head(nrows).noalias() += mu[e] * resp_delta_[e].head(nrows);
+  }
+  for (int e = 0; e < ne; ++e) delta[extra_rows_[e]] = mu[e];
+  return true;
+}
+
+bool ArticulatedSweep::solve(const Model& m, const std::vector<BodyKin>& kin,
+                             const ConstraintEval& ce, int nrows, const VecX& eta, VecX& vd,
+                             VecX& delta, bool reuse, long kkt_factors) {
+  if (!ok_) return false;
+  if (!(reuse && factored(nrows, kkt_factors))) {
+    factored_rows_ = -1;
+    extra_rows_.clear();
+    for (int bi : extra_blocks_) {
+      const ConstraintBlock& b = ce.blocks[bi];
+      if (b.row0 >= nrows) continue;
+      for (int r = 0; r < b.nrows; ++r) {
+        if (static_cast<int>(extra_rows_.size()) == kMaxExtraRows) return false;
+        extra_rows_.push_back(b.row0 + r);
+      }
+    }
+    if (!factor(m, kin, ce)) return false;
+    // the extra rows' responses: the sweep under a unit multiplier of each, no row values
+    int e = 0;
+    for (int bi : extra_blocks_) {
+      const ConstraintBlock& b = ce.blocks[bi];
+      if (b.row0 >= nrows) continue;
+      for (int r = 0; r < b.nrows; ++r, ++e) {
+        load_.setZero();
+        for (int k = 0; k < b.nbody; ++k)
+          if (b.body[k] != kGround)
+            load_.segment<6>(6 * b.body[k]) = -b.J.row(r).segment<6>(6 * k).transpose();
+        resp_delta_[e].setZero();
+        sweep(ce, zero_xi_, load_, resp_vd_[e], resp_delta_[e]);
+      }
+    }
+    factored_rows_ = nrows;
+    kkt_factors_ = kkt_factors;
+  }
+  sweep(ce, ce.xi, eta, vd, delta);
+  if (!extra_rows(ce, nrows, vd, delta)) {
+    factored_rows_ = -1;
+    return false;
+  }
+  return vd.allFinite() && delta.head(nrows).allFinite();
+}
+
+}  // namespace armdyn
