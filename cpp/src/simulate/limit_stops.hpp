@@ -22,12 +22,15 @@
 //     by 1/2 (1 - e^2) mu_c' A mu_c: it never rises (one stop: 1/2 (1 - e^2) qd-^2 / A_kk). A stop
 //     that the restitution drives into its limit (coupled stops) starts another round.
 //  2. Accumulation: a rebound whose apex v+^2 / (2 |a|) under the acceleration a back into the
-//     stop (with the resting stops' forces) stays within the stop's tolerance cannot be resolved
-//     by any event location: the geometric series of ever shorter bounces that would follow is
-//     summed at once (its restitution is dropped, the joint rests on the stop), losing exactly
-//     the energy the series would lose, the rebound's kinetic energy. (Should dropping some
-//     coupled stops' restitution but not others' raise the energy, the whole impact is plastic.)
-//  3. Resting contact: over the stops of C at rest (a rate within the same apex bound), the
+//     stop (with the other resting stops' forces, not its own) stays within the stop's tolerance
+//     cannot be resolved by any event location: the geometric series of ever shorter bounces that
+//     would follow is summed at once (its restitution is dropped, the joint rests on the stop),
+//     losing exactly the energy the series would lose, the rebound's kinetic energy. (Should
+//     dropping some coupled stops' restitution but not others' raise the energy, the whole impact
+//     is plastic.)
+//  3. Resting contact: over the stops of C at rest (a rate within the same apex bound: a held
+//     stop's own force would make its acceleration 0 and release it at any round-off rate, and
+//     two coupled stops, one struck while the other rests, would then take turns), the
 //     acceleration-level problem  w = A lambda + a0,  lambda >= 0, w >= 0, lambda' w = 0  (a0 the
 //     stops' s qdd without stop forces): a stop with w = 0 engages (degenerate ones, lambda = 0,
 //     stay free, and so does one the bilateral solve over the engaged stops then finds pulling
@@ -404,12 +407,16 @@ class LimitStops {
       vp_[r] = at(r).side * qd;
       a0_[r] = at(r).side * a.stop_acceleration(y, f, at(r).coord);
       acc_[r] = a0_[r];
+      lam_[r] = 0.0;
       rest_[static_cast<size_t>(r)] = 0;
     }
     for (int round = 0; round <= k + 1; ++round) {
       bool changed = false;
       for (long r = 0; r < k; ++r) {
-        vr_[r] = std::sqrt(2.0 * tolerance(at(r)) * std::max(0.0, -acc_[r]));
+        // the acceleration back into the stop without its own holding force (the others'
+        // kept): with it, a held stop's acceleration is 0 and any rate would release it
+        const double back = -(acc_[r] - A_(r, r) * lam_[r]);
+        vr_[r] = std::sqrt(2.0 * tolerance(at(r)) * std::max(0.0, back));
         const char in = vp_[r] <= vr_[r] + eps_v_ ? 1 : 0;
         changed = changed || in != rest_[static_cast<size_t>(r)];
         rest_[static_cast<size_t>(r)] = in;
