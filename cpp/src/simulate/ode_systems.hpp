@@ -181,6 +181,15 @@ class MbsSystem : public OdeSystem, public StopAccess {
 
   bool project_last_stage() const override { return !d_.kkt.near_singular(); }
 
+  // The angle tracking (the unwrapped angles' turns, committed at every projection) of the
+  // accepted state, restored after a rejected step whose trial end point was projected: a
+  // rejected trial step can move an angle by more than half a turn (its reference then off by
+  // a turn, and with it the stops' coordinates near limits of +-2 pi).
+  void step_accepted() override { track_save_ = d_.track_ref; }
+  void step_rejected() override {
+    if (track_save_.size() == d_.track_ref.size()) d_.track_ref = track_save_;
+  }
+
   /// Report in the bodies and joints of the full model (a welded run).
   void set_expander(WeldExpander* ex) { ex_ = ex; }
   /// Enforce the joint position limits (simulate's limits="enforce").
@@ -353,6 +362,7 @@ class MbsSystem : public OdeSystem, public StopAccess {
   WeldExpander* ex_ = nullptr;
   LimitStops* stops_ = nullptr;
   VecX fo_, fe_, du_;  // the stops' scratch at outputs and events
+  VecX track_save_;    // the angle tracking of the last accepted state
 };
 
 // The joint-space equations of motion of a tree (TreeDynamics) as an ODE on y = (q, qd, z).
@@ -415,9 +425,16 @@ class JointSystem : public OdeSystem, public StopAccess {
       if (g.coord_a == c || g.coord_b == c) return;
     y[7 * m_.n_free + c] = q;
   }
+  void stop_pin(VecX& y, int c, double q) override {
+    for (const GearConstraint& g : m_.gear_constraints)
+      if (g.coord_a == c || g.coord_b == c) return;
+    y[7 * m_.n_free + c] = q;
+    y[nq_ + 6 * m_.n_free + c] = 0.0;
+  }
 
   void project_and_rhs(double t, VecX& y, VecX& dy) override {
     td_.project(y.data(), y.data() + nq_);
+    if (LimitStops* st = cart_.stops(); st && st->any_engaged()) st->pin(*this, y);
     rhs(t, y, dy);
   }
 
