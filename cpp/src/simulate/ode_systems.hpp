@@ -438,11 +438,20 @@ class JointSystem : public OdeSystem, public StopAccess {
     rhs(t, y, dy);
   }
 
-  void output(double t, const VecX& y) override {
+  void output(double t, const VecX& y_dense) override {
+    // the engaged stops' joints exactly on their limits at rest, as at the steps' ends (the
+    // dense output between them carries the stages' round-off)
+    LimitStops* stops = cart_.stops();
+    const VecX* yp = &y_dense;
+    if (stops && stops->any_engaged()) {
+      yp_ = y_dense;
+      stops->pin(*this, yp_);
+      yp = &yp_;
+    }
+    const VecX& y = *yp;
     const double* z = y.data() + nq_ + n_;
     const Eigen::Map<const VecX> q(y.data(), nq_), qd(y.data() + nq_, n_);
     td_.accelerations(t, q.data(), qd.data(), z, nullptr, qdd_.data());
-    LimitStops* stops = cart_.stops();
     const double* stop_tau = nullptr;
     if (stops && stops->any_engaged()) {
       // the engaged stops' torques, then the accelerations with them
@@ -495,7 +504,7 @@ class JointSystem : public OdeSystem, public StopAccess {
   MbsSystem& cart_;
   int n_, nq_;
   VecX u_, v_, vd_, qdd_;
-  VecX fo_, fe_;  // the stops' scratch at outputs and events
+  VecX fo_, fe_, yp_;  // the stops' scratch at outputs and events
   // the joints whose multipliers load_tree_motion sweeps, children before parents
   const std::vector<std::pair<int, int>> sweep_ = tree_sweep(m_);
 };
