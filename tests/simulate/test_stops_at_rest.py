@@ -365,8 +365,9 @@ def test_the_plain_ur5_fall_runs_in_joint_space_and_matches_the_cartesian_one():
 def test_cartesian_angles_over_many_turns_follow_the_joint_space_ones(integrator):
     """A pendulum thrown over the top turns many times (its stops at +-100 rad are in play but
     never reached) at a loose tolerance, with rejected steps: the Cartesian run's unwrapped
-    angle (its tracking restored after each rejected step) follows the joint-space one, with
-    no jump of a turn."""
+    angle (its tracking saved at each accepted step and restored after each rejected one)
+    follows the joint-space one, with no jump of a turn. (A guard, not a reproduction: no run
+    found here loses a turn to a rejected step without the restore.)"""
     model = pendulum(-100.0, 100.0).finalize()
     kw = dict(q0=[0.0], qd0=[12.0], output_dt=1e-2, integrator=integrator, rtol=1e-5, atol=1e-7)
     rc = ad.simulate(model, 3.0, coordinates="cartesian", **kw)
