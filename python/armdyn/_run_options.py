@@ -147,11 +147,10 @@ and joint, the fixed joints' reactions from their bodies' Newton–Euler balance
         _choice(("cartesian", "joint", "auto")),
         _as_is,
         """``"auto"`` (default): the cheaper exact formulation for the scene: joint
-space where it applies (a tree without drives, no light bodies on a geared model),
-no joint limit stop is in play (``limits="enforce"`` with a limited joint: the
-Cartesian path holds a joint resting on its stop with far fewer events) and the
-measured cost model (:func:`armdyn.dynamics_cost`) predicts its right-hand side
-cheaper, else Cartesian. ``"cartesian"``: the bodies' Cartesian state with the
+space where it applies (a tree without drives, no light bodies on a geared model;
+enforced joint limit stops too) and the measured cost model
+(:func:`armdyn.dynamics_cost`) predicts its right-hand side cheaper, else
+Cartesian. ``"cartesian"``: the bodies' Cartesian state with the
 constrained Newton–Euler equations and the topological projection (the paper's
 method; any mechanism). ``"joint"``: the joint coordinates and rates of a tree
 without drives, ideal gears allowed: the mass matrix by the composite-rigid-body

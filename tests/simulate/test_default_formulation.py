@@ -54,23 +54,32 @@ def test_plain_run_of_a_loop_is_cartesian():
 
 
 @pytest.mark.parametrize("limits", ["enforce", "ignore"])
-def test_limit_stops_keep_the_plain_run_cartesian(limits):
-    """A joint with a position limit: with its stop in play (limits="enforce", the default) the
-    plain run is Cartesian, which holds a joint resting on its stop without chattering events;
-    with the limits ignored, joint space (the cheaper right-hand side)."""
+def test_limit_stops_leave_the_plain_run_in_joint_space(limits):
+    """A joint with a position limit: with its stop in play (limits="enforce", the default) or
+    not, the plain run is the joint-space one (the cost model's choice; the joint-space stops
+    hold a joint resting on its stop with as few events as the Cartesian ones). Enforced, the
+    rod falls onto its stop and rests there, held by the static torque of inverse dynamics,
+    as in the Cartesian run; ignored, it swings through the limit."""
     b = ad.ModelBuilder(gravity=(0.0, 0.0, -9.81))
     b.add_body("rod", 1.0, [0.02, 0.02, 1e-3], position=(0.25, 0, 0))
     b.add_revolute("pivot", "ground", "rod", point=(0, 0, 0), axis=(0, 1, 0))
     b.set_joint_limits("pivot", -0.5, 0.5)
     model = b.finalize()
-    res = ad.simulate(model, 1.0, output_dt=0.1, limits=limits)
+    kw = dict(output_dt=0.1, limits=limits)
+    res = ad.simulate(model, 1.0, **kw)
+    joint = ad.simulate(model, 1.0, coordinates="joint", **kw)
+    assert res.stats["formulation"].startswith("joint space")
+    assert "auto: cost model" in res.stats["formulation"]
+    for f in ("q", "qd", "reaction_forces", "reaction_torques"):
+        np.testing.assert_array_equal(getattr(res, f), getattr(joint, f))
     if limits == "enforce":
-        assert res.stats["formulation"].startswith("cartesian")
-        assert "limit stops" in res.stats["formulation"]
-        # it falls onto its stop and rests there, held by the stop's torque
-        assert res.q[-1, 0] == pytest.approx(0.5, abs=1e-9)
+        cart = ad.simulate(model, 1.0, coordinates="cartesian", **kw)
+        assert res.q[-1, 0] == 0.5  # exactly on the limit
         assert list(res.limit_forces["names"]) == ["pivot"]
-        assert np.abs(res.limit_forces["force"][-1]).max() > 0.0
+        hold = ad.inverse_dynamics(model, [0.5], [0.0], [0.0])[0]
+        assert hold != 0.0
+        assert res.limit_forces["force"][-1, 0] == pytest.approx(hold, rel=1e-9)
+        assert cart.limit_forces["force"][-1, 0] == pytest.approx(hold, rel=1e-9)
+        assert len(res.events["limits"]["t"]) == len(cart.events["limits"]["t"])
     else:
-        assert res.stats["formulation"].startswith("joint space")
         assert res.q[:, 0].max() > 0.5  # it swings through the limit

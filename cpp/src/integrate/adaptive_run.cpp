@@ -13,7 +13,8 @@ AdaptiveRun::AdaptiveRun(const char* name_, OdeSystem& sys, const StepOptions& o
       hmin(1e-14 * std::max(1.0, std::abs(t1_))),
       touts(w.times),
       ev(sys, w, n),
-      yo(w.vec(39, n)) {
+      yo(w.vec(39, n)),
+      sys_(sys) {
   output_times(t0, t1_, o.output_dt, touts);
   every_step = touts.empty();
 }
@@ -22,6 +23,7 @@ void AdaptiveRun::start(OdeSystem& sys, VecX& y, VecX& f0, VecX& yt, VecX& f1, i
                         StepStats& st) {
   sys.project_and_rhs(t, y, f0);
   ++st.rhs_evals;
+  sys.step_accepted();
   sys.output(t, y);
   h = initial_step(sys, t, y, f0, yt, f1, opt, hmax, hmin, order, st);
   ev.init(sys, t, y);

@@ -25,6 +25,7 @@ struct AdaptiveRun {
   bool cut = false;     // an event ended the step early
   EventState ev;
   VecX& yo;
+  OdeSystem& sys_;
 
   /// its buffers: the work's slots 36..42, output times and event signs
   AdaptiveRun(const char* name_, OdeSystem& sys, const StepOptions& o, double t0, double t1_,
@@ -36,6 +37,7 @@ struct AdaptiveRun {
   void guard(const StepStats& st) { guard_step(name, opt, st, t, t1, hmin, h); }
   /// Rejects the step; the next attempt takes h_retry.
   void reject(double h_retry, StepStats& st) {
+    sys_.step_rejected();
     h = h_retry;
     ++st.rejected;
     last_rejected = true;
@@ -78,6 +80,7 @@ struct AdaptiveRun {
   void advance(OdeSystem& sys, double tn, const VecX& y, double hnew, StepStats& st) {
     t = tn;
     ++st.steps;
+    sys.step_accepted();
     if (every_step) sys.output(t, y);
     h = hnew;
     last_rejected = false;

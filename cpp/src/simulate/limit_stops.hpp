@@ -12,9 +12,10 @@
 //  - engaged: the stop holds the joint with a torque s lambda, lambda >= 0, that keeps
 //    s qdd = 0 (a bilateral solve over the engaged stops between events, A lambda = -s qdd_free).
 //    Its event function is lambda: when it turns negative, the contact problem is solved again.
-// The contact problem, at every event, over the stops in contact C (engaged, or within 2 kTol of
-// their limits), through the Delassus matrix A_ik = s_i s_k dqdd_i/dtau_k (the inverse mass
-// matrix seen by the stops: the rate response to a unit impulse at k, positive semi-definite):
+// The contact problem, at every event, over the stops in contact C (engaged, crossed at the event,
+// or within 2 kTol of their limits), through the Delassus matrix A_ik = s_i s_k dqdd_i/dtau_k (the
+// inverse mass matrix seen by the stops: the rate response to a unit impulse at k, positive
+// semi-definite):
 //  1. Impact, when a stop of C approaches (s qd < 0): Poisson's law as linear complementarity
 //     problems (lcp.hpp, exact pivoting, any number of stops, redundant ones too). The
 //     compression impulses solve  w = A mu_c + v-,  mu_c >= 0, w >= 0, mu_c' w = 0  (v- the stops'
@@ -22,12 +23,15 @@
 //     by 1/2 (1 - e^2) mu_c' A mu_c: it never rises (one stop: 1/2 (1 - e^2) qd-^2 / A_kk). A stop
 //     that the restitution drives into its limit (coupled stops) starts another round.
 //  2. Accumulation: a rebound whose apex v+^2 / (2 |a|) under the acceleration a back into the
-//     stop (with the resting stops' forces) stays within the stop's tolerance cannot be resolved
-//     by any event location: the geometric series of ever shorter bounces that would follow is
-//     summed at once (its restitution is dropped, the joint rests on the stop), losing exactly
-//     the energy the series would lose, the rebound's kinetic energy. (Should dropping some
-//     coupled stops' restitution but not others' raise the energy, the whole impact is plastic.)
-//  3. Resting contact: over the stops of C at rest (a rate within the same apex bound), the
+//     stop (with the other resting stops' forces, not its own) stays within the stop's tolerance
+//     cannot be resolved by any event location: the geometric series of ever shorter bounces that
+//     would follow is summed at once (its restitution is dropped, the joint rests on the stop),
+//     losing exactly the energy the series would lose, the rebound's kinetic energy. (Should
+//     dropping some coupled stops' restitution but not others' raise the energy, the whole impact
+//     is plastic.)
+//  3. Resting contact: over the stops of C at rest (a rate within the same apex bound: a held
+//     stop's own force would make its acceleration 0 and release it at any round-off rate, and
+//     two coupled stops, one struck while the other rests, would then take turns), the
 //     acceleration-level problem  w = A lambda + a0,  lambda >= 0, w >= 0, lambda' w = 0  (a0 the
 //     stops' s qdd without stop forces): a stop with w = 0 engages (degenerate ones, lambda = 0,
 //     stay free, and so does one the bilateral solve over the engaged stops then finds pulling
@@ -75,6 +79,9 @@ class StopAccess {
   virtual long stop_velocity_size() const = 0;
   /// Put coordinate c exactly on q (joint space; the Cartesian state leaves it as located).
   virtual void stop_place(VecX& /*y*/, int /*c*/, double /*q*/) {}
+  /// Hold coordinate c exactly on q at rest (joint space: q and its rate 0; the Cartesian
+  /// state is held along the stops' responses by hold()).
+  virtual void stop_pin(VecX& /*y*/, int /*c*/, double /*q*/) {}
   /// Displace the positions of y along the velocity-shaped dv (first order: u += S(u) dv).
   virtual void stop_displace(VecX& /*y*/, const VecX& /*dv*/) {}
 };
@@ -239,6 +246,14 @@ class LimitStops {
     return place(a, y, static_cast<long>(set_.size()), true);
   }
 
+  /// The engaged stops' coordinates exactly on their limits at rest (joint space, after each
+  /// step: the bilateral solve keeps their accelerations at round-off, whose integral would
+  /// otherwise drift them off the limits, and a stop released off its limit would fire again).
+  void pin(StopAccess& a, VecX& y) {
+    for (const Stop& s : stops_)
+      if (s.engaged) a.stop_pin(y, s.coord, s.limit);
+  }
+
   /// The located crossings of a step, at the end of the cut step: the contact problem there.
   /// Returns whether anything changed.
   bool apply(StopAccess& a, double t, VecX& y) {
@@ -280,7 +295,8 @@ class LimitStops {
   // The contact problem at (t, y) over the stops in contact (see the header). Returns whether
   // y or the contact state changed.
   bool resolve(StopAccess& a, double t, VecX& y) {
-    // C: the engaged stops and those within 2 kTol of their limits; their rates v-
+    // C: the engaged stops, the crossed ones and those within 2 kTol of their limits; their
+    // rates v-
     a.stop_load(y);
     set_.clear();
     double vscale = 0.0;
@@ -290,7 +306,10 @@ class LimitStops {
       hit_[static_cast<size_t>(i)] = pend_[static_cast<size_t>(i)] && !s.engaged;
       double q, qd;
       a.stop_coordinate(y, s.coord, q, qd);
-      if (!s.engaged && s.side * (q - s.limit) > 2 * tolerance(s)) continue;
+      // (a located crossing is a contact even where the Cartesian projection of the located
+      // state moved the joint back inside by more than that: else it crosses again at once)
+      if (!s.engaged && !pend_[static_cast<size_t>(i)] && s.side * (q - s.limit) > 2 * tolerance(s))
+        continue;
       vm_[static_cast<long>(set_.size())] = s.side * qd;
       vscale = std::max(vscale, std::abs(s.side * qd));
       set_.push_back(i);
@@ -404,12 +423,16 @@ class LimitStops {
       vp_[r] = at(r).side * qd;
       a0_[r] = at(r).side * a.stop_acceleration(y, f, at(r).coord);
       acc_[r] = a0_[r];
+      lam_[r] = 0.0;
       rest_[static_cast<size_t>(r)] = 0;
     }
     for (int round = 0; round <= k + 1; ++round) {
       bool changed = false;
       for (long r = 0; r < k; ++r) {
-        vr_[r] = std::sqrt(2.0 * tolerance(at(r)) * std::max(0.0, -acc_[r]));
+        // the acceleration back into the stop without its own holding force (the others'
+        // kept): with it, a held stop's acceleration is 0 and any rate would release it
+        const double back = -(acc_[r] - A_(r, r) * lam_[r]);
+        vr_[r] = std::sqrt(2.0 * tolerance(at(r)) * std::max(0.0, back));
         const char in = vp_[r] <= vr_[r] + eps_v_ ? 1 : 0;
         changed = changed || in != rest_[static_cast<size_t>(r)];
         rest_[static_cast<size_t>(r)] = in;
@@ -507,7 +530,10 @@ class LimitStops {
         dv_.setZero(nv);
         for (long c = 0; c < k; ++c) dv_.noalias() += sol_[c] * R_.col(c);
         a.stop_displace(y, dv_);
-        for (long r = 0; r < k; ++r) a.stop_place(y, at(r).coord, at(r).limit);
+        for (long r = 0; r < k; ++r) {
+          a.stop_place(y, at(r).coord, at(r).limit);
+          if (rates) a.stop_pin(y, at(r).coord, at(r).limit);  // an engaged stop at rest
+        }
       }
     }
     a.stop_load(y);

@@ -181,6 +181,15 @@ class MbsSystem : public OdeSystem, public StopAccess {
 
   bool project_last_stage() const override { return !d_.kkt.near_singular(); }
 
+  // The angle tracking (the unwrapped angles' turns, committed at every projection) of the
+  // accepted state, restored after a rejected step whose trial end point was projected: a
+  // rejected trial step can move an angle by more than half a turn (its reference then off by
+  // a turn, and with it the stops' coordinates near limits of +-2 pi).
+  void step_accepted() override { track_save_ = d_.track_ref; }
+  void step_rejected() override {
+    if (track_save_.size() == d_.track_ref.size()) d_.track_ref = track_save_;
+  }
+
   /// Report in the bodies and joints of the full model (a welded run).
   void set_expander(WeldExpander* ex) { ex_ = ex; }
   /// Enforce the joint position limits (simulate's limits="enforce").
@@ -353,6 +362,7 @@ class MbsSystem : public OdeSystem, public StopAccess {
   WeldExpander* ex_ = nullptr;
   LimitStops* stops_ = nullptr;
   VecX fo_, fe_, du_;  // the stops' scratch at outputs and events
+  VecX track_save_;    // the angle tracking of the last accepted state
 };
 
 // The joint-space equations of motion of a tree (TreeDynamics) as an ODE on y = (q, qd, z).
@@ -415,17 +425,33 @@ class JointSystem : public OdeSystem, public StopAccess {
       if (g.coord_a == c || g.coord_b == c) return;
     y[7 * m_.n_free + c] = q;
   }
+  void stop_pin(VecX& y, int c, double q) override {
+    for (const GearConstraint& g : m_.gear_constraints)
+      if (g.coord_a == c || g.coord_b == c) return;
+    y[7 * m_.n_free + c] = q;
+    y[nq_ + 6 * m_.n_free + c] = 0.0;
+  }
 
   void project_and_rhs(double t, VecX& y, VecX& dy) override {
     td_.project(y.data(), y.data() + nq_);
+    if (LimitStops* st = cart_.stops(); st && st->any_engaged()) st->pin(*this, y);
     rhs(t, y, dy);
   }
 
-  void output(double t, const VecX& y) override {
+  void output(double t, const VecX& y_dense) override {
+    // the engaged stops' joints exactly on their limits at rest, as at the steps' ends (the
+    // dense output between them carries the stages' round-off)
+    LimitStops* stops = cart_.stops();
+    const VecX* yp = &y_dense;
+    if (stops && stops->any_engaged()) {
+      yp_ = y_dense;
+      stops->pin(*this, yp_);
+      yp = &yp_;
+    }
+    const VecX& y = *yp;
     const double* z = y.data() + nq_ + n_;
     const Eigen::Map<const VecX> q(y.data(), nq_), qd(y.data() + nq_, n_);
     td_.accelerations(t, q.data(), qd.data(), z, nullptr, qdd_.data());
-    LimitStops* stops = cart_.stops();
     const double* stop_tau = nullptr;
     if (stops && stops->any_engaged()) {
       // the engaged stops' torques, then the accelerations with them
@@ -478,7 +504,7 @@ class JointSystem : public OdeSystem, public StopAccess {
   MbsSystem& cart_;
   int n_, nq_;
   VecX u_, v_, vd_, qdd_;
-  VecX fo_, fe_;  // the stops' scratch at outputs and events
+  VecX fo_, fe_, yp_;  // the stops' scratch at outputs and events
   // the joints whose multipliers load_tree_motion sweeps, children before parents
   const std::vector<std::pair<int, int>> sweep_ = tree_sweep(m_);
 };

@@ -208,13 +208,6 @@ RunPlan plan_run(const Model& m, double t_end, const SimOptions& opt) {
       p.why_coordinates = msg("joint space does not apply: ", why);
     } else if (const std::string why = geared_light_reason(*p.ms); !why.empty()) {
       p.why_coordinates = msg("joint space does not apply: ", why);
-    } else if (opt.limits && detail::LimitStops(*p.ms, opt.restitution).size() > 0) {
-      // a joint resting on its stop: the joint-space run's stop events chatter (the UR5
-      // falling onto its elbow stop, 5 s at rtol 1e-8: 96 222 events and 96 987 steps
-      // against the Cartesian run's 19 and 1171; python -m benchmarks.cartesian_fd)
-      p.why_coordinates =
-          "auto: cartesian, the model has joint limit stops (limits='enforce'), which the "
-          "Cartesian path holds without the joint-space path's chattering stop events";
     } else {
       const DynamicsCost& c = dynamics_cost(*p.ms);
       p.joint = c.joint_rhs_cheaper;

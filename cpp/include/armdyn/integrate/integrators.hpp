@@ -69,6 +69,13 @@ class OdeSystem {
   /// Returns whether it did: the integrator then evaluates f afresh at the (projected) y and
   /// takes the event functions' signs there.
   virtual bool apply_events(double /*t*/, VecX& /*y*/) { return false; }
+  /// Called by the adaptive explicit methods (DOPRI5, DOP853) once the run holds an accepted
+  /// state (at the start and after each accepted step), and after each rejected step, whose
+  /// trial end point the system may have projected (project_and_rhs): a system that keeps a
+  /// state of its own along the run (the Cartesian run's angle tracking) saves it at the one
+  /// and restores it at the other.
+  virtual void step_accepted() {}
+  virtual void step_rejected() {}
 };
 
 struct StepStats {
