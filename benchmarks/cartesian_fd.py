@@ -145,7 +145,7 @@ def main(argv=None) -> dict:
     args = ap.parse_args(argv)
     if args.loop:
         model = ad.load_urdf(str(common.robot_urdf(args.loop)))
-        x = np.random.default_rng(3).uniform(-1, 1, size=(3, 1_000_000, model.n_coords))
+        x = np.random.default_rng(3).uniform(-1, 1, size=(3, 200_000, model.n_coords))
         ad.forward_dynamics(model, *x, method="cartesian")
         return {}
     try:
