@@ -13,13 +13,14 @@ namespace armdyn {
 
 const CostConstants& cost_constants() {
   // measured by `python -m benchmarks.cost_model` (benchmarks/results/cost_model.json)
-  // measured on 2026-11-24 (2-core VM, Release build, spatial chains of 1 to 400 links; the
-  // largest relative misfit of the fits is 27 % (ABA) to 50 % (the joint run's own work): noise
-  // of a shared machine and cache effects beyond 300 links)
-  static const CostConstants k{/*c0*/ 0.0,           /*c_body*/ 0.1824, /*c_path*/ 0.008072,
-                               /*c_chol*/ 0.0001195, /*a0*/ 0.0,        /*a_body*/ 0.1911,
-                               /*k0*/ 0.0,           /*k_body*/ 0.588,  /*j0*/ 0.02423,
-                               /*j_body*/ 0.2883,    /*s0*/ 0.0,        /*s_body*/ 0.8183};
+  // measured on 2026-11-29 (2-core VM, Release build, spatial chains of 1 to 400 links, the
+  // Cartesian forward dynamics of trees on the articulated sweep; the largest relative misfit of
+  // the fits is 8 % (Cartesian) to 23 % (CRBA): noise of a shared machine and cache effects
+  // beyond 300 links)
+  static const CostConstants k{/*c0*/ 0.08105,       /*c_body*/ 0.1318, /*c_path*/ 0.002508,
+                               /*c_chol*/ 0.0001145, /*a0*/ 0.0004758,  /*a_body*/ 0.185,
+                               /*k0*/ 0.0,           /*k_body*/ 0.3873, /*j0*/ 0.0,
+                               /*j_body*/ 0.285,     /*s0*/ 0.0,        /*s_body*/ 0.6799};
   return k;
 }
 
