@@ -195,3 +195,19 @@ def test_limit_stops_and_the_reused_factor_match_dense():
     assert np.count_nonzero(fb[-1]) >= 2  # two joints rest on their stops at the end
     assert np.max(np.abs(a.u - b.u)) <= 1e-12
     assert np.max(np.abs(fa - fb)) <= 1e-9 * np.max(np.abs(fb))
+
+
+def test_a_joint_declared_from_child_to_parent_takes_the_kkt_path_with_the_same_answer():
+    # the middle joint names the deeper link as its parent: the sweep, which runs parents
+    # first, refuses the model and the KKT path solves it
+    b = ad.ModelBuilder()
+    for i in range(3):
+        b.add_body(f"l{i}", 1.0, np.diag([0.01, 0.02, 0.03]), position=(0.3 * i + 0.15, 0, 0))
+    b.add_revolute("j0", "ground", "l0", (0, 0, 0), (0, 0, 1))
+    b.add_revolute("j1", "l1", "l0", (0.3, 0, 0), (0, 1, 0))
+    b.add_revolute("j2", "l1", "l2", (0.6, 0, 0), (0, 0, 1))
+    model = b.finalize()
+    u, v = moving_state(model, 2)
+    assert_matches_dense(model, u, v)
+    a = ad.simulate(model, 0.1, integrator="rk4", dt=1e-3, coordinates="cartesian")
+    assert a.stats["articulated_solves"] == 0 and a.stats["kkt_solves"] > 0

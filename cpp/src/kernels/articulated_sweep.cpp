@@ -83,10 +83,13 @@ void ArticulatedSweep::plan(const Model& m, const ConstraintEval& ce) {
   for (int b = 0; b < static_cast<int>(ce.blocks.size()); ++b)
     if (ce.blocks[b].row0 <= m.nc) block_at_row[ce.blocks[b].row0] = b;
   std::vector<char> joint_block(ce.blocks.size(), 0);
+  std::vector<char> reached(m.nb, 0);  // bodies already the child of an earlier step
   for (int ji : m.tree_order) {
     const Joint& j = m.joints[ji];
-    // parent -> child joints only (the tree order's parent is the joint's)
+    // parent -> child joints only: the joint's parent is ground or reached before its child
     if (j.child == kGround || !supported(j.type)) return;
+    if (j.parent != kGround && !reached[j.parent]) return;
+    reached[j.child] = 1;
     Step s{ji, j.parent, j.child, -1, joint_rows(j.type), j.type, false};
     s.point = j.type == JointType::Revolute || j.type == JointType::Universal ||
               j.type == JointType::Spherical || j.type == JointType::Fixed;
