@@ -4,9 +4,11 @@
 #include <algorithm>
 #include <cmath>
 
+#include "armdyn/math/inverse3.hpp"
+
 namespace armdyn {
 
-namespace {
+namespace artic_detail {
 
 using SmallMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 8, 8>;
 using SmallVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 8, 1>;
@@ -24,15 +26,6 @@ bool supported(JointType t) {
     default:
       return false;
   }
-}
-
-// closed-form inverse of a 3 x 3 block; false when it is singular to working precision (its
-// determinant below 1e-10 of the product of its row norms)
-inline bool inverse3(const Mat3& M, Mat3& Mi) {
-  const double det = M.determinant();
-  if (!(std::abs(det) > 1e-10 * M.row(0).norm() * M.row(1).norm() * M.row(2).norm())) return false;
-  Mi = M.inverse();
-  return true;
 }
 
 // T^-1 of a completed block whose rows split into three with linear columns and three without
@@ -53,7 +46,7 @@ bool invert_block(const Mat6& T, Mat6& Ti) {
       B.row(i) = T.row(lin[i]).tail<3>();
       C.row(i) = T.row(ang[i]).tail<3>();
     }
-    if (!inverse3(L, Li) || !inverse3(C, Ci)) return false;
+    if (!inverse3_checked(L, Li) || !inverse3_checked(C, Ci)) return false;
     const Mat3 X = -Li * B * Ci;
     for (int i = 0; i < 3; ++i) {
       Ti.col(lin[i]).head<3>() = Li.col(i);
@@ -70,7 +63,7 @@ bool invert_block(const Mat6& T, Mat6& Ti) {
   return true;
 }
 
-}  // namespace
+}  // namespace artic_detail
 
 void ArticulatedSweep::plan(const Model& m, const ConstraintEval& ce) {
   ok_ = false;
@@ -87,7 +80,7 @@ void ArticulatedSweep::plan(const Model& m, const ConstraintEval& ce) {
   for (int ji : m.tree_order) {
     const Joint& j = m.joints[ji];
     // parent -> child joints only: the joint's parent is ground or reached before its child
-    if (j.child == kGround || !supported(j.type)) return;
+    if (j.child == kGround || !artic_detail::supported(j.type)) return;
     if (j.parent != kGround && !reached[j.parent]) return;
     reached[j.child] = 1;
     Step s{ji, j.parent, j.child, -1, joint_rows(j.type), j.type, false};
@@ -179,7 +172,7 @@ void ArticulatedSweep::point_block(const Model& m, const std::vector<BodyKin>& k
   }
 }
 
-namespace {
+namespace artic_detail {
 
 // G = Ci[:, :K] W for the K rotation rows W (K x 3) of a point joint
 template <int K>
@@ -214,7 +207,7 @@ void add_congruence(const Mat6& Ia, const Mat3& X, const Mat3& Y, Mat6& M) {
   M.bottomRightCorner<3, 3>().noalias() += X.transpose() * N + Y.transpose() * Q;
 }
 
-}  // namespace
+}  // namespace artic_detail
 
 bool ArticulatedSweep::factor(const Model& m, const std::vector<BodyKin>& kin,
                               const ConstraintEval& ce) {
@@ -233,11 +226,12 @@ bool ArticulatedSweep::factor(const Model& m, const std::vector<BodyKin>& kin,
       // T^-1 = [I, -B C^-1; 0, C^-1]
       Mat3 C;
       point_block(m, kin, ce, s, bm_[k], C);
-      if (!inverse3(C, ci_[k])) return false;
+      if (!inverse3_checked(C, ci_[k])) return false;
       S.topLeftCorner(3, nf).noalias() = -bm_[k] * ci_[k].rightCols(nf);
       S.bottomLeftCorner(3, nf) = ci_[k].rightCols(nf);
     } else {
-      if (!complete_block(m, kin, ce, s, T) || !invert_block(T, tinv_[k])) return false;
+      if (!complete_block(m, kin, ce, s, T) || !artic_detail::invert_block(T, tinv_[k]))
+        return false;
       S.leftCols(nf) = tinv_[k].rightCols(nf);
       tinv_[k].rightCols(nf).setZero();  // P, padded to 6 x 6
     }
@@ -252,10 +246,10 @@ bool ArticulatedSweep::factor(const Model& m, const std::vector<BodyKin>& kin,
       Ia.noalias() -= w.lazyProduct(u.transpose());
     } else if (nf > 1) {
       u_[k].leftCols(nf).noalias() = I * S.leftCols(nf);
-      SmallMat D = S.leftCols(nf).transpose() * u_[k].leftCols(nf);
-      Eigen::LLT<SmallMat> llt(D);
+      artic_detail::SmallMat D = S.leftCols(nf).transpose() * u_[k].leftCols(nf);
+      Eigen::LLT<artic_detail::SmallMat> llt(D);
       if (llt.info() != Eigen::Success) return false;
-      const SmallMat Di = llt.solve(SmallMat::Identity(nf, nf));
+      const artic_detail::SmallMat Di = llt.solve(artic_detail::SmallMat::Identity(nf, nf));
       dinv_[k].topLeftCorner(nf, nf) = Di;
       Ia.noalias() -= u_[k].leftCols(nf) * Di * u_[k].leftCols(nf).transpose();
     }
@@ -267,7 +261,7 @@ bool ArticulatedSweep::factor(const Model& m, const std::vector<BodyKin>& kin,
     const ConstraintBlock& b = ce.blocks[s.block];
     if (s.point) {
       // Z_p = [-I K; 0 W]: Y = -C^-1[:, :nk-3] W, X = -K - B Y
-      const Mat3 G = point_product(s.nk - 3, ci_[k], b.J, 3);
+      const Mat3 G = artic_detail::point_product(s.nk - 3, ci_[k], b.J, 3);
       y_[k] = -G;
       x_[k].noalias() = bm_[k] * G - b.J.block<3, 3>(0, 3);
     } else if (s.nk > 0) {
@@ -280,7 +274,7 @@ bool ArticulatedSweep::factor(const Model& m, const std::vector<BodyKin>& kin,
       x_[k].setZero();
       y_[k].setZero();
     }
-    add_congruence(Ia, x_[k], y_[k], ia_[s.parent]);
+    artic_detail::add_congruence(Ia, x_[k], y_[k], ia_[s.parent]);
   }
   return true;
 }
@@ -321,8 +315,8 @@ void ArticulatedSweep::sweep(const ConstraintEval& ce, const VecX& xi, const Vec
     if (nf == 1) {
       t.noalias() -= (dinv_[k](0, 0) * s_[k].col(0).dot(t)) * u_[k].col(0);
     } else if (nf > 1) {
-      const SmallVec st = s_[k].leftCols(nf).transpose() * t;
-      const SmallVec w = dinv_[k].topLeftCorner(nf, nf) * st;
+      const artic_detail::SmallVec st = s_[k].leftCols(nf).transpose() * t;
+      const artic_detail::SmallVec w = dinv_[k].topLeftCorner(nf, nf) * st;
       t.noalias() -= u_[k].leftCols(nf) * w;
     }
     Vec6& pp = pa_[s.parent];
@@ -346,8 +340,8 @@ void ArticulatedSweep::sweep(const ConstraintEval& ce, const VecX& xi, const Vec
       a.noalias() += sv * s_[k].col(0);
       t.noalias() += sv * u_[k].col(0);
     } else if (nf > 1) {
-      const SmallVec st = s_[k].leftCols(nf).transpose() * t;
-      const SmallVec sv = -(dinv_[k].topLeftCorner(nf, nf) * st);
+      const artic_detail::SmallVec st = s_[k].leftCols(nf).transpose() * t;
+      const artic_detail::SmallVec sv = -(dinv_[k].topLeftCorner(nf, nf) * st);
       a.noalias() += s_[k].leftCols(nf) * sv;
       t.noalias() += u_[k].leftCols(nf) * sv;
     }
@@ -366,7 +360,7 @@ void ArticulatedSweep::sweep(const ConstraintEval& ce, const VecX& xi, const Vec
   }
 }
 
-namespace {
+namespace artic_detail {
 // E_r v: row r of block b applied to the body velocities (or accelerations) v
 double row_times(const ConstraintBlock& b, int r, const VecX& v) {
   double sum = 0.0;
@@ -374,27 +368,27 @@ double row_times(const ConstraintBlock& b, int r, const VecX& v) {
     if (b.body[k] != kGround) sum += b.J.row(r).segment<6>(6 * k).dot(v.segment<6>(6 * b.body[k]));
   return sum;
 }
-}  // namespace
+}  // namespace artic_detail
 
 bool ArticulatedSweep::extra_rows(const ConstraintEval& ce, int nrows, VecX& vd, VecX& delta) {
   const int ne = static_cast<int>(extra_rows_.size());
   if (ne == 0) return true;
   // E Vd mu = -xi_E - E vd0
-  SmallMat H(ne, ne);
-  SmallVec rhs(ne);
+  artic_detail::SmallMat H(ne, ne);
+  artic_detail::SmallVec rhs(ne);
   int i = 0;
   for (int bi : extra_blocks_) {
     const ConstraintBlock& b = ce.blocks[bi];
     if (b.row0 >= nrows) continue;
     for (int r = 0; r < b.nrows; ++r, ++i) {
-      for (int e = 0; e < ne; ++e) H(i, e) = row_times(b, r, resp_vd_[e]);
-      rhs[i] = -ce.xi[b.row0 + r] - row_times(b, r, vd);
+      for (int e = 0; e < ne; ++e) H(i, e) = artic_detail::row_times(b, r, resp_vd_[e]);
+      rhs[i] = -ce.xi[b.row0 + r] - artic_detail::row_times(b, r, vd);
     }
   }
-  const Eigen::PartialPivLU<SmallMat> lu(H);
+  const Eigen::PartialPivLU<artic_detail::SmallMat> lu(H);
   const auto d = lu.matrixLU().diagonal().cwiseAbs();
   if (!(d.minCoeff() > 1e-12 * d.maxCoeff())) return false;
-  const SmallVec mu = lu.solve(rhs);
+  const artic_detail::SmallVec mu = lu.solve(rhs);
   for (int e = 0; e < ne; ++e) {
     vd.noalias() += mu[e] * resp_vd_[e];
     delta.head(nrows).noalias() += mu[e] * resp_delta_[e].head(nrows);

@@ -4,18 +4,9 @@
 #include <algorithm>
 #include <cmath>
 
-namespace armdyn {
+#include "armdyn/math/inverse3.hpp"
 
-namespace {
-// closed-form inverse of a 3 x 3 block; false when it is singular to working precision (its
-// determinant below 1e-10 of the product of its row norms)
-inline bool inverse3(const Mat3& M, Mat3& Mi) {
-  const double det = M.determinant();
-  if (!(std::abs(det) > 1e-10 * M.row(0).norm() * M.row(1).norm() * M.row(2).norm())) return false;
-  Mi = M.inverse();
-  return true;
-}
-}  // namespace
+namespace armdyn {
 
 void TreeSweep::plan(const Model& m, const ConstraintEval& ce) {
   ok_ = false;
@@ -103,7 +94,8 @@ bool TreeSweep::solve(const Model& m, const ConstraintEval& ce, const VecX& eta,
     if (tri) {
       // rows (top, bot) = [A B; 0 C]: x_w = C^-1 rhs_bot, x_v = A^-1 (rhs_top - B x_w)
       const int top = tri == 1 ? 0 : 3, bot = 3 - top;
-      if (!inverse3(Zc.block<3, 3>(top, 0), ai_[k]) || !inverse3(Zc.block<3, 3>(bot, 3), ci_[k]))
+      if (!inverse3_checked(Zc.block<3, 3>(top, 0), ai_[k]) ||
+          !inverse3_checked(Zc.block<3, 3>(bot, 3), ci_[k]))
         return false;
       b_[k] = Zc.block<3, 3>(top, 3);
       const Vec3 xw = ci_[k] * rhs.segment<3>(bot);
