@@ -131,6 +131,47 @@ def ur5_fall(model, rounds: int, limits: str) -> dict:
     }
 
 
+def coupled_chain(n: int, couplings: int):
+    """A spatial chain of n revolute links, its last 2 * couplings joints coupled in pairs."""
+    rng = np.random.default_rng(0)
+    b = ad.ModelBuilder()
+    parent = "ground"
+    for i in range(n):
+        b.add_body(f"l{i}", 1.0, np.diag([0.01, 0.02, 0.03]), position=(0.2 * i + 0.1, 0, 0))
+        axis = rng.normal(size=3)
+        b.add_revolute(
+            f"j{i}", parent, f"l{i}", (0.2 * i, 0, 0), tuple(axis / np.linalg.norm(axis))
+        )
+        parent = f"l{i}"
+    for k in range(couplings):
+        b.add_coupling(f"c{k}", f"j{n - 1 - 2 * k}", f"j{n - 2 - 2 * k}", 0.5)
+    return b.finalize()
+
+
+def extra_rows_scan(n: int = 200, states: int = 50) -> dict:
+    """The Cartesian forward dynamics per state against the number of extra rows, and the path
+    (articulated sweep or KKT factorisation, from a short run's stats)."""
+    out = {}
+    for k in range(10):
+        model = coupled_chain(n, k)
+        x = np.random.default_rng(3).uniform(-1, 1, size=(3, states, model.n_coords))
+        t = kernel_time(lambda m=model, x=x: ad.forward_dynamics(m, *x, method="cartesian"), 5)
+        run = ad.simulate(model, 1e-3, integrator="rk4", dt=1e-3, coordinates="cartesian")
+        path = "articulated sweep" if run.stats["articulated_solves"] else "KKT factorisation"
+        out[k] = {"us_per_state": 1e6 * t / states, "path": path}
+        print(f"{k} extra rows: {out[k]['us_per_state']:.1f} us per state ({path})")
+    return out
+
+
+def kernel_time(fn, rounds: int) -> float:
+    best = float("inf")
+    for _ in range(rounds):
+        t0 = time.thread_time()
+        fn()
+        best = min(best, time.thread_time() - t0)
+    return best
+
+
 def main(argv=None) -> dict:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true")
@@ -142,7 +183,15 @@ def main(argv=None) -> dict:
         "states in one batch call, for a profiler: perf record -g python -m "
         "benchmarks.cartesian_fd --loop ur5",
     )
+    ap.add_argument(
+        "--extra-rows",
+        action="store_true",
+        help="only time the Cartesian forward dynamics of a 200-link chain with 0 to 9 couplings "
+        "(rows outside the tree's joints) and print which solve each took",
+    )
     args = ap.parse_args(argv)
+    if args.extra_rows:
+        return extra_rows_scan()
     if args.loop:
         model = ad.load_urdf(str(common.robot_urdf(args.loop)))
         x = np.random.default_rng(3).uniform(-1, 1, size=(3, 200_000, model.n_coords))

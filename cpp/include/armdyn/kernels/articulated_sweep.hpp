@@ -30,7 +30,11 @@ namespace armdyn {
 
 class ArticulatedSweep {
  public:
-  static constexpr int kMaxExtraRows = 8;
+  /// Each extra row costs one more sweep per factor (about a fifth of the solve): beyond two
+  /// the KKT path's block elimination is cheaper (`python -m benchmarks.cartesian_fd
+  /// --extra-rows`: a 200-link chain with 0 to 9 couplings; with the limit at 8 it measured
+  /// 77, 91, 104, 134 and 189 us per state for 0, 1, 2, 4 and 8 rows, the KKT path 113 us).
+  static constexpr int kMaxExtraRows = 2;
   /// The plan for model m with constraint blocks ce: ok() stays false unless m is a tree whose
   /// bodies each hang from one joint of a supported type (revolute, prismatic, cylindrical,
   /// universal, spherical, fixed, free), with no redundant rows and no forced dense KKT path.
