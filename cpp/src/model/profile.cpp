@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "armdyn/errors.hpp"
 
@@ -231,6 +232,41 @@ ProfileValue Profile::eval(double t) const {
       break;
   }
   return v;
+}
+
+double Profile::time_scale() const {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  switch (kind_) {
+    case Kind::Cubic:
+    case Kind::Quintic:
+      return p_[1] != p_[0] ? p_[3] - p_[2] : inf;
+    case Kind::Sine:
+      return p_[0] != 0.0 && p_[1] != 0.0 ? 1.0 / std::abs(p_[1]) : inf;
+    case Kind::Spline: {
+      double h = inf;
+      for (size_t i = 1; i < t_.size(); ++i) h = std::min(h, t_[i] - t_[i - 1]);
+      return h;
+    }
+    default:
+      return inf;
+  }
+}
+
+double Profile::next_breakpoint(double t, double eps) const {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  switch (kind_) {
+    case Kind::Cubic:
+    case Kind::Quintic:
+      if (p_[1] == p_[0]) return inf;
+      if (p_[2] > t + eps) return p_[2];
+      return p_[3] > t + eps ? p_[3] : inf;
+    case Kind::Spline: {
+      const auto it = std::upper_bound(t_.begin(), t_.end(), t + eps);
+      return it == t_.end() ? inf : *it;
+    }
+    default:
+      return inf;
+  }
 }
 
 std::string Profile::describe() const {

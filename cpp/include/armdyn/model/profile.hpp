@@ -38,6 +38,14 @@ class Profile {
   /// eval at each of the n times t[k]: y[k], yd[k], ydd[k] (Python's Profile.eval of an array).
   void eval(const double* t, long n, double* y, double* yd, double* ydd) const;
   Kind kind() const { return kind_; }
+  /// The time over which the profile changes appreciably (cubic/quintic: the transition's
+  /// duration; sine: its period; spline: the shortest sample interval); infinity for a
+  /// constant and for a callback (unknown). Bounds the steps that must sample a load
+  /// (simulate's held joint stops).
+  double time_scale() const;
+  /// The first time strictly after t + eps where the profile's form changes (cubic/quintic:
+  /// the transition's start and end; spline: its samples); infinity when none.
+  double next_breakpoint(double t, double eps) const;
   std::string describe() const;
 
   /// The stored values of a built-in profile, for serialization (armdyn/io/serialize.hpp):
