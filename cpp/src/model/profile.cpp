@@ -234,18 +234,20 @@ ProfileValue Profile::eval(double t) const {
   return v;
 }
 
-double Profile::time_scale() const {
+double Profile::time_scale(double t, double eps) const {
   constexpr double inf = std::numeric_limits<double>::infinity();
+  const double te = t + eps;
   switch (kind_) {
     case Kind::Cubic:
     case Kind::Quintic:
-      return p_[1] != p_[0] ? p_[3] - p_[2] : inf;
+      return p_[1] != p_[0] && te >= p_[2] && te < p_[3] ? p_[3] - p_[2] : inf;
     case Kind::Sine:
       return p_[0] != 0.0 && p_[1] != 0.0 ? 1.0 / std::abs(p_[1]) : inf;
     case Kind::Spline: {
-      double h = inf;
-      for (size_t i = 1; i < t_.size(); ++i) h = std::min(h, t_[i] - t_[i - 1]);
-      return h;
+      if (te < t_.front() || te >= t_.back()) return inf;
+      const size_t i =
+          static_cast<size_t>(std::upper_bound(t_.begin(), t_.end(), te) - t_.begin()) - 1;
+      return t_[i + 1] - t_[i];
     }
     default:
       return inf;

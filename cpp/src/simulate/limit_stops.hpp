@@ -151,8 +151,9 @@ class LimitStops {
   /// error estimate is then zero (nothing moves) and the steps would grow without bound,
   /// stepping over an interval where the force turns negative and back (a release missed).
   /// The steps are bounded so that the force is sampled densely on the loads' own time
-  /// scales: at most 1/16 of each time-varying load profile's time scale (a sine's period, a
-  /// cubic or quintic transition's duration, a spline's shortest sample interval), and ending
+  /// scales: at most 1/16 of each time-varying load profile's local time scale (a sine's
+  /// period, a cubic or quintic transition's duration while in it, a spline's sample interval
+  /// while within its samples; none where a profile is constant or linear), and ending
   /// on the profiles' breakpoints (a transition's start and end, a spline's samples), so that
   /// a short pulse after a long constant stretch is sampled from its start. A callback profile
   /// has no known time scale: simulate's max_step bounds its steps.
@@ -161,7 +162,7 @@ class LimitStops {
     if (!any_engaged()) return h;
     const double eps = 1e-12 * std::max(1.0, std::abs(t));
     for (const Profile* p : loads_) {
-      h = std::min(h, p->time_scale() / kSamplesPerScale);
+      h = std::min(h, p->time_scale(t, eps) / kSamplesPerScale);
       h = std::min(h, p->next_breakpoint(t, eps) - t);
     }
     return h;
