@@ -180,7 +180,8 @@ duration while in it, a spline's sample interval) and ending on their breakpoint
 (a transition's start and end, a spline's samples), so that the holding force's
 sign is sampled on the loads' own time scale; a callback profile has no known time
 scale (``max_step`` bounds its steps). A run that starts outside a limit is
-refused. ``"ignore"``: the limits play no part in the dynamics (they are still checked by :func:`armdyn.limit_violations`).""",
+refused. ``"ignore"``: the limits play no part in the dynamics (they are still
+checked by :func:`armdyn.limit_violations`).""",
     ),
     RunOption(
         "restitution",
