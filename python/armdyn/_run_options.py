@@ -171,9 +171,17 @@ prismatic), a finite position limit (``set_joint_limits``, the URDF ``<limit>``;
 ``model.coord_lower``/``coord_upper``) and no drive is held within it by a
 unilateral stop: the contact is located as an event, the impact is an impulse of the
 whole mechanism (kinetic energy never rises), and the joint then rests on its stop,
-held by a torque in ``limit_forces``, until the load pulls it off. A run that starts
-outside a limit is refused. ``"ignore"``: the limits play no part in the dynamics
-(they are still checked by :func:`armdyn.limit_violations`).""",
+held by a torque in ``limit_forces``, until the load pulls it off. While a joint is
+held its state stands still, so the error control alone would let the steps grow
+without bound and step over a load that reverses and comes back within one step:
+the adaptive steps are then also bounded by the applied loads' profiles, at most
+1/16 of each one's time scale (a sine's period, a cubic/quintic transition's
+duration while in it, a spline's sample interval) and ending on their breakpoints
+(a transition's start and end, a spline's samples), so that the holding force's
+sign is sampled on the loads' own time scale; a callback profile has no known time
+scale (``max_step`` bounds its steps). A run that starts outside a limit is
+refused. ``"ignore"``: the limits play no part in the dynamics (they are still
+checked by :func:`armdyn.limit_violations`).""",
     ),
     RunOption(
         "restitution",

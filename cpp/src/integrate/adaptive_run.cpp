@@ -26,6 +26,7 @@ void AdaptiveRun::start(OdeSystem& sys, VecX& y, VecX& f0, VecX& yt, VecX& f1, i
   sys.step_accepted();
   sys.output(t, y);
   h = initial_step(sys, t, y, f0, yt, f1, opt, hmax, hmin, order, st);
+  h = std::min(h, sys.step_bound(t));  // (OdeSystem::step_bound)
   ev.init(sys, t, y);
 }
 

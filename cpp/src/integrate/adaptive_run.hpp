@@ -5,6 +5,7 @@
 // output.
 #pragma once
 
+#include <algorithm>
 #include <vector>
 
 #include "dense_output.hpp"
@@ -82,7 +83,7 @@ struct AdaptiveRun {
     ++st.steps;
     sys.step_accepted();
     if (every_step) sys.output(t, y);
-    h = hnew;
+    h = std::min(hnew, sys.step_bound(t));  // (OdeSystem::step_bound)
     last_rejected = false;
   }
 };

@@ -123,7 +123,7 @@ void Trbdf2Run::start() {
   // initial step: a fraction of the span, limited by the first derivative
   h = opt.dt > 0 ? opt.dt
                  : std::min(hmax, 0.01 * std::max(wnorm(K1) > 0 ? 1.0 / wnorm(K1) : span, 1e-6));
-  h = std::min(h, hmax);
+  h = std::min({h, hmax, sys_.step_bound(t_)});  // (OdeSystem::step_bound)
   jacobian();
   jac_current = true;
   refreshed_in_step = false;
@@ -292,7 +292,7 @@ void Trbdf2Run::accept(double fac) {
   ++st.steps;
   if (every_step) sys_.output(t_, y);
   refresh_jacobian();
-  const double hnew = std::min(h * fac, hmax);
+  const double hnew = std::min({h * fac, hmax, sys_.step_bound(t_)});  // (OdeSystem::step_bound)
   if (!(hnew >= h && hnew <= 1.2 * h && h_lu > 0)) h = hnew;
 }
 

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "armdyn/errors.hpp"
 
@@ -231,6 +232,43 @@ ProfileValue Profile::eval(double t) const {
       break;
   }
   return v;
+}
+
+double Profile::time_scale(double t, double eps) const {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  const double te = t + eps;
+  switch (kind_) {
+    case Kind::Cubic:
+    case Kind::Quintic:
+      return p_[1] != p_[0] && te >= p_[2] && te < p_[3] ? p_[3] - p_[2] : inf;
+    case Kind::Sine:
+      return p_[0] != 0.0 && p_[1] != 0.0 ? 1.0 / std::abs(p_[1]) : inf;
+    case Kind::Spline: {
+      if (te < t_.front() || te >= t_.back()) return inf;
+      const size_t i =
+          static_cast<size_t>(std::upper_bound(t_.begin(), t_.end(), te) - t_.begin()) - 1;
+      return t_[i + 1] - t_[i];
+    }
+    default:
+      return inf;
+  }
+}
+
+double Profile::next_breakpoint(double t, double eps) const {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  switch (kind_) {
+    case Kind::Cubic:
+    case Kind::Quintic:
+      if (p_[1] == p_[0]) return inf;
+      if (p_[2] > t + eps) return p_[2];
+      return p_[3] > t + eps ? p_[3] : inf;
+    case Kind::Spline: {
+      const auto it = std::upper_bound(t_.begin(), t_.end(), t + eps);
+      return it == t_.end() ? inf : *it;
+    }
+    default:
+      return inf;
+  }
 }
 
 std::string Profile::describe() const {

@@ -131,6 +131,41 @@ class LimitStops {
     pending_.reserve(stops_.size());
     lcp_.reserve(static_cast<int>(k));
     tau_ = VecX::Zero(m.nv_joint);
+    // the time-varying loads (step_bound)
+    for (const CoordForce& cf : m.coord_forces) {
+      if (cf.has_input) loads_.push_back(&cf.input);
+      if (cf.motor) loads_.push_back(&cf.reference);
+    }
+    for (const BodyLoad& bl : m.body_loads)
+      if (bl.has_profile) loads_.push_back(&bl.profile);
+    for (const Drive& d : m.drives) loads_.push_back(&d.profile);
+  }
+
+  /// Samples of a load's time scale per step while a stop is held (step_bound).
+  static constexpr double kSamplesPerScale = 16.0;
+
+  /// The longest step from t (OdeSystem::step_bound): unbounded while every stop is free (the
+  /// gaps' sign changes follow the motion, which the error control resolves, and their dips
+  /// are caught through their rates); while a stop is held, its event function is its holding
+  /// force, a function of time through the applied loads while the state stands still. The
+  /// error estimate is then zero (nothing moves) and the steps would grow without bound,
+  /// stepping over an interval where the force turns negative and back (a release missed).
+  /// The steps are bounded so that the force is sampled densely on the loads' own time
+  /// scales: at most 1/16 of each time-varying load profile's local time scale (a sine's
+  /// period, a cubic or quintic transition's duration while in it, a spline's sample interval
+  /// while within its samples; none where a profile is constant or linear), and ending
+  /// on the profiles' breakpoints (a transition's start and end, a spline's samples), so that
+  /// a short pulse after a long constant stretch is sampled from its start. A callback profile
+  /// has no known time scale: simulate's max_step bounds its steps.
+  double step_bound(double t) const {
+    double h = std::numeric_limits<double>::infinity();
+    if (!any_engaged()) return h;
+    const double eps = 1e-12 * std::max(1.0, std::abs(t));
+    for (const Profile* p : loads_) {
+      h = std::min(h, p->time_scale(t, eps) / kSamplesPerScale);
+      h = std::min(h, p->next_breakpoint(t, eps) - t);
+    }
+    return h;
   }
 
   int size() const { return static_cast<int>(stops_.size()); }
@@ -595,6 +630,7 @@ class LimitStops {
   double chatter_t_ = -1e300;
   int chatter_n_ = 0;
   std::vector<Stop> stops_;
+  std::vector<const Profile*> loads_;  // the model's time-varying loads (step_bound)
   std::vector<int> limited_, set_, sub_, cset_, pending_;
   std::vector<char> pend_, was_, hit_, rest_, sep_;
   LcpSolver lcp_;

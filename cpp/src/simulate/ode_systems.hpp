@@ -339,6 +339,9 @@ class MbsSystem : public OdeSystem, public StopAccess {
     out_.event_index.push_back(i);
     out_.event_direction.push_back(direction);
   }
+  double step_bound(double t) override {
+    return stops_ ? stops_->step_bound(t) : std::numeric_limits<double>::infinity();
+  }
   bool apply_events(double t, VecX& y) override {
     if (!stops_) return false;
     // the contact problem on the constraint manifold: the located state is the dense output's,
@@ -491,6 +494,7 @@ class JointSystem : public OdeSystem, public StopAccess {
     return true;
   }
   void on_event(double t, int i, int direction) override { cart_.on_event(t, i, direction); }
+  double step_bound(double t) override { return cart_.step_bound(t); }
   bool apply_events(double t, VecX& y) override {
     LimitStops* st = cart_.stops();
     return st && st->apply(*this, t, y);

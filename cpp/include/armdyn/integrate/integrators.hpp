@@ -22,6 +22,7 @@
 
 #include <Eigen/LU>
 #include <array>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -76,6 +77,13 @@ class OdeSystem {
   /// and restores it at the other.
   virtual void step_accepted() {}
   virtual void step_rejected() {}
+  /// The longest step the system allows from the accepted state at t (infinity: none), on top
+  /// of the error control: a quantity the error estimate does not see -- a held joint stop's
+  /// holding force under time-varying loads, whose sign an event function watches while the
+  /// state stands still -- must be sampled densely enough for its sign changes to show. The
+  /// adaptive methods (DOPRI5, DOP853, TR-BDF2) take it at the start and after every accepted
+  /// step; RK4 keeps its fixed step.
+  virtual double step_bound(double /*t*/) { return std::numeric_limits<double>::infinity(); }
 };
 
 struct StepStats {

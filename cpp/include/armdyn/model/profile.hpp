@@ -38,6 +38,16 @@ class Profile {
   /// eval at each of the n times t[k]: y[k], yd[k], ydd[k] (Python's Profile.eval of an array).
   void eval(const double* t, long n, double* y, double* yd, double* ydd) const;
   Kind kind() const { return kind_; }
+  /// The time over which the profile changes appreciably on the step from t (t + eps taken
+  /// for t: a step starting within eps before a breakpoint starts on it): a cubic/quintic's
+  /// transition duration inside the transition, a sine's period, the spline's sample
+  /// interval inside its samples; infinity where it is constant or linear (before or after a
+  /// transition, a spline's extrapolation), for a constant and for a callback (unknown).
+  /// Bounds the steps that must sample a load (simulate's held joint stops).
+  double time_scale(double t, double eps) const;
+  /// The first time strictly after t + eps where the profile's form changes (cubic/quintic:
+  /// the transition's start and end; spline: its samples); infinity when none.
+  double next_breakpoint(double t, double eps) const;
   std::string describe() const;
 
   /// The stored values of a built-in profile, for serialization (armdyn/io/serialize.hpp):
