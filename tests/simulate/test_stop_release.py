@@ -133,6 +133,9 @@ def test_a_held_joint_under_a_ramp_that_stays_below_the_hold_is_sampled_only_on_
     assert np.any(r.t == 4.0) and np.any(r.t == 5.0)
     on = (r.t > 4.0) & (r.t <= 5.0)
     assert np.diff(r.t)[on[1:]].max() <= 1 / 16 + 1e-12
-    assert r.stats["steps"] < 16 + 10
+    # 16 steps on the ramp, and after it the steps grow again at once (the start's own
+    # step-size ramp-up from rest, which differs between the formulations, is not the point)
+    assert np.count_nonzero(on) == 16
+    assert np.count_nonzero(r.t > 5.0) <= 4
     s = _quintic(np.clip(r.t - 4.0, 0.0, 1.0))
     np.testing.assert_allclose(r.limit_forces["force"][:, 0], X - 0.8 * X * s, rtol=1e-9)
