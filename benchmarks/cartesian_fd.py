@@ -179,10 +179,11 @@ def main(argv=None) -> dict:
     ap.add_argument(
         "--loop",
         metavar="ROBOT",
-        help="only evaluate the Cartesian forward dynamics of ROBOT (ur5, panda) on 200000 "
+        help="only evaluate the Cartesian forward dynamics of ROBOT (ur5, panda) on --states "
         "states in one batch call, for a profiler: perf record -g python -m "
         "benchmarks.cartesian_fd --loop ur5",
     )
+    ap.add_argument("--states", type=int, default=200_000, help="the states of --loop")
     ap.add_argument(
         "--extra-rows",
         action="store_true",
@@ -194,7 +195,7 @@ def main(argv=None) -> dict:
         return extra_rows_scan()
     if args.loop:
         model = ad.load_urdf(str(common.robot_urdf(args.loop)))
-        x = np.random.default_rng(3).uniform(-1, 1, size=(3, 200_000, model.n_coords))
+        x = np.random.default_rng(3).uniform(-1, 1, size=(3, args.states, model.n_coords))
         ad.forward_dynamics(model, *x, method="cartesian")
         return {}
     try:

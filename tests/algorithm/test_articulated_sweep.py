@@ -96,8 +96,8 @@ def hand_on(joint_type, floating=False):
 
 
 def moving_state(model, seed):
-    """A state on the constraint manifold with every body moving: a short fixed-step run of the
-    dense path from a random admissible velocity."""
+    """The assembly pose with a random velocity projected onto the velocity constraints
+    (zeta v = 0): a state on the constraint manifold with every body moving."""
     rng = np.random.default_rng(seed)
     c = ad.evaluate_constraints(model, model.u0, np.zeros(model.nv))
     zeta = c["zeta"]

@@ -20,6 +20,8 @@ import armdyn as ad
 import numpy as np
 import pytest
 
+from tests.simulate.test_joint_limits import double_pendulum
+
 G = 9.81
 COORDINATES = ["cartesian", "joint"]
 TIGHT = dict(rtol=1e-10, atol=1e-12)
@@ -150,18 +152,6 @@ def test_two_coupled_stops_engaging_at_one_instant_rest_together(coordinates, e)
         [force[names.index("j2")], force[names.index("j3")]], held[1:], rtol=1e-8
     )
     _energy_never_rises(r, 1e-8)
-
-
-def double_pendulum(limits1, limits2):
-    """Two unit links along -z from the origin, hinged about +y; point masses at their ends."""
-    b = ad.ModelBuilder(gravity=(0, 0, -G))
-    b.add_body("a", 1.0, np.eye(3) * 1e-3, position=(0, 0, -1.0))
-    b.add_body("b", 0.7, np.eye(3) * 1e-3, position=(0, 0, -2.0))
-    b.add_revolute("j1", "ground", "a", (0.0, 0.0, 0.0), (0.0, 1.0, 0.0))
-    b.add_revolute("j2", "a", "b", (0.0, 0.0, -1.0), (0.0, 1.0, 0.0))
-    b.set_joint_limits("j1", *limits1)
-    b.set_joint_limits("j2", *limits2)
-    return b.finalize()
 
 
 def _pinocchio_gravity_torques(q):
