@@ -7,6 +7,7 @@
   Newton–Euler equations solved through their KKT system, the paper's formulation) and the
   default ``forward_dynamics`` (joint space) against ``pin.aba``, timed in interleaved rounds;
   the ratios are the medians of the per-round ratios (target of issue 36: Cartesian <= 1.2x).
+  The same call with ``t`` and ``method`` passed by position shows what the keyword costs.
   The Cartesian answer's largest relative difference from the joint-space one is recorded.
 * The kernel alone: one ``forward_dynamics`` call on a batch of states (one C++ loop), the
   thread's CPU time per state, best of the rounds, for ``"cartesian"`` and ``"auto"``.
@@ -50,6 +51,7 @@ def per_call(pair, number: int) -> dict:
         {
             "pin_aba": lambda: pin.aba(pm, pd, q, v, tau),
             "armdyn_cartesian": lambda: fd(am, qa, va, ta, method="cartesian"),
+            "armdyn_cartesian_positional": lambda: fd(am, qa, va, ta, 0.0, "cartesian"),
             "armdyn_default": lambda: fd(am, qa, va, ta),
         },
         number,
@@ -58,6 +60,7 @@ def per_call(pair, number: int) -> dict:
     c = fd(am, qa, va, ta, method="cartesian")
     r = {f"{k}_us": 1e6 * t[k] for k in t if k != "rounds"}
     r["ratio_cartesian"] = common.paired_ratio(t, "armdyn_cartesian", "pin_aba")
+    r["keyword_us"] = r["armdyn_cartesian_us"] - r["armdyn_cartesian_positional_us"]
     r["ratio_default"] = common.paired_ratio(t, "armdyn_default", "pin_aba")
     r["cartesian_vs_joint_rel_diff"] = float(np.abs(a - c).max() / np.abs(a).max())
     return r

@@ -28,6 +28,7 @@ void bind_frames(py::module_& m);
 void bind_derivatives(py::module_& m);
 void bind_regressor(py::module_& m);
 void bind_parameter_model(py::module_& m);
+void fast_keywords(const py::module_& m);
 }  // namespace armdyn
 
 namespace {
@@ -230,4 +231,5 @@ PYBIND11_MODULE(_core, m) {
   armdyn::bind_regressor(m);
   armdyn::bind_parameter_model(m);
   add_text_signatures(m, py::module_::import("ast").attr("literal_eval"));
+  armdyn::fast_keywords(m);  // last: the functions as bound
 }
