@@ -119,6 +119,9 @@ class Data {
   /// false: cartesian_forces leaves out the joint-coordinate forces and gear pairs (a
   /// joint-space caller adds them to its generalised forces directly).
   bool with_coordinate_forces = true;
+  /// false: body_accelerations may leave delta as it was where that saves work (the articulated
+  /// sweep: a forward-dynamics call reads the accelerations only).
+  bool multipliers = true;
   // buffers:
   ConstraintEval ce;             ///< f, zeta, rhs, xi at the loaded state
   std::vector<int> joint_block;  ///< per joint: its row block in ce.blocks (-1: no rows)

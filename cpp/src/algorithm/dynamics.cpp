@@ -55,9 +55,11 @@ void forward_cartesian(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen:
     ~Settings() {
       d.joint_torques = nullptr;
       d.nrows = d.model->nc;
+      d.multipliers = true;
     }
   } restore{d};
   d.nrows = m.nc_joint;
+  d.multipliers = false;  // the accelerations only
   d.aux = nullptr;
   d.augmented = false;  // each call decides afresh: the result never depends on earlier calls
   d.with_coordinate_forces = true;

@@ -121,8 +121,8 @@ void body_accelerations_loaded(const Model& m, Data& d, double t, double* vdot, 
     // a tree (ideal gears, couplings and a few drives as extra rows): the articulated-body
     // recursions over the Cartesian coordinates, O(n), no KKT factorisation
     const bool reuse = reuse_factor && d.artic.factored(nrows, kkt.factor_count());
-    if (d.artic.solve(m, d.kin, d.ce, nrows, d.eta, d.vd_work, d.delta, reuse,
-                      kkt.factor_count())) {
+    if (d.artic.solve(m, d.kin, d.ce, nrows, d.eta, d.vd_work, d.delta, reuse, kkt.factor_count(),
+                      d.multipliers)) {
       ++st.kkt_solves;
       ++st.articulated_solves;
       d.swept = true;

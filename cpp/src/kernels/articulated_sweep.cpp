@@ -113,7 +113,6 @@ void ArticulatedSweep::plan(const Model& m, const ConstraintEval& ce) {
   resp_vd_.assign(kMaxExtraRows, VecX::Zero(m.nv));
   resp_delta_.assign(kMaxExtraRows, VecX::Zero(m.nc));
   load_ = VecX::Zero(m.nv);
-  zero_xi_ = VecX::Zero(m.nc);
   extra_rows_.reserve(kMaxExtraRows);
   ok_ = true;
 }
@@ -299,19 +298,25 @@ void ArticulatedSweep::bias(const ConstraintEval& ce, const VecX& xi, size_t k) 
   }
 }
 
-void ArticulatedSweep::sweep(const ConstraintEval& ce, const VecX& xi, const VecX& eta, VecX& vd,
-                             VecX& delta) {
+void ArticulatedSweep::sweep(const ConstraintEval& ce, const VecX* xi, const VecX& eta, VecX& vd,
+                             VecX* delta) {
+  backward(ce, xi, eta);
+  forward(ce, xi != nullptr, vd, delta);
+}
+
+// the bias forces, children first: I^A b + p^A with the child's free directions taken out,
+// passed to the parent (b = 0 without row values xi: a response)
+void ArticulatedSweep::backward(const ConstraintEval& ce, const VecX* xi, const VecX& eta) {
   const int nb = static_cast<int>(pa_.size());
   for (int i = 0; i < nb; ++i) pa_[i] = -eta.segment<6>(6 * i);
   Vec6 t;
   for (size_t k = steps_.size(); k-- > 0;) {
     const Step& s = steps_[k];
     const int nf = 6 - s.nk;
-    bias(ce, xi, k);
+    if (xi) bias(ce, *xi, k);
     if (s.parent == kGround) continue;
-    // I^A b + p^A with the child's free directions taken out
-    t.noalias() = ia_[s.child] * b_[k];
-    t += pa_[s.child];
+    t = pa_[s.child];
+    if (xi) t.noalias() += ia_[s.child] * b_[k];
     if (nf == 1) {
       t.noalias() -= (dinv_[k](0, 0) * s_[k].col(0).dot(t)) * u_[k].col(0);
     } else if (nf > 1) {
@@ -323,39 +328,51 @@ void ArticulatedSweep::sweep(const ConstraintEval& ce, const VecX& xi, const Vec
     pp.head<3>() += t.head<3>();
     pp.tail<3>().noalias() += x_[k].transpose() * t.head<3>() + y_[k].transpose() * t.tail<3>();
   }
-  Vec6 a;
+}
+
+// the accelerations, parents first; with delta, the multipliers delta = -P^T (I^A vdot + p^A).
+// The free directions' accelerations s = -D^-1 S^T (I^A a + p^A) = -D^-1 (U^T a + S^T p^A)
+// (I^A symmetric, U = I^A S): without multipliers I^A a is never formed.
+void ArticulatedSweep::forward(const ConstraintEval& ce, bool with_bias, VecX& vd, VecX* delta) {
+  Vec6 a, t;
   for (size_t k = 0; k < steps_.size(); ++k) {
     const Step& s = steps_[k];
     const int nf = 6 - s.nk;
-    a = b_[k];
+    if (with_bias)
+      a = b_[k];
+    else
+      a.setZero();
     if (s.parent != kGround) {
       const auto vp = vd.segment<6>(6 * s.parent);
       a.head<3>().noalias() += vp.head<3>() + x_[k] * vp.tail<3>();
       a.tail<3>().noalias() += y_[k] * vp.tail<3>();
     }
-    t.noalias() = ia_[s.child] * a;
-    t += pa_[s.child];
+    const Vec6& p = pa_[s.child];
+    if (delta) {
+      t.noalias() = ia_[s.child] * a;
+      t += p;
+    }
     if (nf == 1) {
-      const double sv = -dinv_[k](0, 0) * s_[k].col(0).dot(t);
+      const double sv = -dinv_[k](0, 0) * (u_[k].col(0).dot(a) + s_[k].col(0).dot(p));
       a.noalias() += sv * s_[k].col(0);
-      t.noalias() += sv * u_[k].col(0);
+      if (delta) t.noalias() += sv * u_[k].col(0);
     } else if (nf > 1) {
-      const artic_detail::SmallVec st = s_[k].leftCols(nf).transpose() * t;
+      const artic_detail::SmallVec st =
+          u_[k].leftCols(nf).transpose() * a + s_[k].leftCols(nf).transpose() * p;
       const artic_detail::SmallVec sv = -(dinv_[k].topLeftCorner(nf, nf) * st);
       a.noalias() += s_[k].leftCols(nf) * sv;
-      t.noalias() += u_[k].leftCols(nf) * sv;
+      if (delta) t.noalias() += u_[k].leftCols(nf) * sv;
     }
     vd.segment<6>(6 * s.child) = a;
-    if (s.nk == 0) continue;
-    // delta = -P^T (I^A vdot + p^A)
+    if (!delta || s.nk == 0) continue;
     const int r0 = ce.blocks[s.block].row0;
     if (s.point) {
-      delta.segment<3>(r0) = -t.head<3>();
+      delta->segment<3>(r0) = -t.head<3>();
       const Vec3 w = t.tail<3>() - bm_[k].transpose() * t.head<3>();
-      for (int r = 3; r < s.nk; ++r) delta[r0 + r] = -ci_[k].col(r - 3).dot(w);
+      for (int r = 3; r < s.nk; ++r) (*delta)[r0 + r] = -ci_[k].col(r - 3).dot(w);
     } else {
       const Vec6 d = -tinv_[k].transpose() * t;
-      delta.segment(r0, s.nk) = d.head(s.nk);
+      delta->segment(r0, s.nk) = d.head(s.nk);
     }
   }
 }
@@ -370,7 +387,7 @@ double row_times(const ConstraintBlock& b, int r, const VecX& v) {
 }
 }  // namespace artic_detail
 
-bool ArticulatedSweep::extra_rows(const ConstraintEval& ce, int nrows, VecX& vd, VecX& delta) {
+bool ArticulatedSweep::extra_rows(const ConstraintEval& ce, int nrows, VecX& vd, VecX* delta) {
   const int ne = static_cast<int>(extra_rows_.size());
   if (ne == 0) return true;
   // E Vd mu = -xi_E - E vd0
@@ -389,19 +406,18 @@ bool ArticulatedSweep::extra_rows(const ConstraintEval& ce, int nrows, VecX& vd,
   const auto d = lu.matrixLU().diagonal().cwiseAbs();
   if (!(d.minCoeff() > 1e-12 * d.maxCoeff())) return false;
   const artic_detail::SmallVec mu = lu.solve(rhs);
-  for (int e = 0; e < ne; ++e) {
-    vd.noalias() += mu[e] * resp_vd_[e];
-    delta.head(nrows).noalias() += mu[e] * resp_delta_[e].head(nrows);
-  }
-  for (int e = 0; e < ne; ++e) delta[extra_rows_[e]] = mu[e];
+  for (int e = 0; e < ne; ++e) vd.noalias() += mu[e] * resp_vd_[e];
+  if (!delta) return true;
+  for (int e = 0; e < ne; ++e) delta->head(nrows).noalias() += mu[e] * resp_delta_[e].head(nrows);
+  for (int e = 0; e < ne; ++e) (*delta)[extra_rows_[e]] = mu[e];
   return true;
 }
 
 bool ArticulatedSweep::solve(const Model& m, const std::vector<BodyKin>& kin,
                              const ConstraintEval& ce, int nrows, const VecX& eta, VecX& vd,
-                             VecX& delta, bool reuse, long kkt_factors) {
+                             VecX& delta, bool reuse, long kkt_factors, bool multipliers) {
   if (!ok_) return false;
-  if (!(reuse && factored(nrows, kkt_factors))) {
+  if (!(reuse && factored(nrows, kkt_factors) && (resp_multipliers_ || !multipliers))) {
     factored_rows_ = -1;
     extra_rows_.clear();
     for (int bi : extra_blocks_) {
@@ -423,19 +439,21 @@ bool ArticulatedSweep::solve(const Model& m, const std::vector<BodyKin>& kin,
         for (int k = 0; k < b.nbody; ++k)
           if (b.body[k] != kGround)
             load_.segment<6>(6 * b.body[k]) = -b.J.row(r).segment<6>(6 * k).transpose();
-        resp_delta_[e].setZero();
-        sweep(ce, zero_xi_, load_, resp_vd_[e], resp_delta_[e]);
+        if (multipliers) resp_delta_[e].setZero();
+        sweep(ce, nullptr, load_, resp_vd_[e], multipliers ? &resp_delta_[e] : nullptr);
       }
     }
+    resp_multipliers_ = multipliers;
     factored_rows_ = nrows;
     kkt_factors_ = kkt_factors;
   }
-  sweep(ce, ce.xi, eta, vd, delta);
-  if (!extra_rows(ce, nrows, vd, delta)) {
+  VecX* out = multipliers ? &delta : nullptr;
+  sweep(ce, &ce.xi, eta, vd, out);
+  if (!extra_rows(ce, nrows, vd, out)) {
     factored_rows_ = -1;
     return false;
   }
-  return vd.allFinite() && delta.head(nrows).allFinite();
+  return vd.allFinite() && (!multipliers || delta.head(nrows).allFinite());
 }
 
 }  // namespace armdyn

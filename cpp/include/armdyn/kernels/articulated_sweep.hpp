@@ -48,12 +48,14 @@ class ArticulatedSweep {
     return factored_rows_ == nrows && kkt_factors_ == kkt_factors;
   }
   /// vdot and delta (rows [0, nrows)) from the evaluated constraints (with xi) and eta; when
-  /// reuse, the factor of the last call (same pose, same rows) is kept. Returns false, leaving
+  /// reuse, the factor of the last call (same pose, same rows) is kept. Without multipliers
+  /// delta is left as it was (forward dynamics needs vdot only). Returns false, leaving
   /// vdot and delta unspecified, when a joint's completed block is singular to working
   /// precision, the extra rows are too many or dependent, or a result is not finite: the caller
   /// then takes the KKT path, which diagnoses it.
   bool solve(const Model& m, const std::vector<BodyKin>& kin, const ConstraintEval& ce, int nrows,
-             const VecX& eta, VecX& vdot, VecX& delta, bool reuse, long kkt_factors);
+             const VecX& eta, VecX& vdot, VecX& delta, bool reuse, long kkt_factors,
+             bool multipliers = true);
 
  private:
   struct Step {
@@ -77,8 +79,9 @@ class ArticulatedSweep {
   std::vector<Vec6> pa_;
   // the extra rows' responses: per extra row, vdot and delta
   std::vector<VecX> resp_vd_, resp_delta_;
-  VecX load_, zero_xi_;
-  std::vector<int> extra_rows_;  // the extra rows in [0, nrows), this solve's
+  VecX load_;
+  bool resp_multipliers_ = false;  // the responses carry their multipliers
+  std::vector<int> extra_rows_;    // the extra rows in [0, nrows), this solve's
   int factored_rows_ = -1;
   long kkt_factors_ = -1;
   bool ok_ = false;
@@ -88,10 +91,13 @@ class ArticulatedSweep {
                       const Step& s, Mat6& T) const;
   void point_block(const Model& m, const std::vector<BodyKin>& kin, const ConstraintEval& ce,
                    const Step& s, Mat3& B, Mat3& C) const;
-  /// The bias pass and the forward pass for loads eta and row values xi (tree rows only).
-  void sweep(const ConstraintEval& ce, const VecX& xi, const VecX& eta, VecX& vdot, VecX& delta);
+  /// The bias pass and the forward pass for loads eta and row values xi (tree rows only; none:
+  /// a response, zero row values); the multipliers when delta is given.
+  void sweep(const ConstraintEval& ce, const VecX* xi, const VecX& eta, VecX& vdot, VecX* delta);
+  void backward(const ConstraintEval& ce, const VecX* xi, const VecX& eta);
+  void forward(const ConstraintEval& ce, bool with_bias, VecX& vdot, VecX* delta);
   void bias(const ConstraintEval& ce, const VecX& xi, size_t k);
-  bool extra_rows(const ConstraintEval& ce, int nrows, VecX& vdot, VecX& delta);
+  bool extra_rows(const ConstraintEval& ce, int nrows, VecX& vdot, VecX* delta);
 };
 
 }  // namespace armdyn
