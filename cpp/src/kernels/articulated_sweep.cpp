@@ -127,9 +127,6 @@ bool ArticulatedSweep::complete_block(const Model& m, const std::vector<BodyKin>
   const Joint& j = m.joints[s.joint];
   const Vec3 z = kin[j.child].R * j.frame_child.col(2);
   switch (s.type) {
-    case JointType::Prismatic:
-      T.row(5).head<3>() = z;
-      return true;
     case JointType::Cylindrical:
       T.row(4).tail<3>() = j.frame_child.col(2);
       T.row(5).head<3>() = z;
@@ -140,6 +137,29 @@ bool ArticulatedSweep::complete_block(const Model& m, const std::vector<BodyKin>
     default:
       return false;
   }
+}
+
+// A prismatic joint's T^-1 without forming T: its rows are three rotation locks [0 W], two
+// on-axis rows [L_xy K_xy] and the slide [z^T 0] (z the child's joint axis in world), so with
+// L = [L_xy; z^T] and K = [K_xy; 0], T^-1 = [-L^-1 K W^-1, L^-1; W^-1, 0] (invert_block's split,
+// its columns in the rows' order)
+bool ArticulatedSweep::slide_block_inverse(const Model& m, const std::vector<BodyKin>& kin,
+                                           const ConstraintEval& ce, const Step& s,
+                                           Mat6& Ti) const {
+  const BlockMat& J = ce.blocks[s.block].J;
+  const Joint& j = m.joints[s.joint];
+  Mat3 L, K, W, Li, Wi;
+  W = J.block<3, 3>(0, 9);
+  L.topRows<2>() = J.block<2, 3>(3, 6);
+  L.row(2) = (kin[j.child].R * j.frame_child.col(2)).transpose();
+  K.topRows<2>() = J.block<2, 3>(3, 9);
+  K.row(2).setZero();
+  if (!inverse3_checked(L, Li) || !inverse3_checked(W, Wi)) return false;
+  Ti.topLeftCorner<3, 3>().noalias() = -Li * K * Wi;
+  Ti.bottomLeftCorner<3, 3>() = Wi;
+  Ti.topRightCorner<3, 3>() = Li;
+  Ti.bottomRightCorner<3, 3>().setZero();
+  return true;
 }
 
 // A point joint's T = [I B; 0 C]: B (the point rows' angular columns) and C (the rotation rows'
@@ -196,14 +216,18 @@ Mat3 point_product(int K, const Mat3& Ci, const BlockMat& J, int col) {
   }
 }
 
-// M += A^T Ia A for A = [I X; 0 Y] (a point joint's transport)
+// M += A^T Ia A for A = [I X; 0 Y] (a point joint's transport): with Z = [X; Y] (6 x 3) and
+// W = Ia Z, A^T Ia A = [Ia_11, W_top; W_top^T, Z^T W] (the 6-row products vectorise)
 void add_congruence(const Mat6& Ia, const Mat3& X, const Mat3& Y, Mat6& M) {
-  const Mat3 N = Ia.topLeftCorner<3, 3>() * X + Ia.topRightCorner<3, 3>() * Y;
-  const Mat3 Q = Ia.bottomLeftCorner<3, 3>() * X + Ia.bottomRightCorner<3, 3>() * Y;
+  Eigen::Matrix<double, 6, 3> Z;
+  Z.topRows<3>() = X;
+  Z.bottomRows<3>() = Y;
+  Eigen::Matrix<double, 6, 3> W;
+  W.noalias() = Ia * Z;
   M.topLeftCorner<3, 3>() += Ia.topLeftCorner<3, 3>();
-  M.topRightCorner<3, 3>() += N;
-  M.bottomLeftCorner<3, 3>() += N.transpose();
-  M.bottomRightCorner<3, 3>().noalias() += X.transpose() * N + Y.transpose() * Q;
+  M.topRightCorner<3, 3>() += W.topRows<3>();
+  M.bottomLeftCorner<3, 3>() += W.topRows<3>().transpose();
+  M.bottomRightCorner<3, 3>().noalias() += Z.transpose() * W;
 }
 
 }  // namespace artic_detail
@@ -229,8 +253,11 @@ bool ArticulatedSweep::factor(const Model& m, const std::vector<BodyKin>& kin,
       S.topLeftCorner(3, nf).noalias() = -bm_[k] * ci_[k].rightCols(nf);
       S.bottomLeftCorner(3, nf) = ci_[k].rightCols(nf);
     } else {
-      if (!complete_block(m, kin, ce, s, T) || !artic_detail::invert_block(T, tinv_[k]))
+      if (s.type == JointType::Prismatic) {
+        if (!slide_block_inverse(m, kin, ce, s, tinv_[k])) return false;
+      } else if (!complete_block(m, kin, ce, s, T) || !artic_detail::invert_block(T, tinv_[k])) {
         return false;
+      }
       S.leftCols(nf) = tinv_[k].rightCols(nf);
       tinv_[k].rightCols(nf).setZero();  // P, padded to 6 x 6
     }
@@ -453,7 +480,9 @@ bool ArticulatedSweep::solve(const Model& m, const std::vector<BodyKin>& kin,
     factored_rows_ = -1;
     return false;
   }
-  return vd.allFinite() && (!multipliers || delta.head(nrows).allFinite());
+  // a sum is finite only if every term is (an overflowing sum, never reached by physical
+  // accelerations, only sends the solve to the KKT path)
+  return std::isfinite(vd.sum()) && (!multipliers || std::isfinite(delta.head(nrows).sum()));
 }
 
 }  // namespace armdyn

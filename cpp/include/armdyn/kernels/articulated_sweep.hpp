@@ -89,6 +89,8 @@ class ArticulatedSweep {
   bool factor(const Model& m, const std::vector<BodyKin>& kin, const ConstraintEval& ce);
   bool complete_block(const Model& m, const std::vector<BodyKin>& kin, const ConstraintEval& ce,
                       const Step& s, Mat6& T) const;
+  bool slide_block_inverse(const Model& m, const std::vector<BodyKin>& kin,
+                           const ConstraintEval& ce, const Step& s, Mat6& Ti) const;
   void point_block(const Model& m, const std::vector<BodyKin>& kin, const ConstraintEval& ce,
                    const Step& s, Mat3& B, Mat3& C) const;
   /// The bias pass and the forward pass for loads eta and row values xi (tree rows only; none:
