@@ -250,26 +250,42 @@ bool ArticulatedSweep::factor(const Model& m, const std::vector<BodyKin>& kin,
       Mat3 C;
       point_block(m, kin, ce, s, bm_[k], C);
       if (!inverse3_checked(C, ci_[k])) return false;
-      S.topLeftCorner(3, nf).noalias() = -bm_[k] * ci_[k].rightCols(nf);
-      S.bottomLeftCorner(3, nf) = ci_[k].rightCols(nf);
+      if (nf == 1) {  // revolute: the last column
+        S.col(0).head<3>().noalias() = -bm_[k] * ci_[k].col(2);
+        S.col(0).tail<3>() = ci_[k].col(2);
+      } else {
+        S.topLeftCorner(3, nf).noalias() = -bm_[k] * ci_[k].rightCols(nf);
+        S.bottomLeftCorner(3, nf) = ci_[k].rightCols(nf);
+      }
     } else {
       if (s.type == JointType::Prismatic) {
         if (!slide_block_inverse(m, kin, ce, s, tinv_[k])) return false;
       } else if (!complete_block(m, kin, ce, s, T) || !artic_detail::invert_block(T, tinv_[k])) {
         return false;
       }
-      S.leftCols(nf) = tinv_[k].rightCols(nf);
-      tinv_[k].rightCols(nf).setZero();  // P, padded to 6 x 6
+      if (nf == 1) {
+        S.col(0) = tinv_[k].col(5);
+        tinv_[k].col(5).setZero();
+      } else {
+        S.leftCols(nf) = tinv_[k].rightCols(nf);
+        tinv_[k].rightCols(nf).setZero();  // P, padded to 6 x 6
+      }
     }
+    // U = I^A S, D = S^T U; the child's inertia with its free directions taken out,
+    // I^A - U D^-1 U^T, passes to the parent
     const Mat6& I = ia_[s.child];
-    Ia = I;
+    const bool to_parent = s.parent != kGround;
     if (nf == 1) {
-      u_[k].col(0).noalias() = I * S.col(0);
-      const double D = S.col(0).dot(u_[k].col(0));
+      const Vec6 u = I * S.col(0);
+      u_[k].col(0) = u;
+      const double D = S.col(0).dot(u);
       if (!(D > 0.0) || !std::isfinite(D)) return false;
       dinv_[k](0, 0) = 1.0 / D;
-      const Vec6 u = u_[k].col(0), w = u / D;
-      Ia.noalias() -= w.lazyProduct(u.transpose());
+      if (to_parent) {
+        const Vec6 w = u / D;
+        Ia = I;
+        Ia.noalias() -= w.lazyProduct(u.transpose());
+      }
     } else if (nf > 1) {
       u_[k].leftCols(nf).noalias() = I * S.leftCols(nf);
       artic_detail::SmallMat D = S.leftCols(nf).transpose() * u_[k].leftCols(nf);
@@ -277,7 +293,12 @@ bool ArticulatedSweep::factor(const Model& m, const std::vector<BodyKin>& kin,
       if (llt.info() != Eigen::Success) return false;
       const artic_detail::SmallMat Di = llt.solve(artic_detail::SmallMat::Identity(nf, nf));
       dinv_[k].topLeftCorner(nf, nf) = Di;
-      Ia.noalias() -= u_[k].leftCols(nf) * Di * u_[k].leftCols(nf).transpose();
+      if (to_parent) {
+        Ia = I;
+        Ia.noalias() -= u_[k].leftCols(nf) * Di * u_[k].leftCols(nf).transpose();
+      }
+    } else if (to_parent) {
+      Ia = I;
     }
     if (s.parent == kGround) continue;
     // A = -P Z_p moves the child with the parent, the joint held; A + S M for any M does as
@@ -291,8 +312,14 @@ bool ArticulatedSweep::factor(const Model& m, const std::vector<BodyKin>& kin,
       y_[k] = -G;
       x_[k].noalias() = bm_[k] * G - b.J.block<3, 3>(0, 3);
     } else if (s.nk > 0) {
-      Eigen::Matrix<double, 6, 3> Zp = Eigen::Matrix<double, 6, 3>::Zero();
-      Zp.topRows(s.nk) = b.J.block(0, 3, s.nk, 3);
+      Eigen::Matrix<double, 6, 3> Zp;
+      if (s.nk == 5) {
+        Zp.topRows<5>() = b.J.block<5, 3>(0, 3);
+        Zp.row(5).setZero();
+      } else {
+        Zp.setZero();
+        Zp.topRows(s.nk) = b.J.block(0, 3, s.nk, 3);
+      }
       const Eigen::Matrix<double, 6, 3> XY = -tinv_[k] * Zp;
       x_[k] = XY.topRows<3>();
       y_[k] = XY.bottomRows<3>();
