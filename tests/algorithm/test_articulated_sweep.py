@@ -178,12 +178,89 @@ def test_couplings_and_a_partial_drive_match_dense():
 
 
 def test_geared_arm_with_ideal_gears_matches_dense():
-    # 44 bodies, ideal gears between motor, gear and link bodies: gear rows outside the tree's
-    # joints (more of them than the sweep takes as extra rows: it hands over to the KKT path,
-    # which gives the dense answer all the same)
+    # 18 bodies, ideal gears between motor, gear and link bodies: gear rows outside the tree's
+    # joints, each on a body and some of its children (a group) or handed to the KKT path
     model = geared_arm_6dof(n_motors=1, backlash=0.0)
     u, v = moving_state(model, 11)
     assert_matches_dense(model, u, v)
+    a, b = run_pair(model, 0.02)
+    assert np.max(np.abs(a.u - b.u)) <= 1e-11
+    fa, fb = a.gear_forces["force"], b.gear_forces["force"]
+    assert np.max(np.abs(fa - fb)) <= 1e-9 * np.max(np.abs(fb))
+
+
+def hand_with_fingers(kind="prismatic", fingers=2, base="arm"):
+    """An arm on a skew hinge (or the fingers straight on ground: base="ground"), a hand, and
+    fingers on the hand, the second (and third) coupled to the first (URDF <mimic>): coupling
+    rows on the hand and its children only, a group of the sweep."""
+    b = ad.ModelBuilder()
+    parent = "ground"
+    if base == "arm":
+        b.add_body("arm", 1.0, np.diag([0.01, 0.02, 0.02]), position=(0.5, 0, 0))
+        b.add_revolute("shoulder", "ground", "arm", (0, 0, 0), (0, 0.6, 0.8))
+        b.add_body("hand", 0.7, np.diag([0.003, 0.004, 0.005]), position=(1.1, 0.05, 0))
+        b.add_revolute("wrist", "arm", "hand", (1.0, 0, 0), (0.6, 0, 0.8))
+        parent = "hand"
+    mult = [None, -1.0, 0.5]
+    for i in range(fingers):
+        y = 0.05 * (i - 1)
+        b.add_body(f"f{i}", 0.1 + 0.05 * i, np.diag([1e-4, 2e-4, 3e-4]), position=(1.3, y, 0.02))
+        if kind == "prismatic":
+            b.add_prismatic(f"s{i}", parent, f"f{i}", (1.2, y, 0), (0, 1 if i % 2 else -1, 0.2))
+        else:
+            b.add_revolute(f"s{i}", parent, f"f{i}", (1.2, y, 0), (0.3, 0.1 * i, 1))
+        if i:
+            b.add_coupling(f"mimic{i}", f"s{i}", "s0", mult[i], 0.01 * i)
+    return b.finalize()
+
+
+@pytest.mark.parametrize(
+    "kind, fingers, base",
+    [
+        ("prismatic", 2, "arm"),  # mimic fingers on a hand: one row, the fast path
+        ("revolute", 2, "arm"),
+        ("revolute", 2, "ground"),  # the group's body is ground
+        ("revolute", 3, "arm"),  # two rows on one hand: the general path
+        ("prismatic", 3, "ground"),
+    ],
+)
+def test_rows_on_a_body_and_its_children_match_dense(kind, fingers, base):
+    model = hand_with_fingers(kind, fingers, base)
+    u, v = moving_state(model, 13)
+    _, delta = assert_matches_dense(model, u, v)
+    assert np.max(np.abs(delta[-(fingers - 1) :])) > 1e-3  # the couplings carry force
+    a, b = run_pair(model, 0.2)
+    assert np.max(np.abs(a.u - b.u)) <= 1e-12
+    scale = max(1.0, np.max(np.abs(b.reaction_forces)))
+    assert np.max(np.abs(a.reaction_forces - b.reaction_forces)) <= 1e-9 * scale
+    # joint level: the Cartesian forward dynamics against joint space (CRBA on the independent
+    # coordinates), off the assembly pose
+    rng = np.random.default_rng(3)
+    for _ in range(3):
+        q, qd, tau = rng.uniform(-1, 1, size=(3, model.n_coords))
+        x = ad.forward_dynamics(model, q, qd, tau, method="cartesian")
+        y = ad.forward_dynamics(model, q, qd, tau, method="crba")
+        assert np.max(np.abs(x - y)) <= TOL * max(1.0, np.max(np.abs(y)))
+
+
+def test_groups_take_rows_the_responses_could_not():
+    # three couplings on three different bodies' children: beyond kMaxExtraRows (2) as
+    # responses, so before the groups the KKT path took every solve; now the sweep does
+    b = ad.ModelBuilder()
+    parent = "ground"
+    for i in range(3):
+        b.add_body(f"l{i}", 1.0, np.diag([0.01, 0.02, 0.03]), position=(0.4 * i + 0.2, 0, 0))
+        b.add_revolute(f"j{i}", parent, f"l{i}", (0.4 * i, 0, 0), (0, 0, 1) if i % 2 else (0, 1, 0))
+        b.add_body(f"r{i}", 0.2, np.diag([1e-3, 1e-3, 2e-3]), position=(0.4 * i + 0.1, 0.1, 0))
+        b.add_revolute(f"m{i}", parent, f"r{i}", (0.4 * i + 0.1, 0.1, 0), (0, 0, 1))
+        b.add_coupling(f"g{i}", f"m{i}", f"j{i}", -20.0)  # a motor's rotor through a gear
+        parent = f"l{i}"
+    model = b.finalize()
+    u, v = moving_state(model, 17)
+    assert_matches_dense(model, u, v)
+    a, _ = run_pair(model, 0.05)
+    # at least one stage of every step on the sweep (the others reuse a projection's factor)
+    assert a.stats["articulated_solves"] >= a.stats["steps"] > 0
 
 
 def test_limit_stops_and_the_reused_factor_match_dense():

@@ -96,6 +96,7 @@ void ArticulatedSweep::plan(const Model& m, const ConstraintEval& ce) {
     }
     steps_.push_back(s);
   }
+  plan_groups(m, ce, joint_block);  // marks the groups' blocks too
   for (int b = 0; b < static_cast<int>(ce.blocks.size()); ++b)
     if (!joint_block[b]) extra_blocks_.push_back(b);
   const size_t n = steps_.size();
@@ -300,36 +301,49 @@ bool ArticulatedSweep::factor(const Model& m, const std::vector<BodyKin>& kin,
     } else if (to_parent) {
       Ia = I;
     }
-    if (s.parent == kGround) continue;
-    // A = -P Z_p moves the child with the parent, the joint held; A + S M for any M does as
-    // well (s absorbs it, and Ia S = 0): with M = C's linear columns, A = [I X; 0 Y] for every
-    // joint type (the rows' linear columns are opposite on parent and child), [X; Y] = -P Z_p's
-    // angular columns
-    const ConstraintBlock& b = ce.blocks[s.block];
-    if (s.point) {
-      // Z_p = [-I K; 0 W]: Y = -C^-1[:, :nk-3] W, X = -K - B Y
-      const Mat3 G = artic_detail::point_product(s.nk - 3, ci_[k], b.J, 3);
-      y_[k] = -G;
-      x_[k].noalias() = bm_[k] * G - b.J.block<3, 3>(0, 3);
-    } else if (s.nk > 0) {
-      Eigen::Matrix<double, 6, 3> Zp;
-      if (s.nk == 5) {
-        Zp.topRows<5>() = b.J.block<5, 3>(0, 3);
-        Zp.row(5).setZero();
-      } else {
-        Zp.setZero();
-        Zp.topRows(s.nk) = b.J.block(0, 3, s.nk, 3);
-      }
-      const Eigen::Matrix<double, 6, 3> XY = -tinv_[k] * Zp;
-      x_[k] = XY.topRows<3>();
-      y_[k] = XY.bottomRows<3>();
-    } else {
-      x_[k].setZero();
-      y_[k].setZero();
+    if (s.parent != kGround) {
+      transport(ce, k);
+      artic_detail::add_congruence(Ia, x_[k], y_[k], ia_[s.parent]);
     }
-    artic_detail::add_congruence(Ia, x_[k], y_[k], ia_[s.parent]);
+    // a group's rank-r update once its members are done (its trigger is their first step)
+    const int gi = step_group_[k];
+    if (gi >= 0 && groups_[gi].on && static_cast<int>(k) == groups_[gi].trigger &&
+        !factor_group(ce, groups_[gi]))
+      return false;
   }
   return true;
+}
+
+void ArticulatedSweep::transport(const ConstraintEval& ce, size_t k) {
+  const Step& s = steps_[k];
+  // A = -P Z_p moves the child with the parent, the joint held; A + S M for any M does as
+  // well (s absorbs it, and Ia S = 0): with M = C's linear columns, A = [I X; 0 Y] for every
+  // joint type (the rows' linear columns are opposite on parent and child), [X; Y] = -P Z_p's
+  // angular columns (none for a free joint, whose parent is ground)
+  if (s.nk == 0) {
+    x_[k].setZero();
+    y_[k].setZero();
+    return;
+  }
+  const ConstraintBlock& b = ce.blocks[s.block];
+  if (s.point) {
+    // Z_p = [-I K; 0 W]: Y = -C^-1[:, :nk-3] W, X = -K - B Y
+    const Mat3 G = artic_detail::point_product(s.nk - 3, ci_[k], b.J, 3);
+    y_[k] = -G;
+    x_[k].noalias() = bm_[k] * G - b.J.block<3, 3>(0, 3);
+  } else if (s.nk > 0) {
+    Eigen::Matrix<double, 6, 3> Zp;
+    if (s.nk == 5) {
+      Zp.topRows<5>() = b.J.block<5, 3>(0, 3);
+      Zp.row(5).setZero();
+    } else {
+      Zp.setZero();
+      Zp.topRows(s.nk) = b.J.block(0, 3, s.nk, 3);
+    }
+    const Eigen::Matrix<double, 6, 3> XY = -tinv_[k] * Zp;
+    x_[k] = XY.topRows<3>();
+    y_[k] = XY.bottomRows<3>();
+  }
 }
 
 // b = -P xi_j: the child's acceleration with the parent at rest and the free directions still
@@ -368,6 +382,10 @@ void ArticulatedSweep::backward(const ConstraintEval& ce, const VecX* xi, const 
     const Step& s = steps_[k];
     const int nf = 6 - s.nk;
     if (xi) bias(ce, *xi, k);
+    const int gi = step_group_[k];
+    if (gi >= 0 && groups_[gi].on && static_cast<int>(k) == groups_[gi].trigger) {
+      backward_group(ce, xi, groups_[gi]);  // reads the members' b and p^A before the passing
+    }
     if (s.parent == kGround) continue;
     t = pa_[s.child];
     if (xi) t.noalias() += ia_[s.child] * b_[k];
@@ -392,6 +410,10 @@ void ArticulatedSweep::forward(const ConstraintEval& ce, bool with_bias, VecX& v
   for (size_t k = 0; k < steps_.size(); ++k) {
     const Step& s = steps_[k];
     const int nf = 6 - s.nk;
+    // a group member's load includes its rows' forces E_i^T mu (mu from the group's trigger)
+    const int gi = step_group_[k];
+    const bool member = gi >= 0 && groups_[gi].on;
+    if (member && static_cast<int>(k) == groups_[gi].trigger) forward_group(ce, groups_[gi], vd);
     if (with_bias)
       a = b_[k];
     else
@@ -401,7 +423,13 @@ void ArticulatedSweep::forward(const ConstraintEval& ce, bool with_bias, VecX& v
       a.head<3>().noalias() += vp.head<3>() + x_[k] * vp.tail<3>();
       a.tail<3>().noalias() += y_[k] * vp.tail<3>();
     }
-    const Vec6& p = pa_[s.child];
+    Vec6 pm;
+    const Vec6* pp = &pa_[s.child];
+    if (member) {
+      pm = *pp + ext_[k];
+      pp = &pm;
+    }
+    const Vec6& p = *pp;
     if (delta) {
       t.noalias() = ia_[s.child] * a;
       t += p;
@@ -418,16 +446,30 @@ void ArticulatedSweep::forward(const ConstraintEval& ce, bool with_bias, VecX& v
       if (delta) t.noalias() += u_[k].leftCols(nf) * sv;
     }
     vd.segment<6>(6 * s.child) = a;
-    if (!delta || s.nk == 0) continue;
-    const int r0 = ce.blocks[s.block].row0;
-    if (s.point) {
-      delta->segment<3>(r0) = -t.head<3>();
-      const Vec3 w = t.tail<3>() - bm_[k].transpose() * t.head<3>();
-      for (int r = 3; r < s.nk; ++r) (*delta)[r0 + r] = -ci_[k].col(r - 3).dot(w);
-    } else {
-      const Vec6 d = -tinv_[k].transpose() * t;
-      delta->segment(r0, s.nk) = d.head(s.nk);
-    }
+    if (delta) member_multipliers(ce, k, t, *delta);
+  }
+  if (!delta) return;
+  for (const Group& g : groups_) {
+    if (!g.on) continue;
+    int j = 0;
+    for (int bi : g.blocks)
+      for (int r = 0; r < ce.blocks[bi].nrows; ++r) (*delta)[ce.blocks[bi].row0 + r] = g.mu[j++];
+  }
+}
+
+// delta = -P^T t for the joint of step k, t = I^A vdot + p^A (+ the group rows' E^T mu)
+void ArticulatedSweep::member_multipliers(const ConstraintEval& ce, size_t k, const Vec6& t,
+                                          VecX& delta) const {
+  const Step& s = steps_[k];
+  if (s.nk == 0) return;
+  const int r0 = ce.blocks[s.block].row0;
+  if (s.point) {
+    delta.segment<3>(r0) = -t.head<3>();
+    const Vec3 w = t.tail<3>() - bm_[k].transpose() * t.head<3>();
+    for (int r = 3; r < s.nk; ++r) delta[r0 + r] = -ci_[k].col(r - 3).dot(w);
+  } else {
+    const Vec6 d = -tinv_[k].transpose() * t;
+    delta.segment(r0, s.nk) = d.head(s.nk);
   }
 }
 
@@ -474,6 +516,7 @@ bool ArticulatedSweep::solve(const Model& m, const std::vector<BodyKin>& kin,
   if (!(reuse && factored(nrows, kkt_factors) && (resp_multipliers_ || !multipliers))) {
     factored_rows_ = -1;
     extra_rows_.clear();
+    if (!groups_for_rows(ce, nrows)) return false;
     for (int bi : extra_blocks_) {
       const ConstraintBlock& b = ce.blocks[bi];
       if (b.row0 >= nrows) continue;
