@@ -81,6 +81,7 @@ void reset_pipeline(Data& d) {
   d.nrows = d.model->nc;
   d.aux = nullptr;
   d.joint_torques = nullptr;
+  d.joint_q = d.joint_qd = nullptr;
   d.with_coordinate_forces = true;
   d.track_ref.setZero();
   d.swept = false;

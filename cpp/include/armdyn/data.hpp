@@ -116,6 +116,11 @@ class Data {
   /// Joint-space generalised forces (n: the floating bases' wrenches, then the coordinates')
   /// added to eta by cartesian_forces; nullptr: none.
   const double* joint_torques = nullptr;
+  /// With joint_torques: the joint-space q and qd (sizes nq_joint, nv_joint) of the loaded
+  /// state, which the joint-coordinate forces and gear pairs then read instead of the
+  /// coordinates' jets (no angles from atan2); nullptr: from the jets.
+  const double* joint_q = nullptr;
+  const double* joint_qd = nullptr;
   /// false: cartesian_forces leaves out the joint-coordinate forces and gear pairs (a
   /// joint-space caller adds them to its generalised forces directly).
   bool with_coordinate_forces = true;

@@ -53,7 +53,7 @@ void forward_cartesian(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen:
   struct Settings {
     Data& d;
     ~Settings() {
-      d.joint_torques = nullptr;
+      d.joint_torques = d.joint_q = d.joint_qd = nullptr;
       d.nrows = d.model->nc;
       d.multipliers = true;
     }
@@ -64,6 +64,9 @@ void forward_cartesian(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen:
   d.augmented = false;  // each call decides afresh: the result never depends on earlier calls
   d.with_coordinate_forces = true;
   d.joint_torques = d.tau_in.data();
+  // the coordinate forces read the call's q and qd (the loaded state's coordinates)
+  d.joint_q = q.data();
+  d.joint_qd = qd.data();
   load_joint_kinematics(m, d, q, qd);
   d.tau_in = tau;
   body_accelerations_loaded(m, d, t, d.vd.data());

@@ -10,34 +10,39 @@ namespace armdyn {
 
 namespace {
 
-// write one scalar constraint row into block row r
+// write one scalar constraint row into block row r (all 12 columns; rhs stays 0 from init)
 inline void put_row(ConstraintEval& ce, ConstraintBlock& b, int r, const ScalarJet& s,
                     bool with_xi) {
   ce.f[b.row0 + r] = s.val;
-  ce.rhs[b.row0 + r] = 0.0;
   b.J.row(r).head<12>() = s.J;
   if (with_xi) ce.xi[b.row0 + r] = s.bias;
 }
 
+// block row r: a parent axis p dotted with a child axis q (the jet of dot_axes), written in
+// place; its translational columns are zero from init and stay so
+inline void put_axes_row(ConstraintEval& ce, ConstraintBlock& b, int r, const AxisJet& p,
+                         const AxisJet& q, const Mat3& Ra, const Mat3& Rb, bool with_xi) {
+  ce.f[b.row0 + r] = p.val.dot(q.val);
+  const Eigen::Matrix<double, 1, 3> c = p.val.cross(q.val).transpose();
+  auto row = b.J.row(r);
+  row.segment<3>(3).noalias() = c * Ra;
+  row.segment<3>(9).noalias() = -c * Rb;
+  if (with_xi) ce.xi[b.row0 + r] = p.bias.dot(q.val) + 2.0 * p.rate.dot(q.rate) + p.val.dot(q.bias);
+}
+
 // the three rows x_b + R_b s_b - x_a - R_a s_a = 0 (coincident joint points) in block rows 0..2:
-// Jacobian [-I, skew(r_a) R_a | I, -skew(r_b) R_b] with the world levers r = R s
+// Jacobian [-I, skew(r_a) R_a | I, -skew(r_b) R_b] with the world levers r = R s (the constant
+// -I and I written once by init)
 inline void put_point_rows(ConstraintEval& ce, ConstraintBlock& b, const BodyKin& ka,
                            const BodyKin& kb, const SepJet& d, bool with_xi) {
-  Mat3 Ma, Mb;
   for (int c = 0; c < 3; ++c) {
-    Ma.col(c) = d.ra.cross(ka.R.col(c));
-    Mb.col(c) = kb.R.col(c).cross(d.rb);
+    const Vec3 ma = d.ra.cross(ka.R.col(c)), mb = kb.R.col(c).cross(d.rb);
+    for (int k = 0; k < 3; ++k) {
+      b.J(k, 3 + c) = ma[k];
+      b.J(k, 9 + c) = mb[k];
+    }
   }
-  for (int k = 0; k < 3; ++k) {
-    auto row = b.J.row(k);
-    row.head<12>().setZero();
-    row[k] = -1.0;
-    row.segment<3>(3) = Ma.row(k);
-    row[6 + k] = 1.0;
-    row.segment<3>(9) = Mb.row(k);
-    ce.f[b.row0 + k] = d.val[k];
-    ce.rhs[b.row0 + k] = 0.0;
-  }
+  ce.f.segment<3>(b.row0) = d.val;
   if (with_xi) ce.xi.segment<3>(b.row0) = d.bias;
 }
 
@@ -66,8 +71,15 @@ void ConstraintEval::init(const Model& m) {
     const int r = joint_rows(j.type);
     if (r == 0) continue;
     add_block(j.row0, r, j.parent, j.child);
-    blocks.back().point_rows = j.type == JointType::Spherical || j.type == JointType::Revolute ||
-                               j.type == JointType::Universal || j.type == JointType::Fixed;
+    ConstraintBlock& b = blocks.back();
+    b.point_rows = j.type == JointType::Spherical || j.type == JointType::Revolute ||
+                   j.type == JointType::Universal || j.type == JointType::Fixed;
+    // the point rows' constant translational columns (eval_constraints writes the rest)
+    if (b.point_rows)
+      for (int k = 0; k < 3; ++k) {
+        b.J(k, k) = -1.0;
+        b.J(k, 6 + k) = 1.0;
+      }
   }
   for (const GearConstraint& g : m.gear_constraints) add_block_n(g.row, 1, gear_bodies(m, g));
   for (const Drive& d : m.drives) {
@@ -99,9 +111,6 @@ inline void eval_joint_rows(const Joint& j, const BodyKin& ka, const BodyKin& kb
   auto pa = [&](int k) { return axis_jet(ka, j.frame_parent.col(k)); };
   auto pb = [&](int k) { return axis_jet(kb, j.frame_child.col(k)); };
   // a parent axis dotted with a child axis, or with the separation
-  auto axes_row = [&](int r, const AxisJet& p, const AxisJet& q) {
-    put_row(ce, b, r, dot_axes(p, ka.R, q, kb.R), with_xi);
-  };
   // the child's joint point on the parent's joint axis line: no separation along the
   // parent's x and y axes (2 rows from row r)
   auto on_axis_rows = [&](int r) {
@@ -128,21 +137,21 @@ inline void eval_joint_rows(const Joint& j, const BodyKin& ka, const BodyKin& kb
     case JointType::Cylindrical: {
       // child x and y axes perpendicular to the parent's z axis
       const AxisJet za = pa(2);
-      axes_row(r++, za, pb(0));
-      axes_row(r++, za, pb(1));
+      put_axes_row(ce, b, r++, za, pb(0), ka.R, kb.R, with_xi);
+      put_axes_row(ce, b, r++, za, pb(1), ka.R, kb.R, with_xi);
       if (j.type == JointType::Cylindrical) r = on_axis_rows(r);
       break;
     }
     case JointType::Universal:
-      axes_row(r++, pa(2), pb(2));
+      put_axes_row(ce, b, r++, pa(2), pb(2), ka.R, kb.R, with_xi);
       break;
     case JointType::Fixed:
     case JointType::Prismatic: {
       // relative rotation locked: z_a.x_b = z_a.y_b = x_a.y_b = 0
       const AxisJet za = pa(2), yb = pb(1);
-      axes_row(r++, za, pb(0));
-      axes_row(r++, za, yb);
-      axes_row(r++, pa(0), yb);
+      put_axes_row(ce, b, r++, za, pb(0), ka.R, kb.R, with_xi);
+      put_axes_row(ce, b, r++, za, yb, ka.R, kb.R, with_xi);
+      put_axes_row(ce, b, r++, pa(0), yb, ka.R, kb.R, with_xi);
       if (j.type == JointType::Prismatic) r = on_axis_rows(r);  // sliding along z_a only
       break;
     }

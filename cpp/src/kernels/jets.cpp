@@ -27,10 +27,7 @@ void body_kinematics(const Model& m, const double* u, const double* v, std::vect
   }
 }
 
-const BodyKin& kin_of(const std::vector<BodyKin>& kin, int b) {
-  static const BodyKin ground{};
-  return b == kGround ? ground : kin[b];
-}
+const BodyKin kGroundKin{};
 
 namespace {
 // (R^T (arm x n))^T: n^T times the angular block -skew(arm) R
@@ -153,40 +150,45 @@ double coord_value(const Model& m, const std::vector<BodyKin>& kin, int coord) {
   return (ka.R * jt.frame_parent.col(2)).dot(d);
 }
 
-ScalarJet coord_jet(const Model& m, const std::vector<BodyKin>& kin, int coord, bool value) {
+void coord_jet_into(const Model& m, const std::vector<BodyKin>& kin, int coord, bool value,
+                    ScalarJet& t) {
   const Coord& c = m.coords[coord];
-  if (c.angular) {
-    // angle of the child frame's x axis in the parent frame's (x, y) plane
-    const Joint& jt = m.joints[c.joint];
-    const BodyKin& ka = kin_of(kin, jt.parent);
-    const BodyKin& kb = kin_of(kin, jt.child);
-    const AxisJet xa = axis_jet(ka, jt.frame_parent.col(0));
-    const AxisJet ya = axis_jet(ka, jt.frame_parent.col(1));
-    const AxisJet xb = axis_jet(kb, jt.frame_child.col(0));
-    // theta = atan2(s, c) with s = ya . xb, c = xa . xb: theta' = (c s' - s c') / r^2 and
-    // bias (c s_bias - s c_bias) / r^2 - 2 theta' (c c' + s s') / r^2; the two dot products'
-    // Jacobians (dot_axes) folded into one R^T product per side
-    const double sv = ya.val.dot(xb.val), cv = xa.val.dot(xb.val);
-    const double sr = ya.rate.dot(xb.val) + ya.val.dot(xb.rate);
-    const double cr = xa.rate.dot(xb.val) + xa.val.dot(xb.rate);
-    const double sb = ya.bias.dot(xb.val) + 2.0 * ya.rate.dot(xb.rate) + ya.val.dot(xb.bias);
-    const double cb = xa.bias.dot(xb.val) + 2.0 * xa.rate.dot(xb.rate) + xa.val.dot(xb.bias);
-    const double ir2 = 1.0 / (sv * sv + cv * cv);
-    ScalarJet t;
-    t.val = value ? std::atan2(sv, cv) : 0.0;
-    t.rate = (cv * sr - sv * cr) * ir2;
-    t.bias = (cv * sb - sv * cb) * ir2 - 2.0 * t.rate * (cv * cr + sv * sr) * ir2;
-    const Vec3 g = ((cv * ir2) * ya.val - (sv * ir2) * xa.val).cross(xb.val);
-    t.J.segment<3>(3) = (ka.R.transpose() * g).transpose();
-    t.J.segment<3>(9) = -(kb.R.transpose() * g).transpose();
-    return t;
-  }
-  // displacement along the parent's joint axis
   const Joint& jt = m.joints[c.joint];
   const BodyKin& ka = kin_of(kin, jt.parent);
   const BodyKin& kb = kin_of(kin, jt.child);
-  return dot_axis_sep(axis_jet(ka, jt.frame_parent.col(2)), ka.R,
-                      sep_jet(ka, jt.point_parent, kb, jt.point_child), kb.R);
+  if (!c.angular) {
+    // displacement along the parent's joint axis
+    t = dot_axis_sep(axis_jet(ka, jt.frame_parent.col(2)), ka.R,
+                     sep_jet(ka, jt.point_parent, kb, jt.point_child), kb.R);
+    return;
+  }
+  // angle of the child frame's x axis in the parent frame's (x, y) plane
+  const AxisJet xa = axis_jet(ka, jt.frame_parent.col(0));
+  const AxisJet ya = axis_jet(ka, jt.frame_parent.col(1));
+  const AxisJet xb = axis_jet(kb, jt.frame_child.col(0));
+  // theta = atan2(s, c) with s = ya . xb, c = xa . xb: theta' = (c s' - s c') / r^2 and
+  // bias (c s_bias - s c_bias) / r^2 - 2 theta' (c c' + s s') / r^2; the two dot products'
+  // Jacobians (dot_axes) folded into one R^T product per side
+  const double sv = ya.val.dot(xb.val), cv = xa.val.dot(xb.val);
+  const double sr = ya.rate.dot(xb.val) + ya.val.dot(xb.rate);
+  const double cr = xa.rate.dot(xb.val) + xa.val.dot(xb.rate);
+  const double sb = ya.bias.dot(xb.val) + 2.0 * ya.rate.dot(xb.rate) + ya.val.dot(xb.bias);
+  const double cb = xa.bias.dot(xb.val) + 2.0 * xa.rate.dot(xb.rate) + xa.val.dot(xb.bias);
+  const double ir2 = 1.0 / (sv * sv + cv * cv);
+  t.val = value ? std::atan2(sv, cv) : 0.0;
+  t.rate = (cv * sr - sv * cr) * ir2;
+  t.bias = (cv * sb - sv * cb) * ir2 - 2.0 * t.rate * (cv * cr + sv * sr) * ir2;
+  const Vec3 g = ((cv * ir2) * ya.val - (sv * ir2) * xa.val).cross(xb.val);
+  t.J.segment<3>(0).setZero();
+  t.J.segment<3>(3).noalias() = g.transpose() * ka.R;
+  t.J.segment<3>(6).setZero();
+  t.J.segment<3>(9).noalias() = -g.transpose() * kb.R;
+}
+
+ScalarJet coord_jet(const Model& m, const std::vector<BodyKin>& kin, int coord, bool value) {
+  ScalarJet t;
+  coord_jet_into(m, kin, coord, value, t);
+  return t;
 }
 
 }  // namespace armdyn

@@ -47,8 +47,12 @@ struct ScalarJet {
 /// Fill kin (size nb) from u (nq) and v (nv). Quaternions are used as given (not normalised).
 void body_kinematics(const Model& m, const double* u, const double* v, std::vector<BodyKin>& kin);
 
+/// Ground's kinematics: the identity pose at rest.
+extern const BodyKin kGroundKin;
 /// Kinematics of ground or of body b (b = kGround gives the identity pose at rest).
-const BodyKin& kin_of(const std::vector<BodyKin>& kin, int b);
+inline const BodyKin& kin_of(const std::vector<BodyKin>& kin, int b) {
+  return b == kGround ? kGroundKin : kin[b];
+}
 
 /// World direction R_b a of a vector a fixed in body b, placed in Jacobian slot (0 or 1).
 VecJet direction_jet(const BodyKin& k, const Vec3& a, int slot);
@@ -97,6 +101,9 @@ ScalarJet dot_axis_sep(const AxisJet& p, const Mat3& Ra, const SepJet& d, const 
 /// joint's (parent, child).
 /// value = false skips the angle itself (rate, Jacobian and bias only).
 ScalarJet coord_jet(const Model& m, const std::vector<BodyKin>& kin, int coord, bool value = true);
+/// coord_jet into t (no temporary).
+void coord_jet_into(const Model& m, const std::vector<BodyKin>& kin, int coord, bool value,
+                    ScalarJet& t);
 /// The value of coord_jet alone (positions only: no rates, Jacobian or bias).
 double coord_value(const Model& m, const std::vector<BodyKin>& kin, int coord);
 
