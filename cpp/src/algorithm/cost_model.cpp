@@ -14,13 +14,13 @@ namespace armdyn {
 const CostConstants& cost_constants() {
   // measured by `python -m benchmarks.cost_model` (benchmarks/results/cost_model.json)
   // measured on 2026-11-29 (2-core VM, Release build, spatial chains of 1 to 400 links, the
-  // Cartesian forward dynamics of trees on the articulated sweep; the largest relative misfit of
-  // the fits is 8 % (Cartesian) to 23 % (CRBA): noise of a shared machine and cache effects
-  // beyond 300 links)
-  static const CostConstants k{/*c0*/ 0.08105,       /*c_body*/ 0.1318, /*c_path*/ 0.002508,
-                               /*c_chol*/ 0.0001145, /*a0*/ 0.0004758,  /*a_body*/ 0.185,
-                               /*k0*/ 0.0,           /*k_body*/ 0.3873, /*j0*/ 0.0,
-                               /*j_body*/ 0.285,     /*s0*/ 0.0,        /*s_body*/ 0.6799};
+  // Cartesian forward dynamics of trees on the articulated sweep without its multipliers; the
+  // largest relative misfit of the fits is 3 % (Cartesian) to 23 % (CRBA): noise of a shared
+  // machine and cache effects beyond 300 links)
+  static const CostConstants k{/*c0*/ 0.08896,       /*c_body*/ 0.1334, /*c_path*/ 0.002699,
+                               /*c_chol*/ 0.0001262, /*a0*/ 0.0206,     /*a_body*/ 0.1818,
+                               /*k0*/ 0.01455,       /*k_body*/ 0.3205, /*j0*/ 0.0,
+                               /*j_body*/ 0.2696,    /*s0*/ 0.0,        /*s_body*/ 0.6096};
   return k;
 }
 
