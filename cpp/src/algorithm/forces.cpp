@@ -74,8 +74,8 @@ double coord_actuation_value(const CoordForce& cf, bool angular, double q, doubl
 
 double coord_force_value(const CoordForce& cf, bool angular, double q, double qdot, double t,
                          double z, double* zdot) {
-  const double dq = angular ? wrap_angle(q - cf.rest) : q - cf.rest;
-  double tau = -cf.stiffness * dq - cf.damping * qdot;
+  double tau = -cf.damping * qdot;
+  if (cf.stiffness != 0.0) tau -= cf.stiffness * (angular ? wrap_angle(q - cf.rest) : q - cf.rest);
   if (cf.coulomb > 0) tau -= cf.coulomb * std::tanh(qdot / cf.v_smooth);
   if (cf.has_input) tau += cf.input.eval(t).y;
   if (cf.motor)
