@@ -189,10 +189,11 @@ def test_geared_arm_with_ideal_gears_matches_dense():
     assert np.max(np.abs(fa - fb)) <= 1e-9 * np.max(np.abs(fb))
 
 
-def hand_with_fingers(kind="prismatic", fingers=2, base="arm"):
+def hand_with_fingers(kind="prismatic", fingers=2, base="arm", drive=False):
     """An arm on a skew hinge (or the fingers straight on ground: base="ground"), a hand, and
     fingers on the hand, the second (and third) coupled to the first (URDF <mimic>): coupling
-    rows on the hand and its children only, a group of the sweep."""
+    rows on the hand and its children only, a group of the sweep; optionally the shoulder
+    driven (a row outside the group, solved through its response)."""
     b = ad.ModelBuilder()
     parent = "ground"
     if base == "arm":
@@ -211,6 +212,8 @@ def hand_with_fingers(kind="prismatic", fingers=2, base="arm"):
             b.add_revolute(f"s{i}", parent, f"f{i}", (1.2, y, 0), (0.3, 0.1 * i, 1))
         if i:
             b.add_coupling(f"mimic{i}", f"s{i}", "s0", mult[i], 0.01 * i)
+    if drive:
+        b.add_drive("shoulder", ad.profiles.sine(0.3, 1.5))
     return b.finalize()
 
 
@@ -241,6 +244,18 @@ def test_rows_on_a_body_and_its_children_match_dense(kind, fingers, base):
         x = ad.forward_dynamics(model, q, qd, tau, method="cartesian")
         y = ad.forward_dynamics(model, q, qd, tau, method="crba")
         assert np.max(np.abs(x - y)) <= TOL * max(1.0, np.max(np.abs(y)))
+
+
+def test_a_group_and_a_drive_response_together_match_dense():
+    # the drive's row is solved through its response sweep, which passes through the fingers'
+    # group with no row values; the drive's force and the couplings' against the dense path
+    model = hand_with_fingers("prismatic", 3, "arm", drive=True)
+    u, v = moving_state(model, 19)
+    assert_matches_dense(model, u, v, t=0.2)
+    a, ref = run_pair(model, 0.2)
+    assert np.max(np.abs(a.u - ref.u)) <= 1e-12
+    scale = max(1.0, np.max(np.abs(ref.drive_forces)))
+    assert np.max(np.abs(a.drive_forces - ref.drive_forces)) <= 1e-9 * scale
 
 
 def test_groups_take_rows_the_responses_could_not():
