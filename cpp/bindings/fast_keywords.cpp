@@ -44,7 +44,9 @@ long param_index(const py::detail::function_record& rec, PyObject* key) {
   }
   for (size_t j = 0; j < rec.args.size(); ++j) {
     const char* name = rec.args[j].name;
-    if (name && std::strncmp(name, s, static_cast<size_t>(len)) == 0 && name[len] == '\0')
+    // whole-string equality (a keyword may hold a NUL: its length decides, not strcmp's)
+    if (name && std::strlen(name) == static_cast<size_t>(len) &&
+        std::memcmp(name, s, static_cast<size_t>(len)) == 0)
       return static_cast<long>(j);
   }
   return -1;

@@ -138,3 +138,32 @@ def test_functions_stay_builtins_that_pickle_and_introspect():
         "data",
     ]
     assert f.__doc__.startswith("forward_dynamics(model: ")
+
+
+class _Name(str):
+    """A str subclass as a keyword name (allowed by CPython in **kwargs)."""
+
+
+def test_hostile_keyword_names(model):
+    q, qd, tau = _state(model)
+    ref = ad.forward_dynamics(model, q, qd, tau, 0.0, "aba")
+    # a str subclass naming a real parameter is that parameter
+    np.testing.assert_array_equal(
+        ad.forward_dynamics(model, q, qd, tau, **{_Name("method"): "aba"}), ref
+    )
+    bad = [
+        {"méthode": "aba"},  # non-ASCII
+        {"method" * 10_000: "aba"},  # huge
+        {"meth\x00od": "aba"},  # an embedded NUL: not "method"
+        {"t\x00x": 0.0},  # nor "t" (a C-string comparison would stop at the NUL)
+        {f"k{i}": i for i in range(1000)},  # many unknown keywords
+        {"": 1},  # empty
+    ]
+    for kw in bad:
+        with pytest.raises(TypeError, match="incompatible function arguments"):
+            ad.forward_dynamics(model, q, qd, tau, **kw)
+    # every parameter by keyword, and one too many
+    full = {"model": model, "q": q, "qd": qd, "tau": tau, "t": 0.0, "method": "aba", "data": None}
+    np.testing.assert_array_equal(ad.forward_dynamics(**full), ref)
+    with pytest.raises(TypeError, match="incompatible function arguments"):
+        ad.forward_dynamics(**full, extra=1)
