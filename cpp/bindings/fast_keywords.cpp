@@ -3,15 +3,16 @@
 //
 // pybind11 (3.1) matches a call's keywords by interning every parameter name from its C string
 // on every call, once per positional argument (to reject a keyword that repeats one) and once per
-// remaining parameter: about 0.4 us per call of forward_dynamics(model, q, qd, tau,
-// method="cartesian"), a fifth of the whole call on a 6-joint arm (`python -m
-// benchmarks.cartesian_fd`, "keywords" in the JSON). Here each module-level function with one
-// overload and plain parameters gets its own vectorcall: the keywords are matched against the
-// function record's names, the gaps filled with the record's defaults, and pybind11's dispatcher
-// is called with positional arguments only, so its argument loading, conversions, checks and
-// error messages are its own. Anything this does not handle with certainty (an unknown, repeated
-// or positional-only keyword, a gap without a default, more than kMaxParams parameters) goes
-// through pybind11's own path unchanged, which raises its usual TypeError.
+// remaining parameter: 0.44 us per call of forward_dynamics(model, q, qd, tau,
+// method="cartesian") on the UR5 (`python -m benchmarks.cartesian_fd`, keyword_us in the JSON,
+// with fast_keyword not applied). Each module-level function with one overload and plain
+// parameters gets, in its PyMethodDef, a function of its own in the place of pybind11's
+// dispatcher: the keywords are matched against the function record's names, the gaps filled
+// with the record's defaults, and the dispatcher is called with positional arguments only, so
+// its argument loading, conversions, checks and error messages are its own. Anything this does not
+// handle with certainty (an unknown, repeated or positional-only keyword, a gap without a default,
+// more than kMaxParams parameters) goes through pybind11's own path unchanged, which raises its
+// usual TypeError.
 #include <pybind11/pybind11.h>
 
 #include <algorithm>
@@ -99,24 +100,16 @@ bool eligible(PyObject* f) {
 
 }  // namespace fast_kw
 
-void fast_keywords(const py::module_& m) {
-  const std::string mod = m.attr("__name__").cast<std::string>();
-  for (auto item : m.attr("__dict__").cast<py::dict>()) {
-    PyObject* v = item.second.ptr();
-    if (PyModule_Check(v)) {
-      if (py::handle(v).attr("__name__").cast<std::string>().rfind(mod + ".", 0) == 0)
-        fast_keywords(py::reinterpret_borrow<py::module_>(v));
-    } else if (fast_kw::eligible(v)) {
-      PyMethodDef* def = reinterpret_cast<PyCFunctionObject*>(v)->m_ml;
-      const auto meth =
-          reinterpret_cast<fast_kw::Dispatcher>(reinterpret_cast<void (*)()>(def->ml_meth));
-      if (meth == reinterpret_cast<fast_kw::Dispatcher>(fast_kw::call_with_keywords)) continue;
-      if (!fast_kw::dispatch) fast_kw::dispatch = meth;
-      if (meth != fast_kw::dispatch) continue;  // not pybind11's dispatcher
-      def->ml_meth =
-          reinterpret_cast<PyCFunction>(reinterpret_cast<void (*)()>(fast_kw::call_with_keywords));
-    }
-  }
+void fast_keyword(PyObject* f) {
+  if (!fast_kw::eligible(f)) return;
+  PyMethodDef* def = reinterpret_cast<PyCFunctionObject*>(f)->m_ml;
+  const auto meth =
+      reinterpret_cast<fast_kw::Dispatcher>(reinterpret_cast<void (*)()>(def->ml_meth));
+  if (meth == reinterpret_cast<fast_kw::Dispatcher>(fast_kw::call_with_keywords)) return;
+  if (!fast_kw::dispatch) fast_kw::dispatch = meth;
+  if (meth != fast_kw::dispatch) return;  // not pybind11's dispatcher
+  def->ml_meth =
+      reinterpret_cast<PyCFunction>(reinterpret_cast<void (*)()>(fast_kw::call_with_keywords));
 }
 
 }  // namespace armdyn

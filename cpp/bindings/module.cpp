@@ -28,7 +28,7 @@ void bind_frames(py::module_& m);
 void bind_derivatives(py::module_& m);
 void bind_regressor(py::module_& m);
 void bind_parameter_model(py::module_& m);
-void fast_keywords(const py::module_& m);
+void fast_keyword(PyObject* f);  // fast_keywords.cpp: keywords matched before pybind11
 }  // namespace armdyn
 
 namespace {
@@ -151,13 +151,15 @@ void add_text_signature(PyObject* f, const py::handle& literal_eval) {
   def->ml_doc = copy;
 }
 
-void add_text_signatures(const py::module_& m, const py::handle& literal_eval) {
+// every compiled function of m and its submodules: its text signature; the module-level ones
+// also their keywords matched by armdyn (fast_keywords.cpp)
+void finish_functions(const py::module_& m, const py::handle& literal_eval) {
   const std::string mod = m.attr("__name__").cast<std::string>();
   for (auto item : m.attr("__dict__").cast<py::dict>()) {
     py::handle v = item.second;
     if (PyModule_Check(v.ptr())) {
       if (v.attr("__name__").cast<std::string>().rfind(mod + ".", 0) == 0)
-        add_text_signatures(py::reinterpret_borrow<py::module_>(v), literal_eval);
+        finish_functions(py::reinterpret_borrow<py::module_>(v), literal_eval);
     } else if (PyType_Check(v.ptr())) {
       if (!py::hasattr(v, "__module__") || v.attr("__module__").cast<std::string>() != mod)
         continue;
@@ -173,6 +175,7 @@ void add_text_signatures(const py::module_& m, const py::handle& literal_eval) {
       }
     } else {
       add_text_signature(v.ptr(), literal_eval);
+      armdyn::fast_keyword(v.ptr());
     }
   }
 }
@@ -230,6 +233,5 @@ PYBIND11_MODULE(_core, m) {
   armdyn::bind_derivatives(m);
   armdyn::bind_regressor(m);
   armdyn::bind_parameter_model(m);
-  add_text_signatures(m, py::module_::import("ast").attr("literal_eval"));
-  armdyn::fast_keywords(m);  // last: the functions as bound
+  finish_functions(m, py::module_::import("ast").attr("literal_eval"));
 }

@@ -119,10 +119,7 @@ def test_every_joint_type_matches_dense(joint_type, floating):
     vd, _ = assert_matches_dense(model, u, v)
     assert np.max(np.abs(vd)) > 0.1  # gravity and the motion load it
     # and along a run: fixed steps, so both paths take the same steps
-    a, b = run_pair(model, 0.2)
-    assert np.max(np.abs(a.u - b.u)) <= 1e-12
-    scale = max(1.0, np.max(np.abs(b.reaction_forces)))
-    assert np.max(np.abs(a.reaction_forces - b.reaction_forces)) <= 1e-9 * scale
+    assert_run_matches_dense(model, 0.2, lambda r: r.reaction_forces)
 
 
 def chain(n=5, coupling=False, drive=False, limits=False):
@@ -159,15 +156,20 @@ def run_pair(model, t_end, **kw):
     return a, b
 
 
+def assert_run_matches_dense(model, t_end, output):
+    """run_pair's two runs: the same states to 1e-12 and output(result) to 1e-9 relative."""
+    a, b = run_pair(model, t_end)
+    assert np.max(np.abs(a.u - b.u)) <= 1e-12
+    fa, fb = output(a), output(b)
+    assert np.max(np.abs(fa - fb)) <= 1e-9 * max(1.0, np.max(np.abs(fb)))
+
+
 def test_couplings_and_a_partial_drive_match_dense():
     model = chain(coupling=True, drive=True)
     u, v = moving_state(model, 3)
     # the drive's velocity row does not hold on this state: the solve does not need it to
     assert_matches_dense(model, u, v, t=0.3)
-    a, b = run_pair(model, 0.5)
-    assert np.max(np.abs(a.u - b.u)) <= 1e-12
-    scale = max(1.0, np.max(np.abs(b.drive_forces)))
-    assert np.max(np.abs(a.drive_forces - b.drive_forces)) <= 1e-9 * scale
+    assert_run_matches_dense(model, 0.5, lambda r: r.drive_forces)
     # the coupled model's joint-level forward dynamics: Cartesian against joint space
     cm = chain(coupling=True)
     rng = np.random.default_rng(5)
@@ -232,10 +234,7 @@ def test_rows_on_a_body_and_its_children_match_dense(kind, fingers, base):
     u, v = moving_state(model, 13)
     _, delta = assert_matches_dense(model, u, v)
     assert np.max(np.abs(delta[-(fingers - 1) :])) > 1e-3  # the couplings carry force
-    a, b = run_pair(model, 0.2)
-    assert np.max(np.abs(a.u - b.u)) <= 1e-12
-    scale = max(1.0, np.max(np.abs(b.reaction_forces)))
-    assert np.max(np.abs(a.reaction_forces - b.reaction_forces)) <= 1e-9 * scale
+    assert_run_matches_dense(model, 0.2, lambda r: r.reaction_forces)
     # joint level: the Cartesian forward dynamics against joint space (CRBA on the independent
     # coordinates), off the assembly pose
     rng = np.random.default_rng(3)
@@ -248,14 +247,11 @@ def test_rows_on_a_body_and_its_children_match_dense(kind, fingers, base):
 
 def test_a_group_and_a_drive_response_together_match_dense():
     # the drive's row is solved through its response sweep, which passes through the fingers'
-    # group with no row values; the drive's force and the couplings' against the dense path
+    # group with no row values; the couplings' and the drive's forces against the dense path
     model = hand_with_fingers("prismatic", 3, "arm", drive=True)
     u, v = moving_state(model, 19)
     assert_matches_dense(model, u, v, t=0.2)
-    a, ref = run_pair(model, 0.2)
-    assert np.max(np.abs(a.u - ref.u)) <= 1e-12
-    scale = max(1.0, np.max(np.abs(ref.drive_forces)))
-    assert np.max(np.abs(a.drive_forces - ref.drive_forces)) <= 1e-9 * scale
+    assert_run_matches_dense(model, 0.2, lambda r: r.drive_forces)
 
 
 def test_groups_take_rows_the_responses_could_not():

@@ -11,14 +11,6 @@ namespace armdyn {
 
 namespace artic_group_detail {
 
-// A^T v for a transport A = [I X; 0 Y]
-Vec6 transport_transposed(const Mat3& X, const Mat3& Y, const Vec6& v) {
-  Vec6 r;
-  r.head<3>() = v.head<3>();
-  r.tail<3>().noalias() = X.transpose() * v.head<3>() + Y.transpose() * v.tail<3>();
-  return r;
-}
-
 // the slot of body x in block b, -1 if the block does not hold it
 int slot_in(const ConstraintBlock& b, int x) {
   for (int k = 0; k < b.nbody; ++k)
@@ -131,11 +123,12 @@ Vec6 ArticulatedSweep::free_part(size_t k, const Vec6& v, Vec6& dv) const {
 // C = E_p + sum_i E_i Q_i A_i (rows), H = sum_i E_i Phi_i E_i^T; p receives C^T H^-1 C. False
 // when H is not positive definite (the rows do not move the members' free directions)
 bool ArticulatedSweep::factor_group(const ConstraintEval& ce, Group& g) {
-  using artic_group_detail::transport_transposed;
+  using artic_detail::transport_transposed;
   if (g.simple) return factor_simple_group(ce, g);
   const int r = g.nrows;
-  // per row and member: S_i^T E^T and D_i^-1 S_i^T E^T
-  Vec6 se[kMaxGroupRows][kMaxGroupMembers], dse[kMaxGroupRows][kMaxGroupMembers];
+  // per row and member: S_i^T E^T (here) and D_i^-1 S_i^T E^T (kept for the sweeps)
+  Vec6 se[kMaxGroupRows][kMaxGroupMembers];
+  auto& dse = g.dse_rows;
   int j = 0;
   for (int bi : g.blocks) {
     const ConstraintBlock& b = ce.blocks[bi];
@@ -187,7 +180,7 @@ bool ArticulatedSweep::factor_group(const ConstraintEval& ce, Group& g) {
 // vector; H is accepted above 1e-14 of its terms' Cauchy-Schwarz bound (the row moves the
 // members' free directions)
 bool ArticulatedSweep::factor_simple_group(const ConstraintEval& ce, Group& g) {
-  using artic_group_detail::transport_transposed;
+  using artic_detail::transport_transposed;
   const ConstraintBlock& b = ce.blocks[g.blocks[0]];
   Vec6 col = Vec6::Zero();
   const int ps = g.parent == kGround ? -1 : artic_group_detail::slot_in(b, g.parent);
@@ -224,13 +217,22 @@ void ArticulatedSweep::backward_group(const ConstraintEval& ce, const VecX* xi, 
       double sh = s_[k].col(0).dot(pa_[steps_[k].child]);
       if (xi) {
         sh += u_[k].col(0).dot(b_[k]);
-        v += b.J.row(0).segment<6>(6 * g.slot[i]).dot(b_[k].transpose());
+        v += b.J.row(0).segment<6>(6 * g.slot[i]).dot(b_[k]);
       }
       v -= g.dse[i] * sh;
     }
     g.hc0[0] = v / g.h1;
     if (g.parent != kGround) pa_[g.parent].noalias() += g.hc0[0] * g.c1;
     return;
+  }
+  // per member S_i^T h_i = S_i^T p^A_i + U_i^T b_i, once; per row E_i b_i - (D_i^-1 S_i^T E_i)
+  // . S_i^T h_i
+  Vec6 sh[kMaxGroupMembers];
+  for (size_t i = 0; i < g.members.size(); ++i) {
+    const int k = g.members[i], nf = 6 - steps_[k].nk;
+    sh[i].setZero();
+    sh[i].head(nf).noalias() = s_[k].leftCols(nf).transpose() * pa_[steps_[k].child];
+    if (xi) sh[i].head(nf).noalias() += u_[k].leftCols(nf).transpose() * b_[k];
   }
   GroupVec c0(g.nrows);
   int j = 0;
@@ -239,19 +241,10 @@ void ArticulatedSweep::backward_group(const ConstraintEval& ce, const VecX* xi, 
     for (int row = 0; row < b.nrows; ++row, ++j) {
       double v = xi ? (*xi)[b.row0 + row] : 0.0;
       for (size_t i = 0; i < g.members.size(); ++i) {
-        const int k = g.members[i], c = steps_[k].child;
-        const int slot = artic_group_detail::slot_in(b, c);
+        const int slot = artic_group_detail::slot_in(b, steps_[g.members[i]].child);
         if (slot < 0) continue;
-        const Vec6 E = b.J.row(row).segment<6>(6 * slot).transpose();
-        Vec6 h = pa_[c];
-        if (xi) {
-          h.noalias() += ia_[c] * b_[k];
-          v += E.dot(b_[k]);
-        }
-        Vec6 dh, de;
-        free_part(k, h, dh);
-        const Vec6 se = free_part(k, E, de);
-        v -= se.dot(dh);
+        if (xi) v += b.J.row(row).segment<6>(6 * slot).dot(b_[g.members[i]]);
+        v -= g.dse_rows[j][i].dot(sh[i]);
       }
       c0[j] = v;
     }

@@ -298,12 +298,11 @@ bool ArticulatedSweep::factor(const Model& m, const std::vector<BodyKin>& kin,
         Ia = I;
         Ia.noalias() -= u_[k].leftCols(nf) * Di * u_[k].leftCols(nf).transpose();
       }
-    } else if (to_parent) {
-      Ia = I;
     }
     if (s.parent != kGround) {
       transport(ce, k);
-      artic_detail::add_congruence(Ia, x_[k], y_[k], ia_[s.parent]);
+      // (no free directions: the child's inertia passes whole)
+      artic_detail::add_congruence(nf == 0 ? I : Ia, x_[k], y_[k], ia_[s.parent]);
     }
     // a group's rank-r update once its members are done (its trigger is their first step)
     const int gi = step_group_[k];
@@ -396,9 +395,7 @@ void ArticulatedSweep::backward(const ConstraintEval& ce, const VecX* xi, const 
       const artic_detail::SmallVec w = dinv_[k].topLeftCorner(nf, nf) * st;
       t.noalias() -= u_[k].leftCols(nf) * w;
     }
-    Vec6& pp = pa_[s.parent];
-    pp.head<3>() += t.head<3>();
-    pp.tail<3>().noalias() += x_[k].transpose() * t.head<3>() + y_[k].transpose() * t.tail<3>();
+    pa_[s.parent] += artic_detail::transport_transposed(x_[k], y_[k], t);
   }
 }
 

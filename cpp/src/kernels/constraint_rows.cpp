@@ -18,8 +18,9 @@ inline void put_row(ConstraintEval& ce, ConstraintBlock& b, int r, const ScalarJ
   if (with_xi) ce.xi[b.row0 + r] = s.bias;
 }
 
-// block row r: a parent axis p dotted with a child axis q (the jet of dot_axes), written in
-// place; its translational columns are zero from init and stay so
+// block row r: p . q for p fixed in the parent (rotation Ra) and q fixed in the child (Rb),
+// written in place: d/dt (p . q) = omega_a . Ra^T (p x q) - omega_b . Rb^T (p x q), bias
+// p'' . q + 2 p' . q' + p . q''; its translational columns are zero from init and stay so
 inline void put_axes_row(ConstraintEval& ce, ConstraintBlock& b, int r, const AxisJet& p,
                          const AxisJet& q, const Mat3& Ra, const Mat3& Rb, bool with_xi) {
   ce.f[b.row0 + r] = p.val.dot(q.val);

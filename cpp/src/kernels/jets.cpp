@@ -168,7 +168,7 @@ void coord_jet_into(const Model& m, const std::vector<BodyKin>& kin, int coord, 
   const AxisJet xb = axis_jet(kb, jt.frame_child.col(0));
   // theta = atan2(s, c) with s = ya . xb, c = xa . xb: theta' = (c s' - s c') / r^2 and
   // bias (c s_bias - s c_bias) / r^2 - 2 theta' (c c' + s s') / r^2; the two dot products'
-  // Jacobians (dot_axes) folded into one R^T product per side
+  // Jacobians (as put_axes_row's in constraint_rows.cpp) folded into one R^T product per side
   const double sv = ya.val.dot(xb.val), cv = xa.val.dot(xb.val);
   const double sr = ya.rate.dot(xb.val) + ya.val.dot(xb.rate);
   const double cr = xa.rate.dot(xb.val) + xa.val.dot(xb.rate);

@@ -41,6 +41,13 @@ namespace armdyn {
 namespace artic_detail {
 /// M += A^T Ia A for a transport A = [I X; 0 Y]
 void add_congruence(const Mat6& Ia, const Mat3& X, const Mat3& Y, Mat6& M);
+/// A^T v for a transport A = [I X; 0 Y] (a child's wrench carried to its parent)
+inline Vec6 transport_transposed(const Mat3& X, const Mat3& Y, const Vec6& v) {
+  Vec6 r;
+  r.head<3>() = v.head<3>();
+  r.tail<3>().noalias() = X.transpose() * v.head<3>() + Y.transpose() * v.tail<3>();
+  return r;
+}
 }  // namespace artic_detail
 
 class ArticulatedSweep {
@@ -98,6 +105,7 @@ class ArticulatedSweep {
     // per factor: C, H^-1 C, H's factor; per sweep: H^-1 c0; per forward pass: mu
     GroupRows C, HiC;
     Eigen::LLT<GroupMat> H;
+    Vec6 dse_rows[kMaxGroupRows][kMaxGroupMembers];  // D_i^-1 S_i^T E_i^T per row and member
     GroupVec hc0, mu;
     // one row on one-direction children (a coupling, a gear: the common case), without the
     // dense algebra: the row's slot of each member, C^T, H, D_i^-1 S_i^T E_i^T

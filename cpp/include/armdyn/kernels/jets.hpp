@@ -73,20 +73,6 @@ inline AxisJet axis_jet(const BodyKin& k, const Vec3& a) {
   j.bias = k.W.cross(j.rate);
   return j;
 }
-/// p . q for p fixed in body A (slot 0, rotation Ra) and q fixed in body B (slot 1): the same
-/// jet as dot(direction_jet(A), direction_jet(B)); d/dt (p . q) = omega_A . Ra^T (p x q) -
-/// omega_B . Rb^T (p x q).
-inline ScalarJet dot_axes(const AxisJet& p, const Mat3& Ra, const AxisJet& q, const Mat3& Rb) {
-  ScalarJet s;
-  s.val = p.val.dot(q.val);
-  s.rate = p.rate.dot(q.val) + p.val.dot(q.rate);
-  s.bias = p.bias.dot(q.val) + 2.0 * p.rate.dot(q.rate) + p.val.dot(q.bias);
-  const Vec3 c = p.val.cross(q.val);
-  s.J.segment<3>(3) = (Ra.transpose() * c).transpose();
-  s.J.segment<3>(9) = -(Rb.transpose() * c).transpose();
-  return s;
-}
-
 /// The separation d = (x_b + R_b s_b) - (x_a + R_a s_a) of two body points, with its world
 /// levers r_a = R_a s_a and r_b = R_b s_b (Jacobian [-I, skew(r_a) R_a | I, -skew(r_b) R_b]).
 struct SepJet {
