@@ -117,8 +117,10 @@ class Data {
   /// added to eta by cartesian_forces; nullptr: none.
   const double* joint_torques = nullptr;
   /// With joint_torques: the joint-space q and qd (sizes nq_joint, nv_joint) of the loaded
-  /// state, which the joint-coordinate forces and gear pairs then read instead of the
-  /// coordinates' jets (no angles from atan2); nullptr: from the jets.
+  /// state, which was placed from them (so it is on every joint's manifold). The
+  /// joint-coordinate forces and gear pairs then read them instead of the coordinates' jets (no
+  /// angles from atan2), and revolute coordinates take their closed-form jets
+  /// (revolute_jet_on_manifold); nullptr: from the jets.
   const double* joint_q = nullptr;
   const double* joint_qd = nullptr;
   /// false: cartesian_forces leaves out the joint-coordinate forces and gear pairs (a

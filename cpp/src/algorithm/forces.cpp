@@ -216,16 +216,21 @@ void cartesian_forces(const Model& m, Data& d, double t) {
   // joint-space torques of a joint-space call
   if (d.joint_torques) {
     const double* tau = d.joint_torques + 6 * m.n_free;
+    // a state placed from joint coordinates is on every joint's manifold: revolute jets in
+    // closed form (revolute_jet_on_manifold)
+    const double* qd_joint = d.joint_q ? d.joint_qd + 6 * m.n_free : nullptr;
     for (int c = 0; c < static_cast<int>(m.coords.size()); ++c) {
       // (the coordinate forces' jet of this state when there is one: the same but its value)
       ScalarJet& q = d.tau_jets[c];
-      if (const ScalarJet* cached = d.jets.cached(c))
+      const Joint& j = m.joints[m.coords[c].joint];
+      if (qd_joint && j.type == JointType::Revolute)
+        revolute_jet_on_manifold(m, c, qd_joint[c], q);
+      else if (const ScalarJet* cached = d.jets.cached(c))
         q = *cached;
       else
         coord_jet_into(m, d.kin, c, false, q);
       const double tc = coord_tau_pending ? tau[c] + d.coord_tau[c] : tau[c];
       if (tc == 0.0) continue;
-      const Joint& j = m.joints[m.coords[c].joint];
       add_pair(d.eta, tc * q.J, j.parent, j.child);
     }
     // a floating base's wrench (force, torque in its frame's axes, at its origin P)

@@ -120,6 +120,24 @@ class CoordJetCache {
   unsigned long now_ = 1;
 };
 
+/// The jet (value left 0) of revolute coordinate c at a state on the joint's constraint
+/// manifold (bodies placed from joint coordinates), its rate qd given. There the joint axis is
+/// z = R_p z_p = R_c z_c (z_p, z_c: the axis in each body's frame, constant), the angle's rate is
+/// z . (omega_c - omega_p) and, omega_c - omega_p being parallel to z, its bias
+/// (omega_p x z) . (omega_c - omega_p) vanishes: J = [0, -z_p^T, 0, z_c^T] (angular velocities
+/// in body axes). The same second derivative as coord_jet's atan2 jet along every motion that
+/// keeps the joint's rows; off the manifold use coord_jet.
+inline void revolute_jet_on_manifold(const Model& m, int c, double qd, ScalarJet& t) {
+  const Joint& j = m.joints[m.coords[c].joint];
+  t.val = 0.0;
+  t.rate = qd;
+  t.bias = 0.0;
+  t.J.segment<3>(0).setZero();
+  t.J.segment<3>(3) = -j.frame_parent.col(2).transpose();
+  t.J.segment<3>(6).setZero();
+  t.J.segment<3>(9) = j.frame_child.col(2).transpose();
+}
+
 /// Acceleration of joint coordinate c from the Cartesian accelerations: J vdot + bias.
 inline double coord_acceleration(const Model& m, const ScalarJet& s, int c,
                                  const Eigen::Ref<const VecX>& vdot) {
