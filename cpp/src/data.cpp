@@ -84,6 +84,8 @@ void reset_pipeline(Data& d) {
   d.joint_q = d.joint_qd = nullptr;
   d.with_coordinate_forces = true;
   d.track_ref.setZero();
+  d.track_by_rates = false;
+  d.track_commit = Data::TrackCommit{};
   d.swept = false;
   d.augmented = false;
   d.stats = PipelineStats{};

@@ -4,6 +4,7 @@
 // nothing per call. One Data per thread: a Model is shared read-only, a Data is not.
 #pragma once
 
+#include <limits>
 #include <memory>
 #include <string>
 #include <utility>
@@ -134,6 +135,18 @@ class Data {
   std::vector<int> joint_block;  ///< per joint: its row block in ce.blocks (-1: no rows)
   CoordJetCache jets;            ///< coordinate jets at the loaded state (ce.coord_cache)
   VecX track_ref;  ///< (nco) unwrapped reference of the angle coordinates (ce.track_ref)
+  /// Angle tracking along a run in time (simulate sets track_by_rates): the last commit's
+  /// references, the angles' rates there and its time. project() at time t then first moves
+  /// track_ref on by rate * (t - t_commit), so the turn of an angle that moved more than half a
+  /// turn since the last projection (a fast rotor, a long step of a high-order integrator) is
+  /// taken from its rate, not from the nearest branch. Only while track_ref is still the
+  /// commit's (anything that sets track_ref otherwise falls back to the nearest branch).
+  struct TrackCommit {
+    VecX ref, rate;
+    double t = std::numeric_limits<double>::quiet_NaN();
+  };
+  bool track_by_rates = false;
+  TrackCommit track_commit;
   std::vector<ScalarJet> tau_jets;  ///< (nco) with joint_torques: each coordinate's jet (no value)
   VecX cq, cqd;                     ///< (nco) the coordinates the force laws read, from the jets
   KktSolver kkt;                    ///< the factor of the KKT system's Schur complement

@@ -43,6 +43,7 @@ DrivenSolver::DrivenSolver(const Model& m, Data& d, const char* who, double t0)
       v_save_(d.driven_solve.v_save),
       u_pred_(d.driven_solve.u_pred),
       track_save_(d.driven_solve.track_save),
+      track_by_rates_before_(d.track_by_rates),
       fkw_(d.driven_solve.fk) {
   check_data(m, d, who);
   if (m.mobility_driven > 0)
@@ -56,7 +57,13 @@ DrivenSolver::DrivenSolver(const Model& m, Data& d, const char* who, double t0)
                       std::pair{&u_pred_, long{m.nq}}})
     if (x->size() != n) *x = VecX::Zero(n);
   track_save_ = d.track_ref;
+  // a run in time: each angle's turn between two times follows its rate (a fast rotor may
+  // turn more than half a turn from one time to the next)
+  d.track_by_rates = true;
+  d.track_commit = Data::TrackCommit{};
 }
+
+DrivenSolver::~DrivenSolver() { d_.track_by_rates = track_by_rates_before_; }
 
 void DrivenSolver::predict(double t_from, double t, VecX& u, VecX& v, const VecX& vd) {
   if (fk_) {
@@ -102,16 +109,19 @@ void DrivenSolver::solve(double t, VecX& u, VecX& v, VecX& vd, double& rf, doubl
     u_save_ = u;
     v_save_ = v;
     predict(t_prev_, t, u, v, vd);
+    track_save_ = d_.track_ref;
+    advance_tracking(m_, d_, t);
     body_accelerations(m_, d_, t, u.data(), v.data(), vd.data());
     loaded_residuals(m_, d_, v.data(), rf, rv);
     const double tol_f = 1e-13 * std::max(1.0, m_.length_scale);
     const double tol_v = 1e-13 * std::max(1.0, v.cwiseAbs().maxCoeff());
     solved = rf <= tol_f && rv <= tol_v && flipped_joint(m_, d_.kin) < 0;
     if (solved) {
-      commit_tracking(m_, d_);
+      commit_tracking(m_, d_, t);
     } else {
       u = u_save_;
       v = v_save_;
+      d_.track_ref = track_save_;
     }
   }
   if (!solved) {
@@ -124,6 +134,7 @@ void DrivenSolver::solve(double t, VecX& u, VecX& v, VecX& vd, double& rf, doubl
       u_save_ = u;
       v_save_ = v;
       track_save_ = d_.track_ref;
+      commit_save_ = d_.track_commit;
       std::string failure;
       try {
         predict(t_cur, t_next, u, v, vd);
@@ -149,6 +160,7 @@ void DrivenSolver::solve(double t, VecX& u, VecX& v, VecX& vd, double& rf, doubl
       u = u_save_;
       v = v_save_;
       d_.track_ref = track_save_;
+      d_.track_commit = commit_save_;
       h *= 0.5;
       if (fk_ || !(h >= h_min))
         throw SolverError(msg(who_, " at t=", t_next, ": ", failure, ".", singular_rows()));
@@ -195,7 +207,6 @@ InverseDynamicsResult inverse_dynamics_driven(const Model& m, const std::vector<
   out.position_residual.reserve(nt);
   out.velocity_residual.reserve(nt);
   VecX u = m.u0, v = VecX::Zero(m.nv), vd = VecX::Zero(m.nv);
-  std::vector<double> qprev(nco, 0.0);
   if (poll) poll->start();
   for (size_t k = 0; k < nt; ++k) {
     const double t = times[k];
@@ -208,10 +219,8 @@ InverseDynamicsResult inverse_dynamics_driven(const Model& m, const std::vector<
     }
     for (int c = 0; c < nco; ++c) {
       const ScalarJet s = coord_jet(m, d.kin, c);
-      double qv = s.val;
-      if (m.coords[c].angular && k > 0) qv = qprev[c] + wrap_angle(s.val - qprev[c]);
-      qprev[c] = qv;
-      out.q.push_back(qv);
+      // angles over turns: as tracked by the solve (by their rates from one time to the next)
+      out.q.push_back(m.coords[c].angular ? tracked(d, c, s.val) : s.val);
       out.qd.push_back(s.rate);
       out.qdd.push_back(coord_acceleration(m, s, c, vd));
     }

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "armdyn/algorithm/kinematics.hpp"
 
+#include <cmath>
+
 #include "armdyn/errors.hpp"
 #include "armdyn/math/quaternion.hpp"
 
@@ -37,6 +39,42 @@ void commit_tracking(const Model& m, Data& d) {
   // every angle coordinate is followed over turns (gears need it; outputs use it)
   for (int c = 0; c < static_cast<int>(m.coords.size()); ++c)
     if (m.coords[c].angular) d.track_ref[c] = tracked(d, c, coord_value(m, d.kin, c));
+}
+
+namespace {
+// the rate of angle coordinate c at the loaded kinematics (velocities loaded): for a revolute
+// joint z . (omega_c - omega_p), z the parent's joint axis in world; other angles from their jet
+double angle_rate(const Model& m, const Data& d, int c) {
+  const Joint& j = m.joints[m.coords[c].joint];
+  if (j.type != JointType::Revolute) return coord_jet(m, d.kin, c, false).rate;
+  const BodyKin& p = kin_of(d.kin, j.parent);
+  const BodyKin& k = kin_of(d.kin, j.child);
+  return (p.R * j.frame_parent.col(2)).dot(k.W - p.W);
+}
+}  // namespace
+
+void commit_tracking(const Model& m, Data& d, double t) {
+  commit_tracking(m, d);
+  if (!d.track_by_rates) return;
+  Data::TrackCommit& tc = d.track_commit;
+  const int nco = static_cast<int>(m.coords.size());
+  tc.rate = VecX::Zero(nco);
+  for (int c = 0; c < nco; ++c)
+    if (m.coords[c].angular) tc.rate[c] = angle_rate(m, d, c);
+  // a rate that is not finite predicts nothing (the step that led there fails elsewhere)
+  if (!tc.rate.allFinite()) tc.rate.setZero();
+  tc.ref = d.track_ref;
+  tc.t = t;
+}
+
+void advance_tracking(const Model& m, Data& d, double t) {
+  const Data::TrackCommit& tc = d.track_commit;
+  if (!d.track_by_rates || !std::isfinite(tc.t) || !std::isfinite(t) ||
+      tc.ref.size() != d.track_ref.size() || tc.ref != d.track_ref)
+    return;
+  const double dt = t - tc.t;
+  for (int c = 0; c < static_cast<int>(m.coords.size()); ++c)
+    if (m.coords[c].angular) d.track_ref[c] = tc.ref[c] + tc.rate[c] * dt;
 }
 
 void check_cartesian_state(const Model& m, const VecX& u, const VecX& v, const char* fn) {

@@ -39,6 +39,8 @@ void project(const Model& m, Data& d, double t, double* u, double* v, Metric met
       throw SolverError(msg("invalid Euler parameters of body '", m.bodies[i].name, "' at t=", t));
     e /= n;
   }
+  // (a run in time: the angles' references moved on by their rates first)
+  advance_tracking(m, d, t);
   load_kinematics(m, d, u, nullptr);
   evaluate_constraints(m, d, t, false);
   double rf = nrows ? ce.f.head(nrows).cwiseAbs().maxCoeff() : 0.0;
@@ -90,7 +92,7 @@ void project(const Model& m, Data& d, double t, double* u, double* v, Metric met
   }
   // velocities onto zeta v = rhs, with A at the final u
   load_kinematics(m, d, u, v);
-  commit_tracking(m, d);
+  commit_tracking(m, d, t);
   if (nrows == 0) return;
   kkt.factor(ce, nrows, metric);
   ++st.factorizations;

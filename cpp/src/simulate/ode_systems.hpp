@@ -124,7 +124,13 @@ class MbsSystem : public OdeSystem, public StopAccess {
       : m_(m), d_(d), metric_(metric), out_(out), yo_(d.run.y), vd_(d.run.vd) {
     yo_ = VecX::Zero(m.nq + m.nv + m.n_aux);
     vd_ = VecX::Zero(m.nv);
+    // a run in time: the angles tracked by their rates between projections
+    d_.track_by_rates = true;
+    d_.track_commit = Data::TrackCommit{};
   }
+  ~MbsSystem() override { d_.track_by_rates = false; }
+  MbsSystem(const MbsSystem&) = delete;
+  MbsSystem& operator=(const MbsSystem&) = delete;
 
   // y = (u, v, z): z the auxiliary states (PI integral terms), not projected
   void rhs(double t, const VecX& y, VecX& dy) override {
@@ -185,9 +191,14 @@ class MbsSystem : public OdeSystem, public StopAccess {
   // accepted state, restored after a rejected step whose trial end point was projected: a
   // rejected trial step can move an angle by more than half a turn (its reference then off by
   // a turn, and with it the stops' coordinates near limits of +-2 pi).
-  void step_accepted() override { track_save_ = d_.track_ref; }
+  void step_accepted() override {
+    track_save_ = d_.track_ref;
+    commit_save_ = d_.track_commit;
+  }
   void step_rejected() override {
-    if (track_save_.size() == d_.track_ref.size()) d_.track_ref = track_save_;
+    if (track_save_.size() != d_.track_ref.size()) return;
+    d_.track_ref = track_save_;
+    d_.track_commit = commit_save_;
   }
 
   /// Report in the bodies and joints of the full model (a welded run).
@@ -364,8 +375,9 @@ class MbsSystem : public OdeSystem, public StopAccess {
   VecX base_q_, base_qd_, base_qdd_;  // floating bases' outputs (sized on first use)
   WeldExpander* ex_ = nullptr;
   LimitStops* stops_ = nullptr;
-  VecX fo_, fe_, du_;  // the stops' scratch at outputs and events
-  VecX track_save_;    // the angle tracking of the last accepted state
+  VecX fo_, fe_, du_;              // the stops' scratch at outputs and events
+  VecX track_save_;                // the angle tracking of the last accepted state
+  Data::TrackCommit commit_save_;  // and its commit (rates, time)
 };
 
 // The joint-space equations of motion of a tree (TreeDynamics) as an ODE on y = (q, qd, z).

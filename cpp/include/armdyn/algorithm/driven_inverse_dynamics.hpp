@@ -32,6 +32,10 @@ class DrivenSolver {
   /// t0: the time of the state passed to the first solve().
   /// @throws ModelError naming the undriven coordinates when the drives leave freedom.
   DrivenSolver(const Model& m, Data& d, const char* who, double t0);
+  /// (the Data's angle tracking by rates back as it was)
+  ~DrivenSolver();
+  DrivenSolver(const DrivenSolver&) = delete;
+  DrivenSolver& operator=(const DrivenSolver&) = delete;
   /// (u, v) at the last solved time (or t0) in, at t out; vd the accelerations; the Data is
   /// left loaded at (u, v, t) with its multipliers; rf, rv the position and velocity residuals.
   /// On failure (u, v) hold the last state solved on the way to t, at time t_good.
@@ -52,6 +56,10 @@ class DrivenSolver {
   bool fk_;
   // scratch in the Data (Data::driven_solve)
   VecX &qc_, &qdc_, &ud_, &u_save_, &v_save_, &u_pred_, &track_save_;
+  // the angles are tracked by their rates between the times (Data::track_by_rates); the
+  // caller's setting, and the commit saved with track_save_
+  bool track_by_rates_before_;
+  Data::TrackCommit commit_save_;
   TreeFkWork& fkw_;
   void predict(double t_from, double t, VecX& u, VecX& v, const VecX& vd);
   std::string singular_rows() const;  ///< a sentence when the factor lost rank, else empty

@@ -31,6 +31,13 @@ inline double tracked(const Data& d, int coord, double raw) {
 /// data.track_ref from the loaded kinematics: every angle coordinate followed over turns (done
 /// by project after each projection).
 void commit_tracking(const Model& m, Data& d);
+/// commit_tracking at time t; with data.track_by_rates, also data.track_commit (the references,
+/// the angles' rates from the loaded velocities, t).
+void commit_tracking(const Model& m, Data& d, double t);
+/// With data.track_by_rates and track_ref still the last commit's: track_ref moved on to time t
+/// by the committed rates (each angle's reference then its predicted value, so the nearest
+/// branch of its raw value is the one its rate leads to).
+void advance_tracking(const Model& m, Data& d, double t);
 
 /// Check a Cartesian state (u: nq, v: nv) before evaluating at it: finite, and every body's Euler
 /// parameters non-zero; throws ModelError "fn: ..." naming the body.
