@@ -17,8 +17,8 @@ std::string dependent_row_names(const Model& m, const Data& d) {
   return rows;
 }
 
-double constraint_residual(const ConstraintEval& ce, int nrows, const VecX& vd) {
-  const double vmax = vd.cwiseAbs().maxCoeff();
+double constraint_residual(const ConstraintEval& ce, int nrows, const VecX& vd, double a_scale) {
+  const double vmax = std::max(vd.cwiseAbs().maxCoeff(), a_scale);
   double worst = 0.0;
   for (const ConstraintBlock& blk : ce.blocks) {
     if (blk.row0 >= nrows) continue;
@@ -38,6 +38,15 @@ double constraint_residual(const ConstraintEval& ce, int nrows, const VecX& vd) 
     }
   }
   return worst;
+}
+
+double load_acceleration_scale(const Model& m, const VecX& eta) {
+  double a = 0.0;
+  for (int i = 0; i < m.nb; ++i) {
+    const double mass = m.bodies[i].mass;
+    if (mass > 0.0) a = std::max(a, eta.segment<3>(6 * i).norm() / mass);
+  }
+  return std::isfinite(a) ? a : 0.0;
 }
 
 namespace {
@@ -157,7 +166,10 @@ void body_accelerations_loaded(const Model& m, Data& d, double t, double* vdot, 
   // augmented solve takes over for the rest of this Data's life. (Not near a singular
   // configuration, where the regularised factor leaves a residual on purpose.)
   if (!kkt.near_singular() && !kkt.used_pseudo_inverse()) {
-    const double res = constraint_residual(d.ce, nrows, d.vd_work);
+    // (against the loads' accelerations too: at rest, under gravity, the solve's accelerations
+    // are round-off of g's, and relative to their own size that read as a lost solve)
+    const double res =
+        constraint_residual(d.ce, nrows, d.vd_work, load_acceleration_scale(m, d.eta));
     if (res > 1e-8) {
       d.augmented = true;
       solve_augmented(

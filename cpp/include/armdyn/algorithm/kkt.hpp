@@ -25,9 +25,14 @@ void body_accelerations(const Model& m, Data& d, double t, const double* u, cons
                         double* vdot, bool reuse_factor = false);
 
 /// The largest relative residual of zeta vd = -xi over rows [0, nrows), row by row:
-/// |sum_j zeta_rj vd_j + xi_r| / (sum_j |zeta_rj| max|vd| + |xi_r|), round-off (1e-16) for an
-/// exact solve. O(rows).
-double constraint_residual(const ConstraintEval& ce, int nrows, const VecX& vd);
+/// |sum_j zeta_rj vd_j + xi_r| / (sum_j |zeta_rj| a + |xi_r|), a = max(max|vd|, a_scale),
+/// round-off (1e-16) for an exact solve. O(rows). a_scale: the accelerations the loads alone
+/// give (load_acceleration_scale): at rest vd is round-off of those, not of its own size.
+double constraint_residual(const ConstraintEval& ce, int nrows, const VecX& vd,
+                           double a_scale = 0.0);
+/// The largest linear acceleration |f_i| / m_i the applied forces eta alone give a body (gravity
+/// included): the size against which a solve's accelerations carry round-off. O(bodies).
+double load_acceleration_scale(const Model& m, const VecX& eta);
 
 /// body_accelerations at the kinematics already loaded in data.kin (load_kinematics or
 /// load_joint_kinematics).
