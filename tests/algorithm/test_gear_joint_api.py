@@ -273,3 +273,81 @@ def test_forward_dynamics_equals_the_cartesian_simulation_over_turns():
     assert rel_err(ad.forward_dynamics(m, q, qd, tau, t=res.t), qdd) < 1e-10
     # the closed form of the free pendulum-through-a-gear
     assert rel_err(qdd[:, 0], R * ML * G * L * np.cos(-R * q[:, 0]) / M_RED) < 1e-10
+
+
+def gear_train(independent=None):
+    """Three parallel shafts about z (no gravity torque): a pinion ``ja`` turns a wheel ``jb``
+    (ideal gear, radii RA and RB), whose shaft couples a third ``jc``: q_c = 2 q_b + 0.3 (a
+    coupling with an offset). q_b = -r q_a exactly, every coordinate affine in the one
+    independent."""
+    b = ad.ModelBuilder(gravity=(0.0, 0.0, -G))
+    b.add_body("pinion", MA, [1e-4, 1e-4, IA], position=(0, 0, 0))
+    b.add_body("wheel", MB, [1e-3, 1e-3, IB], position=(RA + RB, 0, 0))
+    b.add_body("third", 0.3, [2e-4, 2e-4, 3e-4], position=(0.3, 0, 0))
+    b.add_revolute("ja", "ground", "pinion", point=(0, 0, 0), axis=(0, 0, 1))
+    b.add_revolute("jb", "ground", "wheel", point=(RA + RB, 0, 0), axis=(0, 0, 1))
+    b.add_revolute("jc", "ground", "third", point=(0.3, 0, 0), axis=(0, 0, 1))
+    b.add_frame("mark", "third", position=(0.35, 0, 0))
+    b.add_gear("mesh", "ja", "jb", RA, RB)
+    b.add_coupling("belt", "jc", "jb", 2.0, 0.3)
+    if independent is not None:
+        b.set_independent_coordinates(independent)
+    return b.finalize()
+
+
+@pytest.mark.parametrize("independent", [None, ["jb"], ["jc"]])
+def test_a_gear_and_coupling_train_in_closed_form_over_many_turns(independent):
+    """The rows place every shaft exactly from the independent coordinate (whichever it is):
+    M = sum I_i s_i^2 with s_i each shaft's rate per unit of the independent one, tau = M qdd
+    (fixed parallel axes: no velocity terms), and the third shaft's mark at its angle
+    2 q_b + 0.3 however many turns the pinion made."""
+    m = gear_train(independent)
+    name = "ja" if independent is None else independent[0]
+    assert list(m.coord_names) == [name]
+    # each shaft's angle as q_i = s_i x + c_i of the independent x
+    s_a, c_a = {"ja": (1.0, 0.0), "jb": (-1.0 / R, 0.0), "jc": (-0.5 / R, 0.15 / R)}[name]
+    s = np.array([s_a, -R * s_a, -2 * R * s_a])
+    c = np.array([c_a, -R * c_a, -2 * R * c_a + 0.3])
+    inertia = np.array([IA, IB, 3e-4])
+    m_red = float(np.sum(inertia * s**2))
+    for qa in (0.0, 20 * np.pi + 0.3, -33.1):
+        x = (qa - c_a) / s_a  # the independent coordinate at which the pinion is at qa
+        assert rel_err(ad.mass_matrix(m, [x]), [[m_red]]) < 1e-12
+        assert rel_err(ad.inverse_dynamics(m, [x], [1.7], [2.5]), [m_red * 2.5]) < 1e-12
+        assert rel_err(ad.forward_dynamics(m, [x], [1.7], [m_red * 2.5]), [2.5]) < 1e-11
+        pose = ad.frame_pose(m, [x], "mark")
+        qc = s[2] * x + c[2]
+        np.testing.assert_allclose(pose[:3, 3], [0.3 + 0.05 * np.cos(qc), 0.05 * np.sin(qc), 0])
+        np.testing.assert_allclose(pose[:2, 0], [np.cos(qc), np.sin(qc)], atol=1e-12)
+        # each shaft's joint carries its weight, and no torque off its axis (the torques about
+        # the axes pass through the gear and coupling rows)
+        f, t = ad.joint_reactions(m, [x], [1.7], [2.5])
+        np.testing.assert_allclose(f, [[0, 0, MA * G], [0, 0, MB * G], [0, 0, 0.3 * G]], atol=1e-12)
+        np.testing.assert_allclose(t, 0.0, atol=1e-12)
+
+
+def test_a_ratio_that_overflows_a_finite_input_is_an_error_naming_the_coordinate():
+    """The wheel independent: the pinion turns 2.5 times as far, so q = 1e308 (finite) has no
+    finite pinion angle. Every joint-level function says so, naming the pinion, and the Data
+    stays usable."""
+    m = gear_train(["jb"])
+    d = ad.Data(m)
+    calls = {
+        "forward_dynamics": lambda q, qd: ad.forward_dynamics(m, q, qd, [0.0], data=d),
+        "inverse_dynamics": lambda q, qd: ad.inverse_dynamics(m, q, qd, [0.0], data=d),
+        "joint_reactions": lambda q, qd: ad.joint_reactions(m, q, qd, [0.0], data=d),
+        "state_from_joints": lambda q, qd: ad.state_from_joints(m, q, qd, data=d),
+        "mass_matrix": lambda q, qd: ad.mass_matrix(m, q, data=d),
+        "frame_pose": lambda q, qd: ad.frame_pose(m, q, "mark", data=d),
+        "frame_jacobian": lambda q, qd: ad.frame_jacobian(m, q, "mark", data=d),
+    }
+    for name, call in calls.items():
+        for q, qd in (([1e308], [0.0]), ([-1.7e308], [0.0])):
+            with pytest.raises(ad.ModelError, match=f"{name}: joint coordinate 'ja' .* overflows"):
+                call(q, qd)
+        if name not in ("mass_matrix", "frame_pose", "frame_jacobian"):
+            with pytest.raises(ad.ModelError, match=f"{name}: joint coordinate 'ja' .* overflows"):
+                call([0.1], [1e308])
+    # afterwards, the closed form again on the same Data
+    m_red = IA * (1 / R) ** 2 + IB + 3e-4 * 4
+    assert rel_err(ad.inverse_dynamics(m, [3.0], [0.5], [2.0], data=d), [2.0 * m_red]) < 1e-12

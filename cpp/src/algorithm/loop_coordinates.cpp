@@ -224,6 +224,57 @@ void choose_loop_coordinates(Model& m) {
 
 // --- the state at the independent coordinates ------------------------------------------------
 
+namespace {
+
+// LoopWork::linear: from each independent coordinate along the gear and coupling rows
+// (r_a q_a + r_b q_b = offset, couplings as the same row), each coordinate reached once; false
+// when the model has other closures, a cycle of rows, or a tree of rows without (or with two)
+// independent coordinates
+bool linear_gear_map(const Model& m, LoopWork& w) {
+  if (!m.is_tree || !m.joint_tree || m.n_free > 0) return false;
+  const int nco = static_cast<int>(m.coords.size());
+  std::vector<std::vector<const GearConstraint*>> rows_of(nco);
+  for (const GearConstraint& g : m.gear_constraints) {
+    if (!(g.r_a != 0.0 && g.r_b != 0.0) || g.coord_a == g.coord_b) return false;
+    rows_of[g.coord_a].push_back(&g);
+    rows_of[g.coord_b].push_back(&g);
+  }
+  const IndependentCoords& ic = m.independent;
+  w.lin_source.assign(nco, -1);
+  w.lin_scale.assign(nco, 0.0);
+  w.lin_shift.assign(nco, 0.0);
+  std::vector<const GearConstraint*> via(nco, nullptr);  // the row each was reached by
+  std::vector<int> queue;
+  for (int k = 0; k < ic.n; ++k) {
+    const int c0 = ic.full[k];
+    if (w.lin_source[c0] >= 0) return false;  // two independent coordinates in one tree
+    w.lin_source[c0] = k;
+    w.lin_scale[c0] = 1.0;
+    queue.assign(1, c0);
+    for (size_t i = 0; i < queue.size(); ++i) {
+      const int c = queue[i];
+      for (const GearConstraint* g : rows_of[c]) {
+        if (g == via[c]) continue;
+        const bool from_a = g->coord_a == c;
+        const int o = from_a ? g->coord_b : g->coord_a;
+        if (w.lin_source[o] >= 0) return false;  // a cycle of rows
+        // q_o = (offset - r_c q_c) / r_o
+        const double r_c = from_a ? g->r_a : g->r_b, r_o = from_a ? g->r_b : g->r_a;
+        w.lin_source[o] = k;
+        w.lin_scale[o] = -r_c / r_o * w.lin_scale[c];
+        w.lin_shift[o] = (g->offset - r_c * w.lin_shift[c]) / r_o;
+        via[o] = g;
+        queue.push_back(o);
+      }
+    }
+  }
+  for (int c = 0; c < nco; ++c)
+    if (w.lin_source[c] < 0) return false;
+  return true;
+}
+
+}  // namespace
+
 LoopWork::LoopWork(const Model& m) {
   const IndependentCoords& ic = m.independent;
   const int n = ic.n;
@@ -257,11 +308,12 @@ LoopWork::LoopWork(const Model& m) {
   for (VecX* x : {&q_last, &q_from, &dq, &out, &qs, &unit, &zero_n}) *x = VecX::Zero(n);
   track_start = track_save = VecX::Zero(static_cast<long>(m.coords.size()));
   tau_full = VecX::Zero(m.nv_joint);
-  gamma = cartesian_mass_matrix(m);
   T = MatX::Zero(m.nv, n);
   GT = MatX::Zero(m.nv, n);
   M = MatX::Zero(n, n);
   J = Mat6X::Zero(6, n);
+  linear = linear_gear_map(m, *this);
+  q_full = qd_full = VecX::Zero(static_cast<long>(m.coords.size()));
 }
 
 namespace {
@@ -382,6 +434,36 @@ std::string singular_note(LoopWork& w) {
       "; dependent rows: ", dependent_row_names(*w.driven, *w.dd), ")");
 }
 
+// LoopWork::linear: the state (w.u, w.v) at (q, qd) placed by the tree's kinematics at the
+// coordinates the rows give (their turns exact), the driven Data's angle references those
+// coordinates and its KKT factor marked stale (the pose changed without a projection)
+void place_linear(const Model& m, LoopWork& w, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
+                  const char* fn) {
+  const int nco = static_cast<int>(m.coords.size());
+  for (int c = 0; c < nco; ++c) {
+    const int k = w.lin_source[c];
+    w.q_full[c] = w.lin_scale[c] * q[k] + w.lin_shift[c];
+    w.qd_full[c] = w.lin_scale[c] * qd[k];
+    if (!std::isfinite(w.q_full[c]) || !std::isfinite(w.qd_full[c]))
+      throw ModelError(msg(fn, ": joint coordinate '", m.coords[c].name, "' (", w.lin_scale[c],
+                           " times independent coordinate '", m.coords[m.independent.full[k]].name,
+                           "' through the gear and coupling rows) overflows at q = ", q[k],
+                           ", qd = ", qd[k], " (scale the inputs down)"));
+  }
+  joint_space_kinematics(m, w.q_full, w.qd_full, w.kin);
+  cartesian_state(m, w.kin, w.u.data(), w.v.data());
+  if (!w.v.allFinite())
+    throw ModelError(msg(fn, ": the bodies' velocities overflow at the rates qd = (",
+                         coordinate_values(m, qd), ") (scale the inputs down)"));
+  Data& dd = *w.dd;
+  for (int c = 0; c < nco; ++c)
+    if (m.coords[c].angular) dd.track_ref[c] = w.q_full[c];
+  dd.kkt.mark_stale();
+  dd.artic.mark_stale();
+  w.q_last = q;
+  w.have = true;
+}
+
 // The state (w.u, w.v) at (q, qd), by continuation from the Data's last state; restores it and
 // throws SolverError on failure
 void solve_state(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
@@ -389,6 +471,10 @@ void solve_state(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen::Ref<c
   LoopWork& w = loop_work(m, d);
   Data& dd = *w.dd;
   const IndependentCoords& ic = m.independent;
+  if (w.linear) {
+    place_linear(m, w, q, qd, fn);
+    return;
+  }
   if (!w.have) {
     w.u = m.u0;
     w.v.setZero();
@@ -459,6 +545,17 @@ void solve_state(const Model& m, Data& d, Eigen::Ref<const VecX> q, Eigen::Ref<c
 void velocity_map(const Model& m, LoopWork& w, Eigen::Ref<const VecX> q, double t) {
   const int n = m.independent.n;
   VecX& unit = w.unit;
+  if (w.linear) {
+    // the tree's velocities at the rates the rows give one unit of coordinate k
+    for (int k = 0; k < n; ++k) {
+      for (int c = 0; c < static_cast<int>(m.coords.size()); ++c)
+        w.qd_full[c] = w.lin_source[c] == k ? w.lin_scale[c] : 0.0;
+      joint_space_kinematics(m, w.q_full, w.qd_full, w.kin);
+      cartesian_state(m, w.kin, w.u_save.data(), w.zero_v.data());
+      w.T.col(k) = w.zero_v;
+    }
+    return;
+  }
   for (int k = 0; k < n; ++k) {
     unit.setZero();
     unit[k] = 1.0;
@@ -575,7 +672,11 @@ const MatX& loop_mass_matrix(const Model& m, Data& d, Eigen::Ref<const VecX> q) 
   LoopWork& w = loop_work(m, d);
   solve_state(m, d, q, w.zero_n, 0.0, fn);
   velocity_map(m, w, q, 0.0);
-  w.GT.noalias() = w.gamma * w.T;
+  // Gamma T by bodies (Gamma block diagonal: m I and the inertia per body)
+  for (int i = 0; i < m.nb; ++i) {
+    w.GT.middleRows<3>(6 * i) = m.bodies[i].mass * w.T.middleRows<3>(6 * i);
+    w.GT.middleRows<3>(6 * i + 3).noalias() = m.bodies[i].inertia * w.T.middleRows<3>(6 * i + 3);
+  }
   w.M.noalias() = w.T.transpose() * w.GT;
   return w.M;
 }

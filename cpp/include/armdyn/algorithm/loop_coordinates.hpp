@@ -58,9 +58,18 @@ struct LoopWork {
   VecX tau_full;            ///< (n_dofs of the model) loads of forward dynamics
   VecX out;                 ///< (n) qdd or tau
   VecX qs, unit, zero_n;    ///< (n) scratch
-  MatX gamma, T, GT, M;     ///< (nv, nv), (nv, n), (nv, n), (n, n)
+  MatX T, GT, M;            ///< (nv, n), (nv, n) Gamma T, (n, n)
   Mat6X J;                  ///< (6, n) frame Jacobian
   bool have = false;        ///< a state was solved on this Data
+  /// A fixed-base tree whose only other rows are ideal gears and couplings forming a forest, each
+  /// of its trees holding one independent coordinate: every coordinate is then
+  /// q_c = lin_scale[c] q[lin_source[c]] + lin_shift[c] (multi-turn, exact), and the state is
+  /// placed by the tree's kinematics, with no position or velocity problem to solve.
+  bool linear = false;
+  std::vector<int> lin_source;
+  std::vector<double> lin_scale, lin_shift;
+  VecX q_full, qd_full;      ///< (nco) the coordinates of the placed state
+  std::vector<BodyKin> kin;  ///< its bodies' kinematics (linear: scratch of the placement)
 };
 
 /// The loop functions (Model::loop_coordinates): inputs checked (sizes, finite), then the
