@@ -13,6 +13,7 @@
 #include "armdyn/algorithm/kkt.hpp"
 #include "armdyn/algorithm/projection.hpp"
 #include "armdyn/algorithm/reactions.hpp"
+#include "armdyn/algorithm/rnea.hpp"
 #include "armdyn/errors.hpp"
 #include "armdyn/kernels/constraint_rows.hpp"
 #include "armdyn/kernels/jets.hpp"
@@ -313,7 +314,7 @@ LoopWork::LoopWork(const Model& m) {
   M = MatX::Zero(n, n);
   J = Mat6X::Zero(6, n);
   linear = linear_gear_map(m, *this);
-  q_full = qd_full = VecX::Zero(static_cast<long>(m.coords.size()));
+  q_full = qd_full = qdd_full = VecX::Zero(static_cast<long>(m.coords.size()));
 }
 
 namespace {
@@ -437,19 +438,31 @@ std::string singular_note(LoopWork& w) {
 // LoopWork::linear: the state (w.u, w.v) at (q, qd) placed by the tree's kinematics at the
 // coordinates the rows give (their turns exact), the driven Data's angle references those
 // coordinates and its KKT factor marked stale (the pose changed without a projection)
-void place_linear(const Model& m, LoopWork& w, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
-                  const char* fn) {
+// LoopWork::linear: every coordinate's q, qd (and qdd, when given) from the independent ones;
+// a ModelError naming the coordinate that overflows
+void expand_linear(const Model& m, LoopWork& w, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
+                   const double* qdd, const char* fn) {
   const int nco = static_cast<int>(m.coords.size());
   for (int c = 0; c < nco; ++c) {
     const int k = w.lin_source[c];
-    w.q_full[c] = w.lin_scale[c] * q[k] + w.lin_shift[c];
-    w.qd_full[c] = w.lin_scale[c] * qd[k];
-    if (!std::isfinite(w.q_full[c]) || !std::isfinite(w.qd_full[c]))
-      throw ModelError(msg(fn, ": joint coordinate '", m.coords[c].name, "' (", w.lin_scale[c],
+    const double s = w.lin_scale[c];
+    w.q_full[c] = s * q[k] + w.lin_shift[c];
+    w.qd_full[c] = s * qd[k];
+    if (qdd) w.qdd_full[c] = s * qdd[k];
+    if (!std::isfinite(w.q_full[c]) || !std::isfinite(w.qd_full[c]) ||
+        (qdd && !std::isfinite(w.qdd_full[c])))
+      throw ModelError(msg(fn, ": joint coordinate '", m.coords[c].name, "' (", s,
                            " times independent coordinate '", m.coords[m.independent.full[k]].name,
                            "' through the gear and coupling rows) overflows at q = ", q[k],
-                           ", qd = ", qd[k], " (scale the inputs down)"));
+                           ", qd = ", qd[k], qdd ? msg(", qdd = ", qdd[k]) : std::string(),
+                           " (scale the inputs down)"));
   }
+}
+
+void place_linear(const Model& m, LoopWork& w, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
+                  const char* fn) {
+  const int nco = static_cast<int>(m.coords.size());
+  expand_linear(m, w, q, qd, nullptr, fn);
   joint_space_kinematics(m, w.q_full, w.qd_full, w.kin);
   cartesian_state(m, w.kin, w.u.data(), w.v.data());
   if (!w.v.allFinite())
@@ -639,8 +652,21 @@ const VecX& loop_inverse_dynamics(const Model& m, Data& d, Eigen::Ref<const VecX
                                   Eigen::Ref<const VecX> qd, Eigen::Ref<const VecX> qdd, double t,
                                   DynamicsMethod method) {
   constexpr const char* fn = "inverse_dynamics";
+  const bool cartesian = method == DynamicsMethod::Cartesian;
   loop_method(method, fn);
   check_loop_inputs(m, d, q, {{"qd", qd}, {"qdd", qdd}}, t, fn);
+  LoopWork& lw = loop_work(m, d);
+  if (lw.linear && !cartesian) {
+    // every coordinate affine in the independent ones (qdd_c = s_c qdd_k exactly): the
+    // Newton-Euler recursion over all coordinates, reduced by the map (the rows' forces do no
+    // work along it): tau_k = sum_c s_c tau_c over the coordinates c of k
+    expand_linear(m, lw, q, qd, qdd.data(), fn);
+    rnea_full(m, d, lw.q_full, lw.qd_full, lw.qdd_full, t);
+    lw.out.setZero();
+    for (int c = 0; c < static_cast<int>(m.coords.size()); ++c)
+      lw.out[lw.lin_source[c]] += lw.lin_scale[c] * d.tau[c];
+    return lw.out;
+  }
   solve_state(m, d, q, qd, t, fn);
   driven_accelerations(m, d, q, qd, qdd, t, fn);
   LoopWork& w = *d.loop;

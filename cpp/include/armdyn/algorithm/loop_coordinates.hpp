@@ -68,8 +68,8 @@ struct LoopWork {
   bool linear = false;
   std::vector<int> lin_source;
   std::vector<double> lin_scale, lin_shift;
-  VecX q_full, qd_full;      ///< (nco) the coordinates of the placed state
-  std::vector<BodyKin> kin;  ///< its bodies' kinematics (linear: scratch of the placement)
+  VecX q_full, qd_full, qdd_full;  ///< (nco) the coordinates of the placed state
+  std::vector<BodyKin> kin;        ///< its bodies' kinematics (linear: scratch of the placement)
 };
 
 /// The loop functions (Model::loop_coordinates): inputs checked (sizes, finite), then the
