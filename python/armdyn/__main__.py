@@ -49,8 +49,8 @@ def main(argv: list[str] | None = None) -> int:
     sub = parser.add_subparsers(dest="command", required=True)
     sub.add_parser("verify", help="print accuracy figures against closed forms and Lagrange")
     rep_help = (
-        "regenerate the papers' tables and figures (measured: 7.0 s on 2 cores, "
-        "1.7 s with --no-geared)"
+        "regenerate the papers' tables and figures (measured: 8.1 s on 2 cores, "
+        "2.3 s with --no-geared)"
     )
     rep = sub.add_parser("reproduce", help=rep_help, description=rep_help)
     rep.add_argument("--out", default="armdyn-report", help="report folder (Markdown + PNG)")
@@ -58,7 +58,7 @@ def main(argv: list[str] | None = None) -> int:
     rep.add_argument(
         "--no-geared",
         action="store_true",
-        help="skip the geared-arm study (7.0 s becomes 1.7 s)",
+        help="skip the geared-arm study (8.1 s becomes 2.3 s)",
     )
     size = sub.add_parser(
         "size", help="sizing report of a planned motion (exit 0: every joint ok, 1: not)"
