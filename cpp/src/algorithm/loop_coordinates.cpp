@@ -435,9 +435,6 @@ std::string singular_note(LoopWork& w) {
       "; dependent rows: ", dependent_row_names(*w.driven, *w.dd), ")");
 }
 
-// LoopWork::linear: the state (w.u, w.v) at (q, qd) placed by the tree's kinematics at the
-// coordinates the rows give (their turns exact), the driven Data's angle references those
-// coordinates and its KKT factor marked stale (the pose changed without a projection)
 // LoopWork::linear: every coordinate's q, qd (and qdd, when given) from the independent ones;
 // a ModelError naming the coordinate that overflows
 void expand_linear(const Model& m, LoopWork& w, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
@@ -459,6 +456,9 @@ void expand_linear(const Model& m, LoopWork& w, Eigen::Ref<const VecX> q, Eigen:
   }
 }
 
+// LoopWork::linear: the state (w.u, w.v) at (q, qd) placed by the tree's kinematics at the
+// coordinates the rows give (their turns exact), the driven Data's angle references those
+// coordinates and its KKT factor marked stale (the pose changed without a projection)
 void place_linear(const Model& m, LoopWork& w, Eigen::Ref<const VecX> q, Eigen::Ref<const VecX> qd,
                   const char* fn) {
   const int nco = static_cast<int>(m.coords.size());
