@@ -58,7 +58,8 @@ void commit_tracking(const Model& m, Data& d, double t) {
   if (!d.track_by_rates) return;
   Data::TrackCommit& tc = d.track_commit;
   const int nco = static_cast<int>(m.coords.size());
-  tc.rate = VecX::Zero(nco);
+  tc.rate.resize(nco);  // (sized once: every projection of a run commits)
+  tc.rate.setZero();
   for (int c = 0; c < nco; ++c)
     if (m.coords[c].angular) tc.rate[c] = angle_rate(m, d, c);
   // a rate that is not finite predicts nothing (the step that led there fails elsewhere)
